@@ -1,0 +1,47 @@
+//! Argument structs (kept dumb) and dispatch to one file per subcommand.
+
+use std::process::ExitCode;
+
+use clap::{Parser, Subcommand};
+
+pub mod sweep;
+
+/// Replay recorded ball trajectories through a swept-sphere vs triangle-mesh
+/// collision core and see, frame by frame, why each collision was or was not
+/// found.
+#[derive(Debug, Parser)]
+#[command(name = "sweeptrace", version, about, long_about = None)]
+pub struct Cli {
+    #[command(subcommand)]
+    pub command: Command,
+}
+
+#[derive(Debug, Subcommand)]
+pub enum Command {
+    /// Run one sweep against a built-in scene and explain every test that came close.
+    Sweep(sweep::Args),
+}
+
+/// Runs the chosen subcommand; `Ok` carries the exit code.
+pub fn run(cli: Cli) -> anyhow::Result<ExitCode> {
+    match cli.command {
+        Command::Sweep(args) => sweep::run(args),
+    }
+}
+
+/// Parses `x,y,z` into three finite numbers.
+pub fn parse_point(s: &str) -> Result<[f64; 3], String> {
+    let parts: Vec<&str> = s.split(',').map(str::trim).collect();
+    if parts.len() != 3 {
+        return Err(format!("expected three comma-separated numbers `x,y,z`, got `{s}`"));
+    }
+    let mut out = [0.0; 3];
+    for (o, p) in out.iter_mut().zip(&parts) {
+        let v: f64 = p.parse().map_err(|_| format!("`{p}` is not a number"))?;
+        if !v.is_finite() {
+            return Err(format!("`{p}` is not a finite number"));
+        }
+        *o = v;
+    }
+    Ok(out)
+}

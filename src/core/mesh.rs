@@ -1,0 +1,216 @@
+//! A validated triangle mesh with everything the tests precompute:
+//! per triangle its front normal, per triangle edge its standard frame,
+//! and a bounding volume hierarchy over the triangles.
+
+use nalgebra::{Isometry3, Matrix3, Point3, Rotation3, Translation3, UnitQuaternion, Vector3};
+use serde::Serialize;
+
+use super::bvh::Bvh;
+use super::error::MeshError;
+use super::options::DEGENERATE_TOLERANCE;
+
+/// The standard frame of one triangle edge `(v0, v1)`: `v0` at the origin,
+/// `v1` at `(L, 0, 0)`, `+y` the triangle's front normal, `+z = x × y`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct StandardFrame {
+    /// Rotation part of the transform from world to edge coordinates.
+    pub edge_from_world_rotation: Rotation3<f64>,
+    /// `v0` in world coordinates (the frame's origin).
+    pub origin_in_world: Point3<f64>,
+    /// Length `L` of the edge.
+    pub length: f64,
+}
+
+impl StandardFrame {
+    /// Builds the frame of the edge `v0 → v1` of a triangle with front normal
+    /// `normal` (unit, perpendicular to the edge).
+    pub fn new(v0: Point3<f64>, v1: Point3<f64>, normal: Vector3<f64>) -> Self {
+        let edge = v1 - v0;
+        let length = edge.norm();
+        let x = edge / length;
+        // Remove the rounding residue so the frame is orthonormal.
+        let y = (normal - x * x.dot(&normal)).normalize();
+        let z = x.cross(&y);
+        let m = Matrix3::from_rows(&[x.transpose(), y.transpose(), z.transpose()]);
+        StandardFrame {
+            edge_from_world_rotation: Rotation3::from_matrix_unchecked(m),
+            origin_in_world: v0,
+            length,
+        }
+    }
+
+    /// A world point in edge coordinates.
+    #[inline]
+    pub fn to_edge(&self, p_in_world: &Point3<f64>) -> Point3<f64> {
+        Point3::from(self.edge_from_world_rotation * (p_in_world - self.origin_in_world))
+    }
+
+    /// An edge-frame point in world coordinates.
+    #[inline]
+    pub fn to_world(&self, p_in_edge: &Point3<f64>) -> Point3<f64> {
+        self.origin_in_world + self.edge_from_world_rotation.inverse() * p_in_edge.coords
+    }
+
+    /// The rigid transform that maps edge coordinates to world coordinates.
+    pub fn world_from_edge(&self) -> Isometry3<f64> {
+        let rotation = UnitQuaternion::from_rotation_matrix(&self.edge_from_world_rotation.inverse());
+        Isometry3::from_parts(Translation3::from(self.origin_in_world.coords), rotation)
+    }
+
+    /// The rigid transform that maps world coordinates to edge coordinates.
+    pub fn edge_from_world(&self) -> Isometry3<f64> {
+        self.world_from_edge().inverse()
+    }
+}
+
+/// One usable triangle with its precomputed data.
+#[derive(Clone, Copy, Debug)]
+pub struct Triangle {
+    /// Index of the triangle in the input (degenerate ones keep their slot).
+    pub index: u32,
+    /// Vertex indices `(a, b, c)`.
+    pub vertex_indices: [u32; 3],
+    /// Vertex positions `(a, b, c)`.
+    pub vertices: [Point3<f64>; 3],
+    /// Unit front normal `normalize((b - a) × (c - a))`.
+    pub normal: Vector3<f64>,
+    /// Standard frame of edge `i`, which joins vertex `i` and `(i + 1) mod 3`.
+    pub edges: [StandardFrame; 3],
+}
+
+/// A triangle left out because it has no area.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct DegenerateTriangle {
+    /// Index of the triangle in the input.
+    pub index: usize,
+    /// Why it was left out.
+    pub reason: DegenerateReason,
+}
+
+/// Why a triangle is degenerate.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum DegenerateReason {
+    /// Two of its vertex indices are equal.
+    RepeatedIndex,
+    /// Its area is zero or below the tolerance (collinear vertices).
+    ZeroArea,
+}
+
+impl std::fmt::Display for DegenerateTriangle {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let why = match self.reason {
+            DegenerateReason::RepeatedIndex => "repeated vertex index",
+            DegenerateReason::ZeroArea => "zero or near-zero area",
+        };
+        write!(f, "triangle {} is degenerate ({why})", self.index)
+    }
+}
+
+/// A validated triangle mesh, ready for sweeps.
+#[derive(Clone, Debug)]
+pub struct Mesh {
+    vertices: Vec<Point3<f64>>,
+    input_triangle_count: usize,
+    triangles: Vec<Triangle>,
+    degenerate: Vec<DegenerateTriangle>,
+    bvh: Bvh,
+}
+
+impl Mesh {
+    /// Builds a mesh from vertices and vertex-index triples.
+    ///
+    /// Indices out of range and non-finite coordinates are errors;
+    /// degenerate triangles are left out and listed in [`Mesh::degenerate`].
+    pub fn new(vertices: Vec<[f64; 3]>, triangles: &[[u64; 3]]) -> Result<Mesh, MeshError> {
+        if vertices.len() > u32::MAX as usize {
+            return Err(MeshError::TooLarge { what: "vertex count", limit: u32::MAX as usize });
+        }
+        if triangles.len() > u32::MAX as usize {
+            return Err(MeshError::TooLarge { what: "triangle count", limit: u32::MAX as usize });
+        }
+        for (i, v) in vertices.iter().enumerate() {
+            if !v.iter().all(|c| c.is_finite()) {
+                return Err(MeshError::NonFiniteVertex { vertex: i, coordinate: *v });
+            }
+        }
+        let vertices: Vec<Point3<f64>> = vertices.into_iter().map(Point3::from).collect();
+        let mut usable = Vec::with_capacity(triangles.len());
+        let mut degenerate = Vec::new();
+        for (t, tri) in triangles.iter().enumerate() {
+            for &i in tri {
+                if i >= vertices.len() as u64 {
+                    return Err(MeshError::IndexOutOfRange {
+                        triangle: t,
+                        index: i,
+                        vertex_count: vertices.len(),
+                    });
+                }
+            }
+            let idx = [tri[0] as u32, tri[1] as u32, tri[2] as u32];
+            if idx[0] == idx[1] || idx[1] == idx[2] || idx[0] == idx[2] {
+                degenerate.push(DegenerateTriangle { index: t, reason: DegenerateReason::RepeatedIndex });
+                continue;
+            }
+            let [a, b, c] = idx.map(|i| vertices[i as usize]);
+            let cross = (b - a).cross(&(c - a));
+            let longest = (b - a).norm_squared().max((c - b).norm_squared()).max((a - c).norm_squared());
+            let area2 = cross.norm();
+            if !(area2 > DEGENERATE_TOLERANCE * longest) || !area2.is_finite() {
+                degenerate.push(DegenerateTriangle { index: t, reason: DegenerateReason::ZeroArea });
+                continue;
+            }
+            let normal = cross / area2;
+            let edges = [
+                StandardFrame::new(a, b, normal),
+                StandardFrame::new(b, c, normal),
+                StandardFrame::new(c, a, normal),
+            ];
+            usable.push(Triangle { index: t as u32, vertex_indices: idx, vertices: [a, b, c], normal, edges });
+        }
+        if usable.is_empty() {
+            return Err(MeshError::Empty { triangles: triangles.len(), degenerate: degenerate.len() });
+        }
+        let input_triangle_count = triangles.len();
+        let bvh = Bvh::build(&usable);
+        // Store triangles in BVH leaf order so leaves are contiguous ranges.
+        let triangles = bvh.order().iter().map(|&i| usable[i as usize]).collect();
+        Ok(Mesh { vertices, input_triangle_count, triangles, degenerate, bvh })
+    }
+
+    /// The vertices, as given.
+    pub fn vertices(&self) -> &[Point3<f64>] {
+        &self.vertices
+    }
+
+    /// The usable triangles, in the order the BVH stores them (use
+    /// [`Triangle::index`] for the input index).
+    pub fn triangles(&self) -> &[Triangle] {
+        &self.triangles
+    }
+
+    /// Number of triangles in the input, degenerate ones included.
+    pub fn input_triangle_count(&self) -> usize {
+        self.input_triangle_count
+    }
+
+    /// The triangles left out, with their input index and reason.
+    pub fn degenerate(&self) -> &[DegenerateTriangle] {
+        &self.degenerate
+    }
+
+    /// The usable triangle with input index `index`, if any.
+    pub fn triangle_by_index(&self, index: u32) -> Option<&Triangle> {
+        self.bvh.position_of(index).map(|p| &self.triangles[p])
+    }
+
+    pub(crate) fn bvh(&self) -> &Bvh {
+        &self.bvh
+    }
+
+    /// Axis-aligned bounds of the mesh (`min`, `max`).
+    pub fn bounds(&self) -> (Point3<f64>, Point3<f64>) {
+        self.bvh.root_bounds()
+    }
+}
+

@@ -1,0 +1,309 @@
+//! What each test computed: the records handed to an [`Observer`](super::Observer).
+
+use nalgebra::{Point3, Vector3};
+use serde::Serialize;
+
+use super::mesh::StandardFrame;
+
+/// The kind of a collision.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Kind {
+    /// Ties between kinds go in this order: face first.
+    Face,
+    /// An edge.
+    Edge,
+    /// A vertex.
+    Vertex,
+    /// Nothing touched.
+    #[default]
+    None,
+}
+
+impl Kind {
+    /// Name used in outcomes.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Kind::Face => "face",
+            Kind::Edge => "edge",
+            Kind::Vertex => "vertex",
+            Kind::None => "none",
+        }
+    }
+}
+
+impl std::fmt::Display for Kind {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.as_str())
+    }
+}
+
+/// The verdict of one test.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Verdict {
+    /// A collision at the record's `alpha`.
+    Hit,
+    /// Face: the ball starts within `ρ` of the plane, or behind it.
+    StartsTooClose,
+    /// Face: moving parallel to the plane. Edge: path parallel to the edge
+    /// (or of zero length).
+    Parallel,
+    /// Vertex: the path has zero length.
+    NotMoving,
+    /// The path's line never comes within `ρ` (negative discriminant).
+    NoRealRoots,
+    /// The first contact lies before the start of the path (`s0 < 0`).
+    BeforeStart,
+    /// The first contact lies beyond the end of the path (`β > 1`, `s0 > 1`).
+    BeyondEnd,
+    /// Edge: the contact with the edge's line is outside `[0, L]`.
+    OffEdge,
+    /// Face: the touch point is outside the triangle.
+    OutsideTriangle,
+    /// The facing rule rejects the direction of travel.
+    BackFacing,
+}
+
+impl Verdict {
+    /// Snake-case name.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Verdict::Hit => "hit",
+            Verdict::StartsTooClose => "starts_too_close",
+            Verdict::Parallel => "parallel",
+            Verdict::NotMoving => "not_moving",
+            Verdict::NoRealRoots => "no_real_roots",
+            Verdict::BeforeStart => "before_start",
+            Verdict::BeyondEnd => "beyond_end",
+            Verdict::OffEdge => "off_edge",
+            Verdict::OutsideTriangle => "outside_triangle",
+            Verdict::BackFacing => "back_facing",
+        }
+    }
+
+    /// Every verdict, in declaration order.
+    pub const ALL: [Verdict; 10] = [
+        Verdict::Hit,
+        Verdict::StartsTooClose,
+        Verdict::Parallel,
+        Verdict::NotMoving,
+        Verdict::NoRealRoots,
+        Verdict::BeforeStart,
+        Verdict::BeyondEnd,
+        Verdict::OffEdge,
+        Verdict::OutsideTriangle,
+        Verdict::BackFacing,
+    ];
+}
+
+impl std::fmt::Display for Verdict {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.as_str())
+    }
+}
+
+/// Everything the face test computed.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct FaceRecord {
+    /// Input index of the triangle.
+    pub triangle: u32,
+    /// Its front normal.
+    pub normal: Vector3<f64>,
+    /// `n · d`, the facing value.
+    pub normal_dot_d: f64,
+    /// Signed distance of `p0` from the plane.
+    pub h0: f64,
+    /// Signed distance of `p1` from the plane.
+    pub h1: f64,
+    /// `(h0 - ρ) / (h0 - h1)`, when computed.
+    pub beta: Option<f64>,
+    /// The touch point `p0 + β d - ρ n`, when computed.
+    pub touch: Option<Point3<f64>>,
+    /// Barycentric coordinates of the touch point (weights of `a`, `b`, `c`).
+    pub barycentric: Option<[f64; 3]>,
+    /// The verdict.
+    pub verdict: Verdict,
+}
+
+/// Everything the edge test computed.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct EdgeRecord {
+    /// Input index of the triangle.
+    pub triangle: u32,
+    /// Edge index `i` (joins the triangle's vertices `i` and `(i + 1) mod 3`).
+    pub edge: u8,
+    /// The standard frame.
+    #[serde(skip)]
+    pub frame: StandardFrame,
+    /// Length `L` of the edge.
+    pub length: f64,
+    /// `p0` in the standard frame.
+    pub p0_in_edge: Point3<f64>,
+    /// `p1` in the standard frame.
+    pub p1_in_edge: Point3<f64>,
+    /// `A` of the quadratic.
+    pub a: f64,
+    /// `B` of the quadratic.
+    pub b: f64,
+    /// `C` of the quadratic.
+    pub c: f64,
+    /// `B² - 4AC`.
+    pub discriminant: f64,
+    /// Roots `s0 ≤ s1`, when real.
+    pub roots: Option<(f64, f64)>,
+    /// Contact with the edge's line, `xc = x0 + s0 (x1 - x0)`, when computed.
+    pub xc: Option<f64>,
+    /// `n · d` in world coordinates.
+    pub normal_dot_d: f64,
+    /// The verdict.
+    pub verdict: Verdict,
+}
+
+/// Everything the vertex test computed.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct VertexRecord {
+    /// Input index of the triangle.
+    pub triangle: u32,
+    /// Which of the triangle's vertices (0, 1, 2).
+    pub vertex: u8,
+    /// Its position.
+    pub position: Point3<f64>,
+    /// `A = d · d`.
+    pub a: f64,
+    /// `B = 2 d · (p0 - v)`.
+    pub b: f64,
+    /// `C = |p0 - v|² - ρ²`.
+    pub c: f64,
+    /// `B² - 4AC`.
+    pub discriminant: f64,
+    /// Roots `s0 ≤ s1`, when real.
+    pub roots: Option<(f64, f64)>,
+    /// `n · d` in world coordinates.
+    pub normal_dot_d: f64,
+    /// The verdict.
+    pub verdict: Verdict,
+}
+
+impl FaceRecord {
+    /// `α` of the collision, if the verdict is a hit.
+    pub fn alpha(&self) -> Option<f64> {
+        (self.verdict == Verdict::Hit).then(|| self.beta.unwrap_or(1.0))
+    }
+}
+
+impl EdgeRecord {
+    /// `α` of the collision, if the verdict is a hit.
+    pub fn alpha(&self) -> Option<f64> {
+        (self.verdict == Verdict::Hit).then(|| self.roots.map_or(1.0, |r| r.0))
+    }
+}
+
+impl VertexRecord {
+    /// `α` of the collision, if the verdict is a hit.
+    pub fn alpha(&self) -> Option<f64> {
+        (self.verdict == Verdict::Hit).then(|| self.roots.map_or(1.0, |r| r.0))
+    }
+}
+
+/// Receives every test's record during an explained sweep.
+///
+/// All methods have empty defaults; the fast query uses [`NoObserver`],
+/// for which the compiler removes every call.
+pub trait Observer {
+    /// Whether records are wanted at all. When `false`, the sweep may skip
+    /// triangles whose every test would end back-facing.
+    const WANTS_RECORDS: bool = true;
+
+    /// A face test finished.
+    #[inline]
+    fn face(&mut self, _record: &FaceRecord) {}
+    /// An edge test finished.
+    #[inline]
+    fn edge(&mut self, _record: &EdgeRecord) {}
+    /// A vertex test finished.
+    #[inline]
+    fn vertex(&mut self, _record: &VertexRecord) {}
+}
+
+/// The observer of the fast path: wants nothing.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct NoObserver;
+
+impl Observer for NoObserver {
+    const WANTS_RECORDS: bool = false;
+}
+
+/// Any test's record.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+#[serde(tag = "test", rename_all = "snake_case")]
+pub enum TestRecord {
+    /// A face test.
+    Face(FaceRecord),
+    /// An edge test.
+    Edge(EdgeRecord),
+    /// A vertex test.
+    Vertex(VertexRecord),
+}
+
+impl TestRecord {
+    /// The triangle tested.
+    pub fn triangle(&self) -> u32 {
+        match self {
+            TestRecord::Face(r) => r.triangle,
+            TestRecord::Edge(r) => r.triangle,
+            TestRecord::Vertex(r) => r.triangle,
+        }
+    }
+    /// The kind of feature tested.
+    pub fn kind(&self) -> Kind {
+        match self {
+            TestRecord::Face(_) => Kind::Face,
+            TestRecord::Edge(_) => Kind::Edge,
+            TestRecord::Vertex(_) => Kind::Vertex,
+        }
+    }
+    /// Feature index (0 for the face).
+    pub fn feature(&self) -> u8 {
+        match self {
+            TestRecord::Face(_) => 0,
+            TestRecord::Edge(r) => r.edge,
+            TestRecord::Vertex(r) => r.vertex,
+        }
+    }
+    /// The verdict.
+    pub fn verdict(&self) -> Verdict {
+        match self {
+            TestRecord::Face(r) => r.verdict,
+            TestRecord::Edge(r) => r.verdict,
+            TestRecord::Vertex(r) => r.verdict,
+        }
+    }
+    /// `α` if a hit.
+    pub fn alpha(&self) -> Option<f64> {
+        match self {
+            TestRecord::Face(r) => r.alpha(),
+            TestRecord::Edge(r) => r.alpha(),
+            TestRecord::Vertex(r) => r.alpha(),
+        }
+    }
+}
+
+/// An observer that keeps every record (for the explained query).
+#[derive(Clone, Debug, Default)]
+pub struct CollectRecords {
+    /// The records, in the order the tests ran.
+    pub records: Vec<TestRecord>,
+}
+
+impl Observer for CollectRecords {
+    fn face(&mut self, r: &FaceRecord) {
+        self.records.push(TestRecord::Face(*r));
+    }
+    fn edge(&mut self, r: &EdgeRecord) {
+        self.records.push(TestRecord::Edge(*r));
+    }
+    fn vertex(&mut self, r: &VertexRecord) {
+        self.records.push(TestRecord::Vertex(*r));
+    }
+}

@@ -1,0 +1,69 @@
+//! The edge test, in the edge's standard frame (the seed's algorithm).
+
+use super::mesh::Triangle;
+use super::options::{Facing, PARALLEL_TOLERANCE};
+use super::path::Path;
+use super::quadratic;
+use super::record::{EdgeRecord, Verdict};
+
+/// Runs the edge test of SEMANTICS.md on edge `edge` (0..3) of `triangle`.
+#[inline]
+pub fn sweep_edge(triangle: &Triangle, edge: u8, path: &Path, facing: Facing) -> EdgeRecord {
+    let frame = triangle.edges[edge as usize];
+    let p0_in_edge = frame.to_edge(&path.p0);
+    let p1_in_edge = frame.to_edge(&path.p1);
+    let (x0, y0, z0) = (p0_in_edge.x, p0_in_edge.y, p0_in_edge.z);
+    let (x1, y1, z1) = (p1_in_edge.x, p1_in_edge.y, p1_in_edge.z);
+    let dy = y1 - y0;
+    let dz = z1 - z0;
+    let a = dy * dy + dz * dz;
+    let b = 2.0 * (y0 * dy + z0 * dz);
+    let c = y0 * y0 + z0 * z0 - path.rho * path.rho;
+    let discriminant = quadratic::discriminant(a, b, c);
+    let normal_dot_d = triangle.normal.dot(&path.d);
+    let mut record = EdgeRecord {
+        triangle: triangle.index,
+        edge,
+        frame,
+        length: frame.length,
+        p0_in_edge,
+        p1_in_edge,
+        a,
+        b,
+        c,
+        discriminant,
+        roots: None,
+        xc: None,
+        normal_dot_d,
+        verdict: Verdict::Hit,
+    };
+    let parallel_limit = PARALLEL_TOLERANCE * path.length;
+    record.verdict = if a <= parallel_limit * parallel_limit {
+        Verdict::Parallel
+    } else if discriminant < 0.0 {
+        Verdict::NoRealRoots
+    } else {
+        match quadratic::solve(a, b, c, discriminant) {
+            None => Verdict::NoRealRoots,
+            Some((s0, s1)) => {
+                record.roots = Some((s0, s1));
+                if s0 < 0.0 {
+                    Verdict::BeforeStart
+                } else if s0 > 1.0 {
+                    Verdict::BeyondEnd
+                } else {
+                    let xc = x0 + s0 * (x1 - x0);
+                    record.xc = Some(xc);
+                    if xc < 0.0 || xc > frame.length {
+                        Verdict::OffEdge
+                    } else if !facing.allows(normal_dot_d) {
+                        Verdict::BackFacing
+                    } else {
+                        Verdict::Hit
+                    }
+                }
+            }
+        }
+    };
+    record
+}

@@ -1,0 +1,51 @@
+//! The vertex test: a moving ball against one of a triangle's corners.
+
+use super::mesh::Triangle;
+use super::options::Facing;
+use super::path::Path;
+use super::quadratic;
+use super::record::{Verdict, VertexRecord};
+
+/// Runs the vertex test of SEMANTICS.md on vertex `vertex` (0..3) of `triangle`.
+#[inline]
+pub fn sweep_vertex(triangle: &Triangle, vertex: u8, path: &Path, facing: Facing) -> VertexRecord {
+    let position = triangle.vertices[vertex as usize];
+    let m = path.p0 - position;
+    let a = path.d.dot(&path.d);
+    let b = 2.0 * path.d.dot(&m);
+    let c = m.dot(&m) - path.rho * path.rho;
+    let discriminant = quadratic::discriminant(a, b, c);
+    let normal_dot_d = triangle.normal.dot(&path.d);
+    let mut record = VertexRecord {
+        triangle: triangle.index,
+        vertex,
+        position,
+        a,
+        b,
+        c,
+        discriminant,
+        roots: None,
+        normal_dot_d,
+        verdict: Verdict::Hit,
+    };
+    record.verdict = if a == 0.0 {
+        Verdict::NotMoving
+    } else {
+        match quadratic::solve(a, b, c, discriminant) {
+            None => Verdict::NoRealRoots,
+            Some((s0, s1)) => {
+                record.roots = Some((s0, s1));
+                if s0 < 0.0 {
+                    Verdict::BeforeStart
+                } else if s0 > 1.0 {
+                    Verdict::BeyondEnd
+                } else if !facing.allows(normal_dot_d) {
+                    Verdict::BackFacing
+                } else {
+                    Verdict::Hit
+                }
+            }
+        }
+    };
+    record
+}

@@ -1,0 +1,10 @@
+//! sweeptrace: replay recorded ball trajectories through a swept-sphere vs
+//! triangle-mesh collision core and explain, frame by frame, why each
+//! collision was or was not found.
+//!
+//! Start with [`core`] (the collision tests) and [`scenes`] (built-in meshes).
+
+pub mod core;
+pub mod report;
+pub mod scenes;
+pub mod trace;

@@ -1,0 +1,136 @@
+//! Rendering reports: pure functions from results to strings.
+
+use std::fmt::Write;
+
+use serde_json::json;
+
+use crate::core::explain::{describe, num};
+use crate::core::{Options, Outcome, Sweep, TestRecord, Verdict};
+
+/// Formats `[x, y, z]` compactly.
+pub fn vec3(v: &[f64]) -> String {
+    format!("({})", v.iter().map(|x| num(*x)).collect::<Vec<_>>().join(", "))
+}
+
+/// One line describing an outcome.
+pub fn outcome_line(o: &Outcome) -> String {
+    if !o.is_hit() {
+        return format!("no collision (alpha = {})", num(o.alpha));
+    }
+    let mut s = format!(
+        "{} collision at alpha = {}: triangle {}, feature {}",
+        o.kind,
+        num(o.alpha),
+        o.triangle.map_or("-".into(), |t| t.to_string()),
+        o.feature.map_or("-".into(), |f| f.to_string()),
+    );
+    if let Some(n) = o.normal {
+        write!(s, ", normal {}", vec3(n.as_slice())).unwrap();
+    }
+    if let Some(c) = o.contact {
+        write!(s, ", contact {}", vec3(c.coords.as_slice())).unwrap();
+    }
+    s
+}
+
+/// The outcome as the JSON object of SEMANTICS.md (without `frame`/`ball`).
+pub fn outcome_json(o: &Outcome) -> serde_json::Value {
+    json!({
+        "alpha": o.alpha,
+        "kind": o.kind,
+        "triangle": o.triangle,
+        "feature": o.feature,
+        "normal": o.normal.map(|n| [n.x, n.y, n.z]),
+        "contact": o.contact.map(|c| [c.x, c.y, c.z]),
+    })
+}
+
+/// Whether a test "came close": it hit, or failed only at the last checks
+/// (contact off the edge, touch point outside the triangle, back-facing).
+pub fn came_close(r: &TestRecord) -> bool {
+    matches!(r.verdict(), Verdict::Hit | Verdict::OffEdge | Verdict::OutsideTriangle | Verdict::BackFacing)
+}
+
+/// Everything the `sweep` command reports.
+pub struct SweepReport<'a> {
+    /// Scene name.
+    pub scene: &'a str,
+    /// Usable triangles.
+    pub triangles: usize,
+    /// The sweep.
+    pub sweep: &'a Sweep,
+    /// The options.
+    pub options: &'a Options,
+    /// The outcome.
+    pub outcome: &'a Outcome,
+    /// Every test's record.
+    pub records: &'a [TestRecord],
+    /// Explain every test, not only those that came close.
+    pub all: bool,
+}
+
+/// The `sweep` report as text.
+pub fn sweep_text(r: &SweepReport) -> String {
+    let mut s = String::new();
+    let rho = r.sweep.radius - r.options.margin;
+    writeln!(
+        s,
+        "scene {} ({} triangles), radius {}, margin {} (ρ = {}), facing {}",
+        r.scene,
+        r.triangles,
+        num(r.sweep.radius),
+        num(r.options.margin),
+        num(rho),
+        r.options.facing
+    )
+    .unwrap();
+    writeln!(s, "path {} -> {}", vec3(r.sweep.p0.coords.as_slice()), vec3(r.sweep.p1.coords.as_slice())).unwrap();
+    writeln!(s, "outcome: {}", outcome_line(r.outcome)).unwrap();
+    let shown: Vec<&TestRecord> = r.records.iter().filter(|t| r.all || came_close(t)).collect();
+    let hidden = r.records.len() - shown.len();
+    if shown.is_empty() {
+        writeln!(s, "no test came close ({} tests run; --all explains each)", r.records.len()).unwrap();
+    } else {
+        writeln!(
+            s,
+            "tests{}:",
+            if r.all { "" } else { " that came close (hits, contacts off the feature, back-facing)" }
+        )
+        .unwrap();
+        for t in shown {
+            writeln!(s, "  {}", describe(t)).unwrap();
+        }
+        if hidden > 0 {
+            writeln!(s, "({hidden} other tests missed earlier; --all explains each)").unwrap();
+        }
+    }
+    s
+}
+
+/// The `sweep` report as one JSON object.
+pub fn sweep_json(r: &SweepReport) -> String {
+    let tests: Vec<serde_json::Value> = r
+        .records
+        .iter()
+        .filter(|t| r.all || came_close(t))
+        .map(|t| {
+            let mut v = serde_json::to_value(t).unwrap_or(serde_json::Value::Null);
+            if let Some(obj) = v.as_object_mut() {
+                obj.insert("explanation".into(), json!(describe(t)));
+            }
+            v
+        })
+        .collect();
+    let value = json!({
+        "scene": r.scene,
+        "triangles": r.triangles,
+        "radius": r.sweep.radius,
+        "p0": [r.sweep.p0.x, r.sweep.p0.y, r.sweep.p0.z],
+        "p1": [r.sweep.p1.x, r.sweep.p1.y, r.sweep.p1.z],
+        "margin": r.options.margin,
+        "facing": r.options.facing,
+        "outcome": outcome_json(r.outcome),
+        "tests": tests,
+    });
+    serde_json::to_string_pretty(&value).unwrap_or_default()
+}

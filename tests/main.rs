@@ -1,1 +1,18 @@
-fn main() {}
+//! The one integration-test binary (heavy crates link once).
+//!
+//! Each module exposes `tests() -> Vec<Trial>`; trace files under `traces/`
+//! are found at run time and become test cases of their own.
+
+use libtest_mimic::{Arguments, Failed, Trial};
+
+/// Builds a trial from a function returning `Result<(), String>`.
+pub fn trial(name: &str, f: impl FnOnce() -> Result<(), String> + Send + 'static) -> Trial {
+    Trial::test(name, move || f().map_err(Failed::from))
+}
+
+fn main() {
+    let args = Arguments::from_args();
+    let mut trials: Vec<Trial> = Vec::new();
+    // Register test modules below (one line each).
+    libtest_mimic::run(&args, trials).exit();
+}

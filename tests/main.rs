@@ -5,6 +5,9 @@
 
 use libtest_mimic::{Arguments, Failed, Trial};
 
+mod core_cases;
+mod support;
+
 /// Builds a trial from a function returning `Result<(), String>`.
 pub fn trial(name: &str, f: impl FnOnce() -> Result<(), String> + Send + 'static) -> Trial {
     Trial::test(name, move || f().map_err(Failed::from))
@@ -14,5 +17,6 @@ fn main() {
     let args = Arguments::from_args();
     let mut trials: Vec<Trial> = Vec::new();
     // Register test modules below (one line each).
+    trials.extend(core_cases::tests());
     libtest_mimic::run(&args, trials).exit();
 }

@@ -1,0 +1,76 @@
+//! Helpers shared by the test modules.
+
+use sweeptrace::core::{
+    Broadphase, CollectRecords, EdgeRecord, Facing, FaceRecord, Mesh, Options, Outcome, Sweep, TestRecord,
+    VertexRecord, sweep_mesh_with,
+};
+
+/// Fails the test with a message unless `cond` holds.
+#[macro_export]
+macro_rules! ensure {
+    ($cond:expr, $($arg:tt)+) => {
+        if !$cond {
+            return Err(format!($($arg)+));
+        }
+    };
+}
+
+/// `|a - b| ≤ tol`, or an error naming `what`.
+pub fn close(what: &str, got: f64, want: f64, tol: f64) -> Result<(), String> {
+    if (got - want).abs() <= tol {
+        Ok(())
+    } else {
+        Err(format!("{what}: got {got}, want {want} (tolerance {tol})"))
+    }
+}
+
+/// A mesh from vertices and triangles that must be valid.
+pub fn mesh(vertices: &[[f64; 3]], triangles: &[[u64; 3]]) -> Mesh {
+    Mesh::new(vertices.to_vec(), triangles).expect("test mesh is valid")
+}
+
+/// The triangle T of SEMANTICS.md's worked examples.
+pub fn triangle_t() -> Mesh {
+    mesh(&[[0.0, 0.0, 0.0], [4.0, 0.0, 0.0], [0.0, 4.0, 0.0]], &[[0, 1, 2]])
+}
+
+/// Runs an exhaustive explained sweep.
+pub fn run(mesh: &Mesh, p0: [f64; 3], p1: [f64; 3], radius: f64, margin: f64, facing: Facing) -> (Outcome, Vec<TestRecord>) {
+    let mut obs = CollectRecords::default();
+    let o = sweep_mesh_with(mesh, &Sweep::new(p0, p1, radius), &Options { margin, facing }, Broadphase::Exhaustive, &mut obs)
+        .expect("valid sweep");
+    (o, obs.records)
+}
+
+/// The face record of triangle `t`.
+pub fn face(records: &[TestRecord], t: u32) -> FaceRecord {
+    records
+        .iter()
+        .find_map(|r| match r {
+            TestRecord::Face(f) if f.triangle == t => Some(*f),
+            _ => None,
+        })
+        .expect("face record present")
+}
+
+/// The record of edge `e` of triangle `t`.
+pub fn edge(records: &[TestRecord], t: u32, e: u8) -> EdgeRecord {
+    records
+        .iter()
+        .find_map(|r| match r {
+            TestRecord::Edge(x) if x.triangle == t && x.edge == e => Some(*x),
+            _ => None,
+        })
+        .expect("edge record present")
+}
+
+/// The record of vertex `v` of triangle `t`.
+pub fn vertex(records: &[TestRecord], t: u32, v: u8) -> VertexRecord {
+    records
+        .iter()
+        .find_map(|r| match r {
+            TestRecord::Vertex(x) if x.triangle == t && x.vertex == v => Some(*x),
+            _ => None,
+        })
+        .expect("vertex record present")
+}

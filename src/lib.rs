@@ -5,6 +5,8 @@
 //! Start with [`core`] (the collision tests) and [`scenes`] (built-in meshes).
 
 pub mod core;
+pub mod replay;
 pub mod report;
 pub mod scenes;
 pub mod trace;
+pub mod viz;

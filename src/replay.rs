@@ -1,0 +1,605 @@
+//! The replay engine: trace events in, one explained result per sweep out.
+//!
+//! [`Replay`] is push-based: feed it the events of a trace in order
+//! ([`Replay::scene`], [`Replay::sweep`], [`Replay::expected`]) and take the
+//! finished [`ReplayEvent`]s with [`Replay::next_event`]; [`Replay::finish`]
+//! flushes what is still held and returns the [`Summary`]. [`replay_events`]
+//! wraps any iterator of trace events into an iterator of results.
+//!
+//! A sweep's result is held back until a sweep of another frame (or a new
+//! scene, or the end) arrives, so that an `/expected` message logged just
+//! after its sweep is still attached to it.
+//!
+//! Nothing here knows about the viewer: `viz` turns results into a Rerun
+//! recording, `check`-like commands compare [`SweepResult::outcome_msg`]
+//! with [`SweepResult::expected`].
+
+use std::collections::{BTreeMap, HashMap, VecDeque};
+use std::sync::Arc;
+use std::time::{Duration, Instant};
+
+use thiserror::Error;
+
+use crate::core::explain::miss_distance;
+use crate::core::{
+    Broadphase, CollectRecords, Facing, Kind, Mesh, MeshError, Options, Outcome,
+    SIMULTANEOUS_TOLERANCE, Sweep, SweepError, TestRecord, Verdict, sweep_mesh, sweep_mesh_with,
+};
+use crate::trace::messages::{OutcomeMsg, SceneMsg, SweepMsg};
+
+/// How many test records each sweep keeps.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum Detail {
+    /// The tests that report the primary collision (the primary test first,
+    /// then every other hit at the same `α` within
+    /// [`SIMULTANEOUS_TOLERANCE`], which share the averaged normal); when
+    /// nothing hits, the one test that came nearest
+    /// ([`crate::core::explain::miss_distance`]) among the BVH candidates.
+    #[default]
+    Primary,
+    /// Every test of every triangle the BVH visited.
+    Candidates,
+    /// Every test of every triangle ([`Broadphase::Exhaustive`]).
+    All,
+}
+
+impl Detail {
+    /// The name used on the command line.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Detail::Primary => "primary",
+            Detail::Candidates => "candidates",
+            Detail::All => "all",
+        }
+    }
+}
+
+impl std::fmt::Display for Detail {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.as_str())
+    }
+}
+
+impl std::str::FromStr for Detail {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        match s {
+            "primary" => Ok(Detail::Primary),
+            "candidates" => Ok(Detail::Candidates),
+            "all" => Ok(Detail::All),
+            other => Err(format!(
+                "unknown detail `{other}` (expected `primary`, `candidates` or `all`)"
+            )),
+        }
+    }
+}
+
+/// A half-open range of frames `start..end`; either end may be open.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub struct FrameRange {
+    /// First frame included.
+    pub start: Option<u64>,
+    /// First frame excluded.
+    pub end: Option<u64>,
+}
+
+impl FrameRange {
+    /// Whether `frame` lies in the range.
+    pub fn contains(&self, frame: u64) -> bool {
+        self.start.is_none_or(|s| frame >= s) && self.end.is_none_or(|e| frame < e)
+    }
+}
+
+impl std::fmt::Display for FrameRange {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        if let Some(s) = self.start {
+            write!(f, "{s}")?;
+        }
+        f.write_str("..")?;
+        if let Some(e) = self.end {
+            write!(f, "{e}")?;
+        }
+        Ok(())
+    }
+}
+
+impl std::str::FromStr for FrameRange {
+    type Err = String;
+    /// `A..B` (A included, B excluded), `A..`, `..B`, `A..=B`, or one frame `A`.
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        let bound = |t: &str| -> Result<Option<u64>, String> {
+            let t = t.trim();
+            if t.is_empty() {
+                return Ok(None);
+            }
+            t.parse::<u64>()
+                .map(Some)
+                .map_err(|_| format!("`{t}` is not a frame number"))
+        };
+        let range = if let Some((a, b)) = s.split_once("..=") {
+            let end = bound(b)?.ok_or_else(|| format!("`{s}`: `..=` needs an end frame"))?;
+            FrameRange {
+                start: bound(a)?,
+                end: Some(end.saturating_add(1)),
+            }
+        } else if let Some((a, b)) = s.split_once("..") {
+            FrameRange {
+                start: bound(a)?,
+                end: bound(b)?,
+            }
+        } else {
+            let f = bound(s)?.ok_or_else(|| "empty frame range".to_string())?;
+            FrameRange {
+                start: Some(f),
+                end: Some(f.saturating_add(1)),
+            }
+        };
+        if let (Some(a), Some(b)) = (range.start, range.end)
+            && b <= a
+        {
+            return Err(format!(
+                "frame range `{s}` is empty (A..B includes A and excludes B)"
+            ));
+        }
+        Ok(range)
+    }
+}
+
+/// Options of a replay.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct ReplayOptions {
+    /// Only sweeps whose frame lies in this range.
+    pub frames: FrameRange,
+    /// Only this ball.
+    pub ball: Option<u32>,
+    /// Which test records each result keeps.
+    pub detail: Detail,
+    /// Whether to run the explained query at all. When `false` every sweep
+    /// uses the fast [`sweep_mesh`] and results carry no records.
+    pub explain: bool,
+    /// Overrides every scene's margin `ε`.
+    pub margin: Option<f64>,
+    /// Overrides every scene's facing rule.
+    pub facing: Option<Facing>,
+}
+
+/// A scene of the trace, built into a mesh.
+#[derive(Clone, Debug)]
+pub struct SceneState {
+    /// 0 for the trace's first scene, 1 for the next, ...
+    pub number: usize,
+    /// Index of the scene message in the trace.
+    pub index: u64,
+    /// `log_time` of the scene message, in nanoseconds.
+    pub log_time_nanos: u64,
+    /// The scene's name, if it has one.
+    pub name: Option<String>,
+    /// The mesh.
+    pub mesh: Mesh,
+    /// The options in force: the scene's margin and facing unless overridden.
+    pub options: Options,
+}
+
+/// The result of one sweep.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SweepResult {
+    /// Frame number.
+    pub frame: u64,
+    /// Ball number.
+    pub ball: u32,
+    /// `log_time` of the sweep message, in nanoseconds.
+    pub log_time_nanos: u64,
+    /// Index of the sweep message in the trace.
+    pub index: u64,
+    /// [`SceneState::number`] of the scene it was swept against.
+    pub scene: usize,
+    /// The sweep.
+    pub sweep: Sweep,
+    /// The options used.
+    pub options: Options,
+    /// The core's outcome.
+    pub outcome: Outcome,
+    /// The test records kept at the chosen [`Detail`] (empty when not
+    /// explained). With [`Detail::Primary`] the first record is the primary
+    /// test, or the nearest miss.
+    pub records: Vec<TestRecord>,
+    /// The trace's `/expected` outcome for this `(frame, ball)`, if any.
+    pub expected: Option<OutcomeMsg>,
+}
+
+impl SweepResult {
+    /// The outcome as the record of SEMANTICS.md (every field present).
+    pub fn outcome_msg(&self) -> OutcomeMsg {
+        OutcomeMsg::from_outcome(self.frame, self.ball, &self.outcome)
+    }
+
+    /// The record that decided the sweep: the primary test when something is
+    /// hit, otherwise the nearest miss among the kept records.
+    pub fn decisive_record(&self) -> Option<&TestRecord> {
+        if self.outcome.is_hit() {
+            self.records.iter().find(|r| is_primary(r, &self.outcome))
+        } else {
+            nearest_miss(&self.records)
+        }
+    }
+
+    /// The detection radius `ρ = r - ε`.
+    pub fn rho(&self) -> f64 {
+        self.sweep.radius - self.options.margin
+    }
+}
+
+/// What the replay produces, in trace order.
+#[derive(Clone, Debug)]
+pub enum ReplayEvent {
+    /// A new scene: every following sweep is against it until the next one.
+    Scene(Arc<SceneState>),
+    /// One sweep's result.
+    Sweep(Box<SweepResult>),
+}
+
+/// Counts of a replay.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Summary {
+    /// Scenes read.
+    pub scenes: usize,
+    /// Degenerate triangles left out, over all scenes.
+    pub degenerate_triangles: usize,
+    /// Sweeps replayed.
+    pub sweeps: u64,
+    /// Sweeps skipped by the frame and ball filters.
+    pub filtered_out: u64,
+    /// Replayed sweeps by the kind of their outcome (`none` included).
+    pub outcomes: BTreeMap<Kind, u64>,
+    /// Verdicts of every test run by the explained query (over the visited
+    /// triangles at `primary`/`candidates`, every triangle at `all`), before
+    /// the detail level drops records.
+    pub verdicts: BTreeMap<Verdict, u64>,
+    /// `/expected` messages attached to a replayed sweep.
+    pub expected_matched: u64,
+    /// `/expected` messages for a replayed `(frame, ball)` that arrived too
+    /// late to be attached, or that match no sweep at all.
+    pub expected_unmatched: u64,
+    /// Time spent in the collision core and the bookkeeping (not reading).
+    pub elapsed: Duration,
+}
+
+impl Summary {
+    /// Sweeps whose outcome is a collision.
+    pub fn collisions(&self) -> u64 {
+        self.outcomes
+            .iter()
+            .filter(|(k, _)| **k != Kind::None)
+            .map(|(_, n)| n)
+            .sum()
+    }
+
+    /// A few lines for people.
+    pub fn render(&self) -> String {
+        use std::fmt::Write;
+        let mut s = String::new();
+        let kinds = [Kind::Face, Kind::Edge, Kind::Vertex]
+            .iter()
+            .map(|k| format!("{} {k}", self.outcomes.get(k).copied().unwrap_or(0)))
+            .collect::<Vec<_>>()
+            .join(", ");
+        let _ = writeln!(
+            s,
+            "{} sweeps replayed ({} filtered out) over {} scene(s): {} collisions ({kinds}), {} without",
+            self.sweeps,
+            self.filtered_out,
+            self.scenes,
+            self.collisions(),
+            self.outcomes.get(&Kind::None).copied().unwrap_or(0),
+        );
+        if !self.verdicts.is_empty() {
+            let v = self
+                .verdicts
+                .iter()
+                .map(|(v, n)| format!("{v} {n}"))
+                .collect::<Vec<_>>()
+                .join(", ");
+            let _ = writeln!(s, "test verdicts: {v}");
+        }
+        if self.expected_matched + self.expected_unmatched > 0 {
+            let _ = writeln!(
+                s,
+                "expected outcomes: {} attached, {} unmatched",
+                self.expected_matched, self.expected_unmatched
+            );
+        }
+        if self.degenerate_triangles > 0 {
+            let _ = writeln!(
+                s,
+                "degenerate triangles left out: {}",
+                self.degenerate_triangles
+            );
+        }
+        let _ = writeln!(s, "time in the core: {:.3} s", self.elapsed.as_secs_f64());
+        s
+    }
+}
+
+/// An event the replay cannot use.
+#[derive(Debug, Error)]
+#[non_exhaustive]
+pub enum ReplayError {
+    /// A scene's mesh is invalid.
+    #[error("scene message {index}: {source}")]
+    Mesh {
+        /// Index of the scene message.
+        index: u64,
+        /// What is wrong.
+        source: MeshError,
+    },
+    /// A sweep came before any scene.
+    #[error("sweep of frame {frame} (message {index}) has no scene before it")]
+    NoScene {
+        /// Frame of the sweep.
+        frame: u64,
+        /// Index of the sweep message.
+        index: u64,
+    },
+    /// A sweep's values are invalid.
+    #[error("frame {frame}, ball {ball} (message {index}): {source}")]
+    Sweep {
+        /// Frame.
+        frame: u64,
+        /// Ball.
+        ball: u32,
+        /// Index of the sweep message.
+        index: u64,
+        /// What is wrong.
+        source: SweepError,
+    },
+}
+
+/// The replay engine (push-based; see the module documentation).
+#[derive(Debug)]
+pub struct Replay {
+    options: ReplayOptions,
+    scene: Option<Arc<SceneState>>,
+    /// Results held until their frame is complete.
+    pending: Vec<SweepResult>,
+    /// `/expected` messages that arrived before their sweep.
+    early_expected: HashMap<(u64, u32), OutcomeMsg>,
+    ready: VecDeque<ReplayEvent>,
+    summary: Summary,
+}
+
+impl Replay {
+    /// A replay with `options`.
+    pub fn new(options: ReplayOptions) -> Replay {
+        Replay {
+            options,
+            scene: None,
+            pending: Vec::new(),
+            early_expected: HashMap::new(),
+            ready: VecDeque::new(),
+            summary: Summary::default(),
+        }
+    }
+
+    /// The options.
+    pub fn options(&self) -> &ReplayOptions {
+        &self.options
+    }
+
+    /// The scene in force, if any.
+    pub fn current_scene(&self) -> Option<&Arc<SceneState>> {
+        self.scene.as_ref()
+    }
+
+    /// A `/scene` message.
+    pub fn scene(
+        &mut self,
+        log_time_nanos: u64,
+        index: u64,
+        scene: SceneMsg,
+    ) -> Result<(), ReplayError> {
+        let start = Instant::now();
+        self.release_pending();
+        let SceneMsg {
+            name,
+            vertices,
+            triangles,
+            margin,
+            facing,
+        } = scene;
+        let mesh = Mesh::new(vertices, &triangles)
+            .map_err(|source| ReplayError::Mesh { index, source })?;
+        let options = Options {
+            margin: self.options.margin.unwrap_or(margin),
+            facing: self.options.facing.unwrap_or(facing),
+        };
+        let number = self.summary.scenes;
+        self.summary.scenes += 1;
+        self.summary.degenerate_triangles += mesh.degenerate().len();
+        let state = Arc::new(SceneState {
+            number,
+            index,
+            log_time_nanos,
+            name,
+            mesh,
+            options,
+        });
+        self.scene = Some(state.clone());
+        self.ready.push_back(ReplayEvent::Scene(state));
+        self.summary.elapsed += start.elapsed();
+        Ok(())
+    }
+
+    /// A `/sweep` message.
+    pub fn sweep(
+        &mut self,
+        log_time_nanos: u64,
+        index: u64,
+        msg: SweepMsg,
+    ) -> Result<(), ReplayError> {
+        if self.pending.first().is_some_and(|p| p.frame != msg.frame) {
+            self.release_pending();
+        }
+        if !self.options.frames.contains(msg.frame)
+            || self.options.ball.is_some_and(|b| b != msg.ball)
+        {
+            self.summary.filtered_out += 1;
+            self.early_expected.remove(&(msg.frame, msg.ball));
+            return Ok(());
+        }
+        let Some(scene) = self.scene.clone() else {
+            return Err(ReplayError::NoScene {
+                frame: msg.frame,
+                index,
+            });
+        };
+        let start = Instant::now();
+        let sweep = Sweep::new(msg.p0, msg.p1, msg.radius);
+        let options = scene.options;
+        let err = |source| ReplayError::Sweep {
+            frame: msg.frame,
+            ball: msg.ball,
+            index,
+            source,
+        };
+        let (outcome, records) = if self.options.explain {
+            let broadphase = match self.options.detail {
+                Detail::All => Broadphase::Exhaustive,
+                Detail::Primary | Detail::Candidates => Broadphase::Bvh,
+            };
+            let mut collect = CollectRecords::default();
+            let outcome = sweep_mesh_with(&scene.mesh, &sweep, &options, broadphase, &mut collect)
+                .map_err(err)?;
+            for r in &collect.records {
+                *self.summary.verdicts.entry(r.verdict()).or_default() += 1;
+            }
+            let records = match self.options.detail {
+                Detail::Primary => primary_records(&outcome, collect.records),
+                Detail::Candidates | Detail::All => collect.records,
+            };
+            (outcome, records)
+        } else {
+            (
+                sweep_mesh(&scene.mesh, &sweep, &options).map_err(err)?,
+                Vec::new(),
+            )
+        };
+        let expected = self.early_expected.remove(&(msg.frame, msg.ball));
+        if expected.is_some() {
+            self.summary.expected_matched += 1;
+        }
+        self.summary.sweeps += 1;
+        *self.summary.outcomes.entry(outcome.kind).or_default() += 1;
+        self.pending.push(SweepResult {
+            frame: msg.frame,
+            ball: msg.ball,
+            log_time_nanos,
+            index,
+            scene: scene.number,
+            sweep,
+            options,
+            outcome,
+            records,
+            expected,
+        });
+        self.summary.elapsed += start.elapsed();
+        Ok(())
+    }
+
+    /// An `/expected` message.
+    pub fn expected(&mut self, _log_time_nanos: u64, _index: u64, outcome: OutcomeMsg) {
+        if !self.options.frames.contains(outcome.frame)
+            || self.options.ball.is_some_and(|b| b != outcome.ball)
+        {
+            return;
+        }
+        if let Some(p) = self
+            .pending
+            .iter_mut()
+            .find(|p| p.frame == outcome.frame && p.ball == outcome.ball)
+        {
+            if p.expected.is_none() {
+                self.summary.expected_matched += 1;
+            } else {
+                self.summary.expected_unmatched += 1;
+            }
+            p.expected = Some(outcome);
+            return;
+        }
+        if self
+            .early_expected
+            .insert((outcome.frame, outcome.ball), outcome)
+            .is_some()
+        {
+            self.summary.expected_unmatched += 1;
+        }
+    }
+
+    /// The next finished event, if any.
+    pub fn next_event(&mut self) -> Option<ReplayEvent> {
+        self.ready.pop_front()
+    }
+
+    /// Releases every held result; returns them with the summary.
+    pub fn finish(mut self) -> (Vec<ReplayEvent>, Summary) {
+        self.release_pending();
+        self.summary.expected_unmatched += self.early_expected.len() as u64;
+        (self.ready.into_iter().collect(), self.summary)
+    }
+
+    /// The counts so far.
+    pub fn summary(&self) -> &Summary {
+        &self.summary
+    }
+
+    fn release_pending(&mut self) {
+        let Some(frame) = self.pending.first().map(|p| p.frame) else {
+            return;
+        };
+        for p in self.pending.drain(..) {
+            self.ready.push_back(ReplayEvent::Sweep(Box::new(p)));
+        }
+        // Expected outcomes of earlier frames can no longer find their sweep.
+        let before = self.early_expected.len();
+        self.early_expected.retain(|(f, _), _| *f >= frame);
+        self.summary.expected_unmatched += (before - self.early_expected.len()) as u64;
+    }
+}
+
+fn is_primary(r: &TestRecord, outcome: &Outcome) -> bool {
+    r.alpha().is_some()
+        && Some(r.triangle()) == outcome.triangle
+        && r.kind() == outcome.kind
+        && Some(r.feature()) == outcome.feature
+}
+
+fn nearest_miss(records: &[TestRecord]) -> Option<&TestRecord> {
+    let mut best: Option<(f64, &TestRecord)> = None;
+    for r in records {
+        if let Some(d) = miss_distance(r)
+            && best.is_none_or(|(b, _)| d < b)
+        {
+            best = Some((d, r));
+        }
+    }
+    best.map(|(_, r)| r)
+}
+
+/// The records of [`Detail::Primary`].
+fn primary_records(outcome: &Outcome, records: Vec<TestRecord>) -> Vec<TestRecord> {
+    if !outcome.is_hit() {
+        return nearest_miss(&records).copied().into_iter().collect();
+    }
+    let mut out: Vec<TestRecord> = records
+        .iter()
+        .filter(|r| is_primary(r, outcome))
+        .take(1)
+        .copied()
+        .collect();
+    let limit = outcome.alpha + SIMULTANEOUS_TOLERANCE;
+    out.extend(
+        records
+            .into_iter()
+            .filter(|r| r.alpha().is_some_and(|a| a <= limit) && !is_primary(r, outcome)),
+    );
+    out
+}

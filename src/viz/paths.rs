@@ -1,0 +1,128 @@
+//! Every entity path of a replay recording, in one place.
+//!
+//! ```text
+//! world                               view coordinates (right-handed, z up), static
+//! world/mesh/{scene}                  Mesh3D of each scene, static
+//! world/ball/{ball}/spheres           Ellipsoids3D: the ball at p0, at the contact, at p1
+//! world/ball/{ball}/sweep             Capsules3D: the volume swept with radius ρ (wireframe)
+//! world/ball/{ball}/contact           Points3D: the contact point
+//! world/ball/{ball}/normal            Arrows3D: the reported normal, from the contact
+//! world/ball/{ball}/primary/triangle  Mesh3D: the primary (or nearest-miss) triangle
+//! world/ball/{ball}/primary/edge      LineStrips3D: its edge, when the test is an edge test
+//! world/ball/{ball}/primary/vertex    Points3D: its vertex, when the test is a vertex test
+//! world/ball/{ball}/edge/{slot}       Transform3D world_from_edge of one logged edge test,
+//!                                     plus its numbers (AnyValues: triangle, edge, A, B, C,
+//!                                     discriminant, s0, s1, xc, verdict)
+//! world/ball/{ball}/edge/{slot}/edge      LineStrips3D (0,0,0)→(L,0,0) in the edge frame
+//! world/ball/{ball}/edge/{slot}/cylinder  Capsules3D of radius ρ around the edge
+//! world/ball/{ball}/edge/{slot}/path      LineStrips3D p0_in_edge→p1_in_edge
+//! world/ball/{ball}/edge/{slot}/points    Points3D p0_in_edge, p1_in_edge (and the ball's
+//!                                         center at s0 when real)
+//! plots/ball/{ball}/alpha             Scalars: the chosen α (AnyValues `kind` alongside)
+//! plots/ball/{ball}/quadratic/{a,b,c,discriminant,s0,s1}
+//!                                     Scalars of the decisive edge or vertex test
+//! plots/ball/{ball}/face/{h0,h1,beta} Scalars of the decisive face test
+//! log                                 TextLog: one line per sweep, the decision in words
+//! ```
+//!
+//! Slot 0 of `edge` is the decisive test when it is an edge test (the
+//! primary test, or the nearest miss); the edge-frame view of the default
+//! blueprint looks at `world/ball/0/edge/0`.
+
+/// Root of the 3D world.
+pub const WORLD: &str = "world";
+/// The text log.
+pub const LOG: &str = "log";
+/// Root of the time-series plots.
+pub const PLOTS: &str = "plots";
+
+/// The mesh of scene `scene` (0-based).
+pub fn mesh(scene: usize) -> String {
+    format!("world/mesh/{scene}")
+}
+
+/// Root of everything of one ball in the world.
+pub fn ball(ball: u32) -> String {
+    format!("world/ball/{ball}")
+}
+
+/// The ball at p0, at the contact and at p1.
+pub fn spheres(ball: u32) -> String {
+    format!("world/ball/{ball}/spheres")
+}
+
+/// The swept volume.
+pub fn sweep(ball: u32) -> String {
+    format!("world/ball/{ball}/sweep")
+}
+
+/// The contact point.
+pub fn contact(ball: u32) -> String {
+    format!("world/ball/{ball}/contact")
+}
+
+/// The reported normal.
+pub fn normal(ball: u32) -> String {
+    format!("world/ball/{ball}/normal")
+}
+
+/// The highlighted triangle of the decisive test.
+pub fn primary_triangle(ball: u32) -> String {
+    format!("world/ball/{ball}/primary/triangle")
+}
+
+/// The highlighted edge of the decisive test.
+pub fn primary_edge(ball: u32) -> String {
+    format!("world/ball/{ball}/primary/edge")
+}
+
+/// The highlighted vertex of the decisive test.
+pub fn primary_vertex(ball: u32) -> String {
+    format!("world/ball/{ball}/primary/vertex")
+}
+
+/// The standard frame of the `slot`-th logged edge test (a Transform3D).
+pub fn edge_frame(ball: u32, slot: usize) -> String {
+    format!("world/ball/{ball}/edge/{slot}")
+}
+
+/// Under [`edge_frame`]: the edge on +x.
+pub fn edge_segment(ball: u32, slot: usize) -> String {
+    format!("world/ball/{ball}/edge/{slot}/edge")
+}
+
+/// Under [`edge_frame`]: the cylinder of radius ρ around the edge.
+pub fn edge_cylinder(ball: u32, slot: usize) -> String {
+    format!("world/ball/{ball}/edge/{slot}/cylinder")
+}
+
+/// Under [`edge_frame`]: the path in the edge frame.
+pub fn edge_path(ball: u32, slot: usize) -> String {
+    format!("world/ball/{ball}/edge/{slot}/path")
+}
+
+/// Under [`edge_frame`]: p0, p1 (and the center at s0) in the edge frame.
+pub fn edge_points(ball: u32, slot: usize) -> String {
+    format!("world/ball/{ball}/edge/{slot}/points")
+}
+
+/// The chosen α.
+pub fn alpha(ball: u32) -> String {
+    format!("plots/ball/{ball}/alpha")
+}
+
+/// One value of the decisive quadratic: `name` is `a`, `b`, `c`,
+/// `discriminant`, `s0` or `s1`.
+pub fn quadratic(ball: u32, name: &str) -> String {
+    format!("plots/ball/{ball}/quadratic/{name}")
+}
+
+/// One value of the decisive face test: `name` is `h0`, `h1` or `beta`.
+pub fn face(ball: u32, name: &str) -> String {
+    format!("plots/ball/{ball}/face/{name}")
+}
+
+/// Names of the quadratic scalars, in order.
+pub const QUADRATIC_NAMES: [&str; 6] = ["a", "b", "c", "discriminant", "s0", "s1"];
+/// Names of the face scalars, in order.
+pub const FACE_NAMES: [&str; 3] = ["h0", "h1", "beta"];

@@ -4,6 +4,7 @@ use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
 
+pub mod info;
 pub mod sweep;
 
 /// Replay recorded ball trajectories through a swept-sphere vs triangle-mesh
@@ -20,12 +21,15 @@ pub struct Cli {
 pub enum Command {
     /// Run one sweep against a built-in scene and explain every test that came close.
     Sweep(sweep::Args),
+    /// Summarise a trace: scenes, sweeps, frames, channels, compression, metadata.
+    Info(info::Args),
 }
 
 /// Runs the chosen subcommand; `Ok` carries the exit code.
 pub fn run(cli: Cli) -> anyhow::Result<ExitCode> {
     match cli.command {
         Command::Sweep(args) => sweep::run(args),
+        Command::Info(args) => info::run(args),
     }
 }
 

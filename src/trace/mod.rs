@@ -1,3 +1,18 @@
 //! Traces: MCAP files holding a scene, ball sweeps and expected outcomes.
+//!
+//! [`read`] streams a trace from any `Read`, [`write`] records one,
+//! [`validate`] holds the message checks both share, and [`info`] summarises
+//! a trace for `sweeptrace info`. The format is described in
+//! `docs/TRACE_FORMAT.md`.
 
+pub mod error;
+pub mod info;
 pub mod messages;
+pub mod read;
+pub mod schemas;
+pub mod validate;
+pub mod write;
+
+pub use error::{MessageAt, TraceError};
+pub use read::{ReadLimits, ReadStats, TraceEvent, TraceReader};
+pub use write::{TraceWriter, write_trace_file};

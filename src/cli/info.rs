@@ -1,0 +1,43 @@
+//! `sweeptrace info`: what a trace holds.
+
+use std::fs::File;
+use std::io::BufReader;
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+use anyhow::Context;
+
+use sweeptrace::trace::TraceReader;
+use sweeptrace::trace::info::{collect, render_json, render_text};
+
+/// Arguments of `info`.
+#[derive(Debug, clap::Args)]
+#[command(after_help = "Example:\n  sweeptrace info run.mcap --json")]
+pub struct Args {
+    /// The trace (an MCAP file).
+    pub trace: PathBuf,
+    /// Print one JSON object instead of text.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// Prints the report. A trace that cannot be read to its end still gets the
+/// report of what came before the error, then the error.
+pub fn run(args: Args) -> anyhow::Result<ExitCode> {
+    let name = args.trace.display().to_string();
+    let file = File::open(&args.trace).with_context(|| format!("cannot open trace {name}"))?;
+    let (info, error) = collect(TraceReader::new(BufReader::new(file), &name));
+    let report = if args.json {
+        render_json(&info)
+    } else {
+        render_text(&info)
+    };
+    print!("{report}");
+    if args.json {
+        println!();
+    }
+    match error {
+        None => Ok(ExitCode::SUCCESS),
+        Some(err) => Err(err).with_context(|| format!("cannot read trace {name} to its end")),
+    }
+}

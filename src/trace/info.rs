@@ -1,0 +1,315 @@
+//! What `sweeptrace info` reports about a trace, and its rendering.
+//!
+//! [`collect`] reads a whole trace (streaming) into a [`TraceInfo`];
+//! [`render_text`] and [`render_json`] are pure functions of it.
+
+use std::collections::{BTreeMap, BTreeSet};
+use std::fmt::Write as _;
+use std::io::Read;
+
+use serde::Serialize;
+
+use super::error::TraceError;
+use super::messages::{EXPECTED_TOPIC, SCENE_TOPIC, SWEEP_TOPIC};
+use super::read::{ReadStats, TraceEvent, TraceReader};
+use crate::core::{Mesh, MeshError};
+
+/// Scenes listed one by one; beyond this only their number is kept.
+pub const MAX_LISTED_SCENES: usize = 64;
+/// Distinct balls listed; beyond this only `balls_truncated` is set.
+pub const MAX_LISTED_BALLS: usize = 1024;
+
+/// One scene of a trace.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct SceneSummary {
+    /// Index of its message in the file.
+    pub index: u64,
+    /// Its `log_time`.
+    pub log_time_nanos: u64,
+    /// Its name, if any.
+    pub name: Option<String>,
+    /// Number of vertices.
+    pub vertices: usize,
+    /// Number of triangles.
+    pub triangles: usize,
+    /// Number of degenerate triangles (left out of every test).
+    pub degenerate: usize,
+    /// Why no mesh can be built from it (e.g. every triangle degenerate).
+    pub mesh_error: Option<String>,
+    /// Its margin.
+    pub margin: f64,
+    /// Its facing rule.
+    pub facing: String,
+}
+
+/// Everything `sweeptrace info` reports.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct TraceInfo {
+    /// File name.
+    pub file: String,
+    /// The first scenes (at most [`MAX_LISTED_SCENES`]).
+    pub scenes: Vec<SceneSummary>,
+    /// Number of scenes.
+    pub scene_count: u64,
+    /// Number of sweeps.
+    pub sweeps: u64,
+    /// Distinct balls (at most [`MAX_LISTED_BALLS`]).
+    pub balls: BTreeSet<u32>,
+    /// Whether more balls were seen than listed.
+    pub balls_truncated: bool,
+    /// Smallest and largest frame of the sweeps and expected outcomes.
+    pub frames: Option<(u64, u64)>,
+    /// Smallest and largest `log_time` of the trace messages, in nanoseconds.
+    pub log_time_nanos: Option<(u64, u64)>,
+    /// Whether the file has an `/expected` channel.
+    pub expected_present: bool,
+    /// Number of expected outcomes.
+    pub expected: u64,
+    /// Expected outcomes by kind.
+    pub expected_by_kind: BTreeMap<String, u64>,
+    /// What the reader saw: channels, chunks, compression, bytes, metadata.
+    pub stats: ReadStats,
+    /// The error that ended reading early, if any (the rest of the report
+    /// covers the messages before it).
+    pub error: Option<String>,
+}
+
+fn widen(range: &mut Option<(u64, u64)>, v: u64) {
+    *range = Some(match *range {
+        None => (v, v),
+        Some((lo, hi)) => (lo.min(v), hi.max(v)),
+    });
+}
+
+/// Reads a whole trace and summarises it. On an error the summary covers
+/// the messages before it, and the error is returned alongside.
+pub fn collect<R: Read>(mut reader: TraceReader<R>) -> (TraceInfo, Option<TraceError>) {
+    let mut info = TraceInfo {
+        file: reader.source_name().to_string(),
+        scenes: Vec::new(),
+        scene_count: 0,
+        sweeps: 0,
+        balls: BTreeSet::new(),
+        balls_truncated: false,
+        frames: None,
+        log_time_nanos: None,
+        expected_present: false,
+        expected: 0,
+        expected_by_kind: BTreeMap::new(),
+        stats: ReadStats::default(),
+        error: None,
+    };
+    let mut error = None;
+    for event in reader.by_ref() {
+        let event = match event {
+            Ok(event) => event,
+            Err(err) => {
+                info.error = Some(err.to_string());
+                error = Some(err);
+                break;
+            }
+        };
+        widen(&mut info.log_time_nanos, event.log_time_nanos());
+        match event {
+            TraceEvent::Scene {
+                log_time_nanos,
+                index,
+                scene,
+            } => {
+                info.scene_count += 1;
+                if info.scenes.len() < MAX_LISTED_SCENES {
+                    let vertices = scene.vertices.len();
+                    let triangles = scene.triangles.len();
+                    let (degenerate, mesh_error) = match Mesh::new(scene.vertices, &scene.triangles)
+                    {
+                        Ok(mesh) => (mesh.degenerate().len(), None),
+                        Err(err @ MeshError::Empty { degenerate, .. }) => {
+                            (degenerate, Some(err.to_string()))
+                        }
+                        Err(err) => (0, Some(err.to_string())),
+                    };
+                    info.scenes.push(SceneSummary {
+                        index,
+                        log_time_nanos,
+                        name: scene.name,
+                        vertices,
+                        triangles,
+                        degenerate,
+                        mesh_error,
+                        margin: scene.margin,
+                        facing: scene.facing.as_str().to_string(),
+                    });
+                }
+            }
+            TraceEvent::Sweep { sweep, .. } => {
+                info.sweeps += 1;
+                widen(&mut info.frames, sweep.frame);
+                if info.balls.len() < MAX_LISTED_BALLS || info.balls.contains(&sweep.ball) {
+                    info.balls.insert(sweep.ball);
+                } else {
+                    info.balls_truncated = true;
+                }
+            }
+            TraceEvent::Expected { outcome, .. } => {
+                info.expected += 1;
+                widen(&mut info.frames, outcome.frame);
+                *info
+                    .expected_by_kind
+                    .entry(outcome.kind.as_str().to_string())
+                    .or_default() += 1;
+            }
+        }
+    }
+    info.stats = reader.stats().clone();
+    info.expected_present = info.stats.channels.contains_key(EXPECTED_TOPIC);
+    (info, error)
+}
+
+fn seconds(nanos: u64) -> String {
+    format!("{:.3} s", nanos as f64 / 1e9)
+}
+
+/// The human-readable report.
+pub fn render_text(info: &TraceInfo) -> String {
+    let mut out = String::new();
+    let s = &info.stats;
+    let compression = if s.compression.is_empty() {
+        "not chunked".to_string()
+    } else {
+        let list: Vec<&str> = s.compression.iter().map(String::as_str).collect();
+        format!("{} chunks, compression {}", s.chunks, list.join(", "))
+    };
+    let _ = writeln!(out, "trace:       {}", info.file);
+    let _ = writeln!(
+        out,
+        "file:        {} bytes, {compression}, summary {}",
+        s.bytes,
+        if s.has_summary { "present" } else { "absent" }
+    );
+    let library = if s.library.is_empty() {
+        "(none)"
+    } else {
+        s.library.as_str()
+    };
+    let _ = writeln!(out, "library:     {library}");
+    let _ = writeln!(out, "scenes:      {}", info.scene_count);
+    for scene in &info.scenes {
+        let name = scene
+            .name
+            .as_deref()
+            .map(|n| format!("`{n}`"))
+            .unwrap_or_else(|| "(unnamed)".to_string());
+        let _ = write!(
+            out,
+            "  {name} (message {}, log_time {} ns): {} vertices, {} triangles, {} degenerate, margin {}, facing {}",
+            scene.index,
+            scene.log_time_nanos,
+            scene.vertices,
+            scene.triangles,
+            scene.degenerate,
+            scene.margin,
+            scene.facing
+        );
+        if let Some(err) = &scene.mesh_error {
+            let _ = write!(out, " (unusable: {err})");
+        }
+        out.push('\n');
+    }
+    if info.scene_count > info.scenes.len() as u64 {
+        let _ = writeln!(
+            out,
+            "  ... and {} more",
+            info.scene_count - info.scenes.len() as u64
+        );
+    }
+    let balls: Vec<String> = info.balls.iter().map(u32::to_string).collect();
+    let more = if info.balls_truncated { ", ..." } else { "" };
+    let _ = writeln!(
+        out,
+        "sweeps:      {} ({} balls: {}{more})",
+        info.sweeps,
+        info.balls.len(),
+        balls.join(", ")
+    );
+    match info.frames {
+        Some((lo, hi)) => {
+            let _ = writeln!(out, "frames:      {lo} to {hi}");
+        }
+        None => {
+            let _ = writeln!(out, "frames:      (none)");
+        }
+    }
+    match info.log_time_nanos {
+        Some((lo, hi)) => {
+            let _ = writeln!(
+                out,
+                "log_time:    {lo} ns to {hi} ns ({} to {}, span {})",
+                seconds(lo),
+                seconds(hi),
+                seconds(hi - lo)
+            );
+        }
+        None => {
+            let _ = writeln!(out, "log_time:    (no messages)");
+        }
+    }
+    if info.expected_present {
+        let kinds: Vec<String> = info
+            .expected_by_kind
+            .iter()
+            .map(|(k, n)| format!("{k} {n}"))
+            .collect();
+        let kinds = if kinds.is_empty() {
+            String::new()
+        } else {
+            format!(" ({})", kinds.join(", "))
+        };
+        let _ = writeln!(
+            out,
+            "expected:    present, {} outcomes{kinds}",
+            info.expected
+        );
+    } else {
+        let _ = writeln!(out, "expected:    absent");
+    }
+    let _ = writeln!(out, "channels:");
+    for (topic, c) in &s.channels {
+        let ours = [SCENE_TOPIC, SWEEP_TOPIC, EXPECTED_TOPIC].contains(&topic.as_str());
+        let schema = if c.schema_name.is_empty() {
+            "(no schema)".to_string()
+        } else {
+            c.schema_name.clone()
+        };
+        let note = if ours { "" } else { ", skipped" };
+        let _ = writeln!(
+            out,
+            "  {topic}  {schema} [{} / {}]  {} messages{note}",
+            if c.schema_encoding.is_empty() {
+                "-"
+            } else {
+                c.schema_encoding.as_str()
+            },
+            c.message_encoding,
+            c.messages
+        );
+    }
+    if s.metadata.is_empty() {
+        let _ = writeln!(out, "metadata:    (none)");
+    } else {
+        let _ = writeln!(out, "metadata:");
+        for (name, map) in &s.metadata {
+            let pairs: Vec<String> = map.iter().map(|(k, v)| format!("{k} = {v:?}")).collect();
+            let _ = writeln!(out, "  {name}: {}", pairs.join(", "));
+        }
+    }
+    if let Some(err) = &info.error {
+        let _ = writeln!(out, "incomplete:  {err}");
+    }
+    out
+}
+
+/// The report as one pretty-printed JSON object.
+pub fn render_json(info: &TraceInfo) -> String {
+    serde_json::to_string_pretty(info)
+        .unwrap_or_else(|e| format!("{{\"error\": {:?}}}", e.to_string()))
+}

@@ -1,0 +1,565 @@
+//! A streaming trace reader over any [`Read`].
+//!
+//! The reader walks the file once from start to end with the `mcap` crate's
+//! sans-io linear reader, so it needs neither the summary nor the indexes
+//! (a file without them is read in full, never refused or read as empty)
+//! and never holds more than one chunk in memory. Chunked or not, zstd, lz4
+//! or uncompressed: all are read.
+//!
+//! # Ordering
+//! Events come in file order. The messages of the three trace channels must
+//! be written in non-decreasing `log_time` order (the format says `log_time`
+//! grows with `frame`); a message whose `log_time` is smaller than that of an
+//! earlier trace message is an error ([`TraceError::OutOfOrder`]) rather
+//! than being reordered, which keeps memory bounded. Messages with equal
+//! `log_time` keep their file order, so a scene must be written before the
+//! sweeps that share its `log_time`.
+//!
+//! # Limits
+//! Sizes declared by the file are checked before anything is allocated for
+//! them (see [`ReadLimits`]): any record, and any chunk compressed or
+//! uncompressed, is refused above [`MAX_RECORD_BYTES`]; a `/scene` message
+//! above [`MAX_SCENE_BYTES`]; a `/sweep` or `/expected` message above
+//! [`MAX_SMALL_MESSAGE_BYTES`]. A scene's vertex and triangle counts are
+//! bounded by its byte size (a JSON number takes at least one byte), so a
+//! scene "claiming" a billion triangles is refused by its size.
+//!
+//! # Errors
+//! Every message of the trace channels is parsed and validated; the first
+//! error ends the iteration (the iterator returns `None` afterwards). The
+//! events before it have already been yielded, so a truncated file still
+//! gives every complete message before the cut, and the error says how many
+//! complete messages were read.
+
+use std::collections::{BTreeMap, BTreeSet, HashMap};
+use std::io::{ErrorKind, Read};
+
+use mcap::McapError;
+use mcap::records::{Record, op};
+use mcap::sans_io::{LinearReadEvent, LinearReader, LinearReaderOptions};
+
+use super::error::{MessageAt, TraceError};
+use super::messages::{EXPECTED_TOPIC, OutcomeMsg, SCENE_TOPIC, SWEEP_TOPIC, SceneMsg, SweepMsg};
+use super::validate::{parse_message, validate_outcome, validate_scene, validate_sweep};
+
+/// Largest record, or chunk (compressed or uncompressed), accepted: 256 MiB.
+pub const MAX_RECORD_BYTES: u64 = 256 * 1024 * 1024;
+/// Largest `/scene` message accepted: 64 MiB of JSON.
+pub const MAX_SCENE_BYTES: u64 = 64 * 1024 * 1024;
+/// Largest `/sweep` or `/expected` message accepted: 64 KiB of JSON.
+pub const MAX_SMALL_MESSAGE_BYTES: u64 = 64 * 1024;
+
+/// Size limits of a [`TraceReader`]; the defaults are the `MAX_*` constants.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct ReadLimits {
+    /// Largest record, or chunk (compressed or uncompressed).
+    pub record_bytes: u64,
+    /// Largest `/scene` message.
+    pub scene_bytes: u64,
+    /// Largest `/sweep` or `/expected` message.
+    pub small_message_bytes: u64,
+}
+
+impl Default for ReadLimits {
+    fn default() -> Self {
+        ReadLimits {
+            record_bytes: MAX_RECORD_BYTES,
+            scene_bytes: MAX_SCENE_BYTES,
+            small_message_bytes: MAX_SMALL_MESSAGE_BYTES,
+        }
+    }
+}
+
+/// One message of a trace channel, parsed and validated.
+#[derive(Debug, Clone, PartialEq)]
+pub enum TraceEvent {
+    /// A `/scene` message.
+    Scene {
+        /// Its `log_time`.
+        log_time_nanos: u64,
+        /// Its index among all messages of the file, from 0.
+        index: u64,
+        /// The scene.
+        scene: SceneMsg,
+    },
+    /// A `/sweep` message.
+    Sweep {
+        /// Its `log_time`.
+        log_time_nanos: u64,
+        /// Its index among all messages of the file, from 0.
+        index: u64,
+        /// The sweep.
+        sweep: SweepMsg,
+    },
+    /// An `/expected` message.
+    Expected {
+        /// Its `log_time`.
+        log_time_nanos: u64,
+        /// Its index among all messages of the file, from 0.
+        index: u64,
+        /// The expected outcome.
+        outcome: OutcomeMsg,
+    },
+}
+
+impl TraceEvent {
+    /// The message's `log_time` in nanoseconds.
+    pub fn log_time_nanos(&self) -> u64 {
+        match self {
+            TraceEvent::Scene { log_time_nanos, .. }
+            | TraceEvent::Sweep { log_time_nanos, .. }
+            | TraceEvent::Expected { log_time_nanos, .. } => *log_time_nanos,
+        }
+    }
+
+    /// The message's index in the file.
+    pub fn index(&self) -> u64 {
+        match self {
+            TraceEvent::Scene { index, .. }
+            | TraceEvent::Sweep { index, .. }
+            | TraceEvent::Expected { index, .. } => *index,
+        }
+    }
+}
+
+/// One channel (or several sharing a topic) as seen in the file.
+#[derive(Debug, Clone, Default, PartialEq, Eq, serde::Serialize)]
+pub struct ChannelStats {
+    /// Schema name (empty when the channel has no schema).
+    pub schema_name: String,
+    /// Schema encoding.
+    pub schema_encoding: String,
+    /// Message encoding.
+    pub message_encoding: String,
+    /// Messages read on this topic.
+    pub messages: u64,
+}
+
+/// What the reader has seen so far.
+#[derive(Debug, Clone, Default, PartialEq, Eq, serde::Serialize)]
+pub struct ReadStats {
+    /// Complete messages read, on every topic.
+    pub messages: u64,
+    /// Messages of foreign topics, skipped, by topic.
+    pub skipped_by_topic: BTreeMap<String, u64>,
+    /// Every topic seen, with its schema and message count.
+    pub channels: BTreeMap<String, ChannelStats>,
+    /// Chunks read.
+    pub chunks: u64,
+    /// Compression of the chunks (`zstd`, `lz4`, `none`); empty when the
+    /// file has no chunk.
+    pub compression: BTreeSet<String>,
+    /// Bytes read from the input.
+    pub bytes: u64,
+    /// Whether the file has a summary section.
+    pub has_summary: bool,
+    /// Metadata records, by name, in file order (the summary's copies are not repeated).
+    pub metadata: Vec<(String, BTreeMap<String, String>)>,
+    /// The header's library string.
+    pub library: String,
+    /// The header's profile.
+    pub profile: String,
+}
+
+#[derive(Debug, Clone)]
+struct ChannelInfo {
+    topic: String,
+}
+
+/// Everything but the byte sources, so records borrowed from a reader can be
+/// handled while the reader is borrowed.
+struct State {
+    source_name: String,
+    limits: ReadLimits,
+    stats: ReadStats,
+    schemas: HashMap<u16, (String, String)>,
+    channels: HashMap<u16, ChannelInfo>,
+    after_data_end: bool,
+    last_log_time: Option<u64>,
+    /// The margin of the current scene; `None` before the first scene.
+    scene_margin: Option<f64>,
+}
+
+/// Reads a trace from any [`Read`], yielding the messages of the three trace
+/// channels in file order. See the [module documentation](self).
+pub struct TraceReader<R: Read> {
+    input: R,
+    file: LinearReader,
+    chunk: Option<LinearReader>,
+    state: State,
+    done: bool,
+}
+
+impl<R: Read> TraceReader<R> {
+    /// A reader with the default [`ReadLimits`]; `source_name` (a file name)
+    /// is used in error messages.
+    pub fn new(reader: R, source_name: &str) -> Self {
+        Self::with_limits(reader, source_name, ReadLimits::default())
+    }
+
+    /// A reader with the given limits.
+    pub fn with_limits(reader: R, source_name: &str, limits: ReadLimits) -> Self {
+        let options = LinearReaderOptions::default()
+            .with_emit_chunks(true)
+            .with_record_length_limit(clamp(limits.record_bytes));
+        TraceReader {
+            input: reader,
+            file: LinearReader::new_with_options(options),
+            chunk: None,
+            state: State {
+                source_name: source_name.to_string(),
+                limits,
+                stats: ReadStats::default(),
+                schemas: HashMap::new(),
+                channels: HashMap::new(),
+                after_data_end: false,
+                last_log_time: None,
+                scene_margin: None,
+            },
+            done: false,
+        }
+    }
+
+    /// What has been read so far (complete after the iterator returned `None`).
+    pub fn stats(&self) -> &ReadStats {
+        &self.state.stats
+    }
+
+    /// The name given to [`TraceReader::new`].
+    pub fn source_name(&self) -> &str {
+        &self.state.source_name
+    }
+
+    fn step(&mut self) -> Result<Option<TraceEvent>, TraceError> {
+        loop {
+            if let Some(chunk) = self.chunk.as_mut() {
+                match chunk.next_event() {
+                    None => {
+                        self.chunk = None;
+                    }
+                    Some(Err(err)) => {
+                        let context =
+                            format!("chunk {}", self.state.stats.chunks.saturating_sub(1));
+                        return Err(self.state.mcap_error(err, &context, true));
+                    }
+                    Some(Ok(LinearReadEvent::ReadRequest(_))) => {
+                        // The whole chunk was handed over: this is its end.
+                        let _ = chunk.insert(0);
+                        chunk.notify_read(0);
+                    }
+                    Some(Ok(LinearReadEvent::Record { data, opcode })) => {
+                        if let Some(event) = self.state.record(opcode, data)? {
+                            return Ok(Some(event));
+                        }
+                    }
+                }
+                continue;
+            }
+            match self.file.next_event() {
+                None => return Ok(None),
+                Some(Err(err)) => return Err(self.state.mcap_error(err, "record", false)),
+                Some(Ok(LinearReadEvent::ReadRequest(want))) => {
+                    let buf = self.file.insert(want);
+                    let read = loop {
+                        match self.input.read(buf) {
+                            Ok(n) => break n,
+                            Err(e) if e.kind() == ErrorKind::Interrupted => continue,
+                            Err(source) => {
+                                return Err(TraceError::Io {
+                                    file: self.state.source_name.clone(),
+                                    messages: self.state.stats.messages,
+                                    source,
+                                });
+                            }
+                        }
+                    };
+                    self.file.notify_read(read);
+                    self.state.stats.bytes += read as u64;
+                }
+                Some(Ok(LinearReadEvent::Record { data, opcode })) => {
+                    if opcode == op::CHUNK {
+                        self.chunk = Some(self.state.open_chunk(data)?);
+                    } else if let Some(event) = self.state.record(opcode, data)? {
+                        return Ok(Some(event));
+                    }
+                }
+            }
+        }
+    }
+}
+
+impl<R: Read> Iterator for TraceReader<R> {
+    type Item = Result<TraceEvent, TraceError>;
+
+    fn next(&mut self) -> Option<Self::Item> {
+        if self.done {
+            return None;
+        }
+        match self.step() {
+            Ok(Some(event)) => Some(Ok(event)),
+            Ok(None) => {
+                self.done = true;
+                None
+            }
+            Err(err) => {
+                self.done = true;
+                Some(Err(err))
+            }
+        }
+    }
+}
+
+fn clamp(n: u64) -> usize {
+    usize::try_from(n).unwrap_or(usize::MAX)
+}
+
+impl State {
+    fn at(&self, channel: &str, index: u64, frame: Option<u64>) -> MessageAt {
+        MessageAt {
+            file: self.source_name.clone(),
+            channel: channel.to_string(),
+            index,
+            frame,
+        }
+    }
+
+    fn mcap_error(&self, err: McapError, context: &str, in_chunk: bool) -> TraceError {
+        let file = self.source_name.clone();
+        let messages = self.stats.messages;
+        let limit = self.limits.record_bytes;
+        match err {
+            McapError::UnexpectedEof if !in_chunk => TraceError::Truncated { file, messages },
+            McapError::RecordTooLarge { opcode, len } => TraceError::TooLarge {
+                file,
+                what: format!("a record with opcode {opcode:#04x} ({context})"),
+                declared: len,
+                limit,
+            },
+            McapError::ChunkTooLarge(len) => TraceError::TooLarge {
+                file,
+                what: context.to_string(),
+                declared: len,
+                limit,
+            },
+            source => TraceError::Corrupt {
+                file,
+                messages,
+                context: context.to_string(),
+                source,
+            },
+        }
+    }
+
+    /// Checks a chunk's declared sizes and returns a reader over its records.
+    fn open_chunk(&mut self, data: &[u8]) -> Result<LinearReader, TraceError> {
+        let index = self.stats.chunks;
+        let context = format!("chunk {index}");
+        let header = match mcap::parse_record(op::CHUNK, data) {
+            Ok(Record::Chunk { header, .. }) => header,
+            // `parse_record(op::CHUNK, ..)` always returns a chunk.
+            Ok(_) => return Err(self.mcap_error(McapError::UnexpectedEoc, &context, true)),
+            Err(err) => return Err(self.mcap_error(err, &context, true)),
+        };
+        if header.uncompressed_size > self.limits.record_bytes {
+            return Err(TraceError::TooLarge {
+                file: self.source_name.clone(),
+                what: format!("{context} (uncompressed)"),
+                declared: header.uncompressed_size,
+                limit: self.limits.record_bytes,
+            });
+        }
+        self.stats.chunks += 1;
+        let compression = if header.compression.is_empty() {
+            "none".to_string()
+        } else {
+            header.compression.clone()
+        };
+        self.stats.compression.insert(compression);
+        // Hand the whole chunk record to a reader of its own, which checks
+        // the CRC before yielding any record of it.
+        let options = LinearReaderOptions::default()
+            .with_skip_start_magic(true)
+            .with_skip_end_magic(true)
+            .with_prevalidate_chunk_crcs(true)
+            .with_record_length_limit(clamp(self.limits.record_bytes));
+        let mut chunk = LinearReader::new_with_options(options);
+        let total = 9 + data.len();
+        let buf = chunk.insert(total);
+        buf[0] = op::CHUNK;
+        buf[1..9].copy_from_slice(&(data.len() as u64).to_le_bytes());
+        buf[9..].copy_from_slice(data);
+        chunk.notify_read(total);
+        Ok(chunk)
+    }
+
+    /// Handles one record (outside or inside a chunk).
+    fn record(&mut self, opcode: u8, data: &[u8]) -> Result<Option<TraceEvent>, TraceError> {
+        if self.after_data_end && opcode != op::FOOTER {
+            self.stats.has_summary = true;
+        }
+        match opcode {
+            op::HEADER | op::SCHEMA | op::CHANNEL | op::MESSAGE | op::METADATA | op::DATA_END => {}
+            // Indexes, statistics, attachments and unknown records are not needed.
+            _ => return Ok(None),
+        }
+        let record = match mcap::parse_record(opcode, data) {
+            Ok(record) => record,
+            Err(err) => {
+                return Err(self.mcap_error(
+                    err,
+                    &format!("record with opcode {opcode:#04x}"),
+                    false,
+                ));
+            }
+        };
+        match record {
+            Record::Header(header) => {
+                self.stats.library = header.library;
+                self.stats.profile = header.profile;
+            }
+            Record::Schema { header, .. } => {
+                self.schemas
+                    .insert(header.id, (header.name, header.encoding));
+            }
+            Record::Channel(channel) => {
+                let is_trace =
+                    [SCENE_TOPIC, SWEEP_TOPIC, EXPECTED_TOPIC].contains(&channel.topic.as_str());
+                if is_trace && channel.message_encoding != "json" {
+                    return Err(TraceError::WrongEncoding {
+                        file: self.source_name.clone(),
+                        channel: channel.topic,
+                        encoding: channel.message_encoding,
+                    });
+                }
+                let (schema_name, schema_encoding) = self
+                    .schemas
+                    .get(&channel.schema_id)
+                    .cloned()
+                    .unwrap_or_default();
+                let entry = self
+                    .stats
+                    .channels
+                    .entry(channel.topic.clone())
+                    .or_default();
+                entry.schema_name = schema_name;
+                entry.schema_encoding = schema_encoding;
+                entry.message_encoding = channel.message_encoding;
+                self.channels.insert(
+                    channel.id,
+                    ChannelInfo {
+                        topic: channel.topic,
+                    },
+                );
+            }
+            Record::Metadata(metadata) if !self.after_data_end => {
+                self.stats.metadata.push((metadata.name, metadata.metadata));
+            }
+            Record::DataEnd(_) => {
+                self.after_data_end = true;
+            }
+            Record::Message { header, data } => {
+                if self.after_data_end {
+                    return Ok(None);
+                }
+                return self.message(header.channel_id, header.log_time, &data);
+            }
+            _ => {}
+        }
+        Ok(None)
+    }
+
+    fn message(
+        &mut self,
+        channel_id: u16,
+        log_time_nanos: u64,
+        data: &[u8],
+    ) -> Result<Option<TraceEvent>, TraceError> {
+        let index = self.stats.messages;
+        let Some(channel) = self.channels.get(&channel_id) else {
+            return Err(TraceError::UnknownChannel {
+                file: self.source_name.clone(),
+                index,
+                channel_id,
+            });
+        };
+        let topic = channel.topic.clone();
+        let limit = match topic.as_str() {
+            SCENE_TOPIC => self.limits.scene_bytes,
+            SWEEP_TOPIC | EXPECTED_TOPIC => self.limits.small_message_bytes,
+            _ => {
+                self.stats.messages += 1;
+                *self
+                    .stats
+                    .skipped_by_topic
+                    .entry(topic.clone())
+                    .or_default() += 1;
+                if let Some(c) = self.stats.channels.get_mut(&topic) {
+                    c.messages += 1;
+                }
+                return Ok(None);
+            }
+        };
+        if data.len() as u64 > limit {
+            return Err(TraceError::MessageTooLarge {
+                at: self.at(&topic, index, None),
+                bytes: data.len() as u64,
+                limit,
+            });
+        }
+        if let Some(previous_nanos) = self.last_log_time
+            && log_time_nanos < previous_nanos
+        {
+            let frame = if topic == SCENE_TOPIC {
+                None
+            } else {
+                super::validate::frame_of(data)
+            };
+            return Err(TraceError::OutOfOrder {
+                at: self.at(&topic, index, frame),
+                log_time_nanos,
+                previous_nanos,
+            });
+        }
+        let event = match topic.as_str() {
+            SCENE_TOPIC => {
+                let scene: SceneMsg = parse_message(data, self.at(&topic, index, None))?;
+                validate_scene(&scene).map_err(|p| p.at(self.at(&topic, index, None)))?;
+                self.scene_margin = Some(scene.margin);
+                TraceEvent::Scene {
+                    log_time_nanos,
+                    index,
+                    scene,
+                }
+            }
+            SWEEP_TOPIC => {
+                let sweep: SweepMsg = parse_message(data, self.at(&topic, index, None))?;
+                let at = || self.at(&topic, index, Some(sweep.frame));
+                if self.scene_margin.is_none() {
+                    return Err(TraceError::SweepBeforeScene { at: at() });
+                }
+                validate_sweep(&sweep, self.scene_margin).map_err(|p| p.at(at()))?;
+                TraceEvent::Sweep {
+                    log_time_nanos,
+                    index,
+                    sweep,
+                }
+            }
+            _ => {
+                let outcome: OutcomeMsg = parse_message(data, self.at(&topic, index, None))?;
+                validate_outcome(&outcome)
+                    .map_err(|p| p.at(self.at(&topic, index, Some(outcome.frame))))?;
+                TraceEvent::Expected {
+                    log_time_nanos,
+                    index,
+                    outcome,
+                }
+            }
+        };
+        self.last_log_time = Some(log_time_nanos);
+        self.stats.messages += 1;
+        if let Some(c) = self.stats.channels.get_mut(&topic) {
+            c.messages += 1;
+        }
+        Ok(Some(event))
+    }
+}

@@ -1,0 +1,184 @@
+//! Parsing and validation of the JSON messages of a trace.
+//!
+//! The reader parses every message of the three channels through
+//! [`parse_message`] (so a JSON error names the field by its path) and then
+//! checks the values with [`validate_scene`], [`validate_sweep`] and
+//! [`validate_outcome`]. The writer runs the same checks, so a trace written
+//! by this crate is always readable by it.
+
+use serde::Deserialize;
+use serde::de::DeserializeOwned;
+
+use super::error::{MessageAt, TraceError};
+use super::messages::{OutcomeMsg, SceneMsg, SweepMsg};
+
+/// A field holding an invalid value, and why.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct FieldProblem {
+    /// Path of the field, such as `triangles[12][1]` or `radius`.
+    pub field: String,
+    /// What is wrong with it.
+    pub problem: String,
+}
+
+impl FieldProblem {
+    fn new(field: impl Into<String>, problem: impl Into<String>) -> FieldProblem {
+        FieldProblem {
+            field: field.into(),
+            problem: problem.into(),
+        }
+    }
+
+    /// Attaches the message's position to make a [`TraceError::Invalid`].
+    pub fn at(self, at: MessageAt) -> TraceError {
+        TraceError::Invalid {
+            at,
+            field: self.field,
+            problem: self.problem,
+        }
+    }
+}
+
+/// Just the frame of a sweep or outcome, read leniently to name the frame of
+/// a message that fails to parse.
+#[derive(Deserialize)]
+struct FrameOnly {
+    #[serde(default)]
+    frame: Option<u64>,
+}
+
+/// The frame of a JSON message, if one can be read from it.
+pub fn frame_of(data: &[u8]) -> Option<u64> {
+    serde_json::from_slice::<FrameOnly>(data)
+        .ok()
+        .and_then(|f| f.frame)
+}
+
+/// Parses one JSON message; errors name the field by its path.
+///
+/// `at` is the message's position; its frame is filled in from the raw
+/// message when it can be read.
+pub fn parse_message<T: DeserializeOwned>(data: &[u8], mut at: MessageAt) -> Result<T, TraceError> {
+    let mut de = serde_json::Deserializer::from_slice(data);
+    // Trailing characters after the object are an error too.
+    let parsed = match serde_path_to_error::deserialize::<_, T>(&mut de) {
+        Ok(value) => de.end().map(|()| value).map_err(|e| (".".to_string(), e)),
+        Err(err) => Err((err.path().to_string(), err.into_inner())),
+    };
+    match parsed {
+        Ok(value) => Ok(value),
+        Err((path, inner)) => {
+            if at.frame.is_none() {
+                at.frame = frame_of(data);
+            }
+            let message = inner.to_string();
+            let field = match message
+                .strip_prefix("missing field `")
+                .and_then(|rest| rest.split('`').next())
+            {
+                Some(name) if path == "." => name.to_string(),
+                Some(name) => format!("{path}.{name}"),
+                None => path,
+            };
+            let detail = if inner.is_syntax() || inner.is_eof() {
+                format!("the message is not valid JSON: {message}")
+            } else if message.contains("invalid type: null") {
+                format!("{message} (`null` is not a number; JSON has no NaN or infinity)")
+            } else {
+                message
+            };
+            Err(TraceError::Json { at, field, detail })
+        }
+    }
+}
+
+fn finite3(field: &str, v: &[f64; 3]) -> Result<(), FieldProblem> {
+    for (k, c) in v.iter().enumerate() {
+        if !c.is_finite() {
+            return Err(FieldProblem::new(
+                format!("{field}[{k}]"),
+                format!("must be a finite number, got {c}"),
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// Checks a scene: finite coordinates, vertex indices in range, a finite
+/// margin `≥ 0`.
+pub fn validate_scene(scene: &SceneMsg) -> Result<(), FieldProblem> {
+    for (i, v) in scene.vertices.iter().enumerate() {
+        finite3(&format!("vertices[{i}]"), v)?;
+    }
+    let count = scene.vertices.len() as u64;
+    for (t, tri) in scene.triangles.iter().enumerate() {
+        for (k, &index) in tri.iter().enumerate() {
+            if index >= count {
+                return Err(FieldProblem::new(
+                    format!("triangles[{t}][{k}]"),
+                    format!(
+                        "vertex index {index} is out of range (the scene has {count} vertices)"
+                    ),
+                ));
+            }
+        }
+    }
+    if !scene.margin.is_finite() || scene.margin < 0.0 {
+        return Err(FieldProblem::new(
+            "margin",
+            format!("must be a finite number ≥ 0, got {}", scene.margin),
+        ));
+    }
+    Ok(())
+}
+
+/// Checks a sweep: a finite radius `> 0` above the scene's margin (when a
+/// scene is given), finite `p0` and `p1`.
+pub fn validate_sweep(sweep: &SweepMsg, scene_margin: Option<f64>) -> Result<(), FieldProblem> {
+    if !sweep.radius.is_finite() || sweep.radius <= 0.0 {
+        return Err(FieldProblem::new(
+            "radius",
+            format!("must be a finite number > 0, got {}", sweep.radius),
+        ));
+    }
+    if let Some(margin) = scene_margin
+        && margin >= sweep.radius
+    {
+        return Err(FieldProblem::new(
+            "radius",
+            format!(
+                "must be larger than the scene's margin {margin}, got {}",
+                sweep.radius
+            ),
+        ));
+    }
+    finite3("p0", &sweep.p0)?;
+    finite3("p1", &sweep.p1)?;
+    Ok(())
+}
+
+/// Checks an outcome: `alpha` in `[0, 1]`, `feature` in `0..=2`, finite
+/// `normal` and `contact`.
+pub fn validate_outcome(outcome: &OutcomeMsg) -> Result<(), FieldProblem> {
+    if !(0.0..=1.0).contains(&outcome.alpha) {
+        return Err(FieldProblem::new(
+            "alpha",
+            format!("must be a number in [0, 1], got {}", outcome.alpha),
+        ));
+    }
+    if let Some(Some(feature)) = outcome.feature
+        && feature > 2
+    {
+        return Err(FieldProblem::new(
+            "feature",
+            format!("must be 0, 1 or 2, got {feature}"),
+        ));
+    }
+    if let Some(Some(normal)) = &outcome.normal {
+        finite3("normal", normal)?;
+    }
+    if let Some(Some(contact)) = &outcome.contact {
+        finite3("contact", contact)?;
+    }
+    Ok(())
+}

@@ -1,0 +1,285 @@
+//! Recording traces.
+//!
+//! [`TraceWriter`] writes the project's own flavour of the format: chunked,
+//! zstd, summary and indexes, library string `sweeptrace <version>`, a
+//! `sweeptrace` metadata record with `format_version = "1"`, the three JSON
+//! Schemas. Output is deterministic: no clock is read and zstd runs on the
+//! calling thread. Every message is checked with the reader's validation
+//! before it is written, so whatever this writer accepts, the reader reads.
+//!
+//! [`write_trace_file`] writes to a temporary file next to the destination
+//! and renames it only when everything succeeded: no half-written trace is
+//! ever left under the destination name.
+
+use std::collections::BTreeMap;
+use std::fs::File;
+use std::io::{BufWriter, Seek, Write};
+use std::path::Path;
+
+use mcap::records::{MessageHeader, Metadata};
+use mcap::{Compression, WriteOptions, Writer};
+use serde::Serialize;
+
+use super::error::{MessageAt, TraceError};
+use super::messages::{
+    EXPECTED_TOPIC, OUTCOME_SCHEMA, OutcomeMsg, SCENE_SCHEMA, SCENE_TOPIC, SWEEP_SCHEMA,
+    SWEEP_TOPIC, SceneMsg, SweepMsg,
+};
+use super::schemas::{
+    FORMAT_VERSION, MESSAGE_ENCODING, METADATA_NAME, OUTCOME_SCHEMA_JSON, SCENE_SCHEMA_JSON,
+    SCHEMA_ENCODING, SWEEP_SCHEMA_JSON,
+};
+use super::validate::{validate_outcome, validate_scene, validate_sweep};
+
+/// The library string written into every trace: `sweeptrace <version>`.
+pub fn library_string() -> String {
+    format!("sweeptrace {}", env!("CARGO_PKG_VERSION"))
+}
+
+/// The write options of the project's own traces: chunked, zstd on the
+/// calling thread (deterministic), summary and indexes on.
+pub fn default_write_options() -> WriteOptions {
+    WriteOptions::new()
+        .compression(Some(Compression::Zstd))
+        .compression_threads(0)
+        .use_chunks(true)
+        .library(library_string())
+}
+
+/// Writes a trace to any `Write + Seek`.
+pub struct TraceWriter<W: Write + Seek> {
+    writer: Writer<W>,
+    name: String,
+    scene_channel: u16,
+    sweep_channel: u16,
+    expected_channel: u16,
+    messages: u64,
+    last_log_time: Option<u64>,
+    scene_margin: Option<f64>,
+}
+
+impl<W: Write + Seek> TraceWriter<W> {
+    /// A writer with the project's options ([`default_write_options`]).
+    pub fn new(w: W) -> Result<Self, TraceError> {
+        Self::with_options(w, default_write_options())
+    }
+
+    /// A writer with other container options (unchunked, lz4, no summary,
+    /// ...); the schemas, channels and metadata are the same. Meant for
+    /// tests and tools; traces recorded by the project use [`TraceWriter::new`].
+    pub fn with_options(w: W, options: WriteOptions) -> Result<Self, TraceError> {
+        Self::build(w, options, "<trace being written>".to_string())
+    }
+
+    fn build(w: W, options: WriteOptions, name: String) -> Result<Self, TraceError> {
+        let error = |source| TraceError::Write {
+            file: name.clone(),
+            source,
+        };
+        let mut writer = options.create(w).map_err(error)?;
+        let metadata = BTreeMap::from([
+            ("format_version".to_string(), FORMAT_VERSION.to_string()),
+            ("writer".to_string(), library_string()),
+        ]);
+        writer
+            .write_metadata(&Metadata {
+                name: METADATA_NAME.to_string(),
+                metadata,
+            })
+            .map_err(error)?;
+        let mut channel = |schema: &str, data: &str, topic: &str| -> Result<u16, TraceError> {
+            let schema_id = writer
+                .add_schema(schema, SCHEMA_ENCODING, data.as_bytes())
+                .map_err(error)?;
+            writer
+                .add_channel(schema_id, topic, MESSAGE_ENCODING, &BTreeMap::new())
+                .map_err(error)
+        };
+        let scene_channel = channel(SCENE_SCHEMA, SCENE_SCHEMA_JSON, SCENE_TOPIC)?;
+        let sweep_channel = channel(SWEEP_SCHEMA, SWEEP_SCHEMA_JSON, SWEEP_TOPIC)?;
+        let expected_channel = channel(OUTCOME_SCHEMA, OUTCOME_SCHEMA_JSON, EXPECTED_TOPIC)?;
+        Ok(TraceWriter {
+            writer,
+            name,
+            scene_channel,
+            sweep_channel,
+            expected_channel,
+            messages: 0,
+            last_log_time: None,
+            scene_margin: None,
+        })
+    }
+
+    /// Messages written so far.
+    pub fn messages(&self) -> u64 {
+        self.messages
+    }
+
+    fn at(&self, channel: &str, frame: Option<u64>) -> MessageAt {
+        MessageAt {
+            file: self.name.clone(),
+            channel: channel.to_string(),
+            index: self.messages,
+            frame,
+        }
+    }
+
+    fn check_time(
+        &self,
+        channel: &str,
+        frame: Option<u64>,
+        log_time_nanos: u64,
+    ) -> Result<(), TraceError> {
+        match self.last_log_time {
+            Some(previous_nanos) if log_time_nanos < previous_nanos => {
+                Err(TraceError::OutOfOrder {
+                    at: self.at(channel, frame),
+                    log_time_nanos,
+                    previous_nanos,
+                })
+            }
+            _ => Ok(()),
+        }
+    }
+
+    fn put<T: Serialize>(
+        &mut self,
+        channel_id: u16,
+        channel: &str,
+        frame: Option<u64>,
+        log_time_nanos: u64,
+        msg: &T,
+    ) -> Result<(), TraceError> {
+        let data = serde_json::to_vec(msg).map_err(|e| TraceError::Json {
+            at: self.at(channel, frame),
+            field: ".".to_string(),
+            detail: e.to_string(),
+        })?;
+        let header = MessageHeader {
+            channel_id,
+            sequence: self.messages as u32,
+            log_time: log_time_nanos,
+            publish_time: log_time_nanos,
+        };
+        self.writer
+            .write_to_known_channel(&header, &data)
+            .map_err(|source| TraceError::Write {
+                file: self.name.clone(),
+                source,
+            })?;
+        self.messages += 1;
+        self.last_log_time = Some(log_time_nanos);
+        Ok(())
+    }
+
+    /// Writes a `/scene` message; it applies to the sweeps written after it.
+    pub fn scene(&mut self, log_time_nanos: u64, scene: &SceneMsg) -> Result<(), TraceError> {
+        self.check_time(SCENE_TOPIC, None, log_time_nanos)?;
+        validate_scene(scene).map_err(|p| p.at(self.at(SCENE_TOPIC, None)))?;
+        self.put(self.scene_channel, SCENE_TOPIC, None, log_time_nanos, scene)?;
+        self.scene_margin = Some(scene.margin);
+        Ok(())
+    }
+
+    /// Writes a `/sweep` message; a scene must have been written before.
+    pub fn sweep(&mut self, log_time_nanos: u64, sweep: &SweepMsg) -> Result<(), TraceError> {
+        let frame = Some(sweep.frame);
+        self.check_time(SWEEP_TOPIC, frame, log_time_nanos)?;
+        if self.scene_margin.is_none() {
+            return Err(TraceError::SweepBeforeScene {
+                at: self.at(SWEEP_TOPIC, frame),
+            });
+        }
+        validate_sweep(sweep, self.scene_margin).map_err(|p| p.at(self.at(SWEEP_TOPIC, frame)))?;
+        self.put(
+            self.sweep_channel,
+            SWEEP_TOPIC,
+            frame,
+            log_time_nanos,
+            sweep,
+        )
+    }
+
+    /// Writes an `/expected` message.
+    pub fn expected(
+        &mut self,
+        log_time_nanos: u64,
+        outcome: &OutcomeMsg,
+    ) -> Result<(), TraceError> {
+        let frame = Some(outcome.frame);
+        self.check_time(EXPECTED_TOPIC, frame, log_time_nanos)?;
+        validate_outcome(outcome).map_err(|p| p.at(self.at(EXPECTED_TOPIC, frame)))?;
+        self.put(
+            self.expected_channel,
+            EXPECTED_TOPIC,
+            frame,
+            log_time_nanos,
+            outcome,
+        )
+    }
+
+    /// Writes the summary and footer and returns the underlying writer.
+    pub fn finish(mut self) -> Result<W, TraceError> {
+        self.writer.finish().map_err(|source| TraceError::Write {
+            file: self.name.clone(),
+            source,
+        })?;
+        Ok(self.writer.into_inner())
+    }
+}
+
+/// Writes a trace to `path` through `f`, atomically: the trace goes to a
+/// temporary file in the same directory, which is renamed to `path` only
+/// when `f` and the writer both succeeded (and the data reached the disk).
+/// On any error the temporary file is removed and `path` is untouched.
+pub fn write_trace_file<T, E: From<TraceError>>(
+    path: impl AsRef<Path>,
+    f: impl FnOnce(&mut TraceWriter<BufWriter<File>>) -> Result<T, E>,
+) -> Result<T, E> {
+    let path = path.as_ref();
+    let name = path.display().to_string();
+    let io = |source: std::io::Error| TraceError::Io {
+        file: name.clone(),
+        messages: 0,
+        source,
+    };
+    let dir = match path.parent() {
+        Some(parent) if !parent.as_os_str().is_empty() => parent,
+        _ => Path::new("."),
+    };
+    let prefix = format!(
+        ".{}.",
+        path.file_name()
+            .map(|n| n.to_string_lossy().into_owned())
+            .unwrap_or_default()
+    );
+    let mut builder = tempfile::Builder::new();
+    builder.prefix(&prefix).suffix(".tmp");
+    // A trace is an ordinary file (temporary files are private by default).
+    #[cfg(unix)]
+    builder.permissions(std::os::unix::fs::PermissionsExt::from_mode(0o644));
+    let temp = builder.tempfile_in(dir).map_err(io)?;
+    let (file, temp_path) = temp.into_parts();
+    let mut writer =
+        TraceWriter::build(BufWriter::new(file), default_write_options(), name.clone())?;
+    let value = f(&mut writer)?;
+    let messages = writer.messages();
+    let buffered = writer.finish()?;
+    let file = buffered.into_inner().map_err(|e| TraceError::Io {
+        file: name.clone(),
+        messages,
+        source: e.into_error(),
+    })?;
+    file.sync_all().map_err(|source| TraceError::Io {
+        file: name.clone(),
+        messages,
+        source,
+    })?;
+    drop(file);
+    temp_path.persist(path).map_err(|e| TraceError::Io {
+        file: name.clone(),
+        messages,
+        source: e.error,
+    })?;
+    Ok(value)
+}

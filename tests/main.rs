@@ -6,6 +6,8 @@
 use libtest_mimic::{Arguments, Failed, Trial};
 
 mod core_cases;
+mod core_random;
+mod oracle;
 mod support;
 
 /// Builds a trial from a function returning `Result<(), String>`.
@@ -18,5 +20,6 @@ fn main() {
     let mut trials: Vec<Trial> = Vec::new();
     // Register test modules below (one line each).
     trials.extend(core_cases::tests());
+    trials.extend(core_random::tests());
     libtest_mimic::run(&args, trials).exit();
 }

@@ -253,7 +253,10 @@ fn sweep_path<O: Observer>(mesh: &Mesh, path: &Path, options: &Options, broadpha
             }
         }
     } else {
-        for &(alpha, position) in &combiner.window[..combiner.len] {
+        // Sum in mesh order so the bits do not depend on the traversal order.
+        let window = &mut combiner.window[..combiner.len];
+        window.sort_unstable_by_key(|w| w.1);
+        for &(alpha, position) in window.iter() {
             if alpha <= limit {
                 sum += triangles[position as usize].normal;
             }

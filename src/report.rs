@@ -9,7 +9,10 @@ use crate::core::{Options, Outcome, Sweep, TestRecord, Verdict};
 
 /// Formats `[x, y, z]` compactly.
 pub fn vec3(v: &[f64]) -> String {
-    format!("({})", v.iter().map(|x| num(*x)).collect::<Vec<_>>().join(", "))
+    format!(
+        "({})",
+        v.iter().map(|x| num(*x)).collect::<Vec<_>>().join(", ")
+    )
 }
 
 /// One line describing an outcome.
@@ -48,7 +51,10 @@ pub fn outcome_json(o: &Outcome) -> serde_json::Value {
 /// Whether a test "came close": it hit, or failed only at the last checks
 /// (contact off the edge, touch point outside the triangle, back-facing).
 pub fn came_close(r: &TestRecord) -> bool {
-    matches!(r.verdict(), Verdict::Hit | Verdict::OffEdge | Verdict::OutsideTriangle | Verdict::BackFacing)
+    matches!(
+        r.verdict(),
+        Verdict::Hit | Verdict::OffEdge | Verdict::OutsideTriangle | Verdict::BackFacing
+    )
 }
 
 /// Everything the `sweep` command reports.
@@ -84,24 +90,47 @@ pub fn sweep_text(r: &SweepReport) -> String {
         r.options.facing
     )
     .unwrap();
-    writeln!(s, "path {} -> {}", vec3(r.sweep.p0.coords.as_slice()), vec3(r.sweep.p1.coords.as_slice())).unwrap();
+    writeln!(
+        s,
+        "path {} -> {}",
+        vec3(r.sweep.p0.coords.as_slice()),
+        vec3(r.sweep.p1.coords.as_slice())
+    )
+    .unwrap();
     writeln!(s, "outcome: {}", outcome_line(r.outcome)).unwrap();
-    let shown: Vec<&TestRecord> = r.records.iter().filter(|t| r.all || came_close(t)).collect();
+    let shown: Vec<&TestRecord> = r
+        .records
+        .iter()
+        .filter(|t| r.all || came_close(t))
+        .collect();
     let hidden = r.records.len() - shown.len();
     if shown.is_empty() {
-        writeln!(s, "no test came close ({} tests run; --all explains each)", r.records.len()).unwrap();
+        writeln!(
+            s,
+            "no test came close ({} tests run; --all explains each)",
+            r.records.len()
+        )
+        .unwrap();
     } else {
         writeln!(
             s,
             "tests{}:",
-            if r.all { "" } else { " that came close (hits, contacts off the feature, back-facing)" }
+            if r.all {
+                ""
+            } else {
+                " that came close (hits, contacts off the feature, back-facing)"
+            }
         )
         .unwrap();
         for t in shown {
             writeln!(s, "  {}", describe(t)).unwrap();
         }
         if hidden > 0 {
-            writeln!(s, "({hidden} other tests missed earlier; --all explains each)").unwrap();
+            writeln!(
+                s,
+                "({hidden} other tests missed earlier; --all explains each)"
+            )
+            .unwrap();
         }
     }
     s

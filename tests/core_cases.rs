@@ -35,30 +35,55 @@ pub fn tests() -> Vec<Trial> {
         trial("core::edge_no_real_roots", edge_no_real_roots),
         trial("core::edge_off_edge", edge_off_edge),
         trial("core::edge_back_facing", edge_back_facing),
-        trial("core::edge_strict_facing_rejects_n_dot_d_zero", edge_strict_facing),
-        trial("core::hit_exactly_at_alpha_1_worked_example_4", hit_at_alpha_one),
+        trial(
+            "core::edge_strict_facing_rejects_n_dot_d_zero",
+            edge_strict_facing,
+        ),
+        trial(
+            "core::hit_exactly_at_alpha_1_worked_example_4",
+            hit_at_alpha_one,
+        ),
         trial("core::zero_length_path", zero_length_path),
         trial("core::vertex_hit_worked_example_3", vertex_hit),
         trial("core::vertex_no_real_roots", vertex_no_real_roots),
         trial("core::vertex_before_start", vertex_before_start),
         trial("core::vertex_beyond_end", vertex_beyond_end),
         trial("core::vertex_back_facing", vertex_back_facing),
-        trial("core::endpoint_contact_exactly_at_xc_eq_l_is_edge", endpoint_tie_is_edge),
+        trial(
+            "core::endpoint_contact_exactly_at_xc_eq_l_is_edge",
+            endpoint_tie_is_edge,
+        ),
         trial("core::shared_edge_reported_for_both", shared_edge_both),
         trial("core::shared_edge_reported_for_one", shared_edge_one),
-        trial("core::shared_edge_reported_for_neither", shared_edge_neither),
-        trial("core::cube_shared_edge_averaged_normal_worked_example_5", cube_averaged_normal),
+        trial(
+            "core::shared_edge_reported_for_neither",
+            shared_edge_neither,
+        ),
+        trial(
+            "core::cube_shared_edge_averaged_normal_worked_example_5",
+            cube_averaged_normal,
+        ),
         trial("core::margin_shrinks_detection_radius", margin_case),
         trial("core::standard_frame_round_trip", standard_frame_round_trip),
         trial("core::bad_input_errors", bad_input),
-        trial("core::degenerate_triangles_reported_and_skipped", degenerate),
+        trial(
+            "core::degenerate_triangles_reported_and_skipped",
+            degenerate,
+        ),
     ]
 }
 
 fn face_hit() -> Result<(), String> {
     // h0 = 3, h1 = -3, β = (3 - 0.5) / 6 = 5/12, touch (1,1,0), barycentric
     // (1 - 0.25 - 0.25, 0.25, 0.25).
-    let (o, recs) = run(&triangle_t(), [1.0, 1.0, 3.0], [1.0, 1.0, -3.0], 0.5, 0.0, NS);
+    let (o, recs) = run(
+        &triangle_t(),
+        [1.0, 1.0, 3.0],
+        [1.0, 1.0, -3.0],
+        0.5,
+        0.0,
+        NS,
+    );
     let f = face(&recs, 0);
     ensure!(f.verdict == Verdict::Hit, "verdict {:?}", f.verdict);
     close("h0", f.h0, 3.0, TOL)?;
@@ -67,7 +92,10 @@ fn face_hit() -> Result<(), String> {
     let b = f.barycentric.ok_or("no barycentric")?;
     close("bary a", b[0], 0.5, TOL)?;
     close("bary b", b[1], 0.25, TOL)?;
-    ensure!(o.kind == Kind::Face && o.triangle == Some(0) && o.feature == Some(0), "outcome {o:?}");
+    ensure!(
+        o.kind == Kind::Face && o.triangle == Some(0) && o.feature == Some(0),
+        "outcome {o:?}"
+    );
     close("alpha", o.alpha, 5.0 / 12.0, TOL)?;
     let c = o.contact.ok_or("no contact")?;
     close("contact x", c.x, 1.0, TOL)?;
@@ -78,23 +106,52 @@ fn face_hit() -> Result<(), String> {
 
 fn face_starts_too_close() -> Result<(), String> {
     // h0 = 0.3 < ρ = 0.5: the ball starts within ρ of the plane.
-    let (_, recs) = run(&triangle_t(), [1.0, 1.0, 0.3], [1.0, 1.0, -3.0], 0.5, 0.0, NS);
+    let (_, recs) = run(
+        &triangle_t(),
+        [1.0, 1.0, 0.3],
+        [1.0, 1.0, -3.0],
+        0.5,
+        0.0,
+        NS,
+    );
     let f = face(&recs, 0);
-    ensure!(f.verdict == Verdict::StartsTooClose, "verdict {:?}", f.verdict);
+    ensure!(
+        f.verdict == Verdict::StartsTooClose,
+        "verdict {:?}",
+        f.verdict
+    );
     close("h0", f.h0, 0.3, TOL)
 }
 
 fn face_parallel() -> Result<(), String> {
     // h0 = h1 = 3.
-    let (o, recs) = run(&triangle_t(), [1.0, 1.0, 3.0], [2.0, 1.0, 3.0], 0.5, 0.0, NS);
-    ensure!(face(&recs, 0).verdict == Verdict::Parallel, "verdict {:?}", face(&recs, 0).verdict);
+    let (o, recs) = run(
+        &triangle_t(),
+        [1.0, 1.0, 3.0],
+        [2.0, 1.0, 3.0],
+        0.5,
+        0.0,
+        NS,
+    );
+    ensure!(
+        face(&recs, 0).verdict == Verdict::Parallel,
+        "verdict {:?}",
+        face(&recs, 0).verdict
+    );
     ensure!(o.kind == Kind::None && o.alpha == 1.0, "outcome {o:?}");
     Ok(())
 }
 
 fn face_back_facing() -> Result<(), String> {
     // Moving away from the front: h0 = 3, h1 = 5, n·d = 2 > 0.
-    let (_, recs) = run(&triangle_t(), [1.0, 1.0, 3.0], [1.0, 1.0, 5.0], 0.5, 0.0, NS);
+    let (_, recs) = run(
+        &triangle_t(),
+        [1.0, 1.0, 3.0],
+        [1.0, 1.0, 5.0],
+        0.5,
+        0.0,
+        NS,
+    );
     let f = face(&recs, 0);
     ensure!(f.verdict == Verdict::BackFacing, "verdict {:?}", f.verdict);
     close("n.d", f.normal_dot_d, 2.0, TOL)
@@ -102,7 +159,14 @@ fn face_back_facing() -> Result<(), String> {
 
 fn face_beyond_end() -> Result<(), String> {
     // h0 = 3, h1 = 2: β = 2.5 / 1 = 2.5 > 1.
-    let (_, recs) = run(&triangle_t(), [1.0, 1.0, 3.0], [1.0, 1.0, 2.0], 0.5, 0.0, NS);
+    let (_, recs) = run(
+        &triangle_t(),
+        [1.0, 1.0, 3.0],
+        [1.0, 1.0, 2.0],
+        0.5,
+        0.0,
+        NS,
+    );
     let f = face(&recs, 0);
     ensure!(f.verdict == Verdict::BeyondEnd, "verdict {:?}", f.verdict);
     close("beta", f.beta.unwrap_or(f64::NAN), 2.5, TOL)
@@ -110,9 +174,20 @@ fn face_beyond_end() -> Result<(), String> {
 
 fn face_outside_triangle() -> Result<(), String> {
     // β = 5/12, touch (3,3,0): barycentric (1 - 0.75 - 0.75, 0.75, 0.75) = (-0.5, ...).
-    let (_, recs) = run(&triangle_t(), [3.0, 3.0, 3.0], [3.0, 3.0, -3.0], 0.5, 0.0, NS);
+    let (_, recs) = run(
+        &triangle_t(),
+        [3.0, 3.0, 3.0],
+        [3.0, 3.0, -3.0],
+        0.5,
+        0.0,
+        NS,
+    );
     let f = face(&recs, 0);
-    ensure!(f.verdict == Verdict::OutsideTriangle, "verdict {:?}", f.verdict);
+    ensure!(
+        f.verdict == Verdict::OutsideTriangle,
+        "verdict {:?}",
+        f.verdict
+    );
     close("bary a", f.barycentric.ok_or("no bary")?[0], -0.5, TOL)
 }
 
@@ -120,7 +195,14 @@ fn edge_hit() -> Result<(), String> {
     // Worked example 2. p0 → (2, 3, 0.3), p1 → (2, -3, 0.3). A = 36, B = -36,
     // C = 9 + 0.09 - 0.25 = 8.84, disc = 1296 - 1272.96 = 23.04 (√ = 4.8),
     // roots (36 ∓ 4.8) / 72 = 0.43333, 0.56667; xc = 2; n·d = -6: α = 13/30.
-    let (o, recs) = run(&triangle_t(), [2.0, -0.3, 3.0], [2.0, -0.3, -3.0], 0.5, 0.0, NS);
+    let (o, recs) = run(
+        &triangle_t(),
+        [2.0, -0.3, 3.0],
+        [2.0, -0.3, -3.0],
+        0.5,
+        0.0,
+        NS,
+    );
     let e = edge(&recs, 0, 0);
     close("p0 x", e.p0_in_edge.x, 2.0, TOL)?;
     close("p0 y", e.p0_in_edge.y, 3.0, TOL)?;
@@ -136,8 +218,15 @@ fn edge_hit() -> Result<(), String> {
     close("xc", e.xc.unwrap_or(f64::NAN), 2.0, 1e-12)?;
     ensure!(e.verdict == Verdict::Hit, "verdict {:?}", e.verdict);
     // The face test's touch point (2, -0.3, 0) lies outside T.
-    ensure!(face(&recs, 0).verdict == Verdict::OutsideTriangle, "face {:?}", face(&recs, 0).verdict);
-    ensure!(o.kind == Kind::Edge && o.feature == Some(0), "outcome {o:?}");
+    ensure!(
+        face(&recs, 0).verdict == Verdict::OutsideTriangle,
+        "face {:?}",
+        face(&recs, 0).verdict
+    );
+    ensure!(
+        o.kind == Kind::Edge && o.feature == Some(0),
+        "outcome {o:?}"
+    );
     close("alpha", o.alpha, 13.0 / 30.0, 1e-12)?;
     let c = o.contact.ok_or("no contact")?;
     close("contact x", c.x, 2.0, 1e-12)?;
@@ -150,7 +239,14 @@ fn edge_between_roots() -> Result<(), String> {
     // B = 2 (0.2 · -3.2) = -1.28, C = 0.04 + 0.09 - 0.25 = -0.12,
     // disc = 1.6384 + 4.9152 = 6.5536 (√ = 2.56), roots (1.28 ∓ 2.56) / 20.48
     // = -0.0625, 0.1875: s0 < 0 ≤ s1, before the start.
-    let (_, recs) = run(&triangle_t(), [2.0, -0.3, 0.2], [2.0, -0.3, -3.0], 0.5, 0.0, NS);
+    let (_, recs) = run(
+        &triangle_t(),
+        [2.0, -0.3, 0.2],
+        [2.0, -0.3, -3.0],
+        0.5,
+        0.0,
+        NS,
+    );
     let e = edge(&recs, 0, 0);
     let (s0, s1) = e.roots.ok_or("no roots")?;
     close("s0", s0, -0.0625, 1e-12)?;
@@ -163,7 +259,14 @@ fn edge_after_roots() -> Result<(), String> {
     // Start after S1: p0 → (2, -3, 0.3), p1 → (2, -6, 0.3): A = 9, B = 18,
     // C = 8.84, disc = 324 - 318.24 = 5.76 (√ = 2.4), roots (-18 ∓ 2.4) / 18
     // = -1.13333, -0.86667: both negative.
-    let (_, recs) = run(&triangle_t(), [2.0, -0.3, -3.0], [2.0, -0.3, -6.0], 0.5, 0.0, NS);
+    let (_, recs) = run(
+        &triangle_t(),
+        [2.0, -0.3, -3.0],
+        [2.0, -0.3, -6.0],
+        0.5,
+        0.0,
+        NS,
+    );
     let e = edge(&recs, 0, 0);
     let (s0, s1) = e.roots.ok_or("no roots")?;
     close("s0", s0, -20.4 / 18.0, 1e-12)?;
@@ -175,7 +278,14 @@ fn edge_after_roots() -> Result<(), String> {
 fn edge_beyond_end() -> Result<(), String> {
     // p0 → (2, 3, 0.3), p1 → (2, 1, 0.3): A = 4, B = -12, C = 8.84,
     // disc = 144 - 141.44 = 2.56 (√ = 1.6), roots (12 ∓ 1.6) / 8 = 1.3, 1.7.
-    let (_, recs) = run(&triangle_t(), [2.0, -0.3, 3.0], [2.0, -0.3, 1.0], 0.5, 0.0, NS);
+    let (_, recs) = run(
+        &triangle_t(),
+        [2.0, -0.3, 3.0],
+        [2.0, -0.3, 1.0],
+        0.5,
+        0.0,
+        NS,
+    );
     let e = edge(&recs, 0, 0);
     close("s0", e.roots.ok_or("no roots")?.0, 1.3, 1e-12)?;
     ensure!(e.verdict == Verdict::BeyondEnd, "verdict {:?}", e.verdict);
@@ -187,7 +297,14 @@ fn edge_tangent() -> Result<(), String> {
     // p1 → (2, -3, 0.5): A = 36, B = -36, C = 9 + 0.25 - 0.25 = 9,
     // disc = 1296 - 1296 = 0 (every value exact in binary): a double root
     // s0 = s1 = 0.5, xc = 2: a touching hit at α = 0.5.
-    let (o, recs) = run(&triangle_t(), [2.0, -0.5, 3.0], [2.0, -0.5, -3.0], 0.5, 0.0, NS);
+    let (o, recs) = run(
+        &triangle_t(),
+        [2.0, -0.5, 3.0],
+        [2.0, -0.5, -3.0],
+        0.5,
+        0.0,
+        NS,
+    );
     let e = edge(&recs, 0, 0);
     ensure!(e.discriminant == 0.0, "discriminant {}", e.discriminant);
     ensure!(e.roots == Some((0.5, 0.5)), "roots {:?}", e.roots);
@@ -198,7 +315,14 @@ fn edge_tangent() -> Result<(), String> {
 
 fn edge_parallel() -> Result<(), String> {
     // Rolling along edge 0: p0 → (1, 0.2, 0.3), p1 → (3, 0.2, 0.3), A = 0.
-    let (_, recs) = run(&triangle_t(), [1.0, -0.3, 0.2], [3.0, -0.3, 0.2], 0.5, 0.0, NS);
+    let (_, recs) = run(
+        &triangle_t(),
+        [1.0, -0.3, 0.2],
+        [3.0, -0.3, 0.2],
+        0.5,
+        0.0,
+        NS,
+    );
     let e = edge(&recs, 0, 0);
     ensure!(e.verdict == Verdict::Parallel, "verdict {:?}", e.verdict);
     ensure!(e.a == 0.0, "A = {}", e.a);
@@ -208,16 +332,34 @@ fn edge_parallel() -> Result<(), String> {
 fn edge_no_real_roots() -> Result<(), String> {
     // p0 → (2, 3, 2), p1 → (2, -3, 2): A = 36, B = -36, C = 9 + 4 - 0.25 =
     // 12.75, disc = 1296 - 1836 = -540.
-    let (_, recs) = run(&triangle_t(), [2.0, -2.0, 3.0], [2.0, -2.0, -3.0], 0.5, 0.0, NS);
+    let (_, recs) = run(
+        &triangle_t(),
+        [2.0, -2.0, 3.0],
+        [2.0, -2.0, -3.0],
+        0.5,
+        0.0,
+        NS,
+    );
     let e = edge(&recs, 0, 0);
     close("disc", e.discriminant, -540.0, 1e-9)?;
-    ensure!(e.verdict == Verdict::NoRealRoots && e.roots.is_none(), "verdict {:?}", e.verdict);
+    ensure!(
+        e.verdict == Verdict::NoRealRoots && e.roots.is_none(),
+        "verdict {:?}",
+        e.verdict
+    );
     Ok(())
 }
 
 fn edge_off_edge() -> Result<(), String> {
     // As example 2 but at x = 5: s0 = 13/30, xc = 5 > L = 4.
-    let (_, recs) = run(&triangle_t(), [5.0, -0.3, 3.0], [5.0, -0.3, -3.0], 0.5, 0.0, NS);
+    let (_, recs) = run(
+        &triangle_t(),
+        [5.0, -0.3, 3.0],
+        [5.0, -0.3, -3.0],
+        0.5,
+        0.0,
+        NS,
+    );
     let e = edge(&recs, 0, 0);
     close("xc", e.xc.unwrap_or(f64::NAN), 5.0, 1e-12)?;
     ensure!(e.verdict == Verdict::OffEdge, "verdict {:?}", e.verdict);
@@ -227,7 +369,14 @@ fn edge_off_edge() -> Result<(), String> {
 fn edge_back_facing() -> Result<(), String> {
     // Example 2 reversed: p0 → (2, -3, 0.3), p1 → (2, 3, 0.3): A = 36,
     // B = -36, same roots, xc = 2, but n·d = +6.
-    let (o, recs) = run(&triangle_t(), [2.0, -0.3, -3.0], [2.0, -0.3, 3.0], 0.5, 0.0, NS);
+    let (o, recs) = run(
+        &triangle_t(),
+        [2.0, -0.3, -3.0],
+        [2.0, -0.3, 3.0],
+        0.5,
+        0.0,
+        NS,
+    );
     let e = edge(&recs, 0, 0);
     close("s0", e.roots.ok_or("no roots")?.0, 13.0 / 30.0, 1e-12)?;
     ensure!(e.verdict == Verdict::BackFacing, "verdict {:?}", e.verdict);
@@ -240,11 +389,33 @@ fn edge_strict_facing() -> Result<(), String> {
     // p1 = (2, 3, 0): n·d = 0. Frame: p0 → (2, 0, 3), p1 → (2, 0, -3);
     // A = 36, B = -36, C = 9 - 0.25 = 8.75, disc = 36, roots (36 ∓ 6)/72 =
     // 5/12, 7/12; xc = 2. non_strict accepts n·d = 0, strict rejects it.
-    let (o, recs) = run(&triangle_t(), [2.0, -3.0, 0.0], [2.0, 3.0, 0.0], 0.5, 0.0, Facing::NonStrict);
-    ensure!(edge(&recs, 0, 0).verdict == Verdict::Hit, "non_strict {:?}", edge(&recs, 0, 0).verdict);
+    let (o, recs) = run(
+        &triangle_t(),
+        [2.0, -3.0, 0.0],
+        [2.0, 3.0, 0.0],
+        0.5,
+        0.0,
+        Facing::NonStrict,
+    );
+    ensure!(
+        edge(&recs, 0, 0).verdict == Verdict::Hit,
+        "non_strict {:?}",
+        edge(&recs, 0, 0).verdict
+    );
     close("alpha", o.alpha, 5.0 / 12.0, 1e-12)?;
-    let (o, recs) = run(&triangle_t(), [2.0, -3.0, 0.0], [2.0, 3.0, 0.0], 0.5, 0.0, Facing::Strict);
-    ensure!(edge(&recs, 0, 0).verdict == Verdict::BackFacing, "strict {:?}", edge(&recs, 0, 0).verdict);
+    let (o, recs) = run(
+        &triangle_t(),
+        [2.0, -3.0, 0.0],
+        [2.0, 3.0, 0.0],
+        0.5,
+        0.0,
+        Facing::Strict,
+    );
+    ensure!(
+        edge(&recs, 0, 0).verdict == Verdict::BackFacing,
+        "strict {:?}",
+        edge(&recs, 0, 0).verdict
+    );
     ensure!(o.kind == Kind::None, "strict outcome {o:?}");
     Ok(())
 }
@@ -255,21 +426,48 @@ fn hit_at_alpha_one() -> Result<(), String> {
     // B = 2 · 3 · -2.5 = -15, C = 9 + 0.140625 - 0.390625 = 8.75,
     // disc = 225 - 218.75 = 6.25, q = (15 + 2.5)/2 = 8.75, roots C/q = 1 and
     // q/A = 1.4: s0 = 1 exactly. A touch at the end is a collision.
-    let (o, recs) = run(&triangle_t(), [2.0, -0.375, 3.0], [2.0, -0.375, 0.5], 0.625, 0.0, NS);
+    let (o, recs) = run(
+        &triangle_t(),
+        [2.0, -0.375, 3.0],
+        [2.0, -0.375, 0.5],
+        0.625,
+        0.0,
+        NS,
+    );
     let e = edge(&recs, 0, 0);
-    ensure!(e.a == 6.25 && e.b == -15.0 && e.c == 8.75 && e.discriminant == 6.25, "quadratic {e:?}");
+    ensure!(
+        e.a == 6.25 && e.b == -15.0 && e.c == 8.75 && e.discriminant == 6.25,
+        "quadratic {e:?}"
+    );
     ensure!(e.roots == Some((1.0, 1.4)), "roots {:?}", e.roots);
-    ensure!(o.kind == Kind::Edge && o.alpha == 1.0 && o.triangle == Some(0), "outcome {o:?}");
+    ensure!(
+        o.kind == Kind::Edge && o.alpha == 1.0 && o.triangle == Some(0),
+        "outcome {o:?}"
+    );
     Ok(())
 }
 
 fn zero_length_path() -> Result<(), String> {
     // d = 0: face parallel, edges parallel (A = 0), vertices not moving.
-    let (o, recs) = run(&triangle_t(), [2.0, -0.3, 3.0], [2.0, -0.3, 3.0], 0.5, 0.0, NS);
-    ensure!(face(&recs, 0).verdict == Verdict::Parallel, "face {:?}", face(&recs, 0).verdict);
+    let (o, recs) = run(
+        &triangle_t(),
+        [2.0, -0.3, 3.0],
+        [2.0, -0.3, 3.0],
+        0.5,
+        0.0,
+        NS,
+    );
+    ensure!(
+        face(&recs, 0).verdict == Verdict::Parallel,
+        "face {:?}",
+        face(&recs, 0).verdict
+    );
     for i in 0..3 {
         ensure!(edge(&recs, 0, i).verdict == Verdict::Parallel, "edge {i}");
-        ensure!(vertex(&recs, 0, i).verdict == Verdict::NotMoving, "vertex {i}");
+        ensure!(
+            vertex(&recs, 0, i).verdict == Verdict::NotMoving,
+            "vertex {i}"
+        );
     }
     ensure!(o.kind == Kind::None && o.alpha == 1.0, "outcome {o:?}");
     Ok(())
@@ -282,20 +480,35 @@ fn vertex_hit() -> Result<(), String> {
     // vertex 0: A = 36, B = 2 (0,0,-6)·(-0.3,-0.2,3) = -36, C = 0.09 + 0.04 + 9
     // - 0.25 = 8.88, disc = 1296 - 1278.72 = 17.28, s0 = (36 - √17.28) / 72
     // = 0.44226.
-    let (o, recs) = run(&triangle_t(), [-0.3, -0.2, 3.0], [-0.3, -0.2, -3.0], 0.5, 0.0, NS);
+    let (o, recs) = run(
+        &triangle_t(),
+        [-0.3, -0.2, 3.0],
+        [-0.3, -0.2, -3.0],
+        0.5,
+        0.0,
+        NS,
+    );
     let e0 = edge(&recs, 0, 0);
     ensure!(e0.verdict == Verdict::OffEdge, "edge 0 {:?}", e0.verdict);
     close("edge 0 xc", e0.xc.unwrap_or(f64::NAN), -0.3, 1e-12)?;
     let e2 = edge(&recs, 0, 2);
     ensure!(e2.verdict == Verdict::OffEdge, "edge 2 {:?}", e2.verdict);
-    ensure!(e2.xc.unwrap_or(0.0) > e2.length, "edge 2 xc {:?} beyond L {}", e2.xc, e2.length);
+    ensure!(
+        e2.xc.unwrap_or(0.0) > e2.length,
+        "edge 2 xc {:?} beyond L {}",
+        e2.xc,
+        e2.length
+    );
     let v = vertex(&recs, 0, 0);
     close("A", v.a, 36.0, 1e-12)?;
     close("B", v.b, -36.0, 1e-12)?;
     close("C", v.c, 8.88, 1e-12)?;
     let want = (36.0 - 17.28f64.sqrt()) / 72.0;
     close("s0", v.roots.ok_or("roots")?.0, want, 1e-12)?;
-    ensure!(o.kind == Kind::Vertex && o.feature == Some(0), "outcome {o:?}");
+    ensure!(
+        o.kind == Kind::Vertex && o.feature == Some(0),
+        "outcome {o:?}"
+    );
     close("alpha", o.alpha, 0.44226, 1e-5)?;
     let c = o.contact.ok_or("contact")?;
     ensure!(c.coords.norm() == 0.0, "contact {c:?} is the vertex");
@@ -304,7 +517,14 @@ fn vertex_hit() -> Result<(), String> {
 
 fn vertex_no_real_roots() -> Result<(), String> {
     // p0 = (-2, -2, 3): C = 4 + 4 + 9 - 0.25 = 16.75, disc = 1296 - 2412 < 0.
-    let (_, recs) = run(&triangle_t(), [-2.0, -2.0, 3.0], [-2.0, -2.0, -3.0], 0.5, 0.0, NS);
+    let (_, recs) = run(
+        &triangle_t(),
+        [-2.0, -2.0, 3.0],
+        [-2.0, -2.0, -3.0],
+        0.5,
+        0.0,
+        NS,
+    );
     let v = vertex(&recs, 0, 0);
     close("disc", v.discriminant, 1296.0 - 2412.0, 1e-9)?;
     ensure!(v.verdict == Verdict::NoRealRoots, "verdict {:?}", v.verdict);
@@ -313,7 +533,14 @@ fn vertex_no_real_roots() -> Result<(), String> {
 
 fn vertex_before_start() -> Result<(), String> {
     // The ball starts overlapping vertex 0: C = 0.03 - 0.25 < 0, so s0 < 0.
-    let (_, recs) = run(&triangle_t(), [-0.1, -0.1, 0.1], [-0.1, -0.1, -3.0], 0.5, 0.0, NS);
+    let (_, recs) = run(
+        &triangle_t(),
+        [-0.1, -0.1, 0.1],
+        [-0.1, -0.1, -3.0],
+        0.5,
+        0.0,
+        NS,
+    );
     let v = vertex(&recs, 0, 0);
     close("C", v.c, 0.03 - 0.25, 1e-12)?;
     ensure!(v.verdict == Verdict::BeforeStart, "verdict {:?}", v.verdict);
@@ -322,9 +549,21 @@ fn vertex_before_start() -> Result<(), String> {
 
 fn vertex_beyond_end() -> Result<(), String> {
     // d = (0,0,-1): A = 1, B = -6, C = 8.88, disc = 0.48, s0 = (6 - √0.48)/2 = 2.6536.
-    let (_, recs) = run(&triangle_t(), [-0.3, -0.2, 3.0], [-0.3, -0.2, 2.0], 0.5, 0.0, NS);
+    let (_, recs) = run(
+        &triangle_t(),
+        [-0.3, -0.2, 3.0],
+        [-0.3, -0.2, 2.0],
+        0.5,
+        0.0,
+        NS,
+    );
     let v = vertex(&recs, 0, 0);
-    close("s0", v.roots.ok_or("roots")?.0, (6.0 - 0.48f64.sqrt()) / 2.0, 1e-12)?;
+    close(
+        "s0",
+        v.roots.ok_or("roots")?.0,
+        (6.0 - 0.48f64.sqrt()) / 2.0,
+        1e-12,
+    )?;
     ensure!(v.verdict == Verdict::BeyondEnd, "verdict {:?}", v.verdict);
     Ok(())
 }
@@ -332,9 +571,21 @@ fn vertex_beyond_end() -> Result<(), String> {
 fn vertex_back_facing() -> Result<(), String> {
     // Example 3 reversed: same quadratic up to the sign of B... m = (-0.3,
     // -0.2, -3), d = (0,0,6): B = -36, s0 = 0.44226, but n·d = 6 > 0.
-    let (o, recs) = run(&triangle_t(), [-0.3, -0.2, -3.0], [-0.3, -0.2, 3.0], 0.5, 0.0, NS);
+    let (o, recs) = run(
+        &triangle_t(),
+        [-0.3, -0.2, -3.0],
+        [-0.3, -0.2, 3.0],
+        0.5,
+        0.0,
+        NS,
+    );
     let v = vertex(&recs, 0, 0);
-    close("s0", v.roots.ok_or("roots")?.0, (36.0 - 17.28f64.sqrt()) / 72.0, 1e-12)?;
+    close(
+        "s0",
+        v.roots.ok_or("roots")?.0,
+        (36.0 - 17.28f64.sqrt()) / 72.0,
+        1e-12,
+    )?;
     ensure!(v.verdict == Verdict::BackFacing, "verdict {:?}", v.verdict);
     ensure!(o.kind == Kind::None, "outcome {o:?}");
     Ok(())
@@ -345,12 +596,25 @@ fn endpoint_tie_is_edge() -> Result<(), String> {
     // (accepted, boundary included); vertex 1 = (4,0,0) gives A = 6.25,
     // B = 2 (0,0,-2.5)·(0,-0.375,3) = -15, C = 0.140625 + 9 - 0.390625 = 8.75:
     // the same quadratic, s0 = 1. Exact tie: face < edge < vertex → edge.
-    let (o, recs) = run(&triangle_t(), [4.0, -0.375, 3.0], [4.0, -0.375, 0.5], 0.625, 0.0, NS);
+    let (o, recs) = run(
+        &triangle_t(),
+        [4.0, -0.375, 3.0],
+        [4.0, -0.375, 0.5],
+        0.625,
+        0.0,
+        NS,
+    );
     let e = edge(&recs, 0, 0);
     let v = vertex(&recs, 0, 1);
     ensure!(e.verdict == Verdict::Hit && e.xc == Some(4.0), "edge {e:?}");
-    ensure!(v.verdict == Verdict::Hit && v.roots.map(|r| r.0) == Some(1.0), "vertex {v:?}");
-    ensure!(o.kind == Kind::Edge && o.feature == Some(0) && o.alpha == 1.0, "outcome {o:?}");
+    ensure!(
+        v.verdict == Verdict::Hit && v.roots.map(|r| r.0) == Some(1.0),
+        "vertex {v:?}"
+    );
+    ensure!(
+        o.kind == Kind::Edge && o.feature == Some(0) && o.alpha == 1.0,
+        "outcome {o:?}"
+    );
     Ok(())
 }
 
@@ -359,7 +623,12 @@ fn endpoint_tie_is_edge() -> Result<(), String> {
 /// ridge along the x axis. Its edge 0 runs (4,0,0) → (0,0,0).
 fn ridge() -> Mesh {
     mesh(
-        &[[0.0, 0.0, 0.0], [4.0, 0.0, 0.0], [0.0, 4.0, 0.0], [0.0, -4.0, -4.0]],
+        &[
+            [0.0, 0.0, 0.0],
+            [4.0, 0.0, 0.0],
+            [0.0, 4.0, 0.0],
+            [0.0, -4.0, -4.0],
+        ],
         &[[0, 1, 2], [1, 0, 3]],
     )
 }
@@ -383,7 +652,12 @@ fn shared_edge_both() -> Result<(), String> {
     let (o, recs) = run(&ridge(), p0, p1, 0.5, 0.0, NS);
     let e0 = edge(&recs, 0, 0);
     let e1 = edge(&recs, 1, 0);
-    ensure!(e0.verdict == Verdict::Hit && e1.verdict == Verdict::Hit, "edges {:?} {:?}", e0.verdict, e1.verdict);
+    ensure!(
+        e0.verdict == Verdict::Hit && e1.verdict == Verdict::Hit,
+        "edges {:?} {:?}",
+        e0.verdict,
+        e1.verdict
+    );
     close("alpha 0", e0.roots.ok_or("roots")?.0, 0.5, 1e-12)?;
     close("alpha 1", e1.roots.ok_or("roots")?.0, 0.5, 1e-12)?;
     ensure!(o.kind == Kind::Edge, "outcome {o:?}");
@@ -404,8 +678,15 @@ fn shared_edge_one() -> Result<(), String> {
     let e0 = edge(&recs, 0, 0);
     let e1 = edge(&recs, 1, 0);
     ensure!(e0.verdict == Verdict::Hit, "triangle 0 {:?}", e0.verdict);
-    ensure!(e1.verdict == Verdict::BackFacing, "triangle 1 {:?}", e1.verdict);
-    ensure!(o.kind == Kind::Edge && o.triangle == Some(0), "outcome {o:?}");
+    ensure!(
+        e1.verdict == Verdict::BackFacing,
+        "triangle 1 {:?}",
+        e1.verdict
+    );
+    ensure!(
+        o.kind == Kind::Edge && o.triangle == Some(0),
+        "outcome {o:?}"
+    );
     close("alpha", o.alpha, 0.5, 1e-12)?;
     let n = o.normal.ok_or("normal")?;
     close("normal z", n.z, 1.0, 1e-12)
@@ -419,7 +700,11 @@ fn shared_edge_neither() -> Result<(), String> {
     let (o, recs) = run(&ridge(), p0, p1, 0.5, 0.0, NS);
     for t in 0..2 {
         let e = edge(&recs, t, 0);
-        ensure!(e.verdict == Verdict::BackFacing, "triangle {t}: {:?}", e.verdict);
+        ensure!(
+            e.verdict == Verdict::BackFacing,
+            "triangle {t}: {:?}",
+            e.verdict
+        );
         close("s0", e.roots.ok_or("roots")?.0, 0.5, 1e-12)?;
     }
     ensure!(o.kind == Kind::None, "outcome {o:?}");
@@ -429,11 +714,22 @@ fn shared_edge_neither() -> Result<(), String> {
 fn cube_averaged_normal() -> Result<(), String> {
     // Worked example 5: distance to the edge x = 1, z = 1 is 0.5 when
     // 0.0625 + (z - 1)² = 0.25, z = 1.43301, β = (3 - 1.43301)/6 = 0.26116.
-    let cube = sweeptrace::scenes::cube().to_mesh().map_err(|e| e.to_string())?;
-    let o = sweep_mesh(&cube, &Sweep::new([1.25, 0.125, 3.0], [1.25, 0.125, -3.0], 0.5), &Options::default())
+    let cube = sweeptrace::scenes::cube()
+        .to_mesh()
         .map_err(|e| e.to_string())?;
+    let o = sweep_mesh(
+        &cube,
+        &Sweep::new([1.25, 0.125, 3.0], [1.25, 0.125, -3.0], 0.5),
+        &Options::default(),
+    )
+    .map_err(|e| e.to_string())?;
     ensure!(o.kind == Kind::Edge, "outcome {o:?}");
-    close("alpha", o.alpha, (3.0 - (1.0 + 0.1875f64.sqrt())) / 6.0, 1e-12)?;
+    close(
+        "alpha",
+        o.alpha,
+        (3.0 - (1.0 + 0.1875f64.sqrt())) / 6.0,
+        1e-12,
+    )?;
     let n = o.normal.ok_or("normal")?;
     let s = std::f64::consts::FRAC_1_SQRT_2;
     close("normal x", n.x, s, 1e-12)?;
@@ -444,7 +740,14 @@ fn cube_averaged_normal() -> Result<(), String> {
 fn margin_case() -> Result<(), String> {
     // Example 1 with r = 0.5, ε = 0.25: ρ = 0.25, β = (3 - 0.25)/6 = 11/24;
     // the contact is on the plane.
-    let (o, _) = run(&triangle_t(), [1.0, 1.0, 3.0], [1.0, 1.0, -3.0], 0.5, 0.25, NS);
+    let (o, _) = run(
+        &triangle_t(),
+        [1.0, 1.0, 3.0],
+        [1.0, 1.0, -3.0],
+        0.5,
+        0.25,
+        NS,
+    );
     close("alpha", o.alpha, 11.0 / 24.0, 1e-12)?;
     close("contact z", o.contact.ok_or("contact")?.z, 0.0, 1e-12)
 }
@@ -452,7 +755,9 @@ fn margin_case() -> Result<(), String> {
 fn standard_frame_round_trip() -> Result<(), String> {
     // For every edge of every cube triangle: v0 → origin, v1 → (L,0,0), the
     // third vertex at y = 0, z ≤ 0; world_from_edge inverts to_edge.
-    let cube = sweeptrace::scenes::cube().to_mesh().map_err(|e| e.to_string())?;
+    let cube = sweeptrace::scenes::cube()
+        .to_mesh()
+        .map_err(|e| e.to_string())?;
     for t in cube.triangles() {
         for i in 0..3 {
             let f = &t.edges[i];
@@ -465,7 +770,10 @@ fn standard_frame_round_trip() -> Result<(), String> {
             ensure!(a.coords.norm() < 1e-12, "v0 → {a:?}");
             close("v1 x", b.x, f.length, 1e-12)?;
             ensure!(b.y.abs() < 1e-12 && b.z.abs() < 1e-12, "v1 → {b:?}");
-            ensure!(c.y.abs() < 1e-12 && c.z < 0.0, "third vertex → {c:?} not in z < 0 of y = 0");
+            ensure!(
+                c.y.abs() < 1e-12 && c.z < 0.0,
+                "third vertex → {c:?} not in z < 0 of y = 0"
+            );
             let back = f.world_from_edge() * b;
             ensure!((back - v1).norm() < 1e-12, "world_from_edge(v1) = {back:?}");
             ensure!((f.to_world(&c) - v2).norm() < 1e-12, "to_world");
@@ -478,26 +786,72 @@ fn bad_input() -> Result<(), String> {
     let m = triangle_t();
     let opts = Options::default();
     let e = sweep_mesh(&m, &Sweep::new([f64::NAN, 0.0, 0.0], [0.0; 3], 0.5), &opts).err();
-    ensure!(matches!(e, Some(SweepError::NonFinite { field: "p0", .. })), "NaN p0: {e:?}");
-    let e = sweep_mesh(&m, &Sweep::new([0.0; 3], [0.0, f64::INFINITY, 0.0], 0.5), &opts).err();
-    ensure!(matches!(e, Some(SweepError::NonFinite { field: "p1", .. })), "inf p1: {e:?}");
+    ensure!(
+        matches!(e, Some(SweepError::NonFinite { field: "p0", .. })),
+        "NaN p0: {e:?}"
+    );
+    let e = sweep_mesh(
+        &m,
+        &Sweep::new([0.0; 3], [0.0, f64::INFINITY, 0.0], 0.5),
+        &opts,
+    )
+    .err();
+    ensure!(
+        matches!(e, Some(SweepError::NonFinite { field: "p1", .. })),
+        "inf p1: {e:?}"
+    );
     let e = sweep_mesh(&m, &Sweep::new([0.0; 3], [1e308, -1e308, 0.0], 0.5), &opts).err();
     ensure!(e.is_some(), "overflowing path length accepted");
     let e = sweep_mesh(&m, &Sweep::new([0.0; 3], [1.0; 3], 0.0), &opts).err();
-    ensure!(matches!(e, Some(SweepError::NonPositiveRadius(_))), "radius 0: {e:?}");
+    ensure!(
+        matches!(e, Some(SweepError::NonPositiveRadius(_))),
+        "radius 0: {e:?}"
+    );
     let e = sweep_mesh(&m, &Sweep::new([0.0; 3], [1.0; 3], -1.0), &opts).err();
-    ensure!(matches!(e, Some(SweepError::NonPositiveRadius(_))), "radius -1: {e:?}");
-    let big = Options { margin: 0.5, ..opts };
+    ensure!(
+        matches!(e, Some(SweepError::NonPositiveRadius(_))),
+        "radius -1: {e:?}"
+    );
+    let big = Options {
+        margin: 0.5,
+        ..opts
+    };
     let e = sweep_mesh(&m, &Sweep::new([0.0; 3], [1.0; 3], 0.5), &big).err();
-    ensure!(matches!(e, Some(SweepError::MarginNotBelowRadius { .. })), "ε = r: {e:?}");
+    ensure!(
+        matches!(e, Some(SweepError::MarginNotBelowRadius { .. })),
+        "ε = r: {e:?}"
+    );
     let e = Mesh::new(vec![], &[]).err();
-    ensure!(matches!(e, Some(MeshError::Empty { .. })), "empty mesh: {e:?}");
+    ensure!(
+        matches!(e, Some(MeshError::Empty { .. })),
+        "empty mesh: {e:?}"
+    );
     let e = Mesh::new(vec![[0.0; 3]; 3], &[[0, 1, 3]]).err();
-    ensure!(matches!(e, Some(MeshError::IndexOutOfRange { triangle: 0, index: 3, .. })), "index: {e:?}");
+    ensure!(
+        matches!(
+            e,
+            Some(MeshError::IndexOutOfRange {
+                triangle: 0,
+                index: 3,
+                ..
+            })
+        ),
+        "index: {e:?}"
+    );
     let e = Mesh::new(vec![[0.0, f64::NAN, 0.0]; 3], &[[0, 1, 2]]).err();
-    ensure!(matches!(e, Some(MeshError::NonFiniteVertex { vertex: 0, .. })), "NaN vertex: {e:?}");
-    let msg = SweepError::MarginNotBelowRadius { margin: 0.5, radius: 0.5 }.to_string();
-    ensure!(msg.contains("margin") && msg.contains("radius"), "message {msg}");
+    ensure!(
+        matches!(e, Some(MeshError::NonFiniteVertex { vertex: 0, .. })),
+        "NaN vertex: {e:?}"
+    );
+    let msg = SweepError::MarginNotBelowRadius {
+        margin: 0.5,
+        radius: 0.5,
+    }
+    .to_string();
+    ensure!(
+        msg.contains("margin") && msg.contains("radius"),
+        "message {msg}"
+    );
     Ok(())
 }
 
@@ -505,17 +859,45 @@ fn degenerate() -> Result<(), String> {
     // Triangle 1 repeats an index, triangle 2 is collinear; both are left
     // out and never produce NaN; triangle 0 still works.
     let m = Mesh::new(
-        vec![[0.0, 0.0, 0.0], [4.0, 0.0, 0.0], [0.0, 4.0, 0.0], [8.0, 0.0, 0.0]],
+        vec![
+            [0.0, 0.0, 0.0],
+            [4.0, 0.0, 0.0],
+            [0.0, 4.0, 0.0],
+            [8.0, 0.0, 0.0],
+        ],
         &[[0, 1, 2], [0, 0, 1], [0, 1, 3]],
     )
     .map_err(|e| e.to_string())?;
     let d: Vec<usize> = m.degenerate().iter().map(|d| d.index).collect();
     ensure!(d == vec![1, 2], "degenerate {d:?}");
-    ensure!(m.triangles().len() == 1 && m.input_triangle_count() == 3, "counts");
-    let o = sweep_mesh(&m, &Sweep::new([6.0, 0.0, 3.0], [6.0, 0.0, -3.0], 0.5), &Options::default())
-        .map_err(|e| e.to_string())?;
-    ensure!(o.kind == Kind::None && !o.alpha.is_nan(), "through the collinear triangle: {o:?}");
-    let e = Mesh::new(vec![[0.0; 3], [1.0, 0.0, 0.0], [2.0, 0.0, 0.0]], &[[0, 1, 2]]).err();
-    ensure!(matches!(e, Some(MeshError::Empty { triangles: 1, degenerate: 1 })), "all degenerate: {e:?}");
+    ensure!(
+        m.triangles().len() == 1 && m.input_triangle_count() == 3,
+        "counts"
+    );
+    let o = sweep_mesh(
+        &m,
+        &Sweep::new([6.0, 0.0, 3.0], [6.0, 0.0, -3.0], 0.5),
+        &Options::default(),
+    )
+    .map_err(|e| e.to_string())?;
+    ensure!(
+        o.kind == Kind::None && !o.alpha.is_nan(),
+        "through the collinear triangle: {o:?}"
+    );
+    let e = Mesh::new(
+        vec![[0.0; 3], [1.0, 0.0, 0.0], [2.0, 0.0, 0.0]],
+        &[[0, 1, 2]],
+    )
+    .err();
+    ensure!(
+        matches!(
+            e,
+            Some(MeshError::Empty {
+                triangles: 1,
+                degenerate: 1
+            })
+        ),
+        "all degenerate: {e:?}"
+    );
     Ok(())
 }

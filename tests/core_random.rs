@@ -6,14 +6,20 @@ use libtest_mimic::Trial;
 use nalgebra::{Point3, Rotation3, Vector3};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
-use sweeptrace::core::{Broadphase, Facing, Kind, Mesh, NoObserver, Options, Outcome, Sweep, sweep_mesh, sweep_mesh_with};
+use sweeptrace::core::{
+    Broadphase, Facing, Kind, Mesh, NoObserver, Options, Outcome, Sweep, sweep_mesh,
+    sweep_mesh_with,
+};
 
 use crate::oracle::{OTri, OracleResult, oracle};
 use crate::trial;
 
 pub fn tests() -> Vec<Trial> {
     vec![
-        trial("core_random::oracle_agreement_100k_sweeps", oracle_agreement),
+        trial(
+            "core_random::oracle_agreement_100k_sweeps",
+            oracle_agreement,
+        ),
         trial("core_random::parry_agreement_front_facing", parry_agreement),
         trial("core_random::bvh_equals_exhaustive", bvh_equals_exhaustive),
     ]
@@ -39,7 +45,11 @@ fn uniform(rng: &mut ChaCha8Rng, lo: f64, hi: f64) -> f64 {
 }
 
 fn random_point(rng: &mut ChaCha8Rng, s: f64) -> [f64; 3] {
-    [uniform(rng, -s, s), uniform(rng, -s, s), uniform(rng, -s, s)]
+    [
+        uniform(rng, -s, s),
+        uniform(rng, -s, s),
+        uniform(rng, -s, s),
+    ]
 }
 
 fn unit(rng: &mut ChaCha8Rng) -> Vector3<f64> {
@@ -55,7 +65,11 @@ fn unit(rng: &mut ChaCha8Rng) -> Vector3<f64> {
 /// A random well-shaped triangle (area and angles bounded away from 0).
 fn random_triangle(rng: &mut ChaCha8Rng) -> [[f64; 3]; 3] {
     loop {
-        let t = [random_point(rng, 2.0), random_point(rng, 2.0), random_point(rng, 2.0)];
+        let t = [
+            random_point(rng, 2.0),
+            random_point(rng, 2.0),
+            random_point(rng, 2.0),
+        ];
         let [a, b, c] = t.map(Point3::from);
         let area2 = (b - a).cross(&(c - a)).norm();
         let longest = (b - a).norm().max((c - b).norm()).max((a - c).norm());
@@ -82,7 +96,11 @@ fn random_patch(rng: &mut ChaCha8Rng) -> (Vec<[f64; 3]>, Vec<[u64; 3]>) {
         for i in 0..2u64 {
             let a = j * 3 + i;
             let (b, c, d) = (a + 1, a + 4, a + 3);
-            let (t1, t2) = if rng.random_bool(0.5) { ([a, b, c], [a, c, d]) } else { ([a, b, d], [b, c, d]) };
+            let (t1, t2) = if rng.random_bool(0.5) {
+                ([a, b, c], [a, c, d])
+            } else {
+                ([a, b, d], [b, c, d])
+            };
             for mut t in [t1, t2] {
                 if flip {
                     t.swap(1, 2);
@@ -96,7 +114,11 @@ fn random_patch(rng: &mut ChaCha8Rng) -> (Vec<[f64; 3]>, Vec<[u64; 3]>) {
 
 /// A sweep aimed near a random point of a random triangle, so that about
 /// half of the sweeps hit.
-fn random_sweep(rng: &mut ChaCha8Rng, vertices: &[[f64; 3]], triangles: &[[u64; 3]]) -> ([f64; 3], [f64; 3], f64, f64, Facing) {
+fn random_sweep(
+    rng: &mut ChaCha8Rng,
+    vertices: &[[f64; 3]],
+    triangles: &[[u64; 3]],
+) -> ([f64; 3], [f64; 3], f64, f64, Facing) {
     let t = triangles[rng.random_range(0..triangles.len())];
     let [a, b, c] = t.map(|i| Vector3::from(vertices[i as usize]));
     let (mut u, mut v) = (uniform(rng, 0.0, 1.0), uniform(rng, 0.0, 1.0));
@@ -108,8 +130,16 @@ fn random_sweep(rng: &mut ChaCha8Rng, vertices: &[[f64; 3]], triangles: &[[u64; 
     let target = a + (b - a) * u + (c - a) * v + unit(rng) * uniform(rng, 0.0, 2.0 * radius);
     let p0 = target + unit(rng) * uniform(rng, 1.0, 4.0);
     let p1 = p0 + (target - p0) * uniform(rng, 0.3, 1.6);
-    let margin = if rng.random_bool(0.5) { 0.0 } else { uniform(rng, 0.0, 0.5 * radius) };
-    let facing = if rng.random_bool(0.8) { Facing::NonStrict } else { Facing::Strict };
+    let margin = if rng.random_bool(0.5) {
+        0.0
+    } else {
+        uniform(rng, 0.0, 0.5 * radius)
+    };
+    let facing = if rng.random_bool(0.8) {
+        Facing::NonStrict
+    } else {
+        Facing::Strict
+    };
     (p0.into(), p1.into(), radius, margin, facing)
 }
 
@@ -120,7 +150,15 @@ fn random_case(rng: &mut ChaCha8Rng) -> Case {
         random_patch(rng)
     };
     let (p0, p1, radius, margin, facing) = random_sweep(rng, &vertices, &triangles);
-    Case { vertices, triangles, p0, p1, radius, margin, facing }
+    Case {
+        vertices,
+        triangles,
+        p0,
+        p1,
+        radius,
+        margin,
+        facing,
+    }
 }
 
 fn oracle_triangles(case: &Case) -> Vec<OTri> {
@@ -136,8 +174,12 @@ fn oracle_triangles(case: &Case) -> Vec<OTri> {
 
 fn run_core(case: &Case) -> Result<(Mesh, Outcome), String> {
     let mesh = Mesh::new(case.vertices.clone(), &case.triangles).map_err(|e| e.to_string())?;
-    let options = Options { margin: case.margin, facing: case.facing };
-    let o = sweep_mesh(&mesh, &Sweep::new(case.p0, case.p1, case.radius), &options).map_err(|e| e.to_string())?;
+    let options = Options {
+        margin: case.margin,
+        facing: case.facing,
+    };
+    let o = sweep_mesh(&mesh, &Sweep::new(case.p0, case.p1, case.radius), &options)
+        .map_err(|e| e.to_string())?;
     Ok((mesh, o))
 }
 
@@ -166,7 +208,11 @@ fn oracle_agreement() -> Result<(), String> {
                     failures.push(format!("oracle: miss; {}", describe(&case, &o)));
                 }
             }
-            OracleResult::Hit { alpha, touching, kind } => {
+            OracleResult::Hit {
+                alpha,
+                touching,
+                kind,
+            } => {
                 hits += 1;
                 let tri_ok = o.triangle.is_some_and(|t| touching.contains(&t));
                 let alpha_ok = o.is_hit() && (o.alpha - alpha).abs() <= ALPHA_TOLERANCE;
@@ -192,10 +238,20 @@ fn oracle_agreement() -> Result<(), String> {
          kind compared on {kind_compared}, primary triangle unique on {unique_primary}; {} disagreements",
         failures.len()
     );
-    crate::ensure!(hits > N / 4 && misses > N / 10, "the generator hits too rarely: {hits} hits, {misses} misses");
-    crate::ensure!(total_excluded < N / 20, "too many exclusions: {total_excluded}");
+    crate::ensure!(
+        hits > N / 4 && misses > N / 10,
+        "the generator hits too rarely: {hits} hits, {misses} misses"
+    );
+    crate::ensure!(
+        total_excluded < N / 20,
+        "too many exclusions: {total_excluded}"
+    );
     if !failures.is_empty() {
-        return Err(format!("{} disagreements, first:\n{}", failures.len(), failures[..failures.len().min(5)].join("\n")));
+        return Err(format!(
+            "{} disagreements, first:\n{}",
+            failures.len(),
+            failures[..failures.len().min(5)].join("\n")
+        ));
     }
     Ok(())
 }
@@ -213,7 +269,15 @@ fn parry_agreement() -> Result<(), String> {
         let vertices = t.to_vec();
         let triangles = vec![[0, 1, 2]];
         let (p0, p1, radius, margin, facing) = random_sweep(&mut rng, &vertices, &triangles);
-        let case = Case { vertices, triangles, p0, p1, radius, margin, facing };
+        let case = Case {
+            vertices,
+            triangles,
+            p0,
+            p1,
+            radius,
+            margin,
+            facing,
+        };
         let tri = OTri::new(0, t[0], t[1], t[2]);
         let d = Point3::from(p1) - Point3::from(p0);
         let front = match facing {
@@ -225,7 +289,10 @@ fn parry_agreement() -> Result<(), String> {
         }
         let rho = radius - margin;
         // The same ill-conditioned cases as the oracle comparison are left out.
-        if matches!(oracle(std::slice::from_ref(&tri), p0, p1, rho, facing), OracleResult::Excluded(_)) {
+        if matches!(
+            oracle(std::slice::from_ref(&tri), p0, p1, rho, facing),
+            OracleResult::Excluded(_)
+        ) {
             skipped += 1;
             continue;
         }
@@ -253,7 +320,11 @@ fn parry_agreement() -> Result<(), String> {
                 hits += 1;
                 let diff = (h.time_of_impact - o.alpha).abs();
                 if !o.is_hit() || diff > PARRY_TOLERANCE {
-                    failures.push(format!("parry toi {}; {}", h.time_of_impact, describe(&case, &o)));
+                    failures.push(format!(
+                        "parry toi {}; {}",
+                        h.time_of_impact,
+                        describe(&case, &o)
+                    ));
                 } else {
                     worst = worst.max(diff);
                 }
@@ -271,7 +342,11 @@ fn parry_agreement() -> Result<(), String> {
         failures.len()
     );
     if !failures.is_empty() {
-        return Err(format!("{} disagreements, first:\n{}", failures.len(), failures[..failures.len().min(5)].join("\n")));
+        return Err(format!(
+            "{} disagreements, first:\n{}",
+            failures.len(),
+            failures[..failures.len().min(5)].join("\n")
+        ));
     }
     Ok(())
 }
@@ -288,7 +363,11 @@ fn bvh_equals_exhaustive() -> Result<(), String> {
             for j in 0..=n {
                 for i in 0..=n {
                     let (x, y) = (i as f64 * 0.25, j as f64 * 0.25);
-                    v.push([x, y, 0.3 * (x * 1.3).sin() * (y * 0.7).cos() + uniform(&mut rng, -0.05, 0.05)]);
+                    v.push([
+                        x,
+                        y,
+                        0.3 * (x * 1.3).sin() * (y * 0.7).cos() + uniform(&mut rng, -0.05, 0.05),
+                    ]);
                 }
             }
             let mut t = Vec::new();
@@ -315,24 +394,41 @@ fn bvh_equals_exhaustive() -> Result<(), String> {
             (v, t)
         };
         let mesh = Mesh::new(vertices.clone(), &triangles).map_err(|e| e.to_string())?;
-        let usable: Vec<[u64; 3]> = mesh.triangles().iter().map(|t| t.vertex_indices.map(u64::from)).collect();
+        let usable: Vec<[u64; 3]> = mesh
+            .triangles()
+            .iter()
+            .map(|t| t.vertex_indices.map(u64::from))
+            .collect();
         for _ in 0..2_000 {
             let (p0, p1, radius, margin, facing) = random_sweep(&mut rng, &vertices, &usable);
             let sweep = Sweep::new(p0, p1, radius);
             let options = Options { margin, facing };
             let fast = sweep_mesh(&mesh, &sweep, &options).map_err(|e| e.to_string())?;
-            let all = sweep_mesh_with(&mesh, &sweep, &options, Broadphase::Exhaustive, &mut NoObserver)
-                .map_err(|e| e.to_string())?;
+            let all = sweep_mesh_with(
+                &mesh,
+                &sweep,
+                &options,
+                Broadphase::Exhaustive,
+                &mut NoObserver,
+            )
+            .map_err(|e| e.to_string())?;
             checked += 1;
             if fast.kind != Kind::None {
                 hits += 1;
             }
             if fast != all {
-                return Err(format!("mesh {m}: p0 {p0:?} p1 {p1:?} r {radius} margin {margin}: bvh {fast:?} != exhaustive {all:?}"));
+                return Err(format!(
+                    "mesh {m}: p0 {p0:?} p1 {p1:?} r {radius} margin {margin}: bvh {fast:?} != exhaustive {all:?}"
+                ));
             }
         }
     }
-    println!("    {checked} sweeps on 12 meshes of 1,152 to 1,800 triangles: BVH identical to exhaustive ({hits} hits)");
-    crate::ensure!(hits > checked / 5, "too few hits ({hits}) to exercise the BVH");
+    println!(
+        "    {checked} sweeps on 12 meshes of 1,152 to 1,800 triangles: BVH identical to exhaustive ({hits} hits)"
+    );
+    crate::ensure!(
+        hits > checked / 5,
+        "too few hits ({hits}) to exercise the BVH"
+    );
     Ok(())
 }

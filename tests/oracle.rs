@@ -47,7 +47,11 @@ pub fn closest(t: &OTri, p: &Point3<f64>) -> Closest {
     let wb = (a - c).cross(&(q - c)).dot(&t.n) / area;
     let wc = (b - a).cross(&(q - a)).dot(&t.n) / area;
     if wa >= 0.0 && wb >= 0.0 && wc >= 0.0 {
-        return Closest { point: q, kind: Kind::Face, boundary_margin: wa.min(wb).min(wc) };
+        return Closest {
+            point: q,
+            kind: Kind::Face,
+            boundary_margin: wa.min(wb).min(wc),
+        };
     }
     let mut best: Option<(f64, Closest)> = None;
     for i in 0..3 {
@@ -64,7 +68,14 @@ pub fn closest(t: &OTri, p: &Point3<f64>) -> Closest {
         };
         let d = (p - point).norm();
         if best.as_ref().is_none_or(|(bd, _)| d < *bd) {
-            best = Some((d, Closest { point, kind, boundary_margin: margin }));
+            best = Some((
+                d,
+                Closest {
+                    point,
+                    kind,
+                    boundary_margin: margin,
+                },
+            ));
         }
     }
     let mut out = best.expect("three segments").1;
@@ -104,8 +115,17 @@ pub fn first_contact(t: &OTri, p0: &Point3<f64>, d: &Vector3<f64>, rho: f64) -> 
         let dist = to.norm();
         let g = dist - rho;
         if g <= 1e-13 * (1.0 + rho) {
-            let approach = if dist > 0.0 { -to.dot(d) / (dist * len) } else { 1.0 };
-            return Root::Contact(Contact { beta, kind: cl.kind, boundary_margin: cl.boundary_margin, approach });
+            let approach = if dist > 0.0 {
+                -to.dot(d) / (dist * len)
+            } else {
+                1.0
+            };
+            return Root::Contact(Contact {
+                beta,
+                kind: cl.kind,
+                boundary_margin: cl.boundary_margin,
+                approach,
+            });
         }
         let slope = to.dot(d) / dist;
         if slope >= 0.0 {
@@ -128,7 +148,11 @@ pub enum OracleResult {
     Miss,
     /// First contact at `alpha`; `touching` = triangles whose own contact
     /// lies within the tie tolerance of `alpha`; `kind` when unambiguous.
-    Hit { alpha: f64, touching: Vec<u32>, kind: Option<Kind> },
+    Hit {
+        alpha: f64,
+        touching: Vec<u32>,
+        kind: Option<Kind>,
+    },
 }
 
 /// Tolerances of the comparison, in one place.
@@ -139,7 +163,12 @@ pub const BOUNDARY_MARGIN: f64 = 1e-7;
 pub const FACING_MARGIN: f64 = 1e-9;
 pub const TIE: f64 = 1e-7;
 
-fn earliest(tris: &[&OTri], p0: &Point3<f64>, d: &Vector3<f64>, rho: f64) -> Result<Vec<(u32, Contact)>, &'static str> {
+fn earliest(
+    tris: &[&OTri],
+    p0: &Point3<f64>,
+    d: &Vector3<f64>,
+    rho: f64,
+) -> Result<Vec<(u32, Contact)>, &'static str> {
     let mut out = Vec::new();
     for t in tris {
         match first_contact(t, p0, d, rho) {
@@ -200,8 +229,14 @@ pub fn oracle(tris: &[OTri], p0: [f64; 3], p1: [f64; 3], rho: f64, facing: Facin
     if contacts.is_empty() {
         return OracleResult::Miss;
     }
-    let alpha = contacts.iter().map(|c| c.1.beta).fold(f64::INFINITY, f64::min);
-    let firsts: Vec<&(u32, Contact)> = contacts.iter().filter(|c| c.1.beta <= alpha + TIE).collect();
+    let alpha = contacts
+        .iter()
+        .map(|c| c.1.beta)
+        .fold(f64::INFINITY, f64::min);
+    let firsts: Vec<&(u32, Contact)> = contacts
+        .iter()
+        .filter(|c| c.1.beta <= alpha + TIE)
+        .collect();
     if firsts.iter().any(|c| c.1.approach < MIN_APPROACH_COSINE) {
         return OracleResult::Excluded("grazing");
     }
@@ -211,5 +246,9 @@ pub fn oracle(tris: &[OTri], p0: [f64; 3], p1: [f64; 3], rho: f64, facing: Facin
     } else {
         None
     };
-    OracleResult::Hit { alpha, touching, kind }
+    OracleResult::Hit {
+        alpha,
+        touching,
+        kind,
+    }
 }

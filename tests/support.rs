@@ -1,8 +1,8 @@
 //! Helpers shared by the test modules.
 
 use sweeptrace::core::{
-    Broadphase, CollectRecords, EdgeRecord, Facing, FaceRecord, Mesh, Options, Outcome, Sweep, TestRecord,
-    VertexRecord, sweep_mesh_with,
+    Broadphase, CollectRecords, EdgeRecord, FaceRecord, Facing, Mesh, Options, Outcome, Sweep,
+    TestRecord, VertexRecord, sweep_mesh_with,
 };
 
 /// Fails the test with a message unless `cond` holds.
@@ -31,14 +31,30 @@ pub fn mesh(vertices: &[[f64; 3]], triangles: &[[u64; 3]]) -> Mesh {
 
 /// The triangle T of SEMANTICS.md's worked examples.
 pub fn triangle_t() -> Mesh {
-    mesh(&[[0.0, 0.0, 0.0], [4.0, 0.0, 0.0], [0.0, 4.0, 0.0]], &[[0, 1, 2]])
+    mesh(
+        &[[0.0, 0.0, 0.0], [4.0, 0.0, 0.0], [0.0, 4.0, 0.0]],
+        &[[0, 1, 2]],
+    )
 }
 
 /// Runs an exhaustive explained sweep.
-pub fn run(mesh: &Mesh, p0: [f64; 3], p1: [f64; 3], radius: f64, margin: f64, facing: Facing) -> (Outcome, Vec<TestRecord>) {
+pub fn run(
+    mesh: &Mesh,
+    p0: [f64; 3],
+    p1: [f64; 3],
+    radius: f64,
+    margin: f64,
+    facing: Facing,
+) -> (Outcome, Vec<TestRecord>) {
     let mut obs = CollectRecords::default();
-    let o = sweep_mesh_with(mesh, &Sweep::new(p0, p1, radius), &Options { margin, facing }, Broadphase::Exhaustive, &mut obs)
-        .expect("valid sweep");
+    let o = sweep_mesh_with(
+        mesh,
+        &Sweep::new(p0, p1, radius),
+        &Options { margin, facing },
+        Broadphase::Exhaustive,
+        &mut obs,
+    )
+    .expect("valid sweep");
     (o, obs.records)
 }
 

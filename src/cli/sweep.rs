@@ -10,7 +10,9 @@ use sweeptrace::scenes;
 
 /// Arguments of `sweep`.
 #[derive(Debug, clap::Args)]
-#[command(after_help = "Example:\n  sweeptrace sweep --scene cube --radius 0.5 --from 0,3,0.2 --to 0.9,-3,0.2")]
+#[command(
+    after_help = "Example:\n  sweeptrace sweep --scene cube --radius 0.5 --from 0,3,0.2 --to 0.9,-3,0.2"
+)]
 pub struct Args {
     /// Built-in scene: `cube` (the cube [-1,1]³, 12 triangles) or `triangle`
     /// ((0,0,0), (4,0,0), (0,4,0), front +z).
@@ -42,14 +44,29 @@ pub struct Args {
 /// Runs the sweep and prints the outcome and explanations.
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     let Some(scene) = scenes::by_name(&args.scene) else {
-        bail!("unknown scene `{}` (built-in scenes: {})", args.scene, scenes::NAMES.join(", "));
+        bail!(
+            "unknown scene `{}` (built-in scenes: {})",
+            args.scene,
+            scenes::NAMES.join(", ")
+        );
     };
-    let mesh = scene.to_mesh().with_context(|| format!("building scene `{}`", scene.name))?;
-    let options = Options { margin: args.margin, facing: args.facing };
+    let mesh = scene
+        .to_mesh()
+        .with_context(|| format!("building scene `{}`", scene.name))?;
+    let options = Options {
+        margin: args.margin,
+        facing: args.facing,
+    };
     let sweep = Sweep::new(args.from, args.to, args.radius);
     let mut records = CollectRecords::default();
-    let outcome = sweep_mesh_with(&mesh, &sweep, &options, Broadphase::Exhaustive, &mut records)
-        .context("invalid sweep")?;
+    let outcome = sweep_mesh_with(
+        &mesh,
+        &sweep,
+        &options,
+        Broadphase::Exhaustive,
+        &mut records,
+    )
+    .context("invalid sweep")?;
     let explained = report::SweepReport {
         scene: &scene.name,
         triangles: mesh.triangles().len(),

@@ -49,7 +49,12 @@ impl Bvh {
         }
         let mut order: Vec<u32> = (0..n as u32).collect();
         let mut nodes = Vec::with_capacity(2 * n / LEAF_SIZE + 2);
-        nodes.push(Node { min: [0.0; 3], max: [0.0; 3], first: 0, count: 0 });
+        nodes.push(Node {
+            min: [0.0; 3],
+            max: [0.0; 3],
+            first: 0,
+            count: 0,
+        });
         // Iterative build: (node index, start, end).
         let mut work = vec![(0usize, 0usize, n)];
         while let Some((node, start, end)) = work.pop() {
@@ -84,19 +89,37 @@ impl Bvh {
                 centroids[i as usize][axis].total_cmp(&centroids[j as usize][axis])
             });
             let left = nodes.len();
-            nodes.push(Node { min: [0.0; 3], max: [0.0; 3], first: 0, count: 0 });
-            nodes.push(Node { min: [0.0; 3], max: [0.0; 3], first: 0, count: 0 });
+            nodes.push(Node {
+                min: [0.0; 3],
+                max: [0.0; 3],
+                first: 0,
+                count: 0,
+            });
+            nodes.push(Node {
+                min: [0.0; 3],
+                max: [0.0; 3],
+                first: 0,
+                count: 0,
+            });
             nodes[node].first = left as u32;
             nodes[node].count = 0;
             work.push((left + 1, start + mid, end));
             work.push((left, start, start + mid));
         }
-        let max_index = triangles.iter().map(|t| t.index as usize + 1).max().unwrap_or(0);
+        let max_index = triangles
+            .iter()
+            .map(|t| t.index as usize + 1)
+            .max()
+            .unwrap_or(0);
         let mut position_by_index = vec![u32::MAX; max_index];
         for (pos, &i) in order.iter().enumerate() {
             position_by_index[triangles[i as usize].index as usize] = pos as u32;
         }
-        Bvh { nodes, order, position_by_index }
+        Bvh {
+            nodes,
+            order,
+            position_by_index,
+        }
     }
 
     /// Position in BVH order → index in the list the tree was built from.
@@ -180,7 +203,14 @@ impl Bvh {
     /// Entry parameter of the segment into node `i`'s box grown by `grow`,
     /// clamped to `[0, 1]`, or `None` if the segment misses it.
     #[inline]
-    fn entry(&self, i: u32, p0: &Point3<f64>, d: &Vector3<f64>, inv: &Vector3<f64>, grow: f64) -> Option<f64> {
+    fn entry(
+        &self,
+        i: u32,
+        p0: &Point3<f64>,
+        d: &Vector3<f64>,
+        inv: &Vector3<f64>,
+        grow: f64,
+    ) -> Option<f64> {
         let n = &self.nodes[i as usize];
         let mut t0 = 0.0f64;
         let mut t1 = 1.0f64;

@@ -15,7 +15,9 @@ pub enum MeshError {
         coordinate: [f64; 3],
     },
     /// A triangle refers to a vertex that does not exist.
-    #[error("triangle {triangle} refers to vertex {index}, but the mesh has {vertex_count} vertices")]
+    #[error(
+        "triangle {triangle} refers to vertex {index}, but the mesh has {vertex_count} vertices"
+    )]
     IndexOutOfRange {
         /// Index of the triangle.
         triangle: usize,

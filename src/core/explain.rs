@@ -49,10 +49,19 @@ fn facing(n_dot_d: f64, verdict: Verdict) -> String {
 fn describe_face(r: &FaceRecord) -> String {
     let mut s = format!("h0 = {}, h1 = {}", num(r.h0), num(r.h1));
     match r.verdict {
-        Verdict::StartsTooClose => s.push_str(" (h0 < ρ: starts within ρ of the plane or behind it): none"),
+        Verdict::StartsTooClose => {
+            s.push_str(" (h0 < ρ: starts within ρ of the plane or behind it): none")
+        }
         Verdict::Parallel => s.push_str(" (h0 = h1: moving parallel to the plane): none"),
-        Verdict::BackFacing => write!(s, ", {}: back-facing", facing(r.normal_dot_d, r.verdict)).unwrap(),
-        Verdict::BeyondEnd => write!(s, ", β = {} > 1: does not reach the plane", num(r.beta.unwrap_or(f64::NAN))).unwrap(),
+        Verdict::BackFacing => {
+            write!(s, ", {}: back-facing", facing(r.normal_dot_d, r.verdict)).unwrap()
+        }
+        Verdict::BeyondEnd => write!(
+            s,
+            ", β = {} > 1: does not reach the plane",
+            num(r.beta.unwrap_or(f64::NAN))
+        )
+        .unwrap(),
         Verdict::OutsideTriangle | Verdict::Hit => {
             let b = r.barycentric.unwrap_or([f64::NAN; 3]);
             write!(
@@ -90,7 +99,9 @@ fn describe_edge(r: &EdgeRecord) -> String {
             let (s0, s1) = r.roots.unwrap_or((f64::NAN, f64::NAN));
             let roots = format!("s0 = {}, s1 = {}", num(s0), num(s1));
             match r.verdict {
-                Verdict::BeforeStart => format!("{roots}: s0 < 0 (before the start of the path): none"),
+                Verdict::BeforeStart => {
+                    format!("{roots}: s0 < 0 (before the start of the path): none")
+                }
                 Verdict::BeyondEnd => format!("{roots}: s0 > 1 (beyond the end of the path): none"),
                 _ => {
                     let xc = r.xc.unwrap_or(f64::NAN);
@@ -126,8 +137,15 @@ fn describe_vertex(r: &VertexRecord) -> String {
         _ => {
             let (s0, s1) = r.roots.unwrap_or((f64::NAN, f64::NAN));
             match r.verdict {
-                Verdict::BeforeStart => format!("s0 = {}, s1 = {}: s0 < 0 (before the start): none", num(s0), num(s1)),
-                Verdict::BeyondEnd => format!("s0 = {}: s0 > 1 (beyond the end of the path): none", num(s0)),
+                Verdict::BeforeStart => format!(
+                    "s0 = {}, s1 = {}: s0 < 0 (before the start): none",
+                    num(s0),
+                    num(s1)
+                ),
+                Verdict::BeyondEnd => format!(
+                    "s0 = {}: s0 > 1 (beyond the end of the path): none",
+                    num(s0)
+                ),
                 Verdict::BackFacing => format!(
                     "s0 = {} in [0, 1], {}: back-facing",
                     num(s0),
@@ -163,13 +181,17 @@ pub fn miss_distance(record: &TestRecord) -> Option<f64> {
             }
             Verdict::BeyondEnd => e.roots.map_or(f64::INFINITY, |r| r.0 - 1.0),
             Verdict::BackFacing => 2.0,
-            Verdict::NoRealRoots => 3.0 + (-e.discriminant).max(0.0).sqrt() / e.a.max(f64::MIN_POSITIVE),
+            Verdict::NoRealRoots => {
+                3.0 + (-e.discriminant).max(0.0).sqrt() / e.a.max(f64::MIN_POSITIVE)
+            }
             _ => 10.0,
         },
         TestRecord::Vertex(v) => match v.verdict {
             Verdict::BeyondEnd => v.roots.map_or(f64::INFINITY, |r| r.0 - 1.0),
             Verdict::BackFacing => 2.0,
-            Verdict::NoRealRoots => 3.0 + (-v.discriminant).max(0.0).sqrt() / v.a.max(f64::MIN_POSITIVE),
+            Verdict::NoRealRoots => {
+                3.0 + (-v.discriminant).max(0.0).sqrt() / v.a.max(f64::MIN_POSITIVE)
+            }
             _ => 10.0,
         },
     })

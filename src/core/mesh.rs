@@ -53,7 +53,8 @@ impl StandardFrame {
 
     /// The rigid transform that maps edge coordinates to world coordinates.
     pub fn world_from_edge(&self) -> Isometry3<f64> {
-        let rotation = UnitQuaternion::from_rotation_matrix(&self.edge_from_world_rotation.inverse());
+        let rotation =
+            UnitQuaternion::from_rotation_matrix(&self.edge_from_world_rotation.inverse());
         Isometry3::from_parts(Translation3::from(self.origin_in_world.coords), rotation)
     }
 
@@ -124,14 +125,23 @@ impl Mesh {
     /// degenerate triangles are left out and listed in [`Mesh::degenerate`].
     pub fn new(vertices: Vec<[f64; 3]>, triangles: &[[u64; 3]]) -> Result<Mesh, MeshError> {
         if vertices.len() > u32::MAX as usize {
-            return Err(MeshError::TooLarge { what: "vertex count", limit: u32::MAX as usize });
+            return Err(MeshError::TooLarge {
+                what: "vertex count",
+                limit: u32::MAX as usize,
+            });
         }
         if triangles.len() > u32::MAX as usize {
-            return Err(MeshError::TooLarge { what: "triangle count", limit: u32::MAX as usize });
+            return Err(MeshError::TooLarge {
+                what: "triangle count",
+                limit: u32::MAX as usize,
+            });
         }
         for (i, v) in vertices.iter().enumerate() {
             if !v.iter().all(|c| c.is_finite()) {
-                return Err(MeshError::NonFiniteVertex { vertex: i, coordinate: *v });
+                return Err(MeshError::NonFiniteVertex {
+                    vertex: i,
+                    coordinate: *v,
+                });
             }
         }
         let vertices: Vec<Point3<f64>> = vertices.into_iter().map(Point3::from).collect();
@@ -149,15 +159,24 @@ impl Mesh {
             }
             let idx = [tri[0] as u32, tri[1] as u32, tri[2] as u32];
             if idx[0] == idx[1] || idx[1] == idx[2] || idx[0] == idx[2] {
-                degenerate.push(DegenerateTriangle { index: t, reason: DegenerateReason::RepeatedIndex });
+                degenerate.push(DegenerateTriangle {
+                    index: t,
+                    reason: DegenerateReason::RepeatedIndex,
+                });
                 continue;
             }
             let [a, b, c] = idx.map(|i| vertices[i as usize]);
             let cross = (b - a).cross(&(c - a));
-            let longest = (b - a).norm_squared().max((c - b).norm_squared()).max((a - c).norm_squared());
+            let longest = (b - a)
+                .norm_squared()
+                .max((c - b).norm_squared())
+                .max((a - c).norm_squared());
             let area2 = cross.norm();
             if !(area2 > DEGENERATE_TOLERANCE * longest) || !area2.is_finite() {
-                degenerate.push(DegenerateTriangle { index: t, reason: DegenerateReason::ZeroArea });
+                degenerate.push(DegenerateTriangle {
+                    index: t,
+                    reason: DegenerateReason::ZeroArea,
+                });
                 continue;
             }
             let normal = cross / area2;
@@ -166,16 +185,31 @@ impl Mesh {
                 StandardFrame::new(b, c, normal),
                 StandardFrame::new(c, a, normal),
             ];
-            usable.push(Triangle { index: t as u32, vertex_indices: idx, vertices: [a, b, c], normal, edges });
+            usable.push(Triangle {
+                index: t as u32,
+                vertex_indices: idx,
+                vertices: [a, b, c],
+                normal,
+                edges,
+            });
         }
         if usable.is_empty() {
-            return Err(MeshError::Empty { triangles: triangles.len(), degenerate: degenerate.len() });
+            return Err(MeshError::Empty {
+                triangles: triangles.len(),
+                degenerate: degenerate.len(),
+            });
         }
         let input_triangle_count = triangles.len();
         let bvh = Bvh::build(&usable);
         // Store triangles in BVH leaf order so leaves are contiguous ranges.
         let triangles = bvh.order().iter().map(|&i| usable[i as usize]).collect();
-        Ok(Mesh { vertices, input_triangle_count, triangles, degenerate, bvh })
+        Ok(Mesh {
+            vertices,
+            input_triangle_count,
+            triangles,
+            degenerate,
+            bvh,
+        })
     }
 
     /// The vertices, as given.
@@ -213,4 +247,3 @@ impl Mesh {
         self.bvh.root_bounds()
     }
 }
-

@@ -25,10 +25,13 @@ mod sweep_vertex;
 
 pub use error::{MeshError, SweepError};
 pub use mesh::{DegenerateReason, DegenerateTriangle, Mesh, StandardFrame, Triangle};
-pub use options::{DEGENERATE_TOLERANCE, Facing, Options, PARALLEL_TOLERANCE, SIMULTANEOUS_TOLERANCE};
+pub use options::{
+    DEGENERATE_TOLERANCE, Facing, Options, PARALLEL_TOLERANCE, SIMULTANEOUS_TOLERANCE,
+};
 pub use path::{Path, Sweep};
 pub use record::{
-    CollectRecords, EdgeRecord, FaceRecord, Kind, NoObserver, Observer, TestRecord, Verdict, VertexRecord,
+    CollectRecords, EdgeRecord, FaceRecord, Kind, NoObserver, Observer, TestRecord, Verdict,
+    VertexRecord,
 };
 pub use sweep_edge::sweep_edge;
 pub use sweep_face::{barycentric, sweep_face};

@@ -19,7 +19,11 @@ pub struct Sweep {
 impl Sweep {
     /// A sweep from `p0` to `p1` of a ball of radius `radius`.
     pub fn new(p0: [f64; 3], p1: [f64; 3], radius: f64) -> Sweep {
-        Sweep { p0: Point3::from(p0), p1: Point3::from(p1), radius }
+        Sweep {
+            p0: Point3::from(p0),
+            p1: Point3::from(p1),
+            radius,
+        }
     }
 }
 
@@ -49,10 +53,16 @@ impl Path {
             }
         }
         if !sweep.radius.is_finite() {
-            return Err(SweepError::NonFinite { field: "radius", value: sweep.radius });
+            return Err(SweepError::NonFinite {
+                field: "radius",
+                value: sweep.radius,
+            });
         }
         if !options.margin.is_finite() {
-            return Err(SweepError::NonFinite { field: "margin", value: options.margin });
+            return Err(SweepError::NonFinite {
+                field: "margin",
+                value: options.margin,
+            });
         }
         if sweep.radius <= 0.0 {
             return Err(SweepError::NonPositiveRadius(sweep.radius));
@@ -61,14 +71,26 @@ impl Path {
             return Err(SweepError::NegativeMargin(options.margin));
         }
         if options.margin >= sweep.radius {
-            return Err(SweepError::MarginNotBelowRadius { margin: options.margin, radius: sweep.radius });
+            return Err(SweepError::MarginNotBelowRadius {
+                margin: options.margin,
+                radius: sweep.radius,
+            });
         }
         let d = sweep.p1 - sweep.p0;
         let length = d.norm();
         if !length.is_finite() {
-            return Err(SweepError::NonFinite { field: "p1 - p0", value: length });
+            return Err(SweepError::NonFinite {
+                field: "p1 - p0",
+                value: length,
+            });
         }
-        Ok(Path { p0: sweep.p0, p1: sweep.p1, d, length, rho: sweep.radius - options.margin })
+        Ok(Path {
+            p0: sweep.p0,
+            p1: sweep.p1,
+            d,
+            length,
+            rho: sweep.radius - options.margin,
+        })
     }
 
     /// The ball's center at fraction `beta` of the path.

@@ -12,7 +12,11 @@ pub fn solve(a: f64, b: f64, c: f64, discriminant: f64) -> Option<(f64, f64)> {
         return None;
     }
     let sqrt = discriminant.sqrt();
-    let q = if b >= 0.0 { -0.5 * (b + sqrt) } else { -0.5 * (b - sqrt) };
+    let q = if b >= 0.0 {
+        -0.5 * (b + sqrt)
+    } else {
+        -0.5 * (b - sqrt)
+    };
     if q == 0.0 {
         // b = 0 and disc = 0, so c = 0: a double root at 0.
         return Some((0.0, 0.0));

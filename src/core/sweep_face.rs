@@ -41,7 +41,11 @@ pub fn sweep_face(triangle: &Triangle, path: &Path, facing: Facing) -> FaceRecor
             record.touch = Some(touch);
             let bary = barycentric(triangle, &touch);
             record.barycentric = Some(bary);
-            if bary.iter().all(|&w| w >= 0.0) { Verdict::Hit } else { Verdict::OutsideTriangle }
+            if bary.iter().all(|&w| w >= 0.0) {
+                Verdict::Hit
+            } else {
+                Verdict::OutsideTriangle
+            }
         }
     };
     record

@@ -34,8 +34,14 @@ pub struct Outcome {
 
 impl Outcome {
     /// The outcome of a sweep that touches nothing.
-    pub const NONE: Outcome =
-        Outcome { alpha: 1.0, kind: Kind::None, triangle: None, feature: None, normal: None, contact: None };
+    pub const NONE: Outcome = Outcome {
+        alpha: 1.0,
+        kind: Kind::None,
+        triangle: None,
+        feature: None,
+        normal: None,
+        contact: None,
+    };
 
     /// Whether something was hit.
     pub fn is_hit(&self) -> bool {
@@ -71,7 +77,12 @@ impl Candidate {
 
 /// Runs the seven tests of one triangle; returns its best collision.
 #[inline]
-fn test_triangle<O: Observer>(triangle: &Triangle, path: &Path, options: &Options, observer: &mut O) -> Option<Candidate> {
+fn test_triangle<O: Observer>(
+    triangle: &Triangle,
+    path: &Path,
+    options: &Options,
+    observer: &mut O,
+) -> Option<Candidate> {
     let facing = options.facing;
     let mut best: Option<Candidate> = None;
     let mut offer = |c: Candidate| {
@@ -132,7 +143,12 @@ struct Combiner {
 
 impl Combiner {
     fn new() -> Self {
-        Combiner { best: None, window: [(0.0, 0); WINDOW], len: 0, overflow: false }
+        Combiner {
+            best: None,
+            window: [(0.0, 0); WINDOW],
+            len: 0,
+            overflow: false,
+        }
     }
 
     fn best_alpha(&self) -> f64 {
@@ -220,21 +236,38 @@ fn visit_triangles<O: Observer>(
         }
         Broadphase::Bvh => {
             let (lo, hi) = mesh.bounds();
-            let scale = [lo.coords.amax(), hi.coords.amax(), path.p0.coords.amax(), path.p1.coords.amax()]
-                .into_iter()
-                .fold(path.rho, f64::max);
+            let scale = [
+                lo.coords.amax(),
+                hi.coords.amax(),
+                path.p0.coords.amax(),
+                path.p1.coords.amax(),
+            ]
+            .into_iter()
+            .fold(path.rho, f64::max);
             let grow = path.rho + 1e-9 * scale;
-            mesh.bvh().traverse(&path.p0, &path.d, grow, 1.0 + SIMULTANEOUS_TOLERANCE, |range| {
-                for position in range {
-                    run(position, combiner, observer);
-                }
-                combiner.best_alpha() + SIMULTANEOUS_TOLERANCE
-            });
+            mesh.bvh().traverse(
+                &path.p0,
+                &path.d,
+                grow,
+                1.0 + SIMULTANEOUS_TOLERANCE,
+                |range| {
+                    for position in range {
+                        run(position, combiner, observer);
+                    }
+                    combiner.best_alpha() + SIMULTANEOUS_TOLERANCE
+                },
+            );
         }
     }
 }
 
-fn sweep_path<O: Observer>(mesh: &Mesh, path: &Path, options: &Options, broadphase: Broadphase, observer: &mut O) -> Outcome {
+fn sweep_path<O: Observer>(
+    mesh: &Mesh,
+    path: &Path,
+    options: &Options,
+    broadphase: Broadphase,
+    observer: &mut O,
+) -> Outcome {
     let mut combiner = Combiner::new();
     visit_triangles(mesh, path, options, broadphase, observer, &mut combiner);
     let Some((best, triangle_index, position)) = combiner.best else {
@@ -264,7 +297,11 @@ fn sweep_path<O: Observer>(mesh: &Mesh, path: &Path, options: &Options, broadpha
     }
     let primary_normal = triangles[position].normal;
     let norm = sum.norm();
-    let normal = if norm > 1e-9 { sum / norm } else { primary_normal };
+    let normal = if norm > 1e-9 {
+        sum / norm
+    } else {
+        primary_normal
+    };
     Outcome {
         alpha: best.alpha,
         kind: best.kind,

@@ -26,6 +26,7 @@ use crate::core::{
     SIMULTANEOUS_TOLERANCE, Sweep, SweepError, TestRecord, Verdict, sweep_mesh, sweep_mesh_with,
 };
 use crate::trace::messages::{OutcomeMsg, SceneMsg, SweepMsg};
+use crate::trace::{TraceError, TraceEvent};
 
 /// How many test records each sweep keeps.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
@@ -352,6 +353,9 @@ pub enum ReplayError {
         /// What is wrong.
         source: SweepError,
     },
+    /// The trace could not be read further.
+    #[error(transparent)]
+    Trace(#[from] TraceError),
 }
 
 /// The replay engine (push-based; see the module documentation).
@@ -505,6 +509,30 @@ impl Replay {
         Ok(())
     }
 
+    /// Any trace event.
+    pub fn push(&mut self, event: TraceEvent) -> Result<(), ReplayError> {
+        match event {
+            TraceEvent::Scene {
+                log_time_nanos,
+                index,
+                scene,
+            } => self.scene(log_time_nanos, index, scene),
+            TraceEvent::Sweep {
+                log_time_nanos,
+                index,
+                sweep,
+            } => self.sweep(log_time_nanos, index, sweep),
+            TraceEvent::Expected {
+                log_time_nanos,
+                index,
+                outcome,
+            } => {
+                self.expected(log_time_nanos, index, outcome);
+                Ok(())
+            }
+        }
+    }
+
     /// An `/expected` message.
     pub fn expected(&mut self, _log_time_nanos: u64, _index: u64, outcome: OutcomeMsg) {
         if !self.options.frames.contains(outcome.frame)
@@ -602,4 +630,86 @@ fn primary_records(outcome: &Outcome, records: Vec<TestRecord>) -> Vec<TestRecor
             .filter(|r| r.alpha().is_some_and(|a| a <= limit) && !is_primary(r, outcome)),
     );
     out
+}
+
+/// Replays a stream of trace events (a [`crate::trace::TraceReader`], or
+/// events built in memory).
+pub fn replay_events<I>(events: I, options: ReplayOptions) -> ReplayIter<I>
+where
+    I: Iterator<Item = Result<TraceEvent, TraceError>>,
+{
+    ReplayIter {
+        events,
+        replay: Some(Replay::new(options)),
+        tail: VecDeque::new(),
+        summary: None,
+    }
+}
+
+/// The iterator of [`replay_events`]: results in trace order, errors where
+/// they occur. After a trace error (the reader stops there) the results held
+/// back are still yielded; after an invalid scene or sweep the replay goes
+/// on, and the caller decides whether to stop.
+pub struct ReplayIter<I> {
+    events: I,
+    replay: Option<Replay>,
+    tail: VecDeque<ReplayEvent>,
+    summary: Option<Summary>,
+}
+
+impl<I> ReplayIter<I> {
+    /// The counts so far; final once the iterator returned `None`.
+    pub fn summary(&self) -> Summary {
+        match (&self.summary, &self.replay) {
+            (Some(s), _) => s.clone(),
+            (None, Some(r)) => r.summary().clone(),
+            (None, None) => Summary::default(),
+        }
+    }
+
+    /// The engine, while the input lasts.
+    pub fn replay(&self) -> Option<&Replay> {
+        self.replay.as_ref()
+    }
+}
+
+impl<I> Iterator for ReplayIter<I>
+where
+    I: Iterator<Item = Result<TraceEvent, TraceError>>,
+{
+    type Item = Result<ReplayEvent, ReplayError>;
+
+    fn next(&mut self) -> Option<Self::Item> {
+        loop {
+            if let Some(e) = self.tail.pop_front() {
+                return Some(Ok(e));
+            }
+            let replay = self.replay.as_mut()?;
+            if let Some(e) = replay.next_event() {
+                return Some(Ok(e));
+            }
+            match self.events.next() {
+                Some(Ok(event)) => {
+                    if let Err(err) = replay.push(event) {
+                        return Some(Err(err));
+                    }
+                }
+                Some(Err(err)) => {
+                    self.finish();
+                    return Some(Err(ReplayError::Trace(err)));
+                }
+                None => self.finish(),
+            }
+        }
+    }
+}
+
+impl<I> ReplayIter<I> {
+    fn finish(&mut self) {
+        if let Some(replay) = self.replay.take() {
+            let (events, summary) = replay.finish();
+            self.tail.extend(events);
+            self.summary = Some(summary);
+        }
+    }
 }

@@ -8,6 +8,7 @@ use libtest_mimic::{Arguments, Failed, Trial};
 mod core_cases;
 mod core_random;
 mod oracle;
+mod replay;
 mod support;
 
 /// Builds a trial from a function returning `Result<(), String>`.
@@ -21,5 +22,6 @@ fn main() {
     // Register test modules below (one line each).
     trials.extend(core_cases::tests());
     trials.extend(core_random::tests());
+    trials.extend(replay::tests());
     libtest_mimic::run(&args, trials).exit();
 }

@@ -5,6 +5,7 @@ use std::process::ExitCode;
 use clap::{Parser, Subcommand};
 
 pub mod info;
+pub mod replay;
 pub mod sweep;
 
 /// Replay recorded ball trajectories through a swept-sphere vs triangle-mesh
@@ -23,6 +24,8 @@ pub enum Command {
     Sweep(sweep::Args),
     /// Summarise a trace: scenes, sweeps, frames, channels, compression, metadata.
     Info(info::Args),
+    /// Replay a trace through the core: outcomes and a Rerun recording explaining each sweep.
+    Replay(replay::Args),
 }
 
 /// Runs the chosen subcommand; `Ok` carries the exit code.
@@ -30,6 +33,7 @@ pub fn run(cli: Cli) -> anyhow::Result<ExitCode> {
     match cli.command {
         Command::Sweep(args) => sweep::run(args),
         Command::Info(args) => info::run(args),
+        Command::Replay(args) => replay::run(args),
     }
 }
 
@@ -37,7 +41,9 @@ pub fn run(cli: Cli) -> anyhow::Result<ExitCode> {
 pub fn parse_point(s: &str) -> Result<[f64; 3], String> {
     let parts: Vec<&str> = s.split(',').map(str::trim).collect();
     if parts.len() != 3 {
-        return Err(format!("expected three comma-separated numbers `x,y,z`, got `{s}`"));
+        return Err(format!(
+            "expected three comma-separated numbers `x,y,z`, got `{s}`"
+        ));
     }
     let mut out = [0.0; 3];
     for (o, p) in out.iter_mut().zip(&parts) {

@@ -1,0 +1,354 @@
+//! `sweeptrace replay`: run every sweep of a trace through the core and
+//! write the outcomes and/or a Rerun recording that explains them.
+
+use std::fs::File;
+use std::io::{BufReader, BufWriter, IsTerminal, Read, Write};
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+use std::sync::Arc;
+use std::sync::atomic::{AtomicU64, Ordering};
+
+use anyhow::{Context, bail};
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+
+use sweeptrace::core::Facing;
+use sweeptrace::replay::{
+    Detail, FrameRange, ReplayError, ReplayEvent, ReplayOptions, replay_events,
+};
+use sweeptrace::trace::TraceReader;
+use sweeptrace::viz;
+
+/// The viewer address `--connect` uses when given no URL.
+pub const DEFAULT_CONNECT_URL: &str = "rerun+http://127.0.0.1:9876/proxy";
+
+/// Arguments of `replay`.
+#[derive(Debug, clap::Args)]
+#[command(after_help = "\
+Examples:
+  sweeptrace replay traces/bowl.mcap                      # writes ./bowl.rrd
+  sweeptrace replay traces/bowl.mcap --spawn --frames 100..200 --detail candidates
+  sweeptrace replay traces/bowl.mcap --outcomes - --rrd /tmp/bowl.rrd --ball 0
+
+Without --outcomes, --rrd, --spawn or --connect the recording is written to
+<trace stem>.rrd in the current directory. Files are written under a
+temporary name next to the target and renamed once complete.")]
+pub struct Args {
+    /// The trace (an MCAP file).
+    #[arg(value_name = "TRACE")]
+    pub trace: PathBuf,
+    /// Write one JSON outcome per replayed sweep, in trace order (`-` for
+    /// stdout): frame, ball, alpha, kind, triangle, feature, normal, contact.
+    #[arg(long, value_name = "FILE")]
+    pub outcomes: Option<PathBuf>,
+    /// Write the Rerun recording to this `.rrd` file.
+    #[arg(long, value_name = "FILE")]
+    pub rrd: Option<PathBuf>,
+    /// Start a Rerun viewer (the `rerun` executable on PATH) and stream to it.
+    #[arg(long)]
+    pub spawn: bool,
+    /// Stream to a running Rerun viewer [default URL: rerun+http://127.0.0.1:9876/proxy].
+    #[arg(long, value_name = "URL", num_args = 0..=1, default_missing_value = DEFAULT_CONNECT_URL)]
+    pub connect: Option<String>,
+    /// Only frames A..B (A included, B excluded; also `A..`, `..B`, `A..=B`, `A`).
+    #[arg(long, value_name = "A..B")]
+    pub frames: Option<FrameRange>,
+    /// Only ball N.
+    #[arg(long, value_name = "N")]
+    pub ball: Option<u32>,
+    /// Which tests to log: `primary` (the tests reporting the collision, or
+    /// the nearest miss), `candidates` (every test of the triangles the BVH
+    /// visited) or `all` (every test of every triangle).
+    #[arg(long, default_value = "primary", value_name = "LEVEL")]
+    pub detail: Detail,
+    /// Override every scene's margin ε (tests use ρ = r - ε).
+    #[arg(long, value_name = "EPSILON")]
+    pub margin: Option<f64>,
+    /// Override every scene's facing rule: `non_strict` (n·d ≤ 0) or `strict` (n·d < 0).
+    #[arg(long, value_name = "RULE")]
+    pub facing: Option<Facing>,
+    /// Do not embed the default viewer layout (blueprint) in the recording.
+    #[arg(long)]
+    pub no_blueprint: bool,
+}
+
+/// Counts bytes read, for the progress bar.
+struct CountingReader<R> {
+    inner: R,
+    count: Arc<AtomicU64>,
+}
+
+impl<R: Read> Read for CountingReader<R> {
+    fn read(&mut self, buf: &mut [u8]) -> std::io::Result<usize> {
+        let n = self.inner.read(buf)?;
+        self.count.fetch_add(n as u64, Ordering::Relaxed);
+        Ok(n)
+    }
+}
+
+/// A file written under a temporary name in the target's directory and
+/// renamed when complete; removed if never completed.
+struct PendingFile {
+    temp: tempfile::TempPath,
+    target: PathBuf,
+}
+
+impl PendingFile {
+    fn new(target: &Path) -> anyhow::Result<PendingFile> {
+        let dir = match target.parent() {
+            Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
+            _ => PathBuf::from("."),
+        };
+        let name = target
+            .file_name()
+            .map(|n| n.to_string_lossy().into_owned())
+            .unwrap_or_default();
+        let mut builder = tempfile::Builder::new();
+        builder.prefix(&format!(".{name}.")).suffix(".tmp");
+        // An ordinary file once renamed (temporary files are private by default).
+        #[cfg(unix)]
+        builder.permissions(std::os::unix::fs::PermissionsExt::from_mode(0o644));
+        let temp = builder
+            .tempfile_in(&dir)
+            .with_context(|| format!("creating a temporary file in {}", dir.display()))?
+            .into_temp_path();
+        Ok(PendingFile {
+            temp,
+            target: target.to_path_buf(),
+        })
+    }
+
+    fn path(&self) -> &Path {
+        &self.temp
+    }
+
+    fn complete(self) -> anyhow::Result<()> {
+        let target = self.target;
+        self.temp
+            .persist(&target)
+            .with_context(|| format!("renaming the finished file to {}", target.display()))?;
+        Ok(())
+    }
+}
+
+/// Where the outcomes go.
+enum OutcomeSink {
+    Stdout(BufWriter<std::io::Stdout>),
+    File(BufWriter<File>, PendingFile),
+}
+
+impl OutcomeSink {
+    fn writer(&mut self) -> &mut dyn Write {
+        match self {
+            OutcomeSink::Stdout(w) => w,
+            OutcomeSink::File(w, _) => w,
+        }
+    }
+}
+
+/// Runs the replay.
+pub fn run(args: Args) -> anyhow::Result<ExitCode> {
+    let trace_path = &args.trace;
+    let file =
+        File::open(trace_path).with_context(|| format!("opening {}", trace_path.display()))?;
+    let total_bytes = file.metadata().map(|m| m.len()).unwrap_or(0);
+    let source_name = trace_path.display().to_string();
+
+    let no_output =
+        args.outcomes.is_none() && args.rrd.is_none() && !args.spawn && args.connect.is_none();
+    let rrd_path = match (&args.rrd, no_output) {
+        (Some(p), _) => Some(p.clone()),
+        (None, true) => {
+            let stem = trace_path
+                .file_stem()
+                .map(|s| s.to_string_lossy().into_owned())
+                .unwrap_or("replay".into());
+            Some(PathBuf::from(format!("{stem}.rrd")))
+        }
+        (None, false) => None,
+    };
+    let record = rrd_path.is_some() || args.spawn || args.connect.is_some();
+    if let Some(m) = args.margin
+        && !(m.is_finite() && m >= 0.0)
+    {
+        bail!("--margin must be a finite number ≥ 0, got {m}");
+    }
+
+    let options = ReplayOptions {
+        frames: args.frames.unwrap_or_default(),
+        ball: args.ball,
+        detail: args.detail,
+        explain: record,
+        margin: args.margin,
+        facing: args.facing,
+    };
+
+    // The recording.
+    let mut rrd_file = None;
+    let mut logger = None;
+    if record {
+        let id = recording_id_of(trace_path, &options)?;
+        let mut sinks: Vec<Box<dyn rerun::sink::LogSink>> = Vec::new();
+        if let Some(path) = &rrd_path {
+            let pending = PendingFile::new(path)?;
+            let sink = rerun::sink::FileSink::new(pending.path())
+                .with_context(|| format!("opening {} for writing", pending.path().display()))?;
+            sinks.push(Box::new(sink));
+            rrd_file = Some(pending);
+        }
+        if args.spawn {
+            let info = rerun::spawn(&rerun::SpawnOptions::default())
+                .context("starting the Rerun viewer (is `rerun` on PATH?)")?;
+            let uri = format!("rerun+http://127.0.0.1:{}/proxy", info.port);
+            sinks.push(Box::new(rerun::sink::GrpcSink::new(
+                uri.parse().context("viewer address")?,
+            )));
+        }
+        if let Some(url) = &args.connect {
+            let uri = url
+                .parse()
+                .map_err(|e| anyhow::anyhow!("--connect `{url}`: {e}"))?;
+            sinks.push(Box::new(rerun::sink::GrpcSink::new(uri)));
+        }
+        let name = trace_path
+            .file_name()
+            .map(|n| n.to_string_lossy().into_owned())
+            .unwrap_or_default();
+        let rec = viz::builder(&id, &name)
+            .set_sinks(sinks)
+            .context("creating the recording")?;
+        logger = Some(viz::Logger::new(rec, !args.no_blueprint).context("starting the recording")?);
+    }
+
+    // The outcomes.
+    let mut outcomes = match &args.outcomes {
+        None => None,
+        Some(p) if p.as_os_str() == "-" => {
+            Some(OutcomeSink::Stdout(BufWriter::new(std::io::stdout())))
+        }
+        Some(p) => {
+            let pending = PendingFile::new(p)?;
+            let f = File::create(pending.path())
+                .with_context(|| format!("creating {}", pending.path().display()))?;
+            Some(OutcomeSink::File(BufWriter::new(f), pending))
+        }
+    };
+
+    let count = Arc::new(AtomicU64::new(0));
+    let reader = CountingReader {
+        inner: BufReader::with_capacity(1 << 16, file),
+        count: count.clone(),
+    };
+    let progress = progress_bar(total_bytes);
+    let mut events = replay_events(TraceReader::new(reader, &source_name), options);
+    let mut trace_error = None;
+    let mut last_frame = None;
+    while let Some(event) = events.next() {
+        progress.set_position(count.load(Ordering::Relaxed));
+        match event {
+            Ok(ReplayEvent::Scene(scene)) => {
+                for d in scene.mesh.degenerate() {
+                    progress
+                        .suspend(|| eprintln!("warning: scene {}: {d}, left out", scene.number));
+                }
+                if let Some(l) = logger.as_mut() {
+                    l.log_scene(&scene).context("logging the scene")?;
+                }
+            }
+            Ok(ReplayEvent::Sweep(result)) => {
+                last_frame = Some(result.frame);
+                if let Some(o) = outcomes.as_mut() {
+                    let line = serde_json::to_string(&result.outcome_msg())
+                        .context("serializing an outcome")?;
+                    writeln!(o.writer(), "{line}").context("writing outcomes")?;
+                }
+                if let Some(l) = logger.as_mut() {
+                    l.log_sweep(&result)
+                        .with_context(|| format!("logging frame {}", result.frame))?;
+                }
+            }
+            Err(ReplayError::Trace(err)) => {
+                // The reader stops here; what was read is still replayed.
+                trace_error = Some(err);
+            }
+            Err(err) => {
+                progress.finish_and_clear();
+                return Err(anyhow::Error::new(err).context(format!("replaying {source_name}")));
+            }
+        }
+    }
+    progress.finish_and_clear();
+    let summary = events.summary();
+
+    // Finish the files: the recording's footer is written when the last
+    // clone of the stream is dropped.
+    if let Some(l) = logger {
+        let rec = l.finish();
+        rec.flush_blocking().context("flushing the recording")?;
+        drop(rec);
+    }
+    if let Some(pending) = rrd_file {
+        let target = pending.target.clone();
+        pending.complete()?;
+        eprintln!("wrote the recording to {}", target.display());
+    }
+    match outcomes {
+        Some(OutcomeSink::Stdout(mut w)) => w.flush().context("writing outcomes")?,
+        Some(OutcomeSink::File(mut w, pending)) => {
+            w.flush().context("writing outcomes")?;
+            w.into_inner()
+                .map_err(|e| e.into_error())
+                .context("writing outcomes")?
+                .sync_all()
+                .ok();
+            let target = pending.target.clone();
+            pending.complete()?;
+            eprintln!("wrote the outcomes to {}", target.display());
+        }
+        None => {}
+    }
+    if args.spawn || args.connect.is_some() {
+        eprintln!("streamed the recording to the viewer");
+    }
+    eprint!("{}", summary.render());
+    if let Some(err) = trace_error {
+        eprintln!(
+            "error: {err:#}\nthe outputs hold the {} sweeps read before it{}",
+            summary.sweeps,
+            last_frame.map_or(String::new(), |f| format!(" (up to frame {f})"))
+        );
+        return Ok(ExitCode::FAILURE);
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+fn progress_bar(total_bytes: u64) -> ProgressBar {
+    if !std::io::stderr().is_terminal() {
+        return ProgressBar::hidden();
+    }
+    let bar = ProgressBar::with_draw_target(Some(total_bytes), ProgressDrawTarget::stderr());
+    if let Ok(style) =
+        ProgressStyle::with_template("{spinner} replaying [{bar:40}] {bytes}/{total_bytes} ({eta})")
+    {
+        bar.set_style(style.progress_chars("=> "));
+    }
+    bar
+}
+
+/// The recording id: a hash of the trace's bytes and of the options.
+fn recording_id_of(trace: &Path, options: &ReplayOptions) -> anyhow::Result<String> {
+    let mut hasher = viz::IdHasher::new();
+    let mut f =
+        BufReader::new(File::open(trace).with_context(|| format!("opening {}", trace.display()))?);
+    let mut buf = vec![0u8; 1 << 16];
+    loop {
+        let n = f
+            .read(&mut buf)
+            .with_context(|| format!("reading {}", trace.display()))?;
+        if n == 0 {
+            break;
+        }
+        hasher.update(&buf[..n]);
+    }
+    hasher.update(format!("{options:?}").as_bytes());
+    Ok(hasher.finish())
+}

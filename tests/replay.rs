@@ -1,0 +1,1076 @@
+//! The replay engine and its Rerun recording: outcomes equal the core's,
+//! filters, detail levels, expected outcomes, and the written `.rrd` read
+//! back through Rerun's own decoder.
+
+use std::collections::BTreeMap;
+use std::io::BufReader;
+
+use libtest_mimic::Trial;
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+
+use sweeptrace::core::explain::miss_distance;
+use sweeptrace::core::{
+    Broadphase, CollectRecords, Facing, Kind, Mesh, Options, SIMULTANEOUS_TOLERANCE, Sweep,
+    TestRecord, sweep_mesh, sweep_mesh_with,
+};
+use sweeptrace::replay::{
+    Detail, FrameRange, ReplayEvent, ReplayOptions, Summary, SweepResult, replay_events,
+};
+use sweeptrace::trace::messages::{OutcomeMsg, SceneMsg, SweepMsg};
+use sweeptrace::trace::{TraceError, TraceEvent, TraceReader, TraceWriter};
+use sweeptrace::{scenes, viz};
+
+use crate::ensure;
+use crate::trial;
+
+pub fn tests() -> Vec<Trial> {
+    vec![
+        trial(
+            "replay::outcomes_equal_sweep_mesh",
+            outcomes_equal_sweep_mesh,
+        ),
+        trial(
+            "replay::outcomes_equal_without_explanation",
+            outcomes_equal_without_explanation,
+        ),
+        trial("replay::frame_and_ball_filters", frame_and_ball_filters),
+        trial("replay::frame_range_parsing", frame_range_parsing),
+        trial(
+            "replay::detail_levels_choose_records",
+            detail_levels_choose_records,
+        ),
+        trial(
+            "replay::expected_attached_before_and_after",
+            expected_attached_before_and_after,
+        ),
+        trial("replay::scene_overrides_apply", scene_overrides_apply),
+        trial(
+            "replay::sweep_before_scene_is_an_error",
+            sweep_before_scene_is_an_error,
+        ),
+        trial("replay::through_an_mcap_trace", through_an_mcap_trace),
+        trial(
+            "replay::rrd_reads_back_through_rerun",
+            rrd_reads_back_through_rerun,
+        ),
+        trial(
+            "replay::cli_writes_outcomes_and_rrd",
+            cli_writes_outcomes_and_rrd,
+        ),
+    ]
+}
+
+type Events = Vec<Result<TraceEvent, TraceError>>;
+
+fn cube_scene() -> SceneMsg {
+    let c = scenes::cube();
+    SceneMsg {
+        name: Some(c.name),
+        vertices: c.vertices,
+        triangles: c.triangles,
+        margin: 0.0,
+        facing: Facing::NonStrict,
+    }
+}
+
+fn triangle_scene() -> SceneMsg {
+    SceneMsg {
+        name: Some("triangle".into()),
+        vertices: vec![[0.0, 0.0, 0.0], [4.0, 0.0, 0.0], [0.0, 4.0, 0.0]],
+        triangles: vec![[0, 1, 2]],
+        margin: 0.0,
+        facing: Facing::NonStrict,
+    }
+}
+
+fn mesh_of(scene: &SceneMsg) -> Mesh {
+    Mesh::new(scene.vertices.clone(), &scene.triangles).expect("valid test scene")
+}
+
+/// `frames` frames of `balls` balls flying at the cube from random
+/// directions, seeded; about half of them hit.
+fn random_sweeps(seed: u64, frames: u64, balls: u32) -> Vec<SweepMsg> {
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let mut out = Vec::new();
+    for frame in 0..frames {
+        for ball in 0..balls {
+            let mut p = || {
+                [
+                    rng.random_range(-3.0..3.0),
+                    rng.random_range(-3.0..3.0),
+                    rng.random_range(-3.0..3.0),
+                ]
+            };
+            let p0 = p();
+            let p1 = p();
+            let radius = rng.random_range(0.05..0.6);
+            out.push(SweepMsg {
+                frame,
+                ball,
+                radius,
+                p0,
+                p1,
+            });
+        }
+    }
+    out
+}
+
+fn events_for(scene: SceneMsg, sweeps: &[SweepMsg]) -> Events {
+    let mut ev = vec![Ok(TraceEvent::Scene {
+        log_time_nanos: 0,
+        index: 0,
+        scene,
+    })];
+    for (i, s) in sweeps.iter().enumerate() {
+        ev.push(Ok(TraceEvent::Sweep {
+            log_time_nanos: 1_000_000 * (s.frame + 1),
+            index: i as u64 + 1,
+            sweep: *s,
+        }));
+    }
+    ev
+}
+
+fn run(events: Events, options: ReplayOptions) -> Result<(Vec<SweepResult>, Summary), String> {
+    let mut it = replay_events(events.into_iter(), options);
+    let mut out = Vec::new();
+    for e in it.by_ref() {
+        match e.map_err(|e| e.to_string())? {
+            ReplayEvent::Sweep(r) => out.push(*r),
+            ReplayEvent::Scene(_) => {}
+        }
+    }
+    Ok((out, it.summary()))
+}
+
+fn explained(detail: Detail) -> ReplayOptions {
+    ReplayOptions {
+        detail,
+        explain: true,
+        ..ReplayOptions::default()
+    }
+}
+
+fn outcomes_equal_sweep_mesh() -> Result<(), String> {
+    let scene = cube_scene();
+    let mesh = mesh_of(&scene);
+    let sweeps = random_sweeps(7, 150, 2);
+    for detail in [Detail::Primary, Detail::Candidates, Detail::All] {
+        let (results, summary) = run(events_for(scene.clone(), &sweeps), explained(detail))?;
+        ensure!(
+            results.len() == sweeps.len(),
+            "{detail}: {} results for {} sweeps",
+            results.len(),
+            sweeps.len()
+        );
+        let mut hits = 0;
+        for (r, s) in results.iter().zip(&sweeps) {
+            ensure!(
+                r.frame == s.frame && r.ball == s.ball,
+                "{detail}: results out of order"
+            );
+            let want = sweep_mesh(
+                &mesh,
+                &Sweep::new(s.p0, s.p1, s.radius),
+                &Options::default(),
+            )
+            .map_err(|e| e.to_string())?;
+            ensure!(
+                r.outcome == want,
+                "{detail}: frame {} ball {}: {:?} != {:?}",
+                s.frame,
+                s.ball,
+                r.outcome,
+                want
+            );
+            ensure!(
+                r.outcome_msg() == OutcomeMsg::from_outcome(s.frame, s.ball, &want),
+                "outcome record differs"
+            );
+            hits += u64::from(want.is_hit());
+        }
+        ensure!(
+            summary.sweeps == sweeps.len() as u64,
+            "summary counts {} sweeps",
+            summary.sweeps
+        );
+        ensure!(
+            summary.collisions() == hits,
+            "summary counts {} collisions, want {hits}",
+            summary.collisions()
+        );
+        ensure!(
+            hits > 30 && hits < 270,
+            "the random sweeps should mix hits and misses, got {hits} hits"
+        );
+        ensure!(
+            !summary.verdicts.is_empty(),
+            "explained replay counts verdicts"
+        );
+    }
+    Ok(())
+}
+
+fn outcomes_equal_without_explanation() -> Result<(), String> {
+    let scene = cube_scene();
+    let sweeps = random_sweeps(11, 80, 1);
+    let fast = run(events_for(scene.clone(), &sweeps), ReplayOptions::default())?.0;
+    let slow = run(events_for(scene, &sweeps), explained(Detail::All))?.0;
+    ensure!(
+        fast.iter().all(|r| r.records.is_empty()),
+        "fast replay keeps no records"
+    );
+    for (a, b) in fast.iter().zip(&slow) {
+        ensure!(
+            a.outcome == b.outcome,
+            "frame {}: fast {:?} != explained {:?}",
+            a.frame,
+            a.outcome,
+            b.outcome
+        );
+    }
+    Ok(())
+}
+
+fn frame_and_ball_filters() -> Result<(), String> {
+    let sweeps = random_sweeps(3, 40, 3);
+    let options = ReplayOptions {
+        frames: "10..20".parse()?,
+        ball: Some(1),
+        ..explained(Detail::Primary)
+    };
+    let (results, summary) = run(events_for(cube_scene(), &sweeps), options)?;
+    let got: Vec<(u64, u32)> = results.iter().map(|r| (r.frame, r.ball)).collect();
+    let want: Vec<(u64, u32)> = (10..20).map(|f| (f, 1)).collect();
+    ensure!(got == want, "filtered sweeps {got:?}, want {want:?}");
+    ensure!(
+        summary.filtered_out == 120 - 10,
+        "filtered_out = {}",
+        summary.filtered_out
+    );
+    let (open, _) = run(
+        events_for(cube_scene(), &sweeps),
+        ReplayOptions {
+            frames: "38..".parse()?,
+            ..ReplayOptions::default()
+        },
+    )?;
+    ensure!(
+        open.len() == 6,
+        "`38..` keeps frames 38 and 39 of 3 balls, got {}",
+        open.len()
+    );
+    Ok(())
+}
+
+fn frame_range_parsing() -> Result<(), String> {
+    let r: FrameRange = "3..7".parse()?;
+    ensure!(
+        r.contains(3) && r.contains(6) && !r.contains(7) && !r.contains(2),
+        "3..7"
+    );
+    let r: FrameRange = "3..=7".parse()?;
+    ensure!(r.contains(7) && !r.contains(8), "3..=7");
+    let r: FrameRange = "5".parse()?;
+    ensure!(r.contains(5) && !r.contains(4) && !r.contains(6), "5");
+    let r: FrameRange = "..4".parse()?;
+    ensure!(r.contains(0) && !r.contains(4), "..4");
+    for bad in ["7..3", "5..5", "a..b", "", "1..2..3", "-1..4"] {
+        ensure!(
+            bad.parse::<FrameRange>().is_err(),
+            "`{bad}` should be refused"
+        );
+    }
+    Ok(())
+}
+
+fn detail_levels_choose_records() -> Result<(), String> {
+    let scene = cube_scene();
+    let mesh = mesh_of(&scene);
+    let sweeps = random_sweeps(5, 120, 1);
+    let primary = run(
+        events_for(scene.clone(), &sweeps),
+        explained(Detail::Primary),
+    )?
+    .0;
+    let candidates = run(
+        events_for(scene.clone(), &sweeps),
+        explained(Detail::Candidates),
+    )?
+    .0;
+    let all = run(events_for(scene, &sweeps), explained(Detail::All))?.0;
+    let (mut hits, mut misses_explained) = (0, 0);
+    for ((p, c), a) in primary.iter().zip(&candidates).zip(&all) {
+        let sweep = p.sweep;
+        let mut bvh = CollectRecords::default();
+        sweep_mesh_with(
+            &mesh,
+            &sweep,
+            &Options::default(),
+            Broadphase::Bvh,
+            &mut bvh,
+        )
+        .map_err(|e| e.to_string())?;
+        ensure!(
+            c.records == bvh.records,
+            "frame {}: candidates are not the BVH's tests",
+            p.frame
+        );
+        ensure!(
+            a.records.len() == 7 * mesh.triangles().len(),
+            "frame {}: `all` has {} records",
+            p.frame,
+            a.records.len()
+        );
+        let o = &p.outcome;
+        if o.is_hit() {
+            hits += 1;
+            let first = p
+                .records
+                .first()
+                .ok_or(format!("frame {}: hit without records", p.frame))?;
+            ensure!(
+                Some(first.triangle()) == o.triangle
+                    && first.kind() == o.kind
+                    && Some(first.feature()) == o.feature,
+                "frame {}: first primary record {first:?} is not the primary test {o:?}",
+                p.frame
+            );
+            ensure!(
+                first.alpha() == Some(o.alpha),
+                "frame {}: primary α differs",
+                p.frame
+            );
+            for r in &p.records {
+                let alpha = r.alpha().ok_or(format!(
+                    "frame {}: a non-hit among primary records",
+                    p.frame
+                ))?;
+                ensure!(
+                    alpha <= o.alpha + SIMULTANEOUS_TOLERANCE,
+                    "frame {}: a later hit kept",
+                    p.frame
+                );
+            }
+            let simultaneous = c
+                .records
+                .iter()
+                .filter(|r| {
+                    r.alpha()
+                        .is_some_and(|x| x <= o.alpha + SIMULTANEOUS_TOLERANCE)
+                })
+                .count();
+            ensure!(
+                p.records.len() == simultaneous,
+                "frame {}: {} primary records, {simultaneous} hits at α",
+                p.frame,
+                p.records.len()
+            );
+            ensure!(
+                p.decisive_record() == Some(first),
+                "decisive record is the primary one"
+            );
+        } else {
+            ensure!(
+                p.records.len() <= 1,
+                "frame {}: a miss keeps at most the nearest miss",
+                p.frame
+            );
+            let best = c
+                .records
+                .iter()
+                .filter_map(|r| miss_distance(r))
+                .fold(f64::INFINITY, f64::min);
+            match p.records.first() {
+                Some(r) => {
+                    misses_explained += 1;
+                    ensure!(
+                        miss_distance(r) == Some(best),
+                        "frame {}: kept miss is not the nearest",
+                        p.frame
+                    );
+                }
+                None => ensure!(
+                    c.records.is_empty(),
+                    "frame {}: nearest miss dropped",
+                    p.frame
+                ),
+            }
+        }
+    }
+    ensure!(
+        hits > 10 && misses_explained > 10,
+        "{hits} hits, {misses_explained} explained misses: too few to test"
+    );
+    Ok(())
+}
+
+fn expected_attached_before_and_after() -> Result<(), String> {
+    let scene = triangle_scene();
+    let sweep = |frame| SweepMsg {
+        frame,
+        ball: 0,
+        radius: 0.5,
+        p0: [1.0, 1.0, 3.0],
+        p1: [1.0, 1.0, -3.0],
+    };
+    let expected = |frame, alpha| OutcomeMsg {
+        frame,
+        ball: 0,
+        alpha,
+        kind: Kind::Face,
+        triangle: None,
+        feature: None,
+        normal: None,
+        contact: None,
+    };
+    let ev: Events = vec![
+        Ok(TraceEvent::Scene {
+            log_time_nanos: 0,
+            index: 0,
+            scene,
+        }),
+        // Before its sweep.
+        Ok(TraceEvent::Expected {
+            log_time_nanos: 1,
+            index: 1,
+            outcome: expected(0, 0.1),
+        }),
+        Ok(TraceEvent::Sweep {
+            log_time_nanos: 1,
+            index: 2,
+            sweep: sweep(0),
+        }),
+        // After its sweep.
+        Ok(TraceEvent::Sweep {
+            log_time_nanos: 2,
+            index: 3,
+            sweep: sweep(1),
+        }),
+        Ok(TraceEvent::Expected {
+            log_time_nanos: 2,
+            index: 4,
+            outcome: expected(1, 0.2),
+        }),
+        // None for frame 2; one that matches nothing.
+        Ok(TraceEvent::Sweep {
+            log_time_nanos: 3,
+            index: 5,
+            sweep: sweep(2),
+        }),
+        Ok(TraceEvent::Expected {
+            log_time_nanos: 4,
+            index: 6,
+            outcome: expected(99, 0.3),
+        }),
+    ];
+    let (results, summary) = run(ev, explained(Detail::Primary))?;
+    let got: Vec<Option<f64>> = results
+        .iter()
+        .map(|r| r.expected.map(|e| e.alpha))
+        .collect();
+    ensure!(
+        got == vec![Some(0.1), Some(0.2), None],
+        "expected attached: {got:?}"
+    );
+    ensure!(
+        summary.expected_matched == 2 && summary.expected_unmatched == 1,
+        "summary {summary:?}"
+    );
+    let (line, mismatch) = viz::decision_line(&results[0], results[0].decisive_record());
+    ensure!(
+        mismatch && line.contains("[expected face at α = 0.1]"),
+        "mismatch shown: {line}"
+    );
+    Ok(())
+}
+
+fn scene_overrides_apply() -> Result<(), String> {
+    // Worked example 1 with margin 0.25: ρ = 0.25, β = (3 - 0.25) / 6.
+    let sweep = SweepMsg {
+        frame: 0,
+        ball: 0,
+        radius: 0.5,
+        p0: [1.0, 1.0, 3.0],
+        p1: [1.0, 1.0, -3.0],
+    };
+    let options = ReplayOptions {
+        margin: Some(0.25),
+        facing: Some(Facing::Strict),
+        ..ReplayOptions::default()
+    };
+    let (r, _) = run(events_for(triangle_scene(), &[sweep]), options)?;
+    ensure!(
+        r[0].options.margin == 0.25 && r[0].options.facing == Facing::Strict,
+        "overrides not applied"
+    );
+    ensure!(
+        (r[0].outcome.alpha - 2.75 / 6.0).abs() < 1e-12,
+        "α = {}",
+        r[0].outcome.alpha
+    );
+    let mut scene = triangle_scene();
+    scene.margin = 0.1;
+    let (r, _) = run(events_for(scene, &[sweep]), ReplayOptions::default())?;
+    ensure!(
+        (r[0].outcome.alpha - 2.6 / 6.0).abs() < 1e-12,
+        "scene margin: α = {}",
+        r[0].outcome.alpha
+    );
+    Ok(())
+}
+
+fn sweep_before_scene_is_an_error() -> Result<(), String> {
+    let sweep = SweepMsg {
+        frame: 4,
+        ball: 0,
+        radius: 0.5,
+        p0: [0.0; 3],
+        p1: [1.0; 3],
+    };
+    let ev: Events = vec![Ok(TraceEvent::Sweep {
+        log_time_nanos: 0,
+        index: 0,
+        sweep,
+    })];
+    let errors: Vec<String> = replay_events(ev.into_iter(), ReplayOptions::default())
+        .filter_map(|e| e.err())
+        .map(|e| e.to_string())
+        .collect();
+    ensure!(
+        errors.len() == 1 && errors[0].contains("frame 4"),
+        "errors: {errors:?}"
+    );
+    let bad = SweepMsg {
+        frame: 9,
+        ball: 2,
+        radius: -1.0,
+        p0: [0.0; 3],
+        p1: [1.0; 3],
+    };
+    let errors: Vec<String> = replay_events(
+        events_for(cube_scene(), &[bad]).into_iter(),
+        ReplayOptions::default(),
+    )
+    .filter_map(|e| e.err())
+    .map(|e| e.to_string())
+    .collect();
+    ensure!(
+        errors.len() == 1 && errors[0].contains("frame 9") && errors[0].contains("ball 2"),
+        "errors: {errors:?}"
+    );
+    Ok(())
+}
+
+fn write_trace(scene: &SceneMsg, sweeps: &[SweepMsg], expected: bool) -> Result<Vec<u8>, String> {
+    let mut w = TraceWriter::new(std::io::Cursor::new(Vec::new())).map_err(|e| e.to_string())?;
+    w.scene(0, scene).map_err(|e| e.to_string())?;
+    let mesh = mesh_of(scene);
+    for s in sweeps {
+        let t = 1_000_000 * (s.frame + 1);
+        w.sweep(t, s).map_err(|e| e.to_string())?;
+        if expected {
+            let o = sweep_mesh(
+                &mesh,
+                &Sweep::new(s.p0, s.p1, s.radius),
+                &Options::default(),
+            )
+            .map_err(|e| e.to_string())?;
+            w.expected(t, &OutcomeMsg::from_outcome(s.frame, s.ball, &o))
+                .map_err(|e| e.to_string())?;
+        }
+    }
+    Ok(w.finish().map_err(|e| e.to_string())?.into_inner())
+}
+
+fn through_an_mcap_trace() -> Result<(), String> {
+    let scene = cube_scene();
+    let sweeps = random_sweeps(13, 60, 2);
+    let bytes = write_trace(&scene, &sweeps, true)?;
+    let mut it = replay_events(
+        TraceReader::new(bytes.as_slice(), "memory.mcap"),
+        explained(Detail::Primary),
+    );
+    let mut n = 0;
+    for e in it.by_ref() {
+        if let ReplayEvent::Sweep(r) = e.map_err(|e| e.to_string())? {
+            let exp = r
+                .expected
+                .ok_or(format!("frame {}: expected not attached", r.frame))?;
+            ensure!(
+                exp == r.outcome_msg(),
+                "frame {}: expected {exp:?} != {:?}",
+                r.frame,
+                r.outcome_msg()
+            );
+            n += 1;
+        }
+    }
+    ensure!(n == sweeps.len(), "{n} results for {} sweeps", sweeps.len());
+    ensure!(
+        it.summary().expected_matched == n as u64,
+        "summary {:?}",
+        it.summary()
+    );
+    Ok(())
+}
+
+/// The worked examples 1-3 of SEMANTICS.md and a miss, frames 0-3.
+fn worked_sweeps() -> Vec<SweepMsg> {
+    let s = |frame, p0, p1| SweepMsg {
+        frame,
+        ball: 0,
+        radius: 0.5,
+        p0,
+        p1,
+    };
+    vec![
+        s(0, [1.0, 1.0, 3.0], [1.0, 1.0, -3.0]),
+        s(1, [2.0, -0.3, 3.0], [2.0, -0.3, -3.0]),
+        s(2, [-0.3, -0.2, 3.0], [-0.3, -0.2, -3.0]),
+        s(3, [6.0, 6.0, 3.0], [6.0, 6.0, 2.0]),
+    ]
+}
+
+/// Values decoded from an `.rrd`: per entity and component, the values at
+/// each frame (static data at frame `i64::MIN`).
+#[derive(Default)]
+struct Decoded {
+    scalars: BTreeMap<(String, String), BTreeMap<i64, Vec<f64>>>,
+    texts: BTreeMap<(String, String), BTreeMap<i64, Vec<String>>>,
+    translations: BTreeMap<String, BTreeMap<i64, [f32; 3]>>,
+    quaternions: BTreeMap<String, BTreeMap<i64, [f32; 4]>>,
+    timelines: std::collections::BTreeSet<String>,
+    recording_ids: std::collections::BTreeSet<String>,
+    blueprint_stores: usize,
+    static_entities: std::collections::BTreeSet<String>,
+}
+
+fn decode_rrd(path: &std::path::Path) -> Result<Decoded, String> {
+    use rerun::external::re_log_encoding::DecoderApp;
+    use rerun::log::{Chunk, LogMsg};
+    let file = std::fs::File::open(path).map_err(|e| e.to_string())?;
+    let mut d = Decoded::default();
+    for msg in DecoderApp::decode_lazy(BufReader::new(file)) {
+        let msg = msg.map_err(|e| format!("decoding {}: {e}", path.display()))?;
+        match &msg {
+            LogMsg::SetStoreInfo(info) => {
+                if info.info.store_id.kind() == rerun::StoreKind::Blueprint {
+                    d.blueprint_stores += 1;
+                } else {
+                    d.recording_ids
+                        .insert(info.info.store_id.recording_id().to_string());
+                }
+            }
+            LogMsg::ArrowMsg(store, arrow) => {
+                if store.kind() != rerun::StoreKind::Recording {
+                    continue;
+                }
+                let chunk = Chunk::from_arrow_msg(arrow).map_err(|e| e.to_string())?;
+                let entity = chunk.entity_path().to_string();
+                for t in chunk.timelines().keys() {
+                    d.timelines.insert(t.to_string());
+                }
+                if chunk.is_static() {
+                    d.static_entities.insert(entity.clone());
+                }
+                let frames: Vec<i64> = if chunk.is_static() {
+                    vec![i64::MIN; chunk.num_rows()]
+                } else {
+                    chunk
+                        .iter_indices(&"frame".into())
+                        .map(|(t, _)| t.as_i64())
+                        .collect()
+                };
+                for (id, _) in chunk.components().iter() {
+                    let name = id.to_string();
+                    let key = (entity.clone(), name.clone());
+                    let rows: Vec<usize> = chunk
+                        .iter_component_offsets(*id)
+                        .enumerate()
+                        .filter(|(_, span)| span.len > 0)
+                        .map(|(i, _)| i)
+                        .collect();
+                    if name == "Scalars:scalars" || is_any_scalar(&name) {
+                        let scalar: Vec<Vec<f64>> = chunk
+                            .iter_component::<rerun::components::Scalar>(*id)
+                            .map(|b| b.iter().map(|s| s.0.0).collect())
+                            .collect();
+                        for (row, v) in rows.iter().zip(scalar.iter().filter(|v| !v.is_empty())) {
+                            d.scalars
+                                .entry(key.clone())
+                                .or_default()
+                                .insert(frames[*row], v.clone());
+                        }
+                    }
+                    if name.ends_with("text")
+                        || name == "kind"
+                        || name == "verdict"
+                        || name == "test"
+                    {
+                        let texts: Vec<Vec<String>> = chunk
+                            .iter_component::<rerun::components::Text>(*id)
+                            .map(|b| b.iter().map(|s| s.0.to_string()).collect())
+                            .collect();
+                        for (row, v) in rows.iter().zip(texts.iter().filter(|v| !v.is_empty())) {
+                            d.texts
+                                .entry(key.clone())
+                                .or_default()
+                                .insert(frames[*row], v.clone());
+                        }
+                    }
+                    if name == "Transform3D:translation" {
+                        let v: Vec<Vec<[f32; 3]>> = chunk
+                            .iter_component::<rerun::components::Translation3D>(*id)
+                            .map(|b| b.iter().map(|t| t.0.0).collect())
+                            .collect();
+                        for (row, v) in rows.iter().zip(v.iter().filter(|v| !v.is_empty())) {
+                            d.translations
+                                .entry(entity.clone())
+                                .or_default()
+                                .insert(frames[*row], v[0]);
+                        }
+                    }
+                    if name == "Transform3D:quaternion" {
+                        let v: Vec<Vec<[f32; 4]>> = chunk
+                            .iter_component::<rerun::components::RotationQuat>(*id)
+                            .map(|b| b.iter().map(|q| q.0.0).collect())
+                            .collect();
+                        for (row, v) in rows.iter().zip(v.iter().filter(|v| !v.is_empty())) {
+                            d.quaternions
+                                .entry(entity.clone())
+                                .or_default()
+                                .insert(frames[*row], v[0]);
+                        }
+                    }
+                }
+            }
+            LogMsg::BlueprintActivationCommand(_) => {}
+        }
+    }
+    Ok(d)
+}
+
+fn is_any_scalar(name: &str) -> bool {
+    ["length", "a", "b", "c", "discriminant", "s0", "s1", "xc"].contains(&name)
+}
+
+fn write_rrd(
+    results_of: Events,
+    detail: Detail,
+    path: &std::path::Path,
+) -> Result<Vec<SweepResult>, String> {
+    let id = viz::recording_id(&[b"test trace", detail.as_str().as_bytes()]);
+    let rec = viz::builder(&id, "test")
+        .save(path)
+        .map_err(|e| e.to_string())?;
+    let mut logger = viz::Logger::new(rec, true).map_err(|e| e.to_string())?;
+    let mut results = Vec::new();
+    for e in replay_events(results_of.into_iter(), explained(detail)) {
+        let e = e.map_err(|e| e.to_string())?;
+        logger.log(&e).map_err(|e| e.to_string())?;
+        if let ReplayEvent::Sweep(r) = e {
+            results.push(*r);
+        }
+    }
+    drop(logger.finish());
+    Ok(results)
+}
+
+fn rrd_reads_back_through_rerun() -> Result<(), String> {
+    let dir = tempfile::tempdir().map_err(|e| e.to_string())?;
+    let path = dir.path().join("worked.rrd");
+    let results = write_rrd(
+        events_for(triangle_scene(), &worked_sweeps()),
+        Detail::Primary,
+        &path,
+    )?;
+    let d = decode_rrd(&path)?;
+
+    let want_id = viz::recording_id(&[b"test trace", b"primary"]);
+    ensure!(
+        d.recording_ids.iter().all(|r| *r == want_id) && !d.recording_ids.is_empty(),
+        "recording ids {:?}",
+        d.recording_ids
+    );
+    ensure!(
+        d.blueprint_stores >= 1,
+        "no blueprint store in the recording"
+    );
+    ensure!(
+        !d.timelines.contains("log_time") && !d.timelines.contains("log_tick"),
+        "wall-clock timelines present: {:?}",
+        d.timelines
+    );
+    ensure!(
+        d.timelines.contains("frame") && d.timelines.contains("time"),
+        "timelines {:?}",
+        d.timelines
+    );
+    ensure!(
+        d.static_entities.contains("/world/mesh/0"),
+        "the mesh is not static: {:?}",
+        d.static_entities
+    );
+
+    // α at every frame equals the outcome, exactly.
+    let alpha = d
+        .scalars
+        .get(&(
+            "/plots/ball/0/alpha".to_string(),
+            "Scalars:scalars".to_string(),
+        ))
+        .ok_or(format!(
+            "no α scalars; have {:?}",
+            d.scalars.keys().collect::<Vec<_>>()
+        ))?;
+    for r in &results {
+        let got = alpha
+            .get(&(r.frame as i64))
+            .ok_or(format!("no α at frame {}", r.frame))?;
+        ensure!(
+            got == &vec![r.outcome.alpha],
+            "frame {}: α {got:?}, outcome {}",
+            r.frame,
+            r.outcome.alpha
+        );
+    }
+    ensure!(
+        (alpha[&1][0] - 13.0 / 30.0).abs() < 1e-12,
+        "worked example 2: α = {}",
+        alpha[&1][0]
+    );
+    let kinds = &d.texts[&("/plots/ball/0/alpha".to_string(), "kind".to_string())];
+    ensure!(
+        kinds[&1] == vec!["edge".to_string()] && kinds[&3] == vec!["none".to_string()],
+        "kinds {kinds:?}"
+    );
+
+    // The roots of the decisive edge test (worked example 2: 0.43333, 0.56667).
+    let TestRecord::Edge(edge) = results[1].records[0] else {
+        return Err(format!(
+            "frame 1: decisive record is not an edge test: {:?}",
+            results[1].records[0]
+        ));
+    };
+    let scalar_at = |entity: &str, frame: i64| -> Result<f64, String> {
+        d.scalars
+            .get(&(entity.to_string(), "Scalars:scalars".to_string()))
+            .and_then(|m| m.get(&frame))
+            .and_then(|v| v.first().copied())
+            .ok_or(format!("no scalar {entity} at frame {frame}"))
+    };
+    let (s0, s1) = edge.roots.ok_or("edge without roots")?;
+    ensure!(
+        scalar_at("/plots/ball/0/quadratic/s0", 1)? == s0,
+        "s0 differs"
+    );
+    ensure!(
+        scalar_at("/plots/ball/0/quadratic/s1", 1)? == s1,
+        "s1 differs"
+    );
+    ensure!(
+        (s0 - 13.0 / 30.0).abs() < 1e-12 && (s1 - 17.0 / 30.0).abs() < 1e-12,
+        "roots {s0}, {s1}"
+    );
+    ensure!(scalar_at("/plots/ball/0/quadratic/a", 1)? == 36.0, "A");
+    ensure!(
+        scalar_at("/plots/ball/0/quadratic/discriminant", 1)? == edge.discriminant,
+        "discriminant"
+    );
+    // Vertex example: the vertex quadratic's s0.
+    ensure!(
+        (scalar_at("/plots/ball/0/quadratic/s0", 2)? - 0.44226).abs() < 1e-5,
+        "vertex s0"
+    );
+    // Face example: h0, h1, β.
+    ensure!(
+        scalar_at("/plots/ball/0/face/h0", 0)? == 3.0
+            && scalar_at("/plots/ball/0/face/h1", 0)? == -3.0,
+        "h0, h1"
+    );
+    ensure!(
+        (scalar_at("/plots/ball/0/face/beta", 0)? - 5.0 / 12.0).abs() < 1e-12,
+        "β"
+    );
+    // The edge's numbers alongside its transform.
+    ensure!(
+        d.scalars
+            .get(&("/world/ball/0/edge/0".to_string(), "s0".to_string()))
+            .and_then(|m| m.get(&1))
+            == Some(&vec![s0]),
+        "edge slot values"
+    );
+
+    // The transform of the edge frame: origin v0 = (0,0,0), rotation
+    // x → x, y → z, z → -y (a quarter turn about +x).
+    let t = d
+        .translations
+        .get("/world/ball/0/edge/0")
+        .and_then(|m| m.get(&1))
+        .ok_or("no edge transform at frame 1")?;
+    ensure!(t.iter().all(|c| c.abs() < 1e-6), "translation {t:?}");
+    let q = d
+        .quaternions
+        .get("/world/ball/0/edge/0")
+        .and_then(|m| m.get(&1))
+        .ok_or("no edge rotation at frame 1")?;
+    let h = std::f32::consts::FRAC_1_SQRT_2;
+    let want = [h, 0.0, 0.0, h];
+    let same = q.iter().zip(want).all(|(a, b)| (a - b).abs() < 1e-6)
+        || q.iter().zip(want).all(|(a, b)| (a + b).abs() < 1e-6);
+    ensure!(same, "rotation {q:?}, want {want:?}");
+    let world_from_edge = edge.frame.world_from_edge();
+    let v = world_from_edge.rotation * nalgebra::Vector3::y();
+    ensure!(
+        (v - nalgebra::Vector3::z()).norm() < 1e-12,
+        "edge frame +y is the front normal +z"
+    );
+
+    // One text line per frame; the edge frame says why.
+    let log = &d.texts[&("/log".to_string(), "TextLog:text".to_string())];
+    ensure!(log.len() == 4, "{} text lines", log.len());
+    ensure!(
+        log[&1][0].contains("edge 0.0: s0 = 0.43333 in [0, 1], xc = 2 in [0, 4], facing ok: hit"),
+        "line: {}",
+        log[&1][0]
+    );
+    ensure!(log[&3][0].contains("no collision"), "line: {}", log[&3][0]);
+
+    // Same trace and options: same content.
+    let again = dir.path().join("again.rrd");
+    write_rrd(
+        events_for(triangle_scene(), &worked_sweeps()),
+        Detail::Primary,
+        &again,
+    )?;
+    let d2 = decode_rrd(&again)?;
+    ensure!(
+        d2.scalars == d.scalars && d2.texts == d.texts && d2.recording_ids == d.recording_ids,
+        "content differs between runs"
+    );
+    ensure!(
+        d2.translations == d.translations && d2.quaternions == d.quaternions,
+        "transforms differ between runs"
+    );
+    Ok(())
+}
+
+fn cli_writes_outcomes_and_rrd() -> Result<(), String> {
+    let dir = tempfile::tempdir().map_err(|e| e.to_string())?;
+    let trace = dir.path().join("cube run.mcap");
+    let sweeps = random_sweeps(21, 30, 2);
+    std::fs::write(&trace, write_trace(&cube_scene(), &sweeps, true)?)
+        .map_err(|e| e.to_string())?;
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_sweeptrace"))
+        .current_dir(dir.path())
+        .args([
+            "replay",
+            "cube run.mcap",
+            "--outcomes",
+            "out.jsonl",
+            "--rrd",
+            "sub.rrd",
+            "--frames",
+            "5..25",
+            "--detail",
+            "candidates",
+        ])
+        .output()
+        .map_err(|e| e.to_string())?;
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    ensure!(out.status.success(), "replay failed: {stderr}");
+    ensure!(stderr.contains("40 sweeps replayed"), "summary: {stderr}");
+    let lines = std::fs::read_to_string(dir.path().join("out.jsonl")).map_err(|e| e.to_string())?;
+    let lines: Vec<&str> = lines.lines().collect();
+    ensure!(lines.len() == 40, "{} outcome lines", lines.len());
+    let mesh = mesh_of(&cube_scene());
+    let wanted: Vec<&SweepMsg> = sweeps
+        .iter()
+        .filter(|s| (5..25).contains(&s.frame))
+        .collect();
+    for (line, s) in lines.iter().zip(wanted) {
+        let v: serde_json::Value = serde_json::from_str(line).map_err(|e| e.to_string())?;
+        let keys: Vec<&str> = v
+            .as_object()
+            .ok_or("not an object")?
+            .keys()
+            .map(String::as_str)
+            .collect();
+        let mut sorted = keys.clone();
+        sorted.sort();
+        ensure!(
+            sorted
+                == [
+                    "alpha", "ball", "contact", "feature", "frame", "kind", "normal", "triangle"
+                ],
+            "fields {keys:?}"
+        );
+        let o: OutcomeMsg = serde_json::from_str(line).map_err(|e| e.to_string())?;
+        let want = sweep_mesh(
+            &mesh,
+            &Sweep::new(s.p0, s.p1, s.radius),
+            &Options::default(),
+        )
+        .map_err(|e| e.to_string())?;
+        ensure!(
+            o == OutcomeMsg::from_outcome(s.frame, s.ball, &want),
+            "line {line} != {want:?}"
+        );
+    }
+    let d = decode_rrd(&dir.path().join("sub.rrd"))?;
+    ensure!(
+        d.scalars.keys().any(|(e, _)| e == "/plots/ball/1/alpha"),
+        "ball 1 plotted"
+    );
+    // Nothing left behind but the inputs and outputs.
+    let mut names: Vec<String> = std::fs::read_dir(dir.path())
+        .map_err(|e| e.to_string())?
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    names.sort();
+    ensure!(
+        names == ["cube run.mcap", "out.jsonl", "sub.rrd"],
+        "files {names:?}"
+    );
+
+    // No output option: `<stem>.rrd` in the current directory.
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_sweeptrace"))
+        .current_dir(dir.path())
+        .args(["replay", "cube run.mcap", "--ball", "0"])
+        .output()
+        .map_err(|e| e.to_string())?;
+    ensure!(
+        out.status.success(),
+        "replay failed: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    ensure!(
+        dir.path().join("cube run.rrd").is_file(),
+        "default output missing"
+    );
+    ensure!(
+        String::from_utf8_lossy(&out.stderr).contains("cube run.rrd"),
+        "says where it wrote"
+    );
+
+    // A truncated trace: the readable part is still replayed, the exit code says it failed.
+    let bytes = std::fs::read(&trace).map_err(|e| e.to_string())?;
+    std::fs::write(dir.path().join("cut.mcap"), &bytes[..bytes.len() * 2 / 3])
+        .map_err(|e| e.to_string())?;
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_sweeptrace"))
+        .current_dir(dir.path())
+        .args(["replay", "cut.mcap", "--outcomes", "cut.jsonl"])
+        .output()
+        .map_err(|e| e.to_string())?;
+    ensure!(
+        out.status.code() == Some(1),
+        "truncated trace: exit {:?}",
+        out.status.code()
+    );
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    ensure!(stderr.contains("error"), "truncated trace: {stderr}");
+    Ok(())
+}

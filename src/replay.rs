@@ -354,8 +354,15 @@ pub enum ReplayError {
         source: SweepError,
     },
     /// The trace could not be read further.
+    /// (Boxed: a trace error is large, and results pass through here.)
     #[error(transparent)]
-    Trace(#[from] TraceError),
+    Trace(Box<TraceError>),
+}
+
+impl From<TraceError> for ReplayError {
+    fn from(err: TraceError) -> Self {
+        ReplayError::Trace(Box::new(err))
+    }
 }
 
 /// The replay engine (push-based; see the module documentation).
@@ -696,7 +703,7 @@ where
                 }
                 Some(Err(err)) => {
                     self.finish();
-                    return Some(Err(ReplayError::Trace(err)));
+                    return Some(Err(ReplayError::from(err)));
                 }
                 None => self.finish(),
             }

@@ -103,7 +103,8 @@ impl PendingFile {
             .map(|n| n.to_string_lossy().into_owned())
             .unwrap_or_default();
         let mut builder = tempfile::Builder::new();
-        builder.prefix(&format!(".{name}.")).suffix(".tmp");
+        let prefix = format!(".{name}.");
+        builder.prefix(&prefix).suffix(".tmp");
         // An ordinary file once renamed (temporary files are private by default).
         #[cfg(unix)]
         builder.permissions(std::os::unix::fs::PermissionsExt::from_mode(0o644));

@@ -8,5 +8,6 @@ pub mod core;
 pub mod replay;
 pub mod report;
 pub mod scenes;
+pub mod sim;
 pub mod trace;
 pub mod viz;

@@ -4,7 +4,10 @@
 //!
 //! Start with [`core`] (the collision tests) and [`scenes`] (built-in meshes).
 
+pub mod bless;
+pub mod check;
 pub mod core;
+pub mod diff;
 pub mod replay;
 pub mod report;
 pub mod scenes;

@@ -5,6 +5,7 @@
 
 use libtest_mimic::{Arguments, Failed, Trial};
 
+mod check;
 mod core_cases;
 mod core_random;
 mod oracle;
@@ -22,6 +23,7 @@ fn main() {
     // Register test modules below (one line each).
     trials.extend(core_cases::tests());
     trials.extend(core_random::tests());
+    trials.extend(check::tests());
     trials.extend(replay::tests());
     libtest_mimic::run(&args, trials).exit();
 }

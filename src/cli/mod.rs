@@ -4,6 +4,9 @@ use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
 
+pub mod bless;
+pub mod check;
+pub mod diff;
 pub mod info;
 pub mod replay;
 pub mod sweep;
@@ -26,6 +29,12 @@ pub enum Command {
     Info(info::Args),
     /// Replay a trace through the core: outcomes and a Rerun recording explaining each sweep.
     Replay(replay::Args),
+    /// Compare every sweep's outcome with the trace's /expected channel (regression check).
+    Check(check::Args),
+    /// Rewrite a trace's /expected channel with the current core's outcomes, keeping everything else.
+    Bless(bless::Args),
+    /// Compare the outcomes of two traces, or of one trace replayed with different options.
+    Diff(diff::Args),
 }
 
 /// Runs the chosen subcommand; `Ok` carries the exit code.
@@ -34,6 +43,9 @@ pub fn run(cli: Cli) -> anyhow::Result<ExitCode> {
         Command::Sweep(args) => sweep::run(args),
         Command::Info(args) => info::run(args),
         Command::Replay(args) => replay::run(args),
+        Command::Check(args) => check::run(args),
+        Command::Bless(args) => bless::run(args),
+        Command::Diff(args) => diff::run(args),
     }
 }
 

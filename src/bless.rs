@@ -1,0 +1,381 @@
+//! Blessing a trace: replacing its `/expected` channel with the current
+//! core's outcomes, keeping everything else.
+//!
+//! Two passes over the input bytes:
+//! 1. the trace is replayed (the same [`crate::replay`] engine as `check`)
+//!    and every sweep's outcome is kept, by `(frame, ball)`;
+//! 2. the file's records are copied in order with the `mcap` crate's raw
+//!    reader: every schema, channel, message, metadata record and attachment
+//!    is kept verbatim (channel and schema ids may be renumbered), except the
+//!    messages of `/expected` channels, which are dropped; after each `/sweep`
+//!    message its new expectation is written on a `/expected` channel with
+//!    the project's `sweeptrace.Outcome` schema, at the sweep's `log_time`.
+//!
+//! The header's profile and library string are kept. The output is written
+//! with the project's container options (chunked, zstd, summary and
+//! indexes). [`bless_file`] writes to a temporary file next to the output
+//! and renames it when complete, so the output is never half-written and the
+//! input is untouched unless it is also the output.
+
+use std::borrow::Cow;
+use std::collections::{BTreeMap, HashMap, HashSet, VecDeque};
+use std::io::{BufWriter, Seek, Write};
+use std::path::Path;
+
+use mcap::read::ChunkFlattener;
+use mcap::records::{MessageHeader, Record};
+use mcap::{Attachment, McapError};
+use thiserror::Error;
+
+use crate::replay::{ReplayError, ReplayEvent, ReplayOptions, replay_events};
+use crate::trace::TraceReader;
+use crate::trace::messages::{EXPECTED_TOPIC, OUTCOME_SCHEMA, OutcomeMsg, SWEEP_TOPIC};
+use crate::trace::schemas::{MESSAGE_ENCODING, OUTCOME_SCHEMA_JSON, SCHEMA_ENCODING};
+use crate::trace::validate::frame_of;
+use crate::trace::write::default_write_options;
+
+/// What went wrong while blessing.
+#[derive(Debug, Error)]
+#[non_exhaustive]
+pub enum BlessError {
+    /// The trace could not be replayed (read error, invalid scene or sweep).
+    #[error("{file}: cannot replay the trace: {source}")]
+    Replay {
+        /// The input's name.
+        file: String,
+        /// What went wrong.
+        #[source]
+        source: ReplayError,
+    },
+    /// The MCAP container could not be read or written.
+    #[error("{file}: {what}: {source}")]
+    Mcap {
+        /// The file's name.
+        file: String,
+        /// What was being done.
+        what: String,
+        /// The error.
+        #[source]
+        source: McapError,
+    },
+    /// A file could not be read or written.
+    #[error("{file}: {what}: {source}")]
+    Io {
+        /// The file's name.
+        file: String,
+        /// What was being done.
+        what: String,
+        /// The error.
+        #[source]
+        source: std::io::Error,
+    },
+    /// A `/sweep` message found in the copy pass has no outcome from the
+    /// replay pass (the two passes disagree on the file).
+    #[error("{file}: channel `/sweep`, message {index}: no replayed outcome for this sweep")]
+    Unmatched {
+        /// The input's name.
+        file: String,
+        /// Index of the message in the file.
+        index: u64,
+    },
+}
+
+/// Counts of a bless.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct BlessSummary {
+    /// Expectations written (one per sweep).
+    pub expected_written: u64,
+    /// `/expected` messages of the input dropped.
+    pub expected_dropped: u64,
+    /// Messages of other channels copied.
+    pub messages_copied: u64,
+    /// Channels other than `/expected` copied.
+    pub channels_copied: u64,
+    /// Schemas copied.
+    pub schemas_copied: u64,
+    /// Metadata records copied.
+    pub metadata_copied: u64,
+    /// Attachments copied.
+    pub attachments_copied: u64,
+}
+
+/// The outcomes of every sweep of a trace, by `(frame, ball)` in trace order.
+fn outcomes_of(
+    input: &[u8],
+    name: &str,
+    options: ReplayOptions,
+) -> Result<HashMap<(u64, u32), VecDeque<OutcomeMsg>>, BlessError> {
+    let options = ReplayOptions {
+        explain: false,
+        frames: Default::default(),
+        ball: None,
+        ..options
+    };
+    let mut out: HashMap<(u64, u32), VecDeque<OutcomeMsg>> = HashMap::new();
+    for event in replay_events(TraceReader::new(input, name), options) {
+        match event {
+            Ok(ReplayEvent::Sweep(r)) => out
+                .entry((r.frame, r.ball))
+                .or_default()
+                .push_back(r.outcome_msg()),
+            Ok(ReplayEvent::Scene(_)) => {}
+            Err(source) => {
+                return Err(BlessError::Replay {
+                    file: name.to_string(),
+                    source,
+                });
+            }
+        }
+    }
+    Ok(out)
+}
+
+/// Blesses the trace `input` (its bytes; `name` is used in messages) into
+/// `output`. `options` may override the scenes' margin and facing rule (the
+/// frame and ball filters are ignored: every sweep gets an expectation);
+/// the command line always uses the scenes' own.
+pub fn bless_bytes<W: Write + Seek>(
+    input: &[u8],
+    name: &str,
+    output: W,
+    options: ReplayOptions,
+) -> Result<(BlessSummary, W), BlessError> {
+    let mut outcomes = outcomes_of(input, name, options)?;
+    let read_err = |source| BlessError::Mcap {
+        file: name.to_string(),
+        what: "reading the container".to_string(),
+        source,
+    };
+    let write_err = |source| BlessError::Mcap {
+        file: name.to_string(),
+        what: "writing the blessed trace".to_string(),
+        source,
+    };
+
+    // Pass 1 (cheap): the header, and which schemas only `/expected` uses.
+    let mut write_options = default_write_options();
+    let mut used_by_others: HashSet<u16> = HashSet::new();
+    let mut used_by_expected: HashSet<u16> = HashSet::new();
+    for record in ChunkFlattener::new(input).map_err(read_err)? {
+        match record.map_err(read_err)? {
+            Record::Header(h) => {
+                write_options = write_options.profile(h.profile).library(h.library);
+            }
+            Record::Channel(c) if c.topic == EXPECTED_TOPIC => {
+                used_by_expected.insert(c.schema_id);
+            }
+            Record::Channel(c) => {
+                used_by_others.insert(c.schema_id);
+            }
+            Record::DataEnd(_) => break,
+            _ => {}
+        }
+    }
+
+    let mut writer = write_options.create(output).map_err(write_err)?;
+    let mut summary = BlessSummary::default();
+    let mut schema_ids: HashMap<u16, u16> = HashMap::new();
+    let mut channel_ids: HashMap<u16, u16> = HashMap::new();
+    let mut channel_topics: HashMap<u16, String> = HashMap::new();
+    let mut expected_channel: Option<u16> = None;
+    let mut index: u64 = 0;
+    let mut sequence: u32 = 0;
+    for record in ChunkFlattener::new(input).map_err(read_err)? {
+        match record.map_err(read_err)? {
+            Record::Schema { header, data } => {
+                if schema_ids.contains_key(&header.id)
+                    || (used_by_expected.contains(&header.id)
+                        && !used_by_others.contains(&header.id))
+                {
+                    continue;
+                }
+                let id = writer
+                    .add_schema(&header.name, &header.encoding, &data)
+                    .map_err(write_err)?;
+                schema_ids.insert(header.id, id);
+                summary.schemas_copied += 1;
+            }
+            Record::Channel(c) => {
+                if channel_topics.contains_key(&c.id) {
+                    continue;
+                }
+                channel_topics.insert(c.id, c.topic.clone());
+                if c.topic == EXPECTED_TOPIC {
+                    continue;
+                }
+                let schema_id = if c.schema_id == 0 {
+                    0
+                } else {
+                    *schema_ids
+                        .get(&c.schema_id)
+                        .ok_or_else(|| BlessError::Mcap {
+                            file: name.to_string(),
+                            what: format!("channel `{}`", c.topic),
+                            source: McapError::UnknownSchema(c.topic.clone(), c.schema_id),
+                        })?
+                };
+                let id = writer
+                    .add_channel(schema_id, &c.topic, &c.message_encoding, &c.metadata)
+                    .map_err(write_err)?;
+                channel_ids.insert(c.id, id);
+                summary.channels_copied += 1;
+            }
+            Record::Message { header, data } => {
+                let this = index;
+                index += 1;
+                let topic = channel_topics.get(&header.channel_id).map(String::as_str);
+                if topic == Some(EXPECTED_TOPIC) {
+                    summary.expected_dropped += 1;
+                    continue;
+                }
+                let Some(&channel_id) = channel_ids.get(&header.channel_id) else {
+                    return Err(BlessError::Mcap {
+                        file: name.to_string(),
+                        what: format!("message {this}"),
+                        source: McapError::UnknownChannel(header.sequence, header.channel_id),
+                    });
+                };
+                writer
+                    .write_to_known_channel(
+                        &MessageHeader {
+                            channel_id,
+                            sequence,
+                            ..header
+                        },
+                        &data,
+                    )
+                    .map_err(write_err)?;
+                sequence = sequence.wrapping_add(1);
+                summary.messages_copied += 1;
+                if topic != Some(SWEEP_TOPIC) {
+                    continue;
+                }
+                let ball = serde_json::from_slice::<BallOnly>(&data)
+                    .map(|b| b.ball)
+                    .unwrap_or(0);
+                let Some(outcome) = frame_of(&data)
+                    .and_then(|frame| outcomes.get_mut(&(frame, ball)))
+                    .and_then(VecDeque::pop_front)
+                else {
+                    return Err(BlessError::Unmatched {
+                        file: name.to_string(),
+                        index: this,
+                    });
+                };
+                let channel_id = match expected_channel {
+                    Some(id) => id,
+                    None => {
+                        let schema = writer
+                            .add_schema(
+                                OUTCOME_SCHEMA,
+                                SCHEMA_ENCODING,
+                                OUTCOME_SCHEMA_JSON.as_bytes(),
+                            )
+                            .map_err(write_err)?;
+                        let id = writer
+                            .add_channel(schema, EXPECTED_TOPIC, MESSAGE_ENCODING, &BTreeMap::new())
+                            .map_err(write_err)?;
+                        expected_channel = Some(id);
+                        id
+                    }
+                };
+                let json = serde_json::to_vec(&outcome).map_err(|e| BlessError::Io {
+                    file: name.to_string(),
+                    what: format!("serializing the outcome of frame {}", outcome.frame),
+                    source: std::io::Error::other(e),
+                })?;
+                writer
+                    .write_to_known_channel(
+                        &MessageHeader {
+                            channel_id,
+                            sequence,
+                            log_time: header.log_time,
+                            publish_time: header.log_time,
+                        },
+                        &json,
+                    )
+                    .map_err(write_err)?;
+                sequence = sequence.wrapping_add(1);
+                summary.expected_written += 1;
+            }
+            Record::Metadata(m) => {
+                writer.write_metadata(&m).map_err(write_err)?;
+                summary.metadata_copied += 1;
+            }
+            Record::Attachment { header, data, .. } => {
+                writer
+                    .attach(&Attachment {
+                        log_time: header.log_time,
+                        create_time: header.create_time,
+                        name: header.name,
+                        media_type: header.media_type,
+                        data: Cow::Borrowed(&data),
+                    })
+                    .map_err(write_err)?;
+                summary.attachments_copied += 1;
+            }
+            // The summary section is rebuilt by the writer.
+            Record::DataEnd(_) => break,
+            _ => {}
+        }
+    }
+    writer.finish().map_err(write_err)?;
+    Ok((summary, writer.into_inner()))
+}
+
+#[derive(serde::Deserialize)]
+struct BallOnly {
+    #[serde(default)]
+    ball: u32,
+}
+
+/// Blesses the file `input` into `output` (which may be the same path, for
+/// `--in-place`), through a temporary file in `output`'s directory renamed
+/// when complete.
+pub fn bless_file(
+    input: &Path,
+    output: &Path,
+    options: ReplayOptions,
+) -> Result<BlessSummary, BlessError> {
+    let in_name = input.display().to_string();
+    let out_name = output.display().to_string();
+    let io = |file: &str, what: &str| {
+        let file = file.to_string();
+        let what = what.to_string();
+        move |source| BlessError::Io { file, what, source }
+    };
+    let bytes = std::fs::read(input).map_err(io(&in_name, "reading"))?;
+    let dir = match output.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p,
+        _ => Path::new("."),
+    };
+    let prefix = format!(
+        ".{}.",
+        output
+            .file_name()
+            .map(|n| n.to_string_lossy().into_owned())
+            .unwrap_or_default()
+    );
+    let mut builder = tempfile::Builder::new();
+    builder.prefix(&prefix).suffix(".tmp");
+    #[cfg(unix)]
+    builder.permissions(std::os::unix::fs::PermissionsExt::from_mode(0o644));
+    let temp = builder
+        .tempfile_in(dir)
+        .map_err(io(&out_name, "creating a temporary file next to it"))?;
+    let (file, temp_path) = temp.into_parts();
+    let (summary, buffered) = bless_bytes(&bytes, &in_name, BufWriter::new(file), options)?;
+    let file = buffered.into_inner().map_err(|e| BlessError::Io {
+        file: out_name.clone(),
+        what: "writing".to_string(),
+        source: e.into_error(),
+    })?;
+    file.sync_all().map_err(io(&out_name, "writing"))?;
+    drop(file);
+    temp_path.persist(output).map_err(|e| BlessError::Io {
+        file: out_name.clone(),
+        what: "renaming the finished file into place".to_string(),
+        source: e.error,
+    })?;
+    Ok(summary)
+}

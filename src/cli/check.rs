@@ -1,0 +1,176 @@
+//! `sweeptrace check`: replay traces and compare every sweep's outcome with
+//! the trace's `/expected` channel (the library's [`sweeptrace::check`]).
+
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+
+use anyhow::{Context, bail};
+
+use sweeptrace::check::{
+    CheckOptions, DEFAULT_ALPHA_TOLERANCE, DEFAULT_CONTACT_TOLERANCE, DEFAULT_MAX_DETAILS,
+    DEFAULT_NORMAL_TOLERANCE_DEGREES, Status, Tolerances, TraceReport, check_file, find_traces,
+    frames_around, render_json, render_text,
+};
+use sweeptrace::replay::{Detail, ReplayError, ReplayEvent, ReplayOptions, replay_events};
+use sweeptrace::trace::TraceReader;
+use sweeptrace::viz;
+
+/// Frames of context logged before and after the divergences by `--rrd-on-failure`.
+const RRD_CONTEXT_FRAMES: u64 = 10;
+
+/// Arguments of `check`.
+#[derive(Debug, clap::Args)]
+#[command(after_help = "\
+Examples:
+  sweeptrace check traces/                     # every *.mcap under traces/
+  sweeptrace check run.mcap --tolerance 1e-4 --normal-tolerance 0.5
+  sweeptrace check traces/ --json --rrd-on-failure /tmp/failures
+
+Per trace: `ok`, `FAIL` (with the first divergences explained),
+`NO EXPECTATIONS` (no /expected channel, or none matches a sweep: never a
+pass) or `ERROR`. Exit status: 0 every trace matches, 1 a divergence was
+found, 2 something could not be checked (bad input, I/O error, no
+expectations).")]
+pub struct Args {
+    /// Trace files, or directories searched recursively for `*.mcap`.
+    #[arg(value_name = "TRACE|DIR", required = true)]
+    pub paths: Vec<PathBuf>,
+    /// Absolute tolerance on α.
+    #[arg(long, value_name = "A", default_value_t = DEFAULT_ALPHA_TOLERANCE)]
+    pub tolerance: f64,
+    /// Angular tolerance on the normal, in degrees.
+    #[arg(long, value_name = "DEG", default_value_t = DEFAULT_NORMAL_TOLERANCE_DEGREES)]
+    pub normal_tolerance: f64,
+    /// Distance tolerance on the contact point, in scene units.
+    #[arg(long, value_name = "D", default_value_t = DEFAULT_CONTACT_TOLERANCE)]
+    pub contact_tolerance: f64,
+    /// Print one JSON document instead of text.
+    #[arg(long)]
+    pub json: bool,
+    /// How many divergences per trace are explained in detail.
+    #[arg(long, value_name = "N", default_value_t = DEFAULT_MAX_DETAILS)]
+    pub max_details: usize,
+    /// For each failing trace, write DIR/<trace stem>.rrd: a Rerun recording
+    /// of the frames around its first divergences.
+    #[arg(long, value_name = "DIR")]
+    pub rrd_on_failure: Option<PathBuf>,
+}
+
+/// Checks every trace, prints the reports, returns the exit code.
+pub fn run(args: Args) -> anyhow::Result<ExitCode> {
+    let tolerances = Tolerances {
+        alpha: args.tolerance,
+        normal_degrees: args.normal_tolerance,
+        contact: args.contact_tolerance,
+    };
+    if let Err(e) = tolerances.validate() {
+        bail!("{e}");
+    }
+    let traces = find_traces(&args.paths).map_err(anyhow::Error::msg)?;
+    if traces.is_empty() {
+        bail!(
+            "no trace found (directories are searched for *.mcap): {}",
+            args.paths
+                .iter()
+                .map(|p| p.display().to_string())
+                .collect::<Vec<_>>()
+                .join(", ")
+        );
+    }
+    if let Some(dir) = &args.rrd_on_failure {
+        std::fs::create_dir_all(dir)
+            .with_context(|| format!("creating the directory {}", dir.display()))?;
+    }
+    let options = CheckOptions {
+        tolerances,
+        max_details: args.max_details,
+        replay: ReplayOptions::default(),
+    };
+    let mut reports: Vec<TraceReport> = Vec::new();
+    let mut rrd_error = false;
+    for path in &traces {
+        let report = check_file(path, &options);
+        if !args.json {
+            print!("{}", render_text(&report));
+        }
+        if report.status == Status::Fail
+            && let Some(dir) = &args.rrd_on_failure
+        {
+            match write_failure_rrd(path, dir, &report) {
+                Ok(out) => eprintln!("wrote {}", out.display()),
+                Err(err) => {
+                    eprintln!("error: {}: writing the recording: {err:#}", path.display());
+                    rrd_error = true;
+                }
+            }
+        }
+        reports.push(report);
+    }
+    if args.json {
+        print!("{}", render_json(&reports));
+    } else if traces.len() > 1 {
+        let count = |s: Status| reports.iter().filter(|r| r.status == s).count();
+        println!(
+            "{} traces: {} ok, {} FAIL, {} NO EXPECTATIONS, {} ERROR",
+            reports.len(),
+            count(Status::Ok),
+            count(Status::Fail),
+            count(Status::NoExpectations),
+            count(Status::Error)
+        );
+    }
+    let code = Status::exit_code(reports.iter().map(|r| &r.status));
+    Ok(ExitCode::from(if rrd_error { 2 } else { code }))
+}
+
+/// Replays the frames around the report's first divergences into
+/// `dir/<stem>.rrd` (written under a temporary name and renamed).
+fn write_failure_rrd(trace: &Path, dir: &Path, report: &TraceReport) -> anyhow::Result<PathBuf> {
+    let frames = frames_around(report, RRD_CONTEXT_FRAMES, RRD_CONTEXT_FRAMES)
+        .context("no divergence to record")?;
+    let stem = trace
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_else(|| "trace".to_string());
+    let target = dir.join(format!("{stem}.rrd"));
+    let temp = tempfile::Builder::new()
+        .prefix(&format!(".{stem}.rrd."))
+        .suffix(".tmp")
+        .tempfile_in(dir)
+        .with_context(|| format!("creating a temporary file in {}", dir.display()))?
+        .into_temp_path();
+    let options = ReplayOptions {
+        frames,
+        detail: Detail::Candidates,
+        explain: true,
+        ..ReplayOptions::default()
+    };
+    let name = trace.display().to_string();
+    let bytes = std::fs::read(trace).with_context(|| format!("reading {name}"))?;
+    let id = viz::recording_id(&[&bytes, format!("check {options:?}").as_bytes()]);
+    let sink = rerun::sink::FileSink::new(&*temp)
+        .with_context(|| format!("opening {} for writing", temp.display()))?;
+    let rec = viz::builder(&id, &format!("{name} (check, frames {frames})"))
+        .set_sinks(vec![Box::new(sink) as Box<dyn rerun::sink::LogSink>])
+        .context("creating the recording")?;
+    let mut logger = viz::Logger::new(rec, true).context("starting the recording")?;
+    for event in replay_events(TraceReader::new(bytes.as_slice(), &name), options) {
+        match event {
+            Ok(ReplayEvent::Scene(scene)) => {
+                logger.log_scene(&scene).context("logging the scene")?
+            }
+            Ok(ReplayEvent::Sweep(r)) => logger
+                .log_sweep(&r)
+                .with_context(|| format!("logging frame {}", r.frame))?,
+            // The check already reported read errors; record what was read.
+            Err(ReplayError::Trace(_)) => break,
+            Err(err) => return Err(err).context(format!("replaying {name}")),
+        }
+    }
+    let rec = logger.finish();
+    rec.flush_blocking().context("flushing the recording")?;
+    drop(rec);
+    temp.persist(&target)
+        .with_context(|| format!("renaming the finished file to {}", target.display()))?;
+    Ok(target)
+}

@@ -1,0 +1,308 @@
+//! Comparing the outcomes of two replays: two traces, or one trace replayed
+//! twice with different options (`diff T T --facing-b strict`).
+//!
+//! Sweeps are matched by `(frame, ball)`; every field of the two outcomes is
+//! compared with [`crate::check::compare`] and the same [`Tolerances`]. The
+//! [`DiffReport`] counts the sweeps that are the same, differ, or exist on one
+//! side only, summarises the changes by kind (`edge -> none: 12`) and
+//! explains the first divergence on both sides (the tests that decided, from
+//! an exhaustive explained re-run of that one sweep).
+
+use std::collections::BTreeMap;
+use std::fmt::Write as _;
+use std::sync::Arc;
+
+use serde::Serialize;
+use serde_json::json;
+
+use crate::check::{
+    ExpectedTest, FieldDiff, Tolerances, compare, expected_tests, explain_outcome,
+    explained_records,
+};
+use crate::core::explain::num;
+use crate::replay::{
+    ReplayError, ReplayEvent, ReplayOptions, SceneState, SweepResult, replay_events,
+};
+use crate::trace::messages::OutcomeMsg;
+use crate::trace::{TraceError, TraceEvent};
+
+/// One side's replayed sweeps, by `(frame, ball)`.
+pub struct Side {
+    /// The trace's name.
+    pub name: String,
+    /// The options it was replayed with.
+    pub options: ReplayOptions,
+    sweeps: BTreeMap<(u64, u32), (Box<SweepResult>, Arc<SceneState>)>,
+    /// Sweeps that share a `(frame, ball)` with an earlier one (only the
+    /// first is compared).
+    pub duplicates: u64,
+}
+
+impl Side {
+    /// Replays `events` with `options` (no explanation: the fast query).
+    /// The first error (read error, invalid scene or sweep) is returned.
+    pub fn replay<I>(events: I, name: &str, options: ReplayOptions) -> Result<Side, ReplayError>
+    where
+        I: Iterator<Item = Result<TraceEvent, TraceError>>,
+    {
+        let options = ReplayOptions {
+            explain: false,
+            ..options
+        };
+        let mut side = Side {
+            name: name.to_string(),
+            options,
+            sweeps: BTreeMap::new(),
+            duplicates: 0,
+        };
+        let mut scene: Option<Arc<SceneState>> = None;
+        for event in replay_events(events, options) {
+            match event? {
+                ReplayEvent::Scene(s) => scene = Some(s),
+                ReplayEvent::Sweep(r) => {
+                    // A sweep is only yielded after a scene.
+                    let Some(s) = scene.clone() else { continue };
+                    let key = (r.frame, r.ball);
+                    if let std::collections::btree_map::Entry::Vacant(e) = side.sweeps.entry(key) {
+                        e.insert((r, s));
+                    } else {
+                        side.duplicates += 1;
+                    }
+                }
+            }
+        }
+        Ok(side)
+    }
+
+    /// Number of distinct sweeps.
+    pub fn len(&self) -> usize {
+        self.sweeps.len()
+    }
+
+    /// Whether there is no sweep.
+    pub fn is_empty(&self) -> bool {
+        self.sweeps.is_empty()
+    }
+}
+
+/// The first sweep whose outcomes differ.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct FirstDifference {
+    /// Frame.
+    pub frame: u64,
+    /// Ball.
+    pub ball: u32,
+    /// The fields that differ (`expected` is side A, `got` side B).
+    pub fields: Vec<FieldDiff>,
+    /// Side A's outcome.
+    pub a: OutcomeMsg,
+    /// Side B's outcome.
+    pub b: OutcomeMsg,
+    /// The tests that decided side A's outcome.
+    pub a_explanation: Vec<String>,
+    /// The tests that decided side B's outcome.
+    pub b_explanation: Vec<String>,
+    /// Side B's records of the test that decided side A, and why it did
+    /// not decide side B.
+    pub a_test_in_b: Vec<ExpectedTest>,
+    /// Side A's records of the test that decided side B, and why it did
+    /// not decide side A.
+    pub b_test_in_a: Vec<ExpectedTest>,
+}
+
+/// The comparison of two replays.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct DiffReport {
+    /// Side A's name and options in words.
+    pub a: String,
+    /// Side B's name and options in words.
+    pub b: String,
+    /// Sweeps on both sides.
+    pub compared: u64,
+    /// Sweeps whose outcomes match.
+    pub same: u64,
+    /// Sweeps whose outcomes differ.
+    pub different: u64,
+    /// Sweeps only in A.
+    pub only_in_a: u64,
+    /// Sweeps only in B.
+    pub only_in_b: u64,
+    /// Differing sweeps by `"<kind in A> -> <kind in B>"`.
+    pub by_kind: BTreeMap<String, u64>,
+    /// Differing sweeps by field.
+    pub by_field: BTreeMap<String, u64>,
+    /// The first differing sweep (in frame, then ball order).
+    pub first: Option<FirstDifference>,
+    /// The first sweep present on one side only: `(frame, ball, side)`.
+    pub first_unmatched: Option<(u64, u32, char)>,
+    /// The tolerances used.
+    pub tolerances: Tolerances,
+}
+
+impl DiffReport {
+    /// Whether the two replays agree on every sweep.
+    pub fn is_same(&self) -> bool {
+        self.different == 0 && self.only_in_a == 0 && self.only_in_b == 0
+    }
+}
+
+fn describe_side(side: &Side) -> String {
+    let mut s = side.name.clone();
+    let mut opts = Vec::new();
+    if let Some(m) = side.options.margin {
+        opts.push(format!("margin {}", num(m)));
+    }
+    if let Some(f) = side.options.facing {
+        opts.push(format!("facing {f}"));
+    }
+    if !opts.is_empty() {
+        let _ = write!(s, " ({})", opts.join(", "));
+    }
+    s
+}
+
+/// Compares two replays sweep by sweep.
+pub fn diff(a: &Side, b: &Side, tolerances: &Tolerances) -> DiffReport {
+    let mut report = DiffReport {
+        a: describe_side(a),
+        b: describe_side(b),
+        compared: 0,
+        same: 0,
+        different: 0,
+        only_in_a: 0,
+        only_in_b: 0,
+        by_kind: BTreeMap::new(),
+        by_field: BTreeMap::new(),
+        first: None,
+        first_unmatched: None,
+        tolerances: *tolerances,
+    };
+    let unmatched = |key: (u64, u32), side: char, report: &mut DiffReport| {
+        if report.first_unmatched.is_none_or(|(f, b, _)| key < (f, b)) {
+            report.first_unmatched = Some((key.0, key.1, side));
+        }
+    };
+    for (key, (ra, sa)) in &a.sweeps {
+        let Some((rb, sb)) = b.sweeps.get(key) else {
+            report.only_in_a += 1;
+            unmatched(*key, 'A', &mut report);
+            continue;
+        };
+        report.compared += 1;
+        let oa = ra.outcome_msg();
+        let ob = rb.outcome_msg();
+        let fields = compare(&oa, &ob, tolerances);
+        if fields.is_empty() {
+            report.same += 1;
+            continue;
+        }
+        report.different += 1;
+        *report
+            .by_kind
+            .entry(format!("{} -> {}", oa.kind, ob.kind))
+            .or_default() += 1;
+        for f in &fields {
+            *report.by_field.entry(f.field.to_string()).or_default() += 1;
+        }
+        if report.first.is_none() {
+            let records_a = explained_records(ra, sa);
+            let records_b = explained_records(rb, sb);
+            report.first = Some(FirstDifference {
+                frame: key.0,
+                ball: key.1,
+                fields,
+                a: oa,
+                b: ob,
+                a_explanation: explain_outcome(&ra.outcome, &records_a),
+                b_explanation: explain_outcome(&rb.outcome, &records_b),
+                a_test_in_b: expected_tests(&oa, &rb.outcome, &records_b, Some(sb)),
+                b_test_in_a: expected_tests(&ob, &ra.outcome, &records_a, Some(sa)),
+            });
+        }
+    }
+    for key in b.sweeps.keys() {
+        if !a.sweeps.contains_key(key) {
+            report.only_in_b += 1;
+            unmatched(*key, 'B', &mut report);
+        }
+    }
+    report
+}
+
+/// The report in words.
+pub fn render_text(r: &DiffReport) -> String {
+    let mut s = String::new();
+    let _ = writeln!(s, "A: {}\nB: {}", r.a, r.b);
+    if r.is_same() {
+        let _ = writeln!(s, "same: {} sweeps, identical outcomes", r.compared);
+        return s;
+    }
+    let _ = writeln!(
+        s,
+        "different: {} of {} sweeps differ; {} only in A, {} only in B",
+        r.different, r.compared, r.only_in_a, r.only_in_b
+    );
+    if !r.by_kind.is_empty() {
+        let _ = writeln!(s, "by kind (A -> B):");
+        for (k, n) in &r.by_kind {
+            let _ = writeln!(s, "  {k}: {n}");
+        }
+        let fields = r
+            .by_field
+            .iter()
+            .map(|(f, n)| format!("{f} {n}"))
+            .collect::<Vec<_>>()
+            .join(", ");
+        let _ = writeln!(s, "by field: {fields}");
+    }
+    if let Some(f) = &r.first {
+        let _ = writeln!(s, "first divergence: frame {}, ball {}", f.frame, f.ball);
+        for d in &f.fields {
+            let _ = write!(
+                s,
+                "  {}: A {}, B {}",
+                d.field,
+                crate::check::value_text(&d.expected),
+                crate::check::value_text(&d.got)
+            );
+            if let Some(detail) = &d.detail {
+                let _ = write!(s, " ({detail})");
+            }
+            s.push('\n');
+        }
+        let _ = writeln!(s, "  A:");
+        for line in &f.a_explanation {
+            let _ = writeln!(s, "    {line}");
+        }
+        let _ = writeln!(s, "  B:");
+        for line in &f.b_explanation {
+            let _ = writeln!(s, "    {line}");
+        }
+        for t in &f.a_test_in_b {
+            let _ = writeln!(s, "  A's test in B: {}", t.description);
+            let _ = writeln!(s, "    why it does not decide B: {}", t.why_not);
+        }
+        for t in &f.b_test_in_a {
+            let _ = writeln!(s, "  B's test in A: {}", t.description);
+            let _ = writeln!(s, "    why it does not decide A: {}", t.why_not);
+        }
+    }
+    if let Some((frame, ball, side)) = r.first_unmatched {
+        let _ = writeln!(
+            s,
+            "first sweep on one side only: frame {frame}, ball {ball}, in {side}"
+        );
+    }
+    s
+}
+
+/// The report as pretty JSON, ending with a newline.
+pub fn render_json(r: &DiffReport) -> String {
+    let mut v = serde_json::to_value(r).unwrap_or_else(|e| json!({ "error": e.to_string() }));
+    if let Some(obj) = v.as_object_mut() {
+        obj.insert("same_outcomes".into(), json!(r.is_same()));
+    }
+    let mut s = serde_json::to_string_pretty(&v).unwrap_or_default();
+    s.push('\n');
+    s
+}

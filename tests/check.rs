@@ -1,0 +1,909 @@
+//! Regression checking, blessing and diffing.
+//!
+//! Every `*.mcap` under `traces/` (found at run time, so adding a trace
+//! needs no code) is a test case of its own, checked with the same library
+//! code as `sweeptrace check`.
+//!
+//! The fixture `tests/fixtures/wrong_engine_config.mcap` is made by the
+//! ignored generator below, from the project's own writer:
+//! `cargo test --test integration -- --ignored check::generate_wrong_engine_config`.
+//! Its scene declares margin 0.1; its `/expected` outcomes were computed
+//! with margin 0 (an engine configuration the scene does not declare), so
+//! the first divergent sweep is frame 2 (expected an edge hit on edge 0.0,
+//! the core finds nothing at ρ = 0.4) and frame 3 differs in α.
+
+use std::borrow::Cow;
+use std::collections::BTreeMap;
+use std::io::Cursor;
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+use libtest_mimic::{Failed, Trial};
+use sweeptrace::bless::bless_bytes;
+use sweeptrace::check::{
+    CheckOptions, Field, Status, Tolerances, check_file, check_reader, compare, find_traces,
+    render_json, render_text,
+};
+use sweeptrace::core::{Facing, Kind};
+use sweeptrace::diff::{Side, diff};
+use sweeptrace::replay::ReplayOptions;
+use sweeptrace::trace::messages::{OutcomeMsg, SceneMsg, SweepMsg};
+use sweeptrace::trace::{TraceReader, TraceWriter};
+
+use crate::ensure;
+use crate::trial;
+
+const FIXTURE: &str = "tests/fixtures/wrong_engine_config.mcap";
+
+pub fn tests() -> Vec<Trial> {
+    let mut trials = vec![
+        trial(
+            "check::compare_only_fields_present",
+            compare_only_fields_present,
+        ),
+        trial("check::compare_null_is_compared", compare_null_is_compared),
+        trial("check::compare_tolerances", compare_tolerances),
+        trial(
+            "check::compare_nan_never_matches",
+            compare_nan_never_matches,
+        ),
+        trial("check::blessed_trace_passes", blessed_trace_passes),
+        trial(
+            "check::wrong_engine_config_fixture_fails_with_frame_and_reason",
+            fixture_fails_through_library,
+        ),
+        trial(
+            "check::wrong_engine_config_fixture_binary_exit_1",
+            fixture_fails_through_binary,
+        ),
+        trial("check::no_expected_channel_is_not_a_pass", no_expectations),
+        trial("check::binary_errors_exit_2", binary_errors_exit_2),
+        trial("check::trace_discovery_in_directories", discovery),
+        trial(
+            "check::bless_round_trip_fixes_wrong_expectations",
+            bless_round_trip,
+        ),
+        trial(
+            "check::bless_keeps_foreign_channel_metadata_attachment",
+            bless_keeps_foreign,
+        ),
+        trial(
+            "check::bless_binary_requires_output_and_keeps_input",
+            bless_binary,
+        ),
+        trial("check::diff_same_trace_is_same", diff_same),
+        trial(
+            "check::diff_strict_facing_reports_first_divergence",
+            diff_facing,
+        ),
+        trial("check::diff_binary_exit_codes", diff_binary),
+        Trial::test("check::generate_wrong_engine_config", || {
+            generate_fixture().map_err(Failed::from)
+        })
+        .with_ignored_flag(true),
+    ];
+    trials.extend(trace_trials());
+    trials
+}
+
+/// One trial per `*.mcap` under `traces/`, found at run time.
+fn trace_trials() -> Vec<Trial> {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let dir = root.join("traces");
+    if !dir.is_dir() {
+        return Vec::new();
+    }
+    match find_traces(&[dir]) {
+        Ok(paths) => paths
+            .into_iter()
+            .map(|path| {
+                let name = path
+                    .strip_prefix(root)
+                    .unwrap_or(&path)
+                    .display()
+                    .to_string();
+                trial(&format!("check::trace::{name}"), move || {
+                    let report = check_file(&path, &CheckOptions::default());
+                    ensure!(report.status == Status::Ok, "{}", render_text(&report));
+                    Ok(())
+                })
+            })
+            .collect(),
+        Err(e) => vec![trial("check::trace::discovery", move || Err(e))],
+    }
+}
+
+// ---------------------------------------------------------------- helpers
+
+/// Triangle T of SEMANTICS.md.
+fn scene_t(margin: f64) -> SceneMsg {
+    SceneMsg {
+        name: Some("triangle_t".into()),
+        vertices: vec![[0.0, 0.0, 0.0], [4.0, 0.0, 0.0], [0.0, 4.0, 0.0]],
+        triangles: vec![[0, 1, 2]],
+        margin,
+        facing: Facing::NonStrict,
+    }
+}
+
+fn sweep(frame: u64, p0: [f64; 3], p1: [f64; 3]) -> SweepMsg {
+    SweepMsg {
+        frame,
+        ball: 0,
+        radius: 0.5,
+        p0,
+        p1,
+    }
+}
+
+/// The sweeps of the fixture: two misses, an edge hit that needs ρ ≥ 0.45,
+/// the face of worked example 1, a miss.
+fn fixture_sweeps() -> Vec<SweepMsg> {
+    vec![
+        sweep(0, [10.0, 10.0, 3.0], [11.0, 10.0, 3.0]),
+        sweep(1, [10.0, 10.0, 3.0], [10.0, 11.0, 3.0]),
+        sweep(2, [2.0, -0.45, 3.0], [2.0, -0.45, -3.0]),
+        sweep(3, [1.0, 1.0, 3.0], [1.0, 1.0, -3.0]),
+        sweep(4, [10.0, 10.0, 3.0], [11.0, 11.0, 3.0]),
+    ]
+}
+
+/// A trace of `scene` and `sweeps`, with the given expectations logged
+/// right after their sweeps.
+fn write_trace(scene: &SceneMsg, sweeps: &[SweepMsg], expected: &[OutcomeMsg]) -> Vec<u8> {
+    let mut w = TraceWriter::new(Cursor::new(Vec::new())).expect("writer");
+    w.scene(0, scene).expect("scene");
+    for s in sweeps {
+        let t = 1_000_000 * (s.frame + 1);
+        w.sweep(t, s).expect("sweep");
+        for e in expected
+            .iter()
+            .filter(|e| e.frame == s.frame && e.ball == s.ball)
+        {
+            w.expected(t, e).expect("expected");
+        }
+    }
+    w.finish().expect("finish").into_inner()
+}
+
+/// Blesses `bytes` in memory with `options`.
+fn bless_with(bytes: &[u8], options: ReplayOptions) -> Result<Vec<u8>, String> {
+    bless_bytes(bytes, "<memory>", Cursor::new(Vec::new()), options)
+        .map(|(_, c)| c.into_inner())
+        .map_err(|e| e.to_string())
+}
+
+/// The fixture's bytes: scene margin 0.1, expectations from margin 0.
+fn fixture_bytes() -> Result<Vec<u8>, String> {
+    let plain = write_trace(&scene_t(0.1), &fixture_sweeps(), &[]);
+    bless_with(
+        &plain,
+        ReplayOptions {
+            margin: Some(0.0),
+            ..ReplayOptions::default()
+        },
+    )
+}
+
+fn check_bytes(bytes: &[u8]) -> sweeptrace::check::TraceReport {
+    check_reader(bytes, "<memory>", &CheckOptions::default())
+}
+
+fn fixture_path() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join(FIXTURE)
+}
+
+fn bin() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_sweeptrace"))
+}
+
+fn run_bin(args: &[&std::ffi::OsStr]) -> Result<(i32, String, String), String> {
+    let out = bin()
+        .args(args)
+        .output()
+        .map_err(|e| format!("running sweeptrace: {e}"))?;
+    Ok((
+        out.status.code().unwrap_or(-1),
+        String::from_utf8_lossy(&out.stdout).into_owned(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    ))
+}
+
+macro_rules! os {
+    ($($a:expr),* $(,)?) => { &[$(std::ffi::OsStr::new($a)),*] };
+}
+
+fn full(frame: u64, alpha: f64, kind: Kind) -> OutcomeMsg {
+    OutcomeMsg {
+        frame,
+        ball: 0,
+        alpha,
+        kind,
+        triangle: Some(Some(0)),
+        feature: Some(Some(0)),
+        normal: Some(Some([0.0, 0.0, 1.0])),
+        contact: Some(Some([1.0, 1.0, 0.0])),
+    }
+}
+
+// ---------------------------------------------------------------- compare
+
+fn compare_only_fields_present() -> Result<(), String> {
+    let got = full(0, 0.5, Kind::Face);
+    let expected = OutcomeMsg {
+        triangle: None,
+        feature: None,
+        normal: None,
+        contact: None,
+        ..full(0, 0.5, Kind::Face)
+    };
+    // Absent fields are not compared even though `got` differs there.
+    let got_other = OutcomeMsg {
+        triangle: Some(Some(7)),
+        normal: Some(Some([1.0, 0.0, 0.0])),
+        ..got
+    };
+    let d = compare(&expected, &got_other, &Tolerances::default());
+    ensure!(d.is_empty(), "absent fields were compared: {d:?}");
+    let expected_tri = OutcomeMsg {
+        triangle: Some(Some(0)),
+        ..expected
+    };
+    let d = compare(&expected_tri, &got_other, &Tolerances::default());
+    ensure!(
+        d.len() == 1 && d[0].field == Field::Triangle,
+        "a present triangle must be compared: {d:?}"
+    );
+    Ok(())
+}
+
+fn compare_null_is_compared() -> Result<(), String> {
+    let got = full(0, 0.5, Kind::Face);
+    let expected = OutcomeMsg {
+        normal: Some(None),
+        contact: None,
+        triangle: None,
+        feature: None,
+        ..got
+    };
+    let d = compare(&expected, &got, &Tolerances::default());
+    ensure!(
+        d.len() == 1 && d[0].field == Field::Normal,
+        "a null normal must be compared: {d:?}"
+    );
+    Ok(())
+}
+
+fn compare_tolerances() -> Result<(), String> {
+    let tol = Tolerances {
+        alpha: 1e-3,
+        normal_degrees: 1.0,
+        contact: 0.01,
+    };
+    let expected = full(0, 0.5, Kind::Face);
+    // 0.5° off, α 5e-4 off, contact 0.005 off: all within.
+    let a = 0.5f64.to_radians();
+    let got = OutcomeMsg {
+        alpha: 0.5005,
+        normal: Some(Some([a.sin(), 0.0, a.cos()])),
+        contact: Some(Some([1.005, 1.0, 0.0])),
+        ..expected
+    };
+    let d = compare(&expected, &got, &tol);
+    ensure!(d.is_empty(), "within tolerance: {d:?}");
+    // 2° off, α 2e-3 off, contact 0.02 off: all out.
+    let a = 2f64.to_radians();
+    let got = OutcomeMsg {
+        alpha: 0.502,
+        normal: Some(Some([a.sin(), 0.0, a.cos()])),
+        contact: Some(Some([1.02, 1.0, 0.0])),
+        ..expected
+    };
+    let fields: Vec<Field> = compare(&expected, &got, &tol)
+        .iter()
+        .map(|f| f.field)
+        .collect();
+    ensure!(
+        fields == vec![Field::Alpha, Field::Normal, Field::Contact],
+        "outside tolerance: {fields:?}"
+    );
+    Ok(())
+}
+
+fn compare_nan_never_matches() -> Result<(), String> {
+    let expected = full(0, 0.5, Kind::Face);
+    let got = OutcomeMsg {
+        alpha: f64::NAN,
+        normal: Some(Some([f64::NAN, 0.0, 1.0])),
+        ..expected
+    };
+    let fields: Vec<Field> = compare(&expected, &got, &Tolerances::default())
+        .iter()
+        .map(|f| f.field)
+        .collect();
+    ensure!(
+        fields == vec![Field::Alpha, Field::Normal],
+        "NaN must differ: {fields:?}"
+    );
+    Ok(())
+}
+
+// ---------------------------------------------------------------- check
+
+fn blessed_trace_passes() -> Result<(), String> {
+    let plain = write_trace(&scene_t(0.1), &fixture_sweeps(), &[]);
+    let blessed = bless_with(&plain, ReplayOptions::default())?;
+    let report = check_bytes(&blessed);
+    ensure!(report.status == Status::Ok, "{}", render_text(&report));
+    ensure!(
+        report.compared == 5 && report.sweeps_without_expectation == 0,
+        "counts: {report:?}"
+    );
+    ensure!(
+        render_text(&report).starts_with("ok "),
+        "text: {}",
+        render_text(&report)
+    );
+    Ok(())
+}
+
+fn check_fixture_report(report: &sweeptrace::check::TraceReport) -> Result<(), String> {
+    let text = render_text(report);
+    ensure!(
+        report.status == Status::Fail,
+        "status {:?}\n{text}",
+        report.status
+    );
+    ensure!(
+        report.divergent == 2,
+        "two sweeps diverge (2 and 3):\n{text}"
+    );
+    let first = report.divergences.first().ok_or("no divergence detail")?;
+    ensure!(
+        first.frame == 2,
+        "first divergent frame is 2, got {}",
+        first.frame
+    );
+    ensure!(
+        first.fields.iter().any(|f| f.field == Field::Kind),
+        "frame 2 differs in kind: {:?}",
+        first.fields
+    );
+    ensure!(
+        text.contains("first divergence: frame 2, ball 0"),
+        "names the first frame:\n{text}"
+    );
+    ensure!(
+        text.contains("kind: expected edge, got none"),
+        "the reason:\n{text}"
+    );
+    // The test that would have produced the expected edge, and why not:
+    // at ρ = 0.4 the path never comes within ρ of edge 0's line.
+    ensure!(
+        text.contains("expected result's test: edge 0.0: ") && text.contains("< 0 (never within ρ"),
+        "explains the expected test:\n{text}"
+    );
+    ensure!(
+        text.contains("margin 0.1"),
+        "names the margin used:\n{text}"
+    );
+    ensure!(text.contains("edge -> none: 1"), "summary by kind:\n{text}");
+    Ok(())
+}
+
+fn fixture_fails_through_library() -> Result<(), String> {
+    let report = check_file(&fixture_path(), &CheckOptions::default());
+    check_fixture_report(&report)?;
+    // The committed fixture is what the generator makes.
+    let fresh = check_bytes(&fixture_bytes()?);
+    check_fixture_report(&fresh)?;
+    let json: serde_json::Value =
+        serde_json::from_str(&render_json(&[report])).map_err(|e| e.to_string())?;
+    ensure!(json["exit_code"] == 1, "json exit code: {json}");
+    ensure!(
+        json["traces"][0]["divergences"][0]["frame"] == 2,
+        "json first frame: {json}"
+    );
+    Ok(())
+}
+
+fn fixture_fails_through_binary() -> Result<(), String> {
+    let fixture = fixture_path();
+    let (code, out, err) = run_bin(os!["check", fixture.as_os_str()])?;
+    ensure!(code == 1, "exit {code}\n{out}\n{err}");
+    ensure!(out.starts_with("FAIL "), "stdout:\n{out}");
+    ensure!(out.contains("first divergence: frame 2"), "stdout:\n{out}");
+    let (code, out, err) = run_bin(os!["check", fixture.as_os_str(), "--json"])?;
+    ensure!(code == 1, "exit {code}\n{out}\n{err}");
+    let json: serde_json::Value = serde_json::from_str(&out).map_err(|e| format!("{e}: {out}"))?;
+    ensure!(json["traces"][0]["status"] == "fail", "json: {json}");
+    // A tolerance wide enough for frame 3's α still fails on frame 2's kind.
+    let (code, _, _) = run_bin(os!["check", fixture.as_os_str(), "--tolerance", "0.5"])?;
+    ensure!(code == 1, "exit {code} with a wide α tolerance");
+    Ok(())
+}
+
+fn no_expectations() -> Result<(), String> {
+    let plain = write_trace(&scene_t(0.0), &fixture_sweeps(), &[]);
+    let report = check_bytes(&plain);
+    ensure!(
+        report.status == Status::NoExpectations,
+        "status {:?}",
+        report.status
+    );
+    let text = render_text(&report);
+    ensure!(
+        text.starts_with("NO EXPECTATIONS")
+            && text.contains("the /expected channel holds no message"),
+        "{text}"
+    );
+    // Without the channel at all.
+    let raw = foreign_trace_with(false)?;
+    let text = render_text(&check_bytes(&raw));
+    ensure!(
+        text.starts_with("NO EXPECTATIONS") && text.contains("no /expected channel"),
+        "{text}"
+    );
+    // Through the binary: exit 2.
+    let dir = tempfile::tempdir().map_err(|e| e.to_string())?;
+    let path = dir.path().join("plain.mcap");
+    std::fs::write(&path, &plain).map_err(|e| e.to_string())?;
+    let (code, out, _) = run_bin(os!["check", path.as_os_str()])?;
+    ensure!(
+        code == 2 && out.contains("NO EXPECTATIONS"),
+        "exit {code}: {out}"
+    );
+    Ok(())
+}
+
+fn binary_errors_exit_2() -> Result<(), String> {
+    let dir = tempfile::tempdir().map_err(|e| e.to_string())?;
+    let missing = dir.path().join("missing.mcap");
+    let (code, out, _) = run_bin(os!["check", missing.as_os_str()])?;
+    ensure!(
+        code == 2 && out.contains("ERROR"),
+        "missing file: exit {code}: {out}"
+    );
+    let garbage = dir.path().join("garbage.mcap");
+    std::fs::write(&garbage, b"not an mcap file").map_err(|e| e.to_string())?;
+    let (code, out, _) = run_bin(os!["check", garbage.as_os_str()])?;
+    ensure!(
+        code == 2 && out.contains("ERROR"),
+        "garbage: exit {code}: {out}"
+    );
+    // A truncated good trace: an error, never a pass.
+    let good = bless_with(
+        &write_trace(&scene_t(0.0), &fixture_sweeps(), &[]),
+        ReplayOptions::default(),
+    )?;
+    let cut = dir.path().join("cut.mcap");
+    std::fs::write(&cut, &good[..good.len() * 2 / 3]).map_err(|e| e.to_string())?;
+    let (code, out, _) = run_bin(os!["check", cut.as_os_str()])?;
+    ensure!(code == 2, "truncated: exit {code}: {out}");
+    let (code, _, err) = run_bin(os!["check", missing.as_os_str(), "--tolerance", "nan"])?;
+    ensure!(code == 2, "NaN tolerance: exit {code}: {err}");
+    Ok(())
+}
+
+fn discovery() -> Result<(), String> {
+    let dir = tempfile::tempdir().map_err(|e| e.to_string())?;
+    let sub = dir.path().join("b");
+    std::fs::create_dir_all(&sub).map_err(|e| e.to_string())?;
+    let good = bless_with(
+        &write_trace(&scene_t(0.0), &fixture_sweeps(), &[]),
+        ReplayOptions::default(),
+    )?;
+    std::fs::write(dir.path().join("a.mcap"), &good).map_err(|e| e.to_string())?;
+    std::fs::write(sub.join("c.mcap"), &good).map_err(|e| e.to_string())?;
+    std::fs::write(sub.join("notes.txt"), b"x").map_err(|e| e.to_string())?;
+    let found = find_traces(&[dir.path().to_path_buf()])?;
+    let names: Vec<String> = found
+        .iter()
+        .map(|p| {
+            p.strip_prefix(dir.path())
+                .unwrap_or(p)
+                .display()
+                .to_string()
+        })
+        .collect();
+    ensure!(
+        names
+            == vec![
+                "a.mcap".to_string(),
+                format!("b{}c.mcap", std::path::MAIN_SEPARATOR)
+            ],
+        "found {names:?}"
+    );
+    let (code, out, err) = run_bin(os!["check", dir.path().as_os_str()])?;
+    ensure!(code == 0, "exit {code}\n{out}\n{err}");
+    ensure!(out.contains("2 traces: 2 ok"), "{out}");
+    // One failing trace among passing ones: exit 1, and an .rrd of it.
+    std::fs::copy(fixture_path(), sub.join("wrong.mcap")).map_err(|e| e.to_string())?;
+    let rrd_dir = dir.path().join("rrd");
+    let (code, out, err) = run_bin(os![
+        "check",
+        dir.path().as_os_str(),
+        "--rrd-on-failure",
+        rrd_dir.as_os_str()
+    ])?;
+    ensure!(code == 1, "exit {code}\n{out}\n{err}");
+    let rrd = rrd_dir.join("wrong.rrd");
+    let size = std::fs::metadata(&rrd).map(|m| m.len()).unwrap_or(0);
+    ensure!(size > 0, "no recording at {}: {err}", rrd.display());
+    Ok(())
+}
+
+// ---------------------------------------------------------------- bless
+
+fn bless_round_trip() -> Result<(), String> {
+    let wrong = fixture_bytes()?;
+    ensure!(
+        check_bytes(&wrong).status == Status::Fail,
+        "the input must fail"
+    );
+    let blessed = bless_with(&wrong, ReplayOptions::default())?;
+    let report = check_bytes(&blessed);
+    ensure!(report.status == Status::Ok, "{}", render_text(&report));
+    ensure!(
+        report.compared == 5 && report.expectations_without_sweep == 0,
+        "one expectation per sweep, old ones gone: {report:?}"
+    );
+    // Blessing twice gives the same bytes (deterministic writer).
+    let twice = bless_with(&blessed, ReplayOptions::default())?;
+    ensure!(twice == blessed, "bless is not idempotent");
+    Ok(())
+}
+
+/// A trace written with the raw `mcap` writer: a foreign channel with its
+/// own schema, a channel without schema, a metadata record, an attachment,
+/// and wrong expectations.
+fn foreign_trace() -> Result<Vec<u8>, String> {
+    foreign_trace_with(true)
+}
+
+/// [`foreign_trace`], with or without its `/expected` channel.
+fn foreign_trace_with(with_expected: bool) -> Result<Vec<u8>, String> {
+    use sweeptrace::trace::schemas::{OUTCOME_SCHEMA_JSON, SCENE_SCHEMA_JSON, SWEEP_SCHEMA_JSON};
+    let e = |e: mcap::McapError| e.to_string();
+    let mut w = mcap::WriteOptions::new()
+        .library("some-engine 3.1")
+        .profile("game")
+        .create(Cursor::new(Vec::new()))
+        .map_err(e)?;
+    let none = BTreeMap::new();
+    let scene_s = w
+        .add_schema(
+            "sweeptrace.Scene",
+            "jsonschema",
+            SCENE_SCHEMA_JSON.as_bytes(),
+        )
+        .map_err(e)?;
+    let sweep_s = w
+        .add_schema(
+            "sweeptrace.Sweep",
+            "jsonschema",
+            SWEEP_SCHEMA_JSON.as_bytes(),
+        )
+        .map_err(e)?;
+    let out_s = w
+        .add_schema(
+            "sweeptrace.Outcome",
+            "jsonschema",
+            OUTCOME_SCHEMA_JSON.as_bytes(),
+        )
+        .map_err(e)?;
+    let cam_s = w
+        .add_schema("game.Camera", "protobuf", b"\x0a\x05hello")
+        .map_err(e)?;
+    let scene_c = w.add_channel(scene_s, "/scene", "json", &none).map_err(e)?;
+    let sweep_c = w.add_channel(sweep_s, "/sweep", "json", &none).map_err(e)?;
+    let out_c = if with_expected {
+        w.add_channel(out_s, "/expected", "json", &none)
+            .map_err(e)?
+    } else {
+        0
+    };
+    let cam_meta = BTreeMap::from([("fps".to_string(), "60".to_string())]);
+    let cam_c = w
+        .add_channel(cam_s, "/camera", "protobuf", &cam_meta)
+        .map_err(e)?;
+    let log_c = w.add_channel(0, "/log", "text", &none).map_err(e)?;
+    w.write_metadata(&mcap::records::Metadata {
+        name: "engine".into(),
+        metadata: BTreeMap::from([("gravity".to_string(), "-9.81".to_string())]),
+    })
+    .map_err(e)?;
+    let put = |w: &mut mcap::Writer<Cursor<Vec<u8>>>, c: u16, t: u64, data: &[u8]| {
+        w.write_to_known_channel(
+            &mcap::records::MessageHeader {
+                channel_id: c,
+                sequence: 0,
+                log_time: t,
+                publish_time: t,
+            },
+            data,
+        )
+        .map_err(|e| e.to_string())
+    };
+    let json = |v: &dyn erased::Ser| v.json();
+    put(&mut w, scene_c, 0, &json(&scene_t(0.0)))?;
+    for (i, s) in fixture_sweeps().iter().enumerate() {
+        let t = 10 + i as u64 * 10;
+        put(&mut w, cam_c, t, &[1, 2, 3, i as u8])?;
+        put(&mut w, sweep_c, t, &json(s))?;
+        // Wrong on purpose: everything hits the face at α = 0.
+        let wrong = OutcomeMsg {
+            frame: s.frame,
+            ball: 0,
+            alpha: 0.0,
+            kind: Kind::Face,
+            triangle: None,
+            feature: None,
+            normal: None,
+            contact: None,
+        };
+        if with_expected {
+            put(&mut w, out_c, t, &json(&wrong))?;
+        }
+        put(
+            &mut w,
+            log_c,
+            t + 1,
+            format!("frame {}", s.frame).as_bytes(),
+        )?;
+    }
+    w.attach(&mcap::Attachment {
+        log_time: 5,
+        create_time: 6,
+        name: "calibration.txt".into(),
+        media_type: "text/plain".into(),
+        data: Cow::Borrowed(b"k = 1.5"),
+    })
+    .map_err(e)?;
+    w.finish().map_err(e)?;
+    Ok(w.into_inner().into_inner())
+}
+
+mod erased {
+    /// Serializes any message to JSON bytes (keeps the helper closure simple).
+    pub trait Ser {
+        fn json(&self) -> Vec<u8>;
+    }
+    impl<T: serde::Serialize> Ser for T {
+        fn json(&self) -> Vec<u8> {
+            serde_json::to_vec(self).expect("messages serialize")
+        }
+    }
+}
+
+/// Everything in a file but the `/expected` messages and the container's
+/// own bookkeeping: (schemas, channels, messages by topic, metadata, attachments).
+type Contents = (
+    Vec<(String, String, Vec<u8>)>,
+    Vec<(String, String, String, BTreeMap<String, String>)>,
+    BTreeMap<String, Vec<(u64, Vec<u8>)>>,
+    Vec<(String, BTreeMap<String, String>)>,
+    Vec<(String, String, u64, u64, Vec<u8>)>,
+    String,
+);
+
+fn contents(bytes: &[u8]) -> Result<Contents, String> {
+    let mut schemas = BTreeMap::new();
+    let mut channels = BTreeMap::new();
+    let mut messages: BTreeMap<String, Vec<(u64, Vec<u8>)>> = BTreeMap::new();
+    let mut metadata = Vec::new();
+    let mut attachments = Vec::new();
+    let mut header = String::new();
+    for r in mcap::read::ChunkFlattener::new(bytes).map_err(|e| e.to_string())? {
+        match r.map_err(|e| e.to_string())? {
+            mcap::records::Record::Header(h) => header = format!("{} / {}", h.profile, h.library),
+            mcap::records::Record::Schema { header, data } => {
+                schemas.insert(header.id, (header.name, header.encoding, data.into_owned()));
+            }
+            mcap::records::Record::Channel(c) => {
+                let schema = schemas
+                    .get(&c.schema_id)
+                    .map(|s| s.0.clone())
+                    .unwrap_or_default();
+                channels.insert(c.id, (c.topic, schema, c.message_encoding, c.metadata));
+            }
+            mcap::records::Record::Message { header, data } => {
+                let topic = channels
+                    .get(&header.channel_id)
+                    .map(|c| c.0.clone())
+                    .unwrap_or_default();
+                messages
+                    .entry(topic)
+                    .or_default()
+                    .push((header.log_time, data.into_owned()));
+            }
+            mcap::records::Record::Metadata(m) => metadata.push((m.name, m.metadata)),
+            mcap::records::Record::Attachment { header, data, .. } => attachments.push((
+                header.name,
+                header.media_type,
+                header.log_time,
+                header.create_time,
+                data.into_owned(),
+            )),
+            mcap::records::Record::DataEnd(_) => break,
+            _ => {}
+        }
+    }
+    let mut schemas: Vec<_> = schemas.into_values().collect();
+    schemas.sort();
+    let mut channels: Vec<_> = channels.into_values().collect();
+    channels.sort();
+    Ok((schemas, channels, messages, metadata, attachments, header))
+}
+
+fn bless_keeps_foreign() -> Result<(), String> {
+    let input = foreign_trace()?;
+    ensure!(
+        check_bytes(&input).status == Status::Fail,
+        "input expectations are wrong"
+    );
+    let output = bless_with(&input, ReplayOptions::default())?;
+    let report = check_bytes(&output);
+    ensure!(report.status == Status::Ok, "{}", render_text(&report));
+    let (s_in, c_in, mut m_in, md_in, a_in, h_in) = contents(&input)?;
+    let (s_out, c_out, mut m_out, md_out, a_out, h_out) = contents(&output)?;
+    ensure!(s_in == s_out, "schemas:\n{s_in:?}\n{s_out:?}");
+    ensure!(c_in == c_out, "channels:\n{c_in:?}\n{c_out:?}");
+    ensure!(md_in == md_out, "metadata:\n{md_in:?}\n{md_out:?}");
+    ensure!(
+        a_in == a_out && a_out.len() == 1,
+        "attachments:\n{a_in:?}\n{a_out:?}"
+    );
+    ensure!(h_in == h_out, "header: {h_in} vs {h_out}");
+    let exp_in = m_in.remove("/expected").unwrap_or_default();
+    let exp_out = m_out.remove("/expected").unwrap_or_default();
+    ensure!(m_in == m_out, "messages of the other channels changed");
+    ensure!(
+        exp_in.len() == 5 && exp_out.len() == 5 && exp_in != exp_out,
+        "expectations: {} in, {} out",
+        exp_in.len(),
+        exp_out.len()
+    );
+    ensure!(
+        m_out.get("/camera").map(Vec::len) == Some(5) && m_out.get("/log").map(Vec::len) == Some(5),
+        "foreign messages: {:?}",
+        m_out.keys().collect::<Vec<_>>()
+    );
+    // The reader still reads it (log times in order).
+    let events = TraceReader::new(output.as_slice(), "<blessed>").count();
+    ensure!(
+        events == 11,
+        "1 scene + 5 sweeps + 5 expected, got {events}"
+    );
+    Ok(())
+}
+
+fn bless_binary() -> Result<(), String> {
+    let dir = tempfile::tempdir().map_err(|e| e.to_string())?;
+    let input = dir.path().join("wrong.mcap");
+    std::fs::copy(fixture_path(), &input).map_err(|e| e.to_string())?;
+    let before = std::fs::read(&input).map_err(|e| e.to_string())?;
+    let (code, _, err) = run_bin(os!["bless", input.as_os_str()])?;
+    ensure!(
+        code == 2 && err.contains("-o"),
+        "no output named: exit {code}: {err}"
+    );
+    let out = dir.path().join("blessed.mcap");
+    let (code, _, err) = run_bin(os!["bless", input.as_os_str(), "-o", out.as_os_str()])?;
+    ensure!(code == 0, "bless -o: exit {code}: {err}");
+    let after = std::fs::read(&input).map_err(|e| e.to_string())?;
+    ensure!(before == after, "the input changed");
+    let (code, stdout, _) = run_bin(os!["check", out.as_os_str()])?;
+    ensure!(code == 0, "check after bless: exit {code}: {stdout}");
+    let (code, _, err) = run_bin(os!["bless", input.as_os_str(), "--in-place"])?;
+    ensure!(code == 0, "bless --in-place: exit {code}: {err}");
+    let (code, stdout, _) = run_bin(os!["check", input.as_os_str()])?;
+    ensure!(
+        code == 0,
+        "check after bless --in-place: exit {code}: {stdout}"
+    );
+    let leftovers: Vec<_> = std::fs::read_dir(dir.path())
+        .map_err(|e| e.to_string())?
+        .filter_map(Result::ok)
+        .filter(|e| e.file_name().to_string_lossy().ends_with(".tmp"))
+        .collect();
+    ensure!(leftovers.is_empty(), "temporary files left: {leftovers:?}");
+    // A trace that cannot be replayed is refused and nothing is written.
+    let cut = dir.path().join("cut.mcap");
+    std::fs::write(&cut, &before[..before.len() / 2]).map_err(|e| e.to_string())?;
+    let never = dir.path().join("never.mcap");
+    let (code, _, err) = run_bin(os!["bless", cut.as_os_str(), "-o", never.as_os_str()])?;
+    ensure!(
+        code == 2 && !never.exists(),
+        "truncated input: exit {code}: {err}"
+    );
+    Ok(())
+}
+
+// ---------------------------------------------------------------- diff
+
+/// A ball rolling parallel to T's plane (n·d = 0) into edge 0: an edge hit
+/// under `non_strict`, nothing under `strict`; plus the fixture's sweeps.
+fn facing_trace() -> Vec<u8> {
+    let mut sweeps = fixture_sweeps();
+    sweeps.push(sweep(5, [2.0, -3.0, 0.3], [2.0, 1.0, 0.3]));
+    write_trace(&scene_t(0.0), &sweeps, &[])
+}
+
+fn diff_same() -> Result<(), String> {
+    let bytes = facing_trace();
+    let side = |o| Side::replay(TraceReader::new(bytes.as_slice(), "t"), "t", o);
+    let a = side(ReplayOptions::default()).map_err(|e| e.to_string())?;
+    let b = side(ReplayOptions::default()).map_err(|e| e.to_string())?;
+    let r = diff(&a, &b, &Tolerances::default());
+    ensure!(r.is_same() && r.compared == 6, "{r:?}");
+    Ok(())
+}
+
+fn diff_facing() -> Result<(), String> {
+    let bytes = facing_trace();
+    let side = |o| Side::replay(TraceReader::new(bytes.as_slice(), "t"), "t", o);
+    let a = side(ReplayOptions::default()).map_err(|e| e.to_string())?;
+    let b = side(ReplayOptions {
+        facing: Some(Facing::Strict),
+        ..ReplayOptions::default()
+    })
+    .map_err(|e| e.to_string())?;
+    let r = diff(&a, &b, &Tolerances::default());
+    let text = sweeptrace::diff::render_text(&r);
+    ensure!(!r.is_same() && r.different == 1, "{text}");
+    let first = r.first.as_ref().ok_or("no first divergence")?;
+    ensure!(first.frame == 5, "first divergence at frame 5: {text}");
+    ensure!(r.by_kind.get("edge -> none") == Some(&1), "{text}");
+    ensure!(
+        text.contains("first divergence: frame 5, ball 0")
+            && text.contains("A's test in B: edge 0.0: s0 = 0.65 in [0, 1], xc = 2 in [0, 4], n·d = 0 fails the facing rule: back-facing"),
+        "{text}"
+    );
+    Ok(())
+}
+
+fn diff_binary() -> Result<(), String> {
+    let dir = tempfile::tempdir().map_err(|e| e.to_string())?;
+    let t = dir.path().join("t.mcap");
+    std::fs::write(&t, facing_trace()).map_err(|e| e.to_string())?;
+    let (code, out, err) = run_bin(os!["diff", t.as_os_str(), t.as_os_str()])?;
+    ensure!(code == 0, "same: exit {code}\n{out}\n{err}");
+    let (code, out, err) = run_bin(os![
+        "diff",
+        t.as_os_str(),
+        t.as_os_str(),
+        "--facing-b",
+        "strict"
+    ])?;
+    ensure!(code == 1, "strict: exit {code}\n{out}\n{err}");
+    ensure!(out.contains("first divergence: frame 5"), "{out}");
+    let (code, out, _) = run_bin(os![
+        "diff",
+        t.as_os_str(),
+        t.as_os_str(),
+        "--margin-b",
+        "0.1",
+        "--json"
+    ])?;
+    let json: serde_json::Value = serde_json::from_str(&out).map_err(|e| format!("{e}: {out}"))?;
+    ensure!(
+        code == 1 && json["same_outcomes"] == false,
+        "margin: exit {code}: {json}"
+    );
+    ensure!(
+        json["first"]["frame"] == 2,
+        "margin changes frame 2 first: {json}"
+    );
+    let missing = dir.path().join("missing.mcap");
+    let (code, _, _) = run_bin(os!["diff", t.as_os_str(), missing.as_os_str()])?;
+    ensure!(code == 2, "missing: exit {code}");
+    Ok(())
+}
+
+// ---------------------------------------------------------------- fixture
+
+fn generate_fixture() -> Result<(), String> {
+    let bytes = fixture_bytes()?;
+    std::fs::write(fixture_path(), bytes).map_err(|e| e.to_string())
+}

@@ -8,6 +8,7 @@ pub mod bless;
 pub mod check;
 pub mod diff;
 pub mod info;
+pub mod record;
 pub mod replay;
 pub mod sweep;
 
@@ -35,12 +36,15 @@ pub enum Command {
     Bless(bless::Args),
     /// Compare the outcomes of two traces, or of one trace replayed with different options.
     Diff(diff::Args),
+    /// Simulate balls through a scene and record their sweeps and expected outcomes as a trace.
+    Record(record::Args),
 }
 
 /// Runs the chosen subcommand; `Ok` carries the exit code.
 pub fn run(cli: Cli) -> anyhow::Result<ExitCode> {
     match cli.command {
         Command::Sweep(args) => sweep::run(args),
+        Command::Record(args) => record::run(args),
         Command::Info(args) => info::run(args),
         Command::Replay(args) => replay::run(args),
         Command::Check(args) => check::run(args),

@@ -1,0 +1,256 @@
+//! `sweeptrace record`: simulate balls through a scene and write a trace.
+
+use std::io::IsTerminal;
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+use anyhow::{Context, bail};
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+
+use sweeptrace::core::Facing;
+use sweeptrace::scenes::{self, SceneMesh};
+use sweeptrace::sim::{self, SimOptions, StopReason, Summary};
+use sweeptrace::trace::write_trace_file;
+
+/// Arguments of `record`. Every simulation option defaults to the scene's
+/// own choice (`sweeptrace::sim::SimOptions::for_scene`).
+#[derive(Debug, clap::Args)]
+#[command(after_help = "Examples:\n  \
+    sweeptrace record --scene mini_golf -o mini_golf.mcap\n  \
+    sweeptrace record --scene terrain --terrain-cells 64 --balls 4 --seed 7 --frames 600 -o hills.mcap\n  \
+    sweeptrace record --mesh level.obj --radius 0.2 --position 0,0,5 --margin 0.01 -o level.mcap")]
+pub struct Args {
+    /// Built-in scene: `mini_golf` (green, walls, ramp, cup), `bowl`, `box`
+    /// (closed, ball inside), `terrain` (height field, 100,352 triangles by
+    /// default), `cube` or `triangle`.
+    #[arg(long, default_value = "mini_golf", conflicts_with = "mesh")]
+    pub scene: String,
+    /// Record against a Wavefront OBJ file instead of a built-in scene
+    /// (faces counter-clockwise seen from the front; the scene is named
+    /// after the file).
+    #[arg(long, value_name = "FILE")]
+    pub mesh: Option<PathBuf>,
+    /// Cells per side of the `terrain` scene (two triangles per cell;
+    /// 1 to 4096).
+    #[arg(long, default_value_t = scenes::TERRAIN_DEFAULT_CELLS, value_name = "N")]
+    pub terrain_cells: usize,
+    /// Output trace file [default: `<scene>.mcap`]. Written atomically: a
+    /// failed run leaves no file behind.
+    #[arg(short, long, value_name = "OUT")]
+    pub output: Option<PathBuf>,
+    /// Number of simulation frames (a frame whose balls collide records
+    /// extra sub-step frames).
+    #[arg(long)]
+    pub frames: Option<u64>,
+    /// Seed of the per-ball jitter: the same seed gives the same trace, byte
+    /// for byte.
+    #[arg(long)]
+    pub seed: Option<u64>,
+    /// Number of balls. Ball 0 starts exactly at --position with
+    /// --velocity; the others are jittered from the seed.
+    #[arg(long)]
+    pub balls: Option<u32>,
+    /// Radius of every ball.
+    #[arg(long)]
+    pub radius: Option<f64>,
+    /// Initial position of ball 0's centre, `x,y,z`.
+    #[arg(long, value_parser = super::parse_point, allow_hyphen_values = true)]
+    pub position: Option<[f64; 3]>,
+    /// Initial velocity of ball 0, `x,y,z` (units per second).
+    #[arg(long, value_parser = super::parse_point, allow_hyphen_values = true)]
+    pub velocity: Option<[f64; 3]>,
+    /// Largest offset added to the other balls' x and y start coordinates.
+    #[arg(long)]
+    pub position_jitter: Option<f64>,
+    /// Largest offset added to each component of the other balls' velocity.
+    #[arg(long)]
+    pub velocity_jitter: Option<f64>,
+    /// Duration of a frame in seconds (1e-6 to 10).
+    #[arg(long)]
+    pub time_step: Option<f64>,
+    /// Gravity, `x,y,z` (units per second squared; scenes are `+z` up).
+    #[arg(long, value_parser = super::parse_point, allow_hyphen_values = true)]
+    pub gravity: Option<[f64; 3]>,
+    /// Fraction of the normal speed kept at each bounce, 0 to 1.
+    #[arg(long)]
+    pub restitution: Option<f64>,
+    /// Margin ε (0 ≤ ε < radius): sweeps detect at ρ = r - ε and the ball is
+    /// pushed out by ε after each collision. Written into the scene.
+    #[arg(long)]
+    pub margin: Option<f64>,
+    /// Facing rule of the sweeps: `non_strict` (n·d ≤ 0) or `strict`
+    /// (n·d < 0). Written into the scene.
+    #[arg(long)]
+    pub facing: Option<Facing>,
+    /// Largest number of sweeps per ball and frame (1 to 64); time left after
+    /// the last one is dropped.
+    #[arg(long)]
+    pub max_substeps: Option<u32>,
+}
+
+impl Args {
+    /// The simulation options: the scene's defaults, overridden by the
+    /// options given.
+    fn sim_options(&self, defaults: SimOptions) -> SimOptions {
+        SimOptions {
+            frames: self.frames.unwrap_or(defaults.frames),
+            seed: self.seed.unwrap_or(defaults.seed),
+            balls: self.balls.unwrap_or(defaults.balls),
+            radius: self.radius.unwrap_or(defaults.radius),
+            position: self.position.unwrap_or(defaults.position),
+            velocity: self.velocity.unwrap_or(defaults.velocity),
+            position_jitter: self.position_jitter.unwrap_or(defaults.position_jitter),
+            velocity_jitter: self.velocity_jitter.unwrap_or(defaults.velocity_jitter),
+            time_step: self.time_step.unwrap_or(defaults.time_step),
+            gravity: self.gravity.unwrap_or(defaults.gravity),
+            restitution: self.restitution.unwrap_or(defaults.restitution),
+            margin: self.margin.unwrap_or(defaults.margin),
+            facing: self.facing.unwrap_or(defaults.facing),
+            max_substeps: self.max_substeps.unwrap_or(defaults.max_substeps),
+            separation: defaults.separation,
+        }
+    }
+}
+
+/// Simulates, writes the trace and prints a summary.
+pub fn run(args: Args) -> anyhow::Result<ExitCode> {
+    let scene: SceneMesh = match &args.mesh {
+        Some(path) => scenes::load_obj(path)?,
+        None => match sim::builtin_scene(&args.scene, args.terrain_cells) {
+            Some(scene) => scene,
+            None => bail!(
+                "unknown scene `{}` (built-in scenes: {})",
+                args.scene,
+                scenes::NAMES.join(", ")
+            ),
+        },
+    };
+    let mesh = scene
+        .to_mesh()
+        .with_context(|| format!("building scene `{}`", scene.name))?;
+    if !mesh.degenerate().is_empty() {
+        let first: Vec<String> = mesh
+            .degenerate()
+            .iter()
+            .take(5)
+            .map(|d| d.index.to_string())
+            .collect();
+        eprintln!(
+            "warning: scene `{}`: {} degenerate triangle(s) left out (first: {})",
+            scene.name,
+            mesh.degenerate().len(),
+            first.join(", ")
+        );
+    }
+    let mut defaults = SimOptions::for_scene(&scene.name);
+    if args.mesh.is_some() {
+        // A ball above the middle of an unknown mesh.
+        let (lo, hi) = mesh.bounds();
+        let radius = args.radius.unwrap_or(defaults.radius);
+        defaults.position = [
+            0.5 * (lo.x + hi.x),
+            0.5 * (lo.y + hi.y),
+            hi.z + 2.0 * radius,
+        ];
+    }
+    let options = args.sim_options(defaults);
+    options.validate()?;
+    let output = args
+        .output
+        .clone()
+        .unwrap_or_else(|| PathBuf::from(format!("{}.mcap", scene.name)));
+    let scene_msg = sim::scene_message(&scene, &options);
+
+    let bar = progress_bar(options.frames);
+    let summary = write_trace_file(&output, |writer| -> anyhow::Result<Summary> {
+        writer.scene(0, &scene_msg)?;
+        let mut shown = 0;
+        let summary = sim::simulate(&mesh, &options, |event| -> anyhow::Result<()> {
+            writer.sweep(event.log_time_nanos, &event.sweep)?;
+            writer.expected(event.log_time_nanos, &event.outcome)?;
+            if event.sim_frame >= shown + 256 {
+                shown = event.sim_frame;
+                bar.set_position(shown);
+            }
+            Ok(())
+        })?;
+        Ok(summary)
+    })
+    .with_context(|| format!("recording {}", output.display()))?;
+    bar.finish_and_clear();
+    println!(
+        "{}",
+        summary_paragraph(
+            &scene.name,
+            mesh.triangles().len(),
+            &options,
+            &summary,
+            &output.display().to_string()
+        )
+    );
+    Ok(ExitCode::SUCCESS)
+}
+
+/// The closing summary of a recording, one paragraph.
+pub fn summary_paragraph(
+    scene: &str,
+    triangles: usize,
+    options: &SimOptions,
+    s: &Summary,
+    file: &str,
+) -> String {
+    let mut text = format!(
+        "Recorded {} sweeps of {} ball(s) of radius {} over {} frames ({} trace frames with sub-steps) \
+         in scene `{scene}` ({triangles} triangles, margin {}, facing {}, seed {}): {} collisions \
+         ({} face, {} edge, {} vertex) and {} misses.",
+        s.sweeps,
+        options.balls,
+        options.radius,
+        s.sim_frames,
+        s.trace_frames,
+        options.margin,
+        options.facing,
+        options.seed,
+        s.collisions(),
+        s.face,
+        s.edge,
+        s.vertex,
+        s.none,
+    );
+    if s.truncated > 0 {
+        text.push_str(&format!(
+            " {} ball-frames ran out of sub-steps.",
+            s.truncated
+        ));
+    }
+    if !s.stopped.is_empty() {
+        let left = s
+            .stopped
+            .iter()
+            .filter(|b| b.reason == StopReason::LeftBounds)
+            .count();
+        let bad = s.stopped.len() - left;
+        text.push_str(&format!(
+            " {left} ball(s) left the play volume and stopped recording"
+        ));
+        if bad > 0 {
+            text.push_str(&format!(", {bad} stopped on a non-finite value"));
+        }
+        text.push('.');
+    }
+    text.push_str(&format!(" Wrote {file}."));
+    text
+}
+
+fn progress_bar(frames: u64) -> ProgressBar {
+    if !std::io::stderr().is_terminal() {
+        return ProgressBar::hidden();
+    }
+    let bar = ProgressBar::with_draw_target(Some(frames), ProgressDrawTarget::stderr());
+    if let Ok(style) =
+        ProgressStyle::with_template("{spinner} recording [{bar:40}] {pos}/{len} frames ({eta})")
+    {
+        bar.set_style(style.progress_chars("=> "));
+    }
+    bar
+}

@@ -13,9 +13,10 @@ pub mod paths;
 use std::collections::BTreeMap;
 
 use nalgebra::{UnitQuaternion, Vector3};
+use rerun::blueprint::components::PanelState;
 use rerun::blueprint::{
-    Blueprint, BlueprintActivation, Horizontal, Spatial3DView, TextLogView, TimeSeriesView,
-    Vertical,
+    Blueprint, BlueprintActivation, BlueprintPanel, Horizontal, SelectionPanel, Spatial3DView,
+    TextLogView, TimePanel, TimeSeriesView, Vertical,
 };
 use rerun::components::{FillMode, TextLogLevel};
 use rerun::{
@@ -114,8 +115,13 @@ pub fn builder(recording_id: &str, name: &str) -> RecordingStreamBuilder {
         .send_properties(false)
 }
 
-/// The default layout: the world, the decisive edge in its standard frame,
-/// the plots (α, the quadratic, the face test) and the text log.
+/// The default layout: on top the world and the decisive edge in its
+/// standard frame, below them the plots (α, the quadratic, the face test),
+/// at the bottom the text log; the time panel on the `frame` timeline, the
+/// side panels collapsed.
+///
+/// The SDK gives the blueprint store and its views random ids, so unlike the
+/// recording itself the blueprint's ids differ between runs.
 pub fn default_blueprint() -> Blueprint {
     let world = Spatial3DView::new("World").with_origin(paths::WORLD);
     let edge = Spatial3DView::new("Edge frame (ball 0, decisive edge)")
@@ -126,16 +132,24 @@ pub fn default_blueprint() -> Blueprint {
     let face = TimeSeriesView::new("Face h0, h1, β (ball 0)")
         .with_origin(format!("{}/ball/0/face", paths::PLOTS));
     let log = TextLogView::new("Decisions").with_origin(paths::LOG);
-    Blueprint::new(Horizontal::new(vec![
-        Vertical::new(vec![world.into(), log.into()]).into(),
+    Blueprint::new(
         Vertical::new(vec![
-            edge.into(),
-            alpha.into(),
-            quadratic.into(),
-            face.into(),
+            Horizontal::new(vec![world.into(), edge.into()])
+                .with_column_shares(vec![3.0, 2.0])
+                .into(),
+            Horizontal::new(vec![alpha.into(), quadratic.into(), face.into()]).into(),
+            log.into(),
         ])
-        .into(),
-    ]))
+        .with_row_shares(vec![3.0, 1.4, 1.2]),
+    )
+    .with_blueprint_panel(BlueprintPanel::new().with_state(PanelState::Collapsed))
+    .with_selection_panel(SelectionPanel::new().with_state(PanelState::Collapsed))
+    .with_time_panel(
+        TimePanel::new()
+            .with_state(PanelState::Collapsed)
+            .with_timeline(FRAME_TIMELINE)
+            .with_fps(10.0),
+    )
 }
 
 #[derive(Debug, Default)]
@@ -264,7 +278,7 @@ impl Logger {
         // The ball at p0, at the contact (when hit) and at p1.
         let mut centers = vec![f32x3(p0.coords)];
         let mut colors = vec![rgba(P0_COLOR)];
-        let mut labels = vec![format!("p0 (frame {})", r.frame)];
+        let mut labels = vec!["p0".to_string()];
         if o.is_hit() {
             centers.push(f32x3(at_contact.coords));
             colors.push(rgba(CONTACT_BALL_COLOR));
@@ -432,18 +446,20 @@ impl Logger {
             )?;
             rec.log(paths::edge_frame(b, slot), &edge_values(e))?;
             let length = e.length as f32;
-            rec.log(
-                paths::edge_segment(b, slot),
-                &LineStrips3D::new([[[0.0f32, 0.0, 0.0], [length, 0.0, 0.0]]])
-                    .with_colors([rgba(EDGE_COLOR)])
-                    .with_radii([(rho * 0.04) as f32])
-                    .with_labels([format!(
-                        "edge {}.{} (L = {})",
-                        e.triangle,
-                        e.edge,
-                        num(e.length)
-                    )]),
-            )?;
+            // Only the first slot is labelled: with many slots the labels
+            // would hide the world view.
+            let mut segment = LineStrips3D::new([[[0.0f32, 0.0, 0.0], [length, 0.0, 0.0]]])
+                .with_colors([rgba(EDGE_COLOR)])
+                .with_radii([(rho * 0.04) as f32]);
+            if slot == 0 {
+                segment = segment.with_labels([format!(
+                    "edge {}.{} (L = {})",
+                    e.triangle,
+                    e.edge,
+                    num(e.length)
+                )]);
+            }
+            rec.log(paths::edge_segment(b, slot), &segment)?;
             // A capsule lies along +z; turn it onto +x (90° about +y).
             let half = std::f32::consts::FRAC_1_SQRT_2;
             rec.log(

@@ -11,6 +11,7 @@ mod core_random;
 mod oracle;
 mod replay;
 mod support;
+mod trace_io;
 
 /// Builds a trial from a function returning `Result<(), String>`.
 pub fn trial(name: &str, f: impl FnOnce() -> Result<(), String> + Send + 'static) -> Trial {
@@ -24,6 +25,7 @@ fn main() {
     trials.extend(core_cases::tests());
     trials.extend(core_random::tests());
     trials.extend(check::tests());
+    trials.extend(trace_io::tests());
     trials.extend(replay::tests());
     libtest_mimic::run(&args, trials).exit();
 }

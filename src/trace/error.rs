@@ -91,7 +91,7 @@ pub enum TraceError {
     )]
     MessageTooLarge {
         /// The message.
-        at: MessageAt,
+        at: Box<MessageAt>,
         /// Its size.
         bytes: u64,
         /// The limit.
@@ -101,7 +101,7 @@ pub enum TraceError {
     #[error("{at}: field `{field}`: {detail}")]
     Json {
         /// The message.
-        at: MessageAt,
+        at: Box<MessageAt>,
         /// The field (a path such as `p0[1]`; `.` for the whole message).
         field: String,
         /// What is wrong.
@@ -111,7 +111,7 @@ pub enum TraceError {
     #[error("{at}: field `{field}`: {problem}")]
     Invalid {
         /// The message.
-        at: MessageAt,
+        at: Box<MessageAt>,
         /// The field (a path such as `triangles[12][1]`).
         field: String,
         /// What is wrong.
@@ -123,7 +123,7 @@ pub enum TraceError {
     )]
     SweepBeforeScene {
         /// The sweep message.
-        at: MessageAt,
+        at: Box<MessageAt>,
     },
     /// A message's `log_time` is smaller than that of an earlier message.
     #[error(
@@ -132,7 +132,7 @@ pub enum TraceError {
     )]
     OutOfOrder {
         /// The message.
-        at: MessageAt,
+        at: Box<MessageAt>,
         /// Its log time.
         log_time_nanos: u64,
         /// The largest log time seen before it.
@@ -179,7 +179,7 @@ impl TraceError {
             | TraceError::Json { at, .. }
             | TraceError::Invalid { at, .. }
             | TraceError::SweepBeforeScene { at }
-            | TraceError::OutOfOrder { at, .. } => Some(at),
+            | TraceError::OutOfOrder { at, .. } => Some(at.as_ref()),
             _ => None,
         }
     }

@@ -501,7 +501,7 @@ impl State {
         };
         if data.len() as u64 > limit {
             return Err(TraceError::MessageTooLarge {
-                at: self.at(&topic, index, None),
+                at: Box::new(self.at(&topic, index, None)),
                 bytes: data.len() as u64,
                 limit,
             });
@@ -515,7 +515,7 @@ impl State {
                 super::validate::frame_of(data)
             };
             return Err(TraceError::OutOfOrder {
-                at: self.at(&topic, index, frame),
+                at: Box::new(self.at(&topic, index, frame)),
                 log_time_nanos,
                 previous_nanos,
             });
@@ -535,7 +535,7 @@ impl State {
                 let sweep: SweepMsg = parse_message(data, self.at(&topic, index, None))?;
                 let at = || self.at(&topic, index, Some(sweep.frame));
                 if self.scene_margin.is_none() {
-                    return Err(TraceError::SweepBeforeScene { at: at() });
+                    return Err(TraceError::SweepBeforeScene { at: Box::new(at()) });
                 }
                 validate_sweep(&sweep, self.scene_margin).map_err(|p| p.at(at()))?;
                 TraceEvent::Sweep {

@@ -32,7 +32,7 @@ impl FieldProblem {
     /// Attaches the message's position to make a [`TraceError::Invalid`].
     pub fn at(self, at: MessageAt) -> TraceError {
         TraceError::Invalid {
-            at,
+            at: Box::new(at),
             field: self.field,
             problem: self.problem,
         }
@@ -87,7 +87,11 @@ pub fn parse_message<T: DeserializeOwned>(data: &[u8], mut at: MessageAt) -> Res
             } else {
                 message
             };
-            Err(TraceError::Json { at, field, detail })
+            Err(TraceError::Json {
+                at: Box::new(at),
+                field,
+                detail,
+            })
         }
     }
 }

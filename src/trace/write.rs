@@ -133,7 +133,7 @@ impl<W: Write + Seek> TraceWriter<W> {
         match self.last_log_time {
             Some(previous_nanos) if log_time_nanos < previous_nanos => {
                 Err(TraceError::OutOfOrder {
-                    at: self.at(channel, frame),
+                    at: Box::new(self.at(channel, frame)),
                     log_time_nanos,
                     previous_nanos,
                 })
@@ -151,7 +151,7 @@ impl<W: Write + Seek> TraceWriter<W> {
         msg: &T,
     ) -> Result<(), TraceError> {
         let data = serde_json::to_vec(msg).map_err(|e| TraceError::Json {
-            at: self.at(channel, frame),
+            at: Box::new(self.at(channel, frame)),
             field: ".".to_string(),
             detail: e.to_string(),
         })?;
@@ -187,7 +187,7 @@ impl<W: Write + Seek> TraceWriter<W> {
         self.check_time(SWEEP_TOPIC, frame, log_time_nanos)?;
         if self.scene_margin.is_none() {
             return Err(TraceError::SweepBeforeScene {
-                at: self.at(SWEEP_TOPIC, frame),
+                at: Box::new(self.at(SWEEP_TOPIC, frame)),
             });
         }
         validate_sweep(sweep, self.scene_margin).map_err(|p| p.at(self.at(SWEEP_TOPIC, frame)))?;

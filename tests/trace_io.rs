@@ -1,0 +1,1257 @@
+//! Trace files: write → read round trips, every container flavour, the
+//! Python-written fixture, every error of the format page, `info` rendering.
+
+use std::collections::BTreeMap;
+use std::io::Cursor;
+use std::path::Path;
+
+use libtest_mimic::Trial;
+use mcap::records::MessageHeader;
+use mcap::{Compression, WriteOptions};
+use rand::{Rng, SeedableRng};
+use sweeptrace::core::{Facing, Kind};
+use sweeptrace::trace::info::{collect, render_json, render_text};
+use sweeptrace::trace::messages::{OutcomeMsg, SceneMsg, SweepMsg};
+use sweeptrace::trace::{
+    ReadLimits, ReadStats, TraceError, TraceEvent, TraceReader, TraceWriter, write_trace_file,
+};
+
+use crate::ensure;
+use crate::trial;
+
+pub fn tests() -> Vec<Trial> {
+    vec![
+        trial(
+            "trace_io::round_trip_default_writer",
+            round_trip_default_writer,
+        ),
+        trial(
+            "trace_io::writer_output_is_deterministic",
+            writer_is_deterministic,
+        ),
+        trial("trace_io::reads_unchunked", || flavour(unchunked(), &[])),
+        trial("trace_io::reads_lz4_chunks", || flavour(lz4(), &["lz4"])),
+        trial("trace_io::reads_uncompressed_chunks", || {
+            flavour(uncompressed_chunks(), &["none"])
+        }),
+        trial("trace_io::reads_without_summary_or_indexes", || {
+            flavour(no_summary(), &["zstd"])
+        }),
+        trial("trace_io::reads_unchunked_without_summary", || {
+            flavour(no_summary().use_chunks(false), &[])
+        }),
+        trial("trace_io::python_fixture_exact_values", python_fixture),
+        trial(
+            "trace_io::foreign_channels_skipped_and_counted",
+            foreign_channels,
+        ),
+        trial("trace_io::error_truncated_every_cut", truncated_every_cut),
+        trial("trace_io::error_truncated_chunked", truncated_chunked),
+        trial("trace_io::error_corrupt_zstd_chunk", || {
+            corrupt_chunk(default_opts())
+        }),
+        trial("trace_io::error_corrupt_uncompressed_chunk", || {
+            corrupt_chunk(uncompressed_chunks())
+        }),
+        trial("trace_io::error_not_json", not_json),
+        trial("trace_io::error_missing_field", missing_field),
+        trial("trace_io::error_mistyped_field", mistyped_field),
+        trial("trace_io::error_null_for_number", null_for_number),
+        trial("trace_io::error_number_out_of_range", number_out_of_range),
+        trial(
+            "trace_io::error_vertex_index_out_of_range",
+            vertex_out_of_range,
+        ),
+        trial("trace_io::error_radius_not_positive", radius_not_positive),
+        trial(
+            "trace_io::error_margin_not_below_radius",
+            margin_not_below_radius,
+        ),
+        trial("trace_io::error_sweep_before_scene", sweep_before_scene),
+        trial("trace_io::error_oversized_scene", oversized_scene),
+        trial("trace_io::error_huge_declared_record", huge_declared_record),
+        trial("trace_io::error_huge_declared_chunk", huge_declared_chunk),
+        trial("trace_io::error_out_of_order_log_time", out_of_order),
+        trial("trace_io::error_wrong_message_encoding", wrong_encoding),
+        trial("trace_io::error_bad_outcome_alpha", bad_outcome),
+        trial(
+            "trace_io::random_corruption_never_panics",
+            random_corruption,
+        ),
+        trial(
+            "trace_io::writer_refuses_invalid_messages",
+            writer_refuses_invalid,
+        ),
+        trial("trace_io::write_trace_file_is_atomic", write_file_atomic),
+        trial("trace_io::info_renders_python_fixture", info_render),
+        trial("trace_io::info_reports_partial_trace", info_partial),
+        trial("trace_io::python_reads_our_trace", python_reads_our_trace),
+    ]
+}
+
+// ---------------------------------------------------------------- helpers
+
+const FIXTURE: &str = "tests/fixtures/python_written.mcap";
+
+fn triangle_scene() -> SceneMsg {
+    SceneMsg {
+        name: Some("triangle".to_string()),
+        vertices: vec![[0.0, 0.0, 0.0], [4.0, 0.0, 0.0], [0.0, 4.0, 0.0]],
+        triangles: vec![[0, 1, 2]],
+        margin: 0.0,
+        facing: Facing::NonStrict,
+    }
+}
+
+fn sweep(frame: u64, ball: u32) -> SweepMsg {
+    SweepMsg {
+        frame,
+        ball,
+        radius: 0.5,
+        p0: [1.0 + frame as f64 * 0.01, 1.0, 3.0],
+        p1: [1.0, 1.0, -3.0],
+    }
+}
+
+fn outcome(frame: u64) -> OutcomeMsg {
+    OutcomeMsg {
+        frame,
+        ball: 0,
+        alpha: 5.0 / 12.0,
+        kind: Kind::Face,
+        triangle: Some(Some(0)),
+        feature: Some(None),
+        normal: Some(Some([0.0, 0.0, 1.0])),
+        contact: None,
+    }
+}
+
+/// The events a sample trace holds: one scene, `frames` frames of two
+/// balls, an expected outcome per frame for ball 0, a second scene midway.
+fn sample_events(frames: u64) -> Vec<TraceEvent> {
+    let mut events = Vec::new();
+    let mut index = 0;
+    let mut push = |e: TraceEvent| {
+        events.push(e);
+    };
+    push(TraceEvent::Scene {
+        log_time_nanos: 0,
+        index,
+        scene: triangle_scene(),
+    });
+    index += 1;
+    for frame in 0..frames {
+        let t = 1_000 + frame * 1_000_000;
+        if frame == frames / 2 {
+            let mut scene = triangle_scene();
+            scene.name = Some("second".to_string());
+            scene.margin = 0.125;
+            scene.facing = Facing::Strict;
+            push(TraceEvent::Scene {
+                log_time_nanos: t,
+                index,
+                scene,
+            });
+            index += 1;
+        }
+        for ball in 0..2 {
+            push(TraceEvent::Sweep {
+                log_time_nanos: t,
+                index,
+                sweep: sweep(frame, ball),
+            });
+            index += 1;
+        }
+        push(TraceEvent::Expected {
+            log_time_nanos: t,
+            index,
+            outcome: outcome(frame),
+        });
+        index += 1;
+    }
+    events
+}
+
+fn default_opts() -> WriteOptions {
+    sweeptrace::trace::write::default_write_options()
+}
+fn unchunked() -> WriteOptions {
+    default_opts().use_chunks(false)
+}
+fn lz4() -> WriteOptions {
+    default_opts()
+        .compression(Some(Compression::Lz4))
+        .chunk_size(Some(4096))
+}
+fn uncompressed_chunks() -> WriteOptions {
+    default_opts().compression(None)
+}
+fn no_summary() -> WriteOptions {
+    default_opts()
+        .emit_summary_records(false)
+        .emit_summary_offsets(false)
+        .emit_statistics(false)
+        .emit_chunk_indexes(false)
+        .emit_message_indexes(false)
+        .emit_metadata_indexes(false)
+        .emit_attachment_indexes(false)
+        .repeat_channels(false)
+        .repeat_schemas(false)
+}
+
+fn write_events(events: &[TraceEvent], opts: WriteOptions) -> Result<Vec<u8>, String> {
+    let mut w =
+        TraceWriter::with_options(Cursor::new(Vec::new()), opts).map_err(|e| e.to_string())?;
+    for e in events {
+        match e {
+            TraceEvent::Scene {
+                log_time_nanos,
+                scene,
+                ..
+            } => w.scene(*log_time_nanos, scene),
+            TraceEvent::Sweep {
+                log_time_nanos,
+                sweep,
+                ..
+            } => w.sweep(*log_time_nanos, sweep),
+            TraceEvent::Expected {
+                log_time_nanos,
+                outcome,
+                ..
+            } => w.expected(*log_time_nanos, outcome),
+        }
+        .map_err(|e| e.to_string())?;
+    }
+    Ok(w.finish().map_err(|e| e.to_string())?.into_inner())
+}
+
+/// Every event, the error that ended reading (if any) and the stats.
+fn read_all(bytes: &[u8]) -> (Vec<TraceEvent>, Option<TraceError>, ReadStats) {
+    read_all_with(bytes, ReadLimits::default())
+}
+
+fn read_all_with(
+    bytes: &[u8],
+    limits: ReadLimits,
+) -> (Vec<TraceEvent>, Option<TraceError>, ReadStats) {
+    let mut reader = TraceReader::with_limits(bytes, "test.mcap", limits);
+    let mut events = Vec::new();
+    let mut error = None;
+    for e in reader.by_ref() {
+        match e {
+            Ok(e) => events.push(e),
+            Err(e) => {
+                error = Some(e);
+                break;
+            }
+        }
+    }
+    (events, error, reader.stats().clone())
+}
+
+/// A trace written with the raw `mcap` writer: our three channels plus
+/// `/foreign`; each message is (topic, log_time, JSON bytes).
+fn raw_trace(messages: &[(&str, u64, &[u8])]) -> Vec<u8> {
+    raw_trace_with(messages, "json")
+}
+
+fn raw_trace_with(messages: &[(&str, u64, &[u8])], encoding: &str) -> Vec<u8> {
+    let mut w = default_opts()
+        .create(Cursor::new(Vec::new()))
+        .expect("writer");
+    let mut ids = BTreeMap::new();
+    for (topic, schema) in [
+        ("/scene", "sweeptrace.Scene"),
+        ("/sweep", "sweeptrace.Sweep"),
+        ("/expected", "sweeptrace.Outcome"),
+    ] {
+        let s = w.add_schema(schema, "jsonschema", b"{}").expect("schema");
+        ids.insert(
+            topic,
+            w.add_channel(s, topic, encoding, &BTreeMap::new())
+                .expect("channel"),
+        );
+    }
+    ids.insert(
+        "/foreign",
+        w.add_channel(0, "/foreign", "cdr", &BTreeMap::new())
+            .expect("channel"),
+    );
+    for (seq, (topic, t, data)) in messages.iter().enumerate() {
+        let header = MessageHeader {
+            channel_id: ids[topic],
+            sequence: seq as u32,
+            log_time: *t,
+            publish_time: *t,
+        };
+        w.write_to_known_channel(&header, data).expect("write");
+    }
+    w.finish().expect("finish");
+    w.into_inner().into_inner()
+}
+
+const SCENE_JSON: &[u8] =
+    br#"{"name":"t","vertices":[[0,0,0],[4,0,0],[0,4,0]],"triangles":[[0,1,2]]}"#;
+
+/// Reads `bytes`, expects an error, checks its message contains every `needle`.
+fn expect_error(bytes: &[u8], needles: &[&str]) -> Result<(Vec<TraceEvent>, TraceError), String> {
+    let (events, error, _) = read_all(bytes);
+    let Some(error) = error else {
+        return Err(format!(
+            "expected an error, read {} events without one",
+            events.len()
+        ));
+    };
+    let text = error.to_string();
+    for needle in needles {
+        ensure!(
+            text.contains(needle),
+            "error `{text}` does not mention `{needle}`"
+        );
+    }
+    Ok((events, error))
+}
+
+/// The first difference between two event lists, if any.
+fn same(got: &[TraceEvent], want: &[TraceEvent]) -> Result<(), String> {
+    for (i, (g, w)) in got.iter().zip(want).enumerate() {
+        ensure!(g == w, "event {i} differs:\n got {g:?}\nwant {w:?}");
+    }
+    ensure!(
+        got.len() == want.len(),
+        "read {} events, wrote {}",
+        got.len(),
+        want.len()
+    );
+    Ok(())
+}
+
+// ---------------------------------------------------------------- round trips
+
+fn round_trip_default_writer() -> Result<(), String> {
+    let events = sample_events(20);
+    let bytes = write_events(&events, default_opts())?;
+    let (got, error, stats) = read_all(&bytes);
+    ensure!(error.is_none(), "error: {error:?}");
+    same(&got, &events)?;
+    ensure!(
+        stats.messages == events.len() as u64,
+        "messages {}",
+        stats.messages
+    );
+    ensure!(stats.chunks >= 1, "not chunked");
+    ensure!(
+        stats.compression.iter().eq(["zstd"]),
+        "compression {:?}",
+        stats.compression
+    );
+    ensure!(stats.has_summary, "no summary");
+    ensure!(
+        stats.bytes == bytes.len() as u64,
+        "bytes {} of {}",
+        stats.bytes,
+        bytes.len()
+    );
+    ensure!(
+        stats.library == format!("sweeptrace {}", env!("CARGO_PKG_VERSION")),
+        "library {}",
+        stats.library
+    );
+    let meta = stats.metadata.iter().find(|(n, _)| n == "sweeptrace");
+    ensure!(
+        meta.and_then(|(_, m)| m.get("format_version"))
+            .map(String::as_str)
+            == Some("1"),
+        "metadata {:?}",
+        stats.metadata
+    );
+    ensure!(
+        stats.metadata.len() == 1,
+        "metadata repeated: {:?}",
+        stats.metadata
+    );
+    for (topic, schema) in [
+        ("/scene", "sweeptrace.Scene"),
+        ("/sweep", "sweeptrace.Sweep"),
+        ("/expected", "sweeptrace.Outcome"),
+    ] {
+        let c = stats
+            .channels
+            .get(topic)
+            .ok_or(format!("no channel {topic}"))?;
+        ensure!(
+            c.schema_name == schema
+                && c.schema_encoding == "jsonschema"
+                && c.message_encoding == "json",
+            "{topic}: {c:?}"
+        );
+    }
+    ensure!(
+        stats.channels["/sweep"].messages == 40,
+        "sweeps {:?}",
+        stats.channels["/sweep"]
+    );
+    ensure!(
+        stats.skipped_by_topic.is_empty(),
+        "skipped {:?}",
+        stats.skipped_by_topic
+    );
+    Ok(())
+}
+
+fn writer_is_deterministic() -> Result<(), String> {
+    let events = sample_events(50);
+    let a = write_events(&events, default_opts())?;
+    let b = write_events(&events, default_opts())?;
+    ensure!(a == b, "two writes of the same trace differ");
+    Ok(())
+}
+
+fn flavour(opts: WriteOptions, compression: &[&str]) -> Result<(), String> {
+    let events = sample_events(300);
+    let bytes = write_events(&events, opts)?;
+    let (got, error, stats) = read_all(&bytes);
+    ensure!(error.is_none(), "error: {error:?}");
+    ensure!(
+        got.len() == events.len(),
+        "read {} of {} events",
+        got.len(),
+        events.len()
+    );
+    same(&got, &events)?;
+    ensure!(
+        stats.compression.iter().eq(compression.iter()),
+        "compression {:?}",
+        stats.compression
+    );
+    ensure!(
+        (stats.chunks == 0) == compression.is_empty(),
+        "chunks {}",
+        stats.chunks
+    );
+    Ok(())
+}
+
+fn python_fixture() -> Result<(), String> {
+    let bytes = std::fs::read(FIXTURE).map_err(|e| format!("{FIXTURE}: {e}"))?;
+    let (events, error, stats) = read_all(&bytes);
+    ensure!(error.is_none(), "error: {error:?}");
+    ensure!(events.len() == 10, "{} events", events.len());
+    let TraceEvent::Scene {
+        log_time_nanos: 0,
+        index: 0,
+        scene,
+    } = &events[0]
+    else {
+        return Err(format!("first event {:?}", events[0]));
+    };
+    ensure!(*scene == triangle_scene(), "scene {scene:?}");
+    let frame_nanos = 16_666_667;
+    let sweeps: Vec<_> = events
+        .iter()
+        .filter_map(|e| match e {
+            TraceEvent::Sweep {
+                log_time_nanos,
+                index,
+                sweep,
+            } => Some((*log_time_nanos, *index, *sweep)),
+            _ => None,
+        })
+        .collect();
+    let want = [
+        (
+            frame_nanos,
+            1,
+            SweepMsg {
+                frame: 0,
+                ball: 0,
+                radius: 0.5,
+                p0: [1.0, 1.0, 3.0],
+                p1: [1.0, 1.0, -3.0],
+            },
+        ),
+        (
+            2 * frame_nanos,
+            4,
+            SweepMsg {
+                frame: 1,
+                ball: 0,
+                radius: 0.5,
+                p0: [2.0, -0.3, 3.0],
+                p1: [2.0, -0.3, -3.0],
+            },
+        ),
+        (
+            3 * frame_nanos,
+            7,
+            SweepMsg {
+                frame: 2,
+                ball: 0,
+                radius: 0.5,
+                p0: [-0.3, -0.2, 3.0],
+                p1: [-0.3, -0.2, -3.0],
+            },
+        ),
+        (
+            4 * frame_nanos,
+            10,
+            SweepMsg {
+                frame: 3,
+                ball: 0,
+                radius: 0.5,
+                p0: [10.0, 10.0, 3.0],
+                p1: [10.0, 10.0, 2.0],
+            },
+        ),
+        (
+            4 * frame_nanos,
+            13,
+            SweepMsg {
+                frame: 3,
+                ball: 1,
+                radius: 0.25,
+                p0: [1.0, 1.0, 1.0],
+                p1: [1.0, 1.0, 0.0],
+            },
+        ),
+    ];
+    ensure!(sweeps == want, "sweeps {sweeps:?}");
+    let outcomes: Vec<_> = events
+        .iter()
+        .filter_map(|e| match e {
+            TraceEvent::Expected { outcome, .. } => Some(*outcome),
+            _ => None,
+        })
+        .collect();
+    let face = OutcomeMsg {
+        frame: 0,
+        ball: 0,
+        alpha: 5.0 / 12.0,
+        kind: Kind::Face,
+        triangle: Some(Some(0)),
+        feature: None,
+        normal: Some(Some([0.0, 0.0, 1.0])),
+        contact: None,
+    };
+    let edge = OutcomeMsg {
+        frame: 1,
+        alpha: 13.0 / 30.0,
+        kind: Kind::Edge,
+        feature: Some(Some(0)),
+        normal: None,
+        ..face
+    };
+    let vertex = OutcomeMsg {
+        frame: 2,
+        alpha: 0.44226,
+        kind: Kind::Vertex,
+        triangle: None,
+        feature: None,
+        normal: None,
+        ..face
+    };
+    let none = OutcomeMsg {
+        frame: 3,
+        alpha: 1.0,
+        kind: Kind::None,
+        triangle: Some(None),
+        feature: Some(None),
+        normal: Some(None),
+        contact: Some(None),
+        ..face
+    };
+    ensure!(
+        outcomes == [face, edge, vertex, none],
+        "outcomes {outcomes:?}"
+    );
+    ensure!(
+        stats.compression.iter().eq(["lz4"]),
+        "compression {:?}",
+        stats.compression
+    );
+    ensure!(
+        stats.library == "python fixture for sweeptrace",
+        "library {}",
+        stats.library
+    );
+    ensure!(
+        stats.metadata
+            == vec![(
+                "recorder".to_string(),
+                BTreeMap::from([
+                    ("engine".to_string(), "python".to_string()),
+                    ("units".to_string(), "m".to_string())
+                ])
+            )],
+        "metadata {:?}",
+        stats.metadata
+    );
+    Ok(())
+}
+
+fn foreign_channels() -> Result<(), String> {
+    let bytes = raw_trace(&[
+        ("/foreign", 0, b"\x00\x01binary"),
+        ("/scene", 1, SCENE_JSON),
+        ("/foreign", 2, b"more"),
+        (
+            "/sweep",
+            3,
+            br#"{"frame":0,"radius":0.5,"p0":[0,0,1],"p1":[0,0,0]}"#,
+        ),
+        ("/foreign", 4, b"x"),
+    ]);
+    let (events, error, stats) = read_all(&bytes);
+    ensure!(error.is_none(), "error: {error:?}");
+    ensure!(events.len() == 2, "{} events", events.len());
+    ensure!(
+        events[0].index() == 1 && events[1].index() == 3,
+        "indices {events:?}"
+    );
+    ensure!(stats.messages == 5, "messages {}", stats.messages);
+    ensure!(
+        stats.skipped_by_topic.get("/foreign") == Some(&3),
+        "skipped {:?}",
+        stats.skipped_by_topic
+    );
+    ensure!(
+        stats.channels["/foreign"].messages == 3,
+        "channels {:?}",
+        stats.channels
+    );
+    Ok(())
+}
+
+// ---------------------------------------------------------------- errors
+
+fn truncated_every_cut() -> Result<(), String> {
+    let events = sample_events(4);
+    let bytes = write_events(&events, unchunked())?;
+    let mut saw_partial = false;
+    for cut in 0..bytes.len() {
+        let (got, error, stats) = read_all(&bytes[..cut]);
+        let Some(error) = error else {
+            return Err(format!("cut at {cut} of {}: no error", bytes.len()));
+        };
+        ensure!(
+            got.as_slice() == &events[..got.len()],
+            "cut at {cut}: events read differ from those written"
+        );
+        if let TraceError::Truncated { messages, .. } = &error {
+            ensure!(
+                *messages == got.len() as u64,
+                "cut at {cut}: {error} but {} events",
+                got.len()
+            );
+            ensure!(stats.messages == got.len() as u64, "stats");
+            let text = error.to_string();
+            ensure!(
+                text.contains("test.mcap")
+                    && text.contains("truncated")
+                    && text.contains(&format!("after {} complete messages", got.len())),
+                "message: {text}"
+            );
+            saw_partial |= !got.is_empty() && got.len() < events.len();
+        } else if cut >= 8 {
+            return Err(format!("cut at {cut}: not reported as truncated: {error}"));
+        }
+    }
+    ensure!(saw_partial, "no cut yielded a partial read");
+    Ok(())
+}
+
+fn truncated_chunked() -> Result<(), String> {
+    let events = sample_events(400);
+    let bytes = write_events(&events, lz4())?;
+    let (full, _, stats) = read_all(&bytes);
+    ensure!(
+        stats.chunks > 3,
+        "want several chunks, got {}",
+        stats.chunks
+    );
+    let cut = bytes.len() * 2 / 3;
+    let (got, error, _) = read_all(&bytes[..cut]);
+    let error = error.ok_or("no error")?;
+    ensure!(
+        matches!(error, TraceError::Truncated { .. }),
+        "not truncated: {error}"
+    );
+    ensure!(
+        !got.is_empty() && got.len() < full.len(),
+        "read {} events",
+        got.len()
+    );
+    ensure!(
+        error
+            .to_string()
+            .contains(&format!("after {} complete messages", got.len())),
+        "{error}"
+    );
+    Ok(())
+}
+
+/// Offset of the first chunk record (opcode 0x06) of a file.
+fn first_chunk(bytes: &[u8]) -> Option<(usize, usize)> {
+    let mut at = 8;
+    while at + 9 <= bytes.len() {
+        let op = bytes[at];
+        let len = u64::from_le_bytes(bytes[at + 1..at + 9].try_into().ok()?) as usize;
+        if op == 0x06 {
+            return Some((at, len));
+        }
+        at += 9 + len;
+    }
+    None
+}
+
+fn corrupt_chunk(opts: WriteOptions) -> Result<(), String> {
+    let events = sample_events(30);
+    let mut bytes = write_events(&events, opts)?;
+    let (start, len) = first_chunk(&bytes).ok_or("no chunk")?;
+    // A byte inside the records, well past the chunk header.
+    let at = start + 9 + len - len / 3;
+    bytes[at] ^= 0x5a;
+    let (got, error) = expect_error(&bytes, &["test.mcap", "corrupt", "chunk 0"])?;
+    ensure!(
+        got.is_empty(),
+        "{} events were read from a corrupt chunk",
+        got.len()
+    );
+    ensure!(matches!(error, TraceError::Corrupt { .. }), "{error:?}");
+    Ok(())
+}
+
+fn not_json() -> Result<(), String> {
+    let bytes = raw_trace(&[
+        ("/scene", 0, SCENE_JSON),
+        ("/sweep", 1, b"{frame: 3, radius"),
+    ]);
+    let (events, _) = expect_error(
+        &bytes,
+        &["test.mcap", "`/sweep`", "message 1", "not valid JSON"],
+    )?;
+    ensure!(
+        events.len() == 1,
+        "the scene before the bad message was not yielded"
+    );
+    Ok(())
+}
+
+fn missing_field() -> Result<(), String> {
+    let bytes = raw_trace(&[
+        ("/scene", 0, SCENE_JSON),
+        ("/sweep", 1, br#"{"frame":3,"p0":[0,0,1],"p1":[0,0,0]}"#),
+    ]);
+    expect_error(
+        &bytes,
+        &[
+            "test.mcap",
+            "`/sweep`",
+            "frame 3",
+            "message 1",
+            "`radius`",
+            "missing",
+        ],
+    )?;
+    let bytes = raw_trace(&[("/scene", 0, br#"{"vertices":[[0,0,0]]}"#)]);
+    expect_error(&bytes, &["`/scene`", "message 0", "`triangles`"])?;
+    Ok(())
+}
+
+fn mistyped_field() -> Result<(), String> {
+    let bytes = raw_trace(&[
+        ("/scene", 0, SCENE_JSON),
+        (
+            "/sweep",
+            1,
+            br#"{"frame":7,"radius":"big","p0":[0,0,1],"p1":[0,0,0]}"#,
+        ),
+    ]);
+    expect_error(&bytes, &["`/sweep`", "frame 7", "`radius`", "invalid type"])?;
+    let bytes = raw_trace(&[(
+        "/scene",
+        0,
+        br#"{"vertices":[[0,0,0]],"triangles":[[0,1,-2]]}"#,
+    )]);
+    expect_error(&bytes, &["`/scene`", "`triangles[0][2]`"])?;
+    let bytes = raw_trace(&[
+        ("/scene", 0, SCENE_JSON),
+        (
+            "/expected",
+            1,
+            br#"{"frame":2,"alpha":0.5,"kind":"corner"}"#,
+        ),
+    ]);
+    expect_error(&bytes, &["`/expected`", "frame 2", "`kind`"])?;
+    Ok(())
+}
+
+fn null_for_number() -> Result<(), String> {
+    let bytes = raw_trace(&[
+        ("/scene", 0, SCENE_JSON),
+        (
+            "/sweep",
+            1,
+            br#"{"frame":9,"radius":0.5,"p0":[1,null,2],"p1":[0,0,0]}"#,
+        ),
+    ]);
+    expect_error(&bytes, &["`/sweep`", "frame 9", "`p0[1]`", "null"])?;
+    let bytes = raw_trace(&[(
+        "/scene",
+        0,
+        br#"{"vertices":[[0,0,0],[1,0,null]],"triangles":[]}"#,
+    )]);
+    expect_error(&bytes, &["`/scene`", "`vertices[1][2]`", "null"])?;
+    Ok(())
+}
+
+fn number_out_of_range() -> Result<(), String> {
+    let bytes = raw_trace(&[
+        ("/scene", 0, SCENE_JSON),
+        (
+            "/sweep",
+            1,
+            br#"{"frame":4,"radius":0.5,"p0":[1e400,0,2],"p1":[0,0,0]}"#,
+        ),
+    ]);
+    expect_error(&bytes, &["`/sweep`", "frame 4", "`p0[0]`"])?;
+    Ok(())
+}
+
+fn vertex_out_of_range() -> Result<(), String> {
+    let bytes = raw_trace(&[(
+        "/scene",
+        0,
+        br#"{"vertices":[[0,0,0],[4,0,0],[0,4,0]],"triangles":[[0,1,2],[2,1,7]]}"#,
+    )]);
+    expect_error(
+        &bytes,
+        &[
+            "test.mcap",
+            "`/scene`",
+            "message 0",
+            "`triangles[1][2]`",
+            "7",
+            "out of range",
+        ],
+    )?;
+    Ok(())
+}
+
+fn radius_not_positive() -> Result<(), String> {
+    for radius in ["0", "-0.5", "0.0"] {
+        let sweep = format!(r#"{{"frame":11,"radius":{radius},"p0":[0,0,1],"p1":[0,0,0]}}"#);
+        let bytes = raw_trace(&[("/scene", 0, SCENE_JSON), ("/sweep", 1, sweep.as_bytes())]);
+        expect_error(
+            &bytes,
+            &["test.mcap", "`/sweep`", "frame 11", "`radius`", "> 0"],
+        )?;
+    }
+    Ok(())
+}
+
+fn margin_not_below_radius() -> Result<(), String> {
+    let scene = br#"{"vertices":[[0,0,0],[4,0,0],[0,4,0]],"triangles":[[0,1,2]],"margin":0.5}"#;
+    let bytes = raw_trace(&[
+        ("/scene", 0, scene),
+        (
+            "/sweep",
+            1,
+            br#"{"frame":5,"radius":0.5,"p0":[0,0,1],"p1":[0,0,0]}"#,
+        ),
+    ]);
+    expect_error(&bytes, &["frame 5", "`radius`", "margin"])?;
+    let bytes = raw_trace(&[(
+        "/scene",
+        0,
+        br#"{"vertices":[],"triangles":[],"margin":-1}"#,
+    )]);
+    expect_error(&bytes, &["`/scene`", "`margin`"])?;
+    Ok(())
+}
+
+fn sweep_before_scene() -> Result<(), String> {
+    let bytes = raw_trace(&[
+        (
+            "/sweep",
+            0,
+            br#"{"frame":12,"radius":0.5,"p0":[0,0,1],"p1":[0,0,0]}"#,
+        ),
+        ("/scene", 1, SCENE_JSON),
+    ]);
+    let (_, error) = expect_error(
+        &bytes,
+        &["test.mcap", "`/sweep`", "frame 12", "before any `/scene`"],
+    )?;
+    ensure!(
+        matches!(error, TraceError::SweepBeforeScene { .. }),
+        "{error:?}"
+    );
+    Ok(())
+}
+
+fn oversized_scene() -> Result<(), String> {
+    let mut scene = triangle_scene();
+    scene.vertices = (0..200).map(|i| [i as f64, 0.5, 0.25]).collect();
+    let mut w = TraceWriter::new(Cursor::new(Vec::new())).map_err(|e| e.to_string())?;
+    w.scene(0, &scene).map_err(|e| e.to_string())?;
+    let bytes = w.finish().map_err(|e| e.to_string())?.into_inner();
+    let limits = ReadLimits {
+        scene_bytes: 1000,
+        ..ReadLimits::default()
+    };
+    let (events, error, _) = read_all_with(&bytes, limits);
+    ensure!(events.is_empty(), "events {events:?}");
+    let error = error.ok_or("no error")?;
+    let text = error.to_string();
+    ensure!(
+        matches!(error, TraceError::MessageTooLarge { .. }),
+        "{error:?}"
+    );
+    ensure!(
+        text.contains("`/scene`")
+            && text.contains("message 0")
+            && text.contains("limit of 1000 bytes"),
+        "{text}"
+    );
+    Ok(())
+}
+
+/// Minimal MCAP pieces to hand-craft files whose sizes lie.
+fn record(op: u8, body: &[u8]) -> Vec<u8> {
+    let mut out = vec![op];
+    out.extend((body.len() as u64).to_le_bytes());
+    out.extend(body);
+    out
+}
+
+fn magic_and_header() -> Vec<u8> {
+    let mut out = b"\x89MCAP0\r\n".to_vec();
+    let mut header = Vec::new();
+    header.extend(0u32.to_le_bytes()); // profile ""
+    header.extend(0u32.to_le_bytes()); // library ""
+    out.extend(record(0x01, &header));
+    out
+}
+
+fn huge_declared_record() -> Result<(), String> {
+    // A message record declaring a terabyte (a scene "with a billion triangles").
+    let mut bytes = magic_and_header();
+    bytes.push(0x05);
+    bytes.extend((1u64 << 40).to_le_bytes());
+    bytes.extend([0u8; 64]);
+    let (_, error) = expect_error(
+        &bytes,
+        &["test.mcap", "declares 1099511627776 bytes", "limit"],
+    )?;
+    ensure!(matches!(error, TraceError::TooLarge { .. }), "{error:?}");
+    Ok(())
+}
+
+fn huge_declared_chunk() -> Result<(), String> {
+    let mut chunk = Vec::new();
+    chunk.extend(0u64.to_le_bytes()); // message start time
+    chunk.extend(0u64.to_le_bytes()); // message end time
+    chunk.extend((1u64 << 40).to_le_bytes()); // uncompressed size: 1 TiB
+    chunk.extend(0u32.to_le_bytes()); // crc
+    chunk.extend(4u32.to_le_bytes());
+    chunk.extend(b"zstd");
+    chunk.extend(16u64.to_le_bytes()); // compressed size
+    chunk.extend([0u8; 16]);
+    let mut bytes = magic_and_header();
+    bytes.extend(record(0x06, &chunk));
+    let (_, error) = expect_error(
+        &bytes,
+        &["test.mcap", "chunk 0 (uncompressed)", "1099511627776"],
+    )?;
+    ensure!(matches!(error, TraceError::TooLarge { .. }), "{error:?}");
+    Ok(())
+}
+
+fn out_of_order() -> Result<(), String> {
+    let bytes = raw_trace(&[
+        ("/scene", 0, SCENE_JSON),
+        (
+            "/sweep",
+            2_000,
+            br#"{"frame":1,"radius":0.5,"p0":[0,0,1],"p1":[0,0,0]}"#,
+        ),
+        ("/foreign", 10, b"foreign topics may be in any order"),
+        (
+            "/sweep",
+            1_000,
+            br#"{"frame":0,"radius":0.5,"p0":[0,0,1],"p1":[0,0,0]}"#,
+        ),
+    ]);
+    let (events, _) = expect_error(
+        &bytes,
+        &["`/sweep`", "frame 0", "message 3", "1000", "2000", "order"],
+    )?;
+    ensure!(events.len() == 2, "{} events", events.len());
+    Ok(())
+}
+
+fn wrong_encoding() -> Result<(), String> {
+    let bytes = raw_trace_with(&[("/scene", 0, SCENE_JSON)], "cbor");
+    expect_error(&bytes, &["test.mcap", "`/scene`", "cbor", "json"])?;
+    Ok(())
+}
+
+fn bad_outcome() -> Result<(), String> {
+    let bytes = raw_trace(&[
+        ("/scene", 0, SCENE_JSON),
+        ("/expected", 1, br#"{"frame":6,"alpha":1.5,"kind":"none"}"#),
+    ]);
+    expect_error(&bytes, &["`/expected`", "frame 6", "`alpha`"])?;
+    let bytes = raw_trace(&[
+        ("/scene", 0, SCENE_JSON),
+        (
+            "/expected",
+            1,
+            br#"{"frame":6,"alpha":0.5,"kind":"edge","feature":3}"#,
+        ),
+    ]);
+    expect_error(&bytes, &["`/expected`", "frame 6", "`feature`"])?;
+    Ok(())
+}
+
+fn random_corruption() -> Result<(), String> {
+    let events = sample_events(40);
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(0x5eed_7ace);
+    for opts in [default_opts(), unchunked(), lz4(), uncompressed_chunks()] {
+        let bytes = write_events(&events, opts)?;
+        for _ in 0..300 {
+            let mut b = bytes.clone();
+            for _ in 0..rng.random_range(1..4) {
+                let i = rng.random_range(0..b.len());
+                b[i] = rng.random();
+            }
+            if rng.random_bool(0.3) {
+                b.truncate(rng.random_range(0..b.len()));
+            }
+            // Must terminate without panicking; errors are fine.
+            let _ = read_all(&b);
+        }
+    }
+    Ok(())
+}
+
+fn writer_refuses_invalid() -> Result<(), String> {
+    let mut w = TraceWriter::new(Cursor::new(Vec::new())).map_err(|e| e.to_string())?;
+    let e = w
+        .sweep(0, &sweep(3, 0))
+        .err()
+        .ok_or("sweep before scene accepted")?;
+    ensure!(
+        matches!(e, TraceError::SweepBeforeScene { .. }) && e.to_string().contains("frame 3"),
+        "{e}"
+    );
+    w.scene(0, &triangle_scene()).map_err(|e| e.to_string())?;
+    let mut s = sweep(4, 0);
+    s.radius = f64::NAN;
+    let e = w.sweep(1, &s).err().ok_or("NaN radius accepted")?;
+    ensure!(
+        e.to_string().contains("`radius`") && e.to_string().contains("frame 4"),
+        "{e}"
+    );
+    let mut s = sweep(4, 0);
+    s.p1[2] = f64::INFINITY;
+    let e = w.sweep(1, &s).err().ok_or("infinite p1 accepted")?;
+    ensure!(e.to_string().contains("`p1[2]`"), "{e}");
+    let mut scene = triangle_scene();
+    scene.triangles.push([0, 1, 3]);
+    let e = w.scene(1, &scene).err().ok_or("bad index accepted")?;
+    ensure!(e.to_string().contains("`triangles[1][2]`"), "{e}");
+    w.sweep(10, &sweep(5, 0)).map_err(|e| e.to_string())?;
+    let e = w
+        .sweep(5, &sweep(6, 0))
+        .err()
+        .ok_or("time going back accepted")?;
+    ensure!(matches!(e, TraceError::OutOfOrder { .. }), "{e}");
+    // The rejected messages were not written: the trace still reads cleanly.
+    let bytes = w.finish().map_err(|e| e.to_string())?.into_inner();
+    let (events, error, _) = read_all(&bytes);
+    ensure!(error.is_none() && events.len() == 2, "{events:?} {error:?}");
+    Ok(())
+}
+
+fn write_file_atomic() -> Result<(), String> {
+    let dir = tempfile::tempdir().map_err(|e| e.to_string())?;
+    let path = dir.path().join("run.mcap");
+    let events = sample_events(5);
+    write_trace_file(&path, |w| -> Result<(), TraceError> {
+        for e in &events {
+            match e {
+                TraceEvent::Scene {
+                    log_time_nanos,
+                    scene,
+                    ..
+                } => w.scene(*log_time_nanos, scene)?,
+                TraceEvent::Sweep {
+                    log_time_nanos,
+                    sweep,
+                    ..
+                } => w.sweep(*log_time_nanos, sweep)?,
+                TraceEvent::Expected {
+                    log_time_nanos,
+                    outcome,
+                    ..
+                } => w.expected(*log_time_nanos, outcome)?,
+            }
+        }
+        Ok(())
+    })
+    .map_err(|e| e.to_string())?;
+    let bytes = std::fs::read(&path).map_err(|e| e.to_string())?;
+    ensure!(
+        bytes == write_events(&events, default_opts())?,
+        "file differs from in-memory write"
+    );
+    let (got, error, _) = read_all(&bytes);
+    ensure!(error.is_none() && got == events, "read back: {error:?}");
+
+    // A failing recording leaves the old file untouched and no temporary file.
+    let result = write_trace_file(&path, |w| -> Result<(), TraceError> {
+        w.scene(0, &triangle_scene())?;
+        w.sweep(
+            1,
+            &SweepMsg {
+                radius: -1.0,
+                ..sweep(0, 0)
+            },
+        )?;
+        Ok(())
+    });
+    ensure!(result.is_err(), "invalid sweep accepted");
+    ensure!(
+        std::fs::read(&path).map_err(|e| e.to_string())? == bytes,
+        "old file changed"
+    );
+    let fresh = dir.path().join("never.mcap");
+    let _ = write_trace_file(&fresh, |_| {
+        Err::<(), _>(TraceError::SweepBeforeScene {
+            at: Box::new(sweeptrace::trace::MessageAt {
+                file: "x".into(),
+                channel: "/sweep".into(),
+                index: 0,
+                frame: None,
+            }),
+        })
+    });
+    ensure!(!fresh.exists(), "failed recording left a file");
+    let entries: Vec<_> = std::fs::read_dir(dir.path())
+        .map_err(|e| e.to_string())?
+        .filter_map(|e| e.ok().map(|e| e.file_name().to_string_lossy().into_owned()))
+        .collect();
+    ensure!(entries == ["run.mcap"], "directory holds {entries:?}");
+    Ok(())
+}
+
+fn info_render() -> Result<(), String> {
+    let bytes = std::fs::read(FIXTURE).map_err(|e| format!("{FIXTURE}: {e}"))?;
+    let (info, error) = collect(TraceReader::new(bytes.as_slice(), "python_written.mcap"));
+    ensure!(error.is_none(), "{error:?}");
+    let text = render_text(&info);
+    for needle in [
+        "trace:       python_written.mcap",
+        &format!(
+            "file:        {} bytes, 1 chunks, compression lz4, summary present",
+            bytes.len()
+        ),
+        "library:     python fixture for sweeptrace",
+        "scenes:      1",
+        "`triangle` (message 0, log_time 0 ns): 3 vertices, 1 triangles, 0 degenerate, margin 0, facing non_strict",
+        "sweeps:      5 (2 balls: 0, 1)",
+        "frames:      0 to 3",
+        "log_time:    0 ns to 66666668 ns",
+        "expected:    present, 4 outcomes (edge 1, face 1, none 1, vertex 1)",
+        "  /debug  (no schema) [- / json]  4 messages, skipped",
+        "  /sweep  sweeptrace.Sweep [jsonschema / json]  5 messages",
+        "  recorder: engine = \"python\", units = \"m\"",
+    ] {
+        ensure!(text.contains(needle), "report lacks `{needle}`:\n{text}");
+    }
+    ensure!(!text.contains("incomplete"), "{text}");
+    let json: serde_json::Value =
+        serde_json::from_str(&render_json(&info)).map_err(|e| e.to_string())?;
+    ensure!(json["sweeps"] == 5 && json["expected"] == 4, "{json}");
+    ensure!(json["stats"]["skipped_by_topic"]["/debug"] == 4, "{json}");
+    ensure!(json["scenes"][0]["triangles"] == 1, "{json}");
+
+    // Degenerate triangles are counted; no expected channel is reported absent.
+    let mut scene = triangle_scene();
+    scene.triangles.push([0, 0, 1]);
+    scene.vertices.push([8.0, 0.0, 0.0]);
+    scene.triangles.push([0, 1, 3]);
+    let mut w = TraceWriter::with_options(Cursor::new(Vec::new()), default_opts())
+        .map_err(|e| e.to_string())?;
+    w.scene(0, &scene).map_err(|e| e.to_string())?;
+    let bytes = w.finish().map_err(|e| e.to_string())?.into_inner();
+    let (info, _) = collect(TraceReader::new(bytes.as_slice(), "d.mcap"));
+    let text = render_text(&info);
+    ensure!(
+        text.contains("4 vertices, 3 triangles, 2 degenerate"),
+        "{text}"
+    );
+    ensure!(
+        text.contains("sweeptrace: format_version = \"1\""),
+        "{text}"
+    );
+    // The writer registers all three channels; with no outcome written the
+    // channel is present but empty.
+    ensure!(text.contains("expected:    present, 0 outcomes"), "{text}");
+    Ok(())
+}
+
+fn info_partial() -> Result<(), String> {
+    let bytes = write_events(&sample_events(10), unchunked())?;
+    let cut = &bytes[..bytes.len() / 2];
+    let (info, error) = collect(TraceReader::new(cut, "cut.mcap"));
+    let error = error.ok_or("no error")?;
+    ensure!(matches!(error, TraceError::Truncated { .. }), "{error}");
+    let text = render_text(&info);
+    ensure!(
+        text.contains("incomplete:  cut.mcap: the file is truncated"),
+        "{text}"
+    );
+    ensure!(info.sweeps > 0, "partial report counted no sweep");
+    Ok(())
+}
+
+fn python_reads_our_trace() -> Result<(), String> {
+    let has_mcap = std::process::Command::new("python3")
+        .args(["-c", "import mcap"])
+        .output()
+        .map(|o| o.status.success())
+        .unwrap_or(false);
+    if !has_mcap {
+        println!(
+            "note: python3 with the `mcap` package not found; skipping scripts/read_with_python.py"
+        );
+        return Ok(());
+    }
+    let dir = tempfile::tempdir().map_err(|e| e.to_string())?;
+    let path = dir.path().join("py.mcap");
+    let events = sample_events(30);
+    std::fs::write(&path, write_events(&events, default_opts())?).map_err(|e| e.to_string())?;
+    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("scripts/read_with_python.py");
+    let run = |extra: &[&str]| {
+        std::process::Command::new("python3")
+            .arg(&script)
+            .arg(&path)
+            .args(extra)
+            .output()
+    };
+    let ok =
+        run(&["--scenes", "2", "--sweeps", "60", "--expected", "30"]).map_err(|e| e.to_string())?;
+    ensure!(
+        ok.status.success(),
+        "script failed: {}{}",
+        String::from_utf8_lossy(&ok.stdout),
+        String::from_utf8_lossy(&ok.stderr)
+    );
+    // And it can fail.
+    let bad = run(&["--sweeps", "61"]).map_err(|e| e.to_string())?;
+    ensure!(!bad.status.success(), "script accepted a wrong count");
+    Ok(())
+}

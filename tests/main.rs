@@ -9,6 +9,7 @@ mod check;
 mod core_cases;
 mod core_random;
 mod oracle;
+mod record;
 mod replay;
 mod support;
 mod trace_io;
@@ -27,5 +28,6 @@ fn main() {
     trials.extend(check::tests());
     trials.extend(trace_io::tests());
     trials.extend(replay::tests());
+    trials.extend(record::tests());
     libtest_mimic::run(&args, trials).exit();
 }

@@ -210,7 +210,7 @@ pub fn compare(expected: &OutcomeMsg, got: &OutcomeMsg, tol: &Tolerances) -> Vec
         }
     }
     let delta = (got.alpha - expected.alpha).abs();
-    if !(delta <= tol.alpha) {
+    if delta.is_nan() || delta > tol.alpha {
         out.push(FieldDiff {
             field: Field::Alpha,
             expected: json!(expected.alpha),
@@ -656,8 +656,18 @@ pub fn expected_tests(
 
 fn expected_test(r: &TestRecord, expected: &OutcomeMsg, got: &Outcome) -> ExpectedTest {
     let verdict = r.verdict();
+    let decides = got.is_hit()
+        && Some(r.triangle()) == got.triangle
+        && r.kind() == got.kind
+        && Some(r.feature()) == got.feature;
     let why_not = match r.alpha() {
         None => format!("it reports no collision ({verdict})"),
+        Some(a) if decides => format!(
+            "it decides the sweep, at α = {} where the expectation has α = {} \
+             (was the expectation recorded with another margin or facing rule?)",
+            num(a),
+            num(expected.alpha)
+        ),
         Some(a) if got.is_hit() && a > got.alpha + SIMULTANEOUS_TOLERANCE => format!(
             "it hits at α = {}, later than the primary collision at α = {}",
             num(a),
@@ -796,6 +806,11 @@ pub fn render_text(r: &TraceReport) -> String {
                 "FAIL {}: {} of {} compared sweeps diverge ({kinds}); {counts}",
                 r.trace, r.divergent, r.compared
             );
+            if r.divergences.is_empty()
+                && let Some(frame) = r.divergent_frames.first()
+            {
+                let _ = writeln!(s, "  first divergence: frame {frame}");
+            }
             if let Some(first) = r.divergences.first() {
                 let _ = writeln!(
                     s,
@@ -881,16 +896,24 @@ pub fn render_json(reports: &[TraceReport]) -> String {
     s
 }
 
-/// A frame range around the first detailed divergences: from `before`
-/// frames before the first to `after` frames after the last one kept in
-/// detail. `None` when there is no divergence.
+/// A frame range around the first divergences: from `before` frames
+/// before the first divergent frame to `after` frames after the last one
+/// kept in detail (or the first, when none is kept in detail). `None` when
+/// there is no divergence.
 pub fn frames_around(
     r: &TraceReport,
     before: u64,
     after: u64,
 ) -> Option<crate::replay::FrameRange> {
-    let first = r.divergences.first()?.frame;
-    let last = r.divergences.iter().map(|d| d.frame).max().unwrap_or(first);
+    let first = *r.divergent_frames.first()?;
+    let kept = r.divergences.len().max(1);
+    let last = r
+        .divergent_frames
+        .iter()
+        .take(kept)
+        .copied()
+        .max()
+        .unwrap_or(first);
     Some(crate::replay::FrameRange {
         start: Some(first.saturating_sub(before)),
         end: Some(last.saturating_add(after).saturating_add(1)),

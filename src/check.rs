@@ -49,11 +49,11 @@ pub const DEFAULT_MAX_DETAILS: usize = 3;
 /// only tolerances of the comparison; their defaults are the `DEFAULT_*`
 /// constants of this module:
 ///
-/// | field     | compared as                                   | default   |
-/// |-----------|-----------------------------------------------|-----------|
-/// | `alpha`   | `|got - expected| ≤ alpha`                     | `1e-6`    |
-/// | `normal`  | angle between the two vectors ≤ `normal_degrees` (degrees) | `0.01°` |
-/// | `contact` | Euclidean distance ≤ `contact`                | `1e-6`    |
+/// - `alpha`: the absolute difference is at most `alpha` (default `1e-6`);
+/// - `normal`: the angle between the two vectors is at most
+///   `normal_degrees`, in **degrees** (default `0.01°`);
+/// - `contact`: the Euclidean distance is at most `contact`, in the scene's
+///   length unit (default `1e-6`).
 ///
 /// `kind`, `triangle` and `feature` are compared exactly.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]

@@ -57,6 +57,40 @@ pub fn came_close(r: &TestRecord) -> bool {
     )
 }
 
+/// Whether `t` is the test that produced the primary collision.
+pub fn is_primary(o: &Outcome, t: &TestRecord) -> bool {
+    o.is_hit()
+        && o.triangle == Some(t.triangle())
+        && o.kind == t.kind()
+        && o.feature == Some(t.feature())
+}
+
+/// A marker for the primary test and for other hits at the same `α`
+/// (simultaneous: their triangles' normals are averaged).
+fn role(o: &Outcome, t: &TestRecord) -> &'static str {
+    if is_primary(o, t) {
+        "   <- primary"
+    } else if t
+        .alpha()
+        .is_some_and(|a| (a - o.alpha).abs() <= crate::core::SIMULTANEOUS_TOLERANCE)
+    {
+        "   <- simultaneous"
+    } else {
+        ""
+    }
+}
+
+/// The records to show, ordered by triangle, then face, edges, vertices.
+fn shown_records<'a>(r: &SweepReport<'a>) -> Vec<&'a TestRecord> {
+    let mut shown: Vec<&TestRecord> = r
+        .records
+        .iter()
+        .filter(|t| r.all || came_close(t))
+        .collect();
+    shown.sort_by_key(|t| (t.triangle(), t.kind(), t.feature()));
+    shown
+}
+
 /// Everything the `sweep` command reports.
 pub struct SweepReport<'a> {
     /// Scene name.
@@ -98,11 +132,7 @@ pub fn sweep_text(r: &SweepReport) -> String {
     )
     .unwrap();
     writeln!(s, "outcome: {}", outcome_line(r.outcome)).unwrap();
-    let shown: Vec<&TestRecord> = r
-        .records
-        .iter()
-        .filter(|t| r.all || came_close(t))
-        .collect();
+    let shown = shown_records(r);
     let hidden = r.records.len() - shown.len();
     if shown.is_empty() {
         writeln!(
@@ -123,7 +153,7 @@ pub fn sweep_text(r: &SweepReport) -> String {
         )
         .unwrap();
         for t in shown {
-            writeln!(s, "  {}", describe(t)).unwrap();
+            writeln!(s, "  {}{}", describe(t), role(r.outcome, t)).unwrap();
         }
         if hidden > 0 {
             writeln!(
@@ -138,14 +168,13 @@ pub fn sweep_text(r: &SweepReport) -> String {
 
 /// The `sweep` report as one JSON object.
 pub fn sweep_json(r: &SweepReport) -> String {
-    let tests: Vec<serde_json::Value> = r
-        .records
-        .iter()
-        .filter(|t| r.all || came_close(t))
+    let tests: Vec<serde_json::Value> = shown_records(r)
+        .into_iter()
         .map(|t| {
             let mut v = serde_json::to_value(t).unwrap_or(serde_json::Value::Null);
             if let Some(obj) = v.as_object_mut() {
                 obj.insert("explanation".into(), json!(describe(t)));
+                obj.insert("primary".into(), json!(is_primary(r.outcome, t)));
             }
             v
         })

@@ -189,6 +189,7 @@ fn earliest(
 ///   (grazing: the discriminant is near zero);
 /// - hit or miss changes when ρ moves by ±`RADIUS_PERTURBATION` (near miss,
 ///   or a contact at the very end of the path).
+///
 /// A contact within `BOUNDARY_MARGIN` of a feature boundary keeps α in the
 /// comparison but not its kind.
 pub fn oracle(tris: &[OTri], p0: [f64; 3], p1: [f64; 3], rho: f64, facing: Facing) -> OracleResult {

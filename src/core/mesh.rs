@@ -172,7 +172,7 @@ impl Mesh {
                 .max((c - b).norm_squared())
                 .max((a - c).norm_squared());
             let area2 = cross.norm();
-            if !(area2 > DEGENERATE_TOLERANCE * longest) || !area2.is_finite() {
+            if area2.is_nan() || area2 <= DEGENERATE_TOLERANCE * longest || !area2.is_finite() {
                 degenerate.push(DegenerateTriangle {
                     index: t,
                     reason: DegenerateReason::ZeroArea,

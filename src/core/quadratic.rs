@@ -8,7 +8,7 @@
 /// for finite inputs with `A > 0`.
 #[inline]
 pub fn solve(a: f64, b: f64, c: f64, discriminant: f64) -> Option<(f64, f64)> {
-    if discriminant < 0.0 || !(a > 0.0) {
+    if discriminant < 0.0 || a.is_nan() || a <= 0.0 {
         return None;
     }
     let sqrt = discriminant.sqrt();

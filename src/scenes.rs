@@ -463,7 +463,6 @@ pub fn obj_from_reader(reader: &mut impl std::io::BufRead) -> Result<SceneMesh, 
         single_index: false,
         ignore_points: true,
         ignore_lines: true,
-        ..Default::default()
     };
     let no_materials =
         |_: &std::path::Path| -> tobj::MTLLoadResult { Ok((Vec::new(), Default::default())) };

@@ -433,8 +433,8 @@ pub fn initial_states(options: &SimOptions) -> Vec<([f64; 3], [f64; 3])> {
         let mut p = options.position;
         let mut v = options.velocity;
         if ball > 0 {
-            for axis in 0..2 {
-                p[axis] += jitter(&mut rng, options.position_jitter);
+            for coordinate in p.iter_mut().take(2) {
+                *coordinate += jitter(&mut rng, options.position_jitter);
             }
             for axis in v.iter_mut() {
                 *axis += jitter(&mut rng, options.velocity_jitter);

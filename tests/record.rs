@@ -474,7 +474,9 @@ fn scenes_face_the_play_side() -> Result<(), String> {
     let mesh = scenes::closed_box().to_mesh().map_err(|e| e.to_string())?;
     for t in mesh.triangles() {
         ensure!(
-            t.normal.dot(&(Point3::origin() - t.vertices[0])) > 0.0,
+            t.normal
+                .dot(&(Point3::origin() - t.vertices[0]))
+                .is_sign_positive(),
             "box: triangle {} points outward",
             t.index
         );
@@ -485,7 +487,7 @@ fn scenes_face_the_play_side() -> Result<(), String> {
     let bowl = scenes::bowl().to_mesh().map_err(|e| e.to_string())?;
     for t in bowl.triangles() {
         ensure!(
-            t.normal.z > 0.0,
+            t.normal.z.is_sign_positive(),
             "bowl: triangle {} faces down ({:?})",
             t.index,
             t.normal
@@ -494,7 +496,7 @@ fn scenes_face_the_play_side() -> Result<(), String> {
         let c = (t.vertices[0].coords + t.vertices[1].coords + t.vertices[2].coords) / 3.0;
         let outward = Vector3::new(c.x, c.y, 0.0);
         ensure!(
-            t.normal.dot(&outward) <= 1e-12,
+            (t.normal.dot(&outward) - 1e-12).is_sign_negative(),
             "bowl: triangle {} leans outward",
             t.index
         );
@@ -557,7 +559,7 @@ fn terrain_size() -> Result<(), String> {
     for i in -200..200 {
         let x = f64::from(i) * 0.37;
         ensure!(
-            (scenes::det_sin(x) - x.sin()).abs() < 1e-9,
+            ((scenes::det_sin(x) - x.sin()).abs() - 1e-9).is_sign_negative(),
             "det_sin({x}) = {}",
             scenes::det_sin(x)
         );

@@ -243,7 +243,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     let mut events = replay_events(TraceReader::new(reader, &source_name), options);
     let mut trace_error = None;
     let mut last_frame = None;
-    while let Some(event) = events.next() {
+    for event in events.by_ref() {
         progress.set_position(count.load(Ordering::Relaxed));
         match event {
             Ok(ReplayEvent::Scene(scene)) => {

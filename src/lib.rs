@@ -13,4 +13,5 @@ pub mod report;
 pub mod scenes;
 pub mod sim;
 pub mod trace;
+#[cfg(feature = "viewer")]
 pub mod viz;

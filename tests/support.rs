@@ -9,7 +9,8 @@ use sweeptrace::core::{
 #[macro_export]
 macro_rules! ensure {
     ($cond:expr, $($arg:tt)+) => {
-        if !$cond {
+        if $cond {
+        } else {
             return Err(format!($($arg)+));
         }
     };

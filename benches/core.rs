@@ -78,12 +78,21 @@ struct Setup {
 fn setup(n: usize) -> Setup {
     let (vertices, triangles) = terrain(n);
     let parry = TriMesh::new(
-        vertices.iter().map(|v| Vector::new(v[0], v[1], v[2])).collect(),
+        vertices
+            .iter()
+            .map(|v| Vector::new(v[0], v[1], v[2]))
+            .collect(),
         triangles.iter().map(|t| t.map(|i| i as u32)).collect(),
     )
     .expect("valid terrain for parry");
     let ours = Mesh::new(vertices, &triangles).expect("valid terrain");
-    Setup { n, triangles: triangles.len(), ours, parry, sweeps: sweeps(n, 7 + n as u64) }
+    Setup {
+        n,
+        triangles: triangles.len(),
+        ours,
+        parry,
+        sweeps: sweeps(n, 7 + n as u64),
+    }
 }
 
 fn parry_cast(mesh: &TriMesh, s: &Sweep) -> Option<f64> {

@@ -15,3 +15,8 @@ pub mod sim;
 pub mod trace;
 #[cfg(feature = "viewer")]
 pub mod viz;
+
+/// The README's Rust examples, compiled and run as doctests.
+#[cfg(doctest)]
+#[doc = include_str!("../README.md")]
+pub struct ReadmeDoctests;

@@ -14,12 +14,13 @@ use sweeptrace::scenes;
     after_help = "Example:\n  sweeptrace sweep --scene cube --radius 0.5 --from 0,3,0.2 --to 0.9,-3,0.2"
 )]
 pub struct Args {
-    /// Built-in scene: `cube` (the cube [-1,1]³, 12 triangles) or `triangle`
-    /// ((0,0,0), (4,0,0), (0,4,0), front +z).
+    /// Built-in scene: `cube` (the cube [-1,1]³, 12 outward triangles),
+    /// `triangle` ((0,0,0), (4,0,0), (0,4,0), front +z), `mini_golf`, `bowl`,
+    /// `box` (closed, faces inward) or `terrain` (100,352 triangles).
     #[arg(long, default_value = "cube")]
     pub scene: String,
     /// Radius r of the ball.
-    #[arg(long, default_value_t = 0.5)]
+    #[arg(long, default_value_t = 0.5, allow_negative_numbers = true)]
     pub radius: f64,
     /// Start of the ball's center, `x,y,z`.
     #[arg(long, value_parser = super::parse_point, allow_hyphen_values = true)]
@@ -28,7 +29,7 @@ pub struct Args {
     #[arg(long, value_parser = super::parse_point, allow_hyphen_values = true)]
     pub to: [f64; 3],
     /// Margin ε: tests use the detection radius ρ = r - ε (0 ≤ ε < r).
-    #[arg(long, default_value_t = 0.0)]
+    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
     pub margin: f64,
     /// Facing rule: `non_strict` (n·d ≤ 0) or `strict` (n·d < 0).
     #[arg(long, default_value = "non_strict")]

@@ -450,9 +450,7 @@ impl Replay {
         if self.pending.first().is_some_and(|p| p.frame != msg.frame) {
             self.release_pending();
         }
-        if !self.options.frames.contains(msg.frame)
-            || self.options.ball.is_some_and(|b| b != msg.ball)
-        {
+        if !self.wanted(msg.frame, msg.ball) {
             self.summary.filtered_out += 1;
             self.early_expected.remove(&(msg.frame, msg.ball));
             return Ok(());
@@ -463,42 +461,67 @@ impl Replay {
                 index,
             });
         };
-        let start = Instant::now();
-        let sweep = Sweep::new(msg.p0, msg.p1, msg.radius);
-        let options = scene.options;
-        let err = |source| ReplayError::Sweep {
-            frame: msg.frame,
-            ball: msg.ball,
-            index,
-            source,
+        let computed = compute_sweep(&scene, &msg, index, &self.options);
+        self.commit(log_time_nanos, index, msg, &scene, computed?);
+        Ok(())
+    }
+
+    /// A `/sweep` message whose core query already ran ([`compute_sweep`]
+    /// against [`Replay::current_scene`], or `None` when the sweep is
+    /// filtered out or comes before any scene): the same as
+    /// [`Replay::sweep`] without the query. Used by [`replay_events_parallel`].
+    pub fn sweep_computed(
+        &mut self,
+        log_time_nanos: u64,
+        index: u64,
+        msg: SweepMsg,
+        computed: Option<Result<ComputedSweep, ReplayError>>,
+    ) -> Result<(), ReplayError> {
+        let Some(computed) = computed else {
+            return self.sweep(log_time_nanos, index, msg);
         };
-        let (outcome, records) = if self.options.explain {
-            let broadphase = match self.options.detail {
-                Detail::All => Broadphase::Exhaustive,
-                Detail::Primary | Detail::Candidates => Broadphase::Bvh,
-            };
-            let mut collect = CollectRecords::default();
-            let outcome = sweep_mesh_with(&scene.mesh, &sweep, &options, broadphase, &mut collect)
-                .map_err(err)?;
-            for r in &collect.records {
-                *self.summary.verdicts.entry(r.verdict()).or_default() += 1;
-            }
-            let records = match self.options.detail {
-                Detail::Primary => primary_records(&outcome, collect.records),
-                Detail::Candidates | Detail::All => collect.records,
-            };
-            (outcome, records)
-        } else {
-            (
-                sweep_mesh(&scene.mesh, &sweep, &options).map_err(err)?,
-                Vec::new(),
-            )
+        if self.pending.first().is_some_and(|p| p.frame != msg.frame) {
+            self.release_pending();
+        }
+        let Some(scene) = self.scene.clone() else {
+            return Err(ReplayError::NoScene {
+                frame: msg.frame,
+                index,
+            });
         };
+        self.commit(log_time_nanos, index, msg, &scene, computed?);
+        Ok(())
+    }
+
+    /// Whether a sweep passes the frame and ball filters.
+    fn wanted(&self, frame: u64, ball: u32) -> bool {
+        replay_wanted(&self.options, frame, ball)
+    }
+
+    fn commit(
+        &mut self,
+        log_time_nanos: u64,
+        index: u64,
+        msg: SweepMsg,
+        scene: &SceneState,
+        computed: ComputedSweep,
+    ) {
+        let ComputedSweep {
+            sweep,
+            outcome,
+            records,
+            verdicts,
+            elapsed,
+        } = computed;
+        for (v, n) in verdicts {
+            *self.summary.verdicts.entry(v).or_default() += n;
+        }
         let expected = self.early_expected.remove(&(msg.frame, msg.ball));
         if expected.is_some() {
             self.summary.expected_matched += 1;
         }
         self.summary.sweeps += 1;
+        self.summary.elapsed += elapsed;
         *self.summary.outcomes.entry(outcome.kind).or_default() += 1;
         self.pending.push(SweepResult {
             frame: msg.frame,
@@ -507,13 +530,11 @@ impl Replay {
             index,
             scene: scene.number,
             sweep,
-            options,
+            options: scene.options,
             outcome,
             records,
             expected,
         });
-        self.summary.elapsed += start.elapsed();
-        Ok(())
     }
 
     /// Any trace event.
@@ -598,6 +619,75 @@ impl Replay {
         self.early_expected.retain(|(f, _), _| *f >= frame);
         self.summary.expected_unmatched += (before - self.early_expected.len()) as u64;
     }
+}
+
+/// The core's part of one sweep, independent of every other sweep: what
+/// [`Replay::sweep_computed`] takes.
+#[derive(Clone, Debug)]
+pub struct ComputedSweep {
+    sweep: Sweep,
+    outcome: Outcome,
+    records: Vec<TestRecord>,
+    verdicts: Vec<(Verdict, u64)>,
+    elapsed: Duration,
+}
+
+/// Runs the core query of one sweep message against `scene` as a replay
+/// with `options` would (the filters are not applied here).
+pub fn compute_sweep(
+    scene: &SceneState,
+    msg: &SweepMsg,
+    index: u64,
+    options: &ReplayOptions,
+) -> Result<ComputedSweep, ReplayError> {
+    let start = Instant::now();
+    let sweep = Sweep::new(msg.p0, msg.p1, msg.radius);
+    let err = |source| ReplayError::Sweep {
+        frame: msg.frame,
+        ball: msg.ball,
+        index,
+        source,
+    };
+    let mut verdicts: Vec<(Verdict, u64)> = Vec::new();
+    let (outcome, records) = if options.explain {
+        let broadphase = match options.detail {
+            Detail::All => Broadphase::Exhaustive,
+            Detail::Primary | Detail::Candidates => Broadphase::Bvh,
+        };
+        let mut collect = CollectRecords::default();
+        let outcome = sweep_mesh_with(
+            &scene.mesh,
+            &sweep,
+            &scene.options,
+            broadphase,
+            &mut collect,
+        )
+        .map_err(err)?;
+        for r in &collect.records {
+            let v = r.verdict();
+            match verdicts.iter_mut().find(|(w, _)| *w == v) {
+                Some((_, n)) => *n += 1,
+                None => verdicts.push((v, 1)),
+            }
+        }
+        let records = match options.detail {
+            Detail::Primary => primary_records(&outcome, collect.records),
+            Detail::Candidates | Detail::All => collect.records,
+        };
+        (outcome, records)
+    } else {
+        (
+            sweep_mesh(&scene.mesh, &sweep, &scene.options).map_err(err)?,
+            Vec::new(),
+        )
+    };
+    Ok(ComputedSweep {
+        sweep,
+        outcome,
+        records,
+        verdicts,
+        elapsed: start.elapsed(),
+    })
 }
 
 fn is_primary(r: &TestRecord, outcome: &Outcome) -> bool {
@@ -717,6 +807,189 @@ impl<I> ReplayIter<I> {
             let (events, summary) = replay.finish();
             self.tail.extend(events);
             self.summary = Some(summary);
+        }
+    }
+}
+
+/// Trace events per batch of [`replay_events_parallel`] unless told otherwise.
+pub const DEFAULT_BATCH_EVENTS: usize = 4096;
+
+/// Replays a stream of trace events like [`replay_events`], with the core
+/// queries of each batch of `batch_events` events run in parallel on `pool`
+/// (rayon's global pool when `None`). The results, their order, the errors
+/// and the summary are those of [`replay_events`]: only the independent
+/// part of each sweep (the query, [`compute_sweep`]) runs in parallel; the
+/// bookkeeping goes through the same [`Replay`] in trace order.
+///
+/// A batch ends before a scene message, so every sweep of a batch is
+/// against the scene in force at its start. Memory is bounded by one batch
+/// of events and their results (plus the frame whose results are held back
+/// for its `/expected` messages), whatever the trace's length.
+pub fn replay_events_parallel<I>(
+    events: I,
+    options: ReplayOptions,
+    batch_events: usize,
+    pool: Option<Arc<rayon::ThreadPool>>,
+) -> ParallelReplayIter<I>
+where
+    I: Iterator<Item = Result<TraceEvent, TraceError>>,
+{
+    ParallelReplayIter {
+        events,
+        replay: Some(Replay::new(options)),
+        out: VecDeque::new(),
+        held_scene: None,
+        summary: None,
+        batch_events: batch_events.max(1),
+        pool,
+    }
+}
+
+/// The iterator of [`replay_events_parallel`].
+pub struct ParallelReplayIter<I> {
+    events: I,
+    replay: Option<Replay>,
+    out: VecDeque<Result<ReplayEvent, ReplayError>>,
+    /// A scene message that ended the previous batch.
+    held_scene: Option<TraceEvent>,
+    summary: Option<Summary>,
+    batch_events: usize,
+    pool: Option<Arc<rayon::ThreadPool>>,
+}
+
+impl<I> ParallelReplayIter<I> {
+    /// The counts so far; final once the iterator returned `None`.
+    pub fn summary(&self) -> Summary {
+        match (&self.summary, &self.replay) {
+            (Some(s), _) => s.clone(),
+            (None, Some(r)) => r.summary().clone(),
+            (None, None) => Summary::default(),
+        }
+    }
+}
+
+impl<I> ParallelReplayIter<I>
+where
+    I: Iterator<Item = Result<TraceEvent, TraceError>>,
+{
+    /// Reads, computes and pushes one batch; its results go to `out`.
+    fn run_batch(&mut self) {
+        let Some(replay) = self.replay.as_mut() else {
+            return;
+        };
+        let mut batch: Vec<TraceEvent> = Vec::with_capacity(self.batch_events.min(1 << 16));
+        batch.extend(self.held_scene.take());
+        let mut end: Option<Option<TraceError>> = None;
+        while batch.len() < self.batch_events {
+            match self.events.next() {
+                Some(Ok(event)) => {
+                    let is_scene = matches!(event, TraceEvent::Scene { .. });
+                    if is_scene && batch.iter().any(|e| !matches!(e, TraceEvent::Scene { .. })) {
+                        self.held_scene = Some(event);
+                        break;
+                    }
+                    batch.push(event);
+                }
+                Some(Err(err)) => {
+                    end = Some(Some(err));
+                    break;
+                }
+                None => {
+                    end = Some(None);
+                    break;
+                }
+            }
+        }
+
+        // Leading scenes first, so the sweeps see the scene in force.
+        let scenes = batch
+            .iter()
+            .take_while(|e| matches!(e, TraceEvent::Scene { .. }))
+            .count();
+        let rest = batch.split_off(scenes);
+        for event in batch {
+            let result = replay.push(event);
+            drain(replay, result, &mut self.out);
+        }
+
+        let scene = replay.current_scene().cloned();
+        let options = *replay.options();
+        let compute = |event: &TraceEvent| match (event, &scene) {
+            (TraceEvent::Sweep { index, sweep, .. }, Some(scene))
+                if replay_wanted(&options, sweep.frame, sweep.ball) =>
+            {
+                Some(compute_sweep(scene, sweep, *index, &options))
+            }
+            _ => None,
+        };
+        let computed: Vec<Option<Result<ComputedSweep, ReplayError>>> = {
+            use rayon::prelude::*;
+            let run = || rest.par_iter().with_min_len(16).map(compute).collect();
+            match &self.pool {
+                Some(pool) => pool.install(run),
+                None => run(),
+            }
+        };
+        for (event, computed) in rest.into_iter().zip(computed) {
+            let result = match event {
+                TraceEvent::Sweep {
+                    log_time_nanos,
+                    index,
+                    sweep,
+                } => replay.sweep_computed(log_time_nanos, index, sweep, computed),
+                other => replay.push(other),
+            };
+            drain(replay, result, &mut self.out);
+        }
+
+        match end {
+            None => {}
+            Some(err) => {
+                if let Some(err) = err {
+                    self.out.push_back(Err(ReplayError::from(err)));
+                }
+                if let Some(replay) = self.replay.take() {
+                    let (events, summary) = replay.finish();
+                    self.out.extend(events.into_iter().map(Ok));
+                    self.summary = Some(summary);
+                }
+            }
+        }
+    }
+}
+
+fn replay_wanted(options: &ReplayOptions, frame: u64, ball: u32) -> bool {
+    options.frames.contains(frame) && options.ball.is_none_or(|b| b == ball)
+}
+
+/// Moves the outcome of one push and what it made ready to `out`, in the
+/// order [`ReplayIter`] yields them.
+fn drain(
+    replay: &mut Replay,
+    result: Result<(), ReplayError>,
+    out: &mut VecDeque<Result<ReplayEvent, ReplayError>>,
+) {
+    if let Err(err) = result {
+        out.push_back(Err(err));
+    }
+    while let Some(e) = replay.next_event() {
+        out.push_back(Ok(e));
+    }
+}
+
+impl<I> Iterator for ParallelReplayIter<I>
+where
+    I: Iterator<Item = Result<TraceEvent, TraceError>>,
+{
+    type Item = Result<ReplayEvent, ReplayError>;
+
+    fn next(&mut self) -> Option<Self::Item> {
+        loop {
+            if let Some(e) = self.out.pop_front() {
+                return Some(e);
+            }
+            self.replay.as_ref()?;
+            self.run_batch();
         }
     }
 }

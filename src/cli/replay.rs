@@ -11,9 +11,11 @@ use std::sync::atomic::{AtomicU64, Ordering};
 use anyhow::{Context, bail};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 
+use rayon::prelude::*;
 use sweeptrace::core::Facing;
 use sweeptrace::replay::{
-    Detail, FrameRange, ReplayError, ReplayEvent, ReplayOptions, replay_events,
+    DEFAULT_BATCH_EVENTS, Detail, FrameRange, ReplayError, ReplayEvent, ReplayOptions, SceneState,
+    replay_events_parallel,
 };
 use sweeptrace::trace::TraceReader;
 use sweeptrace::viz;
@@ -69,6 +71,10 @@ pub struct Args {
     /// Do not embed the default viewer layout (blueprint) in the recording.
     #[arg(long)]
     pub no_blueprint: bool,
+    /// Worker threads for the core queries and the logging [default: one
+    /// per core]. The outputs do not depend on it.
+    #[arg(long, value_name = "N")]
+    pub threads: Option<usize>,
 }
 
 /// Counts bytes read, for the progress bar.
@@ -234,46 +240,102 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         }
     };
 
+    if args.threads == Some(0) {
+        bail!("--threads must be at least 1");
+    }
+    let pool = Arc::new(
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(args.threads.unwrap_or(0))
+            .build()
+            .context("starting the worker threads")?,
+    );
+
     let count = Arc::new(AtomicU64::new(0));
     let reader = CountingReader {
         inner: BufReader::with_capacity(1 << 16, file),
         count: count.clone(),
     };
     let progress = progress_bar(total_bytes);
-    let mut events = replay_events(TraceReader::new(reader, &source_name), options);
+    let mut events = replay_events_parallel(
+        TraceReader::new(reader, &source_name),
+        options,
+        DEFAULT_BATCH_EVENTS,
+        Some(pool.clone()),
+    );
     let mut trace_error = None;
     let mut last_frame = None;
-    for event in events.by_ref() {
+    let mut scenes: Vec<Arc<SceneState>> = Vec::new();
+    let max_edge_frames = logger.as_ref().map(|l| l.max_edge_frames());
+    let write_outcomes = outcomes.is_some();
+    let mut batch = Vec::with_capacity(DEFAULT_BATCH_EVENTS);
+    loop {
+        // A bounded batch of results: the outcome lines and the recording's
+        // rows are built in parallel, then written in trace order.
+        batch.clear();
+        batch.extend(events.by_ref().take(DEFAULT_BATCH_EVENTS));
+        if batch.is_empty() {
+            break;
+        }
         progress.set_position(count.load(Ordering::Relaxed));
-        match event {
-            Ok(ReplayEvent::Scene(scene)) => {
-                for d in scene.mesh.degenerate() {
-                    progress
-                        .suspend(|| eprintln!("warning: scene {}: {d}, left out", scene.number));
-                }
-                if let Some(l) = logger.as_mut() {
-                    l.log_scene(&scene).context("logging the scene")?;
-                }
+        for event in &batch {
+            if let Ok(ReplayEvent::Scene(scene)) = event {
+                scenes.push(scene.clone());
             }
-            Ok(ReplayEvent::Sweep(result)) => {
-                last_frame = Some(result.frame);
-                if let Some(o) = outcomes.as_mut() {
-                    let line = serde_json::to_string(&result.outcome_msg())
-                        .context("serializing an outcome")?;
-                    writeln!(o.writer(), "{line}").context("writing outcomes")?;
+        }
+        let prepared: Vec<(Option<String>, Option<viz::PreparedSweep>)> = pool.install(|| {
+            batch
+                .par_iter()
+                .with_min_len(64)
+                .map(|event| match event {
+                    Ok(ReplayEvent::Sweep(result)) => {
+                        let line = write_outcomes
+                            .then(|| serde_json::to_string(&result.outcome_msg()).ok())
+                            .flatten();
+                        let rows = max_edge_frames.map(|max| {
+                            let scene = scenes.iter().find(|s| s.number == result.scene);
+                            viz::prepare_sweep(scene.map(|s| &**s), result, max)
+                        });
+                        (line, rows)
+                    }
+                    _ => (None, None),
+                })
+                .collect()
+        });
+        for (event, (line, rows)) in batch.drain(..).zip(prepared) {
+            match event {
+                Ok(ReplayEvent::Scene(scene)) => {
+                    for d in scene.mesh.degenerate() {
+                        progress.suspend(|| {
+                            eprintln!("warning: scene {}: {d}, left out", scene.number)
+                        });
+                    }
+                    if let Some(l) = logger.as_mut() {
+                        l.log_scene(&scene).context("logging the scene")?;
+                    }
                 }
-                if let Some(l) = logger.as_mut() {
-                    l.log_sweep(&result)
-                        .with_context(|| format!("logging frame {}", result.frame))?;
+                Ok(ReplayEvent::Sweep(result)) => {
+                    last_frame = Some(result.frame);
+                    if let Some(o) = outcomes.as_mut() {
+                        let line = match line {
+                            Some(line) => line,
+                            None => serde_json::to_string(&result.outcome_msg())
+                                .context("serializing an outcome")?,
+                        };
+                        writeln!(o.writer(), "{line}").context("writing outcomes")?;
+                    }
+                    if let (Some(l), Some(rows)) = (logger.as_mut(), rows) {
+                        l.log_prepared(rows)
+                            .with_context(|| format!("logging frame {}", result.frame))?;
+                    }
                 }
-            }
-            Err(ReplayError::Trace(err)) => {
-                // The reader stops here; what was read is still replayed.
-                trace_error = Some(err);
-            }
-            Err(err) => {
-                progress.finish_and_clear();
-                return Err(anyhow::Error::new(err).context(format!("replaying {source_name}")));
+                Err(ReplayError::Trace(err)) => {
+                    // The reader stops here; what was read is still replayed.
+                    trace_error = Some(err);
+                }
+                Err(err) => {
+                    progress.finish_and_clear();
+                    return Err(anyhow::Error::new(err).context(format!("replaying {source_name}")));
+                }
             }
         }
     }
@@ -282,7 +344,8 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
 
     // Finish the files: the recording's footer is written when the last
     // clone of the stream is dropped.
-    if let Some(l) = logger {
+    if let Some(mut l) = logger {
+        l.flush().context("logging the last frames")?;
         let rec = l.finish();
         rec.flush_blocking().context("flushing the recording")?;
         drop(rec);

@@ -8,6 +8,7 @@
 //! same trace and options give the same content. (Rerun's row and chunk ids
 //! are still fresh per run, so the bytes of two `.rrd` files differ.)
 
+mod columns;
 pub mod paths;
 
 use std::collections::BTreeMap;
@@ -20,8 +21,8 @@ use rerun::blueprint::{
 };
 use rerun::components::{FillMode, TextLogLevel};
 use rerun::{
-    AnyValues, Arrows3D, Capsules3D, Clear, Color, Ellipsoids3D, LineStrips3D, Mesh3D, Points3D,
-    RecordingStream, RecordingStreamBuilder, Scalars, TextLog, TimeCell, Transform3D,
+    AnyValues, Arrows3D, AsComponents, Capsules3D, Clear, Color, Ellipsoids3D, LineStrips3D,
+    Mesh3D, Points3D, RecordingStream, RecordingStreamBuilder, Scalars, TextLog, Transform3D,
     ViewCoordinates,
 };
 
@@ -159,6 +160,12 @@ struct BallState {
 }
 
 /// Logs replay events to a recording stream.
+///
+/// Rows are not sent one by one: they are buffered per entity, as columns,
+/// and sent as one chunk per entity every [`DEFAULT_FLUSH_ROWS`] rows (and
+/// by [`Logger::flush`] and [`Logger::finish`]). What the recording holds is
+/// what logging each row on its own would give, with ids that depend only
+/// on the order of the rows, so the same events give the same chunks.
 #[derive(Debug)]
 pub struct Logger {
     rec: RecordingStream,
@@ -166,6 +173,57 @@ pub struct Logger {
     scenes: Vec<std::sync::Arc<SceneState>>,
     time_origin_nanos: Option<u64>,
     max_edge_frames: usize,
+    columns: columns::Columns,
+    flush_rows: usize,
+}
+
+/// Rows buffered before the logger sends them (see [`Logger`]).
+pub const DEFAULT_FLUSH_ROWS: usize = 1 << 14;
+
+/// What one sweep logs, built without the logger ([`prepare_sweep`]), so
+/// that many sweeps can be prepared in parallel and logged in order with
+/// [`Logger::log_prepared`].
+#[derive(Debug)]
+pub struct PreparedSweep {
+    frame: u64,
+    log_time_nanos: u64,
+    ball: u32,
+    edge_slots: usize,
+    rows: Rows,
+}
+
+/// The rows of one sweep: entity path and serialized components, in order.
+#[derive(Debug, Default)]
+struct Rows(Vec<(String, Vec<rerun::SerializedComponentBatch>)>);
+
+impl Rows {
+    fn push(&mut self, path: impl Into<String>, value: &dyn rerun::AsComponents) {
+        self.0.push((path.into(), value.as_serialized_batches()));
+    }
+}
+
+/// Prepares what [`Logger::log_sweep`] logs for `r`: `scene` is the scene
+/// it was swept against, `max_edge_frames` as in
+/// [`Logger::with_max_edge_frames`].
+pub fn prepare_sweep(
+    scene: Option<&SceneState>,
+    r: &SweepResult,
+    max_edge_frames: usize,
+) -> PreparedSweep {
+    let mut rows = Rows::default();
+    let decisive = r.decisive_record().copied();
+    sweep_rows(&mut rows, r);
+    decisive_rows(&mut rows, scene, r, decisive.as_ref());
+    let edge_slots = edge_frame_rows(&mut rows, r, decisive.as_ref(), max_edge_frames);
+    plot_rows(&mut rows, r, decisive.as_ref());
+    text_rows(&mut rows, r, decisive.as_ref());
+    PreparedSweep {
+        frame: r.frame,
+        log_time_nanos: r.log_time_nanos,
+        ball: r.ball,
+        edge_slots,
+        rows,
+    }
 }
 
 impl Logger {
@@ -183,14 +241,42 @@ impl Logger {
                 },
             )?;
         }
-        rec.log_static(paths::WORLD, &ViewCoordinates::RIGHT_HAND_Z_UP())?;
-        Ok(Logger {
+        let mut logger = Logger {
             rec,
             balls: BTreeMap::new(),
             scenes: Vec::new(),
             time_origin_nanos: None,
             max_edge_frames: MAX_EDGE_FRAMES,
-        })
+            columns: columns::Columns::default(),
+            flush_rows: DEFAULT_FLUSH_ROWS,
+        };
+        logger.log_static(paths::WORLD, &ViewCoordinates::RIGHT_HAND_Z_UP())?;
+        Ok(logger)
+    }
+
+    /// Sets how many rows are buffered before they are sent (at least 1).
+    pub fn with_flush_rows(mut self, rows: usize) -> Logger {
+        self.flush_rows = rows.max(1);
+        self
+    }
+
+    /// How many edge tests per sweep get an edge frame.
+    pub fn max_edge_frames(&self) -> usize {
+        self.max_edge_frames
+    }
+
+    /// Sends every buffered row.
+    pub fn flush(&mut self) -> Result<(), RecordingStreamError> {
+        self.columns.send(&self.rec)
+    }
+
+    fn log_static(
+        &mut self,
+        path: impl Into<String>,
+        value: &dyn rerun::AsComponents,
+    ) -> Result<(), RecordingStreamError> {
+        self.columns
+            .send_static(&self.rec, path.into(), value.as_serialized_batches())
     }
 
     /// Sets how many edge tests per sweep get an edge frame.
@@ -212,9 +298,11 @@ impl Logger {
         }
     }
 
-    /// Flushes and hands the stream back (drop it, and every clone, to
-    /// finish a file).
-    pub fn finish(self) -> RecordingStream {
+    /// Sends what is buffered, flushes and hands the stream back (drop it,
+    /// and every clone, to finish a file). Use [`Logger::flush`] first to
+    /// see an error of the last rows.
+    pub fn finish(mut self) -> RecordingStream {
+        let _ = self.flush();
         let _ = self.rec.flush_blocking();
         self.rec
     }
@@ -239,333 +327,331 @@ impl Logger {
             .with_vertex_normals(normals)
             .with_triangle_indices(indices)
             .with_albedo_factor(albedo(MESH_COLOR));
-        self.rec.log_static(paths::mesh(scene.number), &mesh)?;
+        self.log_static(paths::mesh(scene.number), &mesh)?;
         self.scenes.push(scene.clone());
         Ok(())
     }
 
-    fn set_time(&mut self, frame: u64, log_time_nanos: u64) {
-        self.rec
-            .set_time_sequence(FRAME_TIMELINE, i64::try_from(frame).unwrap_or(i64::MAX));
+    /// The `time` timeline's value of a `log_time`.
+    fn time_of(&mut self, log_time_nanos: u64) -> columns::Time {
         let clamp = |n: u64| i64::try_from(n).unwrap_or(i64::MAX);
         if log_time_nanos >= TIMESTAMP_THRESHOLD_NANOS {
-            self.rec.set_time(
-                TIME_TIMELINE,
-                TimeCell::from_timestamp_nanos_since_epoch(clamp(log_time_nanos)),
-            );
+            columns::Time::Timestamp(clamp(log_time_nanos))
         } else {
             let origin = *self.time_origin_nanos.get_or_insert(0);
-            self.rec.set_time(
-                TIME_TIMELINE,
-                TimeCell::from_duration_nanos(clamp(log_time_nanos.saturating_sub(origin))),
-            );
+            columns::Time::Duration(clamp(log_time_nanos.saturating_sub(origin)))
         }
     }
 
     /// Logs one sweep's result at its frame.
     pub fn log_sweep(&mut self, r: &SweepResult) -> Result<(), RecordingStreamError> {
-        self.set_time(r.frame, r.log_time_nanos);
-        let b = r.ball;
-        let rec = &self.rec;
-        let o = &r.outcome;
-        let p0 = r.sweep.p0;
-        let p1 = r.sweep.p1;
-        let d = p1 - p0;
-        let rho = r.rho();
-        let radius = r.sweep.radius as f32;
-        let at_contact = p0 + d * o.alpha;
-
-        // The ball at p0, at the contact (when hit) and at p1.
-        let mut centers = vec![f32x3(p0.coords)];
-        let mut colors = vec![rgba(P0_COLOR)];
-        let mut labels = vec!["p0".to_string()];
-        if o.is_hit() {
-            centers.push(f32x3(at_contact.coords));
-            colors.push(rgba(CONTACT_BALL_COLOR));
-            labels.push(format!("α = {}", num(o.alpha)));
-        }
-        centers.push(f32x3(p1.coords));
-        colors.push(rgba(P1_COLOR));
-        labels.push("p1".to_string());
-        let n = centers.len();
-        rec.log(
-            paths::spheres(b),
-            &Ellipsoids3D::from_centers_and_radii(centers, std::iter::repeat_n(radius, n))
-                .with_colors(colors)
-                .with_labels(labels)
-                .with_fill_mode(FillMode::Solid),
-        )?;
-
-        // The swept volume at the detection radius.
-        let (length, rotation) = capsule_pose(&d);
-        rec.log(
-            paths::sweep(b),
-            &Capsules3D::from_lengths_and_radii([length], [rho as f32])
-                .with_translations([f32x3(p0.coords)])
-                .with_quaternions([rotation])
-                .with_colors([rgba(SWEEP_COLOR)])
-                .with_fill_mode(FillMode::MajorWireframe),
-        )?;
-
-        // Contact and normal.
-        match (o.contact, o.normal) {
-            (Some(c), Some(nrm)) => {
-                rec.log(
-                    paths::contact(b),
-                    &Points3D::new([f32x3(c.coords)])
-                        .with_colors([rgba(HIT_COLOR)])
-                        .with_radii([(rho * 0.08) as f32]),
-                )?;
-                rec.log(
-                    paths::normal(b),
-                    &Arrows3D::from_vectors([f32x3(nrm * (r.sweep.radius.max(1e-3) * 1.5))])
-                        .with_origins([f32x3(c.coords)])
-                        .with_colors([rgba(NORMAL_COLOR)])
-                        .with_labels(["normal"]),
-                )?;
-            }
-            _ => {
-                rec.log(paths::contact(b), &Clear::flat())?;
-                rec.log(paths::normal(b), &Clear::flat())?;
-            }
-        }
-
-        let decisive = r.decisive_record().copied();
-        self.log_decisive(r, decisive.as_ref())?;
-        self.log_edge_frames(r, decisive.as_ref())?;
-        self.log_plots(r, decisive.as_ref())?;
-        self.log_text(r, decisive.as_ref())?;
-        Ok(())
+        let scene = self.scenes.iter().find(|s| s.number == r.scene).cloned();
+        let prepared = prepare_sweep(scene.as_deref(), r, self.max_edge_frames);
+        self.log_prepared(prepared)
     }
 
-    fn log_decisive(
-        &self,
-        r: &SweepResult,
-        decisive: Option<&TestRecord>,
-    ) -> Result<(), RecordingStreamError> {
-        let rec = &self.rec;
-        let b = r.ball;
-        let scene = self.scenes.iter().find(|s| s.number == r.scene);
-        let triangle =
-            decisive.and_then(|t| scene.and_then(|s| s.mesh.triangle_by_index(t.triangle())));
-        let (Some(t), Some(test)) = (triangle, decisive) else {
-            rec.log(paths::primary_triangle(b), &Clear::flat())?;
-            rec.log(paths::primary_edge(b), &Clear::flat())?;
-            rec.log(paths::primary_vertex(b), &Clear::flat())?;
-            return Ok(());
-        };
-        let color = if test.alpha().is_some() {
-            HIT_COLOR
-        } else {
-            MISS_COLOR
-        };
-        // Lift the highlight a little off the mesh so it is not hidden by it.
-        let lift = t.normal * (r.rho() * 0.02);
-        let verts: Vec<[f32; 3]> = t.vertices.iter().map(|v| f32x3(v.coords + lift)).collect();
-        rec.log(
-            paths::primary_triangle(b),
-            &Mesh3D::new(verts.clone())
-                .with_triangle_indices([[0u32, 1, 2]])
-                .with_albedo_factor(albedo([color[0], color[1], color[2], 110])),
-        )?;
-        let f = test.feature() as usize % 3;
-        match test {
-            TestRecord::Edge(_) => {
-                rec.log(
-                    paths::primary_edge(b),
-                    &LineStrips3D::new([[verts[f], verts[(f + 1) % 3]]])
-                        .with_colors([rgba(color)])
-                        .with_radii([(r.rho() * 0.05) as f32])
-                        .with_labels([crate::core::explain::label(test)]),
-                )?;
-                rec.log(paths::primary_vertex(b), &Clear::flat())?;
-            }
-            TestRecord::Vertex(_) => {
-                rec.log(
-                    paths::primary_vertex(b),
-                    &Points3D::new([verts[f]])
-                        .with_colors([rgba(color)])
-                        .with_radii([(r.rho() * 0.12) as f32])
-                        .with_labels([crate::core::explain::label(test)]),
-                )?;
-                rec.log(paths::primary_edge(b), &Clear::flat())?;
-            }
-            TestRecord::Face(_) => {
-                let mut outline = verts.clone();
-                outline.push(verts[0]);
-                rec.log(
-                    paths::primary_edge(b),
-                    &LineStrips3D::new([outline])
-                        .with_colors([rgba(color)])
-                        .with_radii([(r.rho() * 0.03) as f32])
-                        .with_labels([crate::core::explain::label(test)]),
-                )?;
-                rec.log(paths::primary_vertex(b), &Clear::flat())?;
-            }
+    /// Logs a sweep prepared by [`prepare_sweep`] (sweeps must be logged in
+    /// trace order).
+    pub fn log_prepared(&mut self, p: PreparedSweep) -> Result<(), RecordingStreamError> {
+        let frame = i64::try_from(p.frame).unwrap_or(i64::MAX);
+        let time = self.time_of(p.log_time_nanos);
+        for (path, batches) in p.rows.0 {
+            self.columns
+                .push_row(&self.rec, path, frame, time, batches)?;
         }
-        Ok(())
-    }
-
-    fn log_edge_frames(
-        &mut self,
-        r: &SweepResult,
-        decisive: Option<&TestRecord>,
-    ) -> Result<(), RecordingStreamError> {
-        let b = r.ball;
-        let rho = r.rho();
-        let mut edges: Vec<(f64, &EdgeRecord)> = r
-            .records
-            .iter()
-            .filter_map(|t| match t {
-                TestRecord::Edge(e) => {
-                    let rank = if decisive == Some(t) {
-                        f64::NEG_INFINITY
-                    } else if t.alpha().is_some() {
-                        -1.0
-                    } else {
-                        miss_distance(t).unwrap_or(f64::INFINITY)
-                    };
-                    Some((rank, e))
-                }
-                _ => None,
-            })
-            .collect();
-        edges.sort_by(|x, y| x.0.total_cmp(&y.0));
-        edges.truncate(self.max_edge_frames);
-        let rec = &self.rec;
-        for (slot, (_, e)) in edges.iter().enumerate() {
-            let world_from_edge = e.frame.world_from_edge();
-            let q = world_from_edge.rotation;
-            let t = world_from_edge.translation.vector;
-            rec.log(
-                paths::edge_frame(b, slot),
-                &Transform3D::from_translation_rotation(
-                    f32x3(t),
-                    rerun::Quaternion::from_xyzw([q.i as f32, q.j as f32, q.k as f32, q.w as f32]),
-                ),
-            )?;
-            rec.log(paths::edge_frame(b, slot), &edge_values(e))?;
-            let length = e.length as f32;
-            // Only the first slot is labelled: with many slots the labels
-            // would hide the world view.
-            let mut segment = LineStrips3D::new([[[0.0f32, 0.0, 0.0], [length, 0.0, 0.0]]])
-                .with_colors([rgba(EDGE_COLOR)])
-                .with_radii([(rho * 0.04) as f32]);
-            if slot == 0 {
-                segment = segment.with_labels([format!(
-                    "edge {}.{} (L = {})",
-                    e.triangle,
-                    e.edge,
-                    num(e.length)
-                )]);
-            }
-            rec.log(paths::edge_segment(b, slot), &segment)?;
-            // A capsule lies along +z; turn it onto +x (90° about +y).
-            let half = std::f32::consts::FRAC_1_SQRT_2;
-            rec.log(
-                paths::edge_cylinder(b, slot),
-                &Capsules3D::from_lengths_and_radii([length], [rho as f32])
-                    .with_quaternions([rerun::Quaternion::from_xyzw([0.0, half, 0.0, half])])
-                    .with_colors([rgba(CYLINDER_COLOR)])
-                    .with_fill_mode(FillMode::MajorWireframe),
-            )?;
-            let p0e = f32x3(e.p0_in_edge.coords);
-            let p1e = f32x3(e.p1_in_edge.coords);
-            rec.log(
-                paths::edge_path(b, slot),
-                &LineStrips3D::new([[p0e, p1e]])
-                    .with_colors([rgba(PATH_COLOR)])
-                    .with_radii([(rho * 0.03) as f32]),
-            )?;
-            let mut points = vec![p0e, p1e];
-            let mut labels = vec!["p0".to_string(), "p1".to_string()];
-            if let Some((s0, _)) = e.roots
-                && (-1.0..=2.0).contains(&s0)
-            {
-                let at = e.p0_in_edge + (e.p1_in_edge - e.p0_in_edge) * s0;
-                points.push(f32x3(at.coords));
-                labels.push(format!("s0 = {}", num(s0)));
-            }
-            rec.log(
-                paths::edge_points(b, slot),
-                &Points3D::new(points)
-                    .with_labels(labels)
-                    .with_radii([(rho * 0.06) as f32]),
-            )?;
-        }
+        let b = p.ball;
         let state = self.balls.entry(b).or_default();
-        for slot in edges.len()..state.edge_slots {
-            self.rec
-                .log(paths::edge_frame(b, slot), &Clear::recursive())?;
+        let previous = std::mem::replace(&mut state.edge_slots, p.edge_slots);
+        for slot in p.edge_slots..previous {
+            self.columns.push_row(
+                &self.rec,
+                paths::edge_frame(b, slot),
+                frame,
+                time,
+                Clear::recursive().as_serialized_batches(),
+            )?;
         }
-        state.edge_slots = edges.len();
-        Ok(())
-    }
-
-    fn log_plots(
-        &self,
-        r: &SweepResult,
-        decisive: Option<&TestRecord>,
-    ) -> Result<(), RecordingStreamError> {
-        let rec = &self.rec;
-        let b = r.ball;
-        rec.log(paths::alpha(b), &Scalars::single(r.outcome.alpha))?;
-        rec.log(
-            paths::alpha(b),
-            &AnyValues::default()
-                .with_component::<rerun::components::Text>("kind", [r.outcome.kind.as_str()]),
-        )?;
-        let quadratic = |a: f64,
-                         bb: f64,
-                         c: f64,
-                         disc: f64,
-                         roots: Option<(f64, f64)>|
-         -> Result<(), RecordingStreamError> {
-            let mut values = vec![a, bb, c, disc];
-            if let Some((s0, s1)) = roots {
-                values.extend([s0, s1]);
-            }
-            for (name, v) in paths::QUADRATIC_NAMES.iter().zip(values) {
-                if v.is_finite() {
-                    rec.log(paths::quadratic(b, name), &Scalars::single(v))?;
-                }
-            }
-            Ok(())
-        };
-        match decisive {
-            Some(TestRecord::Edge(e)) => quadratic(e.a, e.b, e.c, e.discriminant, e.roots)?,
-            Some(TestRecord::Vertex(v)) => quadratic(v.a, v.b, v.c, v.discriminant, v.roots)?,
-            Some(TestRecord::Face(f)) => {
-                for (name, v) in paths::FACE_NAMES
-                    .iter()
-                    .zip([Some(f.h0), Some(f.h1), f.beta])
-                {
-                    if let Some(v) = v.filter(|v| v.is_finite()) {
-                        rec.log(paths::face(b, name), &Scalars::single(v))?;
-                    }
-                }
-            }
-            None => {}
+        if self.columns.rows() >= self.flush_rows {
+            self.flush()?;
         }
         Ok(())
     }
+}
 
-    fn log_text(
-        &self,
-        r: &SweepResult,
-        decisive: Option<&TestRecord>,
-    ) -> Result<(), RecordingStreamError> {
-        let (line, mismatch) = decision_line(r, decisive);
-        let level = if mismatch {
-            TextLogLevel::WARN
-        } else if r.outcome.is_hit() {
-            TextLogLevel::INFO
-        } else {
-            TextLogLevel::DEBUG
-        };
-        self.rec
-            .log(paths::LOG, &TextLog::new(line).with_level(level))
+/// The balls, the swept volume, the contact and the normal.
+fn sweep_rows(rows: &mut Rows, r: &SweepResult) {
+    let b = r.ball;
+    let o = &r.outcome;
+    let p0 = r.sweep.p0;
+    let p1 = r.sweep.p1;
+    let d = p1 - p0;
+    let rho = r.rho();
+    let radius = r.sweep.radius as f32;
+    let at_contact = p0 + d * o.alpha;
+
+    // The ball at p0, at the contact (when hit) and at p1.
+    let mut centers = vec![f32x3(p0.coords)];
+    let mut colors = vec![rgba(P0_COLOR)];
+    let mut labels = vec!["p0".to_string()];
+    if o.is_hit() {
+        centers.push(f32x3(at_contact.coords));
+        colors.push(rgba(CONTACT_BALL_COLOR));
+        labels.push(format!("α = {}", num(o.alpha)));
     }
+    centers.push(f32x3(p1.coords));
+    colors.push(rgba(P1_COLOR));
+    labels.push("p1".to_string());
+    let n = centers.len();
+    rows.push(
+        paths::spheres(b),
+        &Ellipsoids3D::from_centers_and_radii(centers, std::iter::repeat_n(radius, n))
+            .with_colors(colors)
+            .with_labels(labels)
+            .with_fill_mode(FillMode::Solid),
+    );
+
+    // The swept volume at the detection radius.
+    let (length, rotation) = capsule_pose(&d);
+    rows.push(
+        paths::sweep(b),
+        &Capsules3D::from_lengths_and_radii([length], [rho as f32])
+            .with_translations([f32x3(p0.coords)])
+            .with_quaternions([rotation])
+            .with_colors([rgba(SWEEP_COLOR)])
+            .with_fill_mode(FillMode::MajorWireframe),
+    );
+
+    // Contact and normal.
+    match (o.contact, o.normal) {
+        (Some(c), Some(nrm)) => {
+            rows.push(
+                paths::contact(b),
+                &Points3D::new([f32x3(c.coords)])
+                    .with_colors([rgba(HIT_COLOR)])
+                    .with_radii([(rho * 0.08) as f32]),
+            );
+            rows.push(
+                paths::normal(b),
+                &Arrows3D::from_vectors([f32x3(nrm * (r.sweep.radius.max(1e-3) * 1.5))])
+                    .with_origins([f32x3(c.coords)])
+                    .with_colors([rgba(NORMAL_COLOR)])
+                    .with_labels(["normal"]),
+            );
+        }
+        _ => {
+            rows.push(paths::contact(b), &Clear::flat());
+            rows.push(paths::normal(b), &Clear::flat());
+        }
+    }
+}
+
+/// The highlighted triangle, edge or vertex of the decisive test.
+fn decisive_rows(
+    rows: &mut Rows,
+    scene: Option<&SceneState>,
+    r: &SweepResult,
+    decisive: Option<&TestRecord>,
+) {
+    let b = r.ball;
+    let scene = scene.filter(|s| s.number == r.scene);
+    let triangle =
+        decisive.and_then(|t| scene.and_then(|s| s.mesh.triangle_by_index(t.triangle())));
+    let (Some(t), Some(test)) = (triangle, decisive) else {
+        rows.push(paths::primary_triangle(b), &Clear::flat());
+        rows.push(paths::primary_edge(b), &Clear::flat());
+        rows.push(paths::primary_vertex(b), &Clear::flat());
+        return;
+    };
+    let color = if test.alpha().is_some() {
+        HIT_COLOR
+    } else {
+        MISS_COLOR
+    };
+    // Lift the highlight a little off the mesh so it is not hidden by it.
+    let lift = t.normal * (r.rho() * 0.02);
+    let verts: Vec<[f32; 3]> = t.vertices.iter().map(|v| f32x3(v.coords + lift)).collect();
+    rows.push(
+        paths::primary_triangle(b),
+        &Mesh3D::new(verts.clone())
+            .with_triangle_indices([[0u32, 1, 2]])
+            .with_albedo_factor(albedo([color[0], color[1], color[2], 110])),
+    );
+    let f = test.feature() as usize % 3;
+    match test {
+        TestRecord::Edge(_) => {
+            rows.push(
+                paths::primary_edge(b),
+                &LineStrips3D::new([[verts[f], verts[(f + 1) % 3]]])
+                    .with_colors([rgba(color)])
+                    .with_radii([(r.rho() * 0.05) as f32])
+                    .with_labels([crate::core::explain::label(test)]),
+            );
+            rows.push(paths::primary_vertex(b), &Clear::flat());
+        }
+        TestRecord::Vertex(_) => {
+            rows.push(
+                paths::primary_vertex(b),
+                &Points3D::new([verts[f]])
+                    .with_colors([rgba(color)])
+                    .with_radii([(r.rho() * 0.12) as f32])
+                    .with_labels([crate::core::explain::label(test)]),
+            );
+            rows.push(paths::primary_edge(b), &Clear::flat());
+        }
+        TestRecord::Face(_) => {
+            let mut outline = verts.clone();
+            outline.push(verts[0]);
+            rows.push(
+                paths::primary_edge(b),
+                &LineStrips3D::new([outline])
+                    .with_colors([rgba(color)])
+                    .with_radii([(r.rho() * 0.03) as f32])
+                    .with_labels([crate::core::explain::label(test)]),
+            );
+            rows.push(paths::primary_vertex(b), &Clear::flat());
+        }
+    }
+}
+
+/// The edge tests in their standard frames; returns how many slots it used.
+fn edge_frame_rows(
+    rows: &mut Rows,
+    r: &SweepResult,
+    decisive: Option<&TestRecord>,
+    max_edge_frames: usize,
+) -> usize {
+    let b = r.ball;
+    let rho = r.rho();
+    let mut edges: Vec<(f64, &EdgeRecord)> = r
+        .records
+        .iter()
+        .filter_map(|t| match t {
+            TestRecord::Edge(e) => {
+                let rank = if decisive == Some(t) {
+                    f64::NEG_INFINITY
+                } else if t.alpha().is_some() {
+                    -1.0
+                } else {
+                    miss_distance(t).unwrap_or(f64::INFINITY)
+                };
+                Some((rank, e))
+            }
+            _ => None,
+        })
+        .collect();
+    edges.sort_by(|x, y| x.0.total_cmp(&y.0));
+    edges.truncate(max_edge_frames);
+    for (slot, (_, e)) in edges.iter().enumerate() {
+        let world_from_edge = e.frame.world_from_edge();
+        let q = world_from_edge.rotation;
+        let t = world_from_edge.translation.vector;
+        rows.push(
+            paths::edge_frame(b, slot),
+            &Transform3D::from_translation_rotation(
+                f32x3(t),
+                rerun::Quaternion::from_xyzw([q.i as f32, q.j as f32, q.k as f32, q.w as f32]),
+            ),
+        );
+        rows.push(paths::edge_frame(b, slot), &edge_values(e));
+        let length = e.length as f32;
+        // Only the first slot is labelled: with many slots the labels
+        // would hide the world view.
+        let mut segment = LineStrips3D::new([[[0.0f32, 0.0, 0.0], [length, 0.0, 0.0]]])
+            .with_colors([rgba(EDGE_COLOR)])
+            .with_radii([(rho * 0.04) as f32]);
+        if slot == 0 {
+            segment = segment.with_labels([format!(
+                "edge {}.{} (L = {})",
+                e.triangle,
+                e.edge,
+                num(e.length)
+            )]);
+        }
+        rows.push(paths::edge_segment(b, slot), &segment);
+        // A capsule lies along +z; turn it onto +x (90° about +y).
+        let half = std::f32::consts::FRAC_1_SQRT_2;
+        rows.push(
+            paths::edge_cylinder(b, slot),
+            &Capsules3D::from_lengths_and_radii([length], [rho as f32])
+                .with_quaternions([rerun::Quaternion::from_xyzw([0.0, half, 0.0, half])])
+                .with_colors([rgba(CYLINDER_COLOR)])
+                .with_fill_mode(FillMode::MajorWireframe),
+        );
+        let p0e = f32x3(e.p0_in_edge.coords);
+        let p1e = f32x3(e.p1_in_edge.coords);
+        rows.push(
+            paths::edge_path(b, slot),
+            &LineStrips3D::new([[p0e, p1e]])
+                .with_colors([rgba(PATH_COLOR)])
+                .with_radii([(rho * 0.03) as f32]),
+        );
+        let mut points = vec![p0e, p1e];
+        let mut labels = vec!["p0".to_string(), "p1".to_string()];
+        if let Some((s0, _)) = e.roots
+            && (-1.0..=2.0).contains(&s0)
+        {
+            let at = e.p0_in_edge + (e.p1_in_edge - e.p0_in_edge) * s0;
+            points.push(f32x3(at.coords));
+            labels.push(format!("s0 = {}", num(s0)));
+        }
+        rows.push(
+            paths::edge_points(b, slot),
+            &Points3D::new(points)
+                .with_labels(labels)
+                .with_radii([(rho * 0.06) as f32]),
+        );
+    }
+    edges.len()
+}
+
+/// The α plot and the decisive test's numbers.
+fn plot_rows(rows: &mut Rows, r: &SweepResult, decisive: Option<&TestRecord>) {
+    let b = r.ball;
+    rows.push(paths::alpha(b), &Scalars::single(r.outcome.alpha));
+    rows.push(
+        paths::alpha(b),
+        &AnyValues::default()
+            .with_component::<rerun::components::Text>("kind", [r.outcome.kind.as_str()]),
+    );
+    let mut quadratic = |a: f64, bb: f64, c: f64, disc: f64, roots: Option<(f64, f64)>| {
+        let mut values = vec![a, bb, c, disc];
+        if let Some((s0, s1)) = roots {
+            values.extend([s0, s1]);
+        }
+        for (name, v) in paths::QUADRATIC_NAMES.iter().zip(values) {
+            if v.is_finite() {
+                rows.push(paths::quadratic(b, name), &Scalars::single(v));
+            }
+        }
+    };
+    match decisive {
+        Some(TestRecord::Edge(e)) => quadratic(e.a, e.b, e.c, e.discriminant, e.roots),
+        Some(TestRecord::Vertex(v)) => quadratic(v.a, v.b, v.c, v.discriminant, v.roots),
+        Some(TestRecord::Face(f)) => {
+            for (name, v) in paths::FACE_NAMES
+                .iter()
+                .zip([Some(f.h0), Some(f.h1), f.beta])
+            {
+                if let Some(v) = v.filter(|v| v.is_finite()) {
+                    rows.push(paths::face(b, name), &Scalars::single(v));
+                }
+            }
+        }
+        None => {}
+    }
+}
+
+/// The decision in words.
+fn text_rows(rows: &mut Rows, r: &SweepResult, decisive: Option<&TestRecord>) {
+    let (line, mismatch) = decision_line(r, decisive);
+    let level = if mismatch {
+        TextLogLevel::WARN
+    } else if r.outcome.is_hit() {
+        TextLogLevel::INFO
+    } else {
+        TextLogLevel::DEBUG
+    };
+    rows.push(paths::LOG, &TextLog::new(line).with_level(level));
 }
 
 /// The text line of one sweep, and whether it disagrees with the trace's

@@ -1,0 +1,174 @@
+//! Replay throughput on generated traces (`examples/long_trace.rs`).
+//!
+//! Run: `cargo bench --bench replay` (the `.rrd` part needs the default
+//! `viewer` feature; without it only the floor and the outcomes are run).
+//!
+//! On the same in-memory traces: the read-and-decode floor (the trace
+//! reader alone), replay to outcomes (JSON lines into a sink, as
+//! `replay --outcomes`), replay to an `.rrd` file at each detail level (as
+//! `replay --rrd`), and replay time against the trace's length. Every
+//! replay uses rayon's global pool (one thread per core), as the command
+//! does by default.
+
+use std::hint::black_box;
+use std::io::Write;
+
+use criterion::{BenchmarkId, Criterion, Throughput, criterion_group};
+use sweeptrace::replay::{
+    DEFAULT_BATCH_EVENTS, Detail, ReplayEvent, ReplayOptions, replay_events_parallel,
+};
+use sweeptrace::trace::TraceReader;
+
+#[path = "../examples/long_trace.rs"]
+mod long_trace;
+
+const LENGTHS: [u64; 3] = [1_000, 10_000, 100_000];
+/// Length of the trace the detail levels are compared on.
+const RRD_SWEEPS: u64 = 10_000;
+
+fn trace(sweeps: u64) -> Vec<u8> {
+    long_trace::write_long_trace(std::io::Cursor::new(Vec::new()), sweeps, 7)
+        .expect("writing to memory")
+        .into_inner()
+}
+
+/// Reads and decodes every message; returns how many.
+fn floor(bytes: &[u8]) -> usize {
+    TraceReader::new(bytes, "bench.mcap")
+        .map(|e| e.expect("valid trace"))
+        .count()
+}
+
+/// Replays to outcome lines written into a sink; returns the sweeps.
+fn outcomes(bytes: &[u8]) -> u64 {
+    let options = ReplayOptions::default();
+    let mut sink = std::io::BufWriter::new(std::io::sink());
+    let mut n = 0;
+    let events = replay_events_parallel(
+        TraceReader::new(bytes, "bench.mcap"),
+        options,
+        DEFAULT_BATCH_EVENTS,
+        None,
+    );
+    for event in events {
+        if let ReplayEvent::Sweep(r) = event.expect("valid trace") {
+            serde_json::to_writer(&mut sink, &r.outcome_msg()).expect("sink");
+            sink.write_all(b"\n").expect("sink");
+            n += 1;
+        }
+    }
+    n
+}
+
+#[cfg(feature = "viewer")]
+fn rrd(bytes: &[u8], detail: Detail, path: &std::path::Path) -> u64 {
+    use rayon::prelude::*;
+    use sweeptrace::viz;
+
+    let options = ReplayOptions {
+        detail,
+        explain: true,
+        ..ReplayOptions::default()
+    };
+    let id = viz::recording_id(&[bytes, detail.as_str().as_bytes()]);
+    let rec = viz::builder(&id, "bench").save(path).expect("rrd file");
+    let mut logger = viz::Logger::new(rec, true).expect("recording");
+    let max = logger.max_edge_frames();
+    let mut events = replay_events_parallel(
+        TraceReader::new(bytes, "bench.mcap"),
+        options,
+        DEFAULT_BATCH_EVENTS,
+        None,
+    );
+    let mut n = 0;
+    let mut scenes = Vec::new();
+    loop {
+        let batch: Vec<ReplayEvent> = events
+            .by_ref()
+            .take(DEFAULT_BATCH_EVENTS)
+            .map(|e| e.expect("valid trace"))
+            .collect();
+        if batch.is_empty() {
+            break;
+        }
+        for e in &batch {
+            if let ReplayEvent::Scene(s) = e {
+                logger.log_scene(s).expect("scene");
+                scenes.push(s.clone());
+            }
+        }
+        let prepared: Vec<Option<viz::PreparedSweep>> = batch
+            .par_iter()
+            .with_min_len(64)
+            .map(|e| match e {
+                ReplayEvent::Sweep(r) => {
+                    let scene = scenes.iter().find(|s| s.number == r.scene);
+                    Some(viz::prepare_sweep(scene.map(|s| &**s), r, max))
+                }
+                ReplayEvent::Scene(_) => None,
+            })
+            .collect();
+        for p in prepared.into_iter().flatten() {
+            logger.log_prepared(p).expect("logging");
+            n += 1;
+        }
+    }
+    logger.flush().expect("flush");
+    let rec = logger.finish();
+    rec.flush_blocking().expect("flush");
+    drop(rec);
+    n
+}
+
+fn bench(c: &mut Criterion) {
+    let traces: Vec<(u64, Vec<u8>)> = LENGTHS.iter().map(|&n| (n, trace(n))).collect();
+    for (n, bytes) in &traces {
+        eprintln!(
+            "trace of {n} sweeps: {} bytes, {} messages",
+            bytes.len(),
+            floor(bytes)
+        );
+    }
+
+    let mut g = c.benchmark_group("replay");
+    g.sample_size(10);
+    for (n, bytes) in &traces {
+        g.throughput(Throughput::Elements(*n));
+        g.bench_with_input(BenchmarkId::new("floor", n), bytes, |b, t| {
+            b.iter(|| black_box(floor(t)))
+        });
+        g.bench_with_input(BenchmarkId::new("outcomes", n), bytes, |b, t| {
+            b.iter(|| black_box(outcomes(t)))
+        });
+    }
+    #[cfg(feature = "viewer")]
+    {
+        let dir = tempfile::tempdir().expect("temporary directory");
+        let path = dir.path().join("bench.rrd");
+        for (n, bytes) in &traces {
+            g.throughput(Throughput::Elements(*n));
+            g.bench_with_input(BenchmarkId::new("rrd-primary", n), bytes, |b, t| {
+                b.iter(|| black_box(rrd(t, Detail::Primary, &path)))
+            });
+        }
+        let bytes = trace(RRD_SWEEPS);
+        g.throughput(Throughput::Elements(RRD_SWEEPS));
+        for detail in [Detail::Candidates, Detail::All] {
+            g.bench_with_input(
+                BenchmarkId::new(format!("rrd-{detail}"), RRD_SWEEPS),
+                &bytes,
+                |b, t| b.iter(|| black_box(rrd(t, detail, &path))),
+            );
+        }
+    }
+    #[cfg(not(feature = "viewer"))]
+    let _ = Detail::Primary;
+    g.finish();
+}
+
+criterion_group!(benches, bench);
+
+fn main() {
+    benches();
+    Criterion::default().configure_from_args().final_summary();
+}

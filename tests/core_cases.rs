@@ -8,7 +8,8 @@
 
 use libtest_mimic::Trial;
 use sweeptrace::core::{
-    Facing, Kind, Mesh, MeshError, Options, Sweep, SweepError, Verdict, sweep_mesh,
+    Broadphase, Facing, Kind, Mesh, MeshError, NoObserver, Options, Outcome, Sweep, SweepError,
+    Verdict, sweep_mesh, sweep_mesh_with,
 };
 
 use crate::ensure;
@@ -70,6 +71,11 @@ pub fn tests() -> Vec<Trial> {
             "core::degenerate_triangles_reported_and_skipped",
             degenerate,
         ),
+        trial(
+            "core::edge_far_start_small_radius_discriminant_without_cancellation",
+            edge_far_start_small_radius,
+        ),
+        trial("core::very_long_path_never_nan", very_long_path_never_nan),
     ]
 }
 
@@ -900,4 +906,91 @@ fn degenerate() -> Result<(), String> {
         "all degenerate: {e:?}"
     );
     Ok(())
+}
+
+fn both_broadphases(m: &Mesh, p0: [f64; 3], p1: [f64; 3], r: f64) -> Result<Outcome, String> {
+    let sweep = Sweep::new(p0, p1, r);
+    let fast = sweep_mesh(m, &sweep, &Options::default()).map_err(|e| e.to_string())?;
+    let all = sweep_mesh_with(
+        m,
+        &sweep,
+        &Options::default(),
+        Broadphase::Exhaustive,
+        &mut NoObserver,
+    )
+    .map_err(|e| e.to_string())?;
+    ensure!(fast == all, "bvh {fast:?} != exhaustive {all:?}");
+    Ok(all)
+}
+
+fn edge_far_start_small_radius() -> Result<(), String> {
+    // r = 1e-3, a path of length 2e5 straight down past edge 0 of T
+    // (p0 = (2, -y, 1e5), p1 = (2, -y, -1e5)), so |p0| / ρ = 1e8.
+    // In edge 0's frame p0 → (2, 1e5, y), p1 → (2, -1e5, y):
+    // dy = -2e5, dz = 0, A = 4e10, B = 2·1e5·(-2e5) = -4e10,
+    // C = 1e10 + y² - 1e-6. B² and 4AC are both 1.6e21, and their difference
+    // is below one ulp of either, so B² - 4AC in floating point is noise.
+    // The same value without cancellation: B² - 4AC = 4 (ρ² A - w²) with
+    // w = y0 dz - z0 dy = 2e5·y.
+    let r = 1e-3;
+    // Miss: y = 1.5e-3 = 1.5ρ, w = 300, ρ²A = 4e4, w² = 9e4:
+    // disc = 4 (4e4 - 9e4) = -2e5 < 0: no real roots. The face's touch
+    // point (2, -1.5e-3, 0) is outside T: nothing is hit.
+    let m = triangle_t();
+    let (p0, p1) = ([2.0, -1.5e-3, 1e5], [2.0, -1.5e-3, -1e5]);
+    let (o, recs) = run(&m, p0, p1, r, 0.0, NS);
+    let e = edge(&recs, 0, 0);
+    ensure!(
+        e.verdict == Verdict::NoRealRoots,
+        "edge 0 verdict {:?} (disc {})",
+        e.verdict,
+        e.discriminant
+    );
+    close("disc", e.discriminant, -2e5, 1e-3)?;
+    ensure!(o.kind == Kind::None, "outcome {o:?}");
+    both_broadphases(&m, p0, p1, r)?;
+    // Hit: y = 0.5e-3 = 0.5ρ, w = 100, disc = 4 (4e4 - 1e4) = 1.2e5. The
+    // center is ρ from the edge's line at height ρ·√0.75 above it, so
+    // s0 = (1e5 - ρ√0.75) / 2e5 = 0.5 - 4.330127e-9.
+    let (p0, p1) = ([2.0, -0.5e-3, 1e5], [2.0, -0.5e-3, -1e5]);
+    let (o, recs) = run(&m, p0, p1, r, 0.0, NS);
+    let e = edge(&recs, 0, 0);
+    close("disc", e.discriminant, 1.2e5, 1e-3)?;
+    ensure!(
+        o.kind == Kind::Edge && o.feature == Some(0),
+        "outcome {o:?}"
+    );
+    close("alpha", o.alpha, 0.5 - r * 0.75f64.sqrt() / 2e5, 1e-15)?;
+    both_broadphases(&m, p0, p1, r)?;
+    Ok(())
+}
+
+fn very_long_path_never_nan() -> Result<(), String> {
+    // A finite path of length 2e100: B = 2 d·m ≈ -4e200, so B² overflows to
+    // infinity, 4AC too, and B² - 4AC = inf - inf = NaN, which passed every
+    // comparison and was reported as a hit with α = NaN.
+    // Miss: p0 = (5, 5, 1e100), p1 = (5, 5, -1e100). The path's line is
+    // 6/√2 ≈ 4.24 from T's hypotenuse and farther from its other edges and
+    // vertices (edge 0: p0 → (5, 1e100, -5), w = y0 dz - z0 dy = -1e101,
+    // w² = 1e202 > ρ²A = 1e200):
+    // nothing is hit, and no record holds a NaN.
+    let m = triangle_t();
+    let (p0, p1) = ([5.0, 5.0, 1e100], [5.0, 5.0, -1e100]);
+    let (o, recs) = run(&m, p0, p1, 0.5, 0.0, NS);
+    ensure!(o.kind == Kind::None && o.alpha == 1.0, "outcome {o:?}");
+    for r in &recs {
+        ensure!(!r.alpha().is_some_and(f64::is_nan), "NaN alpha in {r:?}");
+    }
+    both_broadphases(&m, p0, p1, 0.5)?;
+    // Hit: p0 = (2, -0.3, 1e100) passes edge 0 at distance 0.3 < ρ = 0.5:
+    // w = 0.3·2e100 = 6e99, disc = 4 (1e200 - 3.6e199) > 0, and
+    // s0 = C / q = 1e200 / 2e200 = 0.5 (the offset ρ·0.8/2e100 is far below
+    // one ulp of 0.5). The face's touch point (2, -0.3, 0) is outside T.
+    let (p0, p1) = ([2.0, -0.3, 1e100], [2.0, -0.3, -1e100]);
+    let o = both_broadphases(&m, p0, p1, 0.5)?;
+    ensure!(
+        o.kind == Kind::Edge && o.feature == Some(0),
+        "outcome {o:?}"
+    );
+    close("alpha", o.alpha, 0.5, 1e-15)
 }

@@ -4,11 +4,11 @@
 /// is negative. The smaller root comes first; a double root is returned twice.
 ///
 /// Uses `q = -(B + sign(B) √disc) / 2`, roots `q / A` and `C / q`, which
-/// avoids the cancellation of the schoolbook formula. Never produces NaN
-/// for finite inputs with `A > 0`.
+/// avoids the cancellation of the schoolbook formula. Never produces NaN:
+/// a NaN discriminant (an overflowed input) or a NaN root gives `None`.
 #[inline]
 pub fn solve(a: f64, b: f64, c: f64, discriminant: f64) -> Option<(f64, f64)> {
-    if discriminant < 0.0 || a.is_nan() || a <= 0.0 {
+    if discriminant.is_nan() || discriminant < 0.0 || a.is_nan() || a <= 0.0 {
         return None;
     }
     let sqrt = discriminant.sqrt();
@@ -23,11 +23,29 @@ pub fn solve(a: f64, b: f64, c: f64, discriminant: f64) -> Option<(f64, f64)> {
     }
     let r0 = q / a;
     let r1 = c / q;
+    if r0.is_nan() || r1.is_nan() {
+        return None;
+    }
     Some(if r0 <= r1 { (r0, r1) } else { (r1, r0) })
 }
 
-/// `B² - 4AC`.
+/// `B² - 4AC` as written: only for well-scaled inputs. The sweeps compute
+/// the same value as `4 (ρ² A - |w|²)` (see [`discriminant_from_cross`]).
 #[inline]
 pub fn discriminant(a: f64, b: f64, c: f64) -> f64 {
     b * b - 4.0 * a * c
+}
+
+/// `B² - 4AC` of a ball-versus-line or ball-versus-point quadratic, computed
+/// without cancellation: with `A = |d|²`, `B = 2 d·m`, `C = |m|² - ρ²`
+/// (Lagrange's identity `|d|²|m|² - (d·m)² = |d × m|²`),
+/// `B² - 4AC = 4 (ρ² A - |d × m|²)`. `cross_squared` is `|d × m|²`.
+///
+/// `B²` and `4AC` are both about `(2 |d| |m|)²`; when the start is far from
+/// the feature compared with `ρ`, their difference `4 ρ² A - 4 |d × m|²` is
+/// below their rounding error, and for `|d| |m|` above about 1e154 both
+/// overflow and `B² - 4AC` is NaN. This form has neither problem.
+#[inline]
+pub fn discriminant_from_cross(a: f64, rho: f64, cross_squared: f64) -> f64 {
+    4.0 * (rho * rho * a - cross_squared)
 }

@@ -150,7 +150,8 @@ pub struct EdgeRecord {
     pub b: f64,
     /// `C` of the quadratic.
     pub c: f64,
-    /// `B² - 4AC`.
+    /// `B² - 4AC`, computed as `4 (ρ² A - w²)` with `w = y0 dz - z0 dy`
+    /// (the same value, without the cancellation of `B² - 4AC`).
     pub discriminant: f64,
     /// Roots `s0 ≤ s1`, when real.
     pub roots: Option<(f64, f64)>,
@@ -177,7 +178,8 @@ pub struct VertexRecord {
     pub b: f64,
     /// `C = |p0 - v|² - ρ²`.
     pub c: f64,
-    /// `B² - 4AC`.
+    /// `B² - 4AC`, computed as `4 (ρ² A - |d × (p0 - v)|²)` (the same value,
+    /// without the cancellation of `B² - 4AC`).
     pub discriminant: f64,
     /// Roots `s0 ≤ s1`, when real.
     pub roots: Option<(f64, f64)>,

@@ -19,7 +19,10 @@ pub fn sweep_edge(triangle: &Triangle, edge: u8, path: &Path, facing: Facing) ->
     let a = dy * dy + dz * dz;
     let b = 2.0 * (y0 * dy + z0 * dz);
     let c = y0 * y0 + z0 * z0 - path.rho * path.rho;
-    let discriminant = quadratic::discriminant(a, b, c);
+    // B² - 4AC without cancellation: in the (y, z) plane, m = (y0, z0) and
+    // d = (dy, dz), so |d × m|² = (y0 dz - z0 dy)².
+    let w = y0 * dz - z0 * dy;
+    let discriminant = quadratic::discriminant_from_cross(a, path.rho, w * w);
     let normal_dot_d = triangle.normal.dot(&path.d);
     let mut record = EdgeRecord {
         triangle: triangle.index,

@@ -14,7 +14,9 @@ pub fn sweep_vertex(triangle: &Triangle, vertex: u8, path: &Path, facing: Facing
     let a = path.d.dot(&path.d);
     let b = 2.0 * path.d.dot(&m);
     let c = m.dot(&m) - path.rho * path.rho;
-    let discriminant = quadratic::discriminant(a, b, c);
+    // B² - 4AC without cancellation: 4 (ρ² A - |d × m|²).
+    let discriminant =
+        quadratic::discriminant_from_cross(a, path.rho, path.d.cross(&m).norm_squared());
     let normal_dot_d = triangle.normal.dot(&path.d);
     let mut record = VertexRecord {
         triangle: triangle.index,

@@ -76,6 +76,10 @@ pub fn tests() -> Vec<Trial> {
             edge_far_start_small_radius,
         ),
         trial("core::very_long_path_never_nan", very_long_path_never_nan),
+        trial(
+            "core::sliver_triangle_face_hit_barycentric_without_cancellation",
+            sliver_face_hit,
+        ),
     ]
 }
 
@@ -993,4 +997,45 @@ fn very_long_path_never_nan() -> Result<(), String> {
         "outcome {o:?}"
     );
     close("alpha", o.alpha, 0.5, 1e-15)
+}
+
+fn sliver_face_hit() -> Result<(), String> {
+    // A sliver a = (0,0,0), b = (1,0,0), c = (0.3, h, 0), h = 1e-9: |(b-a)×(c-a)|
+    // = 1e-9 > DEGENERATE_TOLERANCE · longest² = 1e-12, so it is usable.
+    // r = 0.25, p0 = (0.4, h/3, 2), p1 = (0.4, h/3, -2): h0 = 2, h1 = -2,
+    // β = 1.75 / 4 = 0.4375, touch (0.4, h/3, 0). Its barycentric weights:
+    // w_c = y / h = 1/3, w_b = x - 0.3 w_c = 0.3, w_a = 1 - 0.3 - 1/3 = 0.36667:
+    // inside, a face hit at α = 0.4375. (Edge 0 is touched at the same α in
+    // floating point, the center being only h/3 off its line, and the tie
+    // goes to the face.) The Gram form d00 d11 - d01² = 0.09 - 0.09 of the
+    // barycentric denominator rounds to 0 here: NaN weights, the face test
+    // said outside_triangle and the outcome was an edge.
+    let h = 1e-9;
+    let m = mesh(
+        &[[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.3, h, 0.0]],
+        &[[0, 1, 2]],
+    );
+    let (o, recs) = run(&m, [0.4, h / 3.0, 2.0], [0.4, h / 3.0, -2.0], 0.25, 0.0, NS);
+    let f = face(&recs, 0);
+    let b = f.barycentric.ok_or("no barycentric")?;
+    close("bary a", b[0], 1.0 - 0.3 - 1.0 / 3.0, 1e-6)?;
+    close("bary b", b[1], 0.3, 1e-6)?;
+    close("bary c", b[2], 1.0 / 3.0, 1e-6)?;
+    ensure!(f.verdict == Verdict::Hit, "face verdict {:?}", f.verdict);
+    ensure!(o.kind == Kind::Face, "outcome {o:?}");
+    close("alpha", o.alpha, 0.4375, TOL)?;
+    // Just outside edge b-c, which has y = h (1 - x) / 0.7 = (6/7) h at
+    // x = 0.4: at y = 1.01 (6/7) h, w_c = 0.865714, w_b = 0.4 - 0.3 w_c =
+    // 0.140286, w_a = 1 - w_b - w_c = -0.006 < 0: outside, every weight finite.
+    let y = 1.01 * (6.0 / 7.0) * h;
+    let (_, recs) = run(&m, [0.4, y, 2.0], [0.4, y, -2.0], 0.25, 0.0, NS);
+    let f = face(&recs, 0);
+    let b = f.barycentric.ok_or("no barycentric")?;
+    ensure!(b.iter().all(|w| w.is_finite()), "barycentric {b:?}");
+    ensure!(
+        f.verdict == Verdict::OutsideTriangle && (b[0] + 0.006).abs() < 1e-4,
+        "face {:?}, barycentric {b:?}",
+        f.verdict
+    );
+    Ok(())
 }

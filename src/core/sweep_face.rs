@@ -53,19 +53,24 @@ pub fn sweep_face(triangle: &Triangle, path: &Path, facing: Facing) -> FaceRecor
 
 /// Barycentric coordinates (weights of `a`, `b`, `c`) of a point in the
 /// triangle's plane.
+///
+/// Each weight is the signed area of the sub-triangle opposite its vertex
+/// over the triangle's, measured along the front normal:
+/// `w_a = n · ((b - p) × (c - p)) / n · ((b - a) × (c - a))`, and so on.
+/// Unlike the Gram-matrix form, whose denominator `|b-a|²|c-a|² - ((b-a)·(c-a))²`
+/// cancels to 0 on thin usable triangles, this stays accurate down to the
+/// degeneracy tolerance. On a shared edge the two triangles' weights for it
+/// are exact negatives (when their normals agree), so a point on the edge is
+/// inside at least one of them.
 #[inline]
 pub fn barycentric(triangle: &Triangle, p: &nalgebra::Point3<f64>) -> [f64; 3] {
     let [a, b, c] = triangle.vertices;
-    let v0 = b - a;
-    let v1 = c - a;
-    let v2 = p - a;
-    let d00 = v0.dot(&v0);
-    let d01 = v0.dot(&v1);
-    let d11 = v1.dot(&v1);
-    let d20 = v2.dot(&v0);
-    let d21 = v2.dot(&v1);
-    let denom = d00 * d11 - d01 * d01;
-    let v = (d11 * d20 - d01 * d21) / denom;
-    let w = (d00 * d21 - d01 * d20) / denom;
-    [1.0 - v - w, v, w]
+    let n = triangle.normal;
+    let area2 = n.dot(&(b - a).cross(&(c - a)));
+    let (pa, pb, pc) = (a - p, b - p, c - p);
+    [
+        n.dot(&pb.cross(&pc)) / area2,
+        n.dot(&pc.cross(&pa)) / area2,
+        n.dot(&pa.cross(&pb)) / area2,
+    ]
 }

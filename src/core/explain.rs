@@ -52,7 +52,15 @@ fn describe_face(r: &FaceRecord) -> String {
         Verdict::StartsTooClose => {
             s.push_str(" (h0 < ρ: starts within ρ of the plane or behind it): none")
         }
-        Verdict::Parallel => s.push_str(" (h0 = h1: moving parallel to the plane): none"),
+        Verdict::Parallel => {
+            s.push_str(" (|h0 - h1| ≤ PARALLEL_TOLERANCE·|d|: moving parallel to the plane): none")
+        }
+        Verdict::BackFacing if r.h1 > r.h0 && r.normal_dot_d <= 0.0 => write!(
+            s,
+            ", n·d = {} but h1 > h0 (moving away from the plane, by rounding): back-facing",
+            num(r.normal_dot_d)
+        )
+        .unwrap(),
         Verdict::BackFacing => {
             write!(s, ", {}: back-facing", facing(r.normal_dot_d, r.verdict)).unwrap()
         }
@@ -93,7 +101,10 @@ fn describe_edge(r: &EdgeRecord) -> String {
         num(r.discriminant)
     );
     match r.verdict {
-        Verdict::Parallel => format!("A = {} (path parallel to the edge): none", num(r.a)),
+        Verdict::Parallel => format!(
+            "A = {} ≤ (PARALLEL_TOLERANCE·|d|)² (path parallel to the edge, or not moving): none",
+            num(r.a)
+        ),
         Verdict::NoRealRoots => format!("{quad} < 0 (never within ρ of the edge's line): none"),
         _ => {
             let (s0, s1) = r.roots.unwrap_or((f64::NAN, f64::NAN));

@@ -61,6 +61,14 @@ pub fn tests() -> Vec<Trial> {
             "replay::cli_writes_outcomes_and_rrd",
             cli_writes_outcomes_and_rrd,
         ),
+        trial(
+            "replay::threads_do_not_change_the_outputs",
+            threads_do_not_change_the_outputs,
+        ),
+        trial(
+            "replay::parallel_iterator_equals_sequential",
+            parallel_iterator_equals_sequential,
+        ),
     ]
 }
 
@@ -1075,5 +1083,172 @@ fn cli_writes_outcomes_and_rrd() -> Result<(), String> {
     );
     let stderr = String::from_utf8_lossy(&out.stderr);
     ensure!(stderr.contains("error"), "truncated trace: {stderr}");
+    Ok(())
+}
+
+/// `--threads 1` and `--threads 4` write the same bytes of outcomes and a
+/// recording with the same content (the bytes of two `.rrd` files still
+/// differ in the ids the SDK itself draws: the store-info message's, the
+/// recording name's and, with a blueprint, the blueprint's); several
+/// batches of events and a scene change in the middle.
+fn threads_do_not_change_the_outputs() -> Result<(), String> {
+    let dir = tempfile::tempdir().map_err(|e| e.to_string())?;
+    let trace = dir.path().join("two scenes.mcap");
+    let sweeps = random_sweeps(5, 600, 8);
+    let mut w = TraceWriter::new(std::io::Cursor::new(Vec::new())).map_err(|e| e.to_string())?;
+    w.scene(0, &cube_scene()).map_err(|e| e.to_string())?;
+    for (i, s) in sweeps.iter().enumerate() {
+        if i == sweeps.len() / 2 {
+            w.scene(1_000_000 * s.frame, &triangle_scene())
+                .map_err(|e| e.to_string())?;
+        }
+        w.sweep(1_000_000 * (s.frame + 1), s)
+            .map_err(|e| e.to_string())?;
+    }
+    let bytes = w.finish().map_err(|e| e.to_string())?.into_inner();
+    std::fs::write(&trace, bytes).map_err(|e| e.to_string())?;
+    let run =
+        |threads: &str, detail: &str, blueprint: bool| -> Result<(Vec<u8>, Vec<u8>), String> {
+            let outcomes = format!("{threads}-{detail}.jsonl");
+            let rrd = format!("{threads}-{detail}-{blueprint}.rrd");
+            let mut args = vec![
+                "replay",
+                "two scenes.mcap",
+                "--threads",
+                threads,
+                "--detail",
+                detail,
+                "--outcomes",
+                &outcomes,
+                "--rrd",
+                &rrd,
+            ];
+            if !blueprint {
+                args.push("--no-blueprint");
+            }
+            let out = std::process::Command::new(env!("CARGO_BIN_EXE_sweeptrace"))
+                .current_dir(dir.path())
+                .args(&args)
+                .output()
+                .map_err(|e| e.to_string())?;
+            ensure!(
+                out.status.success(),
+                "replay --threads {threads} failed: {}",
+                String::from_utf8_lossy(&out.stderr)
+            );
+            Ok((
+                std::fs::read(dir.path().join(&outcomes)).map_err(|e| e.to_string())?,
+                std::fs::read(dir.path().join(&rrd)).map_err(|e| e.to_string())?,
+            ))
+        };
+    {
+        let detail = "primary";
+        let (o1, _) = run("1", detail, false)?;
+        let (o4, _) = run("4", detail, false)?;
+        ensure!(
+            o1.iter().filter(|b| **b == b'\n').count() == sweeps.len(),
+            "{detail}: outcome lines"
+        );
+        ensure!(
+            o1 == o4,
+            "{detail}: outcomes differ between 1 and 4 threads"
+        );
+        let d1 = decode_rrd(&dir.path().join(format!("1-{detail}-false.rrd")))?;
+        let d4 = decode_rrd(&dir.path().join(format!("4-{detail}-false.rrd")))?;
+        ensure!(
+            d1.scalars == d4.scalars
+                && d1.texts == d4.texts
+                && d1.translations == d4.translations
+                && d1.quaternions == d4.quaternions,
+            "{detail}: recording content differs between 1 and 4 threads"
+        );
+    }
+    // With the blueprint: the recording's content is the same.
+    run("1", "primary", true)?;
+    run("4", "primary", true)?;
+    let d1 = decode_rrd(&dir.path().join("1-primary-true.rrd"))?;
+    let d4 = decode_rrd(&dir.path().join("4-primary-true.rrd"))?;
+    ensure!(
+        d1.scalars == d4.scalars
+            && d1.texts == d4.texts
+            && d1.translations == d4.translations
+            && d1.quaternions == d4.quaternions
+            && d1.recording_ids == d4.recording_ids
+            && d1.static_entities == d4.static_entities,
+        "recording content differs between 1 and 4 threads"
+    );
+    Ok(())
+}
+
+/// `replay_events_parallel` yields what `replay_events` yields, batch size
+/// 1 to many, with expected outcomes before and after their sweeps and an
+/// invalid sweep in the middle.
+fn parallel_iterator_equals_sequential() -> Result<(), String> {
+    use sweeptrace::replay::replay_events_parallel;
+    let sweeps = random_sweeps(9, 40, 3);
+    let mesh = mesh_of(&cube_scene());
+    let mut events: Vec<TraceEvent> = vec![TraceEvent::Scene {
+        log_time_nanos: 0,
+        index: 0,
+        scene: cube_scene(),
+    }];
+    for (i, s) in sweeps.iter().enumerate() {
+        let o = sweep_mesh(
+            &mesh,
+            &Sweep::new(s.p0, s.p1, s.radius),
+            &Options::default(),
+        )
+        .map_err(|e| e.to_string())?;
+        let expected = TraceEvent::Expected {
+            log_time_nanos: s.frame,
+            index: 0,
+            outcome: OutcomeMsg::from_outcome(s.frame, s.ball, &o),
+        };
+        let mut sweep = *s;
+        if i == 50 {
+            sweep.radius = -1.0;
+        }
+        let sweep = TraceEvent::Sweep {
+            log_time_nanos: s.frame,
+            index: i as u64 + 1,
+            sweep,
+        };
+        if i % 2 == 0 {
+            events.push(expected);
+            events.push(sweep);
+        } else {
+            events.push(sweep);
+            events.push(expected);
+        }
+    }
+    let render = |items: Vec<Result<ReplayEvent, sweeptrace::replay::ReplayError>>| -> Vec<String> {
+        items
+            .into_iter()
+            .map(|e| match e {
+                Ok(ReplayEvent::Sweep(r)) => format!("{r:?}"),
+                Ok(ReplayEvent::Scene(s)) => format!("scene {}", s.number),
+                Err(err) => format!("error {err}"),
+            })
+            .collect()
+    };
+    let options = explained(Detail::Candidates);
+    let mut it = replay_events(events.iter().cloned().map(Ok), options);
+    let want = render(it.by_ref().collect());
+    let want_summary = it.summary();
+    ensure!(
+        want.iter().any(|l| l.starts_with("error")),
+        "the invalid sweep is reported"
+    );
+    for batch in [1, 2, 7, 64, 10_000] {
+        let mut it = replay_events_parallel(events.iter().cloned().map(Ok), options, batch, None);
+        let got = render(it.by_ref().collect());
+        ensure!(got == want, "batch {batch}: results differ");
+        let mut summary = it.summary();
+        summary.elapsed = want_summary.elapsed;
+        ensure!(
+            summary == want_summary,
+            "batch {batch}: summary {summary:?}"
+        );
+    }
     Ok(())
 }

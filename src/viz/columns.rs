@@ -108,7 +108,7 @@ impl EntityColumns {
             timelines,
             components,
         )
-        .map_err(|e| RecordingStreamError::Chunk(e.into()))?;
+        .map_err(RecordingStreamError::Chunk)?;
         Ok(Some(chunk))
     }
 }
@@ -234,7 +234,7 @@ impl Columns {
             Default::default(),
             components.into_iter().collect(),
         )
-        .map_err(|e| RecordingStreamError::Chunk(e.into()))?;
+        .map_err(RecordingStreamError::Chunk)?;
         rec.send_chunk(chunk);
         Ok(())
     }

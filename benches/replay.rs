@@ -101,20 +101,30 @@ fn rrd(bytes: &[u8], detail: Detail, path: &std::path::Path) -> u64 {
                 scenes.push(s.clone());
             }
         }
-        let prepared: Vec<Option<viz::PreparedSweep>> = batch
+        // Runs of consecutive sweeps, as the command cuts them.
+        let mut groups: Vec<std::ops::Range<usize>> = Vec::new();
+        for (i, e) in batch.iter().enumerate() {
+            if !matches!(e, ReplayEvent::Sweep(_)) {
+                continue;
+            }
+            match groups.last_mut() {
+                Some(g) if g.end == i && g.len() < viz::PREPARE_GROUP_SWEEPS => g.end += 1,
+                _ => groups.push(i..i + 1),
+            }
+        }
+        let prepared: Vec<viz::PreparedSweeps> = groups
             .par_iter()
-            .with_min_len(64)
-            .map(|e| match e {
-                ReplayEvent::Sweep(r) => {
-                    let scene = scenes.iter().find(|s| s.number == r.scene);
-                    Some(viz::prepare_sweep(scene.map(|s| &**s), r, max))
-                }
-                ReplayEvent::Scene(_) => None,
+            .map(|g| {
+                let sweeps = batch[g.clone()].iter().filter_map(|e| match e {
+                    ReplayEvent::Sweep(r) => Some(&**r),
+                    ReplayEvent::Scene(_) => None,
+                });
+                viz::prepare_sweeps(&scenes, sweeps, max)
             })
             .collect();
-        for p in prepared.into_iter().flatten() {
+        for p in prepared {
+            n += p.len() as u64;
             logger.log_prepared(p).expect("logging");
-            n += 1;
         }
     }
     logger.flush().expect("flush");

@@ -77,6 +77,14 @@ pub struct Args {
     pub threads: Option<usize>,
 }
 
+/// The result of a sweep event.
+fn sweep_of(event: &Result<ReplayEvent, ReplayError>) -> Option<&sweeptrace::replay::SweepResult> {
+    match event {
+        Ok(ReplayEvent::Sweep(result)) => Some(result),
+        _ => None,
+    }
+}
+
 /// Counts bytes read, for the progress bar.
 struct CountingReader<R> {
     inner: R,
@@ -282,26 +290,63 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
                 scenes.push(scene.clone());
             }
         }
-        let prepared: Vec<(Option<String>, Option<viz::PreparedSweep>)> = pool.install(|| {
-            batch
-                .par_iter()
-                .with_min_len(64)
-                .map(|event| match event {
-                    Ok(ReplayEvent::Sweep(result)) => {
-                        let line = write_outcomes
-                            .then(|| serde_json::to_string(&result.outcome_msg()).ok())
-                            .flatten();
-                        let rows = max_edge_frames.map(|max| {
-                            let scene = scenes.iter().find(|s| s.number == result.scene);
-                            viz::prepare_sweep(scene.map(|s| &**s), result, max)
-                        });
-                        (line, rows)
-                    }
-                    _ => (None, None),
-                })
-                .collect()
-        });
-        for (event, (line, rows)) in batch.drain(..).zip(prepared) {
+        // Runs of consecutive sweeps, cut at `PREPARE_GROUP_SWEEPS`: the
+        // recording's rows of each run are built on one worker.
+        let mut groups: Vec<std::ops::Range<usize>> = Vec::new();
+        if logger.is_some() {
+            for (i, event) in batch.iter().enumerate() {
+                if !matches!(event, Ok(ReplayEvent::Sweep(_))) {
+                    continue;
+                }
+                match groups.last_mut() {
+                    Some(g) if g.end == i && g.len() < viz::PREPARE_GROUP_SWEEPS => g.end += 1,
+                    _ => groups.push(i..i + 1),
+                }
+            }
+        }
+        let (lines, prepared): (Vec<Option<String>>, Vec<viz::PreparedSweeps>) =
+            pool.install(|| {
+                rayon::join(
+                    || {
+                        if !write_outcomes {
+                            return Vec::new();
+                        }
+                        batch
+                            .par_iter()
+                            .with_min_len(64)
+                            .map(|event| {
+                                sweep_of(event)
+                                    .and_then(|r| serde_json::to_string(&r.outcome_msg()).ok())
+                            })
+                            .collect()
+                    },
+                    || {
+                        let Some(max) = max_edge_frames else {
+                            return Vec::new();
+                        };
+                        groups
+                            .par_iter()
+                            .map(|g| {
+                                viz::prepare_sweeps(
+                                    &scenes,
+                                    batch[g.clone()].iter().filter_map(sweep_of),
+                                    max,
+                                )
+                            })
+                            .collect()
+                    },
+                )
+            });
+        let mut lines = lines.into_iter();
+        let mut prepared = groups.iter().map(|g| g.start).zip(prepared).peekable();
+        for (i, event) in batch.drain(..).enumerate() {
+            let line = lines.next().flatten();
+            if let Some((_, rows)) = prepared.next_if(|(start, _)| *start == i)
+                && let (Some(l), Ok(ReplayEvent::Sweep(result))) = (logger.as_mut(), &event)
+            {
+                l.log_prepared(rows)
+                    .with_context(|| format!("logging the frames from {}", result.frame))?;
+            }
             match event {
                 Ok(ReplayEvent::Scene(scene)) => {
                     for d in scene.mesh.degenerate() {
@@ -322,10 +367,6 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
                                 .context("serializing an outcome")?,
                         };
                         writeln!(o.writer(), "{line}").context("writing outcomes")?;
-                    }
-                    if let (Some(l), Some(rows)) = (logger.as_mut(), rows) {
-                        l.log_prepared(rows)
-                            .with_context(|| format!("logging frame {}", result.frame))?;
                     }
                 }
                 Err(ReplayError::Trace(err)) => {

@@ -1,28 +1,42 @@
-//! Rows buffered per entity as columns and sent as one chunk per entity.
+//! Rows buffered per entity as typed columns and sent as one chunk per
+//! entity.
 //!
 //! Logging a row at a time costs a channel message and a pass through the
-//! SDK's batcher per row. Here the rows of each entity and set of components
-//! (an entity that logs a `Points3D` at one frame and a `Clear` at another
-//! has two sets) keep their time columns (`frame`, `time`), their row ids and
-//! one column per component, and [`Columns::send`] turns each into one dense
-//! [`Chunk`] with one concatenation per component, like the chunks the
-//! batcher builds.
+//! SDK's batcher per row, and serializing each archetype at once costs
+//! several small Arrow arrays per component per row. Here a row is a set of
+//! plain values: each entity and set of components (an entity that logs a
+//! `Points3D` at one frame and a `Clear` at another has two sets) keeps its
+//! time columns (`frame`, `time`), its row numbers and one typed column per
+//! component (a `Vec` of the component's values and the number of values of
+//! each row; strings in one byte buffer). [`Columns::send`] turns each into
+//! one dense [`Chunk`], with one Arrow array per component built from the
+//! whole column, like the chunks the SDK's batcher builds.
+//!
+//! A [`Columns`] can be filled on its own (for example on a worker thread,
+//! for a run of sweeps) and appended to another one in order
+//! ([`Columns::append`]): its rows are numbered after those already there.
 //!
 //! Row and chunk ids come from counters, not from the clock and a random
-//! number: the `n`-th row logged gets row id `n` (above a fixed base), so
-//! later rows still win over earlier ones at the same time, as with
-//! row-by-row logging, and the same rows give the same chunks.
+//! number: the `n`-th row gets row id `n` (above a fixed base), so later rows
+//! still win over earlier ones at the same time, as with row-by-row logging,
+//! and the same rows give the same chunks.
 
+use std::any::Any;
 use std::collections::HashMap;
+use std::fmt;
+use std::hash::{BuildHasherDefault, Hasher};
 use std::sync::Arc;
 
-use rerun::external::arrow::array::{Array, ArrayRef, ListArray};
-use rerun::external::arrow::buffer::{NullBuffer, OffsetBuffer};
-use rerun::external::arrow::compute::concat;
+use rerun::external::arrow::array::{ArrayRef, ListArray, StringArray};
+use rerun::external::arrow::buffer::{Buffer, OffsetBuffer};
 use rerun::external::arrow::datatypes::Field;
 use rerun::log::{Chunk, ChunkComponents, ChunkId, RowId, TimeColumn};
-use rerun::{ComponentDescriptor, RecordingStream, RecordingStreamError, SerializedComponentBatch};
+use rerun::{
+    Component, ComponentDescriptor, EntityPath, RecordingStream, RecordingStreamError,
+    SerializedComponentBatch,
+};
 
+use super::paths::Entity;
 use super::{FRAME_TIMELINE, TIME_TIMELINE};
 
 /// Time part of the ids: 2020-01-01T00:00:00Z in nanoseconds. Fixed, so
@@ -50,36 +64,154 @@ impl Time {
     }
 }
 
-#[derive(Debug)]
-struct ComponentColumn {
+/// The buffer of one entity and set of components: the entity, a number
+/// naming the set (chosen by the caller; every row of a set puts the same
+/// components in the same order) and the kind of `time` (one chunk holds
+/// one kind).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub(crate) struct Key {
+    entity: Entity,
+    set: u8,
+    timestamps: bool,
+}
+
+/// One component's values over the buffered rows.
+trait Column: Send + fmt::Debug {
+    fn descriptor(&self) -> &ComponentDescriptor;
+    /// Moves the rows of `other` (a column of the same type) to the end.
+    fn append(&mut self, other: &mut dyn Column);
+    /// The list array of the buffered rows (one list per row); empties the
+    /// column.
+    fn take_list(&mut self) -> Result<ListArray, RecordingStreamError>;
+    fn as_any_mut(&mut self) -> &mut dyn Any;
+}
+
+/// A column of component `C`: all values in one `Vec`, and how many each
+/// row has.
+struct Typed<C> {
     descriptor: ComponentDescriptor,
-    /// One entry per row of the entity; `None` where the row does not log it.
-    cells: Vec<Option<ArrayRef>>,
+    values: Vec<C>,
+    lengths: Vec<usize>,
+}
+
+impl<C> fmt::Debug for Typed<C> {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.debug_struct("Typed")
+            .field("descriptor", &self.descriptor)
+            .field("values", &self.values.len())
+            .field("rows", &self.lengths.len())
+            .finish()
+    }
+}
+
+impl<C: Component> Column for Typed<C> {
+    fn descriptor(&self) -> &ComponentDescriptor {
+        &self.descriptor
+    }
+
+    fn append(&mut self, other: &mut dyn Column) {
+        let other = other
+            .as_any_mut()
+            .downcast_mut::<Typed<C>>()
+            .expect("columns of one set have the same types");
+        self.values.append(&mut other.values);
+        self.lengths.append(&mut other.lengths);
+    }
+
+    fn take_list(&mut self) -> Result<ListArray, RecordingStreamError> {
+        let values = C::to_arrow(self.values.iter().map(std::borrow::Cow::Borrowed))?;
+        self.values.clear();
+        list_array(values, &mut self.lengths)
+    }
+
+    fn as_any_mut(&mut self) -> &mut dyn Any {
+        self
+    }
+}
+
+/// A column of a string component (`Text`, `TextLogLevel`, ...; Arrow
+/// `Utf8`): the bytes of every string in one buffer.
+#[derive(Debug)]
+struct Strings {
+    descriptor: ComponentDescriptor,
+    bytes: String,
+    /// Length in bytes of each string.
+    string_lengths: Vec<usize>,
+    /// Strings of each row.
+    lengths: Vec<usize>,
+}
+
+impl Column for Strings {
+    fn descriptor(&self) -> &ComponentDescriptor {
+        &self.descriptor
+    }
+
+    fn append(&mut self, other: &mut dyn Column) {
+        let other = other
+            .as_any_mut()
+            .downcast_mut::<Strings>()
+            .expect("columns of one set have the same types");
+        self.bytes.push_str(&other.bytes);
+        other.bytes.clear();
+        self.string_lengths.append(&mut other.string_lengths);
+        self.lengths.append(&mut other.lengths);
+    }
+
+    fn take_list(&mut self) -> Result<ListArray, RecordingStreamError> {
+        let offsets = OffsetBuffer::<i32>::from_lengths(self.string_lengths.drain(..));
+        let bytes = Buffer::from_vec(std::mem::take(&mut self.bytes).into_bytes());
+        let values = StringArray::try_new(offsets, bytes, None)
+            .map_err(|e| RecordingStreamError::Chunk(e.into()))?;
+        list_array(Arc::new(values), &mut self.lengths)
+    }
+
+    fn as_any_mut(&mut self) -> &mut dyn Any {
+        self
+    }
+}
+
+/// One list per row over `values`, `lengths` values each; empties
+/// `lengths`.
+fn list_array(
+    values: ArrayRef,
+    lengths: &mut Vec<usize>,
+) -> Result<ListArray, RecordingStreamError> {
+    let offsets = OffsetBuffer::<i32>::from_lengths(lengths.drain(..));
+    let field = Arc::new(Field::new_list_field(values.data_type().clone(), true));
+    ListArray::try_new(field, offsets, values, None)
+        .map_err(|e| RecordingStreamError::Chunk(e.into()))
 }
 
 #[derive(Debug)]
 struct EntityColumns {
-    path: String,
+    key: Key,
+    path: EntityPath,
     frames: Vec<i64>,
     times: Vec<i64>,
-    timestamps: bool,
-    row_ids: Vec<RowId>,
-    components: Vec<ComponentColumn>,
+    /// Row numbers (0-based, in the order the rows were logged).
+    rows: Vec<u64>,
+    columns: Vec<Box<dyn Column>>,
 }
 
 impl EntityColumns {
-    fn rows(&self) -> usize {
-        self.row_ids.len()
+    fn append(&mut self, other: &mut EntityColumns) {
+        self.frames.append(&mut other.frames);
+        self.times.append(&mut other.times);
+        self.rows.append(&mut other.rows);
+        debug_assert_eq!(self.columns.len(), other.columns.len());
+        for (mine, theirs) in self.columns.iter_mut().zip(&mut other.columns) {
+            mine.append(theirs.as_mut());
+        }
     }
 
     /// The chunk of the buffered rows, and the buffer emptied.
     fn take_chunk(&mut self, id: ChunkId) -> Result<Option<Chunk>, RecordingStreamError> {
-        if self.row_ids.is_empty() {
+        if self.rows.is_empty() {
             return Ok(None);
         }
         let frames = std::mem::take(&mut self.frames);
         let times = std::mem::take(&mut self.times);
-        let time_column = if self.timestamps {
+        let time_column = if self.key.timestamps {
             TimeColumn::new_timestamp_nanos_since_epoch(TIME_TIMELINE, times)
         } else {
             TimeColumn::new_duration_nanos(TIME_TIMELINE, times)
@@ -91,18 +223,16 @@ impl EntityColumns {
         .into_iter()
         .map(|c| (*c.timeline().name(), c))
         .collect();
-        let mut components = Vec::with_capacity(self.components.len());
-        for column in &mut self.components {
-            let cells = std::mem::take(&mut column.cells);
-            if let Some(list) = list_array(&cells)? {
-                components.push((column.descriptor.clone(), list));
-            }
+        let mut components = Vec::with_capacity(self.columns.len());
+        for column in &mut self.columns {
+            let list = column.take_list()?;
+            components.push((column.descriptor().clone(), list));
         }
         let components: ChunkComponents = components.into_iter().collect();
-        let row_ids = std::mem::take(&mut self.row_ids);
+        let row_ids: Vec<RowId> = self.rows.drain(..).map(row_id).collect();
         let chunk = Chunk::from_native_row_ids(
             id,
-            self.path.as_str().into(),
+            self.path.clone(),
             None,
             &row_ids,
             timelines,
@@ -113,13 +243,56 @@ impl EntityColumns {
     }
 }
 
-/// The rows of every entity not yet sent.
+/// The row id of the `n`-th row (0-based).
+fn row_id(n: u64) -> RowId {
+    RowId::from_u128(((ID_BASE_NANOS as u128) << 64) | (n as u128 + 1))
+}
+
+/// FxHash (rustc's): the keys are a few small integers.
+#[derive(Default)]
+pub(crate) struct FxHasher(u64);
+
+impl FxHasher {
+    #[inline]
+    fn add(&mut self, word: u64) {
+        self.0 = (self.0.rotate_left(5) ^ word).wrapping_mul(0x51_7c_c1_b7_27_22_0a_95);
+    }
+}
+
+impl Hasher for FxHasher {
+    fn write(&mut self, bytes: &[u8]) {
+        for &b in bytes {
+            self.add(b as u64);
+        }
+    }
+    fn write_u8(&mut self, i: u8) {
+        self.add(i as u64);
+    }
+    fn write_u32(&mut self, i: u32) {
+        self.add(i as u64);
+    }
+    fn write_u64(&mut self, i: u64) {
+        self.add(i);
+    }
+    fn write_usize(&mut self, i: usize) {
+        self.add(i as u64);
+    }
+    fn write_isize(&mut self, i: isize) {
+        self.add(i as u64);
+    }
+    fn finish(&self) -> u64 {
+        self.0
+    }
+}
+
+/// Rows not yet sent.
 #[derive(Debug, Default)]
 pub struct Columns {
     entities: Vec<EntityColumns>,
-    /// The buffers of each path, one per set of components.
-    by_path: HashMap<String, Vec<usize>>,
+    index: HashMap<Key, usize, BuildHasherDefault<FxHasher>>,
+    /// Rows buffered.
     rows: usize,
+    /// Rows numbered so far (buffered or sent).
     next_row: u64,
     next_chunk: u64,
 }
@@ -130,82 +303,69 @@ impl Columns {
         self.rows
     }
 
-    fn row_id(&mut self) -> RowId {
-        self.next_row += 1;
-        RowId::from_u128(((ID_BASE_NANOS as u128) << 64) | self.next_row as u128)
-    }
-
     fn chunk_id(&mut self) -> ChunkId {
         self.next_chunk += 1;
         ChunkId::from_u128(((ID_BASE_NANOS as u128) << 64) | self.next_chunk as u128)
     }
 
-    /// Buffers one row of `path` at (`frame`, `time`). A row without
-    /// components is dropped, as the SDK does.
-    pub fn push_row(
-        &mut self,
-        rec: &RecordingStream,
-        path: String,
-        frame: i64,
-        time: Time,
-        batches: Vec<SerializedComponentBatch>,
-    ) -> Result<(), RecordingStreamError> {
-        if batches.is_empty() {
-            return Ok(());
-        }
-        let row_id = self.row_id();
-        let same_set = |e: &EntityColumns| {
-            e.components.len() == batches.len()
-                && e.components
-                    .iter()
-                    .zip(&batches)
-                    .all(|(c, b)| c.descriptor == b.descriptor)
+    /// Starts a row of `entity` at (`frame`, `time`) in the buffer of
+    /// component set `set`; put its components with the returned [`Row`]
+    /// (at least one, the same ones in the same order in every row of the
+    /// set).
+    pub(crate) fn row(&mut self, entity: Entity, set: u8, frame: i64, time: Time) -> Row<'_> {
+        let key = Key {
+            entity,
+            set,
+            timestamps: time.is_timestamp(),
         };
-        let found = self
-            .by_path
-            .get(&path)
-            .and_then(|list| list.iter().copied().find(|&i| same_set(&self.entities[i])));
-        let index = match found {
-            Some(i) => i,
+        let index = match self.index.get(&key) {
+            Some(&i) => i,
             None => {
                 let i = self.entities.len();
-                self.by_path.entry(path.clone()).or_default().push(i);
+                self.index.insert(key, i);
                 self.entities.push(EntityColumns {
-                    path,
+                    key,
+                    path: EntityPath::from(entity.path()),
                     frames: Vec::new(),
                     times: Vec::new(),
-                    timestamps: time.is_timestamp(),
-                    row_ids: Vec::new(),
-                    components: batches
-                        .iter()
-                        .map(|b| ComponentColumn {
-                            descriptor: b.descriptor.clone(),
-                            cells: Vec::new(),
-                        })
-                        .collect(),
+                    rows: Vec::new(),
+                    columns: Vec::new(),
                 });
                 i
             }
         };
-        // One chunk holds one kind of `time`: send what came before a change.
-        if self.entities[index].timestamps != time.is_timestamp() {
-            let id = self.chunk_id();
-            let entity = &mut self.entities[index];
-            self.rows -= entity.rows();
-            if let Some(chunk) = entity.take_chunk(id)? {
-                rec.send_chunk(chunk);
-            }
-            entity.timestamps = time.is_timestamp();
-        }
-        let entity = &mut self.entities[index];
-        for (column, batch) in entity.components.iter_mut().zip(batches) {
-            column.cells.push(Some(batch.array));
-        }
-        entity.frames.push(frame);
-        entity.times.push(time.nanos());
-        entity.row_ids.push(row_id);
+        let n = self.next_row;
+        self.next_row += 1;
         self.rows += 1;
-        Ok(())
+        let e = &mut self.entities[index];
+        e.frames.push(frame);
+        e.times.push(time.nanos());
+        e.rows.push(n);
+        Row { entity: e, next: 0 }
+    }
+
+    /// Moves the rows of `other` here, after the rows numbered so far
+    /// (`other`'s entities that are new here come after those already
+    /// here, in `other`'s order).
+    pub fn append(&mut self, mut other: Columns) {
+        let base = self.next_row;
+        for mut e in other.entities.drain(..) {
+            if e.rows.is_empty() {
+                continue;
+            }
+            for r in &mut e.rows {
+                *r += base;
+            }
+            match self.index.get(&e.key) {
+                Some(&i) => self.entities[i].append(&mut e),
+                None => {
+                    self.index.insert(e.key, self.entities.len());
+                    self.entities.push(e);
+                }
+            }
+        }
+        self.rows += other.rows;
+        self.next_row += other.next_row;
     }
 
     /// Sends a static row of `path` at once.
@@ -218,19 +378,20 @@ impl Columns {
         if batches.is_empty() {
             return Ok(());
         }
-        let row_id = self.row_id();
+        let row = row_id(self.next_row);
+        self.next_row += 1;
         let id = self.chunk_id();
         let mut components = Vec::with_capacity(batches.len());
         for batch in batches {
-            if let Some(list) = list_array(&[Some(batch.array)])? {
-                components.push((batch.descriptor, list));
-            }
+            let len = batch_len(&batch);
+            let list = list_array(batch.array, &mut vec![len])?;
+            components.push((batch.descriptor, list));
         }
         let chunk = Chunk::from_native_row_ids(
             id,
             path.as_str().into(),
             None,
-            &[row_id],
+            &[row],
             Default::default(),
             components.into_iter().collect(),
         )
@@ -239,11 +400,11 @@ impl Columns {
         Ok(())
     }
 
-    /// Sends every buffered row, one chunk per entity, entities in the order
+    /// Sends every buffered row, one chunk per entity and set, in the order
     /// they were first logged.
     pub fn send(&mut self, rec: &RecordingStream) -> Result<(), RecordingStreamError> {
         for i in 0..self.entities.len() {
-            if self.entities[i].rows() == 0 {
+            if self.entities[i].rows.is_empty() {
                 continue;
             }
             let id = self.chunk_id();
@@ -256,28 +417,105 @@ impl Columns {
     }
 }
 
-/// The list array of one component column: one list per row, null where
-/// the row does not log the component; `None` when no row does.
-fn list_array(cells: &[Option<ArrayRef>]) -> Result<Option<ListArray>, RecordingStreamError> {
-    let dense: Vec<&dyn Array> = cells.iter().flatten().map(|a| a.as_ref()).collect();
-    let Some(first) = dense.first() else {
-        return Ok(None);
-    };
-    let data_type = first.data_type().clone();
-    let values = if dense.len() == 1 {
-        cells.iter().flatten().next().cloned().expect("one cell")
-    } else {
-        concat(&dense).map_err(|e| RecordingStreamError::Chunk(e.into()))?
-    };
-    let offsets =
-        OffsetBuffer::from_lengths(cells.iter().map(|c| c.as_ref().map_or(0, |a| a.len())));
-    let nulls = if cells.iter().all(Option::is_some) {
-        None
-    } else {
-        Some(NullBuffer::from_iter(cells.iter().map(Option::is_some)))
-    };
-    let field = Arc::new(Field::new_list_field(data_type, true));
-    ListArray::try_new(field, offsets, values, nulls)
-        .map(Some)
-        .map_err(|e| RecordingStreamError::Chunk(e.into()))
+fn batch_len(batch: &SerializedComponentBatch) -> usize {
+    use rerun::external::arrow::array::Array as _;
+    batch.array.len()
+}
+
+/// One row being written: put each component of the set in turn.
+pub(crate) struct Row<'a> {
+    entity: &'a mut EntityColumns,
+    next: usize,
+}
+
+impl Row<'_> {
+    /// The next column, created with `make` in the set's first row.
+    fn column(&mut self, make: impl FnOnce() -> Box<dyn Column>) -> &mut dyn Any {
+        let i = self.next;
+        self.next += 1;
+        if i == self.entity.columns.len() {
+            self.entity.columns.push(make());
+        }
+        self.entity.columns[i].as_any_mut()
+    }
+
+    /// Puts the values of component `C` (`descriptor` names it).
+    pub(crate) fn put<C: Component>(
+        &mut self,
+        descriptor: fn() -> ComponentDescriptor,
+        values: impl IntoIterator<Item = C>,
+    ) -> &mut Self {
+        let column = self
+            .column(|| {
+                Box::new(Typed::<C> {
+                    descriptor: descriptor(),
+                    values: Vec::new(),
+                    lengths: Vec::new(),
+                })
+            })
+            .downcast_mut::<Typed<C>>()
+            .expect("every row of a set puts the same components");
+        let before = column.values.len();
+        column.values.extend(values);
+        column.lengths.push(column.values.len() - before);
+        self
+    }
+
+    /// Puts the strings of a string component (`descriptor` names it; its
+    /// Arrow type must be `Utf8`, as `Text`'s).
+    pub(crate) fn put_strs<'s>(
+        &mut self,
+        descriptor: fn() -> ComponentDescriptor,
+        strings: impl IntoIterator<Item = &'s str>,
+    ) -> &mut Self {
+        let column = self.strings(descriptor);
+        let mut n = 0;
+        for s in strings {
+            column.bytes.push_str(s);
+            column.string_lengths.push(s.len());
+            n += 1;
+        }
+        column.lengths.push(n);
+        self
+    }
+
+    /// Puts one formatted string of a string component.
+    pub(crate) fn put_fmt(
+        &mut self,
+        descriptor: fn() -> ComponentDescriptor,
+        args: fmt::Arguments<'_>,
+    ) -> &mut Self {
+        let column = self.strings(descriptor);
+        let before = column.bytes.len();
+        fmt::Write::write_fmt(&mut column.bytes, args).expect("writing to a String");
+        column.string_lengths.push(column.bytes.len() - before);
+        column.lengths.push(1);
+        self
+    }
+
+    fn strings(&mut self, descriptor: fn() -> ComponentDescriptor) -> &mut Strings {
+        self.column(|| {
+            Box::new(Strings {
+                descriptor: descriptor(),
+                bytes: String::new(),
+                string_lengths: Vec::new(),
+                lengths: Vec::new(),
+            })
+        })
+        .downcast_mut::<Strings>()
+        .expect("every row of a set puts the same components")
+    }
+}
+
+impl Drop for Row<'_> {
+    fn drop(&mut self) {
+        debug_assert_eq!(
+            self.next,
+            self.entity.columns.len(),
+            "a row of {:?} put {} of the set's {} components",
+            self.entity.key,
+            self.next,
+            self.entity.columns.len()
+        );
+    }
 }

@@ -19,16 +19,20 @@ use rerun::blueprint::{
     Blueprint, BlueprintActivation, BlueprintPanel, Horizontal, SelectionPanel, Spatial3DView,
     TextLogView, TimePanel, TimeSeriesView, Vertical,
 };
-use rerun::components::{FillMode, TextLogLevel};
+use rerun::components::{
+    AlbedoFactor, ClearIsRecursive, FillMode, HalfSize3D, Length, LineStrip3D, Position3D, Radius,
+    RotationQuat, Scalar, Text, TextLogLevel, Translation3D, TriangleIndices, Vector3D,
+};
 use rerun::{
-    AnyValues, Arrows3D, AsComponents, Capsules3D, Clear, Color, Ellipsoids3D, LineStrips3D,
-    Mesh3D, Points3D, RecordingStream, RecordingStreamBuilder, Scalars, TextLog, Transform3D,
+    Arrows3D, Capsules3D, Clear, Color, ComponentDescriptor, Ellipsoids3D, LineStrips3D, Mesh3D,
+    Points3D, RecordingStream, RecordingStreamBuilder, Scalars, TextLog, Transform3D,
     ViewCoordinates,
 };
 
 use crate::core::explain::{describe, miss_distance, num};
 use crate::core::{EdgeRecord, TestRecord, Triangle};
 use crate::replay::{ReplayEvent, SceneState, SweepResult};
+use paths::Entity;
 
 pub use rerun::RecordingStreamError;
 
@@ -161,17 +165,17 @@ struct BallState {
 
 /// Logs replay events to a recording stream.
 ///
-/// Rows are not sent one by one: they are buffered per entity, as columns,
-/// and sent as one chunk per entity every [`DEFAULT_FLUSH_ROWS`] rows (and
-/// by [`Logger::flush`] and [`Logger::finish`]). What the recording holds is
-/// what logging each row on its own would give, with ids that depend only
-/// on the order of the rows, so the same events give the same chunks.
+/// Rows are not sent one by one: they are buffered per entity as typed
+/// columns (plain values, see `columns`), and sent as one chunk per entity
+/// every [`DEFAULT_FLUSH_ROWS`] rows (and by [`Logger::flush`] and
+/// [`Logger::finish`]). What the recording holds is what logging each row
+/// on its own would give, with ids that depend only on the order of the
+/// rows, so the same events give the same chunks.
 #[derive(Debug)]
 pub struct Logger {
     rec: RecordingStream,
     balls: BTreeMap<u32, BallState>,
     scenes: Vec<std::sync::Arc<SceneState>>,
-    time_origin_nanos: Option<u64>,
     max_edge_frames: usize,
     columns: columns::Columns,
     flush_rows: usize,
@@ -180,49 +184,108 @@ pub struct Logger {
 /// Rows buffered before the logger sends them (see [`Logger`]).
 pub const DEFAULT_FLUSH_ROWS: usize = 1 << 14;
 
-/// What one sweep logs, built without the logger ([`prepare_sweep`]), so
-/// that many sweeps can be prepared in parallel and logged in order with
-/// [`Logger::log_prepared`].
-#[derive(Debug)]
-pub struct PreparedSweep {
-    frame: u64,
-    log_time_nanos: u64,
-    ball: u32,
-    edge_slots: usize,
-    rows: Rows,
+/// Sweeps per [`PreparedSweeps`] that the command and the bench prepare on
+/// one worker (runs of consecutive sweeps of a batch, cut at this length).
+pub const PREPARE_GROUP_SWEEPS: usize = 256;
+
+/// What a run of consecutive sweeps logs, built without the logger
+/// ([`prepare_sweeps`]), so that runs can be prepared in parallel and logged
+/// in order with [`Logger::log_prepared`].
+#[derive(Debug, Default)]
+pub struct PreparedSweeps {
+    columns: columns::Columns,
+    /// Per sweep: ball, edge slots used, frame, time.
+    sweeps: Vec<(u32, usize, i64, columns::Time)>,
 }
 
-/// The rows of one sweep: entity path and serialized components, in order.
-#[derive(Debug, Default)]
-struct Rows(Vec<(String, Vec<rerun::SerializedComponentBatch>)>);
+impl PreparedSweeps {
+    /// Sweeps prepared.
+    pub fn len(&self) -> usize {
+        self.sweeps.len()
+    }
 
-impl Rows {
-    fn push(&mut self, path: impl Into<String>, value: &dyn rerun::AsComponents) {
-        self.0.push((path.into(), value.as_serialized_batches()));
+    /// Whether no sweep was prepared.
+    pub fn is_empty(&self) -> bool {
+        self.sweeps.is_empty()
     }
 }
 
-/// Prepares what [`Logger::log_sweep`] logs for `r`: `scene` is the scene
-/// it was swept against, `max_edge_frames` as in
-/// [`Logger::with_max_edge_frames`].
-pub fn prepare_sweep(
-    scene: Option<&SceneState>,
-    r: &SweepResult,
+/// Component sets: the rows of one entity with the same set number have the
+/// same components (see `columns::Columns::row`).
+mod set {
+    pub const SPHERES: u8 = 0;
+    pub const SWEEP: u8 = 1;
+    pub const CONTACT: u8 = 2;
+    pub const NORMAL: u8 = 3;
+    pub const CLEAR: u8 = 4;
+    pub const TRIANGLE: u8 = 5;
+    pub const LABELED_STRIP: u8 = 6;
+    pub const LABELED_POINT: u8 = 7;
+    pub const TRANSFORM: u8 = 8;
+    pub const STRIP: u8 = 9;
+    pub const CYLINDER: u8 = 10;
+    pub const EDGE_POINTS: u8 = 11;
+    pub const SCALAR: u8 = 12;
+    pub const KIND: u8 = 13;
+    pub const TEXT_LOG: u8 = 14;
+    /// Plus 1 with roots, plus 2 with xc.
+    pub const EDGE_VALUES: u8 = 16;
+}
+
+/// Where the rows of one sweep go.
+struct Out<'a> {
+    columns: &'a mut columns::Columns,
+    frame: i64,
+    time: columns::Time,
+}
+
+impl Out<'_> {
+    fn row(&mut self, entity: Entity, set: u8) -> columns::Row<'_> {
+        self.columns.row(entity, set, self.frame, self.time)
+    }
+
+    fn clear(&mut self, entity: Entity, recursive: bool) {
+        self.row(entity, set::CLEAR)
+            .put::<ClearIsRecursive>(Clear::descriptor_is_recursive, [recursive.into()]);
+    }
+}
+
+/// Prepares what [`Logger::log_sweep`] logs for each of `results` (in
+/// order): `scenes` holds (at least) the scenes they were swept against,
+/// `max_edge_frames` as in [`Logger::with_max_edge_frames`].
+pub fn prepare_sweeps<'r>(
+    scenes: &[std::sync::Arc<SceneState>],
+    results: impl IntoIterator<Item = &'r SweepResult>,
     max_edge_frames: usize,
-) -> PreparedSweep {
-    let mut rows = Rows::default();
-    let decisive = r.decisive_record().copied();
-    sweep_rows(&mut rows, r);
-    decisive_rows(&mut rows, scene, r, decisive.as_ref());
-    let edge_slots = edge_frame_rows(&mut rows, r, decisive.as_ref(), max_edge_frames);
-    plot_rows(&mut rows, r, decisive.as_ref());
-    text_rows(&mut rows, r, decisive.as_ref());
-    PreparedSweep {
-        frame: r.frame,
-        log_time_nanos: r.log_time_nanos,
-        ball: r.ball,
-        edge_slots,
-        rows,
+) -> PreparedSweeps {
+    let mut p = PreparedSweeps::default();
+    for r in results {
+        let scene = scenes.iter().find(|s| s.number == r.scene).map(|s| &**s);
+        let frame = i64::try_from(r.frame).unwrap_or(i64::MAX);
+        let time = time_of(r.log_time_nanos);
+        let mut out = Out {
+            columns: &mut p.columns,
+            frame,
+            time,
+        };
+        let decisive = r.decisive_record().copied();
+        sweep_rows(&mut out, r);
+        decisive_rows(&mut out, scene, r, decisive.as_ref());
+        let edge_slots = edge_frame_rows(&mut out, r, decisive.as_ref(), max_edge_frames);
+        plot_rows(&mut out, r, decisive.as_ref());
+        text_rows(&mut out, r, decisive.as_ref());
+        p.sweeps.push((r.ball, edge_slots, frame, time));
+    }
+    p
+}
+
+/// The `time` timeline's value of a `log_time`.
+fn time_of(log_time_nanos: u64) -> columns::Time {
+    let clamp = |n: u64| i64::try_from(n).unwrap_or(i64::MAX);
+    if log_time_nanos >= TIMESTAMP_THRESHOLD_NANOS {
+        columns::Time::Timestamp(clamp(log_time_nanos))
+    } else {
+        columns::Time::Duration(clamp(log_time_nanos))
     }
 }
 
@@ -245,7 +308,6 @@ impl Logger {
             rec,
             balls: BTreeMap::new(),
             scenes: Vec::new(),
-            time_origin_nanos: None,
             max_edge_frames: MAX_EDGE_FRAMES,
             columns: columns::Columns::default(),
             flush_rows: DEFAULT_FLUSH_ROWS,
@@ -332,44 +394,29 @@ impl Logger {
         Ok(())
     }
 
-    /// The `time` timeline's value of a `log_time`.
-    fn time_of(&mut self, log_time_nanos: u64) -> columns::Time {
-        let clamp = |n: u64| i64::try_from(n).unwrap_or(i64::MAX);
-        if log_time_nanos >= TIMESTAMP_THRESHOLD_NANOS {
-            columns::Time::Timestamp(clamp(log_time_nanos))
-        } else {
-            let origin = *self.time_origin_nanos.get_or_insert(0);
-            columns::Time::Duration(clamp(log_time_nanos.saturating_sub(origin)))
-        }
-    }
-
     /// Logs one sweep's result at its frame.
     pub fn log_sweep(&mut self, r: &SweepResult) -> Result<(), RecordingStreamError> {
-        let scene = self.scenes.iter().find(|s| s.number == r.scene).cloned();
-        let prepared = prepare_sweep(scene.as_deref(), r, self.max_edge_frames);
+        let prepared = prepare_sweeps(&self.scenes, [r], self.max_edge_frames);
         self.log_prepared(prepared)
     }
 
-    /// Logs a sweep prepared by [`prepare_sweep`] (sweeps must be logged in
+    /// Logs sweeps prepared by [`prepare_sweeps`] (sweeps must be logged in
     /// trace order).
-    pub fn log_prepared(&mut self, p: PreparedSweep) -> Result<(), RecordingStreamError> {
-        let frame = i64::try_from(p.frame).unwrap_or(i64::MAX);
-        let time = self.time_of(p.log_time_nanos);
-        for (path, batches) in p.rows.0 {
-            self.columns
-                .push_row(&self.rec, path, frame, time, batches)?;
-        }
-        let b = p.ball;
-        let state = self.balls.entry(b).or_default();
-        let previous = std::mem::replace(&mut state.edge_slots, p.edge_slots);
-        for slot in p.edge_slots..previous {
-            self.columns.push_row(
-                &self.rec,
-                paths::edge_frame(b, slot),
+    pub fn log_prepared(&mut self, p: PreparedSweeps) -> Result<(), RecordingStreamError> {
+        self.columns.append(p.columns);
+        // Clear the edge frames a ball used at its previous sweep and no
+        // longer uses.
+        for (b, edge_slots, frame, time) in p.sweeps {
+            let state = self.balls.entry(b).or_default();
+            let previous = std::mem::replace(&mut state.edge_slots, edge_slots);
+            let mut out = Out {
+                columns: &mut self.columns,
                 frame,
                 time,
-                Clear::recursive().as_serialized_batches(),
-            )?;
+            };
+            for slot in edge_slots..previous {
+                out.clear(Entity::EdgeFrame(b, slot), true);
+            }
         }
         if self.columns.rows() >= self.flush_rows {
             self.flush()?;
@@ -379,7 +426,8 @@ impl Logger {
 }
 
 /// The balls, the swept volume, the contact and the normal.
-fn sweep_rows(rows: &mut Rows, r: &SweepResult) {
+fn sweep_rows(out: &mut Out<'_>, r: &SweepResult) {
+    use std::iter::once;
     let b = r.ball;
     let o = &r.outcome;
     let p0 = r.sweep.p0;
@@ -390,64 +438,93 @@ fn sweep_rows(rows: &mut Rows, r: &SweepResult) {
     let at_contact = p0 + d * o.alpha;
 
     // The ball at p0, at the contact (when hit) and at p1.
-    let mut centers = vec![f32x3(p0.coords)];
-    let mut colors = vec![rgba(P0_COLOR)];
-    let mut labels = vec!["p0".to_string()];
-    if o.is_hit() {
-        centers.push(f32x3(at_contact.coords));
-        colors.push(rgba(CONTACT_BALL_COLOR));
-        labels.push(format!("α = {}", num(o.alpha)));
-    }
-    centers.push(f32x3(p1.coords));
-    colors.push(rgba(P1_COLOR));
-    labels.push("p1".to_string());
-    let n = centers.len();
-    rows.push(
-        paths::spheres(b),
-        &Ellipsoids3D::from_centers_and_radii(centers, std::iter::repeat_n(radius, n))
-            .with_colors(colors)
-            .with_labels(labels)
-            .with_fill_mode(FillMode::Solid),
-    );
+    let hit = o.is_hit();
+    let n = if hit { 3 } else { 2 };
+    let contact_center = hit.then(|| f32x3(at_contact.coords));
+    let contact_color = hit.then(|| rgba(CONTACT_BALL_COLOR));
+    let contact_label = hit.then(|| format!("α = {}", num(o.alpha)));
+    out.row(Entity::Spheres(b), set::SPHERES)
+        .put::<HalfSize3D>(
+            Ellipsoids3D::descriptor_half_sizes,
+            std::iter::repeat_n(HalfSize3D::splat(radius), n),
+        )
+        .put::<Translation3D>(
+            Ellipsoids3D::descriptor_centers,
+            once(f32x3(p0.coords))
+                .chain(contact_center)
+                .chain(once(f32x3(p1.coords)))
+                .map(Translation3D::from),
+        )
+        .put::<Color>(
+            Ellipsoids3D::descriptor_colors,
+            once(rgba(P0_COLOR))
+                .chain(contact_color)
+                .chain(once(rgba(P1_COLOR))),
+        )
+        .put::<FillMode>(Ellipsoids3D::descriptor_fill_mode, [FillMode::Solid])
+        .put_strs(
+            Ellipsoids3D::descriptor_labels,
+            once("p0").chain(contact_label.as_deref()).chain(once("p1")),
+        );
 
     // The swept volume at the detection radius.
     let (length, rotation) = capsule_pose(&d);
-    rows.push(
-        paths::sweep(b),
-        &Capsules3D::from_lengths_and_radii([length], [rho as f32])
-            .with_translations([f32x3(p0.coords)])
-            .with_quaternions([rotation])
-            .with_colors([rgba(SWEEP_COLOR)])
-            .with_fill_mode(FillMode::MajorWireframe),
-    );
+    out.row(Entity::Sweep(b), set::SWEEP)
+        .put::<Length>(Capsules3D::descriptor_lengths, [length.into()])
+        .put::<Radius>(Capsules3D::descriptor_radii, [(rho as f32).into()])
+        .put::<Translation3D>(
+            Capsules3D::descriptor_translations,
+            [f32x3(p0.coords).into()],
+        )
+        .put::<RotationQuat>(Capsules3D::descriptor_quaternions, [rotation.into()])
+        .put::<Color>(Capsules3D::descriptor_colors, [rgba(SWEEP_COLOR)])
+        .put::<FillMode>(Capsules3D::descriptor_fill_mode, [FillMode::MajorWireframe]);
 
     // Contact and normal.
     match (o.contact, o.normal) {
         (Some(c), Some(nrm)) => {
-            rows.push(
-                paths::contact(b),
-                &Points3D::new([f32x3(c.coords)])
-                    .with_colors([rgba(HIT_COLOR)])
-                    .with_radii([(rho * 0.08) as f32]),
-            );
-            rows.push(
-                paths::normal(b),
-                &Arrows3D::from_vectors([f32x3(nrm * (r.sweep.radius.max(1e-3) * 1.5))])
-                    .with_origins([f32x3(c.coords)])
-                    .with_colors([rgba(NORMAL_COLOR)])
-                    .with_labels(["normal"]),
-            );
+            out.row(Entity::Contact(b), set::CONTACT)
+                .put::<Position3D>(Points3D::descriptor_positions, [f32x3(c.coords).into()])
+                .put::<Radius>(Points3D::descriptor_radii, [((rho * 0.08) as f32).into()])
+                .put::<Color>(Points3D::descriptor_colors, [rgba(HIT_COLOR)]);
+            out.row(Entity::Normal(b), set::NORMAL)
+                .put::<Vector3D>(
+                    Arrows3D::descriptor_vectors,
+                    [f32x3(nrm * (r.sweep.radius.max(1e-3) * 1.5)).into()],
+                )
+                .put::<Position3D>(Arrows3D::descriptor_origins, [f32x3(c.coords).into()])
+                .put::<Color>(Arrows3D::descriptor_colors, [rgba(NORMAL_COLOR)])
+                .put_strs(Arrows3D::descriptor_labels, ["normal"]);
         }
         _ => {
-            rows.push(paths::contact(b), &Clear::flat());
-            rows.push(paths::normal(b), &Clear::flat());
+            out.clear(Entity::Contact(b), false);
+            out.clear(Entity::Normal(b), false);
         }
     }
 }
 
+/// Puts a `LineStrips3D` row: one strip, color, radius and label.
+fn labeled_strip(
+    out: &mut Out<'_>,
+    entity: Entity,
+    strip: &[[f32; 3]],
+    color: [u8; 4],
+    radius: f32,
+    label: &str,
+) {
+    out.row(entity, set::LABELED_STRIP)
+        .put::<LineStrip3D>(
+            LineStrips3D::descriptor_strips,
+            [LineStrip3D::from(strip.iter().copied())],
+        )
+        .put::<Radius>(LineStrips3D::descriptor_radii, [radius.into()])
+        .put::<Color>(LineStrips3D::descriptor_colors, [rgba(color)])
+        .put_strs(LineStrips3D::descriptor_labels, [label]);
+}
+
 /// The highlighted triangle, edge or vertex of the decisive test.
 fn decisive_rows(
-    rows: &mut Rows,
+    out: &mut Out<'_>,
     scene: Option<&SceneState>,
     r: &SweepResult,
     decisive: Option<&TestRecord>,
@@ -457,9 +534,9 @@ fn decisive_rows(
     let triangle =
         decisive.and_then(|t| scene.and_then(|s| s.mesh.triangle_by_index(t.triangle())));
     let (Some(t), Some(test)) = (triangle, decisive) else {
-        rows.push(paths::primary_triangle(b), &Clear::flat());
-        rows.push(paths::primary_edge(b), &Clear::flat());
-        rows.push(paths::primary_vertex(b), &Clear::flat());
+        out.clear(Entity::PrimaryTriangle(b), false);
+        out.clear(Entity::PrimaryEdge(b), false);
+        out.clear(Entity::PrimaryVertex(b), false);
         return;
     };
     let color = if test.alpha().is_some() {
@@ -469,53 +546,59 @@ fn decisive_rows(
     };
     // Lift the highlight a little off the mesh so it is not hidden by it.
     let lift = t.normal * (r.rho() * 0.02);
-    let verts: Vec<[f32; 3]> = t.vertices.iter().map(|v| f32x3(v.coords + lift)).collect();
-    rows.push(
-        paths::primary_triangle(b),
-        &Mesh3D::new(verts.clone())
-            .with_triangle_indices([[0u32, 1, 2]])
-            .with_albedo_factor(albedo([color[0], color[1], color[2], 110])),
-    );
+    let verts: [[f32; 3]; 3] = std::array::from_fn(|i| f32x3(t.vertices[i].coords + lift));
+    out.row(Entity::PrimaryTriangle(b), set::TRIANGLE)
+        .put::<Position3D>(
+            Mesh3D::descriptor_vertex_positions,
+            verts.map(Position3D::from),
+        )
+        .put::<TriangleIndices>(Mesh3D::descriptor_triangle_indices, [[0u32, 1, 2].into()])
+        .put::<AlbedoFactor>(
+            Mesh3D::descriptor_albedo_factor,
+            [albedo([color[0], color[1], color[2], 110]).into()],
+        );
     let f = test.feature() as usize % 3;
+    let label = crate::core::explain::label(test);
     match test {
         TestRecord::Edge(_) => {
-            rows.push(
-                paths::primary_edge(b),
-                &LineStrips3D::new([[verts[f], verts[(f + 1) % 3]]])
-                    .with_colors([rgba(color)])
-                    .with_radii([(r.rho() * 0.05) as f32])
-                    .with_labels([crate::core::explain::label(test)]),
+            labeled_strip(
+                out,
+                Entity::PrimaryEdge(b),
+                &[verts[f], verts[(f + 1) % 3]],
+                color,
+                (r.rho() * 0.05) as f32,
+                &label,
             );
-            rows.push(paths::primary_vertex(b), &Clear::flat());
+            out.clear(Entity::PrimaryVertex(b), false);
         }
         TestRecord::Vertex(_) => {
-            rows.push(
-                paths::primary_vertex(b),
-                &Points3D::new([verts[f]])
-                    .with_colors([rgba(color)])
-                    .with_radii([(r.rho() * 0.12) as f32])
-                    .with_labels([crate::core::explain::label(test)]),
-            );
-            rows.push(paths::primary_edge(b), &Clear::flat());
+            out.row(Entity::PrimaryVertex(b), set::LABELED_POINT)
+                .put::<Position3D>(Points3D::descriptor_positions, [verts[f].into()])
+                .put::<Radius>(
+                    Points3D::descriptor_radii,
+                    [((r.rho() * 0.12) as f32).into()],
+                )
+                .put::<Color>(Points3D::descriptor_colors, [rgba(color)])
+                .put_strs(Points3D::descriptor_labels, [label.as_str()]);
+            out.clear(Entity::PrimaryEdge(b), false);
         }
         TestRecord::Face(_) => {
-            let mut outline = verts.clone();
-            outline.push(verts[0]);
-            rows.push(
-                paths::primary_edge(b),
-                &LineStrips3D::new([outline])
-                    .with_colors([rgba(color)])
-                    .with_radii([(r.rho() * 0.03) as f32])
-                    .with_labels([crate::core::explain::label(test)]),
+            labeled_strip(
+                out,
+                Entity::PrimaryEdge(b),
+                &[verts[0], verts[1], verts[2], verts[0]],
+                color,
+                (r.rho() * 0.03) as f32,
+                &label,
             );
-            rows.push(paths::primary_vertex(b), &Clear::flat());
+            out.clear(Entity::PrimaryVertex(b), false);
         }
     }
 }
 
 /// The edge tests in their standard frames; returns how many slots it used.
 fn edge_frame_rows(
-    rows: &mut Rows,
+    out: &mut Out<'_>,
     r: &SweepResult,
     decisive: Option<&TestRecord>,
     max_edge_frames: usize,
@@ -545,82 +628,117 @@ fn edge_frame_rows(
         let world_from_edge = e.frame.world_from_edge();
         let q = world_from_edge.rotation;
         let t = world_from_edge.translation.vector;
-        rows.push(
-            paths::edge_frame(b, slot),
-            &Transform3D::from_translation_rotation(
-                f32x3(t),
-                rerun::Quaternion::from_xyzw([q.i as f32, q.j as f32, q.k as f32, q.w as f32]),
-            ),
-        );
-        rows.push(paths::edge_frame(b, slot), &edge_values(e));
+        out.row(Entity::EdgeFrame(b, slot), set::TRANSFORM)
+            .put::<Translation3D>(Transform3D::descriptor_translation, [f32x3(t).into()])
+            .put::<RotationQuat>(
+                Transform3D::descriptor_quaternion,
+                [
+                    rerun::Quaternion::from_xyzw([q.i as f32, q.j as f32, q.k as f32, q.w as f32])
+                        .into(),
+                ],
+            );
+        edge_values(out, Entity::EdgeFrame(b, slot), e);
         let length = e.length as f32;
+        let segment = [[0.0f32, 0.0, 0.0], [length, 0.0, 0.0]];
+        let segment_radius = (rho * 0.04) as f32;
         // Only the first slot is labelled: with many slots the labels
         // would hide the world view.
-        let mut segment = LineStrips3D::new([[[0.0f32, 0.0, 0.0], [length, 0.0, 0.0]]])
-            .with_colors([rgba(EDGE_COLOR)])
-            .with_radii([(rho * 0.04) as f32]);
         if slot == 0 {
-            segment = segment.with_labels([format!(
-                "edge {}.{} (L = {})",
-                e.triangle,
-                e.edge,
-                num(e.length)
-            )]);
+            let label = format!("edge {}.{} (L = {})", e.triangle, e.edge, num(e.length));
+            labeled_strip(
+                out,
+                Entity::EdgeSegment(b, slot),
+                &segment,
+                EDGE_COLOR,
+                segment_radius,
+                &label,
+            );
+        } else {
+            strip(
+                out,
+                Entity::EdgeSegment(b, slot),
+                &segment,
+                EDGE_COLOR,
+                segment_radius,
+            );
         }
-        rows.push(paths::edge_segment(b, slot), &segment);
         // A capsule lies along +z; turn it onto +x (90° about +y).
         let half = std::f32::consts::FRAC_1_SQRT_2;
-        rows.push(
-            paths::edge_cylinder(b, slot),
-            &Capsules3D::from_lengths_and_radii([length], [rho as f32])
-                .with_quaternions([rerun::Quaternion::from_xyzw([0.0, half, 0.0, half])])
-                .with_colors([rgba(CYLINDER_COLOR)])
-                .with_fill_mode(FillMode::MajorWireframe),
-        );
+        out.row(Entity::EdgeCylinder(b, slot), set::CYLINDER)
+            .put::<Length>(Capsules3D::descriptor_lengths, [length.into()])
+            .put::<Radius>(Capsules3D::descriptor_radii, [(rho as f32).into()])
+            .put::<RotationQuat>(
+                Capsules3D::descriptor_quaternions,
+                [rerun::Quaternion::from_xyzw([0.0, half, 0.0, half]).into()],
+            )
+            .put::<Color>(Capsules3D::descriptor_colors, [rgba(CYLINDER_COLOR)])
+            .put::<FillMode>(Capsules3D::descriptor_fill_mode, [FillMode::MajorWireframe]);
         let p0e = f32x3(e.p0_in_edge.coords);
         let p1e = f32x3(e.p1_in_edge.coords);
-        rows.push(
-            paths::edge_path(b, slot),
-            &LineStrips3D::new([[p0e, p1e]])
-                .with_colors([rgba(PATH_COLOR)])
-                .with_radii([(rho * 0.03) as f32]),
+        strip(
+            out,
+            Entity::EdgePath(b, slot),
+            &[p0e, p1e],
+            PATH_COLOR,
+            (rho * 0.03) as f32,
         );
-        let mut points = vec![p0e, p1e];
-        let mut labels = vec!["p0".to_string(), "p1".to_string()];
+        let mut at_s0 = None;
         if let Some((s0, _)) = e.roots
             && (-1.0..=2.0).contains(&s0)
         {
             let at = e.p0_in_edge + (e.p1_in_edge - e.p0_in_edge) * s0;
-            points.push(f32x3(at.coords));
-            labels.push(format!("s0 = {}", num(s0)));
+            at_s0 = Some((f32x3(at.coords), format!("s0 = {}", num(s0))));
         }
-        rows.push(
-            paths::edge_points(b, slot),
-            &Points3D::new(points)
-                .with_labels(labels)
-                .with_radii([(rho * 0.06) as f32]),
-        );
+        out.row(Entity::EdgePoints(b, slot), set::EDGE_POINTS)
+            .put::<Position3D>(
+                Points3D::descriptor_positions,
+                [p0e, p1e]
+                    .into_iter()
+                    .chain(at_s0.as_ref().map(|a| a.0))
+                    .map(Position3D::from),
+            )
+            .put::<Radius>(Points3D::descriptor_radii, [((rho * 0.06) as f32).into()])
+            .put_strs(
+                Points3D::descriptor_labels,
+                ["p0", "p1"]
+                    .into_iter()
+                    .chain(at_s0.as_ref().map(|a| a.1.as_str())),
+            );
     }
     edges.len()
 }
 
+/// Puts a `LineStrips3D` row: one strip, color and radius.
+fn strip(out: &mut Out<'_>, entity: Entity, strip: &[[f32; 3]], color: [u8; 4], radius: f32) {
+    out.row(entity, set::STRIP)
+        .put::<LineStrip3D>(
+            LineStrips3D::descriptor_strips,
+            [LineStrip3D::from(strip.iter().copied())],
+        )
+        .put::<Radius>(LineStrips3D::descriptor_radii, [radius.into()])
+        .put::<Color>(LineStrips3D::descriptor_colors, [rgba(color)]);
+}
+
+/// A `Scalars` row.
+fn scalar(out: &mut Out<'_>, entity: Entity, v: f64) {
+    out.row(entity, set::SCALAR)
+        .put::<Scalar>(Scalars::descriptor_scalars, [v.into()]);
+}
+
 /// The α plot and the decisive test's numbers.
-fn plot_rows(rows: &mut Rows, r: &SweepResult, decisive: Option<&TestRecord>) {
+fn plot_rows(out: &mut Out<'_>, r: &SweepResult, decisive: Option<&TestRecord>) {
     let b = r.ball;
-    rows.push(paths::alpha(b), &Scalars::single(r.outcome.alpha));
-    rows.push(
-        paths::alpha(b),
-        &AnyValues::default()
-            .with_component::<rerun::components::Text>("kind", [r.outcome.kind.as_str()]),
-    );
+    scalar(out, Entity::Alpha(b), r.outcome.alpha);
+    out.row(Entity::Alpha(b), set::KIND)
+        .put_strs(|| any_value::<Text>("kind"), [r.outcome.kind.as_str()]);
     let mut quadratic = |a: f64, bb: f64, c: f64, disc: f64, roots: Option<(f64, f64)>| {
-        let mut values = vec![a, bb, c, disc];
-        if let Some((s0, s1)) = roots {
-            values.extend([s0, s1]);
-        }
-        for (name, v) in paths::QUADRATIC_NAMES.iter().zip(values) {
-            if v.is_finite() {
-                rows.push(paths::quadratic(b, name), &Scalars::single(v));
+        let (s0, s1) = roots.unzip();
+        for (i, v) in [Some(a), Some(bb), Some(c), Some(disc), s0, s1]
+            .into_iter()
+            .enumerate()
+        {
+            if let Some(v) = v.filter(|v| v.is_finite()) {
+                scalar(out, Entity::Quadratic(b, i), v);
             }
         }
     };
@@ -628,12 +746,9 @@ fn plot_rows(rows: &mut Rows, r: &SweepResult, decisive: Option<&TestRecord>) {
         Some(TestRecord::Edge(e)) => quadratic(e.a, e.b, e.c, e.discriminant, e.roots),
         Some(TestRecord::Vertex(v)) => quadratic(v.a, v.b, v.c, v.discriminant, v.roots),
         Some(TestRecord::Face(f)) => {
-            for (name, v) in paths::FACE_NAMES
-                .iter()
-                .zip([Some(f.h0), Some(f.h1), f.beta])
-            {
+            for (i, v) in [Some(f.h0), Some(f.h1), f.beta].into_iter().enumerate() {
                 if let Some(v) = v.filter(|v| v.is_finite()) {
-                    rows.push(paths::face(b, name), &Scalars::single(v));
+                    scalar(out, Entity::Face(b, i), v);
                 }
             }
         }
@@ -642,7 +757,7 @@ fn plot_rows(rows: &mut Rows, r: &SweepResult, decisive: Option<&TestRecord>) {
 }
 
 /// The decision in words.
-fn text_rows(rows: &mut Rows, r: &SweepResult, decisive: Option<&TestRecord>) {
+fn text_rows(out: &mut Out<'_>, r: &SweepResult, decisive: Option<&TestRecord>) {
     let (line, mismatch) = decision_line(r, decisive);
     let level = if mismatch {
         TextLogLevel::WARN
@@ -651,7 +766,9 @@ fn text_rows(rows: &mut Rows, r: &SweepResult, decisive: Option<&TestRecord>) {
     } else {
         TextLogLevel::DEBUG
     };
-    rows.push(paths::LOG, &TextLog::new(line).with_level(level));
+    out.row(Entity::Log, set::TEXT_LOG)
+        .put_strs(TextLog::descriptor_text, [line.as_str()])
+        .put_strs(TextLog::descriptor_level, [level]);
 }
 
 /// The text line of one sweep, and whether it disagrees with the trace's
@@ -695,25 +812,36 @@ pub fn decision_line(r: &SweepResult, decisive: Option<&TestRecord>) -> (String,
     (s, mismatch)
 }
 
-fn edge_values(e: &EdgeRecord) -> AnyValues {
-    use rerun::components::{Scalar, Text};
-    let mut v = AnyValues::default()
-        .with_component::<Text>("test", [format!("edge {}.{}", e.triangle, e.edge)])
-        .with_component::<Text>("verdict", [e.verdict.as_str()])
-        .with_component::<Scalar>("length", [e.length])
-        .with_component::<Scalar>("a", [e.a])
-        .with_component::<Scalar>("b", [e.b])
-        .with_component::<Scalar>("c", [e.c])
-        .with_component::<Scalar>("discriminant", [e.discriminant]);
+/// The descriptor `AnyValues::with_component::<C>(name, ..)` gives.
+fn any_value<C: rerun::Component>(name: &'static str) -> ComponentDescriptor {
+    ComponentDescriptor::partial(name).with_component_type(C::name())
+}
+
+/// The numbers of an edge test (as `AnyValues`: test, verdict, length, a,
+/// b, c, discriminant, and s0, s1, xc when known).
+fn edge_values(out: &mut Out<'_>, entity: Entity, e: &EdgeRecord) {
+    let set = set::EDGE_VALUES + u8::from(e.roots.is_some()) + 2 * u8::from(e.xc.is_some());
+    let mut row = out.row(entity, set);
+    row.put_fmt(
+        || any_value::<Text>("test"),
+        format_args!("edge {}.{}", e.triangle, e.edge),
+    )
+    .put_strs(|| any_value::<Text>("verdict"), [e.verdict.as_str()])
+    .put::<Scalar>(|| any_value::<Scalar>("length"), [e.length.into()])
+    .put::<Scalar>(|| any_value::<Scalar>("a"), [e.a.into()])
+    .put::<Scalar>(|| any_value::<Scalar>("b"), [e.b.into()])
+    .put::<Scalar>(|| any_value::<Scalar>("c"), [e.c.into()])
+    .put::<Scalar>(
+        || any_value::<Scalar>("discriminant"),
+        [e.discriminant.into()],
+    );
     if let Some((s0, s1)) = e.roots {
-        v = v
-            .with_component::<Scalar>("s0", [s0])
-            .with_component::<Scalar>("s1", [s1]);
+        row.put::<Scalar>(|| any_value::<Scalar>("s0"), [s0.into()])
+            .put::<Scalar>(|| any_value::<Scalar>("s1"), [s1.into()]);
     }
     if let Some(xc) = e.xc {
-        v = v.with_component::<Scalar>("xc", [xc]);
+        row.put::<Scalar>(|| any_value::<Scalar>("xc"), [xc.into()]);
     }
-    v
 }
 
 /// Length and rotation of a capsule (which lies along +z) from the origin

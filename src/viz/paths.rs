@@ -126,3 +126,51 @@ pub fn face(ball: u32, name: &str) -> String {
 pub const QUADRATIC_NAMES: [&str; 6] = ["a", "b", "c", "discriminant", "s0", "s1"];
 /// Names of the face scalars, in order.
 pub const FACE_NAMES: [&str; 3] = ["h0", "h1", "beta"];
+
+/// A per-frame entity of a sweep, as a small value (the path as a string is
+/// built once per entity, by [`Entity::path`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub(crate) enum Entity {
+    Spheres(u32),
+    Sweep(u32),
+    Contact(u32),
+    Normal(u32),
+    PrimaryTriangle(u32),
+    PrimaryEdge(u32),
+    PrimaryVertex(u32),
+    EdgeFrame(u32, usize),
+    EdgeSegment(u32, usize),
+    EdgeCylinder(u32, usize),
+    EdgePath(u32, usize),
+    EdgePoints(u32, usize),
+    Alpha(u32),
+    /// Index into [`QUADRATIC_NAMES`].
+    Quadratic(u32, usize),
+    /// Index into [`FACE_NAMES`].
+    Face(u32, usize),
+    Log,
+}
+
+impl Entity {
+    /// The entity path.
+    pub(crate) fn path(self) -> String {
+        match self {
+            Entity::Spheres(b) => spheres(b),
+            Entity::Sweep(b) => sweep(b),
+            Entity::Contact(b) => contact(b),
+            Entity::Normal(b) => normal(b),
+            Entity::PrimaryTriangle(b) => primary_triangle(b),
+            Entity::PrimaryEdge(b) => primary_edge(b),
+            Entity::PrimaryVertex(b) => primary_vertex(b),
+            Entity::EdgeFrame(b, s) => edge_frame(b, s),
+            Entity::EdgeSegment(b, s) => edge_segment(b, s),
+            Entity::EdgeCylinder(b, s) => edge_cylinder(b, s),
+            Entity::EdgePath(b, s) => edge_path(b, s),
+            Entity::EdgePoints(b, s) => edge_points(b, s),
+            Entity::Alpha(b) => alpha(b),
+            Entity::Quadratic(b, i) => quadratic(b, QUADRATIC_NAMES[i]),
+            Entity::Face(b, i) => face(b, FACE_NAMES[i]),
+            Entity::Log => LOG.to_string(),
+        }
+    }
+}

@@ -185,7 +185,8 @@ fn list_array(
 #[derive(Debug)]
 struct EntityColumns {
     key: Key,
-    path: EntityPath,
+    /// Built when first sent (not in buffers that are only appended).
+    path: Option<EntityPath>,
     frames: Vec<i64>,
     times: Vec<i64>,
     /// Row numbers (0-based, in the order the rows were logged).
@@ -209,8 +210,9 @@ impl EntityColumns {
         if self.rows.is_empty() {
             return Ok(None);
         }
-        let frames = std::mem::take(&mut self.frames);
-        let times = std::mem::take(&mut self.times);
+        let rows = self.rows.len();
+        let frames = std::mem::replace(&mut self.frames, Vec::with_capacity(rows));
+        let times = std::mem::replace(&mut self.times, Vec::with_capacity(rows));
         let time_column = if self.key.timestamps {
             TimeColumn::new_timestamp_nanos_since_epoch(TIME_TIMELINE, times)
         } else {
@@ -232,7 +234,9 @@ impl EntityColumns {
         let row_ids: Vec<RowId> = self.rows.drain(..).map(row_id).collect();
         let chunk = Chunk::from_native_row_ids(
             id,
-            self.path.clone(),
+            self.path
+                .get_or_insert_with(|| EntityPath::from(self.key.entity.path()))
+                .clone(),
             None,
             &row_ids,
             timelines,
@@ -325,7 +329,7 @@ impl Columns {
                 self.index.insert(key, i);
                 self.entities.push(EntityColumns {
                     key,
-                    path: EntityPath::from(entity.path()),
+                    path: None,
                     frames: Vec::new(),
                     times: Vec::new(),
                     rows: Vec::new(),

@@ -182,11 +182,11 @@ pub struct Logger {
 }
 
 /// Rows buffered before the logger sends them (see [`Logger`]).
-pub const DEFAULT_FLUSH_ROWS: usize = 1 << 14;
+pub const DEFAULT_FLUSH_ROWS: usize = 1 << 17;
 
 /// Sweeps per [`PreparedSweeps`] that the command and the bench prepare on
 /// one worker (runs of consecutive sweeps of a batch, cut at this length).
-pub const PREPARE_GROUP_SWEEPS: usize = 256;
+pub const PREPARE_GROUP_SWEEPS: usize = 1024;
 
 /// What a run of consecutive sweeps logs, built without the logger
 /// ([`prepare_sweeps`]), so that runs can be prepared in parallel and logged

@@ -66,6 +66,10 @@ pub fn tests() -> Vec<Trial> {
             threads_do_not_change_the_outputs,
         ),
         trial(
+            "replay::blueprint_is_reproducible",
+            blueprint_is_reproducible,
+        ),
+        trial(
             "replay::parallel_iterator_equals_sequential",
             parallel_iterator_equals_sequential,
         ),
@@ -1088,9 +1092,8 @@ fn cli_writes_outcomes_and_rrd() -> Result<(), String> {
 
 /// `--threads 1` and `--threads 4` write the same bytes of outcomes and a
 /// recording with the same content (the bytes of two `.rrd` files still
-/// differ in the ids the SDK itself draws: the store-info message's, the
-/// recording name's and, with a blueprint, the blueprint's); several
-/// batches of events and a scene change in the middle.
+/// differ, see `blueprint_is_reproducible`); several batches of events and
+/// a scene change in the middle.
 fn threads_do_not_change_the_outputs() -> Result<(), String> {
     let dir = tempfile::tempdir().map_err(|e| e.to_string())?;
     let trace = dir.path().join("two scenes.mcap");
@@ -1177,6 +1180,136 @@ fn threads_do_not_change_the_outputs() -> Result<(), String> {
             && d1.static_entities == d4.static_entities,
         "recording content differs between 1 and 4 threads"
     );
+    Ok(())
+}
+
+/// Every message of an `.rrd` in order, comparable: a store info with its
+/// row id, a chunk with its store, chunk id and data (row ids included), or
+/// an activation command.
+#[derive(Debug, PartialEq)]
+enum Message {
+    StoreInfo(rerun::external::re_log_types::SetStoreInfo),
+    Chunk(
+        rerun::external::re_log_types::StoreId,
+        String,
+        rerun::log::Chunk,
+    ),
+    Activation(rerun::external::re_log_types::BlueprintActivationCommand),
+}
+
+fn rrd_messages(path: &std::path::Path) -> Result<Vec<Message>, String> {
+    use rerun::external::re_log_encoding::DecoderApp;
+    use rerun::log::{Chunk, LogMsg};
+    let file = std::fs::File::open(path).map_err(|e| e.to_string())?;
+    let mut messages = Vec::new();
+    for msg in DecoderApp::decode_lazy(BufReader::new(file)) {
+        let msg = msg.map_err(|e| format!("decoding {}: {e}", path.display()))?;
+        messages.push(match msg {
+            LogMsg::SetStoreInfo(info) => Message::StoreInfo(info),
+            LogMsg::ArrowMsg(store, arrow) => {
+                let chunk = Chunk::from_arrow_msg(&arrow).map_err(|e| e.to_string())?;
+                // `Chunk`'s `PartialEq` leaves the chunk id out.
+                Message::Chunk(store, chunk.id().to_string(), chunk)
+            }
+            LogMsg::BlueprintActivationCommand(cmd) => Message::Activation(cmd),
+        });
+    }
+    Ok(messages)
+}
+
+/// The same trace written twice gives the same blueprint (store id, store
+/// info with its row id, every chunk with its chunk and row ids, the
+/// activation command) and the same recording chunks, in the same order; the
+/// layout is the default one (three containers, six views, the viewport,
+/// the panels). Only the recording's store-info row id differs.
+fn blueprint_is_reproducible() -> Result<(), String> {
+    use rerun::StoreKind;
+    let dir = tempfile::tempdir().map_err(|e| e.to_string())?;
+    let mut runs = Vec::new();
+    for name in ["a.rrd", "b.rrd"] {
+        let path = dir.path().join(name);
+        write_rrd(
+            events_for(triangle_scene(), &worked_sweeps()),
+            Detail::Primary,
+            &path,
+        )?;
+        runs.push(rrd_messages(&path)?);
+    }
+    let (a, b) = (&runs[0], &runs[1]);
+    fn blueprint(m: &[Message]) -> Vec<&Message> {
+        m.iter()
+            .filter(|m| match m {
+                Message::StoreInfo(i) => i.info.store_id.kind() == StoreKind::Blueprint,
+                Message::Chunk(s, _, _) => s.kind() == StoreKind::Blueprint,
+                Message::Activation(_) => true,
+            })
+            .collect()
+    }
+    let (ba, bb) = (blueprint(a), blueprint(b));
+    ensure!(ba == bb, "the blueprints differ:\n{ba:#?}\n{bb:#?}");
+
+    // The layout.
+    let paths: Vec<String> = ba
+        .iter()
+        .filter_map(|m| match m {
+            Message::Chunk(_, _, c) => Some(c.entity_path().to_string()),
+            _ => None,
+        })
+        .collect();
+    let count = |prefix: &str, suffix: &str| {
+        paths
+            .iter()
+            .filter(|p| p.starts_with(prefix) && p.ends_with(suffix))
+            .count()
+    };
+    ensure!(count("/container/", "") == 3, "containers: {paths:?}");
+    ensure!(count("/view/", "/ViewContents") == 6, "views: {paths:?}");
+    ensure!(count("/view/", "") == 12, "views: {paths:?}");
+    for p in [
+        "/viewport",
+        "/blueprint_panel",
+        "/selection_panel",
+        "/time_panel",
+    ] {
+        ensure!(paths.iter().any(|q| q == p), "{p} missing: {paths:?}");
+    }
+    ensure!(
+        matches!(ba.first(), Some(Message::StoreInfo(_)))
+            && matches!(ba.last(), Some(Message::Activation(a))
+                if a.make_active && a.make_default),
+        "store info first, activation last"
+    );
+    let store_ids: std::collections::BTreeSet<String> = ba
+        .iter()
+        .map(|m| match m {
+            Message::StoreInfo(i) => i.info.store_id.to_string(),
+            Message::Chunk(s, _, _) => s.to_string(),
+            Message::Activation(a) => a.blueprint_id.to_string(),
+        })
+        .collect();
+    ensure!(store_ids.len() == 1, "one blueprint store: {store_ids:?}");
+
+    // Everything else, in order: equal but for the recording's store-info
+    // row id, which the SDK draws itself.
+    ensure!(a.len() == b.len(), "{} and {} messages", a.len(), b.len());
+    for (i, (x, y)) in a.iter().zip(b).enumerate() {
+        match (x, y) {
+            (Message::StoreInfo(x), Message::StoreInfo(y))
+                if x.info.store_id.kind() == StoreKind::Recording =>
+            {
+                ensure!(x.info == y.info, "message {i}: store infos differ");
+            }
+            (Message::Chunk(_, xid, xc), Message::Chunk(_, yid, yc)) => {
+                ensure!(
+                    x == y,
+                    "message {i}: chunks {xid} ({}) and {yid} ({}) differ",
+                    xc.entity_path(),
+                    yc.entity_path()
+                );
+            }
+            _ => ensure!(x == y, "message {i} differs: {x:?} {y:?}"),
+        }
+    }
     Ok(())
 }
 

@@ -8,6 +8,7 @@
 //! same trace and options give the same content. (Rerun's row and chunk ids
 //! are still fresh per run, so the bytes of two `.rrd` files differ.)
 
+pub mod blueprint;
 mod columns;
 pub mod paths;
 
@@ -16,8 +17,8 @@ use std::collections::BTreeMap;
 use nalgebra::{UnitQuaternion, Vector3};
 use rerun::blueprint::components::PanelState;
 use rerun::blueprint::{
-    Blueprint, BlueprintActivation, BlueprintPanel, Horizontal, SelectionPanel, Spatial3DView,
-    TextLogView, TimePanel, TimeSeriesView, Vertical,
+    Blueprint, BlueprintPanel, Horizontal, SelectionPanel, Spatial3DView, TextLogView, TimePanel,
+    TimeSeriesView, Vertical,
 };
 use rerun::components::{
     AlbedoFactor, ClearIsRecursive, FillMode, HalfSize3D, Length, LineStrip3D, Position3D, Radius,
@@ -125,8 +126,9 @@ pub fn builder(recording_id: &str, name: &str) -> RecordingStreamBuilder {
 /// at the bottom the text log; the time panel on the `frame` timeline, the
 /// side panels collapsed.
 ///
-/// The SDK gives the blueprint store and its views random ids, so unlike the
-/// recording itself the blueprint's ids differ between runs.
+/// Built with the SDK's `Blueprint`, which gives the blueprint store and its
+/// views random ids; [`Logger::new`] sends the same layout with fixed ids
+/// instead ([`blueprint::send_default_blueprint`]).
 pub fn default_blueprint() -> Blueprint {
     let world = Spatial3DView::new("World").with_origin(paths::WORLD);
     let edge = Spatial3DView::new("Edge frame (ball 0, decisive edge)")
@@ -296,13 +298,7 @@ impl Logger {
         rec.set_log_time_enabled(false);
         rec.set_log_tick_enabled(false);
         if blueprint {
-            default_blueprint().send(
-                &rec,
-                BlueprintActivation {
-                    make_active: true,
-                    make_default: true,
-                },
-            )?;
+            blueprint::send_default_blueprint(&rec)?;
         }
         let mut logger = Logger {
             rec,

@@ -1,0 +1,323 @@
+//! The default blueprint, with fixed ids.
+//!
+//! The SDK's `Blueprint::send` builds its messages in a fresh blueprint
+//! stream with `RecordingId::random()`, and every container and view gets
+//! `Uuid::new_v4()` (a crate-private field that also appears inside the data:
+//! entity paths `container/<uuid>`, `view/<uuid>`, container contents
+//! `view/<uuid>`, the viewport's root container). Here the same archetypes
+//! are logged by hand, as `Blueprint::send` logs them, into messages of a
+//! blueprint store whose id, container and view ids, row ids and chunk ids
+//! all derive from the recording id, and are handed to the recording with
+//! [`RecordingStream::send_blueprint`]. The same recording id gives the same
+//! blueprint, byte for byte.
+//!
+//! ```text
+//! container/<uuid>                 ContainerBlueprint (vertical: top, plots, log)
+//! container/<uuid>                 ContainerBlueprint (horizontal: world, edge frame)
+//! container/<uuid>                 ContainerBlueprint (horizontal: α, quadratic, face)
+//! view/<uuid>, view/<uuid>/ViewContents   ViewBlueprint and ViewContents of each view
+//! viewport                         ViewportBlueprint (root container)
+//! blueprint_panel, selection_panel PanelBlueprint (collapsed)
+//! time_panel                       TimePanelBlueprint (collapsed, `frame`, 10 fps)
+//! ```
+
+use rerun::blueprint::components::{
+    ColumnShare, ContainerKind, Fps, IncludedContent, PanelState, QueryExpression, RootContainer,
+    RowShare, TimelineName, ViewClass,
+};
+use rerun::components::Name;
+use rerun::datatypes::{Float32, Float64};
+use rerun::external::re_log_types::{
+    BlueprintActivationCommand, LogMsg, RecordingId, SetStoreInfo, StoreId, StoreInfo, StoreKind,
+};
+use rerun::external::re_sdk_types::blueprint::archetypes::{
+    ContainerBlueprint, PanelBlueprint, TimePanelBlueprint, ViewBlueprint, ViewContents,
+    ViewportBlueprint,
+};
+use rerun::log::{Chunk, ChunkId, RowId};
+use rerun::{AsComponents, RecordingStream, RecordingStreamError, TimePoint, Timeline};
+
+use super::{FRAME_TIMELINE, IdHasher, paths};
+
+/// Time part of the blueprint's row and chunk ids: 2020-01-01T00:00:00Z in
+/// nanoseconds (as for the recording's rows).
+const ID_BASE_NANOS: u64 = 1_577_836_800_000_000_000;
+
+/// How long [`send_default_blueprint`] waits for the blueprint to reach the
+/// sink.
+const FLUSH_TIMEOUT: std::time::Duration = std::time::Duration::from_secs(10);
+
+/// Sends the default layout (see [`super::default_blueprint`] for what it
+/// shows) to `rec` as its active and default blueprint, with ids that depend
+/// only on the recording id.
+pub fn send_default_blueprint(rec: &RecordingStream) -> Result<(), RecordingStreamError> {
+    let Some(info) = rec.store_info() else {
+        // A disabled stream: nothing is recorded.
+        return Ok(());
+    };
+    let (msgs, activation) = default_blueprint_messages(&info)?;
+    rec.send_blueprint(msgs, activation);
+    // The blueprint's messages go to the sink through the stream's command
+    // channel, the recording's chunks through its batcher; the thread that
+    // forwards both picks whichever is ready, so without this flush the
+    // place of the blueprint among the first chunks would vary from run to
+    // run. With it, the blueprint comes before every chunk logged later.
+    // Bounded, so that a slow viewer connection cannot hold up the start;
+    // an error only means the order is not guaranteed (nothing is lost).
+    let _ = rec.flush_with_timeout(FLUSH_TIMEOUT);
+    Ok(())
+}
+
+/// The messages of the default blueprint of the recording `info` (store
+/// info first, then one chunk per blueprint entity), and the command that
+/// makes it the active and default blueprint.
+pub fn default_blueprint_messages(
+    info: &StoreInfo,
+) -> Result<(Vec<LogMsg>, BlueprintActivationCommand), RecordingStreamError> {
+    let recording_id = info.store_id.recording_id().to_string();
+    let ids = Ids::new(&recording_id);
+    let store_id = StoreId::new(
+        StoreKind::Blueprint,
+        info.store_id.application_id().clone(),
+        RecordingId::from(ids.store_recording_id()),
+    );
+    let mut b = Builder {
+        store_id: store_id.clone(),
+        msgs: vec![LogMsg::SetStoreInfo(SetStoreInfo {
+            row_id: *row_id(0),
+            info: StoreInfo::new(store_id.clone(), info.store_source.clone()),
+        })],
+        ids,
+        next: 0,
+        items: 0,
+    };
+
+    let world = b.view("3D", "World", paths::WORLD)?;
+    let edge = b.view(
+        "3D",
+        "Edge frame (ball 0, decisive edge)",
+        &paths::edge_frame(0, 0),
+    )?;
+    let top = b.container(
+        ContainerKind::Horizontal,
+        &[world, edge],
+        Some(&[3.0, 2.0]),
+        None,
+    )?;
+    let alpha = b.view("TimeSeries", "α (ball 0)", &paths::alpha(0))?;
+    let quadratic = b.view(
+        "TimeSeries",
+        "Quadratic A, B, C, disc, s0, s1 (ball 0)",
+        &format!("{}/ball/0/quadratic", paths::PLOTS),
+    )?;
+    let face = b.view(
+        "TimeSeries",
+        "Face h0, h1, β (ball 0)",
+        &format!("{}/ball/0/face", paths::PLOTS),
+    )?;
+    let plots = b.container(
+        ContainerKind::Horizontal,
+        &[alpha, quadratic, face],
+        None,
+        None,
+    )?;
+    let log = b.view("TextLog", "Decisions", paths::LOG)?;
+    let root = b.container(
+        ContainerKind::Vertical,
+        &[top, plots, log],
+        None,
+        Some(&[3.0, 1.4, 1.2]),
+    )?;
+
+    let root_uuid = match root {
+        Item::Container(uuid) => uuid,
+        Item::View(_) => unreachable!("the root is a container"),
+    };
+    b.log(
+        "viewport",
+        &ViewportBlueprint::new().with_root_container(RootContainer(rerun::datatypes::Uuid {
+            bytes: root_uuid.to_be_bytes(),
+        })),
+    )?;
+    b.log(
+        "blueprint_panel",
+        &PanelBlueprint::new().with_state(PanelState::Collapsed),
+    )?;
+    b.log(
+        "selection_panel",
+        &PanelBlueprint::new().with_state(PanelState::Collapsed),
+    )?;
+    b.log(
+        "time_panel",
+        &TimePanelBlueprint::new()
+            .with_state(PanelState::Collapsed)
+            .with_timeline(TimelineName(FRAME_TIMELINE.into()))
+            .with_fps(Fps(Float64(10.0))),
+    )?;
+
+    let activation = BlueprintActivationCommand {
+        blueprint_id: store_id,
+        make_active: true,
+        make_default: true,
+    };
+    Ok((b.msgs, activation))
+}
+
+/// The ids of one blueprint: hashes of the recording id and a name.
+struct Ids {
+    recording_id: String,
+}
+
+impl Ids {
+    fn new(recording_id: &str) -> Ids {
+        Ids {
+            recording_id: recording_id.to_string(),
+        }
+    }
+
+    fn hash(&self, what: &str, n: u64) -> u128 {
+        let mut h = IdHasher::new();
+        for part in [
+            self.recording_id.as_bytes(),
+            what.as_bytes(),
+            &n.to_le_bytes(),
+        ] {
+            h.update(&(part.len() as u64).to_le_bytes());
+            h.update(part);
+        }
+        h.0
+    }
+
+    /// The blueprint store's recording id.
+    fn store_recording_id(&self) -> String {
+        format!("sweeptrace-blueprint-{:032x}", self.hash("blueprint", 0))
+    }
+
+    /// The `n`-th container or view id: a version 4 UUID (by its bits).
+    fn uuid(&self, n: u64) -> u128 {
+        let h = self.hash("uuid", n);
+        (h & !(0xf << 76) & !(0b11 << 62)) | (0x4 << 76) | (0b10 << 62)
+    }
+}
+
+/// A container or a view, by its id.
+#[derive(Clone, Copy)]
+enum Item {
+    Container(u128),
+    View(u128),
+}
+
+impl Item {
+    fn path(self) -> String {
+        match self {
+            Item::Container(uuid) => format!("container/{}", uuid_string(uuid)),
+            Item::View(uuid) => format!("view/{}", uuid_string(uuid)),
+        }
+    }
+}
+
+/// `8-4-4-4-12` lowercase hex digits, as `uuid::Uuid` prints.
+fn uuid_string(uuid: u128) -> String {
+    let h = format!("{uuid:032x}");
+    format!(
+        "{}-{}-{}-{}-{}",
+        &h[0..8],
+        &h[8..12],
+        &h[12..16],
+        &h[16..20],
+        &h[20..32]
+    )
+}
+
+/// The row id of the `n`-th message of the blueprint (0 is the store info).
+fn row_id(n: u64) -> RowId {
+    RowId::from_u128(((ID_BASE_NANOS as u128) << 64) | (n as u128 + 1))
+}
+
+struct Builder {
+    store_id: StoreId,
+    msgs: Vec<LogMsg>,
+    ids: Ids,
+    /// Rows (and chunks) logged so far.
+    next: u64,
+    /// Containers and views made so far.
+    items: u64,
+}
+
+impl Builder {
+    /// Logs one row of `archetype` at `path`, on the `blueprint` timeline
+    /// at 0 (which the viewer expects of blueprint data), as one chunk.
+    fn log(
+        &mut self,
+        path: &str,
+        archetype: &dyn AsComponents,
+    ) -> Result<(), RecordingStreamError> {
+        self.next += 1;
+        let n = self.next;
+        let id = ChunkId::from_u128(((ID_BASE_NANOS as u128) << 64) | n as u128);
+        let time = TimePoint::from([(Timeline::new_sequence("blueprint"), 0)]);
+        let chunk = Chunk::builder_with_id(id, path)
+            .with_archetype(row_id(n), time, archetype)
+            .build()
+            .map_err(RecordingStreamError::Chunk)?;
+        let msg = chunk.to_arrow_msg().map_err(RecordingStreamError::Chunk)?;
+        self.msgs.push(LogMsg::ArrowMsg(self.store_id.clone(), msg));
+        Ok(())
+    }
+
+    /// The id of the next container or view: numbered in the order they
+    /// are made, so the same layout gets the same ids.
+    fn next_uuid(&mut self) -> u128 {
+        self.items += 1;
+        self.ids.uuid(self.items)
+    }
+
+    /// A view of class `class` named `name` showing `origin/**`, logged as
+    /// `Blueprint::send` logs a view: its `ViewContents`, then its
+    /// `ViewBlueprint`.
+    fn view(
+        &mut self,
+        class: &str,
+        name: &str,
+        origin: &str,
+    ) -> Result<Item, RecordingStreamError> {
+        let view = Item::View(self.next_uuid());
+        let path = view.path();
+        self.log(
+            &format!("{path}/ViewContents"),
+            &ViewContents::new([QueryExpression("$origin/**".into())]),
+        )?;
+        let origin = rerun::EntityPath::from(origin).to_string();
+        self.log(
+            &path,
+            &ViewBlueprint::new(ViewClass(class.into()))
+                .with_display_name(Name(name.into()))
+                .with_space_origin(origin),
+        )?;
+        Ok(view)
+    }
+
+    /// A container of `kind` holding `contents` (already logged).
+    fn container(
+        &mut self,
+        kind: ContainerKind,
+        contents: &[Item],
+        column_shares: Option<&[f32]>,
+        row_shares: Option<&[f32]>,
+    ) -> Result<Item, RecordingStreamError> {
+        let container = Item::Container(self.next_uuid());
+        let mut arch = ContainerBlueprint::new(kind).with_contents(
+            contents
+                .iter()
+                .map(|c| IncludedContent(rerun::EntityPath::from(c.path()).to_string().into())),
+        );
+        if let Some(shares) = column_shares {
+            arch = arch.with_col_shares(shares.iter().map(|&s| ColumnShare(Float32(s))));
+        }
+        if let Some(shares) = row_shares {
+            arch = arch.with_row_shares(shares.iter().map(|&s| RowShare(Float32(s))));
+        }
+        self.log(&container.path(), &arch)?;
+        Ok(container)
+    }
+}

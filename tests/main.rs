@@ -9,6 +9,7 @@ mod check;
 mod core_cases;
 mod core_random;
 mod oracle;
+mod prefetch;
 mod record;
 mod replay;
 mod support;
@@ -29,5 +30,6 @@ fn main() {
     trials.extend(trace_io::tests());
     trials.extend(replay::tests());
     trials.extend(record::tests());
+    trials.extend(prefetch::tests());
     libtest_mimic::run(&args, trials).exit();
 }

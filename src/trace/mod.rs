@@ -8,6 +8,7 @@
 pub mod error;
 pub mod info;
 pub mod messages;
+pub mod prefetch;
 pub mod read;
 pub mod schemas;
 pub mod validate;

@@ -27,9 +27,12 @@ use std::fmt;
 use std::hash::{BuildHasherDefault, Hasher};
 use std::sync::Arc;
 
-use rerun::external::arrow::array::{ArrayRef, ListArray, StringArray};
-use rerun::external::arrow::buffer::{Buffer, OffsetBuffer};
-use rerun::external::arrow::datatypes::Field;
+use rerun::components::LineStrip3D;
+use rerun::external::arrow::array::{
+    ArrayRef, FixedSizeListArray, Float32Array, ListArray, StringArray,
+};
+use rerun::external::arrow::buffer::{Buffer, OffsetBuffer, ScalarBuffer};
+use rerun::external::arrow::datatypes::{DataType, Field};
 use rerun::log::{Chunk, ChunkComponents, ChunkId, RowId, TimeColumn};
 use rerun::{
     Component, ComponentDescriptor, EntityPath, RecordingStream, RecordingStreamError,
@@ -163,6 +166,59 @@ impl Column for Strings {
         let values = StringArray::try_new(offsets, bytes, None)
             .map_err(|e| RecordingStreamError::Chunk(e.into()))?;
         list_array(Arc::new(values), &mut self.lengths)
+    }
+
+    fn as_any_mut(&mut self) -> &mut dyn Any {
+        self
+    }
+}
+
+/// A column of `LineStrip3D`s (Arrow: a list of `Vec3D` per strip): the
+/// points of every strip in one buffer, no `Vec` per strip.
+#[derive(Debug)]
+struct Strips {
+    descriptor: ComponentDescriptor,
+    /// x, y, z of every point.
+    coords: Vec<f32>,
+    /// Points of each strip.
+    strip_lengths: Vec<usize>,
+    /// Strips of each row.
+    lengths: Vec<usize>,
+}
+
+impl Column for Strips {
+    fn descriptor(&self) -> &ComponentDescriptor {
+        &self.descriptor
+    }
+
+    fn append(&mut self, other: &mut dyn Column) {
+        let other = other
+            .as_any_mut()
+            .downcast_mut::<Strips>()
+            .expect("columns of one set have the same types");
+        self.coords.append(&mut other.coords);
+        self.strip_lengths.append(&mut other.strip_lengths);
+        self.lengths.append(&mut other.lengths);
+    }
+
+    fn take_list(&mut self) -> Result<ListArray, RecordingStreamError> {
+        // The fields `LineStrip3D::to_arrow` uses.
+        let strip_type = <LineStrip3D as rerun::Loggable>::arrow_datatype();
+        let DataType::List(strip_field) = &strip_type else {
+            unreachable!("LineStrip3D is a list");
+        };
+        let DataType::FixedSizeList(point_field, 3) = strip_field.data_type() else {
+            unreachable!("a LineStrip3D's points are Vec3D");
+        };
+        let n = self.coords.len();
+        let coords = std::mem::replace(&mut self.coords, Vec::with_capacity(n));
+        let coords = Float32Array::new(ScalarBuffer::from(coords), None);
+        let points = FixedSizeListArray::try_new(point_field.clone(), 3, Arc::new(coords), None)
+            .map_err(|e| RecordingStreamError::Chunk(e.into()))?;
+        let offsets = OffsetBuffer::<i32>::from_lengths(self.strip_lengths.drain(..));
+        let strips = ListArray::try_new(strip_field.clone(), offsets, Arc::new(points), None)
+            .map_err(|e| RecordingStreamError::Chunk(e.into()))?;
+        list_array(Arc::new(strips), &mut self.lengths)
     }
 
     fn as_any_mut(&mut self) -> &mut dyn Any {
@@ -465,6 +521,30 @@ impl Row<'_> {
         self
     }
 
+    /// Puts one `LineStrip3D` through `points` (`descriptor` names the
+    /// component).
+    pub(crate) fn put_strip(
+        &mut self,
+        descriptor: fn() -> ComponentDescriptor,
+        points: &[[f32; 3]],
+    ) -> &mut Self {
+        let column = self
+            .column(|| {
+                Box::new(Strips {
+                    descriptor: descriptor(),
+                    coords: Vec::new(),
+                    strip_lengths: Vec::new(),
+                    lengths: Vec::new(),
+                })
+            })
+            .downcast_mut::<Strips>()
+            .expect("every row of a set puts the same components");
+        column.coords.extend_from_slice(points.as_flattened());
+        column.strip_lengths.push(points.len());
+        column.lengths.push(1);
+        self
+    }
+
     /// Puts the strings of a string component (`descriptor` names it; its
     /// Arrow type must be `Utf8`, as `Text`'s).
     pub(crate) fn put_strs<'s>(
@@ -497,6 +577,21 @@ impl Row<'_> {
         self
     }
 
+    /// Puts the strings of a string component that `write` pushes (or
+    /// formats) straight into the column's byte buffer.
+    pub(crate) fn put_texts(
+        &mut self,
+        descriptor: fn() -> ComponentDescriptor,
+        write: impl FnOnce(&mut Texts<'_>),
+    ) -> &mut Self {
+        let column = self.strings(descriptor);
+        let mut texts = Texts { column, n: 0 };
+        write(&mut texts);
+        let n = texts.n;
+        texts.column.lengths.push(n);
+        self
+    }
+
     fn strings(&mut self, descriptor: fn() -> ComponentDescriptor) -> &mut Strings {
         self.column(|| {
             Box::new(Strings {
@@ -508,6 +603,37 @@ impl Row<'_> {
         })
         .downcast_mut::<Strings>()
         .expect("every row of a set puts the same components")
+    }
+}
+
+/// The strings of one row of a string column (see [`Row::put_texts`]).
+pub(crate) struct Texts<'a> {
+    column: &'a mut Strings,
+    n: usize,
+}
+
+impl Texts<'_> {
+    /// Adds a string.
+    pub(crate) fn push(&mut self, s: &str) -> &mut Self {
+        self.push_with(|b| b.push_str(s))
+    }
+
+    /// Adds a formatted string.
+    pub(crate) fn push_fmt(&mut self, args: fmt::Arguments<'_>) -> &mut Self {
+        self.push_with(|b| fmt::Write::write_fmt(b, args).expect("writing to a String"))
+    }
+
+    /// Adds the string `write` appends to the given buffer (it must only
+    /// append).
+    pub(crate) fn push_with(&mut self, write: impl FnOnce(&mut String)) -> &mut Self {
+        let before = self.column.bytes.len();
+        write(&mut self.column.bytes);
+        debug_assert!(self.column.bytes.len() >= before);
+        self.column
+            .string_lengths
+            .push(self.column.bytes.len() - before);
+        self.n += 1;
+        self
     }
 }
 

@@ -13,6 +13,7 @@ mod columns;
 pub mod paths;
 
 use std::collections::BTreeMap;
+use std::fmt::{self, Write as _};
 
 use nalgebra::{UnitQuaternion, Vector3};
 use rerun::blueprint::components::PanelState;
@@ -21,8 +22,8 @@ use rerun::blueprint::{
     TimeSeriesView, Vertical,
 };
 use rerun::components::{
-    AlbedoFactor, ClearIsRecursive, FillMode, HalfSize3D, Length, LineStrip3D, Position3D, Radius,
-    RotationQuat, Scalar, Text, TextLogLevel, Translation3D, TriangleIndices, Vector3D,
+    AlbedoFactor, ClearIsRecursive, FillMode, HalfSize3D, Length, Position3D, Radius, RotationQuat,
+    Scalar, Text, TextLogLevel, Translation3D, TriangleIndices, Vector3D,
 };
 use rerun::{
     Arrows3D, Capsules3D, Clear, Color, ComponentDescriptor, Ellipsoids3D, LineStrips3D, Mesh3D,
@@ -30,7 +31,7 @@ use rerun::{
     ViewCoordinates,
 };
 
-use crate::core::explain::{describe, miss_distance, num};
+use crate::core::explain::{describe, miss_distance};
 use crate::core::{EdgeRecord, TestRecord, Triangle};
 use crate::replay::{ReplayEvent, SceneState, SweepResult};
 use paths::Entity;
@@ -438,7 +439,6 @@ fn sweep_rows(out: &mut Out<'_>, r: &SweepResult) {
     let n = if hit { 3 } else { 2 };
     let contact_center = hit.then(|| f32x3(at_contact.coords));
     let contact_color = hit.then(|| rgba(CONTACT_BALL_COLOR));
-    let contact_label = hit.then(|| format!("α = {}", num(o.alpha)));
     out.row(Entity::Spheres(b), set::SPHERES)
         .put::<HalfSize3D>(
             Ellipsoids3D::descriptor_half_sizes,
@@ -458,10 +458,13 @@ fn sweep_rows(out: &mut Out<'_>, r: &SweepResult) {
                 .chain(once(rgba(P1_COLOR))),
         )
         .put::<FillMode>(Ellipsoids3D::descriptor_fill_mode, [FillMode::Solid])
-        .put_strs(
-            Ellipsoids3D::descriptor_labels,
-            once("p0").chain(contact_label.as_deref()).chain(once("p1")),
-        );
+        .put_texts(Ellipsoids3D::descriptor_labels, |t| {
+            t.push("p0");
+            if hit {
+                t.push_fmt(format_args!("α = {}", Num(o.alpha)));
+            }
+            t.push("p1");
+        });
 
     // The swept volume at the detection radius.
     let (length, rotation) = capsule_pose(&d);
@@ -506,16 +509,13 @@ fn labeled_strip(
     strip: &[[f32; 3]],
     color: [u8; 4],
     radius: f32,
-    label: &str,
+    label: fmt::Arguments<'_>,
 ) {
     out.row(entity, set::LABELED_STRIP)
-        .put::<LineStrip3D>(
-            LineStrips3D::descriptor_strips,
-            [LineStrip3D::from(strip.iter().copied())],
-        )
+        .put_strip(LineStrips3D::descriptor_strips, strip)
         .put::<Radius>(LineStrips3D::descriptor_radii, [radius.into()])
         .put::<Color>(LineStrips3D::descriptor_colors, [rgba(color)])
-        .put_strs(LineStrips3D::descriptor_labels, [label]);
+        .put_fmt(LineStrips3D::descriptor_labels, label);
 }
 
 /// The highlighted triangle, edge or vertex of the decisive test.
@@ -554,7 +554,7 @@ fn decisive_rows(
             [albedo([color[0], color[1], color[2], 110]).into()],
         );
     let f = test.feature() as usize % 3;
-    let label = crate::core::explain::label(test);
+    let label = Label(test);
     match test {
         TestRecord::Edge(_) => {
             labeled_strip(
@@ -563,7 +563,7 @@ fn decisive_rows(
                 &[verts[f], verts[(f + 1) % 3]],
                 color,
                 (r.rho() * 0.05) as f32,
-                &label,
+                format_args!("{label}"),
             );
             out.clear(Entity::PrimaryVertex(b), false);
         }
@@ -575,7 +575,7 @@ fn decisive_rows(
                     [((r.rho() * 0.12) as f32).into()],
                 )
                 .put::<Color>(Points3D::descriptor_colors, [rgba(color)])
-                .put_strs(Points3D::descriptor_labels, [label.as_str()]);
+                .put_fmt(Points3D::descriptor_labels, format_args!("{label}"));
             out.clear(Entity::PrimaryEdge(b), false);
         }
         TestRecord::Face(_) => {
@@ -585,7 +585,7 @@ fn decisive_rows(
                 &[verts[0], verts[1], verts[2], verts[0]],
                 color,
                 (r.rho() * 0.03) as f32,
-                &label,
+                format_args!("{label}"),
             );
             out.clear(Entity::PrimaryVertex(b), false);
         }
@@ -640,14 +640,13 @@ fn edge_frame_rows(
         // Only the first slot is labelled: with many slots the labels
         // would hide the world view.
         if slot == 0 {
-            let label = format!("edge {}.{} (L = {})", e.triangle, e.edge, num(e.length));
             labeled_strip(
                 out,
                 Entity::EdgeSegment(b, slot),
                 &segment,
                 EDGE_COLOR,
                 segment_radius,
-                &label,
+                format_args!("edge {}.{} (L = {})", e.triangle, e.edge, Num(e.length)),
             );
         } else {
             strip(
@@ -683,7 +682,7 @@ fn edge_frame_rows(
             && (-1.0..=2.0).contains(&s0)
         {
             let at = e.p0_in_edge + (e.p1_in_edge - e.p0_in_edge) * s0;
-            at_s0 = Some((f32x3(at.coords), format!("s0 = {}", num(s0))));
+            at_s0 = Some((f32x3(at.coords), s0));
         }
         out.row(Entity::EdgePoints(b, slot), set::EDGE_POINTS)
             .put::<Position3D>(
@@ -694,12 +693,12 @@ fn edge_frame_rows(
                     .map(Position3D::from),
             )
             .put::<Radius>(Points3D::descriptor_radii, [((rho * 0.06) as f32).into()])
-            .put_strs(
-                Points3D::descriptor_labels,
-                ["p0", "p1"]
-                    .into_iter()
-                    .chain(at_s0.as_ref().map(|a| a.1.as_str())),
-            );
+            .put_texts(Points3D::descriptor_labels, |t| {
+                t.push("p0").push("p1");
+                if let Some((_, s0)) = at_s0 {
+                    t.push_fmt(format_args!("s0 = {}", Num(s0)));
+                }
+            });
     }
     edges.len()
 }
@@ -707,10 +706,7 @@ fn edge_frame_rows(
 /// Puts a `LineStrips3D` row: one strip, color and radius.
 fn strip(out: &mut Out<'_>, entity: Entity, strip: &[[f32; 3]], color: [u8; 4], radius: f32) {
     out.row(entity, set::STRIP)
-        .put::<LineStrip3D>(
-            LineStrips3D::descriptor_strips,
-            [LineStrip3D::from(strip.iter().copied())],
-        )
+        .put_strip(LineStrips3D::descriptor_strips, strip)
         .put::<Radius>(LineStrips3D::descriptor_radii, [radius.into()])
         .put::<Color>(LineStrips3D::descriptor_colors, [rgba(color)]);
 }
@@ -754,7 +750,11 @@ fn plot_rows(out: &mut Out<'_>, r: &SweepResult, decisive: Option<&TestRecord>) 
 
 /// The decision in words.
 fn text_rows(out: &mut Out<'_>, r: &SweepResult, decisive: Option<&TestRecord>) {
-    let (line, mismatch) = decision_line(r, decisive);
+    let mut row = out.row(Entity::Log, set::TEXT_LOG);
+    let mut mismatch = false;
+    row.put_texts(TextLog::descriptor_text, |t| {
+        t.push_with(|s| mismatch = write_decision_line(s, r, decisive));
+    });
     let level = if mismatch {
         TextLogLevel::WARN
     } else if r.outcome.is_hit() {
@@ -762,24 +762,31 @@ fn text_rows(out: &mut Out<'_>, r: &SweepResult, decisive: Option<&TestRecord>) 
     } else {
         TextLogLevel::DEBUG
     };
-    out.row(Entity::Log, set::TEXT_LOG)
-        .put_strs(TextLog::descriptor_text, [line.as_str()])
-        .put_strs(TextLog::descriptor_level, [level]);
+    row.put_strs(TextLog::descriptor_level, [level]);
 }
 
 /// The text line of one sweep, and whether it disagrees with the trace's
 /// expected outcome.
 pub fn decision_line(r: &SweepResult, decisive: Option<&TestRecord>) -> (String, bool) {
+    let mut s = String::new();
+    let mismatch = write_decision_line(&mut s, r, decisive);
+    (s, mismatch)
+}
+
+/// Appends [`decision_line`]'s line to `s`; returns whether it disagrees
+/// with the trace's expected outcome.
+fn write_decision_line(s: &mut String, r: &SweepResult, decisive: Option<&TestRecord>) -> bool {
     let o = &r.outcome;
-    let mut s = format!("frame {} ball {}: ", r.frame, r.ball);
+    let _ = write!(s, "frame {} ball {}: ", r.frame, r.ball);
     if o.is_hit() {
-        s.push_str(&format!(
+        let _ = write!(
+            s,
             "{} collision at α = {} (triangle {}, feature {})",
             o.kind,
-            num(o.alpha),
-            o.triangle.map_or("-".into(), |t| t.to_string()),
-            o.feature.map_or("-".into(), |f| f.to_string())
-        ));
+            Num(o.alpha),
+            OrDash(o.triangle),
+            OrDash(o.feature)
+        );
         if let Some(t) = decisive {
             s.push_str(" — ");
             s.push_str(&describe(t));
@@ -802,10 +809,92 @@ pub fn decision_line(r: &SweepResult, decisive: Option<&TestRecord>) -> (String,
         let alpha_differs = (e.alpha - o.alpha).abs() > 1e-6 || !e.alpha.is_finite();
         if e.kind != o.kind || alpha_differs {
             mismatch = true;
-            s.push_str(&format!(" [expected {} at α = {}]", e.kind, num(e.alpha)));
+            let _ = write!(s, " [expected {} at α = {}]", e.kind, Num(e.alpha));
         }
     }
-    (s, mismatch)
+    mismatch
+}
+
+/// A number as `crate::core::explain::num` writes it, without allocating.
+#[derive(Clone, Copy, Debug)]
+struct Num(f64);
+
+impl fmt::Display for Num {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let x = self.0;
+        if x == 0.0 {
+            return f.write_str("0");
+        }
+        let a = x.abs();
+        if !(1e-4..1e6).contains(&a) {
+            return write!(f, "{x:.4e}");
+        }
+        // Below 10^6 with 5 decimals: at most 14 bytes.
+        let mut buf = StackStr::<32>::default();
+        if write!(buf, "{x:.5}").is_err() {
+            return f.write_str(&crate::core::explain::num(x));
+        }
+        f.write_str(buf.as_str().trim_end_matches('0').trim_end_matches('.'))
+    }
+}
+
+/// A string of at most `N` bytes on the stack.
+struct StackStr<const N: usize> {
+    bytes: [u8; N],
+    len: usize,
+}
+
+impl<const N: usize> Default for StackStr<N> {
+    fn default() -> Self {
+        StackStr {
+            bytes: [0; N],
+            len: 0,
+        }
+    }
+}
+
+impl<const N: usize> StackStr<N> {
+    fn as_str(&self) -> &str {
+        std::str::from_utf8(&self.bytes[..self.len]).expect("only whole strings are written")
+    }
+}
+
+impl<const N: usize> fmt::Write for StackStr<N> {
+    fn write_str(&mut self, s: &str) -> fmt::Result {
+        let end = self.len + s.len();
+        if end > N {
+            return Err(fmt::Error);
+        }
+        self.bytes[self.len..end].copy_from_slice(s.as_bytes());
+        self.len = end;
+        Ok(())
+    }
+}
+
+/// A number, or `-` for `None`.
+struct OrDash<T>(Option<T>);
+
+impl<T: fmt::Display> fmt::Display for OrDash<T> {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match &self.0 {
+            Some(v) => v.fmt(f),
+            None => f.write_str("-"),
+        }
+    }
+}
+
+/// A test's label as `crate::core::explain::label` writes it (`face 7`,
+/// `edge 12.1`, `vertex 3.2`), without allocating.
+struct Label<'a>(&'a TestRecord);
+
+impl fmt::Display for Label<'_> {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self.0 {
+            TestRecord::Face(r) => write!(f, "face {}", r.triangle),
+            TestRecord::Edge(r) => write!(f, "edge {}.{}", r.triangle, r.edge),
+            TestRecord::Vertex(r) => write!(f, "vertex {}.{}", r.triangle, r.vertex),
+        }
+    }
 }
 
 /// The descriptor `AnyValues::with_component::<C>(name, ..)` gives.
@@ -867,4 +956,33 @@ fn rgba(c: [u8; 4]) -> Color {
 
 fn albedo(c: [u8; 4]) -> rerun::datatypes::Rgba32 {
     rerun::datatypes::Rgba32::from_unmultiplied_rgba(c[0], c[1], c[2], c[3])
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn num_and_label_write_what_explain_writes() {
+        let mut x = 1.234_567_89e-7_f64;
+        let mut values = vec![
+            0.0,
+            -0.0,
+            1.0,
+            -1.0,
+            0.5,
+            1e-4,
+            1e6,
+            999_999.999_999,
+            f64::NAN,
+        ];
+        values.extend([f64::INFINITY, f64::NEG_INFINITY, f64::MIN, f64::MAX, 1e-300]);
+        while x < 1e9 {
+            values.extend([x, -x, x * 1.000_001, (x * 1e5).round() / 1e5]);
+            x *= 1.37;
+        }
+        for v in values {
+            assert_eq!(Num(v).to_string(), crate::core::explain::num(v), "{v:e}");
+        }
+    }
 }

@@ -112,14 +112,18 @@ fn rrd(bytes: &[u8], detail: Detail, path: &std::path::Path) -> u64 {
                 _ => groups.push(i..i + 1),
             }
         }
+        let spares: Vec<viz::PreparedSweeps> =
+            groups.iter().map(|_| logger.spare_prepared()).collect();
         let prepared: Vec<viz::PreparedSweeps> = groups
             .par_iter()
-            .map(|g| {
+            .zip(spares)
+            .map(|(g, mut p)| {
                 let sweeps = batch[g.clone()].iter().filter_map(|e| match e {
                     ReplayEvent::Sweep(r) => Some(&**r),
                     ReplayEvent::Scene(_) => None,
                 });
-                viz::prepare_sweeps(&scenes, sweeps, max)
+                viz::prepare_sweeps_into(&mut p, &scenes, sweeps, max);
+                p
             })
             .collect();
         for p in prepared {

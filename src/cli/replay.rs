@@ -304,6 +304,11 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
                 }
             }
         }
+        // Emptied buffers of earlier runs, reused.
+        let spares: Vec<viz::PreparedSweeps> = match logger.as_mut() {
+            Some(l) => groups.iter().map(|_| l.spare_prepared()).collect(),
+            None => Vec::new(),
+        };
         let (lines, prepared): (Vec<Option<String>>, Vec<viz::PreparedSweeps>) =
             pool.install(|| {
                 rayon::join(
@@ -326,12 +331,15 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
                         };
                         groups
                             .par_iter()
-                            .map(|g| {
-                                viz::prepare_sweeps(
+                            .zip(spares)
+                            .map(|(g, mut p)| {
+                                viz::prepare_sweeps_into(
+                                    &mut p,
                                     &scenes,
                                     batch[g.clone()].iter().filter_map(sweep_of),
                                     max,
-                                )
+                                );
+                                p
                             })
                             .collect()
                     },

@@ -162,7 +162,10 @@ impl Column for Strings {
 
     fn take_list(&mut self) -> Result<ListArray, RecordingStreamError> {
         let offsets = OffsetBuffer::<i32>::from_lengths(self.string_lengths.drain(..));
-        let bytes = Buffer::from_vec(std::mem::take(&mut self.bytes).into_bytes());
+        // The next flush holds about as many bytes: allocate them at once.
+        let n = self.bytes.len();
+        let bytes = std::mem::replace(&mut self.bytes, String::with_capacity(n));
+        let bytes = Buffer::from_vec(bytes.into_bytes());
         let values = StringArray::try_new(offsets, bytes, None)
             .map_err(|e| RecordingStreamError::Chunk(e.into()))?;
         list_array(Arc::new(values), &mut self.lengths)
@@ -251,6 +254,17 @@ struct EntityColumns {
 }
 
 impl EntityColumns {
+    fn new(key: Key) -> EntityColumns {
+        EntityColumns {
+            key,
+            path: None,
+            frames: Vec::new(),
+            times: Vec::new(),
+            rows: Vec::new(),
+            columns: Vec::new(),
+        }
+    }
+
     fn append(&mut self, other: &mut EntityColumns) {
         self.frames.append(&mut other.frames);
         self.times.append(&mut other.times);
@@ -383,14 +397,7 @@ impl Columns {
             None => {
                 let i = self.entities.len();
                 self.index.insert(key, i);
-                self.entities.push(EntityColumns {
-                    key,
-                    path: None,
-                    frames: Vec::new(),
-                    times: Vec::new(),
-                    rows: Vec::new(),
-                    columns: Vec::new(),
-                });
+                self.entities.push(EntityColumns::new(key));
                 i
             }
         };
@@ -406,10 +413,11 @@ impl Columns {
 
     /// Moves the rows of `other` here, after the rows numbered so far
     /// (`other`'s entities that are new here come after those already
-    /// here, in `other`'s order).
-    pub fn append(&mut self, mut other: Columns) {
+    /// here, in `other`'s order). `other` is left empty, with its buffers
+    /// (and their capacity) kept for its next rows.
+    pub fn append(&mut self, other: &mut Columns) {
         let base = self.next_row;
-        for mut e in other.entities.drain(..) {
+        for e in &mut other.entities {
             if e.rows.is_empty() {
                 continue;
             }
@@ -417,15 +425,18 @@ impl Columns {
                 *r += base;
             }
             match self.index.get(&e.key) {
-                Some(&i) => self.entities[i].append(&mut e),
+                Some(&i) => self.entities[i].append(e),
                 None => {
                     self.index.insert(e.key, self.entities.len());
-                    self.entities.push(e);
+                    let empty = EntityColumns::new(e.key);
+                    self.entities.push(std::mem::replace(e, empty));
                 }
             }
         }
         self.rows += other.rows;
         self.next_row += other.next_row;
+        other.rows = 0;
+        other.next_row = 0;
     }
 
     /// Sends a static row of `path` at once.

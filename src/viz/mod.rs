@@ -182,7 +182,13 @@ pub struct Logger {
     max_edge_frames: usize,
     columns: columns::Columns,
     flush_rows: usize,
+    /// Emptied [`PreparedSweeps`], handed out again by
+    /// [`Logger::spare_prepared`] so that their buffers are reused.
+    spare: Vec<PreparedSweeps>,
 }
+
+/// At most this many emptied [`PreparedSweeps`] are kept for reuse.
+const MAX_SPARE_PREPARED: usize = 16;
 
 /// Rows buffered before the logger sends them (see [`Logger`]).
 pub const DEFAULT_FLUSH_ROWS: usize = 1 << 17;
@@ -262,6 +268,19 @@ pub fn prepare_sweeps<'r>(
     max_edge_frames: usize,
 ) -> PreparedSweeps {
     let mut p = PreparedSweeps::default();
+    prepare_sweeps_into(&mut p, scenes, results, max_edge_frames);
+    p
+}
+
+/// [`prepare_sweeps`] into `p` (an empty one, for example from
+/// [`Logger::spare_prepared`], whose buffers are reused).
+pub fn prepare_sweeps_into<'r>(
+    p: &mut PreparedSweeps,
+    scenes: &[std::sync::Arc<SceneState>],
+    results: impl IntoIterator<Item = &'r SweepResult>,
+    max_edge_frames: usize,
+) {
+    debug_assert!(p.is_empty() && p.columns.rows() == 0);
     for r in results {
         let scene = scenes.iter().find(|s| s.number == r.scene).map(|s| &**s);
         let frame = i64::try_from(r.frame).unwrap_or(i64::MAX);
@@ -279,7 +298,6 @@ pub fn prepare_sweeps<'r>(
         text_rows(&mut out, r, decisive.as_ref());
         p.sweeps.push((r.ball, edge_slots, frame, time));
     }
-    p
 }
 
 /// The `time` timeline's value of a `log_time`.
@@ -308,6 +326,7 @@ impl Logger {
             max_edge_frames: MAX_EDGE_FRAMES,
             columns: columns::Columns::default(),
             flush_rows: DEFAULT_FLUSH_ROWS,
+            spare: Vec::new(),
         };
         logger.log_static(paths::WORLD, &ViewCoordinates::RIGHT_HAND_Z_UP())?;
         Ok(logger)
@@ -399,11 +418,11 @@ impl Logger {
 
     /// Logs sweeps prepared by [`prepare_sweeps`] (sweeps must be logged in
     /// trace order).
-    pub fn log_prepared(&mut self, p: PreparedSweeps) -> Result<(), RecordingStreamError> {
-        self.columns.append(p.columns);
+    pub fn log_prepared(&mut self, mut p: PreparedSweeps) -> Result<(), RecordingStreamError> {
+        self.columns.append(&mut p.columns);
         // Clear the edge frames a ball used at its previous sweep and no
         // longer uses.
-        for (b, edge_slots, frame, time) in p.sweeps {
+        for (b, edge_slots, frame, time) in p.sweeps.drain(..) {
             let state = self.balls.entry(b).or_default();
             let previous = std::mem::replace(&mut state.edge_slots, edge_slots);
             let mut out = Out {
@@ -415,10 +434,20 @@ impl Logger {
                 out.clear(Entity::EdgeFrame(b, slot), true);
             }
         }
+        if self.spare.len() < MAX_SPARE_PREPARED {
+            self.spare.push(p);
+        }
         if self.columns.rows() >= self.flush_rows {
             self.flush()?;
         }
         Ok(())
+    }
+
+    /// An empty [`PreparedSweeps`] to fill with [`prepare_sweeps_into`]:
+    /// one handed back by [`Logger::log_prepared`] (buffers kept) when
+    /// there is one.
+    pub fn spare_prepared(&mut self) -> PreparedSweeps {
+        self.spare.pop().unwrap_or_default()
     }
 }
 

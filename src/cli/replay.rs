@@ -18,6 +18,7 @@ use sweeptrace::replay::{
     replay_events_parallel,
 };
 use sweeptrace::trace::TraceReader;
+use sweeptrace::trace::prefetch::{self, prefetch};
 use sweeptrace::viz;
 
 /// The viewer address `--connect` uses when given no URL.
@@ -264,8 +265,15 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         count: count.clone(),
     };
     let progress = progress_bar(total_bytes);
-    let mut events = replay_events_parallel(
+    // Decode on a thread of its own, so reading overlaps the core's work.
+    let read_ahead = prefetch(
         TraceReader::new(reader, &source_name),
+        prefetch::DEFAULT_CHUNK,
+        prefetch::DEFAULT_DEPTH,
+    )
+    .context("starting the trace reader thread")?;
+    let mut events = replay_events_parallel(
+        read_ahead,
         options,
         DEFAULT_BATCH_EVENTS,
         Some(pool.clone()),

@@ -18,6 +18,7 @@ use sweeptrace::replay::{
     DEFAULT_BATCH_EVENTS, Detail, ReplayEvent, ReplayOptions, replay_events_parallel,
 };
 use sweeptrace::trace::TraceReader;
+use sweeptrace::trace::prefetch::{self, prefetch};
 
 #[path = "../examples/long_trace.rs"]
 mod long_trace;
@@ -50,12 +51,15 @@ fn outcomes(bytes: &[u8]) -> u64 {
     let options = ReplayOptions::default();
     let mut sink = std::io::BufWriter::new(std::io::sink());
     let mut n = 0;
-    let events = replay_events_parallel(
-        TraceReader::new(bytes, "bench.mcap"),
-        options,
-        DEFAULT_BATCH_EVENTS,
-        None,
-    );
+    // As the command does: decode on a thread of its own (the copy of the
+    // bytes, a memcpy, lets the reader thread own them).
+    let read_ahead = prefetch(
+        TraceReader::new(std::io::Cursor::new(bytes.to_vec()), "bench.mcap"),
+        prefetch::DEFAULT_CHUNK,
+        prefetch::DEFAULT_DEPTH,
+    )
+    .expect("reader thread");
+    let events = replay_events_parallel(read_ahead, options, DEFAULT_BATCH_EVENTS, None);
     for event in events {
         if let ReplayEvent::Sweep(r) = event.expect("valid trace") {
             serde_json::to_writer(&mut sink, &r.outcome_msg()).expect("sink");
@@ -80,12 +84,13 @@ fn rrd(bytes: &[u8], detail: Detail, path: &std::path::Path) -> u64 {
     let rec = viz::builder(&id, "bench").save(path).expect("rrd file");
     let mut logger = viz::Logger::new(rec, true).expect("recording");
     let max = logger.max_edge_frames();
-    let mut events = replay_events_parallel(
-        TraceReader::new(bytes, "bench.mcap"),
-        options,
-        DEFAULT_BATCH_EVENTS,
-        None,
-    );
+    let read_ahead = prefetch(
+        TraceReader::new(std::io::Cursor::new(bytes.to_vec()), "bench.mcap"),
+        prefetch::DEFAULT_CHUNK,
+        prefetch::DEFAULT_DEPTH,
+    )
+    .expect("reader thread");
+    let mut events = replay_events_parallel(read_ahead, options, DEFAULT_BATCH_EVENTS, None);
     let mut n = 0;
     let mut scenes = Vec::new();
     loop {

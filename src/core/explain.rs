@@ -1,133 +1,198 @@
 //! Test records in words: one line per test, saying what was computed and
 //! why the test decided as it did. Pure functions returning strings.
 
-use std::fmt::Write;
+use std::fmt::{self, Write};
 
 use super::record::{EdgeRecord, FaceRecord, TestRecord, Verdict, VertexRecord};
 
 /// A short number: 4 significant decimals, no trailing noise.
 pub fn num(x: f64) -> String {
-    if x == 0.0 {
-        return "0".into();
+    Num(x).to_string()
+}
+
+/// [`num`] as a `Display` value that writes without allocating.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Num(pub f64);
+
+impl fmt::Display for Num {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let x = self.0;
+        if x == 0.0 {
+            return f.write_str("0");
+        }
+        let a = x.abs();
+        if !(1e-4..1e6).contains(&a) {
+            return write!(f, "{x:.4e}");
+        }
+        // Below 10^6 with 5 decimals: at most 14 bytes.
+        let mut buf = StackText::default();
+        write!(buf, "{x:.5}")?;
+        f.write_str(buf.as_str().trim_end_matches('0').trim_end_matches('.'))
     }
-    let a = x.abs();
-    if !(1e-4..1e6).contains(&a) {
-        return format!("{x:.4e}");
+}
+
+/// A few bytes of text on the stack.
+#[derive(Default)]
+struct StackText {
+    bytes: [u8; 32],
+    len: usize,
+}
+
+impl StackText {
+    fn as_str(&self) -> &str {
+        std::str::from_utf8(&self.bytes[..self.len]).unwrap_or("")
     }
-    let s = format!("{x:.5}");
-    let s = s.trim_end_matches('0').trim_end_matches('.');
-    s.to_string()
+}
+
+impl Write for StackText {
+    fn write_str(&mut self, s: &str) -> fmt::Result {
+        let end = self.len + s.len();
+        if end > self.bytes.len() {
+            return Err(fmt::Error);
+        }
+        self.bytes[self.len..end].copy_from_slice(s.as_bytes());
+        self.len = end;
+        Ok(())
+    }
 }
 
 /// `face 7`, `edge 12.1`, `vertex 3.2`.
 pub fn label(record: &TestRecord) -> String {
+    let mut s = String::new();
+    let _ = write_label(&mut s, record);
+    s
+}
+
+/// Writes [`label`] into `w`.
+pub fn write_label(w: &mut impl Write, record: &TestRecord) -> fmt::Result {
     match record {
-        TestRecord::Face(r) => format!("face {}", r.triangle),
-        TestRecord::Edge(r) => format!("edge {}.{}", r.triangle, r.edge),
-        TestRecord::Vertex(r) => format!("vertex {}.{}", r.triangle, r.vertex),
+        TestRecord::Face(r) => write!(w, "face {}", r.triangle),
+        TestRecord::Edge(r) => write!(w, "edge {}.{}", r.triangle, r.edge),
+        TestRecord::Vertex(r) => write!(w, "vertex {}.{}", r.triangle, r.vertex),
     }
 }
 
 /// One line: label, the numbers that decided, the verdict.
 pub fn describe(record: &TestRecord) -> String {
-    let body = match record {
-        TestRecord::Face(r) => describe_face(r),
-        TestRecord::Edge(r) => describe_edge(r),
-        TestRecord::Vertex(r) => describe_vertex(r),
-    };
-    format!("{}: {}", label(record), body)
-}
-
-fn facing(n_dot_d: f64, verdict: Verdict) -> String {
-    if verdict == Verdict::BackFacing {
-        format!("n·d = {} fails the facing rule", num(n_dot_d))
-    } else {
-        "facing ok".to_string()
-    }
-}
-
-fn describe_face(r: &FaceRecord) -> String {
-    let mut s = format!("h0 = {}, h1 = {}", num(r.h0), num(r.h1));
-    match r.verdict {
-        Verdict::StartsTooClose => {
-            s.push_str(" (h0 < ρ: starts within ρ of the plane or behind it): none")
-        }
-        Verdict::Parallel => {
-            s.push_str(" (|h0 - h1| ≤ PARALLEL_TOLERANCE·|d|: moving parallel to the plane): none")
-        }
-        Verdict::BackFacing if r.h1 > r.h0 && r.normal_dot_d <= 0.0 => write!(
-            s,
-            ", n·d = {} but h1 > h0 (moving away from the plane, by rounding): back-facing",
-            num(r.normal_dot_d)
-        )
-        .unwrap(),
-        Verdict::BackFacing => {
-            write!(s, ", {}: back-facing", facing(r.normal_dot_d, r.verdict)).unwrap()
-        }
-        Verdict::BeyondEnd => write!(
-            s,
-            ", β = {} > 1: does not reach the plane",
-            num(r.beta.unwrap_or(f64::NAN))
-        )
-        .unwrap(),
-        Verdict::OutsideTriangle | Verdict::Hit => {
-            let b = r.barycentric.unwrap_or([f64::NAN; 3]);
-            write!(
-                s,
-                ", β = {} in [0, 1], touch point barycentric ({}, {}, {})",
-                num(r.beta.unwrap_or(f64::NAN)),
-                num(b[0]),
-                num(b[1]),
-                num(b[2])
-            )
-            .unwrap();
-            if r.verdict == Verdict::Hit {
-                s.push_str(" inside, facing ok: hit");
-            } else {
-                s.push_str(" outside the triangle: none");
-            }
-        }
-        other => write!(s, ": {other}").unwrap(),
-    }
+    let mut s = String::with_capacity(128);
+    let _ = write_describe(&mut s, record);
     s
 }
 
-fn describe_edge(r: &EdgeRecord) -> String {
-    let quad = format!(
-        "A = {}, B = {}, C = {}, disc = {}",
-        num(r.a),
-        num(r.b),
-        num(r.c),
-        num(r.discriminant)
-    );
+/// Writes [`describe`]'s line into `w` (no allocation of its own).
+pub fn write_describe(w: &mut impl Write, record: &TestRecord) -> fmt::Result {
+    write_label(w, record)?;
+    w.write_str(": ")?;
+    match record {
+        TestRecord::Face(r) => describe_face(w, r),
+        TestRecord::Edge(r) => describe_edge(w, r),
+        TestRecord::Vertex(r) => describe_vertex(w, r),
+    }
+}
+
+/// `facing ok`, or why the facing rule failed.
+struct FacingText(f64, Verdict);
+
+impl fmt::Display for FacingText {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        if self.1 == Verdict::BackFacing {
+            write!(f, "n·d = {} fails the facing rule", Num(self.0))
+        } else {
+            f.write_str("facing ok")
+        }
+    }
+}
+
+fn describe_face(w: &mut impl Write, r: &FaceRecord) -> fmt::Result {
+    write!(w, "h0 = {}, h1 = {}", Num(r.h0), Num(r.h1))?;
     match r.verdict {
-        Verdict::Parallel => format!(
-            "A = {} ≤ (PARALLEL_TOLERANCE·|d|)² (path parallel to the edge, or not moving): none",
-            num(r.a)
+        Verdict::StartsTooClose => {
+            w.write_str(" (h0 < ρ: starts within ρ of the plane or behind it): none")
+        }
+        Verdict::Parallel => {
+            w.write_str(" (|h0 - h1| ≤ PARALLEL_TOLERANCE·|d|: moving parallel to the plane): none")
+        }
+        Verdict::BackFacing if r.h1 > r.h0 && r.normal_dot_d <= 0.0 => write!(
+            w,
+            ", n·d = {} but h1 > h0 (moving away from the plane, by rounding): back-facing",
+            Num(r.normal_dot_d)
         ),
-        Verdict::NoRealRoots => format!("{quad} < 0 (never within ρ of the edge's line): none"),
+        Verdict::BackFacing => write!(
+            w,
+            ", {}: back-facing",
+            FacingText(r.normal_dot_d, r.verdict)
+        ),
+        Verdict::BeyondEnd => write!(
+            w,
+            ", β = {} > 1: does not reach the plane",
+            Num(r.beta.unwrap_or(f64::NAN))
+        ),
+        Verdict::OutsideTriangle | Verdict::Hit => {
+            let b = r.barycentric.unwrap_or([f64::NAN; 3]);
+            write!(
+                w,
+                ", β = {} in [0, 1], touch point barycentric ({}, {}, {})",
+                Num(r.beta.unwrap_or(f64::NAN)),
+                Num(b[0]),
+                Num(b[1]),
+                Num(b[2])
+            )?;
+            if r.verdict == Verdict::Hit {
+                w.write_str(" inside, facing ok: hit")
+            } else {
+                w.write_str(" outside the triangle: none")
+            }
+        }
+        other => write!(w, ": {other}"),
+    }
+}
+
+fn describe_edge(w: &mut impl Write, r: &EdgeRecord) -> fmt::Result {
+    match r.verdict {
+        Verdict::Parallel => write!(
+            w,
+            "A = {} ≤ (PARALLEL_TOLERANCE·|d|)² (path parallel to the edge, or not moving): none",
+            Num(r.a)
+        ),
+        Verdict::NoRealRoots => write!(
+            w,
+            "A = {}, B = {}, C = {}, disc = {} < 0 (never within ρ of the edge's line): none",
+            Num(r.a),
+            Num(r.b),
+            Num(r.c),
+            Num(r.discriminant)
+        ),
         _ => {
             let (s0, s1) = r.roots.unwrap_or((f64::NAN, f64::NAN));
-            let roots = format!("s0 = {}, s1 = {}", num(s0), num(s1));
             match r.verdict {
-                Verdict::BeforeStart => {
-                    format!("{roots}: s0 < 0 (before the start of the path): none")
-                }
-                Verdict::BeyondEnd => format!("{roots}: s0 > 1 (beyond the end of the path): none"),
+                Verdict::BeforeStart => write!(
+                    w,
+                    "s0 = {}, s1 = {}: s0 < 0 (before the start of the path): none",
+                    Num(s0),
+                    Num(s1)
+                ),
+                Verdict::BeyondEnd => write!(
+                    w,
+                    "s0 = {}, s1 = {}: s0 > 1 (beyond the end of the path): none",
+                    Num(s0),
+                    Num(s1)
+                ),
                 _ => {
                     let xc = r.xc.unwrap_or(f64::NAN);
-                    let head = format!("s0 = {} in [0, 1], xc = {}", num(s0), num(xc));
+                    write!(w, "s0 = {} in [0, 1], xc = {}", Num(s0), Num(xc))?;
                     match r.verdict {
-                        Verdict::OffEdge => format!(
-                            "{head} outside [0, {}] (touches the line off the edge: a vertex case): none",
-                            num(r.length)
+                        Verdict::OffEdge => write!(
+                            w,
+                            " outside [0, {}] (touches the line off the edge: a vertex case): none",
+                            Num(r.length)
                         ),
-                        Verdict::BackFacing => format!(
-                            "{head} in [0, {}], {}: back-facing",
-                            num(r.length),
-                            facing(r.normal_dot_d, r.verdict)
+                        Verdict::BackFacing => write!(
+                            w,
+                            " in [0, {}], {}: back-facing",
+                            Num(r.length),
+                            FacingText(r.normal_dot_d, r.verdict)
                         ),
-                        _ => format!("{head} in [0, {}], facing ok: hit", num(r.length)),
+                        _ => write!(w, " in [0, {}], facing ok: hit", Num(r.length)),
                     }
                 }
             }
@@ -135,34 +200,40 @@ fn describe_edge(r: &EdgeRecord) -> String {
     }
 }
 
-fn describe_vertex(r: &VertexRecord) -> String {
+fn describe_vertex(w: &mut impl Write, r: &VertexRecord) -> fmt::Result {
     match r.verdict {
-        Verdict::NotMoving => "A = 0 (zero-length path): none".to_string(),
-        Verdict::NoRealRoots => format!(
+        Verdict::NotMoving => w.write_str("A = 0 (zero-length path): none"),
+        Verdict::NoRealRoots => write!(
+            w,
             "A = {}, B = {}, C = {}, disc = {} < 0 (never within ρ of the vertex): none",
-            num(r.a),
-            num(r.b),
-            num(r.c),
-            num(r.discriminant)
+            Num(r.a),
+            Num(r.b),
+            Num(r.c),
+            Num(r.discriminant)
         ),
         _ => {
             let (s0, s1) = r.roots.unwrap_or((f64::NAN, f64::NAN));
             match r.verdict {
-                Verdict::BeforeStart => format!(
+                Verdict::BeforeStart => write!(
+                    w,
                     "s0 = {}, s1 = {}: s0 < 0 (before the start): none",
-                    num(s0),
-                    num(s1)
+                    Num(s0),
+                    Num(s1)
                 ),
-                Verdict::BeyondEnd => format!(
-                    "s0 = {}: s0 > 1 (beyond the end of the path): none",
-                    num(s0)
-                ),
-                Verdict::BackFacing => format!(
+                Verdict::BeyondEnd => {
+                    write!(
+                        w,
+                        "s0 = {}: s0 > 1 (beyond the end of the path): none",
+                        Num(s0)
+                    )
+                }
+                Verdict::BackFacing => write!(
+                    w,
                     "s0 = {} in [0, 1], {}: back-facing",
-                    num(s0),
-                    facing(r.normal_dot_d, r.verdict)
+                    Num(s0),
+                    FacingText(r.normal_dot_d, r.verdict)
                 ),
-                _ => format!("s0 = {} in [0, 1], facing ok: hit", num(s0)),
+                _ => write!(w, "s0 = {} in [0, 1], facing ok: hit", Num(s0)),
             }
         }
     }

@@ -31,7 +31,7 @@ use rerun::{
     ViewCoordinates,
 };
 
-use crate::core::explain::{describe, miss_distance};
+use crate::core::explain::{miss_distance, write_describe};
 use crate::core::{EdgeRecord, TestRecord, Triangle};
 use crate::replay::{ReplayEvent, SceneState, SweepResult};
 use paths::Entity;
@@ -818,14 +818,14 @@ fn write_decision_line(s: &mut String, r: &SweepResult, decisive: Option<&TestRe
         );
         if let Some(t) = decisive {
             s.push_str(" — ");
-            s.push_str(&describe(t));
+            let _ = write_describe(s, t);
         }
     } else {
         s.push_str("no collision");
         match decisive {
             Some(t) => {
                 s.push_str("; closest candidate rejected: ");
-                s.push_str(&describe(t));
+                let _ = write_describe(s, t);
             }
             None if r.records.is_empty() => {
                 s.push_str(" (no triangle's box comes within ρ of the path)")

@@ -58,17 +58,20 @@ impl Write for StackText {
 
 /// `face 7`, `edge 12.1`, `vertex 3.2`.
 pub fn label(record: &TestRecord) -> String {
-    let mut s = String::new();
-    let _ = write_label(&mut s, record);
-    s
+    Label(record).to_string()
 }
 
-/// Writes [`label`] into `w`.
-pub fn write_label(w: &mut impl Write, record: &TestRecord) -> fmt::Result {
-    match record {
-        TestRecord::Face(r) => write!(w, "face {}", r.triangle),
-        TestRecord::Edge(r) => write!(w, "edge {}.{}", r.triangle, r.edge),
-        TestRecord::Vertex(r) => write!(w, "vertex {}.{}", r.triangle, r.vertex),
+/// [`label`] as a `Display` value that writes without allocating.
+#[derive(Clone, Copy, Debug)]
+pub struct Label<'a>(pub &'a TestRecord);
+
+impl fmt::Display for Label<'_> {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self.0 {
+            TestRecord::Face(r) => write!(f, "face {}", r.triangle),
+            TestRecord::Edge(r) => write!(f, "edge {}.{}", r.triangle, r.edge),
+            TestRecord::Vertex(r) => write!(f, "vertex {}.{}", r.triangle, r.vertex),
+        }
     }
 }
 
@@ -81,8 +84,7 @@ pub fn describe(record: &TestRecord) -> String {
 
 /// Writes [`describe`]'s line into `w` (no allocation of its own).
 pub fn write_describe(w: &mut impl Write, record: &TestRecord) -> fmt::Result {
-    write_label(w, record)?;
-    w.write_str(": ")?;
+    write!(w, "{}: ", Label(record))?;
     match record {
         TestRecord::Face(r) => describe_face(w, r),
         TestRecord::Edge(r) => describe_edge(w, r),
@@ -277,4 +279,45 @@ pub fn miss_distance(record: &TestRecord) -> Option<f64> {
             _ => 10.0,
         },
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::Num;
+
+    /// The allocating formulation `Num` replaces.
+    fn reference(x: f64) -> String {
+        if x == 0.0 {
+            return "0".into();
+        }
+        if !(1e-4..1e6).contains(&x.abs()) {
+            return format!("{x:.4e}");
+        }
+        let s = format!("{x:.5}");
+        s.trim_end_matches('0').trim_end_matches('.').to_string()
+    }
+
+    #[test]
+    fn num_writes_what_the_string_formulation_writes() {
+        let mut x = 1.234_567_89e-7_f64;
+        let mut values = vec![
+            0.0,
+            -0.0,
+            1.0,
+            -1.0,
+            0.5,
+            1e-4,
+            1e6,
+            999_999.999_999,
+            f64::NAN,
+        ];
+        values.extend([f64::INFINITY, f64::NEG_INFINITY, f64::MIN, f64::MAX, 1e-300]);
+        while x < 1e9 {
+            values.extend([x, -x, x * 1.000_001, (x * 1e5).round() / 1e5]);
+            x *= 1.37;
+        }
+        for v in values {
+            assert_eq!(Num(v).to_string(), reference(v), "{v:e}");
+        }
+    }
 }

@@ -31,7 +31,7 @@ use rerun::{
     ViewCoordinates,
 };
 
-use crate::core::explain::{miss_distance, write_describe};
+use crate::core::explain::{Label, Num, miss_distance, write_describe};
 use crate::core::{EdgeRecord, TestRecord, Triangle};
 use crate::replay::{ReplayEvent, SceneState, SweepResult};
 use paths::Entity;
@@ -844,62 +844,6 @@ fn write_decision_line(s: &mut String, r: &SweepResult, decisive: Option<&TestRe
     mismatch
 }
 
-/// A number as `crate::core::explain::num` writes it, without allocating.
-#[derive(Clone, Copy, Debug)]
-struct Num(f64);
-
-impl fmt::Display for Num {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        let x = self.0;
-        if x == 0.0 {
-            return f.write_str("0");
-        }
-        let a = x.abs();
-        if !(1e-4..1e6).contains(&a) {
-            return write!(f, "{x:.4e}");
-        }
-        // Below 10^6 with 5 decimals: at most 14 bytes.
-        let mut buf = StackStr::<32>::default();
-        if write!(buf, "{x:.5}").is_err() {
-            return f.write_str(&crate::core::explain::num(x));
-        }
-        f.write_str(buf.as_str().trim_end_matches('0').trim_end_matches('.'))
-    }
-}
-
-/// A string of at most `N` bytes on the stack.
-struct StackStr<const N: usize> {
-    bytes: [u8; N],
-    len: usize,
-}
-
-impl<const N: usize> Default for StackStr<N> {
-    fn default() -> Self {
-        StackStr {
-            bytes: [0; N],
-            len: 0,
-        }
-    }
-}
-
-impl<const N: usize> StackStr<N> {
-    fn as_str(&self) -> &str {
-        std::str::from_utf8(&self.bytes[..self.len]).expect("only whole strings are written")
-    }
-}
-
-impl<const N: usize> fmt::Write for StackStr<N> {
-    fn write_str(&mut self, s: &str) -> fmt::Result {
-        let end = self.len + s.len();
-        if end > N {
-            return Err(fmt::Error);
-        }
-        self.bytes[self.len..end].copy_from_slice(s.as_bytes());
-        self.len = end;
-        Ok(())
-    }
-}
-
 /// A number, or `-` for `None`.
 struct OrDash<T>(Option<T>);
 
@@ -908,20 +852,6 @@ impl<T: fmt::Display> fmt::Display for OrDash<T> {
         match &self.0 {
             Some(v) => v.fmt(f),
             None => f.write_str("-"),
-        }
-    }
-}
-
-/// A test's label as `crate::core::explain::label` writes it (`face 7`,
-/// `edge 12.1`, `vertex 3.2`), without allocating.
-struct Label<'a>(&'a TestRecord);
-
-impl fmt::Display for Label<'_> {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match self.0 {
-            TestRecord::Face(r) => write!(f, "face {}", r.triangle),
-            TestRecord::Edge(r) => write!(f, "edge {}.{}", r.triangle, r.edge),
-            TestRecord::Vertex(r) => write!(f, "vertex {}.{}", r.triangle, r.vertex),
         }
     }
 }
@@ -985,33 +915,4 @@ fn rgba(c: [u8; 4]) -> Color {
 
 fn albedo(c: [u8; 4]) -> rerun::datatypes::Rgba32 {
     rerun::datatypes::Rgba32::from_unmultiplied_rgba(c[0], c[1], c[2], c[3])
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn num_and_label_write_what_explain_writes() {
-        let mut x = 1.234_567_89e-7_f64;
-        let mut values = vec![
-            0.0,
-            -0.0,
-            1.0,
-            -1.0,
-            0.5,
-            1e-4,
-            1e6,
-            999_999.999_999,
-            f64::NAN,
-        ];
-        values.extend([f64::INFINITY, f64::NEG_INFINITY, f64::MIN, f64::MAX, 1e-300]);
-        while x < 1e9 {
-            values.extend([x, -x, x * 1.000_001, (x * 1e5).round() / 1e5]);
-            x *= 1.37;
-        }
-        for v in values {
-            assert_eq!(Num(v).to_string(), crate::core::explain::num(v), "{v:e}");
-        }
-    }
 }

@@ -27,6 +27,7 @@ use mcap::records::{MessageHeader, Record};
 use mcap::{Attachment, McapError};
 use thiserror::Error;
 
+use crate::atomic::PendingFile;
 use crate::replay::{ReplayError, ReplayEvent, ReplayOptions, replay_events};
 use crate::trace::TraceReader;
 use crate::trace::messages::{EXPECTED_TOPIC, OUTCOME_SCHEMA, OutcomeMsg, SWEEP_TOPIC};
@@ -345,25 +346,8 @@ pub fn bless_file(
         move |source| BlessError::Io { file, what, source }
     };
     let bytes = std::fs::read(input).map_err(io(&in_name, "reading"))?;
-    let dir = match output.parent() {
-        Some(p) if !p.as_os_str().is_empty() => p,
-        _ => Path::new("."),
-    };
-    let prefix = format!(
-        ".{}.",
-        output
-            .file_name()
-            .map(|n| n.to_string_lossy().into_owned())
-            .unwrap_or_default()
-    );
-    let mut builder = tempfile::Builder::new();
-    builder.prefix(&prefix).suffix(".tmp");
-    #[cfg(unix)]
-    builder.permissions(std::os::unix::fs::PermissionsExt::from_mode(0o644));
-    let temp = builder
-        .tempfile_in(dir)
+    let (pending, file) = PendingFile::create(output)
         .map_err(io(&out_name, "creating a temporary file next to it"))?;
-    let (file, temp_path) = temp.into_parts();
     let (summary, buffered) = bless_bytes(&bytes, &in_name, BufWriter::new(file), options)?;
     let file = buffered.into_inner().map_err(|e| BlessError::Io {
         file: out_name.clone(),
@@ -372,10 +356,8 @@ pub fn bless_file(
     })?;
     file.sync_all().map_err(io(&out_name, "writing"))?;
     drop(file);
-    temp_path.persist(output).map_err(|e| BlessError::Io {
-        file: out_name.clone(),
-        what: "renaming the finished file into place".to_string(),
-        source: e.error,
-    })?;
+    pending
+        .commit()
+        .map_err(io(&out_name, "renaming the finished file into place"))?;
     Ok(summary)
 }

@@ -4,6 +4,7 @@
 //!
 //! Start with [`core`] (the collision tests) and [`scenes`] (built-in meshes).
 
+pub mod atomic;
 pub mod bless;
 pub mod check;
 pub mod core;

@@ -6,6 +6,7 @@ use std::process::ExitCode;
 
 use anyhow::{Context, bail};
 
+use sweeptrace::atomic::PendingFile;
 use sweeptrace::check::{
     CheckOptions, DEFAULT_ALPHA_TOLERANCE, DEFAULT_CONTACT_TOLERANCE, DEFAULT_MAX_DETAILS,
     DEFAULT_NORMAL_TOLERANCE_DEGREES, Status, Tolerances, TraceReport, check_file, find_traces,
@@ -133,12 +134,8 @@ fn write_failure_rrd(trace: &Path, dir: &Path, report: &TraceReport) -> anyhow::
         .map(|s| s.to_string_lossy().into_owned())
         .unwrap_or_else(|| "trace".to_string());
     let target = dir.join(format!("{stem}.rrd"));
-    let temp = tempfile::Builder::new()
-        .prefix(&format!(".{stem}.rrd."))
-        .suffix(".tmp")
-        .tempfile_in(dir)
-        .with_context(|| format!("creating a temporary file in {}", dir.display()))?
-        .into_temp_path();
+    let temp = PendingFile::new(&target)
+        .with_context(|| format!("creating a temporary file in {}", dir.display()))?;
     let options = ReplayOptions {
         frames,
         detail: Detail::Candidates,
@@ -148,8 +145,8 @@ fn write_failure_rrd(trace: &Path, dir: &Path, report: &TraceReport) -> anyhow::
     let name = trace.display().to_string();
     let bytes = std::fs::read(trace).with_context(|| format!("reading {name}"))?;
     let id = viz::recording_id(&[&bytes, format!("check {options:?}").as_bytes()]);
-    let sink = rerun::sink::FileSink::new(&*temp)
-        .with_context(|| format!("opening {} for writing", temp.display()))?;
+    let sink = rerun::sink::FileSink::new(temp.path())
+        .with_context(|| format!("opening {} for writing", temp.path().display()))?;
     let rec = viz::builder(&id, &format!("{name} (check, frames {frames})"))
         .set_sinks(vec![Box::new(sink) as Box<dyn rerun::sink::LogSink>])
         .context("creating the recording")?;
@@ -170,7 +167,7 @@ fn write_failure_rrd(trace: &Path, dir: &Path, report: &TraceReport) -> anyhow::
     let rec = logger.finish();
     rec.flush_blocking().context("flushing the recording")?;
     drop(rec);
-    temp.persist(&target)
+    temp.commit()
         .with_context(|| format!("renaming the finished file to {}", target.display()))?;
     Ok(target)
 }

@@ -12,6 +12,7 @@ use anyhow::{Context, bail};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 
 use rayon::prelude::*;
+use sweeptrace::atomic::PendingFile;
 use sweeptrace::core::Facing;
 use sweeptrace::replay::{
     DEFAULT_BATCH_EVENTS, Detail, FrameRange, ReplayError, ReplayEvent, ReplayOptions, SceneState,
@@ -100,50 +101,18 @@ impl<R: Read> Read for CountingReader<R> {
     }
 }
 
-/// A file written under a temporary name in the target's directory and
-/// renamed when complete; removed if never completed.
-struct PendingFile {
-    temp: tempfile::TempPath,
-    target: PathBuf,
+/// A temporary file next to `target`, with the error naming where.
+fn pending_file(target: &Path) -> anyhow::Result<PendingFile> {
+    PendingFile::new(target)
+        .with_context(|| format!("creating a temporary file next to {}", target.display()))
 }
 
-impl PendingFile {
-    fn new(target: &Path) -> anyhow::Result<PendingFile> {
-        let dir = match target.parent() {
-            Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
-            _ => PathBuf::from("."),
-        };
-        let name = target
-            .file_name()
-            .map(|n| n.to_string_lossy().into_owned())
-            .unwrap_or_default();
-        let mut builder = tempfile::Builder::new();
-        let prefix = format!(".{name}.");
-        builder.prefix(&prefix).suffix(".tmp");
-        // An ordinary file once renamed (temporary files are private by default).
-        #[cfg(unix)]
-        builder.permissions(std::os::unix::fs::PermissionsExt::from_mode(0o644));
-        let temp = builder
-            .tempfile_in(&dir)
-            .with_context(|| format!("creating a temporary file in {}", dir.display()))?
-            .into_temp_path();
-        Ok(PendingFile {
-            temp,
-            target: target.to_path_buf(),
-        })
-    }
-
-    fn path(&self) -> &Path {
-        &self.temp
-    }
-
-    fn complete(self) -> anyhow::Result<()> {
-        let target = self.target;
-        self.temp
-            .persist(&target)
-            .with_context(|| format!("renaming the finished file to {}", target.display()))?;
-        Ok(())
-    }
+/// Renames a finished file into place, with the error naming where.
+fn complete(pending: PendingFile) -> anyhow::Result<()> {
+    let target = pending.target().to_path_buf();
+    pending
+        .commit()
+        .with_context(|| format!("renaming the finished file to {}", target.display()))
 }
 
 /// Where the outcomes go.
@@ -205,7 +174,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         let id = recording_id_of(trace_path, &options)?;
         let mut sinks: Vec<Box<dyn rerun::sink::LogSink>> = Vec::new();
         if let Some(path) = &rrd_path {
-            let pending = PendingFile::new(path)?;
+            let pending = pending_file(path)?;
             let sink = rerun::sink::FileSink::new(pending.path())
                 .with_context(|| format!("opening {} for writing", pending.path().display()))?;
             sinks.push(Box::new(sink));
@@ -242,9 +211,8 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             Some(OutcomeSink::Stdout(BufWriter::new(std::io::stdout())))
         }
         Some(p) => {
-            let pending = PendingFile::new(p)?;
-            let f = File::create(pending.path())
-                .with_context(|| format!("creating {}", pending.path().display()))?;
+            let (pending, f) = PendingFile::create(p)
+                .with_context(|| format!("creating a temporary file next to {}", p.display()))?;
             Some(OutcomeSink::File(BufWriter::new(f), pending))
         }
     };
@@ -408,8 +376,8 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         drop(rec);
     }
     if let Some(pending) = rrd_file {
-        let target = pending.target.clone();
-        pending.complete()?;
+        let target = pending.target().to_path_buf();
+        complete(pending)?;
         eprintln!("wrote the recording to {}", target.display());
     }
     match outcomes {
@@ -421,8 +389,8 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
                 .context("writing outcomes")?
                 .sync_all()
                 .ok();
-            let target = pending.target.clone();
-            pending.complete()?;
+            let target = pending.target().to_path_buf();
+            complete(pending)?;
             eprintln!("wrote the outcomes to {}", target.display());
         }
         None => {}

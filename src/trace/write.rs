@@ -30,6 +30,7 @@ use super::schemas::{
     SCHEMA_ENCODING, SWEEP_SCHEMA_JSON,
 };
 use super::validate::{validate_outcome, validate_scene, validate_sweep};
+use crate::atomic::PendingFile;
 
 /// The library string written into every trace: `sweeptrace <version>`.
 pub fn library_string() -> String {
@@ -243,23 +244,7 @@ pub fn write_trace_file<T, E: From<TraceError>>(
         messages: 0,
         source,
     };
-    let dir = match path.parent() {
-        Some(parent) if !parent.as_os_str().is_empty() => parent,
-        _ => Path::new("."),
-    };
-    let prefix = format!(
-        ".{}.",
-        path.file_name()
-            .map(|n| n.to_string_lossy().into_owned())
-            .unwrap_or_default()
-    );
-    let mut builder = tempfile::Builder::new();
-    builder.prefix(&prefix).suffix(".tmp");
-    // A trace is an ordinary file (temporary files are private by default).
-    #[cfg(unix)]
-    builder.permissions(std::os::unix::fs::PermissionsExt::from_mode(0o644));
-    let temp = builder.tempfile_in(dir).map_err(io)?;
-    let (file, temp_path) = temp.into_parts();
+    let (pending, file) = PendingFile::create(path).map_err(io)?;
     let mut writer =
         TraceWriter::build(BufWriter::new(file), default_write_options(), name.clone())?;
     let value = f(&mut writer)?;
@@ -276,10 +261,10 @@ pub fn write_trace_file<T, E: From<TraceError>>(
         source,
     })?;
     drop(file);
-    temp_path.persist(path).map_err(|e| TraceError::Io {
+    pending.commit().map_err(|source| TraceError::Io {
         file: name.clone(),
         messages,
-        source: e.error,
+        source,
     })?;
     Ok(value)
 }

@@ -1,0 +1,66 @@
+//! Output files that appear complete or not at all: written under a
+//! temporary name in the target's directory (so the final rename stays on
+//! one file system) and renamed into place only when finished. A pending
+//! file that is dropped without [`PendingFile::commit`] is removed.
+
+use std::fs::File;
+use std::io;
+use std::path::{Path, PathBuf};
+
+/// A file being written next to its target.
+#[derive(Debug)]
+pub struct PendingFile {
+    temp: tempfile::TempPath,
+    target: PathBuf,
+}
+
+impl PendingFile {
+    /// Creates the temporary file next to `target` and opens it for writing.
+    pub fn create(target: &Path) -> io::Result<(PendingFile, File)> {
+        let name = target
+            .file_name()
+            .map(|n| n.to_string_lossy().into_owned())
+            .unwrap_or_default();
+        let prefix = format!(".{name}.");
+        let mut builder = tempfile::Builder::new();
+        builder.prefix(&prefix).suffix(".tmp");
+        // An ordinary file once renamed (temporary files are private by default).
+        #[cfg(unix)]
+        builder.permissions(std::os::unix::fs::PermissionsExt::from_mode(0o644));
+        let (file, temp) = builder.tempfile_in(dir_of(target))?.into_parts();
+        let pending = PendingFile {
+            temp,
+            target: target.to_path_buf(),
+        };
+        Ok((pending, file))
+    }
+
+    /// Creates the temporary file next to `target`, for writers that open
+    /// it by its path ([`PendingFile::path`]).
+    pub fn new(target: &Path) -> io::Result<PendingFile> {
+        let (pending, _file) = PendingFile::create(target)?;
+        Ok(pending)
+    }
+
+    /// The temporary file's path.
+    pub fn path(&self) -> &Path {
+        &self.temp
+    }
+
+    /// The final path.
+    pub fn target(&self) -> &Path {
+        &self.target
+    }
+
+    /// Renames the finished file to its target.
+    pub fn commit(self) -> io::Result<()> {
+        self.temp.persist(&self.target).map_err(|e| e.error)
+    }
+}
+
+fn dir_of(target: &Path) -> &Path {
+    match target.parent() {
+        Some(parent) if !parent.as_os_str().is_empty() => parent,
+        _ => Path::new("."),
+    }
+}

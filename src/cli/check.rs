@@ -8,9 +8,8 @@ use anyhow::{Context, bail};
 
 use sweeptrace::atomic::PendingFile;
 use sweeptrace::check::{
-    CheckOptions, DEFAULT_ALPHA_TOLERANCE, DEFAULT_CONTACT_TOLERANCE, DEFAULT_MAX_DETAILS,
-    DEFAULT_NORMAL_TOLERANCE_DEGREES, Status, Tolerances, TraceReport, check_file, find_traces,
-    frames_around, render_json, render_text,
+    CheckOptions, DEFAULT_MAX_DETAILS, Status, TraceReport, check_file, find_traces, frames_around,
+    render_json, render_text,
 };
 use sweeptrace::replay::{Detail, ReplayError, ReplayEvent, ReplayOptions, replay_events};
 use sweeptrace::trace::TraceReader;
@@ -36,15 +35,8 @@ pub struct Args {
     /// Trace files, or directories searched recursively for `*.mcap`.
     #[arg(value_name = "TRACE|DIR", required = true)]
     pub paths: Vec<PathBuf>,
-    /// Absolute tolerance on α.
-    #[arg(long, value_name = "A", default_value_t = DEFAULT_ALPHA_TOLERANCE)]
-    pub tolerance: f64,
-    /// Angular tolerance on the normal, in degrees.
-    #[arg(long, value_name = "DEG", default_value_t = DEFAULT_NORMAL_TOLERANCE_DEGREES)]
-    pub normal_tolerance: f64,
-    /// Distance tolerance on the contact point, in scene units.
-    #[arg(long, value_name = "D", default_value_t = DEFAULT_CONTACT_TOLERANCE)]
-    pub contact_tolerance: f64,
+    #[command(flatten)]
+    pub tolerances: super::ToleranceArgs,
     /// Print one JSON document instead of text.
     #[arg(long)]
     pub json: bool,
@@ -59,14 +51,7 @@ pub struct Args {
 
 /// Checks every trace, prints the reports, returns the exit code.
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
-    let tolerances = Tolerances {
-        alpha: args.tolerance,
-        normal_degrees: args.normal_tolerance,
-        contact: args.contact_tolerance,
-    };
-    if let Err(e) = tolerances.validate() {
-        bail!("{e}");
-    }
+    let tolerances = args.tolerances.to_tolerances()?;
     let traces = find_traces(&args.paths).map_err(anyhow::Error::msg)?;
     if traces.is_empty() {
         bail!(

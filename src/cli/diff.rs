@@ -8,10 +8,6 @@ use std::process::ExitCode;
 
 use anyhow::{Context, bail};
 
-use sweeptrace::check::{
-    DEFAULT_ALPHA_TOLERANCE, DEFAULT_CONTACT_TOLERANCE, DEFAULT_NORMAL_TOLERANCE_DEGREES,
-    Tolerances,
-};
 use sweeptrace::core::Facing;
 use sweeptrace::diff::{Side, diff, render_json, render_text};
 use sweeptrace::replay::{FrameRange, ReplayOptions};
@@ -52,15 +48,8 @@ pub struct Args {
     /// Only ball N.
     #[arg(long, value_name = "N")]
     pub ball: Option<u32>,
-    /// Absolute tolerance on α.
-    #[arg(long, value_name = "A", default_value_t = DEFAULT_ALPHA_TOLERANCE)]
-    pub tolerance: f64,
-    /// Angular tolerance on the normal, in degrees.
-    #[arg(long, value_name = "DEG", default_value_t = DEFAULT_NORMAL_TOLERANCE_DEGREES)]
-    pub normal_tolerance: f64,
-    /// Distance tolerance on the contact point, in scene units.
-    #[arg(long, value_name = "D", default_value_t = DEFAULT_CONTACT_TOLERANCE)]
-    pub contact_tolerance: f64,
+    #[command(flatten)]
+    pub tolerances: super::ToleranceArgs,
     /// Print one JSON object instead of text.
     #[arg(long)]
     pub json: bool,
@@ -75,14 +64,7 @@ fn side(path: &Path, options: ReplayOptions) -> anyhow::Result<Side> {
 
 /// Compares the two replays.
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
-    let tolerances = Tolerances {
-        alpha: args.tolerance,
-        normal_degrees: args.normal_tolerance,
-        contact: args.contact_tolerance,
-    };
-    if let Err(e) = tolerances.validate() {
-        bail!("{e}");
-    }
+    let tolerances = args.tolerances.to_tolerances()?;
     for (flag, m) in [("--margin-a", args.margin_a), ("--margin-b", args.margin_b)] {
         if let Some(m) = m
             && !(m.is_finite() && m >= 0.0)

@@ -53,6 +53,33 @@ pub fn run(cli: Cli) -> anyhow::Result<ExitCode> {
     }
 }
 
+/// The comparison tolerances of `check` and `diff`.
+#[derive(Debug, clap::Args)]
+pub struct ToleranceArgs {
+    /// Absolute tolerance on α.
+    #[arg(long, value_name = "A", default_value_t = sweeptrace::check::DEFAULT_ALPHA_TOLERANCE)]
+    pub tolerance: f64,
+    /// Angular tolerance on the normal, in degrees.
+    #[arg(long, value_name = "DEG", default_value_t = sweeptrace::check::DEFAULT_NORMAL_TOLERANCE_DEGREES)]
+    pub normal_tolerance: f64,
+    /// Distance tolerance on the contact point, in scene units.
+    #[arg(long, value_name = "D", default_value_t = sweeptrace::check::DEFAULT_CONTACT_TOLERANCE)]
+    pub contact_tolerance: f64,
+}
+
+impl ToleranceArgs {
+    /// The library's tolerances, validated.
+    pub fn to_tolerances(&self) -> anyhow::Result<sweeptrace::check::Tolerances> {
+        let tolerances = sweeptrace::check::Tolerances {
+            alpha: self.tolerance,
+            normal_degrees: self.normal_tolerance,
+            contact: self.contact_tolerance,
+        };
+        tolerances.validate().map_err(anyhow::Error::msg)?;
+        Ok(tolerances)
+    }
+}
+
 /// Parses `x,y,z` into three finite numbers.
 pub fn parse_point(s: &str) -> Result<[f64; 3], String> {
     let parts: Vec<&str> = s.split(',').map(str::trim).collect();

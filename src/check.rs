@@ -26,12 +26,14 @@ use std::sync::Arc;
 use serde::Serialize;
 use serde_json::{Value, json};
 
-use crate::core::explain::{describe, label, num};
+use crate::core::explain::{describe, label, nearest_miss, num};
 use crate::core::{
     Broadphase, CollectRecords, Kind, Outcome, SIMULTANEOUS_TOLERANCE, TestRecord, Verdict,
     sweep_mesh_with,
 };
-use crate::replay::{ReplayError, ReplayEvent, ReplayOptions, SceneState, SweepResult};
+use crate::replay::{
+    ReplayError, ReplayEvent, ReplayOptions, SceneState, SweepResult, primary_records,
+};
 use crate::trace::messages::{EXPECTED_TOPIC, OutcomeMsg};
 use crate::trace::{TraceError, TraceEvent, TraceReader};
 
@@ -558,36 +560,24 @@ pub fn explained_records(result: &SweepResult, scene: &SceneState) -> Vec<TestRe
 /// hit, the nearest miss.
 pub fn explain_outcome(outcome: &Outcome, records: &[TestRecord]) -> Vec<String> {
     if !outcome.is_hit() {
-        let nearest = records
-            .iter()
-            .filter_map(|r| crate::core::explain::miss_distance(r).map(|d| (d, r)))
-            .min_by(|a, b| a.0.total_cmp(&b.0));
-        return match nearest {
-            Some((_, r)) => vec![format!("no test hit; nearest miss: {}", describe(r))],
+        return match nearest_miss(records) {
+            Some(r) => vec![format!("no test hit; nearest miss: {}", describe(r))],
             None => vec!["no test hit (no triangle was tested)".to_string()],
         };
     }
-    let is_primary = |r: &TestRecord| {
-        r.alpha().is_some()
-            && Some(r.triangle()) == outcome.triangle
-            && r.kind() == outcome.kind
-            && Some(r.feature()) == outcome.feature
-    };
-    let mut out: Vec<String> = records
-        .iter()
-        .filter(|r| is_primary(r))
-        .take(1)
+    let decided = primary_records(outcome, records.to_vec());
+    let primary = decided.iter().find(|r| outcome.is_reported_by(r));
+    primary
         .map(|r| format!("primary: {}", describe(r)))
-        .collect();
-    let limit = outcome.alpha + SIMULTANEOUS_TOLERANCE;
-    out.extend(
-        records
-            .iter()
-            .filter(|r| r.alpha().is_some_and(|a| a <= limit) && !is_primary(r))
-            .take(8)
-            .map(|r| format!("also at this α: {}", describe(r))),
-    );
-    out
+        .into_iter()
+        .chain(
+            decided
+                .iter()
+                .filter(|r| !outcome.is_reported_by(r))
+                .take(8)
+                .map(|r| format!("also at this α: {}", describe(r))),
+        )
+        .collect()
 }
 
 /// The tests that would have produced `expected`, each with why it did not

@@ -20,7 +20,7 @@ use std::time::{Duration, Instant};
 
 use thiserror::Error;
 
-use crate::core::explain::miss_distance;
+use crate::core::explain::nearest_miss;
 use crate::core::{
     Broadphase, CollectRecords, Facing, Kind, Mesh, MeshError, Options, Outcome,
     SIMULTANEOUS_TOLERANCE, Sweep, SweepError, TestRecord, Verdict, sweep_mesh, sweep_mesh_with,
@@ -218,7 +218,7 @@ impl SweepResult {
     /// hit, otherwise the nearest miss among the kept records.
     pub fn decisive_record(&self) -> Option<&TestRecord> {
         if self.outcome.is_hit() {
-            self.records.iter().find(|r| is_primary(r, &self.outcome))
+            self.records.iter().find(|r| self.outcome.is_reported_by(r))
         } else {
             nearest_miss(&self.records)
         }
@@ -690,33 +690,16 @@ pub fn compute_sweep(
     })
 }
 
-fn is_primary(r: &TestRecord, outcome: &Outcome) -> bool {
-    r.alpha().is_some()
-        && Some(r.triangle()) == outcome.triangle
-        && r.kind() == outcome.kind
-        && Some(r.feature()) == outcome.feature
-}
-
-fn nearest_miss(records: &[TestRecord]) -> Option<&TestRecord> {
-    let mut best: Option<(f64, &TestRecord)> = None;
-    for r in records {
-        if let Some(d) = miss_distance(r)
-            && best.is_none_or(|(b, _)| d < b)
-        {
-            best = Some((d, r));
-        }
-    }
-    best.map(|(_, r)| r)
-}
-
-/// The records of [`Detail::Primary`].
-fn primary_records(outcome: &Outcome, records: Vec<TestRecord>) -> Vec<TestRecord> {
+/// The records of [`Detail::Primary`]: the primary test, then every other
+/// hit within [`SIMULTANEOUS_TOLERANCE`] of its `α`; when nothing is hit,
+/// the nearest miss.
+pub fn primary_records(outcome: &Outcome, records: Vec<TestRecord>) -> Vec<TestRecord> {
     if !outcome.is_hit() {
         return nearest_miss(&records).copied().into_iter().collect();
     }
     let mut out: Vec<TestRecord> = records
         .iter()
-        .filter(|r| is_primary(r, outcome))
+        .filter(|r| outcome.is_reported_by(r))
         .take(1)
         .copied()
         .collect();
@@ -724,7 +707,7 @@ fn primary_records(outcome: &Outcome, records: Vec<TestRecord>) -> Vec<TestRecor
     out.extend(
         records
             .into_iter()
-            .filter(|r| r.alpha().is_some_and(|a| a <= limit) && !is_primary(r, outcome)),
+            .filter(|r| r.alpha().is_some_and(|a| a <= limit) && !outcome.is_reported_by(r)),
     );
     out
 }

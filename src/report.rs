@@ -57,18 +57,10 @@ pub fn came_close(r: &TestRecord) -> bool {
     )
 }
 
-/// Whether `t` is the test that produced the primary collision.
-pub fn is_primary(o: &Outcome, t: &TestRecord) -> bool {
-    o.is_hit()
-        && o.triangle == Some(t.triangle())
-        && o.kind == t.kind()
-        && o.feature == Some(t.feature())
-}
-
 /// A marker for the primary test and for other hits at the same `α`
 /// (simultaneous: their triangles' normals are averaged).
 fn role(o: &Outcome, t: &TestRecord) -> &'static str {
-    if is_primary(o, t) {
+    if o.is_reported_by(t) {
         "   <- primary"
     } else if t
         .alpha()
@@ -174,7 +166,7 @@ pub fn sweep_json(r: &SweepReport) -> String {
             let mut v = serde_json::to_value(t).unwrap_or(serde_json::Value::Null);
             if let Some(obj) = v.as_object_mut() {
                 obj.insert("explanation".into(), json!(describe(t)));
-                obj.insert("primary".into(), json!(is_primary(r.outcome, t)));
+                obj.insert("primary".into(), json!(r.outcome.is_reported_by(t)));
             }
             v
         })

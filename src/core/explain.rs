@@ -241,6 +241,16 @@ fn describe_vertex(w: &mut impl Write, r: &VertexRecord) -> fmt::Result {
     }
 }
 
+/// The rejected test that came nearest to a hit ([`miss_distance`]); the
+/// first of equals.
+pub fn nearest_miss(records: &[TestRecord]) -> Option<&TestRecord> {
+    records
+        .iter()
+        .filter_map(|r| miss_distance(r).map(|d| (d, r)))
+        .min_by(|a, b| a.0.total_cmp(&b.0))
+        .map(|(_, r)| r)
+}
+
 /// How close a rejected test came to a hit, for choosing the "nearest miss"
 /// to explain when nothing is hit: smaller is closer. `None` for hits.
 pub fn miss_distance(record: &TestRecord) -> Option<f64> {

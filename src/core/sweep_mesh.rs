@@ -8,7 +8,7 @@ use super::error::SweepError;
 use super::mesh::{Mesh, Triangle};
 use super::options::{Options, SIMULTANEOUS_TOLERANCE};
 use super::path::{Path, Sweep};
-use super::record::{Kind, NoObserver, Observer, Verdict};
+use super::record::{Kind, NoObserver, Observer, TestRecord, Verdict};
 use super::sweep_edge::sweep_edge;
 use super::sweep_face::sweep_face;
 use super::sweep_vertex::sweep_vertex;
@@ -46,6 +46,15 @@ impl Outcome {
     /// Whether something was hit.
     pub fn is_hit(&self) -> bool {
         self.kind != Kind::None
+    }
+
+    /// Whether `record` is the test that reported this outcome's primary
+    /// collision (a hit on the same triangle, kind and feature).
+    pub fn is_reported_by(&self, record: &TestRecord) -> bool {
+        record.alpha().is_some()
+            && Some(record.triangle()) == self.triangle
+            && record.kind() == self.kind
+            && Some(record.feature()) == self.feature
     }
 }
 

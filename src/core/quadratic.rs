@@ -29,13 +29,6 @@ pub fn solve(a: f64, b: f64, c: f64, discriminant: f64) -> Option<(f64, f64)> {
     Some(if r0 <= r1 { (r0, r1) } else { (r1, r0) })
 }
 
-/// `B² - 4AC` as written: only for well-scaled inputs. The sweeps compute
-/// the same value as `4 (ρ² A - |w|²)` (see [`discriminant_from_cross`]).
-#[inline]
-pub fn discriminant(a: f64, b: f64, c: f64) -> f64 {
-    b * b - 4.0 * a * c
-}
-
 /// `B² - 4AC` of a ball-versus-line or ball-versus-point quadratic, computed
 /// without cancellation: with `A = |d|²`, `B = 2 d·m`, `C = |m|² - ρ²`
 /// (Lagrange's identity `|d|²|m|² - (d·m)² = |d × m|²`),

@@ -43,9 +43,8 @@ pub fn sweep_edge(triangle: &Triangle, edge: u8, path: &Path, facing: Facing) ->
     let parallel_limit = PARALLEL_TOLERANCE * path.length;
     record.verdict = if a <= parallel_limit * parallel_limit {
         Verdict::Parallel
-    } else if discriminant < 0.0 {
-        Verdict::NoRealRoots
     } else {
+        // `solve` answers `None` for a negative (or NaN) discriminant.
         match quadratic::solve(a, b, c, discriminant) {
             None => Verdict::NoRealRoots,
             Some((s0, s1)) => {

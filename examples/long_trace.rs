@@ -17,7 +17,7 @@ use std::io::{Seek, Write};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use sweeptrace::core::Facing;
-use sweeptrace::scenes;
+use sweeptrace::sim::scenes;
 use sweeptrace::trace::messages::{SceneMsg, SweepMsg};
 use sweeptrace::trace::{TraceError, TraceWriter};
 

@@ -5,13 +5,10 @@
 //! Start with [`core`] (the collision tests) and [`scenes`] (built-in meshes).
 
 pub mod atomic;
-pub mod bless;
-pub mod check;
 pub mod core;
-pub mod diff;
+pub mod regress;
 pub mod replay;
 pub mod report;
-pub mod scenes;
 pub mod sim;
 pub mod trace;
 #[cfg(feature = "viewer")]

@@ -19,13 +19,13 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 
 use libtest_mimic::{Failed, Trial};
-use sweeptrace::bless::bless_bytes;
-use sweeptrace::check::{
+use sweeptrace::core::{Facing, Kind};
+use sweeptrace::regress::bless_bytes;
+use sweeptrace::regress::{
     CheckOptions, Field, Status, Tolerances, check_file, check_reader, compare, find_traces,
     render_json, render_text,
 };
-use sweeptrace::core::{Facing, Kind};
-use sweeptrace::diff::{Side, diff};
+use sweeptrace::regress::{Side, diff};
 use sweeptrace::replay::ReplayOptions;
 use sweeptrace::trace::messages::{OutcomeMsg, SceneMsg, SweepMsg};
 use sweeptrace::trace::{TraceReader, TraceWriter};
@@ -185,7 +185,7 @@ fn fixture_bytes() -> Result<Vec<u8>, String> {
     )
 }
 
-fn check_bytes(bytes: &[u8]) -> sweeptrace::check::TraceReport {
+fn check_bytes(bytes: &[u8]) -> sweeptrace::regress::TraceReport {
     check_reader(bytes, "<memory>", &CheckOptions::default())
 }
 
@@ -347,7 +347,7 @@ fn blessed_trace_passes() -> Result<(), String> {
     Ok(())
 }
 
-fn check_fixture_report(report: &sweeptrace::check::TraceReport) -> Result<(), String> {
+fn check_fixture_report(report: &sweeptrace::regress::TraceReport) -> Result<(), String> {
     let text = render_text(report);
     ensure!(
         report.status == Status::Fail,
@@ -850,7 +850,7 @@ fn diff_facing() -> Result<(), String> {
     })
     .map_err(|e| e.to_string())?;
     let r = diff(&a, &b, &Tolerances::default());
-    let text = sweeptrace::diff::render_text(&r);
+    let text = sweeptrace::regress::diff::render_text(&r);
     ensure!(!r.is_same() && r.different == 1, "{text}");
     let first = r.first.as_ref().ok_or("no first divergence")?;
     ensure!(first.frame == 5, "first divergence at frame 5: {text}");

@@ -724,7 +724,7 @@ fn shared_edge_neither() -> Result<(), String> {
 fn cube_averaged_normal() -> Result<(), String> {
     // Worked example 5: distance to the edge x = 1, z = 1 is 0.5 when
     // 0.0625 + (z - 1)² = 0.25, z = 1.43301, β = (3 - 1.43301)/6 = 0.26116.
-    let cube = sweeptrace::scenes::cube()
+    let cube = sweeptrace::sim::scenes::cube()
         .to_mesh()
         .map_err(|e| e.to_string())?;
     let o = sweep_mesh(
@@ -765,7 +765,7 @@ fn margin_case() -> Result<(), String> {
 fn standard_frame_round_trip() -> Result<(), String> {
     // For every edge of every cube triangle: v0 → origin, v1 → (L,0,0), the
     // third vertex at y = 0, z ≤ 0; world_from_edge inverts to_edge.
-    let cube = sweeptrace::scenes::cube()
+    let cube = sweeptrace::sim::scenes::cube()
         .to_mesh()
         .map_err(|e| e.to_string())?;
     for t in cube.triangles() {

@@ -9,7 +9,7 @@ use libtest_mimic::Trial;
 use nalgebra::{Point3, Vector3};
 
 use sweeptrace::core::{Facing, Kind, Mesh, Options, Sweep, sweep_mesh};
-use sweeptrace::scenes::{self, SceneMesh};
+use sweeptrace::sim::scenes::{self, BuiltinScene, SceneMesh};
 use sweeptrace::sim::{self, SimError, SimOptions};
 use sweeptrace::trace::messages::{OutcomeMsg, SceneMsg, SweepMsg};
 use sweeptrace::trace::{TraceEvent, TraceReader, TraceWriter};
@@ -64,7 +64,9 @@ type BoxError = Box<dyn std::error::Error + Send + Sync>;
 
 /// A small scene for the simulation tests (the terrain at 32 cells).
 fn scene(name: &str) -> SceneMesh {
-    sim::builtin_scene(name, 32).expect("built-in scene")
+    BuiltinScene::from_name(name)
+        .expect("built-in scene")
+        .mesh_with_terrain_cells(32)
 }
 
 /// Records `scene` with `options` into memory, as `sweeptrace record` does.
@@ -84,7 +86,7 @@ fn record(scene: &SceneMesh, options: &SimOptions) -> Result<Vec<u8>, String> {
 }
 
 /// Every sweep and outcome of a simulation, without a trace.
-fn events(mesh: &Mesh, options: &SimOptions) -> Result<(Vec<sim::Event>, sim::Summary), String> {
+fn events(mesh: &Mesh, options: &SimOptions) -> Result<(Vec<sim::Event>, sim::SimSummary), String> {
     let mut out = Vec::new();
     let summary = sim::simulate(mesh, options, |e| -> Result<(), SimError> {
         out.push(*e);
@@ -125,7 +127,9 @@ fn same_seed_gives_identical_bytes() -> Result<(), String> {
         let s = scene(name);
         let options = SimOptions {
             frames: 120,
-            ..SimOptions::for_scene(name)
+            ..BuiltinScene::from_name(name)
+                .expect("built-in scene")
+                .sim_options()
         };
         let a = record(&s, &options)?;
         let b = record(&s, &options)?;
@@ -161,7 +165,9 @@ fn expected_equals_rerun() -> Result<(), String> {
             frames: 150,
             margin,
             facing,
-            ..SimOptions::for_scene(name)
+            ..BuiltinScene::from_name(name)
+                .expect("built-in scene")
+                .sim_options()
         };
         let bytes = record(&s, &options)?;
         let trace = read(&bytes, name)?;
@@ -207,7 +213,7 @@ fn finite(p: &[f64; 3]) -> bool {
     p.iter().all(|v| v.is_finite())
 }
 
-fn check_bounded(name: &str, mesh: &Mesh, options: &SimOptions) -> Result<sim::Summary, String> {
+fn check_bounded(name: &str, mesh: &Mesh, options: &SimOptions) -> Result<sim::SimSummary, String> {
     let (lo, hi) = sim::play_volume(mesh, options.radius);
     let (events, summary) = events(mesh, options)?;
     ensure!(!events.is_empty(), "{name}: no sweeps");
@@ -251,15 +257,17 @@ fn check_bounded(name: &str, mesh: &Mesh, options: &SimOptions) -> Result<sim::S
 }
 
 fn no_nan_and_bounded() -> Result<(), String> {
-    for name in scenes::NAMES {
+    for name in BuiltinScene::all().map(BuiltinScene::name) {
         let s = scene(name);
         let mesh = s.to_mesh().map_err(|e| e.to_string())?;
         let options = SimOptions {
             frames: 200,
-            ..SimOptions::for_scene(name)
+            ..BuiltinScene::from_name(name)
+                .expect("built-in scene")
+                .sim_options()
         };
         let summary = check_bounded(name, &mesh, &options)?;
-        if *name == "box" {
+        if name == "box" {
             ensure!(
                 summary.stopped.is_empty(),
                 "box: a ball escaped the closed box: {:?}",
@@ -279,7 +287,7 @@ fn runaway_balls_are_stopped() -> Result<(), String> {
         velocity_jitter: 1e5,
         gravity: [0.0, 0.0, -1e9],
         frames: 1000,
-        ..SimOptions::for_scene("triangle")
+        ..BuiltinScene::Triangle.sim_options()
     };
     let summary = check_bounded("triangle", &mesh, &options)?;
     ensure!(
@@ -299,7 +307,7 @@ fn sub_steps_are_separate_frames() -> Result<(), String> {
     let mesh = s.to_mesh().map_err(|e| e.to_string())?;
     let options = SimOptions {
         frames: 300,
-        ..SimOptions::for_scene("box")
+        ..BuiltinScene::Box.sim_options()
     };
     let (events, summary) = events(&mesh, &options)?;
     let mut seen = HashSet::new();
@@ -414,8 +422,10 @@ fn invalid_options_are_errors() -> Result<(), String> {
 }
 
 fn scenes_have_no_degenerate_triangles() -> Result<(), String> {
-    for name in scenes::NAMES {
-        let s = scenes::by_name(name).ok_or(format!("{name} missing"))?;
+    for name in BuiltinScene::all().map(BuiltinScene::name) {
+        let s = BuiltinScene::from_name(name)
+            .map(BuiltinScene::mesh)
+            .ok_or(format!("{name} missing"))?;
         ensure!(s.name == *name, "scene `{name}` is named `{}`", s.name);
         let mesh = s.to_mesh().map_err(|e| format!("{name}: {e}"))?;
         ensure!(
@@ -431,12 +441,14 @@ fn scenes_have_no_degenerate_triangles() -> Result<(), String> {
         );
         // Cheap and deterministic.
         ensure!(
-            scenes::by_name(name) == Some(s),
+            BuiltinScene::from_name(name).map(BuiltinScene::mesh) == Some(s),
             "{name}: two builds differ"
         );
     }
     ensure!(
-        scenes::by_name("no_such_scene").is_none(),
+        BuiltinScene::from_name("no_such_scene")
+            .map(BuiltinScene::mesh)
+            .is_none(),
         "unknown names must give None"
     );
     Ok(())
@@ -450,7 +462,9 @@ fn check_sides(
     plays: impl Fn(&Point3<f64>) -> bool,
     hidden: impl Fn(&Point3<f64>) -> bool,
 ) -> Result<(), String> {
-    let s = scenes::by_name(name).ok_or(format!("{name} missing"))?;
+    let s = BuiltinScene::from_name(name)
+        .map(BuiltinScene::mesh)
+        .ok_or(format!("{name} missing"))?;
     let mesh = s.to_mesh().map_err(|e| e.to_string())?;
     for t in mesh.triangles() {
         let [a, b, c] = t.vertices;
@@ -528,7 +542,9 @@ fn scenes_face_the_play_side() -> Result<(), String> {
 }
 
 fn terrain_size() -> Result<(), String> {
-    let t = scenes::by_name("terrain").ok_or("terrain missing")?;
+    let t = BuiltinScene::from_name("terrain")
+        .map(BuiltinScene::mesh)
+        .ok_or("terrain missing")?;
     ensure!(
         t.triangles.len() >= 100_000,
         "terrain has {} triangles",
@@ -574,7 +590,7 @@ fn obj_loads() -> Result<(), String> {
                 o quad\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 4\n\
                 o tri\nv 0 0 1\nv 1 0 1\nv 0 1 1\nf 5 6 7\n";
     std::fs::write(&path, text).map_err(|e| e.to_string())?;
-    let scene = scenes::load_obj(&path).map_err(|e| e.to_string())?;
+    let scene = sim::load_obj(&path).map_err(|e| e.to_string())?;
     ensure!(scene.name == "ramp", "named `{}`", scene.name);
     ensure!(
         scene.triangles.len() == 3,
@@ -629,7 +645,7 @@ fn bad_obj_errors() -> Result<(), String> {
     for (file, text, want) in cases {
         let path = dir.path().join(file);
         std::fs::write(&path, text).map_err(|e| e.to_string())?;
-        match scenes::load_obj(&path) {
+        match sim::load_obj(&path) {
             Ok(s) => {
                 return Err(format!(
                     "{file}: loaded {} triangles, expected an error",
@@ -646,7 +662,7 @@ fn bad_obj_errors() -> Result<(), String> {
         }
     }
     let missing = dir.path().join("missing.obj");
-    match scenes::load_obj(&missing) {
+    match sim::load_obj(&missing) {
         Err(e) => ensure!(e.to_string().contains("cannot read"), "missing file: `{e}`"),
         Ok(_) => return Err("a missing file loaded".into()),
     }

@@ -18,11 +18,12 @@ use sweeptrace::core::{
     TestRecord, sweep_mesh, sweep_mesh_with,
 };
 use sweeptrace::replay::{
-    Detail, FrameRange, ReplayEvent, ReplayOptions, Summary, SweepResult, replay_events,
+    Detail, FrameRange, ReplayEvent, ReplayOptions, ReplaySummary, SweepResult, replay_events,
 };
+use sweeptrace::sim::scenes;
 use sweeptrace::trace::messages::{OutcomeMsg, SceneMsg, SweepMsg};
 use sweeptrace::trace::{TraceError, TraceEvent, TraceReader, TraceWriter};
-use sweeptrace::{scenes, viz};
+use sweeptrace::viz;
 
 use crate::ensure;
 use crate::trial;
@@ -148,7 +149,10 @@ fn events_for(scene: SceneMsg, sweeps: &[SweepMsg]) -> Events {
     ev
 }
 
-fn run(events: Events, options: ReplayOptions) -> Result<(Vec<SweepResult>, Summary), String> {
+fn run(
+    events: Events,
+    options: ReplayOptions,
+) -> Result<(Vec<SweepResult>, ReplaySummary), String> {
     let mut it = replay_events(events.into_iter(), options);
     let mut out = Vec::new();
     for e in it.by_ref() {

@@ -1,13 +1,13 @@
 //! `sweeptrace bless`: rewrite a trace's `/expected` channel with the
 //! current core's outcomes, keeping every other channel, schema, metadata
-//! record and attachment (the library's [`sweeptrace::bless`]).
+//! record and attachment (the library's [`sweeptrace::regress`]).
 
 use std::path::PathBuf;
 use std::process::ExitCode;
 
 use anyhow::{Context, bail};
 
-use sweeptrace::bless::bless_file;
+use sweeptrace::regress::bless_file;
 use sweeptrace::replay::ReplayOptions;
 
 /// Arguments of `bless`.

@@ -1,5 +1,5 @@
 //! `sweeptrace check`: replay traces and compare every sweep's outcome with
-//! the trace's `/expected` channel (the library's [`sweeptrace::check`]).
+//! the trace's `/expected` channel (the library's [`sweeptrace::regress`]).
 
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -7,7 +7,7 @@ use std::process::ExitCode;
 use anyhow::{Context, bail};
 
 use sweeptrace::atomic::PendingFile;
-use sweeptrace::check::{
+use sweeptrace::regress::{
     CheckOptions, DEFAULT_MAX_DETAILS, Status, TraceReport, check_file, find_traces, frames_around,
     render_json, render_text,
 };

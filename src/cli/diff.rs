@@ -1,5 +1,5 @@
 //! `sweeptrace diff`: compare the outcomes of two replays, sweep by sweep
-//! (the library's [`sweeptrace::diff`]).
+//! (the library's [`sweeptrace::regress`]).
 
 use std::fs::File;
 use std::io::BufReader;
@@ -9,7 +9,8 @@ use std::process::ExitCode;
 use anyhow::{Context, bail};
 
 use sweeptrace::core::Facing;
-use sweeptrace::diff::{Side, diff, render_json, render_text};
+use sweeptrace::regress::diff::{render_json, render_text};
+use sweeptrace::regress::{Side, diff};
 use sweeptrace::replay::{FrameRange, ReplayOptions};
 use sweeptrace::trace::TraceReader;
 

@@ -57,20 +57,20 @@ pub fn run(cli: Cli) -> anyhow::Result<ExitCode> {
 #[derive(Debug, clap::Args)]
 pub struct ToleranceArgs {
     /// Absolute tolerance on α.
-    #[arg(long, value_name = "A", default_value_t = sweeptrace::check::DEFAULT_ALPHA_TOLERANCE)]
+    #[arg(long, value_name = "A", default_value_t = sweeptrace::regress::DEFAULT_ALPHA_TOLERANCE)]
     pub tolerance: f64,
     /// Angular tolerance on the normal, in degrees.
-    #[arg(long, value_name = "DEG", default_value_t = sweeptrace::check::DEFAULT_NORMAL_TOLERANCE_DEGREES)]
+    #[arg(long, value_name = "DEG", default_value_t = sweeptrace::regress::DEFAULT_NORMAL_TOLERANCE_DEGREES)]
     pub normal_tolerance: f64,
     /// Distance tolerance on the contact point, in scene units.
-    #[arg(long, value_name = "D", default_value_t = sweeptrace::check::DEFAULT_CONTACT_TOLERANCE)]
+    #[arg(long, value_name = "D", default_value_t = sweeptrace::regress::DEFAULT_CONTACT_TOLERANCE)]
     pub contact_tolerance: f64,
 }
 
 impl ToleranceArgs {
     /// The library's tolerances, validated.
-    pub fn to_tolerances(&self) -> anyhow::Result<sweeptrace::check::Tolerances> {
-        let tolerances = sweeptrace::check::Tolerances {
+    pub fn to_tolerances(&self) -> anyhow::Result<sweeptrace::regress::Tolerances> {
+        let tolerances = sweeptrace::regress::Tolerances {
             alpha: self.tolerance,
             normal_degrees: self.normal_tolerance,
             contact: self.contact_tolerance,

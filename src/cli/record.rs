@@ -4,16 +4,16 @@ use std::io::IsTerminal;
 use std::path::PathBuf;
 use std::process::ExitCode;
 
-use anyhow::{Context, bail};
+use anyhow::Context;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 
 use sweeptrace::core::Facing;
-use sweeptrace::scenes::{self, SceneMesh};
-use sweeptrace::sim::{self, SimOptions, StopReason, Summary};
+use sweeptrace::sim::scenes::{self, BuiltinScene, SceneMesh};
+use sweeptrace::sim::{self, SimOptions, SimSummary, StopReason};
 use sweeptrace::trace::write_trace_file;
 
 /// Arguments of `record`. Every simulation option defaults to the scene's
-/// own choice (`sweeptrace::sim::SimOptions::for_scene`).
+/// own choice (`sweeptrace::sim::BuiltinScene::sim_options`).
 #[derive(Debug, clap::Args)]
 #[command(after_help = "Examples:\n  \
     sweeptrace record --scene mini_golf -o mini_golf.mcap\n  \
@@ -23,8 +23,8 @@ pub struct Args {
     /// Built-in scene: `mini_golf` (green, walls, ramp, cup), `bowl`, `box`
     /// (closed, ball inside), `terrain` (height field, 100,352 triangles by
     /// default), `cube` or `triangle`.
-    #[arg(long, default_value = "mini_golf", conflicts_with = "mesh")]
-    pub scene: String,
+    #[arg(long, value_enum, default_value_t = BuiltinScene::MiniGolf, conflicts_with = "mesh")]
+    pub scene: BuiltinScene,
     /// Record against a Wavefront OBJ file instead of a built-in scene
     /// (faces counter-clockwise seen from the front; the scene is named
     /// after the file).
@@ -115,15 +115,8 @@ impl Args {
 /// Simulates, writes the trace and prints a summary.
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     let scene: SceneMesh = match &args.mesh {
-        Some(path) => scenes::load_obj(path)?,
-        None => match sim::builtin_scene(&args.scene, args.terrain_cells) {
-            Some(scene) => scene,
-            None => bail!(
-                "unknown scene `{}` (built-in scenes: {})",
-                args.scene,
-                scenes::NAMES.join(", ")
-            ),
-        },
+        Some(path) => sim::load_obj(path)?,
+        None => args.scene.mesh_with_terrain_cells(args.terrain_cells),
     };
     let mesh = scene
         .to_mesh()
@@ -142,7 +135,10 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             first.join(", ")
         );
     }
-    let mut defaults = SimOptions::for_scene(&scene.name);
+    let mut defaults = match args.mesh {
+        Some(_) => SimOptions::default(),
+        None => args.scene.sim_options(),
+    };
     if args.mesh.is_some() {
         // A ball above the middle of an unknown mesh.
         let (lo, hi) = mesh.bounds();
@@ -162,7 +158,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     let scene_msg = sim::scene_message(&scene, &options);
 
     let bar = progress_bar(options.frames);
-    let summary = write_trace_file(&output, |writer| -> anyhow::Result<Summary> {
+    let summary = write_trace_file(&output, |writer| -> anyhow::Result<SimSummary> {
         writer.scene(0, &scene_msg)?;
         let mut shown = 0;
         let summary = sim::simulate(&mesh, &options, |event| -> anyhow::Result<()> {
@@ -196,7 +192,7 @@ pub fn summary_paragraph(
     scene: &str,
     triangles: usize,
     options: &SimOptions,
-    s: &Summary,
+    s: &SimSummary,
     file: &str,
 ) -> String {
     let mut text = format!(

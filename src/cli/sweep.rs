@@ -2,11 +2,11 @@
 
 use std::process::ExitCode;
 
-use anyhow::{Context, bail};
+use anyhow::Context;
 
 use sweeptrace::core::{Broadphase, CollectRecords, Facing, Options, Sweep, sweep_mesh_with};
 use sweeptrace::report;
-use sweeptrace::scenes;
+use sweeptrace::sim::BuiltinScene;
 
 /// Arguments of `sweep`.
 #[derive(Debug, clap::Args)]
@@ -17,8 +17,8 @@ pub struct Args {
     /// Built-in scene: `cube` (the cube [-1,1]³, 12 outward triangles),
     /// `triangle` ((0,0,0), (4,0,0), (0,4,0), front +z), `mini_golf`, `bowl`,
     /// `box` (closed, faces inward) or `terrain` (100,352 triangles).
-    #[arg(long, default_value = "cube")]
-    pub scene: String,
+    #[arg(long, value_enum, default_value_t = BuiltinScene::Cube)]
+    pub scene: BuiltinScene,
     /// Radius r of the ball.
     #[arg(long, default_value_t = 0.5, allow_negative_numbers = true)]
     pub radius: f64,
@@ -44,13 +44,7 @@ pub struct Args {
 
 /// Runs the sweep and prints the outcome and explanations.
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
-    let Some(scene) = scenes::by_name(&args.scene) else {
-        bail!(
-            "unknown scene `{}` (built-in scenes: {})",
-            args.scene,
-            scenes::NAMES.join(", ")
-        );
-    };
+    let scene = args.scene.mesh();
     let mesh = scene
         .to_mesh()
         .with_context(|| format!("building scene `{}`", scene.name))?;

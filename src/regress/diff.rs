@@ -2,7 +2,7 @@
 //! twice with different options (`diff T T --facing-b strict`).
 //!
 //! Sweeps are matched by `(frame, ball)`; every field of the two outcomes is
-//! compared with [`crate::check::compare`] and the same [`Tolerances`]. The
+//! compared with [`crate::regress::compare`] and the same [`Tolerances`]. The
 //! [`DiffReport`] counts the sweeps that are the same, differ, or exist on one
 //! side only, summarises the changes by kind (`edge -> none: 12`) and
 //! explains the first divergence on both sides (the tests that decided, from
@@ -15,11 +15,11 @@ use std::sync::Arc;
 use serde::Serialize;
 use serde_json::json;
 
-use crate::check::{
+use crate::core::explain::num;
+use crate::regress::{
     ExpectedTest, FieldDiff, Tolerances, compare, expected_tests, explain_outcome,
     explained_records,
 };
-use crate::core::explain::num;
 use crate::replay::{
     ReplayError, ReplayEvent, ReplayOptions, SceneState, SweepResult, replay_events,
 };
@@ -262,8 +262,8 @@ pub fn render_text(r: &DiffReport) -> String {
                 s,
                 "  {}: A {}, B {}",
                 d.field,
-                crate::check::value_text(&d.expected),
-                crate::check::value_text(&d.got)
+                crate::regress::value_text(&d.expected),
+                crate::regress::value_text(&d.got)
             );
             if let Some(detail) = &d.detail {
                 let _ = write!(s, " ({detail})");

@@ -33,8 +33,12 @@ use rand_chacha::ChaCha8Rng;
 use thiserror::Error;
 
 use crate::core::{Facing, Kind, Mesh, Options, Sweep, SweepError, sweep_mesh};
-use crate::scenes::{self, SceneMesh};
+pub mod obj;
+pub mod scenes;
+
 use crate::trace::messages::{OutcomeMsg, SceneMsg, SweepMsg};
+pub use obj::{ObjError, load_obj, obj_from_reader};
+pub use scenes::{BuiltinScene, SceneMesh};
 
 /// Largest number of simulation frames.
 pub const MAX_FRAMES: u64 = 100_000_000;
@@ -111,86 +115,6 @@ impl Default for SimOptions {
 }
 
 impl SimOptions {
-    /// Default parameters for a built-in scene, chosen so that its trace
-    /// shows face, edge and vertex collisions and misses where the scene
-    /// allows; [`SimOptions::default`] for any other name.
-    pub fn for_scene(name: &str) -> SimOptions {
-        let base = SimOptions::default();
-        match name {
-            // Ball 0 dropped onto the corner (1, 1, 1) (a vertex hit), the
-            // others around it: edge and face hits, then falls off the cube.
-            "cube" => SimOptions {
-                radius: 0.25,
-                position: [1.05, 1.05, 2.5],
-                velocity: [0.0, 0.0, 0.0],
-                balls: 6,
-                position_jitter: 0.5,
-                velocity_jitter: 0.2,
-                frames: 150,
-                ..base
-            },
-            "triangle" => SimOptions {
-                radius: 0.5,
-                position: [1.0, 1.0, 3.0],
-                velocity: [0.5, 0.5, 0.0],
-                balls: 3,
-                position_jitter: 1.0,
-                velocity_jitter: 0.5,
-                frames: 150,
-                ..base
-            },
-            // Putted from the tee up the ramp, over its drop, toward the cup.
-            "mini_golf" => SimOptions {
-                radius: 0.1,
-                position: [1.0, 2.0, 0.2],
-                velocity: [3.0, 0.4, 0.0],
-                balls: 8,
-                position_jitter: 1.2,
-                velocity_jitter: 3.0,
-                frames: 600,
-                restitution: 0.6,
-                ..base
-            },
-            // Released on the rim with a sideways push: it circles the bowl.
-            "bowl" => SimOptions {
-                radius: 0.2,
-                position: [1.5, 0.0, 1.0],
-                velocity: [0.0, 2.5, 1.0],
-                balls: 8,
-                position_jitter: 0.3,
-                velocity_jitter: 1.5,
-                frames: 400,
-                restitution: 0.7,
-                ..base
-            },
-            // Thrown across the box: bounces off every wall.
-            "box" => SimOptions {
-                radius: 0.3,
-                position: [0.0, 0.0, 0.5],
-                velocity: [3.0, 2.0, 4.0],
-                balls: 3,
-                position_jitter: 0.8,
-                velocity_jitter: 2.0,
-                frames: 300,
-                restitution: 0.9,
-                ..base
-            },
-            // Boulders thrown onto the hills: they roll and hop over crests.
-            "terrain" => SimOptions {
-                radius: 0.8,
-                position: [0.0, 0.0, 4.0],
-                velocity: [5.0, 2.0, 3.0],
-                balls: 8,
-                position_jitter: 10.0,
-                velocity_jitter: 3.0,
-                frames: 400,
-                restitution: 0.5,
-                ..base
-            },
-            _ => base,
-        }
-    }
-
     /// Checks every parameter; the error names the field.
     pub fn validate(&self) -> Result<(), SimError> {
         let finite = |field: &'static str, v: f64| {
@@ -358,7 +282,7 @@ pub struct Stopped {
 
 /// Counts of a finished simulation.
 #[derive(Clone, Debug, Default, PartialEq)]
-pub struct Summary {
+pub struct SimSummary {
     /// Simulation frames run.
     pub sim_frames: u64,
     /// Trace frames used (sub-steps included).
@@ -380,7 +304,7 @@ pub struct Summary {
     pub stopped: Vec<Stopped>,
 }
 
-impl Summary {
+impl SimSummary {
     /// Collisions of every kind.
     pub fn collisions(&self) -> u64 {
         self.face + self.edge + self.vertex
@@ -458,7 +382,7 @@ pub fn simulate<E: From<SimError>>(
     mesh: &Mesh,
     options: &SimOptions,
     mut on_event: impl FnMut(&Event) -> Result<(), E>,
-) -> Result<Summary, E> {
+) -> Result<SimSummary, E> {
     options.validate()?;
     let core_options = options.core_options();
     let (lo, hi) = play_volume(mesh, options.radius);
@@ -467,7 +391,7 @@ pub fn simulate<E: From<SimError>>(
     let dt = options.time_step;
     let dt_nanos = options.time_step_nanos();
     let push = options.margin + options.separation * options.radius;
-    let mut summary = Summary::default();
+    let mut summary = SimSummary::default();
     let mut balls: Vec<Ball> = initial_states(options)
         .into_iter()
         .map(|(p, v)| Ball {
@@ -590,13 +514,4 @@ pub fn simulate<E: From<SimError>>(
     }
     summary.trace_frames = base;
     Ok(summary)
-}
-
-/// A scene to record: a built-in name, with `terrain_cells` for the terrain.
-pub fn builtin_scene(name: &str, terrain_cells: usize) -> Option<SceneMesh> {
-    if name == "terrain" {
-        Some(scenes::terrain(terrain_cells))
-    } else {
-        scenes::by_name(name)
-    }
 }

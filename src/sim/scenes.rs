@@ -2,6 +2,8 @@
 
 use serde::{Deserialize, Serialize};
 
+use super::SimOptions;
+
 /// A named mesh as plain data (what a trace's `/scene` message holds).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct SceneMesh {
@@ -51,20 +53,160 @@ pub fn triangle() -> SceneMesh {
     }
 }
 
-/// Names of the built-in scenes [`by_name`] knows.
-pub const NAMES: &[&str] = &["cube", "triangle", "mini_golf", "bowl", "box", "terrain"];
+/// The built-in scenes: one definition of their names, meshes and the
+/// simulation parameters `record` uses for them.
+#[derive(
+    Clone,
+    Copy,
+    Debug,
+    PartialEq,
+    Eq,
+    Hash,
+    PartialOrd,
+    Ord,
+    strum::EnumIter,
+    strum::IntoStaticStr,
+    strum::EnumString,
+    strum::Display,
+)]
+#[strum(serialize_all = "snake_case")]
+#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
+#[cfg_attr(feature = "cli", clap(rename_all = "snake_case"))]
+pub enum BuiltinScene {
+    /// The cube `[-1, 1]³`, 12 outward triangles.
+    Cube,
+    /// `(0,0,0), (4,0,0), (0,4,0)`, front `+z` (SEMANTICS.md's examples).
+    Triangle,
+    /// A mini-golf hole: tee, ramp with a drop, walls, a cup.
+    MiniGolf,
+    /// A bowl seen from inside.
+    Bowl,
+    /// A closed box, faces inward.
+    #[strum(serialize = "box")]
+    #[cfg_attr(feature = "cli", value(name = "box"))]
+    Box,
+    /// A height-field terrain (100,352 triangles at its default size).
+    Terrain,
+}
 
-/// A built-in scene by name (`terrain` at its default size,
-/// [`TERRAIN_DEFAULT_CELLS`]).
-pub fn by_name(name: &str) -> Option<SceneMesh> {
-    match name {
-        "cube" => Some(cube()),
-        "triangle" => Some(triangle()),
-        "mini_golf" => Some(mini_golf()),
-        "bowl" => Some(bowl()),
-        "box" => Some(closed_box()),
-        "terrain" => Some(terrain(TERRAIN_DEFAULT_CELLS)),
-        _ => None,
+impl BuiltinScene {
+    /// Every built-in scene, in the order `--help` lists them.
+    pub fn all() -> impl Iterator<Item = BuiltinScene> {
+        <BuiltinScene as strum::IntoEnumIterator>::iter()
+    }
+
+    /// The scene's name (`mini_golf`, `box`, ...).
+    pub fn name(self) -> &'static str {
+        self.into()
+    }
+
+    /// The scene named `name`, if it is built in.
+    pub fn from_name(name: &str) -> Option<BuiltinScene> {
+        name.parse().ok()
+    }
+
+    /// The names of every built-in scene, comma-separated (for messages).
+    pub fn names() -> String {
+        Self::all()
+            .map(BuiltinScene::name)
+            .collect::<Vec<_>>()
+            .join(", ")
+    }
+
+    /// The scene's mesh; the terrain at its default size
+    /// ([`TERRAIN_DEFAULT_CELLS`]).
+    pub fn mesh(self) -> SceneMesh {
+        self.mesh_with_terrain_cells(TERRAIN_DEFAULT_CELLS)
+    }
+
+    /// The scene's mesh, the terrain with `terrain_cells` cells a side.
+    pub fn mesh_with_terrain_cells(self, terrain_cells: usize) -> SceneMesh {
+        match self {
+            BuiltinScene::Cube => cube(),
+            BuiltinScene::Triangle => triangle(),
+            BuiltinScene::MiniGolf => mini_golf(),
+            BuiltinScene::Bowl => bowl(),
+            BuiltinScene::Box => closed_box(),
+            BuiltinScene::Terrain => terrain(terrain_cells),
+        }
+    }
+
+    /// Simulation parameters chosen so that the scene's recording shows
+    /// face, edge and vertex collisions and misses where the scene allows.
+    pub fn sim_options(self) -> SimOptions {
+        let base = SimOptions::default();
+        match self {
+            // Ball 0 dropped onto the corner (1, 1, 1) (a vertex hit), the
+            // others around it: edge and face hits, then falls off the cube.
+            BuiltinScene::Cube => SimOptions {
+                radius: 0.25,
+                position: [1.05, 1.05, 2.5],
+                velocity: [0.0, 0.0, 0.0],
+                balls: 6,
+                position_jitter: 0.5,
+                velocity_jitter: 0.2,
+                frames: 150,
+                ..base
+            },
+            BuiltinScene::Triangle => SimOptions {
+                radius: 0.5,
+                position: [1.0, 1.0, 3.0],
+                velocity: [0.5, 0.5, 0.0],
+                balls: 3,
+                position_jitter: 1.0,
+                velocity_jitter: 0.5,
+                frames: 150,
+                ..base
+            },
+            // Putted from the tee up the ramp, over its drop, toward the cup.
+            BuiltinScene::MiniGolf => SimOptions {
+                radius: 0.1,
+                position: [1.0, 2.0, 0.2],
+                velocity: [3.0, 0.4, 0.0],
+                balls: 8,
+                position_jitter: 1.2,
+                velocity_jitter: 3.0,
+                frames: 600,
+                restitution: 0.6,
+                ..base
+            },
+            // Released on the rim with a sideways push: it circles the bowl.
+            BuiltinScene::Bowl => SimOptions {
+                radius: 0.2,
+                position: [1.5, 0.0, 1.0],
+                velocity: [0.0, 2.5, 1.0],
+                balls: 8,
+                position_jitter: 0.3,
+                velocity_jitter: 1.5,
+                frames: 400,
+                restitution: 0.7,
+                ..base
+            },
+            // Thrown across the box: bounces off every wall.
+            BuiltinScene::Box => SimOptions {
+                radius: 0.3,
+                position: [0.0, 0.0, 0.5],
+                velocity: [3.0, 2.0, 4.0],
+                balls: 3,
+                position_jitter: 0.8,
+                velocity_jitter: 2.0,
+                frames: 300,
+                restitution: 0.9,
+                ..base
+            },
+            // Boulders thrown onto the hills: they roll and hop over crests.
+            BuiltinScene::Terrain => SimOptions {
+                radius: 0.8,
+                position: [0.0, 0.0, 4.0],
+                velocity: [5.0, 2.0, 3.0],
+                balls: 8,
+                position_jitter: 10.0,
+                velocity_jitter: 3.0,
+                frames: 400,
+                restitution: 0.5,
+                ..base
+            },
+        }
     }
 }
 
@@ -397,115 +539,6 @@ pub fn det_sin(x: f64) -> f64 {
         sum += term;
     }
     sum
-}
-
-/// Why a Wavefront OBJ file could not be used as a scene.
-#[derive(Debug, thiserror::Error)]
-#[non_exhaustive]
-pub enum ObjError {
-    /// The file could not be opened or read.
-    #[error("cannot read {path}: {source}")]
-    Io {
-        /// The file.
-        path: String,
-        /// The cause.
-        source: std::io::Error,
-    },
-    /// The OBJ parser refused the file.
-    #[error("{path} is not a valid Wavefront OBJ file: {reason}")]
-    Parse {
-        /// The file.
-        path: String,
-        /// What the parser reported.
-        reason: String,
-    },
-    /// The file parsed but holds no triangle.
-    #[error("{path} holds no triangle (no `f` lines with three or more vertices)")]
-    NoTriangles {
-        /// The file.
-        path: String,
-    },
-}
-
-/// Loads a Wavefront OBJ file (through `tobj`) as a scene named after the
-/// file's stem. Polygons are triangulated as fans; every object and group
-/// of the file goes into one mesh; materials, normals, texture coordinates,
-/// points and lines are ignored. Faces are counter-clockwise seen from the
-/// front, as in the OBJ convention. Coordinates are read as `f32`.
-pub fn load_obj(path: &std::path::Path) -> Result<SceneMesh, ObjError> {
-    let shown = path.display().to_string();
-    let file = std::fs::File::open(path).map_err(|source| ObjError::Io {
-        path: shown.clone(),
-        source,
-    })?;
-    let mut reader = std::io::BufReader::new(file);
-    let mut scene = obj_from_reader(&mut reader).map_err(|e| match e {
-        ObjError::Parse { reason, .. } => ObjError::Parse {
-            path: shown.clone(),
-            reason,
-        },
-        ObjError::NoTriangles { .. } => ObjError::NoTriangles {
-            path: shown.clone(),
-        },
-        other => other,
-    })?;
-    scene.name = path
-        .file_stem()
-        .map_or_else(|| "mesh".into(), |s| s.to_string_lossy().into_owned());
-    Ok(scene)
-}
-
-/// Parses Wavefront OBJ text from a reader (see [`load_obj`]); errors name
-/// the source `<input>`.
-pub fn obj_from_reader(reader: &mut impl std::io::BufRead) -> Result<SceneMesh, ObjError> {
-    let options = tobj::LoadOptions {
-        triangulate: true,
-        single_index: false,
-        ignore_points: true,
-        ignore_lines: true,
-    };
-    let no_materials =
-        |_: &std::path::Path| -> tobj::MTLLoadResult { Ok((Vec::new(), Default::default())) };
-    let (models, _materials) =
-        tobj::load_obj_buf(reader, &options, no_materials).map_err(|e| ObjError::Parse {
-            path: "<input>".into(),
-            reason: e.to_string(),
-        })?;
-    let mut vertices = Vec::new();
-    let mut triangles = Vec::new();
-    for model in &models {
-        let mesh = &model.mesh;
-        let offset = vertices.len() as u64;
-        let count = mesh.positions.len() / 3;
-        vertices.extend(
-            mesh.positions
-                .chunks_exact(3)
-                .map(|p| [f64::from(p[0]), f64::from(p[1]), f64::from(p[2])]),
-        );
-        for t in mesh.indices.chunks_exact(3) {
-            let t = [t[0], t[1], t[2]].map(u64::from);
-            if t.iter().any(|&i| i >= count as u64) {
-                return Err(ObjError::Parse {
-                    path: "<input>".into(),
-                    reason: format!(
-                        "a face of object `{}` refers to a vertex that does not exist",
-                        model.name
-                    ),
-                });
-            }
-            triangles.push(t.map(|i| i + offset));
-        }
-    }
-    if triangles.is_empty() {
-        return Err(ObjError::NoTriangles {
-            path: "<input>".into(),
-        });
-    }
-    Ok(SceneMesh {
-        name: "mesh".into(),
-        vertices,
-        triangles,
-    })
 }
 
 impl SceneMesh {

@@ -1,0 +1,398 @@
+//! Regression checking: the core's outcomes compared with a trace's
+//! `/expected` channel.
+//!
+//! [`check_events`] replays a whole trace (the same [`crate::replay`]
+//! engine as `replay`) and returns a [`TraceReport`]: a [`Status`], the
+//! counts, and the first divergences in detail ([`Divergence`]), each with
+//! the explanation of what the core found and of the test that would have
+//! produced the expected result (see [`super::compare`] for the rule).
+//! [`super::render_text`] and [`super::render_json`] are pure functions of
+//! a report.
+//!
+//! Explanations are computed only for the divergences kept in detail, by
+//! running the explained query over every triangle
+//! ([`crate::core::Broadphase::Exhaustive`]): the fast path stays fast on
+//! passing traces.
+
+use std::collections::BTreeMap;
+use std::fmt::Write as _;
+use std::sync::Arc;
+
+use serde::Serialize;
+
+use crate::replay::{ReplayError, ReplayEvent, ReplayOptions, SceneState, SweepResult};
+use crate::trace::messages::{EXPECTED_TOPIC, OutcomeMsg};
+use crate::trace::{TraceError, TraceEvent, TraceReader};
+
+use super::compare::{FieldDiff, Tolerances, compare};
+use super::explain::{ExpectedTest, expected_tests, explain_outcome, explained_records};
+
+/// Default number of divergences described in detail per trace.
+pub const DEFAULT_MAX_DETAILS: usize = 3;
+
+/// One sweep whose outcome differs from its expectation.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Divergence {
+    /// Frame.
+    pub frame: u64,
+    /// Ball.
+    pub ball: u32,
+    /// `log_time` of the sweep, in nanoseconds.
+    pub log_time_nanos: u64,
+    /// The fields that differ.
+    pub fields: Vec<FieldDiff>,
+    /// The expectation.
+    pub expected: OutcomeMsg,
+    /// The core's outcome.
+    pub got: OutcomeMsg,
+    /// The margin and facing rule the core used.
+    pub margin: f64,
+    /// The facing rule the core used.
+    pub facing: String,
+    /// The tests that decided the core's outcome, in words: the primary
+    /// test and the other hits at the same `α`, or the nearest miss.
+    pub got_explanation: Vec<String>,
+    /// The tests that would have produced the expected result (none when the
+    /// expectation is `none`, or names no triangle).
+    pub expected_tests: Vec<ExpectedTest>,
+}
+
+/// The status of one trace.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Status {
+    /// Every expectation matched.
+    Ok,
+    /// At least one sweep diverged.
+    Fail,
+    /// Nothing to compare: no `/expected` channel, or no expectation matches
+    /// a sweep. Never a pass.
+    NoExpectations,
+    /// The trace could not be (fully) checked.
+    Error,
+}
+
+impl Status {
+    /// `ok`, `FAIL`, `NO EXPECTATIONS`, `ERROR`.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Status::Ok => "ok",
+            Status::Fail => "FAIL",
+            Status::NoExpectations => "NO EXPECTATIONS",
+            Status::Error => "ERROR",
+        }
+    }
+
+    /// The exit code of a set of statuses: 2 when anything could not be
+    /// checked (an error or no expectations), else 1 when a divergence was
+    /// found, else 0.
+    pub fn exit_code<'a>(statuses: impl IntoIterator<Item = &'a Status>) -> u8 {
+        let mut code = 0;
+        for s in statuses {
+            code = code.max(match s {
+                Status::Ok => 0,
+                Status::Fail => 1,
+                Status::NoExpectations | Status::Error => 2,
+            });
+        }
+        code
+    }
+}
+
+impl std::fmt::Display for Status {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.as_str())
+    }
+}
+
+/// Options of a check.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CheckOptions {
+    /// Tolerances of the comparison.
+    pub tolerances: Tolerances,
+    /// How many divergences are described in detail.
+    pub max_details: usize,
+    /// The replay's options (frames, ball, overrides). `explain` and
+    /// `detail` are ignored: the check runs the fast query and explains
+    /// only the detailed divergences.
+    pub replay: ReplayOptions,
+}
+
+impl Default for CheckOptions {
+    fn default() -> Self {
+        CheckOptions {
+            tolerances: Tolerances::default(),
+            max_details: DEFAULT_MAX_DETAILS,
+            replay: ReplayOptions::default(),
+        }
+    }
+}
+
+/// The result of checking one trace.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct TraceReport {
+    /// The trace's name (its path as given).
+    pub trace: String,
+    /// The verdict.
+    pub status: Status,
+    /// Sweeps replayed.
+    pub sweeps: u64,
+    /// Sweeps compared with an expectation.
+    pub compared: u64,
+    /// Sweeps whose outcome differs from its expectation.
+    pub divergent: u64,
+    /// Replayed sweeps without an expectation.
+    pub sweeps_without_expectation: u64,
+    /// Expectations that match no replayed sweep (or arrived after theirs was
+    /// complete, or repeat one).
+    pub expectations_without_sweep: u64,
+    /// `/expected` messages read (matched or not).
+    pub expectations: u64,
+    /// Whether the trace has an `/expected` channel at all.
+    pub has_expected_channel: bool,
+    /// Divergent sweeps by `(expected kind, got kind)`.
+    pub by_kind: BTreeMap<String, u64>,
+    /// The first divergences, in detail (at most `max_details`).
+    pub divergences: Vec<Divergence>,
+    /// Frames of the first divergent sweeps (up to 100), in trace order.
+    pub divergent_frames: Vec<u64>,
+    /// What could not be checked: read errors, invalid scenes or sweeps.
+    pub errors: Vec<String>,
+    /// The tolerances used.
+    pub tolerances: Tolerances,
+}
+
+/// How many divergent frames a report lists.
+const MAX_DIVERGENT_FRAMES: usize = 100;
+/// How many errors a report keeps.
+const MAX_ERRORS: usize = 20;
+
+/// Checks a trace read from any [`std::io::Read`].
+pub fn check_reader<R: std::io::Read>(
+    reader: R,
+    name: &str,
+    options: &CheckOptions,
+) -> TraceReport {
+    let mut reader = TraceReader::new(reader, name);
+    let mut report = check_events(reader.by_ref(), name, options);
+    report.has_expected_channel = reader.stats().channels.contains_key(EXPECTED_TOPIC);
+    report.status = status_of(&report);
+    report
+}
+
+/// Checks a trace given as a stream of events. `has_expected_channel` is
+/// set from the events (true when any `/expected` message was seen);
+/// [`check_reader`] sets it from the file's channels instead.
+pub fn check_events<I>(events: I, name: &str, options: &CheckOptions) -> TraceReport
+where
+    I: Iterator<Item = Result<TraceEvent, TraceError>>,
+{
+    let mut saw_expected = false;
+    let events = events.inspect(|e| {
+        if matches!(e, Ok(TraceEvent::Expected { .. })) {
+            saw_expected = true;
+        }
+    });
+    let replay_options = ReplayOptions {
+        explain: false,
+        ..options.replay
+    };
+    let mut report = TraceReport {
+        trace: name.to_string(),
+        status: Status::Ok,
+        sweeps: 0,
+        compared: 0,
+        divergent: 0,
+        sweeps_without_expectation: 0,
+        expectations_without_sweep: 0,
+        expectations: 0,
+        has_expected_channel: false,
+        by_kind: BTreeMap::new(),
+        divergences: Vec::new(),
+        divergent_frames: Vec::new(),
+        errors: Vec::new(),
+        tolerances: options.tolerances,
+    };
+    let mut scene: Option<Arc<SceneState>> = None;
+    let mut replay = crate::replay::replay_events(events, replay_options);
+    for event in replay.by_ref() {
+        match event {
+            Ok(ReplayEvent::Scene(s)) => scene = Some(s),
+            Ok(ReplayEvent::Sweep(result)) => {
+                report.sweeps += 1;
+                let Some(expected) = &result.expected else {
+                    report.sweeps_without_expectation += 1;
+                    continue;
+                };
+                report.compared += 1;
+                let got = result.outcome_msg();
+                let fields = compare(expected, &got, &options.tolerances);
+                if fields.is_empty() {
+                    continue;
+                }
+                report.divergent += 1;
+                *report
+                    .by_kind
+                    .entry(format!("{} -> {}", expected.kind, got.kind))
+                    .or_default() += 1;
+                if report.divergent_frames.len() < MAX_DIVERGENT_FRAMES {
+                    report.divergent_frames.push(result.frame);
+                }
+                if report.divergences.len() < options.max_details {
+                    report.divergences.push(divergence(
+                        &result,
+                        scene.as_deref(),
+                        *expected,
+                        got,
+                        fields,
+                    ));
+                }
+            }
+            Err(err) => {
+                if report.errors.len() < MAX_ERRORS {
+                    report.errors.push(error_text(&err));
+                }
+            }
+        }
+    }
+    let summary = replay.summary();
+    drop(replay);
+    report.expectations_without_sweep = summary.expected_unmatched;
+    report.expectations = summary.expected_matched + summary.expected_unmatched;
+    report.has_expected_channel = saw_expected;
+    report.status = status_of(&report);
+    report
+}
+
+fn error_text(err: &ReplayError) -> String {
+    let mut s = err.to_string();
+    let mut source = std::error::Error::source(err);
+    while let Some(e) = source {
+        let text = e.to_string();
+        if !s.contains(&text) {
+            let _ = write!(s, ": {text}");
+        }
+        source = e.source();
+    }
+    s
+}
+
+fn status_of(r: &TraceReport) -> Status {
+    if !r.errors.is_empty() {
+        Status::Error
+    } else if r.divergent > 0 {
+        Status::Fail
+    } else if r.compared == 0 {
+        Status::NoExpectations
+    } else {
+        Status::Ok
+    }
+}
+
+fn divergence(
+    result: &SweepResult,
+    scene: Option<&SceneState>,
+    expected: OutcomeMsg,
+    got: OutcomeMsg,
+    fields: Vec<FieldDiff>,
+) -> Divergence {
+    let records = scene
+        .map(|s| explained_records(result, s))
+        .unwrap_or_default();
+    Divergence {
+        frame: result.frame,
+        ball: result.ball,
+        log_time_nanos: result.log_time_nanos,
+        fields,
+        expected,
+        got,
+        margin: result.options.margin,
+        facing: result.options.facing.to_string(),
+        got_explanation: explain_outcome(&result.outcome, &records),
+        expected_tests: expected_tests(&expected, &result.outcome, &records, scene),
+    }
+}
+
+/// A frame range around the first divergences: from `before` frames
+/// before the first divergent frame to `after` frames after the last one
+/// kept in detail (or the first, when none is kept in detail). `None` when
+/// there is no divergence.
+pub fn frames_around(
+    r: &TraceReport,
+    before: u64,
+    after: u64,
+) -> Option<crate::replay::FrameRange> {
+    let first = *r.divergent_frames.first()?;
+    let kept = r.divergences.len().max(1);
+    let last = r
+        .divergent_frames
+        .iter()
+        .take(kept)
+        .copied()
+        .max()
+        .unwrap_or(first);
+    Some(crate::replay::FrameRange {
+        start: Some(first.saturating_sub(before)),
+        end: Some(last.saturating_add(after).saturating_add(1)),
+    })
+}
+
+/// Checks the trace file at `path`; a file that cannot be opened is a
+/// report with [`Status::Error`].
+pub fn check_file(path: &std::path::Path, options: &CheckOptions) -> TraceReport {
+    let name = path.display().to_string();
+    match std::fs::File::open(path) {
+        Ok(file) => check_reader(
+            std::io::BufReader::with_capacity(1 << 16, file),
+            &name,
+            options,
+        ),
+        Err(err) => {
+            let mut report = check_events(std::iter::empty(), &name, options);
+            report.errors.push(format!("{name}: cannot open: {err}"));
+            report.status = Status::Error;
+            report
+        }
+    }
+}
+
+/// The traces named by `paths`: files as given, directories searched
+/// recursively for `*.mcap` files (sorted by path, hidden entries skipped).
+/// Errors name the path that could not be read.
+pub fn find_traces(paths: &[std::path::PathBuf]) -> Result<Vec<std::path::PathBuf>, String> {
+    fn walk(dir: &std::path::Path, out: &mut Vec<std::path::PathBuf>) -> Result<(), String> {
+        let entries = std::fs::read_dir(dir)
+            .map_err(|e| format!("{}: cannot list the directory: {e}", dir.display()))?;
+        let mut found = Vec::new();
+        for entry in entries {
+            let entry =
+                entry.map_err(|e| format!("{}: cannot list the directory: {e}", dir.display()))?;
+            let path = entry.path();
+            if entry.file_name().to_string_lossy().starts_with('.') {
+                continue;
+            }
+            found.push(path);
+        }
+        found.sort();
+        for path in found {
+            if path.is_dir() {
+                walk(&path, out)?;
+            } else if path
+                .extension()
+                .is_some_and(|e| e.eq_ignore_ascii_case("mcap"))
+            {
+                out.push(path);
+            }
+        }
+        Ok(())
+    }
+    let mut out = Vec::new();
+    for p in paths {
+        if p.is_dir() {
+            walk(p, &mut out)?;
+        } else {
+            out.push(p.clone());
+        }
+    }
+    Ok(out)
+}

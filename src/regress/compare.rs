@@ -1,0 +1,240 @@
+//! The one comparison of an outcome with its expectation, used by `check`,
+//! `diff` and the viewer's decision line.
+//!
+//! [`compare`] compares one outcome with one expectation, field by field,
+//! **only over the fields the expectation holds** (an absent field is `None`
+//! in [`OutcomeMsg`] and is not compared; a `null` field is `Some(None)` and
+//! is compared: it must be null in the outcome too). Discrete fields
+//! (`kind`, `triangle`, `feature`) must be equal; the continuous ones are
+//! compared within the [`Tolerances`], whose defaults are listed there.
+
+use nalgebra::Vector3;
+use serde::Serialize;
+use serde_json::{Value, json};
+
+use crate::core::explain::num;
+use crate::trace::messages::OutcomeMsg;
+
+/// Default absolute tolerance on `α` (a fraction of the path, unitless).
+pub const DEFAULT_ALPHA_TOLERANCE: f64 = 1e-6;
+/// Default angular tolerance on the normal, in **degrees**.
+pub const DEFAULT_NORMAL_TOLERANCE_DEGREES: f64 = 0.01;
+/// Default tolerance on the contact point: a Euclidean distance, in the
+/// scene's length unit.
+pub const DEFAULT_CONTACT_TOLERANCE: f64 = 1e-6;
+
+/// How far a continuous field may be from its expectation. These are the
+/// only tolerances of the comparison; their defaults are the `DEFAULT_*`
+/// constants of this module:
+///
+/// - `alpha`: the absolute difference is at most `alpha` (default `1e-6`);
+/// - `normal`: the angle between the two vectors is at most
+///   `normal_degrees`, in **degrees** (default `0.01°`);
+/// - `contact`: the Euclidean distance is at most `contact`, in the scene's
+///   length unit (default `1e-6`).
+///
+/// `kind`, `triangle` and `feature` are compared exactly.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct Tolerances {
+    /// Absolute tolerance on `α`.
+    pub alpha: f64,
+    /// Angular tolerance on the normal, in degrees.
+    pub normal_degrees: f64,
+    /// Distance tolerance on the contact point.
+    pub contact: f64,
+}
+
+impl Default for Tolerances {
+    fn default() -> Self {
+        Tolerances {
+            alpha: DEFAULT_ALPHA_TOLERANCE,
+            normal_degrees: DEFAULT_NORMAL_TOLERANCE_DEGREES,
+            contact: DEFAULT_CONTACT_TOLERANCE,
+        }
+    }
+}
+
+impl Tolerances {
+    /// Checks that every tolerance is a finite number `≥ 0`; names the field.
+    pub fn validate(&self) -> Result<(), String> {
+        for (name, v) in [
+            ("alpha tolerance", self.alpha),
+            ("normal tolerance (degrees)", self.normal_degrees),
+            ("contact tolerance", self.contact),
+        ] {
+            if !(v.is_finite() && v >= 0.0) {
+                return Err(format!("the {name} must be a finite number ≥ 0, got {v}"));
+            }
+        }
+        Ok(())
+    }
+}
+
+/// A field of the outcome record.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Field {
+    /// `kind`.
+    Kind,
+    /// `triangle`.
+    Triangle,
+    /// `feature`.
+    Feature,
+    /// `alpha`.
+    Alpha,
+    /// `normal`.
+    Normal,
+    /// `contact`.
+    Contact,
+}
+
+impl Field {
+    /// The field's name in the outcome record.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Field::Kind => "kind",
+            Field::Triangle => "triangle",
+            Field::Feature => "feature",
+            Field::Alpha => "alpha",
+            Field::Normal => "normal",
+            Field::Contact => "contact",
+        }
+    }
+}
+
+impl std::fmt::Display for Field {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.as_str())
+    }
+}
+
+/// One field that differs.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct FieldDiff {
+    /// The field.
+    pub field: Field,
+    /// The expected value, as JSON (`null` for null).
+    pub expected: Value,
+    /// The value the core produced, as JSON.
+    pub got: Value,
+    /// How far apart, in words (`|Δα| = 0.01 > 1e-6`), when the field is continuous.
+    pub detail: Option<String>,
+}
+
+fn vec3(v: &Option<[f64; 3]>) -> Value {
+    match v {
+        Some(v) => json!(v),
+        None => Value::Null,
+    }
+}
+
+/// The angle between two vectors, in degrees; `None` when either has zero
+/// or non-finite length. Computed as `atan2(|a × b|, a · b)`, accurate for
+/// small angles too (unlike `acos` of the cosine).
+pub fn angle_degrees(a: [f64; 3], b: [f64; 3]) -> Option<f64> {
+    let (a, b) = (Vector3::from(a), Vector3::from(b));
+    let (na, nb) = (a.norm(), b.norm());
+    if !(na.is_finite() && nb.is_finite() && na > 0.0 && nb > 0.0) {
+        return None;
+    }
+    let angle = a.cross(&b).norm().atan2(a.dot(&b)).to_degrees();
+    angle.is_finite().then_some(angle)
+}
+
+fn distance(a: [f64; 3], b: [f64; 3]) -> f64 {
+    (Vector3::from(a) - Vector3::from(b)).norm()
+}
+
+/// Compares `got` with `expected` over the fields `expected` holds (see the
+/// [module documentation](self)). Returns the fields that differ, in the
+/// order kind, triangle, feature, alpha, normal, contact; empty when they
+/// match. `frame` and `ball` are not compared (they are the matching key).
+/// A NaN anywhere counts as a difference, never as a match.
+pub fn compare(expected: &OutcomeMsg, got: &OutcomeMsg, tol: &Tolerances) -> Vec<FieldDiff> {
+    let mut out = Vec::new();
+    if expected.kind != got.kind {
+        out.push(FieldDiff {
+            field: Field::Kind,
+            expected: json!(expected.kind),
+            got: json!(got.kind),
+            detail: None,
+        });
+    }
+    if let Some(want) = expected.triangle {
+        let have = got.triangle.flatten();
+        if want != have {
+            out.push(FieldDiff {
+                field: Field::Triangle,
+                expected: json!(want),
+                got: json!(have),
+                detail: None,
+            });
+        }
+    }
+    if let Some(want) = expected.feature {
+        let have = got.feature.flatten();
+        if want != have {
+            out.push(FieldDiff {
+                field: Field::Feature,
+                expected: json!(want),
+                got: json!(have),
+                detail: None,
+            });
+        }
+    }
+    let delta = (got.alpha - expected.alpha).abs();
+    if delta.is_nan() || delta > tol.alpha {
+        out.push(FieldDiff {
+            field: Field::Alpha,
+            expected: json!(expected.alpha),
+            got: json!(got.alpha),
+            detail: Some(format!("|Δα| = {} > {}", num(delta), num(tol.alpha))),
+        });
+    }
+    if let Some(want) = expected.normal {
+        let have = got.normal.flatten();
+        let detail = match (want, have) {
+            (None, None) => None,
+            (Some(_), None) => Some("expected a normal, got none".to_string()),
+            (None, Some(_)) => Some("expected no normal (null), got one".to_string()),
+            (Some(w), Some(h)) => match angle_degrees(w, h) {
+                None => Some("one of the normals has zero or non-finite length".to_string()),
+                Some(a) if a <= tol.normal_degrees => None,
+                Some(a) => Some(format!("angle {}° > {}°", num(a), num(tol.normal_degrees))),
+            },
+        };
+        if let Some(detail) = detail {
+            out.push(FieldDiff {
+                field: Field::Normal,
+                expected: vec3(&want),
+                got: vec3(&have),
+                detail: Some(detail),
+            });
+        }
+    }
+    if let Some(want) = expected.contact {
+        let have = got.contact.flatten();
+        let detail = match (want, have) {
+            (None, None) => None,
+            (Some(_), None) => Some("expected a contact point, got none".to_string()),
+            (None, Some(_)) => Some("expected no contact point (null), got one".to_string()),
+            (Some(w), Some(h)) => {
+                let d = distance(w, h);
+                if d <= tol.contact {
+                    None
+                } else {
+                    Some(format!("distance {} > {}", num(d), num(tol.contact)))
+                }
+            }
+        };
+        if let Some(detail) = detail {
+            out.push(FieldDiff {
+                field: Field::Contact,
+                expected: vec3(&want),
+                got: vec3(&have),
+                detail: Some(detail),
+            });
+        }
+    }
+    out
+}

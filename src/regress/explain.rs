@@ -1,0 +1,169 @@
+//! Why a sweep diverged: the tests that decided the core's outcome, and the
+//! tests that would have produced the expected one, with why they did not.
+
+use serde::Serialize;
+
+use crate::core::explain::{describe, label, nearest_miss, num};
+use crate::core::{
+    Broadphase, CollectRecords, Kind, Outcome, SIMULTANEOUS_TOLERANCE, TestRecord, Verdict,
+    sweep_mesh_with,
+};
+use crate::replay::{SceneState, SweepResult, primary_records};
+use crate::trace::messages::OutcomeMsg;
+
+/// The test that would have produced the expected result, and why it did not.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct ExpectedTest {
+    /// `edge 12.1`, `face 3`, ...
+    pub test: String,
+    /// Its record in words (`explain::describe`), or why there is none.
+    pub description: String,
+    /// Its verdict, when the test ran.
+    pub verdict: Option<Verdict>,
+    /// Why it did not decide the sweep, in words.
+    pub why_not: String,
+}
+
+/// Re-runs a sweep with every test recorded (the same core, every triangle).
+pub fn explained_records(result: &SweepResult, scene: &SceneState) -> Vec<TestRecord> {
+    let mut collect = CollectRecords::default();
+    match sweep_mesh_with(
+        &scene.mesh,
+        &result.sweep,
+        &result.options,
+        Broadphase::Exhaustive,
+        &mut collect,
+    ) {
+        Ok(_) => collect.records,
+        Err(_) => Vec::new(),
+    }
+}
+
+/// The records that decided `outcome`, described: the primary test then the
+/// other hits within [`SIMULTANEOUS_TOLERANCE`] of its `α`; when nothing is
+/// hit, the nearest miss.
+pub fn explain_outcome(outcome: &Outcome, records: &[TestRecord]) -> Vec<String> {
+    if !outcome.is_hit() {
+        return match nearest_miss(records) {
+            Some(r) => vec![format!("no test hit; nearest miss: {}", describe(r))],
+            None => vec!["no test hit (no triangle was tested)".to_string()],
+        };
+    }
+    let decided = primary_records(outcome, records.to_vec());
+    let primary = decided.iter().find(|r| outcome.is_reported_by(r));
+    primary
+        .map(|r| format!("primary: {}", describe(r)))
+        .into_iter()
+        .chain(
+            decided
+                .iter()
+                .filter(|r| !outcome.is_reported_by(r))
+                .take(8)
+                .map(|r| format!("also at this α: {}", describe(r))),
+        )
+        .collect()
+}
+
+/// The tests that would have produced `expected`, each with why it did not
+/// decide the sweep.
+pub fn expected_tests(
+    expected: &OutcomeMsg,
+    got: &Outcome,
+    records: &[TestRecord],
+    scene: Option<&SceneState>,
+) -> Vec<ExpectedTest> {
+    if expected.kind == Kind::None {
+        return Vec::new();
+    }
+    let Some(Some(triangle)) = expected.triangle else {
+        // Without a triangle every test of that kind could be the one; name
+        // the hits of that kind, if any.
+        return records
+            .iter()
+            .filter(|r| r.kind() == expected.kind && r.verdict() == Verdict::Hit)
+            .take(3)
+            .map(|r| expected_test(r, expected, got))
+            .collect();
+    };
+    let feature = expected.feature.flatten();
+    let found: Vec<&TestRecord> = records
+        .iter()
+        .filter(|r| {
+            r.kind() == expected.kind
+                && r.triangle() == triangle
+                && (expected.kind == Kind::Face || feature.is_none_or(|f| f == r.feature()))
+        })
+        .collect();
+    if found.is_empty() {
+        let test = match (expected.kind, feature) {
+            (Kind::Face, _) => format!("face {triangle}"),
+            (k, Some(f)) => format!("{k} {triangle}.{f}"),
+            (k, None) => format!("{k} {triangle}.*"),
+        };
+        let why = match scene {
+            Some(s) if triangle as usize >= s.mesh.input_triangle_count() => format!(
+                "triangle {triangle} does not exist: the scene has {} triangles",
+                s.mesh.input_triangle_count()
+            ),
+            Some(s)
+                if s.mesh
+                    .degenerate()
+                    .iter()
+                    .any(|d| d.index == triangle as usize) =>
+            {
+                format!("triangle {triangle} is degenerate and left out of every test")
+            }
+            _ => "this test did not run".to_string(),
+        };
+        return vec![ExpectedTest {
+            test,
+            description: why.clone(),
+            verdict: None,
+            why_not: why,
+        }];
+    }
+    found
+        .into_iter()
+        .map(|r| expected_test(r, expected, got))
+        .collect()
+}
+
+fn expected_test(r: &TestRecord, expected: &OutcomeMsg, got: &Outcome) -> ExpectedTest {
+    let verdict = r.verdict();
+    let decides = got.is_hit()
+        && Some(r.triangle()) == got.triangle
+        && r.kind() == got.kind
+        && Some(r.feature()) == got.feature;
+    let why_not = match r.alpha() {
+        None => format!("it reports no collision ({verdict})"),
+        Some(a) if decides => format!(
+            "it decides the sweep, at α = {} where the expectation has α = {} \
+             (was the expectation recorded with another margin or facing rule?)",
+            num(a),
+            num(expected.alpha)
+        ),
+        Some(a) if got.is_hit() && a > got.alpha + SIMULTANEOUS_TOLERANCE => format!(
+            "it hits at α = {}, later than the primary collision at α = {}",
+            num(a),
+            num(got.alpha)
+        ),
+        Some(a) if (a - expected.alpha).abs() > 1e-12 && got.is_hit() => format!(
+            "it hits at α = {} (expected α = {}); the primary collision is at α = {}",
+            num(a),
+            num(expected.alpha),
+            num(got.alpha)
+        ),
+        Some(a) if got.is_hit() => format!(
+            "it hits at α = {}, as expected, but loses the tie to the primary test \
+             (ties go face < edge < vertex, then lower triangle, then lower feature)",
+            num(a)
+        ),
+        Some(a) => format!("it hits at α = {} but the sweep reports none", num(a)),
+    };
+    ExpectedTest {
+        test: label(r),
+        description: describe(r),
+        verdict: Some(verdict),
+        why_not,
+    }
+}

@@ -1,0 +1,31 @@
+//! Regression testing on top of replay: a trace's `/expected` outcomes are
+//! the test case.
+//!
+//! - [`compare`]: the one rule deciding whether an outcome diverges from its
+//!   expectation ([`compare()`], [`Tolerances`]), shared by `check`, `diff`
+//!   and the viewer;
+//! - [`explain`](mod@explain): why a divergent sweep came out as it did;
+//! - [`check`](mod@check): a whole trace checked ([`check_file`]), and
+//!   [`render_text`] / [`render_json`] for its report;
+//! - [`diff`](mod@diff): two traces, or one under two configurations;
+//! - [`bless`](mod@bless): a trace's expectations rewritten from the core.
+
+pub mod bless;
+pub mod check;
+pub mod compare;
+pub mod diff;
+pub mod explain;
+mod render;
+
+pub use bless::{BlessError, BlessSummary, bless_bytes, bless_file};
+pub use check::{
+    CheckOptions, DEFAULT_MAX_DETAILS, Divergence, Status, TraceReport, check_events, check_file,
+    check_reader, find_traces, frames_around,
+};
+pub use compare::{
+    DEFAULT_ALPHA_TOLERANCE, DEFAULT_CONTACT_TOLERANCE, DEFAULT_NORMAL_TOLERANCE_DEGREES, Field,
+    FieldDiff, Tolerances, angle_degrees, compare,
+};
+pub use diff::{DiffReport, FirstDifference, Side, diff};
+pub use explain::{ExpectedTest, expected_tests, explain_outcome, explained_records};
+pub use render::{render_divergence, render_json, render_text, value_text};

@@ -1,0 +1,188 @@
+//! `check` reports in words and as JSON: pure functions of a report.
+
+use std::fmt::Write as _;
+
+use serde_json::{Value, json};
+
+use crate::core::Kind;
+use crate::core::explain::num;
+
+use super::check::{Divergence, Status, TraceReport};
+
+/// A JSON value in words: numbers as [`num`], null as `null`.
+pub fn value_text(v: &Value) -> String {
+    match v {
+        Value::Null => "null".to_string(),
+        Value::String(s) => s.clone(),
+        Value::Number(n) => n.as_f64().map(num).unwrap_or_else(|| n.to_string()),
+        Value::Array(a) => format!(
+            "[{}]",
+            a.iter().map(value_text).collect::<Vec<_>>().join(", ")
+        ),
+        other => other.to_string(),
+    }
+}
+
+/// One divergence in words, several lines, indented by `indent`.
+pub fn render_divergence(d: &Divergence, indent: &str) -> String {
+    let mut s = String::new();
+    let _ = writeln!(
+        s,
+        "{indent}frame {}, ball {}: {} differ (margin {}, facing {})",
+        d.frame,
+        d.ball,
+        d.fields
+            .iter()
+            .map(|f| f.field.as_str())
+            .collect::<Vec<_>>()
+            .join(", "),
+        num(d.margin),
+        d.facing
+    );
+    for f in &d.fields {
+        let _ = write!(
+            s,
+            "{indent}  {}: expected {}, got {}",
+            f.field,
+            value_text(&f.expected),
+            value_text(&f.got)
+        );
+        if let Some(detail) = &f.detail {
+            let _ = write!(s, " ({detail})");
+        }
+        s.push('\n');
+    }
+    let _ = writeln!(s, "{indent}  the core found:");
+    for line in &d.got_explanation {
+        let _ = writeln!(s, "{indent}    {line}");
+    }
+    if d.expected.kind == Kind::None {
+        let _ = writeln!(s, "{indent}  expected no collision");
+    } else if d.expected_tests.is_empty() {
+        let _ = writeln!(
+            s,
+            "{indent}  expected a {} collision; no test of that kind hit",
+            d.expected.kind
+        );
+    } else {
+        for t in &d.expected_tests {
+            let _ = writeln!(s, "{indent}  expected result's test: {}", t.description);
+            let _ = writeln!(s, "{indent}    why not: {}", t.why_not);
+        }
+    }
+    s
+}
+
+/// One line of a trace's status, then (when it failed) the first
+/// divergences in detail.
+pub fn render_text(r: &TraceReport) -> String {
+    let mut s = String::new();
+    let counts = format!(
+        "{} sweeps, {} compared, {} without expectation, {} expectations without a sweep",
+        r.sweeps, r.compared, r.sweeps_without_expectation, r.expectations_without_sweep
+    );
+    match r.status {
+        Status::Ok => {
+            let _ = writeln!(s, "ok {}: {counts}", r.trace);
+        }
+        Status::Fail => {
+            let kinds = r
+                .by_kind
+                .iter()
+                .map(|(k, n)| format!("{k}: {n}"))
+                .collect::<Vec<_>>()
+                .join(", ");
+            let _ = writeln!(
+                s,
+                "FAIL {}: {} of {} compared sweeps diverge ({kinds}); {counts}",
+                r.trace, r.divergent, r.compared
+            );
+            if r.divergences.is_empty()
+                && let Some(frame) = r.divergent_frames.first()
+            {
+                let _ = writeln!(s, "  first divergence: frame {frame}");
+            }
+            if let Some(first) = r.divergences.first() {
+                let _ = writeln!(
+                    s,
+                    "  first divergence: frame {}, ball {} ({})",
+                    first.frame,
+                    first.ball,
+                    first
+                        .fields
+                        .iter()
+                        .map(|f| f.field.as_str())
+                        .collect::<Vec<_>>()
+                        .join(", ")
+                );
+            }
+            for d in &r.divergences {
+                s.push_str(&render_divergence(d, "  "));
+            }
+            if r.divergent as usize > r.divergences.len() {
+                let _ = writeln!(
+                    s,
+                    "  ... {} more divergent sweeps (frames {}{})",
+                    r.divergent as usize - r.divergences.len(),
+                    r.divergent_frames
+                        .iter()
+                        .skip(r.divergences.len())
+                        .take(20)
+                        .map(u64::to_string)
+                        .collect::<Vec<_>>()
+                        .join(", "),
+                    if r.divergent as usize > r.divergences.len() + 20 {
+                        ", ..."
+                    } else {
+                        ""
+                    }
+                );
+            }
+        }
+        Status::NoExpectations => {
+            let why = if !r.has_expected_channel {
+                "no /expected channel".to_string()
+            } else if r.expectations == 0 {
+                "the /expected channel holds no message".to_string()
+            } else {
+                format!(
+                    "none of the {} /expected messages matches a sweep",
+                    r.expectations
+                )
+            };
+            let _ = writeln!(s, "NO EXPECTATIONS {}: {why}; {counts}", r.trace);
+        }
+        Status::Error => {
+            let _ = writeln!(
+                s,
+                "ERROR {}: {}; {counts}, {} diverge",
+                r.trace,
+                r.errors.first().map(String::as_str).unwrap_or("error"),
+                r.divergent
+            );
+            for e in r.errors.iter().skip(1) {
+                let _ = writeln!(s, "  also: {e}");
+            }
+            for d in &r.divergences {
+                s.push_str(&render_divergence(d, "  "));
+            }
+        }
+    }
+    s
+}
+
+/// The reports as one JSON document: `{"status": ..., "traces": [...]}`
+/// (pretty-printed, ending with a newline).
+pub fn render_json(reports: &[TraceReport]) -> String {
+    let overall = reports.iter().map(|r| r.status).max().unwrap_or(Status::Ok);
+    let doc = json!({
+        "status": overall,
+        "exit_code": Status::exit_code(reports.iter().map(|r| &r.status)),
+        "traces": reports,
+    });
+    let mut s = serde_json::to_string_pretty(&doc).unwrap_or_else(|e| {
+        json!({"status": "error", "error": format!("serializing the report: {e}")}).to_string()
+    });
+    s.push('\n');
+    s
+}

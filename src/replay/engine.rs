@@ -1,0 +1,437 @@
+//! The push-based replay engine: scenes built into meshes, each sweep run
+//! through the core, `/expected` outcomes attached to their sweep.
+
+use std::collections::{HashMap, VecDeque};
+use std::sync::Arc;
+use std::time::{Duration, Instant};
+
+use crate::core::explain::nearest_miss;
+use crate::core::{
+    Broadphase, CollectRecords, Mesh, Options, Outcome, SIMULTANEOUS_TOLERANCE, Sweep, TestRecord,
+    Verdict, sweep_mesh, sweep_mesh_with,
+};
+use crate::trace::TraceEvent;
+use crate::trace::messages::{OutcomeMsg, SceneMsg, SweepMsg};
+
+use super::{Detail, ReplayError, ReplayOptions, ReplaySummary};
+
+#[derive(Clone, Debug)]
+pub struct SceneState {
+    /// 0 for the trace's first scene, 1 for the next, ...
+    pub number: usize,
+    /// Index of the scene message in the trace.
+    pub index: u64,
+    /// `log_time` of the scene message, in nanoseconds.
+    pub log_time_nanos: u64,
+    /// The scene's name, if it has one.
+    pub name: Option<String>,
+    /// The mesh.
+    pub mesh: Mesh,
+    /// The options in force: the scene's margin and facing unless overridden.
+    pub options: Options,
+}
+
+/// The result of one sweep.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SweepResult {
+    /// Frame number.
+    pub frame: u64,
+    /// Ball number.
+    pub ball: u32,
+    /// `log_time` of the sweep message, in nanoseconds.
+    pub log_time_nanos: u64,
+    /// Index of the sweep message in the trace.
+    pub index: u64,
+    /// [`SceneState::number`] of the scene it was swept against.
+    pub scene: usize,
+    /// The sweep.
+    pub sweep: Sweep,
+    /// The options used.
+    pub options: Options,
+    /// The core's outcome.
+    pub outcome: Outcome,
+    /// The test records kept at the chosen [`Detail`] (empty when not
+    /// explained). With [`Detail::Primary`] the first record is the primary
+    /// test, or the nearest miss.
+    pub records: Vec<TestRecord>,
+    /// The trace's `/expected` outcome for this `(frame, ball)`, if any.
+    pub expected: Option<OutcomeMsg>,
+}
+
+impl SweepResult {
+    /// The outcome as the record of SEMANTICS.md (every field present).
+    pub fn outcome_msg(&self) -> OutcomeMsg {
+        OutcomeMsg::from_outcome(self.frame, self.ball, &self.outcome)
+    }
+
+    /// The record that decided the sweep: the primary test when something is
+    /// hit, otherwise the nearest miss among the kept records.
+    pub fn decisive_record(&self) -> Option<&TestRecord> {
+        if self.outcome.is_hit() {
+            self.records.iter().find(|r| self.outcome.is_reported_by(r))
+        } else {
+            nearest_miss(&self.records)
+        }
+    }
+
+    /// The detection radius `ρ = r - ε`.
+    pub fn rho(&self) -> f64 {
+        self.sweep.radius - self.options.margin
+    }
+}
+
+/// What the replay produces, in trace order.
+#[derive(Clone, Debug)]
+pub enum ReplayEvent {
+    /// A new scene: every following sweep is against it until the next one.
+    Scene(Arc<SceneState>),
+    /// One sweep's result.
+    Sweep(Box<SweepResult>),
+}
+
+/// The replay engine (push-based; see the module documentation).
+#[derive(Debug)]
+pub struct Replay {
+    options: ReplayOptions,
+    scene: Option<Arc<SceneState>>,
+    /// Results held until their frame is complete.
+    pending: Vec<SweepResult>,
+    /// `/expected` messages that arrived before their sweep.
+    early_expected: HashMap<(u64, u32), OutcomeMsg>,
+    ready: VecDeque<ReplayEvent>,
+    summary: ReplaySummary,
+}
+
+impl Replay {
+    /// A replay with `options`.
+    pub fn new(options: ReplayOptions) -> Replay {
+        Replay {
+            options,
+            scene: None,
+            pending: Vec::new(),
+            early_expected: HashMap::new(),
+            ready: VecDeque::new(),
+            summary: ReplaySummary::default(),
+        }
+    }
+
+    /// The options.
+    pub fn options(&self) -> &ReplayOptions {
+        &self.options
+    }
+
+    /// The scene in force, if any.
+    pub fn current_scene(&self) -> Option<&Arc<SceneState>> {
+        self.scene.as_ref()
+    }
+
+    /// A `/scene` message.
+    pub fn scene(
+        &mut self,
+        log_time_nanos: u64,
+        index: u64,
+        scene: SceneMsg,
+    ) -> Result<(), ReplayError> {
+        let start = Instant::now();
+        self.release_pending();
+        let SceneMsg {
+            name,
+            vertices,
+            triangles,
+            margin,
+            facing,
+        } = scene;
+        let mesh = Mesh::new(vertices, &triangles)
+            .map_err(|source| ReplayError::Mesh { index, source })?;
+        let options = Options {
+            margin: self.options.margin.unwrap_or(margin),
+            facing: self.options.facing.unwrap_or(facing),
+        };
+        let number = self.summary.scenes;
+        self.summary.scenes += 1;
+        self.summary.degenerate_triangles += mesh.degenerate().len();
+        let state = Arc::new(SceneState {
+            number,
+            index,
+            log_time_nanos,
+            name,
+            mesh,
+            options,
+        });
+        self.scene = Some(state.clone());
+        self.ready.push_back(ReplayEvent::Scene(state));
+        self.summary.elapsed += start.elapsed();
+        Ok(())
+    }
+
+    /// A `/sweep` message.
+    pub fn sweep(
+        &mut self,
+        log_time_nanos: u64,
+        index: u64,
+        msg: SweepMsg,
+    ) -> Result<(), ReplayError> {
+        if self.pending.first().is_some_and(|p| p.frame != msg.frame) {
+            self.release_pending();
+        }
+        if !self.wanted(msg.frame, msg.ball) {
+            self.summary.filtered_out += 1;
+            self.early_expected.remove(&(msg.frame, msg.ball));
+            return Ok(());
+        }
+        let Some(scene) = self.scene.clone() else {
+            return Err(ReplayError::NoScene {
+                frame: msg.frame,
+                index,
+            });
+        };
+        let computed = compute_sweep(&scene, &msg, index, &self.options);
+        self.commit(log_time_nanos, index, msg, &scene, computed?);
+        Ok(())
+    }
+
+    /// A `/sweep` message whose core query already ran ([`compute_sweep`]
+    /// against [`Replay::current_scene`], or `None` when the sweep is
+    /// filtered out or comes before any scene): the same as
+    /// [`Replay::sweep`] without the query. Used by [`replay_events_parallel`].
+    pub fn sweep_computed(
+        &mut self,
+        log_time_nanos: u64,
+        index: u64,
+        msg: SweepMsg,
+        computed: Option<Result<ComputedSweep, ReplayError>>,
+    ) -> Result<(), ReplayError> {
+        let Some(computed) = computed else {
+            return self.sweep(log_time_nanos, index, msg);
+        };
+        if self.pending.first().is_some_and(|p| p.frame != msg.frame) {
+            self.release_pending();
+        }
+        let Some(scene) = self.scene.clone() else {
+            return Err(ReplayError::NoScene {
+                frame: msg.frame,
+                index,
+            });
+        };
+        self.commit(log_time_nanos, index, msg, &scene, computed?);
+        Ok(())
+    }
+
+    /// Whether a sweep passes the frame and ball filters.
+    fn wanted(&self, frame: u64, ball: u32) -> bool {
+        self.options.wants(frame, ball)
+    }
+
+    fn commit(
+        &mut self,
+        log_time_nanos: u64,
+        index: u64,
+        msg: SweepMsg,
+        scene: &SceneState,
+        computed: ComputedSweep,
+    ) {
+        let ComputedSweep {
+            sweep,
+            outcome,
+            records,
+            verdicts,
+            elapsed,
+        } = computed;
+        for (v, n) in verdicts {
+            *self.summary.verdicts.entry(v).or_default() += n;
+        }
+        let expected = self.early_expected.remove(&(msg.frame, msg.ball));
+        if expected.is_some() {
+            self.summary.expected_matched += 1;
+        }
+        self.summary.sweeps += 1;
+        self.summary.elapsed += elapsed;
+        *self.summary.outcomes.entry(outcome.kind).or_default() += 1;
+        self.pending.push(SweepResult {
+            frame: msg.frame,
+            ball: msg.ball,
+            log_time_nanos,
+            index,
+            scene: scene.number,
+            sweep,
+            options: scene.options,
+            outcome,
+            records,
+            expected,
+        });
+    }
+
+    /// Any trace event.
+    pub fn push(&mut self, event: TraceEvent) -> Result<(), ReplayError> {
+        match event {
+            TraceEvent::Scene {
+                log_time_nanos,
+                index,
+                scene,
+            } => self.scene(log_time_nanos, index, scene),
+            TraceEvent::Sweep {
+                log_time_nanos,
+                index,
+                sweep,
+            } => self.sweep(log_time_nanos, index, sweep),
+            TraceEvent::Expected {
+                log_time_nanos,
+                index,
+                outcome,
+            } => {
+                self.expected(log_time_nanos, index, outcome);
+                Ok(())
+            }
+        }
+    }
+
+    /// An `/expected` message.
+    pub fn expected(&mut self, _log_time_nanos: u64, _index: u64, outcome: OutcomeMsg) {
+        if !self.options.frames.contains(outcome.frame)
+            || self.options.ball.is_some_and(|b| b != outcome.ball)
+        {
+            return;
+        }
+        if let Some(p) = self
+            .pending
+            .iter_mut()
+            .find(|p| p.frame == outcome.frame && p.ball == outcome.ball)
+        {
+            if p.expected.is_none() {
+                self.summary.expected_matched += 1;
+            } else {
+                self.summary.expected_unmatched += 1;
+            }
+            p.expected = Some(outcome);
+            return;
+        }
+        if self
+            .early_expected
+            .insert((outcome.frame, outcome.ball), outcome)
+            .is_some()
+        {
+            self.summary.expected_unmatched += 1;
+        }
+    }
+
+    /// The next finished event, if any.
+    pub fn next_event(&mut self) -> Option<ReplayEvent> {
+        self.ready.pop_front()
+    }
+
+    /// Releases every held result; returns them with the summary.
+    pub fn finish(mut self) -> (Vec<ReplayEvent>, ReplaySummary) {
+        self.release_pending();
+        self.summary.expected_unmatched += self.early_expected.len() as u64;
+        (self.ready.into_iter().collect(), self.summary)
+    }
+
+    /// The counts so far.
+    pub fn summary(&self) -> &ReplaySummary {
+        &self.summary
+    }
+
+    fn release_pending(&mut self) {
+        let Some(frame) = self.pending.first().map(|p| p.frame) else {
+            return;
+        };
+        for p in self.pending.drain(..) {
+            self.ready.push_back(ReplayEvent::Sweep(Box::new(p)));
+        }
+        // Expected outcomes of earlier frames can no longer find their sweep.
+        let before = self.early_expected.len();
+        self.early_expected.retain(|(f, _), _| *f >= frame);
+        self.summary.expected_unmatched += (before - self.early_expected.len()) as u64;
+    }
+}
+
+/// The core's part of one sweep, independent of every other sweep: what
+/// [`Replay::sweep_computed`] takes.
+#[derive(Clone, Debug)]
+pub struct ComputedSweep {
+    sweep: Sweep,
+    outcome: Outcome,
+    records: Vec<TestRecord>,
+    verdicts: Vec<(Verdict, u64)>,
+    elapsed: Duration,
+}
+
+/// Runs the core query of one sweep message against `scene` as a replay
+/// with `options` would (the filters are not applied here).
+pub fn compute_sweep(
+    scene: &SceneState,
+    msg: &SweepMsg,
+    index: u64,
+    options: &ReplayOptions,
+) -> Result<ComputedSweep, ReplayError> {
+    let start = Instant::now();
+    let sweep = Sweep::new(msg.p0, msg.p1, msg.radius);
+    let err = |source| ReplayError::Sweep {
+        frame: msg.frame,
+        ball: msg.ball,
+        index,
+        source,
+    };
+    let mut verdicts: Vec<(Verdict, u64)> = Vec::new();
+    let (outcome, records) = if options.explain {
+        let broadphase = match options.detail {
+            Detail::All => Broadphase::Exhaustive,
+            Detail::Primary | Detail::Candidates => Broadphase::Bvh,
+        };
+        let mut collect = CollectRecords::default();
+        let outcome = sweep_mesh_with(
+            &scene.mesh,
+            &sweep,
+            &scene.options,
+            broadphase,
+            &mut collect,
+        )
+        .map_err(err)?;
+        for r in &collect.records {
+            let v = r.verdict();
+            match verdicts.iter_mut().find(|(w, _)| *w == v) {
+                Some((_, n)) => *n += 1,
+                None => verdicts.push((v, 1)),
+            }
+        }
+        let records = match options.detail {
+            Detail::Primary => primary_records(&outcome, collect.records),
+            Detail::Candidates | Detail::All => collect.records,
+        };
+        (outcome, records)
+    } else {
+        (
+            sweep_mesh(&scene.mesh, &sweep, &scene.options).map_err(err)?,
+            Vec::new(),
+        )
+    };
+    Ok(ComputedSweep {
+        sweep,
+        outcome,
+        records,
+        verdicts,
+        elapsed: start.elapsed(),
+    })
+}
+
+/// The records of [`Detail::Primary`]: the primary test, then every other
+/// hit within [`SIMULTANEOUS_TOLERANCE`] of its `α`; when nothing is hit,
+/// the nearest miss.
+pub fn primary_records(outcome: &Outcome, records: Vec<TestRecord>) -> Vec<TestRecord> {
+    if !outcome.is_hit() {
+        return nearest_miss(&records).copied().into_iter().collect();
+    }
+    let mut out: Vec<TestRecord> = records
+        .iter()
+        .filter(|r| outcome.is_reported_by(r))
+        .take(1)
+        .copied()
+        .collect();
+    let limit = outcome.alpha + SIMULTANEOUS_TOLERANCE;
+    out.extend(
+        records
+            .into_iter()
+            .filter(|r| r.alpha().is_some_and(|a| a <= limit) && !outcome.is_reported_by(r)),
+    );
+    out
+}

@@ -1,0 +1,49 @@
+//! Why an event of a trace cannot be replayed.
+
+use thiserror::Error;
+
+use crate::core::{MeshError, SweepError};
+use crate::trace::TraceError;
+
+#[derive(Debug, Error)]
+#[non_exhaustive]
+pub enum ReplayError {
+    /// A scene's mesh is invalid.
+    #[error("scene message {index}: {source}")]
+    Mesh {
+        /// Index of the scene message.
+        index: u64,
+        /// What is wrong.
+        source: MeshError,
+    },
+    /// A sweep came before any scene.
+    #[error("sweep of frame {frame} (message {index}) has no scene before it")]
+    NoScene {
+        /// Frame of the sweep.
+        frame: u64,
+        /// Index of the sweep message.
+        index: u64,
+    },
+    /// A sweep's values are invalid.
+    #[error("frame {frame}, ball {ball} (message {index}): {source}")]
+    Sweep {
+        /// Frame.
+        frame: u64,
+        /// Ball.
+        ball: u32,
+        /// Index of the sweep message.
+        index: u64,
+        /// What is wrong.
+        source: SweepError,
+    },
+    /// The trace could not be read further.
+    /// (Boxed: a trace error is large, and results pass through here.)
+    #[error(transparent)]
+    Trace(Box<TraceError>),
+}
+
+impl From<TraceError> for ReplayError {
+    fn from(err: TraceError) -> Self {
+        ReplayError::Trace(Box::new(err))
+    }
+}

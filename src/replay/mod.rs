@@ -1,0 +1,31 @@
+//! The replay engine: trace events in, one explained result per sweep out.
+//!
+//! [`Replay`] is push-based: feed it the events of a trace in order
+//! ([`Replay::scene`], [`Replay::sweep`], [`Replay::expected`]) and take the
+//! finished [`ReplayEvent`]s with [`Replay::next_event`]; [`Replay::finish`]
+//! flushes what is still held and returns the [`ReplaySummary`]. [`replay_events`]
+//! wraps any iterator of trace events into an iterator of results.
+//!
+//! A sweep's result is held back until a sweep of another frame (or a new
+//! scene, or the end) arrives, so that an `/expected` message logged just
+//! after its sweep is still attached to it.
+//!
+//! Nothing here knows about the viewer: `viz` turns results into a Rerun
+//! recording, `check`-like commands compare [`SweepResult::outcome_msg`]
+//! with [`SweepResult::expected`].
+
+mod engine;
+mod error;
+mod iter;
+mod options;
+mod summary;
+
+pub use engine::{
+    ComputedSweep, Replay, ReplayEvent, SceneState, SweepResult, compute_sweep, primary_records,
+};
+pub use error::ReplayError;
+pub use iter::{
+    DEFAULT_BATCH_EVENTS, ParallelReplayIter, ReplayIter, replay_events, replay_events_parallel,
+};
+pub use options::{Detail, FrameRange, ReplayOptions};
+pub use summary::ReplaySummary;

@@ -1,0 +1,147 @@
+//! What a caller chooses about a replay: which sweeps, how much is
+//! explained, and overrides of the scene's margin and facing rule.
+
+use crate::core::Facing;
+
+/// How many test records each sweep keeps.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum Detail {
+    /// The tests that report the primary collision (the primary test first,
+    /// then every other hit at the same `α` within
+    /// [`SIMULTANEOUS_TOLERANCE`], which share the averaged normal); when
+    /// nothing hits, the one test that came nearest
+    /// ([`crate::core::explain::miss_distance`]) among the BVH candidates.
+    #[default]
+    Primary,
+    /// Every test of every triangle the BVH visited.
+    Candidates,
+    /// Every test of every triangle ([`Broadphase::Exhaustive`]).
+    All,
+}
+
+impl Detail {
+    /// The name used on the command line.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Detail::Primary => "primary",
+            Detail::Candidates => "candidates",
+            Detail::All => "all",
+        }
+    }
+}
+
+impl std::fmt::Display for Detail {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.as_str())
+    }
+}
+
+impl std::str::FromStr for Detail {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        match s {
+            "primary" => Ok(Detail::Primary),
+            "candidates" => Ok(Detail::Candidates),
+            "all" => Ok(Detail::All),
+            other => Err(format!(
+                "unknown detail `{other}` (expected `primary`, `candidates` or `all`)"
+            )),
+        }
+    }
+}
+
+/// A half-open range of frames `start..end`; either end may be open.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub struct FrameRange {
+    /// First frame included.
+    pub start: Option<u64>,
+    /// First frame excluded.
+    pub end: Option<u64>,
+}
+
+impl FrameRange {
+    /// Whether `frame` lies in the range.
+    pub fn contains(&self, frame: u64) -> bool {
+        self.start.is_none_or(|s| frame >= s) && self.end.is_none_or(|e| frame < e)
+    }
+}
+
+impl std::fmt::Display for FrameRange {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        if let Some(s) = self.start {
+            write!(f, "{s}")?;
+        }
+        f.write_str("..")?;
+        if let Some(e) = self.end {
+            write!(f, "{e}")?;
+        }
+        Ok(())
+    }
+}
+
+impl std::str::FromStr for FrameRange {
+    type Err = String;
+    /// `A..B` (A included, B excluded), `A..`, `..B`, `A..=B`, or one frame `A`.
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        let bound = |t: &str| -> Result<Option<u64>, String> {
+            let t = t.trim();
+            if t.is_empty() {
+                return Ok(None);
+            }
+            t.parse::<u64>()
+                .map(Some)
+                .map_err(|_| format!("`{t}` is not a frame number"))
+        };
+        let range = if let Some((a, b)) = s.split_once("..=") {
+            let end = bound(b)?.ok_or_else(|| format!("`{s}`: `..=` needs an end frame"))?;
+            FrameRange {
+                start: bound(a)?,
+                end: Some(end.saturating_add(1)),
+            }
+        } else if let Some((a, b)) = s.split_once("..") {
+            FrameRange {
+                start: bound(a)?,
+                end: bound(b)?,
+            }
+        } else {
+            let f = bound(s)?.ok_or_else(|| "empty frame range".to_string())?;
+            FrameRange {
+                start: Some(f),
+                end: Some(f.saturating_add(1)),
+            }
+        };
+        if let (Some(a), Some(b)) = (range.start, range.end)
+            && b <= a
+        {
+            return Err(format!(
+                "frame range `{s}` is empty (A..B includes A and excludes B)"
+            ));
+        }
+        Ok(range)
+    }
+}
+
+/// Options of a replay.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct ReplayOptions {
+    /// Only sweeps whose frame lies in this range.
+    pub frames: FrameRange,
+    /// Only this ball.
+    pub ball: Option<u32>,
+    /// Which test records each result keeps.
+    pub detail: Detail,
+    /// Whether to run the explained query at all. When `false` every sweep
+    /// uses the fast [`sweep_mesh`] and results carry no records.
+    pub explain: bool,
+    /// Overrides every scene's margin `ε`.
+    pub margin: Option<f64>,
+    /// Overrides every scene's facing rule.
+    pub facing: Option<Facing>,
+}
+
+impl ReplayOptions {
+    /// Whether the frame and ball filters keep the sweep of `ball` at `frame`.
+    pub fn wants(&self, frame: u64, ball: u32) -> bool {
+        self.frames.contains(frame) && self.ball.is_none_or(|b| b == ball)
+    }
+}

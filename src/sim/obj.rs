@@ -1,0 +1,112 @@
+//! Scenes from Wavefront OBJ files (triangulated by `tobj`).
+
+use super::scenes::SceneMesh;
+
+/// Why a Wavefront OBJ file could not be used as a scene.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum ObjError {
+    /// The file could not be opened or read.
+    #[error("cannot read {path}: {source}")]
+    Io {
+        /// The file.
+        path: String,
+        /// The cause.
+        source: std::io::Error,
+    },
+    /// The OBJ parser refused the file.
+    #[error("{path} is not a valid Wavefront OBJ file: {reason}")]
+    Parse {
+        /// The file.
+        path: String,
+        /// What the parser reported.
+        reason: String,
+    },
+    /// The file parsed but holds no triangle.
+    #[error("{path} holds no triangle (no `f` lines with three or more vertices)")]
+    NoTriangles {
+        /// The file.
+        path: String,
+    },
+}
+
+/// Loads a Wavefront OBJ file (through `tobj`) as a scene named after the
+/// file's stem. Polygons are triangulated as fans; every object and group
+/// of the file goes into one mesh; materials, normals, texture coordinates,
+/// points and lines are ignored. Faces are counter-clockwise seen from the
+/// front, as in the OBJ convention. Coordinates are read as `f32`.
+pub fn load_obj(path: &std::path::Path) -> Result<SceneMesh, ObjError> {
+    let shown = path.display().to_string();
+    let file = std::fs::File::open(path).map_err(|source| ObjError::Io {
+        path: shown.clone(),
+        source,
+    })?;
+    let mut reader = std::io::BufReader::new(file);
+    let mut scene = obj_from_reader(&mut reader).map_err(|e| match e {
+        ObjError::Parse { reason, .. } => ObjError::Parse {
+            path: shown.clone(),
+            reason,
+        },
+        ObjError::NoTriangles { .. } => ObjError::NoTriangles {
+            path: shown.clone(),
+        },
+        other => other,
+    })?;
+    scene.name = path
+        .file_stem()
+        .map_or_else(|| "mesh".into(), |s| s.to_string_lossy().into_owned());
+    Ok(scene)
+}
+
+/// Parses Wavefront OBJ text from a reader (see [`load_obj`]); errors name
+/// the source `<input>`.
+pub fn obj_from_reader(reader: &mut impl std::io::BufRead) -> Result<SceneMesh, ObjError> {
+    let options = tobj::LoadOptions {
+        triangulate: true,
+        single_index: false,
+        ignore_points: true,
+        ignore_lines: true,
+    };
+    let no_materials =
+        |_: &std::path::Path| -> tobj::MTLLoadResult { Ok((Vec::new(), Default::default())) };
+    let (models, _materials) =
+        tobj::load_obj_buf(reader, &options, no_materials).map_err(|e| ObjError::Parse {
+            path: "<input>".into(),
+            reason: e.to_string(),
+        })?;
+    let mut vertices = Vec::new();
+    let mut triangles = Vec::new();
+    for model in &models {
+        let mesh = &model.mesh;
+        let offset = vertices.len() as u64;
+        let count = mesh.positions.len() / 3;
+        vertices.extend(
+            mesh.positions
+                .chunks_exact(3)
+                .map(|p| [f64::from(p[0]), f64::from(p[1]), f64::from(p[2])]),
+        );
+        for t in mesh.indices.chunks_exact(3) {
+            let t = [t[0], t[1], t[2]].map(u64::from);
+            if t.iter().any(|&i| i >= count as u64) {
+                return Err(ObjError::Parse {
+                    path: "<input>".into(),
+                    reason: format!(
+                        "a face of object `{}` refers to a vertex that does not exist",
+                        model.name
+                    ),
+                });
+            }
+            triangles.push(t.map(|i| i + offset));
+        }
+    }
+    if triangles.is_empty() {
+        return Err(ObjError::NoTriangles {
+            path: "<input>".into(),
+        });
+    }
+    Ok(SceneMesh {
+        name: "mesh".into(),
+        vertices,
+        triangles,
+    })
+}

@@ -9,6 +9,7 @@ pub mod core;
 pub mod regress;
 pub mod replay;
 pub mod report;
+pub mod run;
 pub mod sim;
 pub mod trace;
 #[cfg(feature = "viewer")]

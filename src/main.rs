@@ -6,6 +6,7 @@ mod cli;
 use std::process::ExitCode;
 
 use clap::Parser;
+use sweeptrace::run::RunOutcome;
 
 fn main() -> ExitCode {
     // Like other command-line tools, stop quietly when the reader of our
@@ -17,11 +18,9 @@ fn main() -> ExitCode {
         libc::signal(libc::SIGPIPE, libc::SIG_DFL);
     }
     let args = cli::Cli::parse();
-    match cli::run(args) {
-        Ok(code) => code,
-        Err(err) => {
-            eprintln!("error: {err:#}");
-            ExitCode::from(2)
-        }
-    }
+    let outcome = cli::run(args).unwrap_or_else(|err| {
+        eprintln!("error: {err:#}");
+        RunOutcome::Error
+    });
+    ExitCode::from(outcome.exit_code())
 }

@@ -479,7 +479,27 @@ fn binary_errors_exit_2() -> Result<(), String> {
     let cut = dir.path().join("cut.mcap");
     std::fs::write(&cut, &good[..good.len() * 2 / 3]).map_err(|e| e.to_string())?;
     let (code, out, _) = run_bin(os!["check", cut.as_os_str()])?;
-    ensure!(code == 2, "truncated: exit {code}: {out}");
+    ensure!(code == 3, "truncated: exit {code}: {out}");
+    // Every command gives a truncated trace the same exit code (3,
+    // incomplete input), as the README's table says.
+    let outcomes = dir.path().join("cut.jsonl");
+    let commands: [&[&std::ffi::OsStr]; 3] = [
+        os!["info", cut.as_os_str()],
+        os![
+            "replay",
+            cut.as_os_str(),
+            "--outcomes",
+            outcomes.as_os_str()
+        ],
+        os!["check", cut.as_os_str(), "--json"],
+    ];
+    for args in commands {
+        let (code, _, err) = run_bin(args)?;
+        ensure!(
+            code == 3,
+            "{args:?} on a truncated trace: exit {code}: {err}"
+        );
+    }
     let (code, _, err) = run_bin(os!["check", missing.as_os_str(), "--tolerance", "nan"])?;
     ensure!(code == 2, "NaN tolerance: exit {code}: {err}");
     Ok(())

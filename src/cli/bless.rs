@@ -3,12 +3,12 @@
 //! record and attachment (the library's [`sweeptrace::regress`]).
 
 use std::path::PathBuf;
-use std::process::ExitCode;
 
 use anyhow::{Context, bail};
 
 use sweeptrace::regress::bless_file;
 use sweeptrace::replay::ReplayOptions;
+use sweeptrace::run::RunOutcome;
 
 /// Arguments of `bless`.
 #[derive(Debug, clap::Args)]
@@ -38,7 +38,7 @@ pub struct Args {
 }
 
 /// Blesses the trace.
-pub fn run(args: Args) -> anyhow::Result<ExitCode> {
+pub fn run(args: Args) -> anyhow::Result<RunOutcome> {
     let output = match (&args.output, args.in_place) {
         (Some(out), false) => out.clone(),
         (None, true) => args.trace.clone(),
@@ -58,5 +58,5 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         summary.metadata_copied,
         summary.attachments_copied
     );
-    Ok(ExitCode::SUCCESS)
+    Ok(RunOutcome::Success)
 }

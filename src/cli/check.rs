@@ -2,7 +2,6 @@
 //! the trace's `/expected` channel (the library's [`sweeptrace::regress`]).
 
 use std::path::{Path, PathBuf};
-use std::process::ExitCode;
 
 use anyhow::{Context, bail};
 
@@ -12,6 +11,7 @@ use sweeptrace::regress::{
     render_json, render_text,
 };
 use sweeptrace::replay::{Detail, ReplayError, ReplayEvent, ReplayOptions, replay_events};
+use sweeptrace::run::RunOutcome;
 use sweeptrace::trace::TraceReader;
 use sweeptrace::viz;
 
@@ -50,7 +50,7 @@ pub struct Args {
 }
 
 /// Checks every trace, prints the reports, returns the exit code.
-pub fn run(args: Args) -> anyhow::Result<ExitCode> {
+pub fn run(args: Args) -> anyhow::Result<RunOutcome> {
     let tolerances = args.tolerances.to_tolerances()?;
     let traces = find_traces(&args.paths).map_err(anyhow::Error::msg)?;
     if traces.is_empty() {
@@ -105,8 +105,12 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             count(Status::Error)
         );
     }
-    let code = Status::exit_code(reports.iter().map(|r| &r.status));
-    Ok(ExitCode::from(if rrd_error { 2 } else { code }))
+    let outcome = RunOutcome::worst(reports.iter().map(TraceReport::outcome));
+    Ok(if rrd_error {
+        RunOutcome::Error
+    } else {
+        outcome
+    })
 }
 
 /// Replays the frames around the report's first divergences into

@@ -4,7 +4,6 @@
 use std::fs::File;
 use std::io::BufReader;
 use std::path::{Path, PathBuf};
-use std::process::ExitCode;
 
 use anyhow::{Context, bail};
 
@@ -12,6 +11,7 @@ use sweeptrace::core::Facing;
 use sweeptrace::regress::diff::{render_json, render_text};
 use sweeptrace::regress::{Side, diff};
 use sweeptrace::replay::{FrameRange, ReplayOptions};
+use sweeptrace::run::RunOutcome;
 use sweeptrace::trace::TraceReader;
 
 /// Arguments of `diff`.
@@ -64,7 +64,7 @@ fn side(path: &Path, options: ReplayOptions) -> anyhow::Result<Side> {
 }
 
 /// Compares the two replays.
-pub fn run(args: Args) -> anyhow::Result<ExitCode> {
+pub fn run(args: Args) -> anyhow::Result<RunOutcome> {
     let tolerances = args.tolerances.to_tolerances()?;
     for (flag, m) in [("--margin-a", args.margin_a), ("--margin-b", args.margin_b)] {
         if let Some(m) = m
@@ -100,5 +100,9 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     } else {
         print!("{}", render_text(&report));
     }
-    Ok(ExitCode::from(if report.is_same() { 0 } else { 1 }))
+    Ok(if report.is_same() {
+        RunOutcome::Success
+    } else {
+        RunOutcome::Differences
+    })
 }

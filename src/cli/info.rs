@@ -3,10 +3,10 @@
 use std::fs::File;
 use std::io::BufReader;
 use std::path::PathBuf;
-use std::process::ExitCode;
 
 use anyhow::Context;
 
+use sweeptrace::run::RunOutcome;
 use sweeptrace::trace::TraceReader;
 use sweeptrace::trace::info::{collect, render_json, render_text};
 
@@ -23,7 +23,7 @@ pub struct Args {
 
 /// Prints the report. A trace that cannot be read to its end still gets the
 /// report of what came before the error, then the error.
-pub fn run(args: Args) -> anyhow::Result<ExitCode> {
+pub fn run(args: Args) -> anyhow::Result<RunOutcome> {
     let name = args.trace.display().to_string();
     let file = File::open(&args.trace).with_context(|| format!("cannot open trace {name}"))?;
     let (info, error) = collect(TraceReader::new(BufReader::new(file), &name));
@@ -37,7 +37,11 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         println!();
     }
     match error {
-        None => Ok(ExitCode::SUCCESS),
+        None => Ok(RunOutcome::Success),
+        Some(err) if err.is_truncation() => {
+            eprintln!("error: {err}");
+            Ok(RunOutcome::IncompleteInput)
+        }
         Some(err) => Err(err).with_context(|| format!("cannot read trace {name} to its end")),
     }
 }

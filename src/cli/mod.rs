@@ -1,8 +1,7 @@
 //! Argument structs (kept dumb) and dispatch to one file per subcommand.
 
-use std::process::ExitCode;
-
 use clap::{Parser, Subcommand};
+use sweeptrace::run::RunOutcome;
 
 pub mod bless;
 pub mod check;
@@ -40,8 +39,10 @@ pub enum Command {
     Record(record::Args),
 }
 
-/// Runs the chosen subcommand; `Ok` carries the exit code.
-pub fn run(cli: Cli) -> anyhow::Result<ExitCode> {
+/// Runs the chosen subcommand; `main` turns what it came to into the exit
+/// code ([`RunOutcome::exit_code`]), an error into
+/// [`RunOutcome::Error`]'s.
+pub fn run(cli: Cli) -> anyhow::Result<RunOutcome> {
     match cli.command {
         Command::Sweep(args) => sweep::run(args),
         Command::Record(args) => record::run(args),

@@ -2,12 +2,12 @@
 
 use std::io::IsTerminal;
 use std::path::PathBuf;
-use std::process::ExitCode;
 
 use anyhow::Context;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 
 use sweeptrace::core::Facing;
+use sweeptrace::run::RunOutcome;
 use sweeptrace::sim::scenes::{self, BuiltinScene, SceneMesh};
 use sweeptrace::sim::{self, SimOptions, SimSummary, StopReason};
 use sweeptrace::trace::write_trace_file;
@@ -113,7 +113,7 @@ impl Args {
 }
 
 /// Simulates, writes the trace and prints a summary.
-pub fn run(args: Args) -> anyhow::Result<ExitCode> {
+pub fn run(args: Args) -> anyhow::Result<RunOutcome> {
     let scene: SceneMesh = match &args.mesh {
         Some(path) => sim::load_obj(path)?,
         None => args.scene.mesh_with_terrain_cells(args.terrain_cells),
@@ -184,7 +184,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             &output.display().to_string()
         )
     );
-    Ok(ExitCode::SUCCESS)
+    Ok(RunOutcome::Success)
 }
 
 /// The closing summary of a recording, one paragraph.

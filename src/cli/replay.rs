@@ -4,7 +4,6 @@
 use std::fs::File;
 use std::io::{BufReader, BufWriter, IsTerminal, Read, Write};
 use std::path::{Path, PathBuf};
-use std::process::ExitCode;
 use std::sync::Arc;
 use std::sync::atomic::{AtomicU64, Ordering};
 
@@ -18,6 +17,7 @@ use sweeptrace::replay::{
     DEFAULT_BATCH_EVENTS, Detail, FrameRange, ReplayError, ReplayEvent, ReplayOptions, SceneState,
     replay_events_parallel,
 };
+use sweeptrace::run::RunOutcome;
 use sweeptrace::trace::TraceReader;
 use sweeptrace::trace::prefetch::{self, prefetch};
 use sweeptrace::viz;
@@ -131,7 +131,7 @@ impl OutcomeSink {
 }
 
 /// Runs the replay.
-pub fn run(args: Args) -> anyhow::Result<ExitCode> {
+pub fn run(args: Args) -> anyhow::Result<RunOutcome> {
     let trace_path = &args.trace;
     let file =
         File::open(trace_path).with_context(|| format!("opening {}", trace_path.display()))?;
@@ -405,9 +405,13 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             summary.sweeps,
             last_frame.map_or(String::new(), |f| format!(" (up to frame {f})"))
         );
-        return Ok(ExitCode::FAILURE);
+        return Ok(if err.is_truncation() {
+            RunOutcome::IncompleteInput
+        } else {
+            RunOutcome::Error
+        });
     }
-    Ok(ExitCode::SUCCESS)
+    Ok(RunOutcome::Success)
 }
 
 fn progress_bar(total_bytes: u64) -> ProgressBar {

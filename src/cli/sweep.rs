@@ -1,11 +1,10 @@
 //! `sweeptrace sweep`: one sweep against a built-in scene, explained.
 
-use std::process::ExitCode;
-
 use anyhow::Context;
 
 use sweeptrace::core::{Broadphase, CollectRecords, Facing, Options, Sweep, sweep_mesh_with};
 use sweeptrace::report;
+use sweeptrace::run::RunOutcome;
 use sweeptrace::sim::BuiltinScene;
 
 /// Arguments of `sweep`.
@@ -43,7 +42,7 @@ pub struct Args {
 }
 
 /// Runs the sweep and prints the outcome and explanations.
-pub fn run(args: Args) -> anyhow::Result<ExitCode> {
+pub fn run(args: Args) -> anyhow::Result<RunOutcome> {
     let scene = args.scene.mesh();
     let mesh = scene
         .to_mesh()
@@ -76,5 +75,5 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     } else {
         print!("{}", report::sweep_text(&explained));
     }
-    Ok(ExitCode::SUCCESS)
+    Ok(RunOutcome::Success)
 }

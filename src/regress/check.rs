@@ -21,6 +21,7 @@ use std::sync::Arc;
 use serde::Serialize;
 
 use crate::replay::{ReplayError, ReplayEvent, ReplayOptions, SceneState, SweepResult};
+use crate::run::RunOutcome;
 use crate::trace::messages::{EXPECTED_TOPIC, OutcomeMsg};
 use crate::trace::{TraceError, TraceEvent, TraceReader};
 
@@ -58,50 +59,57 @@ pub struct Divergence {
 }
 
 /// The status of one trace.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize)]
+#[derive(
+    Clone,
+    Copy,
+    Debug,
+    PartialEq,
+    Eq,
+    Hash,
+    PartialOrd,
+    Ord,
+    Serialize,
+    strum::IntoStaticStr,
+    strum::Display,
+)]
 #[serde(rename_all = "snake_case")]
 pub enum Status {
     /// Every expectation matched.
+    #[strum(serialize = "ok")]
     Ok,
     /// At least one sweep diverged.
+    #[strum(serialize = "FAIL")]
     Fail,
     /// Nothing to compare: no `/expected` channel, or no expectation matches
     /// a sweep. Never a pass.
+    #[strum(serialize = "NO EXPECTATIONS")]
     NoExpectations,
     /// The trace could not be (fully) checked.
+    #[strum(serialize = "ERROR")]
     Error,
 }
 
 impl Status {
     /// `ok`, `FAIL`, `NO EXPECTATIONS`, `ERROR`.
     pub fn as_str(self) -> &'static str {
-        match self {
-            Status::Ok => "ok",
-            Status::Fail => "FAIL",
-            Status::NoExpectations => "NO EXPECTATIONS",
-            Status::Error => "ERROR",
-        }
-    }
-
-    /// The exit code of a set of statuses: 2 when anything could not be
-    /// checked (an error or no expectations), else 1 when a divergence was
-    /// found, else 0.
-    pub fn exit_code<'a>(statuses: impl IntoIterator<Item = &'a Status>) -> u8 {
-        let mut code = 0;
-        for s in statuses {
-            code = code.max(match s {
-                Status::Ok => 0,
-                Status::Fail => 1,
-                Status::NoExpectations | Status::Error => 2,
-            });
-        }
-        code
+        self.into()
     }
 }
 
-impl std::fmt::Display for Status {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str(self.as_str())
+impl TraceReport {
+    /// What the check of this trace came to: a divergence is
+    /// [`RunOutcome::Differences`]; a trace that ends early
+    /// [`RunOutcome::IncompleteInput`]; any other error, or nothing to
+    /// compare, [`RunOutcome::Error`].
+    pub fn outcome(&self) -> RunOutcome {
+        match self.status {
+            Status::Ok => RunOutcome::Success,
+            Status::Fail => RunOutcome::Differences,
+            Status::Error if self.incomplete && self.errors.len() == 1 => {
+                RunOutcome::IncompleteInput
+            }
+            Status::NoExpectations | Status::Error => RunOutcome::Error,
+        }
     }
 }
 
@@ -158,6 +166,10 @@ pub struct TraceReport {
     pub divergent_frames: Vec<u64>,
     /// What could not be checked: read errors, invalid scenes or sweeps.
     pub errors: Vec<String>,
+    /// Whether the trace ends early (it is truncated): the sweeps before
+    /// the end were checked. Only in the JSON when true.
+    #[serde(skip_serializing_if = "std::ops::Not::not")]
+    pub incomplete: bool,
     /// The tolerances used.
     pub tolerances: Tolerances,
 }
@@ -211,6 +223,7 @@ where
         divergences: Vec::new(),
         divergent_frames: Vec::new(),
         errors: Vec::new(),
+        incomplete: false,
         tolerances: options.tolerances,
     };
     let mut scene: Option<Arc<SceneState>> = None;
@@ -249,6 +262,9 @@ where
                 }
             }
             Err(err) => {
+                if matches!(&err, ReplayError::Trace(e) if e.is_truncation()) {
+                    report.incomplete = true;
+                }
                 if report.errors.len() < MAX_ERRORS {
                     report.errors.push(error_text(&err));
                 }
@@ -360,38 +376,33 @@ pub fn check_file(path: &std::path::Path, options: &CheckOptions) -> TraceReport
 /// recursively for `*.mcap` files (sorted by path, hidden entries skipped).
 /// Errors name the path that could not be read.
 pub fn find_traces(paths: &[std::path::PathBuf]) -> Result<Vec<std::path::PathBuf>, String> {
-    fn walk(dir: &std::path::Path, out: &mut Vec<std::path::PathBuf>) -> Result<(), String> {
-        let entries = std::fs::read_dir(dir)
-            .map_err(|e| format!("{}: cannot list the directory: {e}", dir.display()))?;
-        let mut found = Vec::new();
-        for entry in entries {
-            let entry =
-                entry.map_err(|e| format!("{}: cannot list the directory: {e}", dir.display()))?;
-            let path = entry.path();
-            if entry.file_name().to_string_lossy().starts_with('.') {
-                continue;
-            }
-            found.push(path);
-        }
-        found.sort();
-        for path in found {
-            if path.is_dir() {
-                walk(&path, out)?;
-            } else if path
-                .extension()
-                .is_some_and(|e| e.eq_ignore_ascii_case("mcap"))
-            {
-                out.push(path);
-            }
-        }
-        Ok(())
-    }
     let mut out = Vec::new();
     for p in paths {
-        if p.is_dir() {
-            walk(p, &mut out)?;
-        } else {
+        if !p.is_dir() {
             out.push(p.clone());
+            continue;
+        }
+        let walk = walkdir::WalkDir::new(p)
+            .follow_links(true)
+            .sort_by_file_name()
+            .into_iter()
+            .filter_entry(|e| e.depth() == 0 || !e.file_name().to_string_lossy().starts_with('.'));
+        for entry in walk {
+            let entry = entry.map_err(|e| {
+                let dir = e.path().unwrap_or(p).display().to_string();
+                let cause = e
+                    .io_error()
+                    .map_or_else(|| e.to_string(), std::io::Error::to_string);
+                format!("{dir}: cannot list the directory: {cause}")
+            })?;
+            if !entry.file_type().is_dir()
+                && entry
+                    .path()
+                    .extension()
+                    .is_some_and(|e| e.eq_ignore_ascii_case("mcap"))
+            {
+                out.push(entry.into_path());
+            }
         }
     }
     Ok(out)

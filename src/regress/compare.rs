@@ -71,8 +71,23 @@ impl Tolerances {
 }
 
 /// A field of the outcome record.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize)]
+#[derive(
+    Clone,
+    Copy,
+    Debug,
+    PartialEq,
+    Eq,
+    Hash,
+    PartialOrd,
+    Ord,
+    Serialize,
+    strum::IntoStaticStr,
+    strum::Display,
+    strum::EnumString,
+    strum::EnumIter,
+)]
 #[serde(rename_all = "snake_case")]
+#[strum(serialize_all = "snake_case")]
 pub enum Field {
     /// `kind`.
     Kind,
@@ -91,20 +106,7 @@ pub enum Field {
 impl Field {
     /// The field's name in the outcome record.
     pub fn as_str(self) -> &'static str {
-        match self {
-            Field::Kind => "kind",
-            Field::Triangle => "triangle",
-            Field::Feature => "feature",
-            Field::Alpha => "alpha",
-            Field::Normal => "normal",
-            Field::Contact => "contact",
-        }
-    }
-}
-
-impl std::fmt::Display for Field {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str(self.as_str())
+        self.into()
     }
 }
 

@@ -6,6 +6,7 @@ use serde_json::{Value, json};
 
 use crate::core::Kind;
 use crate::core::explain::num;
+use crate::run::RunOutcome;
 
 use super::check::{Divergence, Status, TraceReport};
 
@@ -177,7 +178,7 @@ pub fn render_json(reports: &[TraceReport]) -> String {
     let overall = reports.iter().map(|r| r.status).max().unwrap_or(Status::Ok);
     let doc = json!({
         "status": overall,
-        "exit_code": Status::exit_code(reports.iter().map(|r| &r.status)),
+        "exit_code": RunOutcome::worst(reports.iter().map(TraceReport::outcome)).exit_code(),
         "traces": reports,
     });
     let mut s = serde_json::to_string_pretty(&doc).unwrap_or_else(|e| {

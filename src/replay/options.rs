@@ -4,49 +4,38 @@
 use crate::core::Facing;
 
 /// How many test records each sweep keeps.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+#[derive(
+    Clone,
+    Copy,
+    Debug,
+    Default,
+    PartialEq,
+    Eq,
+    Hash,
+    strum::IntoStaticStr,
+    strum::Display,
+    strum::EnumString,
+)]
+#[strum(serialize_all = "snake_case")]
+#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
 pub enum Detail {
     /// The tests that report the primary collision (the primary test first,
     /// then every other hit at the same `α` within
-    /// [`SIMULTANEOUS_TOLERANCE`], which share the averaged normal); when
-    /// nothing hits, the one test that came nearest
+    /// [`crate::core::SIMULTANEOUS_TOLERANCE`], which share the averaged
+    /// normal); when nothing hits, the one test that came nearest
     /// ([`crate::core::explain::miss_distance`]) among the BVH candidates.
     #[default]
     Primary,
     /// Every test of every triangle the BVH visited.
     Candidates,
-    /// Every test of every triangle ([`Broadphase::Exhaustive`]).
+    /// Every test of every triangle ([`crate::core::Broadphase::Exhaustive`]).
     All,
 }
 
 impl Detail {
     /// The name used on the command line.
     pub fn as_str(self) -> &'static str {
-        match self {
-            Detail::Primary => "primary",
-            Detail::Candidates => "candidates",
-            Detail::All => "all",
-        }
-    }
-}
-
-impl std::fmt::Display for Detail {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str(self.as_str())
-    }
-}
-
-impl std::str::FromStr for Detail {
-    type Err = String;
-    fn from_str(s: &str) -> Result<Self, Self::Err> {
-        match s {
-            "primary" => Ok(Detail::Primary),
-            "candidates" => Ok(Detail::Candidates),
-            "all" => Ok(Detail::All),
-            other => Err(format!(
-                "unknown detail `{other}` (expected `primary`, `candidates` or `all`)"
-            )),
-        }
+        self.into()
     }
 }
 

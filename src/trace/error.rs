@@ -172,6 +172,12 @@ pub enum TraceError {
 }
 
 impl TraceError {
+    /// Whether the file ends early (in the middle of a record, or before its
+    /// footer): what came before was read.
+    pub fn is_truncation(&self) -> bool {
+        matches!(self, TraceError::Truncated { .. })
+    }
+
     /// Where the error happened, when a message is at fault.
     pub fn message_at(&self) -> Option<&MessageAt> {
         match self {

@@ -1,0 +1,43 @@
+//! What a command came to, as one value; [`RunOutcome::exit_code`] is the
+//! one place that turns it into the process's exit code (the README's
+//! table lists the same codes).
+
+use serde::Serialize;
+
+/// What a command came to. Ordered by severity: when a command handles
+/// several inputs, the most severe outcome is the command's
+/// ([`RunOutcome::worst`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum RunOutcome {
+    /// Everything was processed and nothing differs. Exit code 0.
+    Success,
+    /// Everything was processed and differences were found (`check`: a
+    /// sweep diverges from its expectation; `diff`: the two sides differ).
+    /// Exit code 1.
+    Differences,
+    /// A trace ends early (it is truncated): what was read before the end
+    /// was processed and written, the rest is missing. Exit code 3.
+    IncompleteInput,
+    /// An input could not be processed (a bad argument, a file that cannot
+    /// be read or written, an invalid trace, nothing to compare). Exit code 2.
+    Error,
+}
+
+impl RunOutcome {
+    /// The process exit code: 0 success, 1 differences found, 2 error,
+    /// 3 incomplete input.
+    pub const fn exit_code(self) -> u8 {
+        match self {
+            RunOutcome::Success => 0,
+            RunOutcome::Differences => 1,
+            RunOutcome::Error => 2,
+            RunOutcome::IncompleteInput => 3,
+        }
+    }
+
+    /// The most severe of `outcomes` ([`RunOutcome::Success`] when empty).
+    pub fn worst(outcomes: impl IntoIterator<Item = RunOutcome>) -> RunOutcome {
+        outcomes.into_iter().max().unwrap_or(RunOutcome::Success)
+    }
+}

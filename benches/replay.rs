@@ -72,7 +72,6 @@ fn outcomes(bytes: &[u8]) -> u64 {
 
 #[cfg(feature = "viewer")]
 fn rrd(bytes: &[u8], detail: Detail, path: &std::path::Path) -> u64 {
-    use rayon::prelude::*;
     use sweeptrace::viz;
 
     let options = ReplayOptions {
@@ -83,7 +82,6 @@ fn rrd(bytes: &[u8], detail: Detail, path: &std::path::Path) -> u64 {
     let id = viz::recording_id(&[bytes, detail.as_str().as_bytes()]);
     let rec = viz::builder(&id, "bench").save(path).expect("rrd file");
     let mut logger = viz::Logger::new(rec, true).expect("recording");
-    let max = logger.max_edge_frames();
     let read_ahead = prefetch(
         TraceReader::new(std::io::Cursor::new(bytes.to_vec()), "bench.mcap"),
         prefetch::DEFAULT_CHUNK,
@@ -91,53 +89,24 @@ fn rrd(bytes: &[u8], detail: Detail, path: &std::path::Path) -> u64 {
     )
     .expect("reader thread");
     let mut events = replay_events_parallel(read_ahead, options, DEFAULT_BATCH_EVENTS, None);
+    let pool = rayon::ThreadPoolBuilder::new()
+        .build()
+        .expect("worker threads");
     let mut n = 0;
-    let mut scenes = Vec::new();
-    loop {
-        let batch: Vec<ReplayEvent> = events
-            .by_ref()
-            .take(DEFAULT_BATCH_EVENTS)
-            .map(|e| e.expect("valid trace"))
-            .collect();
-        if batch.is_empty() {
-            break;
-        }
-        for e in &batch {
-            if let ReplayEvent::Scene(s) = e {
-                logger.log_scene(s).expect("scene");
-                scenes.push(s.clone());
+    // The command's own pipeline (outcome lines off: the recording alone).
+    let result: Result<(), Box<dyn std::error::Error>> = viz::pipeline::run_pipeline(
+        &mut events,
+        &pool,
+        Some(&mut logger),
+        viz::pipeline::PipelineOptions::default(),
+        |event, _| {
+            if let ReplayEvent::Sweep(_) = event? {
+                n += 1;
             }
-        }
-        // Runs of consecutive sweeps, as the command cuts them.
-        let mut groups: Vec<std::ops::Range<usize>> = Vec::new();
-        for (i, e) in batch.iter().enumerate() {
-            if !matches!(e, ReplayEvent::Sweep(_)) {
-                continue;
-            }
-            match groups.last_mut() {
-                Some(g) if g.end == i && g.len() < viz::PREPARE_GROUP_SWEEPS => g.end += 1,
-                _ => groups.push(i..i + 1),
-            }
-        }
-        let spares: Vec<viz::PreparedSweeps> =
-            groups.iter().map(|_| logger.spare_prepared()).collect();
-        let prepared: Vec<viz::PreparedSweeps> = groups
-            .par_iter()
-            .zip(spares)
-            .map(|(g, mut p)| {
-                let sweeps = batch[g.clone()].iter().filter_map(|e| match e {
-                    ReplayEvent::Sweep(r) => Some(&**r),
-                    ReplayEvent::Scene(_) => None,
-                });
-                viz::prepare_sweeps_into(&mut p, &scenes, sweeps, max);
-                p
-            })
-            .collect();
-        for p in prepared {
-            n += p.len() as u64;
-            logger.log_prepared(p).expect("logging");
-        }
-    }
+            Ok(())
+        },
+    );
+    result.expect("valid trace");
     logger.flush().expect("flush");
     let rec = logger.finish();
     rec.flush_blocking().expect("flush");

@@ -10,17 +10,17 @@ use std::sync::atomic::{AtomicU64, Ordering};
 use anyhow::{Context, bail};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 
-use rayon::prelude::*;
 use sweeptrace::atomic::PendingFile;
 use sweeptrace::core::Facing;
 use sweeptrace::replay::{
-    DEFAULT_BATCH_EVENTS, Detail, FrameRange, ReplayError, ReplayEvent, ReplayOptions, SceneState,
+    DEFAULT_BATCH_EVENTS, Detail, FrameRange, ReplayError, ReplayEvent, ReplayOptions,
     replay_events_parallel,
 };
 use sweeptrace::run::RunOutcome;
 use sweeptrace::trace::TraceReader;
 use sweeptrace::trace::prefetch::{self, prefetch};
 use sweeptrace::viz;
+use sweeptrace::viz::pipeline::{PipelineOptions, run_pipeline};
 
 /// The viewer address `--connect` uses when given no URL.
 pub const DEFAULT_CONNECT_URL: &str = "rerun+http://127.0.0.1:9876/proxy";
@@ -77,14 +77,6 @@ pub struct Args {
     /// per core]. The outputs do not depend on it.
     #[arg(long, value_name = "N")]
     pub threads: Option<usize>,
-}
-
-/// The result of a sweep event.
-fn sweep_of(event: &Result<ReplayEvent, ReplayError>) -> Option<&sweeptrace::replay::SweepResult> {
-    match event {
-        Ok(ReplayEvent::Sweep(result)) => Some(result),
-        _ => None,
-    }
 }
 
 /// Counts bytes read, for the progress bar.
@@ -248,98 +240,23 @@ pub fn run(args: Args) -> anyhow::Result<RunOutcome> {
     );
     let mut trace_error = None;
     let mut last_frame = None;
-    let mut scenes: Vec<Arc<SceneState>> = Vec::new();
-    let max_edge_frames = logger.as_ref().map(|l| l.max_edge_frames());
-    let write_outcomes = outcomes.is_some();
-    let mut batch = Vec::with_capacity(DEFAULT_BATCH_EVENTS);
-    loop {
-        // A bounded batch of results: the outcome lines and the recording's
-        // rows are built in parallel, then written in trace order.
-        batch.clear();
-        batch.extend(events.by_ref().take(DEFAULT_BATCH_EVENTS));
-        if batch.is_empty() {
-            break;
-        }
-        progress.set_position(count.load(Ordering::Relaxed));
-        for event in &batch {
-            if let Ok(ReplayEvent::Scene(scene)) = event {
-                scenes.push(scene.clone());
-            }
-        }
-        // Runs of consecutive sweeps, cut at `PREPARE_GROUP_SWEEPS`: the
-        // recording's rows of each run are built on one worker.
-        let mut groups: Vec<std::ops::Range<usize>> = Vec::new();
-        if logger.is_some() {
-            for (i, event) in batch.iter().enumerate() {
-                if !matches!(event, Ok(ReplayEvent::Sweep(_))) {
-                    continue;
-                }
-                match groups.last_mut() {
-                    Some(g) if g.end == i && g.len() < viz::PREPARE_GROUP_SWEEPS => g.end += 1,
-                    _ => groups.push(i..i + 1),
-                }
-            }
-        }
-        // Emptied buffers of earlier runs, reused.
-        let spares: Vec<viz::PreparedSweeps> = match logger.as_mut() {
-            Some(l) => groups.iter().map(|_| l.spare_prepared()).collect(),
-            None => Vec::new(),
-        };
-        let (lines, prepared): (Vec<Option<String>>, Vec<viz::PreparedSweeps>) =
-            pool.install(|| {
-                rayon::join(
-                    || {
-                        if !write_outcomes {
-                            return Vec::new();
-                        }
-                        batch
-                            .par_iter()
-                            .with_min_len(64)
-                            .map(|event| {
-                                sweep_of(event)
-                                    .and_then(|r| serde_json::to_string(&r.outcome_msg()).ok())
-                            })
-                            .collect()
-                    },
-                    || {
-                        let Some(max) = max_edge_frames else {
-                            return Vec::new();
-                        };
-                        groups
-                            .par_iter()
-                            .zip(spares)
-                            .map(|(g, mut p)| {
-                                viz::prepare_sweeps_into(
-                                    &mut p,
-                                    &scenes,
-                                    batch[g.clone()].iter().filter_map(sweep_of),
-                                    max,
-                                );
-                                p
-                            })
-                            .collect()
-                    },
-                )
-            });
-        let mut lines = lines.into_iter();
-        let mut prepared = groups.iter().map(|g| g.start).zip(prepared).peekable();
-        for (i, event) in batch.drain(..).enumerate() {
-            let line = lines.next().flatten();
-            if let Some((_, rows)) = prepared.next_if(|(start, _)| *start == i)
-                && let (Some(l), Ok(ReplayEvent::Sweep(result))) = (logger.as_mut(), &event)
-            {
-                l.log_prepared(rows)
-                    .with_context(|| format!("logging the frames from {}", result.frame))?;
-            }
+    let pipeline = PipelineOptions {
+        outcome_lines: outcomes.is_some(),
+        batch_events: DEFAULT_BATCH_EVENTS,
+    };
+    let result = run_pipeline(
+        &mut events,
+        &pool,
+        logger.as_mut(),
+        pipeline,
+        |event, line| -> anyhow::Result<()> {
+            progress.set_position(count.load(Ordering::Relaxed));
             match event {
                 Ok(ReplayEvent::Scene(scene)) => {
                     for d in scene.mesh.degenerate() {
                         progress.suspend(|| {
                             eprintln!("warning: scene {}: {d}, left out", scene.number)
                         });
-                    }
-                    if let Some(l) = logger.as_mut() {
-                        l.log_scene(&scene).context("logging the scene")?;
                     }
                 }
                 Ok(ReplayEvent::Sweep(result)) => {
@@ -358,11 +275,15 @@ pub fn run(args: Args) -> anyhow::Result<RunOutcome> {
                     trace_error = Some(err);
                 }
                 Err(err) => {
-                    progress.finish_and_clear();
                     return Err(anyhow::Error::new(err).context(format!("replaying {source_name}")));
                 }
             }
-        }
+            Ok(())
+        },
+    );
+    if let Err(err) = result {
+        progress.finish_and_clear();
+        return Err(err);
     }
     progress.finish_and_clear();
     let summary = events.summary();

@@ -11,6 +11,7 @@
 pub mod blueprint;
 mod columns;
 pub mod paths;
+pub mod pipeline;
 
 use std::collections::BTreeMap;
 use std::fmt::{self, Write as _};

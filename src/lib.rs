@@ -6,6 +6,7 @@
 
 pub mod atomic;
 pub mod core;
+pub mod numbers;
 pub mod regress;
 pub mod replay;
 pub mod report;

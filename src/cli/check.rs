@@ -133,7 +133,8 @@ fn write_failure_rrd(trace: &Path, dir: &Path, report: &TraceReport) -> anyhow::
     };
     let name = trace.display().to_string();
     let bytes = std::fs::read(trace).with_context(|| format!("reading {name}"))?;
-    let id = viz::recording_id(&[&bytes, format!("check {options:?}").as_bytes()]);
+    let id = super::recording_id(bytes.as_slice(), "check", &options)
+        .with_context(|| format!("reading {name}"))?;
     let sink = rerun::sink::FileSink::new(temp.path())
         .with_context(|| format!("opening {} for writing", temp.path().display()))?;
     let rec = viz::builder(&id, &format!("{name} (check, frames {frames})"))

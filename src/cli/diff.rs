@@ -5,9 +5,10 @@ use std::fs::File;
 use std::io::BufReader;
 use std::path::{Path, PathBuf};
 
-use anyhow::{Context, bail};
+use anyhow::Context;
 
 use sweeptrace::core::Facing;
+use sweeptrace::numbers::{self, Rule};
 use sweeptrace::regress::diff::{render_json, render_text};
 use sweeptrace::regress::{Side, diff};
 use sweeptrace::replay::{FrameRange, ReplayOptions};
@@ -67,10 +68,8 @@ fn side(path: &Path, options: ReplayOptions) -> anyhow::Result<Side> {
 pub fn run(args: Args) -> anyhow::Result<RunOutcome> {
     let tolerances = args.tolerances.to_tolerances()?;
     for (flag, m) in [("--margin-a", args.margin_a), ("--margin-b", args.margin_b)] {
-        if let Some(m) = m
-            && !(m.is_finite() && m >= 0.0)
-        {
-            bail!("{flag} must be a finite number ≥ 0, got {m}");
+        if let Some(m) = m {
+            numbers::check(m, Rule::NonNegative).map_err(|e| anyhow::anyhow!("{flag} {e}"))?;
         }
     }
     let base = ReplayOptions {

@@ -1,6 +1,7 @@
 //! Argument structs (kept dumb) and dispatch to one file per subcommand.
 
 use clap::{Parser, Subcommand};
+use sweeptrace::replay::ReplayOptions;
 use sweeptrace::run::RunOutcome;
 
 pub mod bless;
@@ -81,6 +82,31 @@ impl ToleranceArgs {
     }
 }
 
+/// The recording id of a replay of `trace` for `purpose` (`replay`,
+/// `check`) with `options`: a hash of the trace's bytes, the purpose and the
+/// options' [stable encoding](ReplayOptions::stable_encoding), so the same
+/// trace replayed the same way gets the same id (and the same blueprint).
+pub fn recording_id(
+    mut trace: impl std::io::Read,
+    purpose: &str,
+    options: &ReplayOptions,
+) -> std::io::Result<String> {
+    let mut hasher = sweeptrace::viz::IdHasher::new();
+    let mut buf = vec![0u8; 1 << 16];
+    loop {
+        let n = trace.read(&mut buf)?;
+        if n == 0 {
+            break;
+        }
+        hasher.update(&buf[..n]);
+    }
+    for part in [purpose, &options.stable_encoding()] {
+        hasher.update(&(part.len() as u64).to_le_bytes());
+        hasher.update(part.as_bytes());
+    }
+    Ok(hasher.finish())
+}
+
 /// Parses `x,y,z` into three finite numbers.
 pub fn parse_point(s: &str) -> Result<[f64; 3], String> {
     let parts: Vec<&str> = s.split(',').map(str::trim).collect();
@@ -92,9 +118,8 @@ pub fn parse_point(s: &str) -> Result<[f64; 3], String> {
     let mut out = [0.0; 3];
     for (o, p) in out.iter_mut().zip(&parts) {
         let v: f64 = p.parse().map_err(|_| format!("`{p}` is not a number"))?;
-        if !v.is_finite() {
-            return Err(format!("`{p}` is not a finite number"));
-        }
+        sweeptrace::numbers::check(v, sweeptrace::numbers::Rule::Finite)
+            .map_err(|e| format!("`{p}`: {e}"))?;
         *o = v;
     }
     Ok(out)

@@ -12,6 +12,7 @@ use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 
 use sweeptrace::atomic::PendingFile;
 use sweeptrace::core::Facing;
+use sweeptrace::numbers::{self, Rule};
 use sweeptrace::replay::{
     DEFAULT_BATCH_EVENTS, Detail, FrameRange, ReplayError, ReplayEvent, ReplayOptions,
     replay_events_parallel,
@@ -144,10 +145,8 @@ pub fn run(args: Args) -> anyhow::Result<RunOutcome> {
         (None, false) => None,
     };
     let record = rrd_path.is_some() || args.spawn || args.connect.is_some();
-    if let Some(m) = args.margin
-        && !(m.is_finite() && m >= 0.0)
-    {
-        bail!("--margin must be a finite number ≥ 0, got {m}");
+    if let Some(m) = args.margin {
+        numbers::check(m, Rule::NonNegative).map_err(|e| anyhow::anyhow!("--margin {e}"))?;
     }
 
     let options = ReplayOptions {
@@ -163,7 +162,10 @@ pub fn run(args: Args) -> anyhow::Result<RunOutcome> {
     let mut rrd_file = None;
     let mut logger = None;
     if record {
-        let id = recording_id_of(trace_path, &options)?;
+        let trace =
+            File::open(trace_path).with_context(|| format!("opening {}", trace_path.display()))?;
+        let id = super::recording_id(BufReader::new(trace), "replay", &options)
+            .with_context(|| format!("reading {}", trace_path.display()))?;
         let mut sinks: Vec<Box<dyn rerun::sink::LogSink>> = Vec::new();
         if let Some(path) = &rrd_path {
             let pending = pending_file(path)?;
@@ -346,23 +348,4 @@ fn progress_bar(total_bytes: u64) -> ProgressBar {
         bar.set_style(style.progress_chars("=> "));
     }
     bar
-}
-
-/// The recording id: a hash of the trace's bytes and of the options.
-fn recording_id_of(trace: &Path, options: &ReplayOptions) -> anyhow::Result<String> {
-    let mut hasher = viz::IdHasher::new();
-    let mut f =
-        BufReader::new(File::open(trace).with_context(|| format!("opening {}", trace.display()))?);
-    let mut buf = vec![0u8; 1 << 16];
-    loop {
-        let n = f
-            .read(&mut buf)
-            .with_context(|| format!("reading {}", trace.display()))?;
-        if n == 0 {
-            break;
-        }
-        hasher.update(&buf[..n]);
-    }
-    hasher.update(format!("{options:?}").as_bytes());
-    Ok(hasher.finish())
 }

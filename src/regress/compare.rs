@@ -13,6 +13,7 @@ use serde::Serialize;
 use serde_json::{Value, json};
 
 use crate::core::explain::num;
+use crate::numbers::{self, Rule};
 use crate::trace::messages::OutcomeMsg;
 
 /// Default absolute tolerance on `α` (a fraction of the path, unitless).
@@ -62,9 +63,7 @@ impl Tolerances {
             ("normal tolerance (degrees)", self.normal_degrees),
             ("contact tolerance", self.contact),
         ] {
-            if !(v.is_finite() && v >= 0.0) {
-                return Err(format!("the {name} must be a finite number ≥ 0, got {v}"));
-            }
+            numbers::check(v, Rule::NonNegative).map_err(|e| format!("the {name} {e}"))?;
         }
         Ok(())
     }

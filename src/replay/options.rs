@@ -129,6 +129,23 @@ pub struct ReplayOptions {
 }
 
 impl ReplayOptions {
+    /// An explicit, stable text of every option (`frames=10..20;ball=*;
+    /// detail=primary;explain=1;margin=scene;facing=scene`), for hashing into
+    /// recording ids: unlike `Debug` output it does not change when a field
+    /// is renamed or added with its default.
+    pub fn stable_encoding(&self) -> String {
+        let or_star = |v: Option<String>, none: &str| v.unwrap_or_else(|| none.to_string());
+        format!(
+            "frames={};ball={};detail={};explain={};margin={};facing={}",
+            self.frames,
+            or_star(self.ball.map(|b| b.to_string()), "*"),
+            self.detail,
+            u8::from(self.explain),
+            or_star(self.margin.map(|m| format!("{m:e}")), "scene"),
+            or_star(self.facing.map(|f| f.to_string()), "scene"),
+        )
+    }
+
     /// Whether the frame and ball filters keep the sweep of `ball` at `frame`.
     pub fn wants(&self, frame: u64, ball: u32) -> bool {
         self.frames.contains(frame) && self.ball.is_none_or(|b| b == ball)

@@ -33,6 +33,7 @@ use rand_chacha::ChaCha8Rng;
 use thiserror::Error;
 
 use crate::core::{Facing, Kind, Mesh, Options, Sweep, SweepError, sweep_mesh};
+use crate::numbers::{self, Rule};
 pub mod obj;
 pub mod scenes;
 
@@ -118,14 +119,7 @@ impl SimOptions {
     /// Checks every parameter; the error names the field.
     pub fn validate(&self) -> Result<(), SimError> {
         let finite = |field: &'static str, v: f64| {
-            if v.is_finite() {
-                Ok(())
-            } else {
-                Err(SimError::Invalid {
-                    field,
-                    reason: format!("{v} is not finite"),
-                })
-            }
+            numbers::check(v, Rule::Finite).map_err(|reason| SimError::Invalid { field, reason })
         };
         finite("radius", self.radius)?;
         for (field, p) in [
@@ -149,18 +143,14 @@ impl SimOptions {
         }
         let invalid =
             |field: &'static str, reason: String| Err(SimError::Invalid { field, reason });
-        if self.radius <= 0.0 {
-            return invalid("radius", format!("must be > 0, got {}", self.radius));
-        }
-        if self.margin < 0.0 || self.margin >= self.radius {
-            return invalid(
-                "margin",
-                format!(
-                    "must satisfy 0 ≤ margin < radius ({}), got {}",
-                    self.radius, self.margin
-                ),
-            );
-        }
+        numbers::check(self.radius, Rule::Positive).map_err(|reason| SimError::Invalid {
+            field: "radius",
+            reason,
+        })?;
+        numbers::check_margin(self.margin, self.radius).map_err(|reason| SimError::Invalid {
+            field: "margin",
+            reason,
+        })?;
         if !(MIN_TIME_STEP..=MAX_TIME_STEP).contains(&self.time_step) {
             return invalid(
                 "time_step",

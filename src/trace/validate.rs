@@ -11,6 +11,7 @@ use serde::de::DeserializeOwned;
 
 use super::error::{MessageAt, TraceError};
 use super::messages::{OutcomeMsg, SceneMsg, SweepMsg};
+use crate::numbers::{self, Rule};
 
 /// A field holding an invalid value, and why.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -97,13 +98,9 @@ pub fn parse_message<T: DeserializeOwned>(data: &[u8], mut at: MessageAt) -> Res
 }
 
 fn finite3(field: &str, v: &[f64; 3]) -> Result<(), FieldProblem> {
-    for (k, c) in v.iter().enumerate() {
-        if !c.is_finite() {
-            return Err(FieldProblem::new(
-                format!("{field}[{k}]"),
-                format!("must be a finite number, got {c}"),
-            ));
-        }
+    for (k, &c) in v.iter().enumerate() {
+        numbers::check(c, Rule::Finite)
+            .map_err(|e| FieldProblem::new(format!("{field}[{k}]"), e))?;
     }
     Ok(())
 }
@@ -127,24 +124,14 @@ pub fn validate_scene(scene: &SceneMsg) -> Result<(), FieldProblem> {
             }
         }
     }
-    if !scene.margin.is_finite() || scene.margin < 0.0 {
-        return Err(FieldProblem::new(
-            "margin",
-            format!("must be a finite number ≥ 0, got {}", scene.margin),
-        ));
-    }
+    numbers::check(scene.margin, Rule::NonNegative).map_err(|e| FieldProblem::new("margin", e))?;
     Ok(())
 }
 
 /// Checks a sweep: a finite radius `> 0` above the scene's margin (when a
 /// scene is given), finite `p0` and `p1`.
 pub fn validate_sweep(sweep: &SweepMsg, scene_margin: Option<f64>) -> Result<(), FieldProblem> {
-    if !sweep.radius.is_finite() || sweep.radius <= 0.0 {
-        return Err(FieldProblem::new(
-            "radius",
-            format!("must be a finite number > 0, got {}", sweep.radius),
-        ));
-    }
+    numbers::check(sweep.radius, Rule::Positive).map_err(|e| FieldProblem::new("radius", e))?;
     if let Some(margin) = scene_margin
         && margin >= sweep.radius
     {

@@ -10,6 +10,7 @@ pub mod diff;
 pub mod info;
 pub mod record;
 pub mod replay;
+pub mod report;
 pub mod sweep;
 
 /// Replay recorded ball trajectories through a swept-sphere vs triangle-mesh

@@ -2,8 +2,8 @@
 
 use anyhow::Context;
 
+use super::report;
 use sweeptrace::core::{Broadphase, CollectRecords, Facing, Options, Sweep, sweep_mesh_with};
-use sweeptrace::report;
 use sweeptrace::run::RunOutcome;
 use sweeptrace::sim::BuiltinScene;
 

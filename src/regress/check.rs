@@ -5,7 +5,7 @@
 //! engine as `replay`) and returns a [`TraceReport`]: a [`Status`], the
 //! counts, and the first divergences in detail ([`Divergence`]), each with
 //! the explanation of what the core found and of the test that would have
-//! produced the expected result (see [`super::compare`] for the rule).
+//! produced the expected result (see [`super::compare()`] for the rule).
 //! [`super::render_text`] and [`super::render_json`] are pure functions of
 //! a report.
 //!

@@ -2,7 +2,7 @@
 //! twice with different options (`diff T T --facing-b strict`).
 //!
 //! Sweeps are matched by `(frame, ball)`; every field of the two outcomes is
-//! compared with [`crate::regress::compare`] and the same [`Tolerances`]. The
+//! compared with [`crate::regress::compare()`] and the same [`Tolerances`]. The
 //! [`DiffReport`] counts the sweeps that are the same, differ, or exist on one
 //! side only, summarises the changes by kind (`edge -> none: 12`) and
 //! explains the first divergence on both sides (the tests that decided, from

@@ -1,7 +1,7 @@
 //! Regression testing on top of replay: a trace's `/expected` outcomes are
 //! the test case.
 //!
-//! - [`compare`]: the one rule deciding whether an outcome diverges from its
+//! - [`compare`](mod@compare): the one rule deciding whether an outcome diverges from its
 //!   expectation ([`compare()`], [`Tolerances`]), shared by `check`, `diff`
 //!   and the viewer;
 //! - [`explain`](mod@explain): why a divergent sweep came out as it did;

@@ -15,6 +15,7 @@ use crate::trace::messages::{OutcomeMsg, SceneMsg, SweepMsg};
 
 use super::{Detail, ReplayError, ReplayOptions, ReplaySummary};
 
+/// A scene of the trace, built into a mesh.
 #[derive(Clone, Debug)]
 pub struct SceneState {
     /// 0 for the trace's first scene, 1 for the next, ...
@@ -193,7 +194,7 @@ impl Replay {
     /// A `/sweep` message whose core query already ran ([`compute_sweep`]
     /// against [`Replay::current_scene`], or `None` when the sweep is
     /// filtered out or comes before any scene): the same as
-    /// [`Replay::sweep`] without the query. Used by [`replay_events_parallel`].
+    /// [`Replay::sweep`] without the query. Used by [`super::replay_events_parallel`].
     pub fn sweep_computed(
         &mut self,
         log_time_nanos: u64,

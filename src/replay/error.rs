@@ -5,6 +5,7 @@ use thiserror::Error;
 use crate::core::{MeshError, SweepError};
 use crate::trace::TraceError;
 
+/// An event the replay cannot use.
 #[derive(Debug, Error)]
 #[non_exhaustive]
 pub enum ReplayError {

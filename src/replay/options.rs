@@ -120,7 +120,7 @@ pub struct ReplayOptions {
     /// Which test records each result keeps.
     pub detail: Detail,
     /// Whether to run the explained query at all. When `false` every sweep
-    /// uses the fast [`sweep_mesh`] and results carry no records.
+    /// uses the fast [`crate::core::sweep_mesh`] and results carry no records.
     pub explain: bool,
     /// Overrides every scene's margin `ε`.
     pub margin: Option<f64>,

@@ -5,6 +5,7 @@ use std::time::Duration;
 
 use crate::core::{Kind, Verdict};
 
+/// Counts of a replay.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct ReplaySummary {
     /// Scenes read.

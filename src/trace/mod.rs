@@ -1,6 +1,6 @@
 //! Traces: MCAP files holding a scene, ball sweeps and expected outcomes.
 //!
-//! [`read`] streams a trace from any `Read`, [`write`] records one,
+//! [`read`] streams a trace from any `Read`, [`write`](mod@write) records one,
 //! [`validate`] holds the message checks both share, and [`info`] summarises
 //! a trace for `sweeptrace info`. The format is described in
 //! `docs/TRACE_FORMAT.md`.

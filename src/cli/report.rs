@@ -4,8 +4,9 @@ use std::fmt::Write;
 
 use serde_json::json;
 
-use crate::core::explain::{describe, num};
-use crate::core::{Options, Outcome, Sweep, TestRecord, Verdict};
+use sweeptrace::core::explain::{describe, num};
+use sweeptrace::core::{Options, Outcome, Sweep, TestRecord, Verdict};
+use sweeptrace::trace::messages::OutcomeMsg;
 
 /// Formats `[x, y, z]` compactly.
 pub fn vec3(v: &[f64]) -> String {
@@ -36,16 +37,17 @@ pub fn outcome_line(o: &Outcome) -> String {
     s
 }
 
-/// The outcome as the JSON object of SEMANTICS.md (without `frame`/`ball`).
+/// The outcome as the JSON object of SEMANTICS.md, without `frame` and
+/// `ball`: the trace's outcome record ([`OutcomeMsg`]) is the one
+/// serialization.
 pub fn outcome_json(o: &Outcome) -> serde_json::Value {
-    json!({
-        "alpha": o.alpha,
-        "kind": o.kind,
-        "triangle": o.triangle,
-        "feature": o.feature,
-        "normal": o.normal.map(|n| [n.x, n.y, n.z]),
-        "contact": o.contact.map(|c| [c.x, c.y, c.z]),
-    })
+    let mut value =
+        serde_json::to_value(OutcomeMsg::from_outcome(0, 0, o)).unwrap_or(serde_json::Value::Null);
+    if let Some(object) = value.as_object_mut() {
+        object.remove("frame");
+        object.remove("ball");
+    }
+    value
 }
 
 /// Whether a test "came close": it hit, or failed only at the last checks
@@ -64,7 +66,7 @@ fn role(o: &Outcome, t: &TestRecord) -> &'static str {
         "   <- primary"
     } else if t
         .alpha()
-        .is_some_and(|a| (a - o.alpha).abs() <= crate::core::SIMULTANEOUS_TOLERANCE)
+        .is_some_and(|a| (a - o.alpha).abs() <= sweeptrace::core::SIMULTANEOUS_TOLERANCE)
     {
         "   <- simultaneous"
     } else {

@@ -80,6 +80,10 @@ pub fn tests() -> Vec<Trial> {
             "core::sliver_triangle_face_hit_barycentric_without_cancellation",
             sliver_face_hit,
         ),
+        trial(
+            "core::zero_q_gives_a_double_root_only_when_c_is_zero",
+            zero_q_gives_a_double_root_only_when_c_is_zero,
+        ),
     ]
 }
 
@@ -1037,5 +1041,31 @@ fn sliver_face_hit() -> Result<(), String> {
         "face {:?}, barycentric {b:?}",
         f.verdict
     );
+    Ok(())
+}
+
+/// Regression: the solver returned a double root at 0 whenever its `q` was
+/// 0, without looking at `C`. Here the ball slides parallel to T's plane one
+/// ulp further from edge 0's line than `ρ`: in the edge frame `B = 0`, the
+/// discriminant (computed as `4 (ρ² A − w²)`) rounds to 0 and `C > 0`, so
+/// the exact answer is no root. It used to be a phantom edge hit at `α = 0`.
+fn zero_q_gives_a_double_root_only_when_c_is_zero() -> Result<(), String> {
+    let rho = 0.3650434993895252;
+    let height = 0.36504349938952524;
+    ensure!(height > rho, "the start is above ρ");
+    let (o, recs) = run(
+        &triangle_t(),
+        [2.0, 0.0, height],
+        [2.5, -1.5398316023792022, height],
+        rho,
+        0.0,
+        NS,
+    );
+    let e = edge(&recs, 0, 0);
+    ensure!(e.b == 0.0, "B = {}", e.b);
+    ensure!(e.c > 0.0, "C = {}", e.c);
+    ensure!(e.discriminant <= 0.0, "discriminant {}", e.discriminant);
+    ensure!(e.verdict == Verdict::NoRealRoots, "verdict {:?}", e.verdict);
+    ensure!(!o.is_hit(), "outcome {o:?}");
     Ok(())
 }

@@ -84,6 +84,10 @@ pub fn tests() -> Vec<Trial> {
             "core::zero_q_gives_a_double_root_only_when_c_is_zero",
             zero_q_gives_a_double_root_only_when_c_is_zero,
         ),
+        trial(
+            "core::face_decides_direction_by_n_dot_d_alone",
+            face_decides_direction_by_n_dot_d_alone,
+        ),
     ]
 }
 
@@ -1067,5 +1071,57 @@ fn zero_q_gives_a_double_root_only_when_c_is_zero() -> Result<(), String> {
     ensure!(e.discriminant <= 0.0, "discriminant {}", e.discriminant);
     ensure!(e.verdict == Verdict::NoRealRoots, "verdict {:?}", e.verdict);
     ensure!(!o.is_hit(), "outcome {o:?}");
+    Ok(())
+}
+
+/// The face test uses one quantity, `n · d`, for the facing rule, the
+/// parallel test and `β`. With the triangle's first vertex far from a short,
+/// nearly parallel path, `h0 - h1` (two dot products of long vectors,
+/// subtracted) and `-(n · d)` disagree in their last bits and sometimes in
+/// sign; every verdict must follow `n · d`.
+fn face_decides_direction_by_n_dot_d_alone() -> Result<(), String> {
+    use sweeptrace::core::{PARALLEL_TOLERANCE, Path, sweep_face};
+    let mut state = 0x9e37_79b9_7f4a_7c15u64;
+    let mut next = move || {
+        state ^= state << 13;
+        state ^= state >> 7;
+        state ^= state << 17;
+        (state >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+    };
+    let mut sign_disagreements = 0;
+    for _ in 0..20_000 {
+        let a = [1e4 + next(), 1e4 * next(), next()];
+        let b = [next(), 3.0 + next(), 0.1 * next()];
+        let c = [next(), -3.0 + next(), 0.1 * next()];
+        let m = mesh(&[a, b, c], &[[0, 1, 2]]);
+        let t = m.triangles()[0];
+        let n = t.normal;
+        let along = n.cross(&nalgebra::Vector3::new(next(), next(), next()));
+        let p0 = nalgebra::Point3::new(next(), next(), next()) + n * (0.5 + next());
+        let d = (along + n * (1e-8 * next())) * 1e-3;
+        let p1 = p0 + d;
+        let path = Path::new(&Sweep::new(p0.into(), p1.into(), 0.25), &Options::default())
+            .map_err(|e| e.to_string())?;
+        let r = sweep_face(&t, &path, NS);
+        let nd = r.normal_dot_d;
+        if (r.h0 - r.h1 > 0.0) != (-nd > 0.0) {
+            sign_disagreements += 1;
+        }
+        match r.verdict {
+            Verdict::StartsTooClose => ensure!(r.h0 < path.rho, "{r:?}"),
+            Verdict::Parallel => {
+                ensure!(nd.abs() <= PARALLEL_TOLERANCE * path.length, "{r:?}")
+            }
+            Verdict::BackFacing => ensure!(nd > 0.0, "{r:?}"),
+            _ => {
+                ensure!(nd < 0.0, "{r:?}");
+                ensure!(r.beta == Some((r.h0 - path.rho) / -nd), "{r:?}");
+            }
+        }
+    }
+    ensure!(
+        sign_disagreements > 0,
+        "the search found no case where h0 - h1 and -(n·d) disagree in sign"
+    );
     Ok(())
 }

@@ -67,7 +67,7 @@ pub struct Options {
 
 /// A path is *parallel* to a plane or an edge when the component of `d`
 /// that matters is at most this fraction of `|d|`:
-/// face test `|h0 - h1| ≤ PARALLEL_TOLERANCE · |d|`,
+/// face test `|n · d| ≤ PARALLEL_TOLERANCE · |d|`,
 /// edge test `A ≤ (PARALLEL_TOLERANCE · |d|)²`.
 /// A zero-length path is parallel to everything.
 pub const PARALLEL_TOLERANCE: f64 = 1e-12;

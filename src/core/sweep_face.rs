@@ -6,6 +6,12 @@ use super::path::Path;
 use super::record::{FaceRecord, Verdict};
 
 /// Runs the face test of SEMANTICS.md on `triangle`.
+///
+/// One quantity decides the direction of travel: `n · d` (mathematically
+/// `h1 - h0`). It is the facing value, the parallel test
+/// (`|n · d| ≤ PARALLEL_TOLERANCE · |d|`) and the denominator of
+/// `β = (h0 - ρ) / -(n · d)`, so the three can never disagree by rounding.
+/// `h1` is recorded for the explanation only.
 #[inline]
 pub fn sweep_face(triangle: &Triangle, path: &Path, facing: Facing) -> FaceRecord {
     let n = triangle.normal;
@@ -27,12 +33,14 @@ pub fn sweep_face(triangle: &Triangle, path: &Path, facing: Facing) -> FaceRecor
     let rho = path.rho;
     record.verdict = if h0 < rho {
         Verdict::StartsTooClose
-    } else if (h0 - h1).abs() <= PARALLEL_TOLERANCE * path.length {
+    } else if normal_dot_d.abs() <= PARALLEL_TOLERANCE * path.length {
         Verdict::Parallel
-    } else if !facing.allows(normal_dot_d) || h1 > h0 {
+    } else if !facing.allows(normal_dot_d) {
+        // Here `n · d ≠ 0`, so both rules reject exactly `n · d > 0`: moving
+        // away from the front.
         Verdict::BackFacing
     } else {
-        let beta = (h0 - rho) / (h0 - h1);
+        let beta = (h0 - rho) / -normal_dot_d;
         record.beta = Some(beta);
         if beta > 1.0 {
             Verdict::BeyondEnd

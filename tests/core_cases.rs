@@ -111,7 +111,7 @@ fn face_hit() -> Result<(), String> {
     close("bary a", b[0], 0.5, TOL)?;
     close("bary b", b[1], 0.25, TOL)?;
     ensure!(
-        o.kind == Kind::Face && o.triangle == Some(0) && o.feature == Some(0),
+        o.kind == Kind::Face && o.triangle == Some(0) && o.feature.is_none(),
         "outcome {o:?}"
     );
     close("alpha", o.alpha, 5.0 / 12.0, TOL)?;

@@ -347,9 +347,7 @@ fn detail_levels_choose_records() -> Result<(), String> {
                 .first()
                 .ok_or(format!("frame {}: hit without records", p.frame))?;
             ensure!(
-                Some(first.triangle()) == o.triangle
-                    && first.kind() == o.kind
-                    && Some(first.feature()) == o.feature,
+                o.is_reported_by(first),
                 "frame {}: first primary record {first:?} is not the primary test {o:?}",
                 p.frame
             );

@@ -270,12 +270,22 @@ impl TestRecord {
             TestRecord::Vertex(_) => Kind::Vertex,
         }
     }
-    /// Feature index (0 for the face).
+    /// Feature index, for ordering and labels: the edge or vertex index,
+    /// 0 for the face (see [`TestRecord::reported_feature`]).
     pub fn feature(&self) -> u8 {
         match self {
             TestRecord::Face(_) => 0,
             TestRecord::Edge(r) => r.edge,
             TestRecord::Vertex(r) => r.vertex,
+        }
+    }
+    /// The feature as an outcome reports it: the edge or vertex index, or
+    /// `None` for the face (a face has no feature).
+    pub fn reported_feature(&self) -> Option<u8> {
+        match self {
+            TestRecord::Face(_) => None,
+            TestRecord::Edge(r) => Some(r.edge),
+            TestRecord::Vertex(r) => Some(r.vertex),
         }
     }
     /// The verdict.

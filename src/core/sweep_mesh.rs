@@ -22,7 +22,9 @@ pub struct Outcome {
     pub kind: Kind,
     /// Input index of the primary triangle.
     pub triangle: Option<u32>,
-    /// Feature of the primary collision: edge or vertex index (0 for a face).
+    /// Feature of the primary collision: the edge or vertex index (0..3)
+    /// within its triangle; `None` for a face (a face has no feature) and
+    /// when nothing is hit.
     pub feature: Option<u8>,
     /// The reported normal: the primary triangle's front normal, or the
     /// normalised average of the front normals of every triangle colliding
@@ -54,7 +56,7 @@ impl Outcome {
         record.alpha().is_some()
             && Some(record.triangle()) == self.triangle
             && record.kind() == self.kind
-            && Some(record.feature()) == self.feature
+            && record.reported_feature() == self.feature
     }
 }
 
@@ -315,7 +317,7 @@ fn sweep_path<O: Observer>(
         alpha: best.alpha,
         kind: best.kind,
         triangle: Some(triangle_index),
-        feature: Some(best.feature),
+        feature: (best.kind != Kind::Face).then_some(best.feature),
         normal: Some(normal),
         contact: Some(best.contact),
     }

@@ -22,8 +22,8 @@ use thiserror::Error;
 
 use crate::core::explain::nearest_miss;
 use crate::core::{
-    Broadphase, CollectRecords, Facing, Kind, Mesh, MeshError, Options, Outcome,
-    SIMULTANEOUS_TOLERANCE, Sweep, SweepError, TestRecord, Verdict, sweep_mesh, sweep_mesh_with,
+    Broadphase, CollectRecords, Facing, Kind, Mesh, MeshError, Options, Outcome, Sweep, SweepError,
+    TestRecord, Verdict, sweep_mesh, sweep_mesh_with,
 };
 use crate::trace::messages::{OutcomeMsg, SceneMsg, SweepMsg};
 use crate::trace::{TraceError, TraceEvent};
@@ -32,8 +32,8 @@ use crate::trace::{TraceError, TraceEvent};
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
 pub enum Detail {
     /// The tests that report the primary collision (the primary test first,
-    /// then every other hit at the same `α` within
-    /// [`SIMULTANEOUS_TOLERANCE`], which share the averaged normal); when
+    /// then every other hit tied with it ([`Outcome::ties_with`]), which
+    /// share the averaged normal); when
     /// nothing hits, the one test that came nearest
     /// ([`crate::core::explain::miss_distance`]) among the BVH candidates.
     #[default]
@@ -691,7 +691,7 @@ pub fn compute_sweep(
 }
 
 /// The records of [`Detail::Primary`]: the primary test, then every other
-/// hit within [`SIMULTANEOUS_TOLERANCE`] of its `α`; when nothing is hit,
+/// hit tied with it ([`Outcome::ties_with`]); when nothing is hit,
 /// the nearest miss.
 pub fn primary_records(outcome: &Outcome, records: Vec<TestRecord>) -> Vec<TestRecord> {
     if !outcome.is_hit() {
@@ -703,11 +703,10 @@ pub fn primary_records(outcome: &Outcome, records: Vec<TestRecord>) -> Vec<TestR
         .take(1)
         .copied()
         .collect();
-    let limit = outcome.alpha + SIMULTANEOUS_TOLERANCE;
     out.extend(
-        records
-            .into_iter()
-            .filter(|r| r.alpha().is_some_and(|a| a <= limit) && !outcome.is_reported_by(r)),
+        records.into_iter().filter(|r| {
+            r.alpha().is_some_and(|a| outcome.ties_with(a)) && !outcome.is_reported_by(r)
+        }),
     );
     out
 }

@@ -14,8 +14,8 @@ use rand_chacha::ChaCha8Rng;
 
 use sweeptrace::core::explain::miss_distance;
 use sweeptrace::core::{
-    Broadphase, CollectRecords, Facing, Kind, Mesh, Options, SIMULTANEOUS_TOLERANCE, Sweep,
-    TestRecord, sweep_mesh, sweep_mesh_with,
+    Broadphase, CollectRecords, Facing, Kind, Mesh, Options, Sweep, TestRecord, sweep_mesh,
+    sweep_mesh_with,
 };
 use sweeptrace::replay::{
     Detail, FrameRange, ReplayEvent, ReplayOptions, Summary, SweepResult, replay_events,
@@ -352,8 +352,8 @@ fn detail_levels_choose_records() -> Result<(), String> {
                 p.frame
             );
             ensure!(
-                first.alpha() == Some(o.alpha),
-                "frame {}: primary α differs",
+                first.alpha().is_some_and(|a| o.ties_with(a)),
+                "frame {}: primary α not tied with the outcome's",
                 p.frame
             );
             for r in &p.records {
@@ -361,19 +361,12 @@ fn detail_levels_choose_records() -> Result<(), String> {
                     "frame {}: a non-hit among primary records",
                     p.frame
                 ))?;
-                ensure!(
-                    alpha <= o.alpha + SIMULTANEOUS_TOLERANCE,
-                    "frame {}: a later hit kept",
-                    p.frame
-                );
+                ensure!(o.ties_with(alpha), "frame {}: a later hit kept", p.frame);
             }
             let simultaneous = c
                 .records
                 .iter()
-                .filter(|r| {
-                    r.alpha()
-                        .is_some_and(|x| x <= o.alpha + SIMULTANEOUS_TOLERANCE)
-                })
+                .filter(|r| r.alpha().is_some_and(|x| o.ties_with(x)))
                 .count();
             ensure!(
                 p.records.len() == simultaneous,

@@ -138,7 +138,12 @@ fn describe_face(w: &mut impl Write, r: &FaceRecord) -> fmt::Result {
                 Num(b[1]),
                 Num(b[2])
             )?;
-            if r.verdict == Verdict::Hit {
+            if r.verdict == Verdict::Hit && b.iter().any(|&x| x < 0.0) {
+                w.write_str(
+                    " outside by less than the tie distance (on the boundary up to rounding), \
+                     facing ok: hit",
+                )
+            } else if r.verdict == Verdict::Hit {
                 w.write_str(" inside, facing ok: hit")
             } else {
                 w.write_str(" outside the triangle: none")
@@ -192,6 +197,12 @@ fn describe_edge(w: &mut impl Write, r: &EdgeRecord) -> fmt::Result {
                             " in [0, {}], {}: back-facing",
                             Num(r.length),
                             FacingText(r.normal_dot_d, r.verdict)
+                        ),
+                        _ if xc < 0.0 || xc > r.length => write!(
+                            w,
+                            " outside [0, {}] by less than the tie distance (at an end up to \
+                             rounding), facing ok: hit",
+                            Num(r.length)
                         ),
                         _ => write!(w, " in [0, {}], facing ok: hit", Num(r.length)),
                     }

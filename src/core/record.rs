@@ -127,6 +127,10 @@ pub struct FaceRecord {
     pub touch: Option<Point3<f64>>,
     /// Barycentric coordinates of the touch point (weights of `a`, `b`, `c`).
     pub barycentric: Option<[f64; 3]>,
+    /// Smallest signed distance of the touch point from the triangle's edge
+    /// lines (positive inside); the touch point counts as inside when this
+    /// is at least minus the tie distance.
+    pub boundary_distance: Option<f64>,
     /// The verdict.
     pub verdict: Verdict,
 }

@@ -2,6 +2,9 @@
 //! and the fragility flags.
 
 use libtest_mimic::Trial;
+use rand::seq::SliceRandom;
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
 use sweeptrace::core::{
     Broadphase, CollectRecords, Facing, FragileReason, Kind, Options, Sweep, sweep_mesh,
     sweep_mesh_with, sweep_ties,
@@ -28,6 +31,10 @@ pub fn tests() -> Vec<Trial> {
         trial(
             "core_decisions::clear_hit_is_robust_with_a_single_member_tie_set",
             clear_hit_is_robust_with_a_single_member_tie_set,
+        ),
+        trial(
+            "core_decisions::exact_ties_on_boxes_and_terrains_follow_the_rules",
+            exact_ties_on_boxes_and_terrains_follow_the_rules,
         ),
         trial(
             "core_decisions::fragile_serializes_as_reason_names",
@@ -205,5 +212,289 @@ fn fragile_serializes_as_reason_names() -> Result<(), String> {
     ensure!(f.to_string() == "tie, near_boundary", "text {f}");
     let json = serde_json::to_string(&Fragility::ROBUST).map_err(|e| e.to_string())?;
     ensure!(json == "[]", "json {json}");
+    Ok(())
+}
+
+// ------------------------------------------------------- exact ties, seeded
+
+/// A mesh with integer coordinates, for the exact reference.
+struct IntMesh {
+    vertices: Vec<[i64; 3]>,
+    triangles: Vec<[usize; 3]>,
+    /// Terrain: only features away from the open border, normals with +z.
+    terrain: Option<(i64, i64, i64, i64)>,
+}
+
+fn sub3(a: [i64; 3], b: [i64; 3]) -> [i64; 3] {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+fn dot3(a: [i64; 3], b: [i64; 3]) -> i64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+fn cross3(a: [i64; 3], b: [i64; 3]) -> [i64; 3] {
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
+}
+
+/// Shuffles the triangle order and rotates each index triple (orientation
+/// kept), so the tie order's triangle and feature numbers are arbitrary.
+fn shuffle_triangles(rng: &mut ChaCha8Rng, triangles: &mut [[usize; 3]]) {
+    triangles.shuffle(rng);
+    for t in triangles.iter_mut() {
+        let k = rng.random_range(0..3);
+        t.rotate_left(k);
+    }
+}
+
+/// A closed axis-aligned box, outward triangles, random diagonals.
+fn int_box(rng: &mut ChaCha8Rng) -> IntMesh {
+    let lo: [i64; 3] = std::array::from_fn(|_| -4 * rng.random_range(1..8i64));
+    let hi: [i64; 3] = std::array::from_fn(|_| 4 * rng.random_range(1..8i64));
+    let vertices: Vec<[i64; 3]> = (0..8)
+        .map(|i| std::array::from_fn(|k| if i & (1 << k) != 0 { hi[k] } else { lo[k] }))
+        .collect();
+    let quads: [[usize; 4]; 6] = [
+        [1, 3, 7, 5],
+        [0, 4, 6, 2],
+        [2, 6, 7, 3],
+        [0, 1, 5, 4],
+        [4, 5, 7, 6],
+        [0, 2, 3, 1],
+    ];
+    let mut triangles = Vec::new();
+    for [a, b, c, d] in quads {
+        if rng.random_bool(0.5) {
+            triangles.extend([[a, b, c], [a, c, d]]);
+        } else {
+            triangles.extend([[a, b, d], [b, c, d]]);
+        }
+    }
+    shuffle_triangles(rng, &mut triangles);
+    IntMesh {
+        vertices,
+        triangles,
+        terrain: None,
+    }
+}
+
+/// A convex height field: the grid points of a downward paraboloid (each
+/// cell's four corners are coplanar, either diagonal splits it), spacing 16.
+fn int_terrain(rng: &mut ChaCha8Rng) -> IntMesh {
+    let n = rng.random_range(4..7i64);
+    let k = rng.random_range(1..5i64);
+    let (ci, cj) = (rng.random_range(0..n), rng.random_range(0..n));
+    let mut vertices = Vec::new();
+    for j in 0..n {
+        for i in 0..n {
+            vertices.push([16 * i, 16 * j, -k * ((i - ci).pow(2) + (j - cj).pow(2))]);
+        }
+    }
+    let id = |i: i64, j: i64| (j * n + i) as usize;
+    let mut triangles = Vec::new();
+    for j in 0..n - 1 {
+        for i in 0..n - 1 {
+            let (a, b, c, d) = (id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1));
+            if rng.random_bool(0.5) {
+                triangles.extend([[a, b, c], [a, c, d]]);
+            } else {
+                triangles.extend([[a, b, d], [b, c, d]]);
+            }
+        }
+    }
+    shuffle_triangles(rng, &mut triangles);
+    IntMesh {
+        vertices,
+        triangles,
+        terrain: Some((0, 16 * (n - 1), 0, 16 * (n - 1))),
+    }
+}
+
+/// Every integer vector of integer length 1..=11 (Pythagorean quadruples).
+fn rational_length_vectors() -> Vec<([i64; 3], i64)> {
+    let mut out = Vec::new();
+    for x in -11i64..=11 {
+        for y in -11i64..=11 {
+            for z in -11i64..=11 {
+                let s = x * x + y * y + z * z;
+                let r = (s as f64).sqrt().round() as i64;
+                if s > 0 && r * r == s && r <= 11 {
+                    out.push(([x, y, z], r));
+                }
+            }
+        }
+    }
+    out
+}
+
+/// Whether `x` lies on the closed segment `a b` (exact).
+fn on_segment(x: [i64; 3], a: [i64; 3], b: [i64; 3]) -> bool {
+    let (ab, ax) = (sub3(b, a), sub3(x, a));
+    cross3(ab, ax) == [0, 0, 0] && dot3(ax, ab) >= 0 && dot3(ax, ab) <= dot3(ab, ab)
+}
+
+/// The exact tie set at the contact point `x`, ball centre `x + w` with
+/// `ρ = |w|`, travelling along `d`, when `w` is in the normal cone at `x`:
+/// `(kind, triangle, feature)` of every test that touches at that moment.
+fn exact_tie_set(m: &IntMesh, x: [i64; 3], w: [i64; 3], d: [i64; 3]) -> Vec<(Kind, u32, u8)> {
+    let mut out = Vec::new();
+    for (t, tri) in m.triangles.iter().enumerate() {
+        let v = tri.map(|i| m.vertices[i]);
+        let normal = cross3(sub3(v[1], v[0]), sub3(v[2], v[0]));
+        if dot3(normal, d) > 0 {
+            continue; // back-facing (non-strict rule)
+        }
+        let contains = (0..3).any(|e| on_segment(x, v[e], v[(e + 1) % 3]));
+        if contains && cross3(normal, w) == [0, 0, 0] && dot3(normal, w) > 0 {
+            out.push((Kind::Face, t as u32, 0));
+        }
+        for e in 0..3 {
+            let (a, b) = (v[e], v[(e + 1) % 3]);
+            if on_segment(x, a, b) && dot3(sub3(b, a), w) == 0 {
+                out.push((Kind::Edge, t as u32, e as u8));
+            }
+        }
+        for (k, &p) in v.iter().enumerate() {
+            if p == x {
+                out.push((Kind::Vertex, t as u32, k as u8));
+            }
+        }
+    }
+    out.sort();
+    out
+}
+
+/// On closed boxes and convex height fields with shuffled triangles, balls
+/// sent at a vertex, a point of an edge or a face's boundary along a
+/// direction of its normal cone, all in small integers (exact in binary),
+/// with `ρ` an integer length: the exact first contact is that point, the
+/// tests that touch there are known exactly, and the core's primary must be
+/// the first of them in the rules' order, whatever rounding did.
+fn exact_ties_on_boxes_and_terrains_follow_the_rules() -> Result<(), String> {
+    let mut rng = ChaCha8Rng::seed_from_u64(0x7135);
+    let candidates = rational_length_vectors();
+    let (mut checked, mut multi, mut by_kind) = (0usize, 0usize, [0usize; 3]);
+    let mut on_terrain = 0usize;
+    for mesh_number in 0..200 {
+        let m = if mesh_number % 2 == 0 {
+            int_box(&mut rng)
+        } else {
+            int_terrain(&mut rng)
+        };
+        let offset: [i64; 3] = std::array::from_fn(|_| rng.random_range(-40..40i64));
+        let core_mesh = mesh(
+            &m.vertices
+                .iter()
+                .map(|v| std::array::from_fn(|k| (v[k] + offset[k]) as f64 / 4.0))
+                .collect::<Vec<[f64; 3]>>(),
+            &m.triangles
+                .iter()
+                .map(|t| t.map(|i| i as u64))
+                .collect::<Vec<_>>(),
+        );
+        for _ in 0..30 {
+            // A vertex, or a quarter point of a triangle's edge.
+            let tri = m.triangles[rng.random_range(0..m.triangles.len())];
+            let e = rng.random_range(0..3);
+            let (a, b) = (m.vertices[tri[e]], m.vertices[tri[(e + 1) % 3]]);
+            let q = rng.random_range(0..4i64);
+            let x: [i64; 3] = std::array::from_fn(|k| a[k] + q * (b[k] - a[k]) / 4);
+            if let Some((x0, x1, y0, y1)) = m.terrain
+                && (x[0] <= x0 || x[0] >= x1 || x[1] <= y0 || x[1] >= y1)
+            {
+                continue; // on the open border of the height field
+            }
+            // Directions in the normal cone at x (for the convex set the mesh
+            // bounds; a height field's set extends downwards).
+            let cone: Vec<&([i64; 3], i64)> = candidates
+                .iter()
+                .filter(|(w, _)| {
+                    m.terrain.is_none_or(|_| w[2] > 0)
+                        && m.vertices.iter().all(|&y| dot3(*w, sub3(y, x)) <= 0)
+                })
+                .collect();
+            if cone.is_empty() {
+                continue;
+            }
+            for _ in 0..4 {
+                let &(w, rho) = cone[rng.random_range(0..cone.len())];
+                let d: [i64; 3] = std::array::from_fn(|_| rng.random_range(-6..=6i64));
+                let dd = dot3(d, d);
+                // Approach at a cosine of at least 0.3, no facing value near 0
+                // among the triangles at x.
+                let wd = dot3(w, d);
+                if dd == 0 || wd >= 0 || (wd * wd) as f64 <= 0.09 * (rho * rho * dd) as f64 {
+                    continue;
+                }
+                let grazing = m.triangles.iter().any(|t| {
+                    let v = t.map(|i| m.vertices[i]);
+                    let n = cross3(sub3(v[1], v[0]), sub3(v[2], v[0]));
+                    let nd = dot3(n, d) as f64;
+                    (0..3).any(|e| on_segment(x, v[e], v[(e + 1) % 3]))
+                        && nd * nd <= 1e-4 * dot3(n, n) as f64 * dd as f64
+                });
+                if grazing {
+                    continue;
+                }
+                let expected = exact_tie_set(&m, x, w, d);
+                let Some(&first) = expected.first() else {
+                    continue;
+                };
+                // p0 = c - t0 d, p1 = c + t1 d, with c = x + w; world = (int + offset) / 4.
+                let (t0, t1) = (rng.random_range(1..5i64), rng.random_range(1..5i64));
+                let world = |k: usize, t: i64| (x[k] + w[k] + t * d[k] + offset[k]) as f64 / 4.0;
+                let p0: [f64; 3] = std::array::from_fn(|k| world(k, -t0));
+                let p1: [f64; 3] = std::array::from_fn(|k| world(k, t1));
+                let radius = rho as f64 / 4.0;
+                for broadphase in [Broadphase::Bvh, Broadphase::Exhaustive] {
+                    let o = sweep_mesh_with(
+                        &core_mesh,
+                        &Sweep::new(p0, p1, radius),
+                        &options(),
+                        broadphase,
+                        &mut sweeptrace::core::NoObserver,
+                    )
+                    .map_err(|e| e.to_string())?;
+                    let got = (
+                        o.kind,
+                        o.triangle.unwrap_or(u32::MAX),
+                        o.feature.unwrap_or(0),
+                    );
+                    ensure!(
+                        got == first,
+                        "mesh {mesh_number} ({}), x {x:?}, w {w:?}, d {d:?}: expected {first:?} \
+                         (exact tie set {expected:?}), got {o:?}",
+                        if m.terrain.is_some() {
+                            "terrain"
+                        } else {
+                            "box"
+                        }
+                    );
+                    close("alpha", o.alpha, t0 as f64 / (t0 + t1) as f64, 1e-9)?;
+                    ensure!(
+                        expected.len() < 2 || o.fragile.contains(FragileReason::Tie),
+                        "a tie of {} hits is flagged: {o:?}",
+                        expected.len()
+                    );
+                }
+                checked += 1;
+                on_terrain += usize::from(m.terrain.is_some());
+                multi += usize::from(expected.len() > 1);
+                by_kind[first.0 as usize] += 1;
+            }
+        }
+    }
+    println!(
+        "    {checked} exact contacts on 100 boxes and 100 height fields ({on_terrain} on height \
+         fields; {multi} ties of 2 or more tests; primary face {}, edge {}, vertex {}): every \
+         primary is the rules' choice",
+        by_kind[0], by_kind[1], by_kind[2]
+    );
+    ensure!(
+        checked > 3000 && on_terrain > 300 && by_kind.iter().all(|&k| k > 300),
+        "too few cases: {checked} {by_kind:?}"
+    );
     Ok(())
 }

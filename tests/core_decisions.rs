@@ -10,6 +10,7 @@ use sweeptrace::core::{
     sweep_mesh_with, sweep_ties,
 };
 
+use crate::core_random::{random_patch, random_sweep, random_triangle, uniform, unit};
 use crate::ensure;
 use crate::support::{close, mesh, run};
 use crate::trial;
@@ -35,6 +36,10 @@ pub fn tests() -> Vec<Trial> {
         trial(
             "core_decisions::exact_ties_on_boxes_and_terrains_follow_the_rules",
             exact_ties_on_boxes_and_terrains_follow_the_rules,
+        ),
+        trial(
+            "core_decisions::unflagged_decisions_survive_one_ulp_changes",
+            unflagged_decisions_survive_one_ulp_changes,
         ),
         trial(
             "core_decisions::fragile_serializes_as_reason_names",
@@ -495,6 +500,143 @@ fn exact_ties_on_boxes_and_terrains_follow_the_rules() -> Result<(), String> {
     ensure!(
         checked > 3000 && on_terrain > 300 && by_kind.iter().all(|&k| k > 300),
         "too few cases: {checked} {by_kind:?}"
+    );
+    Ok(())
+}
+
+// --------------------------------------------- fragility flags, one-ulp test
+
+/// The next float toward +∞ (`up`) or −∞.
+fn ulp_step(x: f64, up: bool) -> f64 {
+    if up { x.next_up() } else { x.next_down() }
+}
+
+/// Sweeps that come close to every kind of fragility: aimed exactly (up to
+/// the rounding of the construction) at a vertex or an edge point along a
+/// direction of its triangle's front side, with the contact put at the
+/// start, the end or the middle of the path, sometimes at a shallow angle.
+fn aimed_sweep(
+    rng: &mut ChaCha8Rng,
+    vertices: &[[f64; 3]],
+    triangles: &[[u64; 3]],
+) -> ([f64; 3], [f64; 3], f64) {
+    use nalgebra::Vector3;
+    let t = triangles[rng.random_range(0..triangles.len())];
+    let [a, b, c] = t.map(|i| Vector3::from(vertices[i as usize]));
+    let n = (b - a).cross(&(c - a)).normalize();
+    let x = match rng.random_range(0..4) {
+        0 => a,
+        1 => a + (b - a) * 0.5,
+        2 => a + (b - a) * uniform(rng, 0.0, 1.0),
+        _ => (a + b + c) / 3.0,
+    };
+    let radius = uniform(rng, 0.05, 0.8);
+    let nu = (n + unit(rng) * uniform(rng, 0.0, 0.9)).normalize();
+    let centre = x + nu * radius;
+    let mut dir = -nu + unit(rng) * uniform(rng, 0.0, 0.9);
+    if rng.random_bool(0.15) {
+        // Shallow: nearly along the surface.
+        dir = dir - nu * dir.dot(&nu) - nu * 10f64.powf(uniform(rng, -6.0, -1.0));
+    }
+    let len = uniform(rng, 0.5, 3.0);
+    let d = dir.normalize() * len;
+    let (t0, t1) = match rng.random_range(0..4) {
+        0 => (10f64.powf(uniform(rng, -14.0, -6.0)), 1.0),
+        1 => (1.0, 10f64.powf(uniform(rng, -14.0, -6.0))),
+        _ => (uniform(rng, 0.2, 1.0), uniform(rng, 0.2, 1.0)),
+    };
+    ((centre - d * t0).into(), (centre + d * t1).into(), radius)
+}
+
+/// The meaning of the flags: over 100,000 seeded sweeps (random ones, and
+/// ones aimed at vertices and edges, near the ends of the path and at
+/// shallow angles), changing any one input (a coordinate of `p0` or `p1`,
+/// the radius, or a coordinate of one mesh vertex) by one ulp never changes
+/// a decision that is not flagged: same kind, triangle and feature, `α`
+/// within 1e-6.
+fn unflagged_decisions_survive_one_ulp_changes() -> Result<(), String> {
+    use std::collections::BTreeMap;
+    let mut rng = ChaCha8Rng::seed_from_u64(0x0f1a_6e11);
+    let (mut robust, mut robust_hits, mut fragile) = (0usize, 0usize, 0usize);
+    let mut fragile_changed = 0usize;
+    let mut reasons: BTreeMap<&'static str, usize> = BTreeMap::new();
+    let decision = |o: &sweeptrace::core::Outcome| (o.kind, o.triangle, o.feature);
+    let mut vertices = Vec::new();
+    let mut triangles = Vec::new();
+    let mut base = None;
+    for case in 0..100_000 {
+        if case % 8 == 0 {
+            (vertices, triangles) = if rng.random_bool(0.3) {
+                (random_triangle(&mut rng).to_vec(), vec![[0, 1, 2]])
+            } else {
+                random_patch(&mut rng)
+            };
+            base = Some(mesh(&vertices, &triangles));
+        }
+        let m = base.as_ref().ok_or("no mesh")?;
+        let (p0, p1, radius, margin, facing) = if rng.random_bool(0.5) {
+            random_sweep(&mut rng, &vertices, &triangles)
+        } else {
+            let (p0, p1, r) = aimed_sweep(&mut rng, &vertices, &triangles);
+            (p0, p1, r, 0.0, Facing::NonStrict)
+        };
+        let options = Options { margin, facing };
+        let o = sweep_mesh(m, &Sweep::new(p0, p1, radius), &options).map_err(|e| e.to_string())?;
+        let flagged = !o.fragile.is_robust();
+        if flagged {
+            fragile += 1;
+            for r in o.fragile.iter() {
+                *reasons.entry(r.as_str()).or_default() += 1;
+            }
+        } else {
+            robust += 1;
+            robust_hits += usize::from(o.is_hit());
+        }
+        let mut changed = false;
+        let mut check = |what: &str, o2: &sweeptrace::core::Outcome| -> Result<(), String> {
+            let same = decision(o2) == decision(&o) && (o2.alpha - o.alpha).abs() <= 1e-6;
+            changed |= !same;
+            ensure!(
+                same || flagged,
+                "case {case}: one ulp on {what} changes an unflagged decision\n  \
+                 p0 {p0:?} p1 {p1:?} radius {radius:?} margin {margin:?} {facing:?}\n  \
+                 vertices {vertices:?}\n  triangles {triangles:?}\n  before {o:?}\n  after  {o2:?}"
+            );
+            Ok(())
+        };
+        for k in 0..7 {
+            let (mut q0, mut q1, mut r) = (p0, p1, radius);
+            let up = rng.random_bool(0.5);
+            match k {
+                0..3 => q0[k] = ulp_step(q0[k], up),
+                3..6 => q1[k - 3] = ulp_step(q1[k - 3], up),
+                _ => r = ulp_step(r, up),
+            }
+            if r <= margin {
+                continue;
+            }
+            let o2 = sweep_mesh(m, &Sweep::new(q0, q1, r), &options).map_err(|e| e.to_string())?;
+            check(
+                ["p0.x", "p0.y", "p0.z", "p1.x", "p1.y", "p1.z", "radius"][k],
+                &o2,
+            )?;
+        }
+        let mut moved = vertices.clone();
+        let (v, k) = (rng.random_range(0..moved.len()), rng.random_range(0..3));
+        moved[v][k] = ulp_step(moved[v][k], rng.random_bool(0.5));
+        let m2 = mesh(&moved, &triangles);
+        let o2 =
+            sweep_mesh(&m2, &Sweep::new(p0, p1, radius), &options).map_err(|e| e.to_string())?;
+        check(&format!("vertex {v} coordinate {k}"), &o2)?;
+        fragile_changed += usize::from(changed && flagged);
+    }
+    println!(
+        "    100000 sweeps: {robust} unflagged ({robust_hits} hits) unchanged by 8 one-ulp changes \
+         each; {fragile} flagged {reasons:?}, of which {fragile_changed} did change"
+    );
+    ensure!(
+        fragile_changed > 10,
+        "the sweeps should include decisions that one ulp does change"
     );
     Ok(())
 }

@@ -40,11 +40,11 @@ struct Case {
     facing: Facing,
 }
 
-fn uniform(rng: &mut ChaCha8Rng, lo: f64, hi: f64) -> f64 {
+pub(crate) fn uniform(rng: &mut ChaCha8Rng, lo: f64, hi: f64) -> f64 {
     rng.random_range(lo..hi)
 }
 
-fn random_point(rng: &mut ChaCha8Rng, s: f64) -> [f64; 3] {
+pub(crate) fn random_point(rng: &mut ChaCha8Rng, s: f64) -> [f64; 3] {
     [
         uniform(rng, -s, s),
         uniform(rng, -s, s),
@@ -52,7 +52,7 @@ fn random_point(rng: &mut ChaCha8Rng, s: f64) -> [f64; 3] {
     ]
 }
 
-fn unit(rng: &mut ChaCha8Rng) -> Vector3<f64> {
+pub(crate) fn unit(rng: &mut ChaCha8Rng) -> Vector3<f64> {
     loop {
         let v = Vector3::from(random_point(rng, 1.0));
         let n = v.norm();
@@ -63,7 +63,7 @@ fn unit(rng: &mut ChaCha8Rng) -> Vector3<f64> {
 }
 
 /// A random well-shaped triangle (area and angles bounded away from 0).
-fn random_triangle(rng: &mut ChaCha8Rng) -> [[f64; 3]; 3] {
+pub(crate) fn random_triangle(rng: &mut ChaCha8Rng) -> [[f64; 3]; 3] {
     loop {
         let t = [
             random_point(rng, 2.0),
@@ -80,7 +80,7 @@ fn random_triangle(rng: &mut ChaCha8Rng) -> [[f64; 3]; 3] {
 }
 
 /// A 3×3 grid of vertices (8 triangles) with random heights, rotated.
-fn random_patch(rng: &mut ChaCha8Rng) -> (Vec<[f64; 3]>, Vec<[u64; 3]>) {
+pub(crate) fn random_patch(rng: &mut ChaCha8Rng) -> (Vec<[f64; 3]>, Vec<[u64; 3]>) {
     let rot = Rotation3::from_scaled_axis(unit(rng) * uniform(rng, 0.0, std::f64::consts::PI));
     let offset = Vector3::from(random_point(rng, 0.5));
     let mut vertices = Vec::new();
@@ -114,7 +114,7 @@ fn random_patch(rng: &mut ChaCha8Rng) -> (Vec<[f64; 3]>, Vec<[u64; 3]>) {
 
 /// A sweep aimed near a random point of a random triangle, so that about
 /// half of the sweeps hit.
-fn random_sweep(
+pub(crate) fn random_sweep(
     rng: &mut ChaCha8Rng,
     vertices: &[[f64; 3]],
     triangles: &[[u64; 3]],

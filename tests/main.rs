@@ -7,6 +7,7 @@ use libtest_mimic::{Arguments, Failed, Trial};
 
 mod check;
 mod core_cases;
+mod core_decisions;
 mod core_random;
 mod oracle;
 mod prefetch;
@@ -25,6 +26,7 @@ fn main() {
     let mut trials: Vec<Trial> = Vec::new();
     // Register test modules below (one line each).
     trials.extend(core_cases::tests());
+    trials.extend(core_decisions::tests());
     trials.extend(core_random::tests());
     trials.extend(check::tests());
     trials.extend(trace_io::tests());

@@ -14,8 +14,8 @@ use rand_chacha::ChaCha8Rng;
 
 use sweeptrace::core::explain::miss_distance;
 use sweeptrace::core::{
-    Broadphase, CollectRecords, Facing, Kind, Mesh, Options, SIMULTANEOUS_TOLERANCE, Sweep,
-    TestRecord, sweep_mesh, sweep_mesh_with,
+    Broadphase, CollectRecords, Facing, Kind, Mesh, Options, Sweep, TestRecord, sweep_mesh,
+    sweep_mesh_with,
 };
 use sweeptrace::replay::{
     Detail, FrameRange, ReplayEvent, ReplayOptions, ReplaySummary, SweepResult, replay_events,
@@ -351,15 +351,13 @@ fn detail_levels_choose_records() -> Result<(), String> {
                 .first()
                 .ok_or(format!("frame {}: hit without records", p.frame))?;
             ensure!(
-                Some(first.triangle()) == o.triangle
-                    && first.kind() == o.kind
-                    && Some(first.feature()) == o.feature,
+                o.is_reported_by(first),
                 "frame {}: first primary record {first:?} is not the primary test {o:?}",
                 p.frame
             );
             ensure!(
-                first.alpha() == Some(o.alpha),
-                "frame {}: primary α differs",
+                first.alpha().is_some_and(|a| o.ties_with(a)),
+                "frame {}: primary α not tied with the outcome's",
                 p.frame
             );
             for r in &p.records {
@@ -367,19 +365,12 @@ fn detail_levels_choose_records() -> Result<(), String> {
                     "frame {}: a non-hit among primary records",
                     p.frame
                 ))?;
-                ensure!(
-                    alpha <= o.alpha + SIMULTANEOUS_TOLERANCE,
-                    "frame {}: a later hit kept",
-                    p.frame
-                );
+                ensure!(o.ties_with(alpha), "frame {}: a later hit kept", p.frame);
             }
             let simultaneous = c
                 .records
                 .iter()
-                .filter(|r| {
-                    r.alpha()
-                        .is_some_and(|x| x <= o.alpha + SIMULTANEOUS_TOLERANCE)
-                })
+                .filter(|r| r.alpha().is_some_and(|x| o.ties_with(x)))
                 .count();
             ensure!(
                 p.records.len() == simultaneous,
@@ -1023,17 +1014,29 @@ fn cli_writes_outcomes_and_rrd() -> Result<(), String> {
         ensure!(
             sorted
                 == [
-                    "alpha", "ball", "contact", "feature", "frame", "kind", "normal", "triangle"
+                    "alpha", "ball", "contact", "feature", "fragile", "frame", "kind", "normal",
+                    "triangle"
                 ],
             "fields {keys:?}"
         );
-        let o: OutcomeMsg = serde_json::from_str(line).map_err(|e| e.to_string())?;
+        // The additive `fragile` field; the rest is the outcome record.
+        let mut value: serde_json::Value = serde_json::from_str(line).map_err(|e| e.to_string())?;
+        let fragile = value
+            .as_object_mut()
+            .and_then(|o| o.remove("fragile"))
+            .ok_or("no fragile field")?;
+        let o: OutcomeMsg = serde_json::from_value(value).map_err(|e| e.to_string())?;
         let want = sweep_mesh(
             &mesh,
             &Sweep::new(s.p0, s.p1, s.radius),
             &Options::default(),
         )
         .map_err(|e| e.to_string())?;
+        ensure!(
+            fragile == serde_json::to_value(want.fragile).map_err(|e| e.to_string())?,
+            "fragile {fragile} vs {}",
+            want.fragile
+        );
         ensure!(
             o == OutcomeMsg::from_outcome(s.frame, s.ball, &want),
             "line {line} != {want:?}"

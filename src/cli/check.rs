@@ -40,6 +40,12 @@ pub struct Args {
     /// Print one JSON document instead of text.
     #[arg(long)]
     pub json: bool,
+    /// Fail on divergences of fragile decisions too (ties across kinds or
+    /// triangles, near-tangent paths, contacts at a feature's boundary, ...:
+    /// see docs/SEMANTICS.md). Without it they are counted and shown apart
+    /// and do not fail the check.
+    #[arg(long)]
+    pub strict: bool,
     /// How many divergences per trace are explained in detail.
     #[arg(long, value_name = "N", default_value_t = DEFAULT_MAX_DETAILS)]
     pub max_details: usize,
@@ -70,6 +76,7 @@ pub fn run(args: Args) -> anyhow::Result<RunOutcome> {
     let options = CheckOptions {
         tolerances,
         max_details: args.max_details,
+        strict: args.strict,
         replay: ReplayOptions::default(),
     };
     let mut reports: Vec<TraceReport> = Vec::new();

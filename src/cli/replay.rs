@@ -266,8 +266,7 @@ pub fn run(args: Args) -> anyhow::Result<RunOutcome> {
                     if let Some(o) = outcomes.as_mut() {
                         let line = match line {
                             Some(line) => line,
-                            None => serde_json::to_string(&result.outcome_msg())
-                                .context("serializing an outcome")?,
+                            None => result.outcome_line().context("serializing an outcome")?,
                         };
                         writeln!(o.writer(), "{line}").context("writing outcomes")?;
                     }

@@ -59,16 +59,13 @@ pub fn came_close(r: &TestRecord) -> bool {
     )
 }
 
-/// A marker for the primary test and for other hits at the same `α`
-/// (simultaneous: their triangles' normals are averaged).
+/// A marker for the primary test and for other hits tied with it
+/// ([`Outcome::ties_with`]: their triangles' normals are averaged).
 fn role(o: &Outcome, t: &TestRecord) -> &'static str {
     if o.is_reported_by(t) {
         "   <- primary"
-    } else if t
-        .alpha()
-        .is_some_and(|a| (a - o.alpha).abs() <= sweeptrace::core::SIMULTANEOUS_TOLERANCE)
-    {
-        "   <- simultaneous"
+    } else if t.alpha().is_some_and(|a| o.ties_with(a)) {
+        "   <- tied"
     } else {
         ""
     }

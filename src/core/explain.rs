@@ -111,12 +111,9 @@ fn describe_face(w: &mut impl Write, r: &FaceRecord) -> fmt::Result {
         Verdict::StartsTooClose => {
             w.write_str(" (h0 < ρ: starts within ρ of the plane or behind it): none")
         }
-        Verdict::Parallel => {
-            w.write_str(" (|h0 - h1| ≤ PARALLEL_TOLERANCE·|d|: moving parallel to the plane): none")
-        }
-        Verdict::BackFacing if r.h1 > r.h0 && r.normal_dot_d <= 0.0 => write!(
+        Verdict::Parallel => write!(
             w,
-            ", n·d = {} but h1 > h0 (moving away from the plane, by rounding): back-facing",
+            ", n·d = {} (|n·d| ≤ PARALLEL_TOLERANCE·|d|: moving parallel to the plane): none",
             Num(r.normal_dot_d)
         ),
         Verdict::BackFacing => write!(
@@ -126,20 +123,27 @@ fn describe_face(w: &mut impl Write, r: &FaceRecord) -> fmt::Result {
         ),
         Verdict::BeyondEnd => write!(
             w,
-            ", β = {} > 1: does not reach the plane",
+            ", n·d = {}, β = (h0 - ρ)/-(n·d) = {} > 1: does not reach the plane",
+            Num(r.normal_dot_d),
             Num(r.beta.unwrap_or(f64::NAN))
         ),
         Verdict::OutsideTriangle | Verdict::Hit => {
             let b = r.barycentric.unwrap_or([f64::NAN; 3]);
             write!(
                 w,
-                ", β = {} in [0, 1], touch point barycentric ({}, {}, {})",
+                ", n·d = {}, β = (h0 - ρ)/-(n·d) = {} in [0, 1], touch point barycentric ({}, {}, {})",
+                Num(r.normal_dot_d),
                 Num(r.beta.unwrap_or(f64::NAN)),
                 Num(b[0]),
                 Num(b[1]),
                 Num(b[2])
             )?;
-            if r.verdict == Verdict::Hit {
+            if r.verdict == Verdict::Hit && b.iter().any(|&x| x < 0.0) {
+                w.write_str(
+                    " outside by less than the tie distance (on the boundary up to rounding), \
+                     facing ok: hit",
+                )
+            } else if r.verdict == Verdict::Hit {
                 w.write_str(" inside, facing ok: hit")
             } else {
                 w.write_str(" outside the triangle: none")
@@ -193,6 +197,12 @@ fn describe_edge(w: &mut impl Write, r: &EdgeRecord) -> fmt::Result {
                             " in [0, {}], {}: back-facing",
                             Num(r.length),
                             FacingText(r.normal_dot_d, r.verdict)
+                        ),
+                        _ if xc < 0.0 || xc > r.length => write!(
+                            w,
+                            " outside [0, {}] by less than the tie distance (at an end up to \
+                             rounding), facing ok: hit",
+                            Num(r.length)
                         ),
                         _ => write!(w, " in [0, {}], facing ok: hit", Num(r.length)),
                     }

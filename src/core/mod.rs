@@ -2,9 +2,11 @@
 //!
 //! The semantics are those of the project's `SEMANTICS.md`: per triangle a
 //! face test, three edge tests in each edge's standard frame and three
-//! vertex tests; the mesh sweep takes the earliest collision, breaks exact
-//! ties by kind (face, edge, vertex), triangle and feature, and averages the
-//! front normals of triangles that collide simultaneously.
+//! vertex tests; the mesh sweep takes the earliest collision, decides
+//! between the hits tied with it (within the tie window, see
+//! [`TIE_WINDOW_ULPS`]) by kind (face, edge, vertex), triangle and feature,
+//! averages the front normals of the tied triangles, and flags a decision
+//! that rounding could change ([`Fragility`]).
 //!
 //! Two entry points share one implementation: [`sweep_mesh`] (fast, no
 //! allocation) and [`sweep_mesh_with`] (hands every test's record to an
@@ -13,6 +15,7 @@
 mod bvh;
 mod error;
 pub mod explain;
+mod fragility;
 mod mesh;
 mod options;
 mod path;
@@ -24,9 +27,11 @@ mod sweep_mesh;
 mod sweep_vertex;
 
 pub use error::{MeshError, SweepError};
+pub use fragility::{FragileReason, Fragility};
 pub use mesh::{DegenerateReason, DegenerateTriangle, Mesh, StandardFrame, Triangle};
 pub use options::{
-    DEGENERATE_TOLERANCE, Facing, Options, PARALLEL_TOLERANCE, SIMULTANEOUS_TOLERANCE,
+    ALPHA_SENSITIVITY, DEGENERATE_TOLERANCE, FRAGILE_ULPS, Facing, GRAZING_COSINE, Options,
+    PARALLEL_TOLERANCE, TIE_WINDOW_ULPS,
 };
 pub use path::{Path, Sweep};
 pub use record::{
@@ -34,6 +39,8 @@ pub use record::{
     VertexRecord,
 };
 pub use sweep_edge::sweep_edge;
-pub use sweep_face::{barycentric, sweep_face};
-pub use sweep_mesh::{Broadphase, Outcome, sweep_mesh, sweep_mesh_with};
+pub use sweep_face::{barycentric, barycentric_and_distance, sweep_face};
+pub use sweep_mesh::{
+    Broadphase, CollectTies, Outcome, Tie, in_tie_window, sweep_mesh, sweep_mesh_with, sweep_ties,
+};
 pub use sweep_vertex::sweep_vertex;

@@ -67,7 +67,7 @@ pub struct Options {
 
 /// A path is *parallel* to a plane or an edge when the component of `d`
 /// that matters is at most this fraction of `|d|`:
-/// face test `|h0 - h1| ≤ PARALLEL_TOLERANCE · |d|`,
+/// face test `|n · d| ≤ PARALLEL_TOLERANCE · |d|`,
 /// edge test `A ≤ (PARALLEL_TOLERANCE · |d|)²`.
 /// A zero-length path is parallel to everything.
 pub const PARALLEL_TOLERANCE: f64 = 1e-12;
@@ -77,8 +77,54 @@ pub const PARALLEL_TOLERANCE: f64 = 1e-12;
 /// below about 1e-12 radians), or when two of its indices are equal.
 pub const DEGENERATE_TOLERANCE: f64 = 1e-12;
 
-/// Triangles whose collision `α` lies within this absolute tolerance of the
-/// minimum collide *simultaneously*: their front normals are averaged into
-/// the reported normal. `α` is a fraction of the path, so the tolerance is
-/// already relative to the path's length.
-pub const SIMULTANEOUS_TOLERANCE: f64 = 1e-9;
+/// The *rounding unit* of a sweep is `u = f64::EPSILON · S`, a length,
+/// where `S = max(|p0|∞, |p1|∞, |mesh bounds|∞) + ρ` is the largest
+/// magnitude the tests subtract or rotate: every position a test computes
+/// (a point in an edge's frame, a touch point, a distance) carries an error
+/// of a few `u`. In `α` (a fraction of the path) that is `u / |d|`, divided
+/// by the cosine of the approach angle.
+///
+/// The **tie window** is `TIE_WINDOW_ULPS · u / |d|` (at most 1): hits
+/// whose `α` lies within it of the minimum are *tied*. The primary hit is
+/// chosen among them by the rules' order (face < edge < vertex, then lower
+/// triangle, then lower feature), and the normals of their triangles are
+/// averaged. The same `TIE_WINDOW_ULPS · u` is the tolerance by which a
+/// contact may lie outside its feature (a face's touch point outside the
+/// triangle, an edge's `xc` outside `[0, L]`) and still count: the exact
+/// contact there is the neighbouring edge or vertex at the same `α` within
+/// rounding, and the tie order would choose the face or the edge anyway.
+///
+/// 1024 ulps covers the rounding of the tests (a few ulps of `S` per
+/// coordinate) for approach cosines down to about 0.01; below that a tie
+/// may still be decided by rounding, and the decision is flagged
+/// ([`FRAGILE_ULPS`], [`GRAZING_COSINE`]).
+pub const TIE_WINDOW_ULPS: f64 = 1024.0;
+
+/// A decision is *fragile* (flagged in [`Outcome::fragile`](super::Outcome))
+/// when a change of the inputs at the level of their rounding could change
+/// it. The band is `FRAGILE_ULPS · u` in length and `FRAGILE_ULPS · u / |d|`
+/// in `α` (see [`TIE_WINDOW_ULPS`] for `u`), 64 times the tie window: a
+/// one-ulp change of an input moves a contact by about `u / cos`, which
+/// stays below the band for every approach cosine above
+/// [`GRAZING_COSINE`]. Used for: another hit within the band of the
+/// minimum `α` (`tie`), a contact within the band of its feature's boundary
+/// (`near_boundary`), a contact within it of `α = 0` or `α = 1`
+/// (`start_touching`, `near_end`), and for rejected tests that missed by
+/// less than it (a tangent missing by less than the band, a touch point or
+/// `xc` outside by less than it, a root just before 0 or beyond 1).
+pub const FRAGILE_ULPS: f64 = 65536.0;
+
+/// A contact whose approach cosine is below this is *grazing* (face:
+/// `|n · d| / |d|`; edge or vertex: `√disc / (2ρ|d|)`, the cosine between
+/// the path and the contact normal, which is the discriminant relative to
+/// its largest value `4ρ²|d|²`): its `α` moves by `1 / cos` times the
+/// rounding of its inputs. Also the facing value `|n · d| / |d|` below
+/// which a triangle's facing rule could turn under rounding.
+pub const GRAZING_COSINE: f64 = 1e-3;
+
+/// A hit's `α` is *imprecise* when one rounding of the inputs moves it by
+/// more than this: `f64::EPSILON · S / (|d| · cos) > ALPHA_SENSITIVITY`
+/// (a path short compared with the coordinates' magnitude, or a shallow
+/// approach). At that level a comparison of `α` with tolerance `1e-6` can
+/// fail from rounding alone.
+pub const ALPHA_SENSITIVITY: f64 = 1e-8;

@@ -3,7 +3,7 @@
 use nalgebra::{Point3, Vector3};
 
 use super::error::SweepError;
-use super::options::Options;
+use super::options::{FRAGILE_ULPS, Options, TIE_WINDOW_ULPS};
 
 /// One sweep as given: the ball of radius `radius` moves from `p0` to `p1`.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -40,6 +40,10 @@ pub struct Path {
     pub length: f64,
     /// Detection radius `ρ = r - ε`.
     pub rho: f64,
+    /// The magnitude `S` the tests' rounding is relative to:
+    /// `max(|p0|∞, |p1|∞) + ρ`, raised to the mesh's bounds by
+    /// [`Path::with_mesh_scale`] (the mesh sweep does that).
+    pub scale: f64,
 }
 
 impl Path {
@@ -84,13 +88,68 @@ impl Path {
                 value: length,
             });
         }
+        let rho = sweep.radius - options.margin;
         Ok(Path {
             p0: sweep.p0,
             p1: sweep.p1,
             d,
             length,
-            rho: sweep.radius - options.margin,
+            rho,
+            scale: sweep.p0.coords.amax().max(sweep.p1.coords.amax()) + rho,
         })
+    }
+
+    /// The path with [`Path::scale`] raised to cover a mesh whose
+    /// axis-aligned bounds are `(lo, hi)`.
+    pub fn with_mesh_scale(mut self, lo: &Point3<f64>, hi: &Point3<f64>) -> Path {
+        let coordinates = self.p0.coords.amax().max(self.p1.coords.amax());
+        self.scale = coordinates.max(lo.coords.amax()).max(hi.coords.amax()) + self.rho;
+        self
+    }
+
+    /// The rounding unit `u = f64::EPSILON · S`: the size of one rounding
+    /// of the positions the tests compute.
+    #[inline]
+    pub fn rounding(&self) -> f64 {
+        f64::EPSILON * self.scale
+    }
+
+    /// `u` as a fraction of the path, `u / |d|` (0 for a path of length 0,
+    /// which hits nothing).
+    #[inline]
+    fn rounding_in_alpha(&self) -> f64 {
+        if self.length > 0.0 {
+            self.rounding() / self.length
+        } else {
+            0.0
+        }
+    }
+
+    /// The tie window in `α`: `TIE_WINDOW_ULPS · u / |d|`, at most 1. Hits
+    /// within it of the minimum `α` are tied (see [`TIE_WINDOW_ULPS`]).
+    #[inline]
+    pub fn tie_window(&self) -> f64 {
+        (TIE_WINDOW_ULPS * self.rounding_in_alpha()).min(1.0)
+    }
+
+    /// The tie window as a length, `TIE_WINDOW_ULPS · u`: how far outside
+    /// its feature a contact may lie and still count.
+    #[inline]
+    pub fn tie_distance(&self) -> f64 {
+        TIE_WINDOW_ULPS * self.rounding()
+    }
+
+    /// The fragility band in `α`, `FRAGILE_ULPS · u / |d|` (see
+    /// [`FRAGILE_ULPS`]).
+    #[inline]
+    pub fn fragile_window(&self) -> f64 {
+        FRAGILE_ULPS * self.rounding_in_alpha()
+    }
+
+    /// The fragility band as a length, `FRAGILE_ULPS · u`.
+    #[inline]
+    pub fn fragile_distance(&self) -> f64 {
+        FRAGILE_ULPS * self.rounding()
     }
 
     /// The ball's center at fraction `beta` of the path.

@@ -6,6 +6,12 @@
 /// Uses `q = -(B + sign(B) √disc) / 2`, roots `q / A` and `C / q`, which
 /// avoids the cancellation of the schoolbook formula. Never produces NaN:
 /// a NaN discriminant (an overflowed input) or a NaN root gives `None`.
+///
+/// `q = 0` happens only when `B = 0` and the discriminant is 0. The
+/// discriminant is computed in another form than `B² - 4AC` (see
+/// [`discriminant_from_cross`]) and can round to 0 while `C ≠ 0`, so the
+/// roots then come from `A β² + C = 0` itself: none for `C > 0`,
+/// `±√(-C/A)` for `C < 0`, a double root at 0 only for `C = 0`.
 #[inline]
 pub fn solve(a: f64, b: f64, c: f64, discriminant: f64) -> Option<(f64, f64)> {
     if discriminant.is_nan() || discriminant < 0.0 || a.is_nan() || a <= 0.0 {
@@ -18,8 +24,15 @@ pub fn solve(a: f64, b: f64, c: f64, discriminant: f64) -> Option<(f64, f64)> {
         -0.5 * (b - sqrt)
     };
     if q == 0.0 {
-        // b = 0 and disc = 0, so c = 0: a double root at 0.
-        return Some((0.0, 0.0));
+        // B = 0 and the discriminant rounded to 0: solve A β² + C = 0.
+        return if c > 0.0 {
+            None
+        } else if c == 0.0 {
+            Some((0.0, 0.0))
+        } else {
+            let r = (-c / a).sqrt();
+            (!r.is_nan()).then_some((-r, r))
+        };
     }
     let r0 = q / a;
     let r1 = c / q;
@@ -41,4 +54,18 @@ pub fn solve(a: f64, b: f64, c: f64, discriminant: f64) -> Option<(f64, f64)> {
 #[inline]
 pub fn discriminant_from_cross(a: f64, rho: f64, cross_squared: f64) -> f64 {
     4.0 * (rho * rho * a - cross_squared)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::solve;
+
+    #[test]
+    fn zero_q_uses_the_sign_of_c() {
+        // B = 0 and a discriminant rounded to 0: the sign of C decides.
+        assert_eq!(solve(2.0, 0.0, 1e-17, 0.0), None);
+        assert_eq!(solve(2.0, 0.0, 0.0, 0.0), Some((0.0, 0.0)));
+        assert_eq!(solve(2.0, 0.0, -8.0, 0.0), Some((-2.0, 2.0)));
+        assert_eq!(solve(2.0, -0.0, 1e-17, 0.0), None);
+    }
 }

@@ -48,7 +48,8 @@ pub enum Verdict {
     Hit,
     /// Face: the ball starts within `ρ` of the plane, or behind it.
     StartsTooClose,
-    /// Face: moving parallel to the plane. Edge: path parallel to the edge
+    /// Face: moving parallel to the plane (`|n · d| ≤ PARALLEL_TOLERANCE · |d|`).
+    /// Edge: path parallel to the edge
     /// (or of zero length).
     Parallel,
     /// Vertex: the path has zero length.
@@ -112,18 +113,24 @@ pub struct FaceRecord {
     pub triangle: u32,
     /// Its front normal.
     pub normal: Vector3<f64>,
-    /// `n · d`, the facing value.
+    /// `n · d` (mathematically `h1 - h0`): the one quantity the test uses
+    /// for the facing rule, the parallel test and `β`.
     pub normal_dot_d: f64,
     /// Signed distance of `p0` from the plane.
     pub h0: f64,
-    /// Signed distance of `p1` from the plane.
+    /// Signed distance of `p1` from the plane (shown in explanations; the
+    /// decisions use `n · d`, never `h0 - h1`).
     pub h1: f64,
-    /// `(h0 - ρ) / (h0 - h1)`, when computed.
+    /// `(h0 - ρ) / -(n · d)`, when computed.
     pub beta: Option<f64>,
     /// The touch point `p0 + β d - ρ n`, when computed.
     pub touch: Option<Point3<f64>>,
     /// Barycentric coordinates of the touch point (weights of `a`, `b`, `c`).
     pub barycentric: Option<[f64; 3]>,
+    /// Smallest signed distance of the touch point from the triangle's edge
+    /// lines (positive inside); the touch point counts as inside when this
+    /// is at least minus the tie distance.
+    pub boundary_distance: Option<f64>,
     /// The verdict.
     pub verdict: Verdict,
 }
@@ -267,12 +274,22 @@ impl TestRecord {
             TestRecord::Vertex(_) => Kind::Vertex,
         }
     }
-    /// Feature index (0 for the face).
+    /// Feature index, for ordering and labels: the edge or vertex index,
+    /// 0 for the face (see [`TestRecord::reported_feature`]).
     pub fn feature(&self) -> u8 {
         match self {
             TestRecord::Face(_) => 0,
             TestRecord::Edge(r) => r.edge,
             TestRecord::Vertex(r) => r.vertex,
+        }
+    }
+    /// The feature as an outcome reports it: the edge or vertex index, or
+    /// `None` for the face (a face has no feature).
+    pub fn reported_feature(&self) -> Option<u8> {
+        match self {
+            TestRecord::Face(_) => None,
+            TestRecord::Edge(r) => Some(r.edge),
+            TestRecord::Vertex(r) => Some(r.vertex),
         }
     }
     /// The verdict.

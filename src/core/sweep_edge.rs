@@ -56,7 +56,10 @@ pub fn sweep_edge(triangle: &Triangle, edge: u8, path: &Path, facing: Facing) ->
                 } else {
                     let xc = x0 + s0 * (x1 - x0);
                     record.xc = Some(xc);
-                    if xc < 0.0 || xc > frame.length {
+                    // On the edge, ends included, up to the tie distance
+                    // (see TIE_WINDOW_ULPS).
+                    let tolerance = path.tie_distance();
+                    if xc < -tolerance || xc > frame.length + tolerance {
                         Verdict::OffEdge
                     } else if !facing.allows(normal_dot_d) {
                         Verdict::BackFacing

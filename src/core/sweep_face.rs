@@ -6,6 +6,17 @@ use super::path::Path;
 use super::record::{FaceRecord, Verdict};
 
 /// Runs the face test of SEMANTICS.md on `triangle`.
+///
+/// One quantity decides the direction of travel: `n · d` (mathematically
+/// `h1 - h0`). It is the facing value, the parallel test
+/// (`|n · d| ≤ PARALLEL_TOLERANCE · |d|`) and the denominator of
+/// `β = (h0 - ρ) / -(n · d)`, so the three can never disagree by rounding.
+/// `h1` is recorded for the explanation only.
+///
+/// The touch point counts as inside when its signed distance from the
+/// triangle's boundary is at least `-`[`Path::tie_distance`] (rounding
+/// level; the exact contact just outside is an edge or vertex at the same
+/// `α` within the tie window, which the tie order gives to the face).
 #[inline]
 pub fn sweep_face(triangle: &Triangle, path: &Path, facing: Facing) -> FaceRecord {
     let n = triangle.normal;
@@ -22,26 +33,32 @@ pub fn sweep_face(triangle: &Triangle, path: &Path, facing: Facing) -> FaceRecor
         beta: None,
         touch: None,
         barycentric: None,
+        boundary_distance: None,
         verdict: Verdict::Hit,
     };
     let rho = path.rho;
     record.verdict = if h0 < rho {
         Verdict::StartsTooClose
-    } else if (h0 - h1).abs() <= PARALLEL_TOLERANCE * path.length {
+    } else if normal_dot_d.abs() <= PARALLEL_TOLERANCE * path.length {
         Verdict::Parallel
-    } else if !facing.allows(normal_dot_d) || h1 > h0 {
+    } else if !facing.allows(normal_dot_d) {
+        // Here `n · d ≠ 0`, so both rules reject exactly `n · d > 0`: moving
+        // away from the front.
         Verdict::BackFacing
     } else {
-        let beta = (h0 - rho) / (h0 - h1);
+        let beta = (h0 - rho) / -normal_dot_d;
         record.beta = Some(beta);
         if beta > 1.0 {
             Verdict::BeyondEnd
         } else {
             let touch = path.at(beta) - n * rho;
             record.touch = Some(touch);
-            let bary = barycentric(triangle, &touch);
+            let (bary, distance) = barycentric_and_distance(triangle, &touch);
             record.barycentric = Some(bary);
-            if bary.iter().all(|&w| w >= 0.0) {
+            record.boundary_distance = Some(distance);
+            // Inside, boundary included, up to the tie distance (a touch
+            // point that rounding put just outside; see TIE_WINDOW_ULPS).
+            if distance >= -path.tie_distance() {
                 Verdict::Hit
             } else {
                 Verdict::OutsideTriangle
@@ -73,4 +90,32 @@ pub fn barycentric(triangle: &Triangle, p: &nalgebra::Point3<f64>) -> [f64; 3] {
         n.dot(&pc.cross(&pa)) / area2,
         n.dot(&pa.cross(&pb)) / area2,
     ]
+}
+
+/// Barycentric coordinates of a point in the triangle's plane (as
+/// [`barycentric`]) and its smallest signed distance from the lines of the
+/// triangle's edges, in the plane: positive inside, 0 on the boundary,
+/// negative outside.
+#[inline]
+pub fn barycentric_and_distance(triangle: &Triangle, p: &nalgebra::Point3<f64>) -> ([f64; 3], f64) {
+    let [a, b, c] = triangle.vertices;
+    let n = triangle.normal;
+    let area2 = n.dot(&(b - a).cross(&(c - a)));
+    let (pa, pb, pc) = (a - p, b - p, c - p);
+    // Twice the signed areas of the sub-triangles opposite a, b and c.
+    let sub = [
+        n.dot(&pb.cross(&pc)),
+        n.dot(&pc.cross(&pa)),
+        n.dot(&pa.cross(&pb)),
+    ];
+    // Opposite a is edge 1 (b → c), opposite b edge 2, opposite c edge 0.
+    let lengths = [
+        triangle.edges[1].length,
+        triangle.edges[2].length,
+        triangle.edges[0].length,
+    ];
+    let distance = (0..3)
+        .map(|i| sub[i] / lengths[i])
+        .fold(f64::INFINITY, f64::min);
+    (sub.map(|s| s / area2), distance)
 }

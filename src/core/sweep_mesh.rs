@@ -5,31 +5,44 @@ use nalgebra::{Point3, Vector3};
 use serde::Serialize;
 
 use super::error::SweepError;
+use super::fragility::{FragileReason, Fragility};
 use super::mesh::{Mesh, Triangle};
-use super::options::{Options, SIMULTANEOUS_TOLERANCE};
+use super::options::{ALPHA_SENSITIVITY, Facing, GRAZING_COSINE, Options};
 use super::path::{Path, Sweep};
 use super::record::{Kind, NoObserver, Observer, TestRecord, Verdict};
 use super::sweep_edge::sweep_edge;
-use super::sweep_face::sweep_face;
+use super::sweep_face::{barycentric_and_distance, sweep_face};
 use super::sweep_vertex::sweep_vertex;
 
 /// The result of one sweep.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
 pub struct Outcome {
-    /// Fraction of the path travelled at first contact; 1 when nothing is hit.
+    /// Fraction of the path travelled at first contact (the minimum `α` over
+    /// every collision); 1 when nothing is hit.
     pub alpha: f64,
-    /// Kind of the primary collision.
+    /// Kind of the primary collision: chosen among the hits tied with
+    /// `alpha` ([`Outcome::ties_with`]) by the order face < edge < vertex,
+    /// then lower triangle, then lower feature.
     pub kind: Kind,
     /// Input index of the primary triangle.
     pub triangle: Option<u32>,
-    /// Feature of the primary collision: edge or vertex index (0 for a face).
+    /// Feature of the primary collision: the edge or vertex index (0..3)
+    /// within its triangle; `None` for a face (a face has no feature) and
+    /// when nothing is hit.
     pub feature: Option<u8>,
     /// The reported normal: the primary triangle's front normal, or the
-    /// normalised average of the front normals of every triangle colliding
-    /// within [`SIMULTANEOUS_TOLERANCE`] of `alpha`.
+    /// normalised average of the front normals of every triangle with a hit
+    /// tied with `alpha`.
     pub normal: Option<Vector3<f64>>,
-    /// The point of the mesh the ball touches at `alpha`.
+    /// The point of the mesh the primary test touches (at its own `α`,
+    /// which is tied with `alpha`).
     pub contact: Option<Point3<f64>>,
+    /// The tie window of this sweep, in `α` ([`Path::tie_window`]): a hit
+    /// at `α ≤ alpha + tie_window` is tied with the primary.
+    pub tie_window: f64,
+    /// Why the decision may not survive a change of the inputs at the level
+    /// of their rounding; empty when it is robust.
+    pub fragile: Fragility,
 }
 
 impl Outcome {
@@ -41,6 +54,8 @@ impl Outcome {
         feature: None,
         normal: None,
         contact: None,
+        tie_window: 0.0,
+        fragile: Fragility::ROBUST,
     };
 
     /// Whether something was hit.
@@ -54,8 +69,138 @@ impl Outcome {
         record.alpha().is_some()
             && Some(record.triangle()) == self.triangle
             && record.kind() == self.kind
-            && Some(record.feature()) == self.feature
+            && record.reported_feature() == self.feature
     }
+
+    /// Whether a hit at `alpha` is tied with this outcome's primary hit: it
+    /// lies within the tie window of the minimum `α` ([`in_tie_window`]).
+    /// Tied hits share the averaged normal, and any of them is an
+    /// acceptable answer to the rules (the primary is the first of them in
+    /// the tie order). Never true when nothing was hit.
+    pub fn ties_with(&self, alpha: f64) -> bool {
+        self.is_hit() && in_tie_window(alpha, self.alpha, self.tie_window)
+    }
+
+    /// The tie set among `records` (the records of this sweep, e.g. from
+    /// [`CollectRecords`](super::CollectRecords) or [`CollectTies`]): every
+    /// hit tied with this outcome, in the tie order (the primary first).
+    pub fn tie_set(&self, records: &[TestRecord]) -> Vec<Tie> {
+        let mut ties: Vec<Tie> = records
+            .iter()
+            .filter_map(Tie::of)
+            .filter(|t| self.ties_with(t.alpha))
+            .collect();
+        ties.sort_by_key(|t| t.order());
+        ties.dedup_by_key(|t| t.order());
+        ties
+    }
+}
+
+/// Whether a hit at `alpha` lies in the tie window `window` of the minimum
+/// `min_alpha`: `alpha ≤ min_alpha + window`. The one definition of "tied"
+/// (the combiner, [`Outcome::ties_with`] and every consumer use it).
+#[inline]
+pub fn in_tie_window(alpha: f64, min_alpha: f64, window: f64) -> bool {
+    alpha <= min_alpha + window
+}
+
+/// One member of a decision's tie set: a hit, named as an outcome names it.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct Tie {
+    /// Kind of the hit.
+    pub kind: Kind,
+    /// Input index of its triangle.
+    pub triangle: u32,
+    /// Edge or vertex index; `None` for a face.
+    pub feature: Option<u8>,
+    /// Its own `α`.
+    pub alpha: f64,
+}
+
+impl Tie {
+    /// The tie-set entry of a record, if it is a hit.
+    pub fn of(record: &TestRecord) -> Option<Tie> {
+        Some(Tie {
+            kind: record.kind(),
+            triangle: record.triangle(),
+            feature: record.reported_feature(),
+            alpha: record.alpha()?,
+        })
+    }
+
+    /// The tie order: face < edge < vertex, then triangle, then feature.
+    pub fn order(&self) -> (Kind, u32, Option<u8>) {
+        (self.kind, self.triangle, self.feature)
+    }
+
+    /// Whether an expectation naming `kind` and, when known, `triangle`
+    /// and `feature` names this hit (`None`: not named, so any value;
+    /// `Some(None)`: null). A face has no feature: any feature an expected
+    /// face names is accepted.
+    pub fn matches(
+        &self,
+        kind: Kind,
+        triangle: Option<Option<u32>>,
+        feature: Option<Option<u8>>,
+    ) -> bool {
+        kind == self.kind
+            && triangle.is_none_or(|t| t == Some(self.triangle))
+            && (self.kind == Kind::Face || feature.is_none_or(|f| f == self.feature))
+    }
+}
+
+/// An observer that keeps the hits of an explained sweep, from which
+/// [`CollectTies::tie_set`] gives the decision's tie set. Cheaper than
+/// [`CollectRecords`](super::CollectRecords): only hits are kept.
+#[derive(Clone, Debug, Default)]
+pub struct CollectTies {
+    /// Every hit, in the order the tests ran.
+    pub hits: Vec<Tie>,
+}
+
+impl CollectTies {
+    /// The hits tied with `outcome`, in the tie order (the primary first).
+    pub fn tie_set(&self, outcome: &Outcome) -> Vec<Tie> {
+        let mut ties: Vec<Tie> = self
+            .hits
+            .iter()
+            .copied()
+            .filter(|t| outcome.ties_with(t.alpha))
+            .collect();
+        ties.sort_by_key(|t| t.order());
+        ties
+    }
+
+    fn keep(&mut self, record: TestRecord) {
+        if let Some(t) = Tie::of(&record) {
+            self.hits.push(t);
+        }
+    }
+}
+
+impl Observer for CollectTies {
+    fn face(&mut self, r: &super::record::FaceRecord) {
+        self.keep(TestRecord::Face(*r));
+    }
+    fn edge(&mut self, r: &super::record::EdgeRecord) {
+        self.keep(TestRecord::Edge(*r));
+    }
+    fn vertex(&mut self, r: &super::record::VertexRecord) {
+        self.keep(TestRecord::Vertex(*r));
+    }
+}
+
+/// The outcome of `sweep` and its tie set (every hit tied with the primary,
+/// in the tie order, the primary first; empty when nothing is hit).
+pub fn sweep_ties(
+    mesh: &Mesh,
+    sweep: &Sweep,
+    options: &Options,
+) -> Result<(Outcome, Vec<Tie>), SweepError> {
+    let mut ties = CollectTies::default();
+    let outcome = sweep_mesh_with(mesh, sweep, options, Broadphase::Bvh, &mut ties)?;
+    let set = ties.tie_set(&outcome);
+    Ok((outcome, set))
 }
 
 /// How the candidate triangles are chosen.
@@ -68,131 +213,362 @@ pub enum Broadphase {
     Exhaustive,
 }
 
-/// The best collision of one triangle.
+/// One hit, with what the tie order and the fragility flags need.
 #[derive(Clone, Copy, Debug)]
-struct Candidate {
+struct Hit {
     alpha: f64,
     kind: Kind,
+    triangle: u32,
+    /// Edge or vertex index; 0 for the face.
     feature: u8,
+    /// Position of the triangle in the mesh's storage order.
+    position: u32,
     contact: Point3<f64>,
+    /// Approach cosine: `|n · d| / |d|` for a face, `√disc / (2ρ|d|)` for
+    /// an edge or a vertex.
+    cosine: f64,
+    /// The triangle's `|n · d| / |d|`.
+    facing_cosine: f64,
+    /// Distance of the contact from its feature's boundary (a length;
+    /// infinite for a vertex).
+    boundary: f64,
 }
 
-impl Candidate {
+impl Hit {
+    const EMPTY: Hit = Hit {
+        alpha: 0.0,
+        kind: Kind::None,
+        triangle: 0,
+        feature: 0,
+        position: 0,
+        contact: Point3::new(0.0, 0.0, 0.0),
+        cosine: 0.0,
+        facing_cosine: 0.0,
+        boundary: 0.0,
+    };
+
     #[inline]
-    fn better_than(&self, other: &Candidate) -> bool {
-        (self.alpha, self.kind, self.feature) < (other.alpha, other.kind, other.feature)
+    fn order(&self) -> (Kind, u32, u8) {
+        (self.kind, self.triangle, self.feature)
     }
 }
 
-/// Runs the seven tests of one triangle; returns its best collision.
+/// Receives what a triangle's tests found: hits, and near misses (a test
+/// rejected by less than the fragility band) with their `α`.
+trait Sink {
+    fn hit(&mut self, hit: Hit);
+    fn near_miss(&mut self, _reason: FragileReason, _alpha: f64) {}
+}
+
+/// Runs the seven tests of one triangle; hands hits and near misses to `sink`.
 #[inline]
-fn test_triangle<O: Observer>(
+fn test_triangle<O: Observer, S: Sink>(
     triangle: &Triangle,
+    position: usize,
     path: &Path,
-    options: &Options,
+    facing: Facing,
     observer: &mut O,
-) -> Option<Candidate> {
-    let facing = options.facing;
-    let mut best: Option<Candidate> = None;
-    let mut offer = |c: Candidate| {
-        if best.as_ref().is_none_or(|b| c.better_than(b)) {
-            best = Some(c);
-        }
+    sink: &mut S,
+) {
+    let rho = path.rho;
+    let length = path.length;
+    let facing_value = triangle.normal.dot(&path.d);
+    let facing_cosine = if length > 0.0 {
+        facing_value.abs() / length
+    } else {
+        0.0
     };
+    let allowed = facing.allows(facing_value);
+    let band = path.fragile_window();
+    let band_distance = path.fragile_distance();
+    let hit = |alpha: f64, kind: Kind, feature: u8, contact, cosine, boundary| Hit {
+        alpha,
+        kind,
+        triangle: triangle.index,
+        feature,
+        position: position as u32,
+        contact,
+        cosine,
+        facing_cosine,
+        boundary,
+    };
+    // Whether a face touch point at `beta` lies within the band of the triangle.
+    let touch_near = |beta: f64| {
+        let touch = path.at(beta) - triangle.normal * rho;
+        barycentric_and_distance(triangle, &touch).1 >= -band_distance
+    };
+
     let face = sweep_face(triangle, path, facing);
     observer.face(&face);
-    if face.verdict == Verdict::Hit {
-        offer(Candidate {
-            alpha: face.beta.unwrap_or(1.0),
-            kind: Kind::Face,
-            feature: 0,
-            contact: face.touch.unwrap_or(triangle.vertices[0]),
-        });
+    match face.verdict {
+        Verdict::Hit => {
+            if let (Some(beta), Some(touch)) = (face.beta, face.touch) {
+                sink.hit(hit(
+                    beta,
+                    Kind::Face,
+                    0,
+                    touch,
+                    facing_cosine,
+                    face.boundary_distance.unwrap_or(0.0),
+                ));
+            }
+        }
+        Verdict::StartsTooClose if allowed && facing_value < 0.0 => {
+            let beta = (face.h0 - rho) / -facing_value;
+            if beta >= -band && touch_near(0.0) {
+                sink.near_miss(FragileReason::StartTouching, beta);
+            }
+        }
+        Verdict::BeyondEnd => {
+            if let Some(beta) = face.beta
+                && beta <= 1.0 + band
+                && touch_near(beta)
+            {
+                sink.near_miss(FragileReason::NearEnd, beta);
+            }
+        }
+        Verdict::OutsideTriangle => {
+            if let (Some(beta), Some(distance)) = (face.beta, face.boundary_distance)
+                && distance >= -band_distance
+            {
+                sink.near_miss(FragileReason::NearBoundary, beta);
+            }
+        }
+        _ => {}
     }
+
+    // Near misses shared by the edge and vertex tests. `on_feature(s)` says
+    // whether the contact at `s` lies within the band of the feature.
+    let quadratic_near_miss = |sink: &mut S,
+                               verdict: Verdict,
+                               (a, b, c, discriminant): (f64, f64, f64, f64),
+                               roots: Option<(f64, f64)>,
+                               on_feature: &dyn Fn(f64) -> bool| {
+        match verdict {
+            Verdict::NoRealRoots if allowed => {
+                // Closest approach within ρ + band of the feature's line or point.
+                let reach = 4.0 * a * band_distance * (2.0 * rho + band_distance);
+                let t = -b / (2.0 * a);
+                if -discriminant <= reach && t >= -band && t <= 1.0 + band && on_feature(t) {
+                    sink.near_miss(FragileReason::NearTangent, t);
+                }
+            }
+            // Moving along the edge's line at a distance within the band of ρ.
+            Verdict::Parallel
+                if allowed && c.abs() <= band_distance * (2.0 * rho + band_distance) =>
+            {
+                sink.near_miss(FragileReason::NearTangent, 0.0);
+            }
+            Verdict::BeforeStart if allowed => {
+                if let Some((s0, _)) = roots
+                    && s0 >= -band
+                    && on_feature(s0)
+                {
+                    sink.near_miss(FragileReason::StartTouching, s0);
+                }
+            }
+            Verdict::BeyondEnd if allowed => {
+                if let Some((s0, _)) = roots
+                    && s0 <= 1.0 + band
+                    && on_feature(s0)
+                {
+                    sink.near_miss(FragileReason::NearEnd, s0);
+                }
+            }
+            Verdict::BackFacing if facing_cosine < GRAZING_COSINE => {
+                // The facing rule could turn and let this hit through.
+                if let Some((s0, _)) = roots {
+                    sink.near_miss(FragileReason::Grazing, s0);
+                }
+            }
+            _ => {}
+        }
+    };
+    let approach = |discriminant: f64| discriminant.max(0.0).sqrt() / (2.0 * rho * length);
+
     for e in 0..3u8 {
         let r = sweep_edge(triangle, e, path, facing);
         observer.edge(&r);
-        if r.verdict == Verdict::Hit {
-            let s0 = r.roots.map_or(1.0, |x| x.0);
-            let xc = r.xc.unwrap_or(0.0);
-            offer(Candidate {
-                alpha: s0,
-                kind: Kind::Edge,
-                feature: e,
-                contact: r.frame.to_world(&Point3::new(xc, 0.0, 0.0)),
-            });
+        let (x0, x1) = (r.p0_in_edge.x, r.p1_in_edge.x);
+        let on_edge = |s: f64| {
+            let xc = x0 + s * (x1 - x0);
+            xc >= -band_distance && xc <= r.length + band_distance
+        };
+        match r.verdict {
+            Verdict::Hit => {
+                if let (Some((s0, _)), Some(xc)) = (r.roots, r.xc) {
+                    sink.hit(hit(
+                        s0,
+                        Kind::Edge,
+                        e,
+                        r.frame.to_world(&Point3::new(xc, 0.0, 0.0)),
+                        approach(r.discriminant),
+                        xc.min(r.length - xc),
+                    ));
+                }
+            }
+            Verdict::OffEdge if allowed => {
+                if let (Some((s0, _)), Some(xc)) = (r.roots, r.xc)
+                    && xc >= -band_distance
+                    && xc <= r.length + band_distance
+                {
+                    sink.near_miss(FragileReason::NearBoundary, s0);
+                }
+            }
+            verdict => quadratic_near_miss(
+                sink,
+                verdict,
+                (r.a, r.b, r.c, r.discriminant),
+                r.roots,
+                &on_edge,
+            ),
         }
     }
     for v in 0..3u8 {
         let r = sweep_vertex(triangle, v, path, facing);
         observer.vertex(&r);
-        if r.verdict == Verdict::Hit {
-            offer(Candidate {
-                alpha: r.roots.map_or(1.0, |x| x.0),
-                kind: Kind::Vertex,
-                feature: v,
-                contact: r.position,
-            });
+        match r.verdict {
+            Verdict::Hit => {
+                if let Some((s0, _)) = r.roots {
+                    sink.hit(hit(
+                        s0,
+                        Kind::Vertex,
+                        v,
+                        r.position,
+                        approach(r.discriminant),
+                        f64::INFINITY,
+                    ));
+                }
+            }
+            verdict => quadratic_near_miss(
+                sink,
+                verdict,
+                (r.a, r.b, r.c, r.discriminant),
+                r.roots,
+                &|_| true,
+            ),
         }
     }
-    best
 }
 
-const WINDOW: usize = 32;
+/// How many hits the combiner keeps without allocating; more within the
+/// fragility band of the minimum (a vertex shared by very many triangles)
+/// trigger a second, exhaustive pass.
+const CAPACITY: usize = 24;
 
-/// Combines triangle results: the primary collision and the triangles that
-/// collide simultaneously with it. Allocates nothing.
+/// Collects the hits within the fragility band of the running minimum `α`
+/// and the earliest near miss of each reason. Allocates nothing.
 struct Combiner {
-    best: Option<(Candidate, u32, usize)>,
-    /// `(alpha, position)` of triangles that may be within the tolerance.
-    window: [(f64, u32); WINDOW],
+    min: f64,
+    band: f64,
+    hits: [Hit; CAPACITY],
     len: usize,
     overflow: bool,
+    near_misses: [f64; FragileReason::ALL.len()],
 }
 
 impl Combiner {
-    fn new() -> Self {
+    fn new(band: f64) -> Self {
         Combiner {
-            best: None,
-            window: [(0.0, 0); WINDOW],
+            min: f64::INFINITY,
+            band,
+            hits: [Hit::EMPTY; CAPACITY],
             len: 0,
             overflow: false,
+            near_misses: [f64::INFINITY; FragileReason::ALL.len()],
         }
     }
 
-    fn best_alpha(&self) -> f64 {
-        self.best.as_ref().map_or(1.0, |b| b.0.alpha)
+    /// The broadphase cutoff: a triangle entered later cannot have a hit or
+    /// a near miss that matters.
+    fn cutoff(&self) -> f64 {
+        self.min.min(1.0) + self.band
     }
+}
 
+impl Sink for Combiner {
     #[inline]
-    fn add(&mut self, c: Candidate, triangle_index: u32, position: usize) {
-        let replace = match &self.best {
-            None => true,
-            Some((b, bi, _)) => {
-                (c.alpha, c.kind, triangle_index, c.feature) < (b.alpha, b.kind, *bi, b.feature)
-            }
-        };
-        if replace {
-            self.best = Some((c, triangle_index, position));
-        }
-        let limit = self.best_alpha() + SIMULTANEOUS_TOLERANCE;
-        if c.alpha <= limit {
-            if replace {
-                // Drop entries the new minimum pushed out of the window.
-                let mut k = 0;
-                for i in 0..self.len {
-                    if self.window[i].0 <= limit {
-                        self.window[k] = self.window[i];
-                        k += 1;
-                    }
+    fn hit(&mut self, hit: Hit) {
+        if hit.alpha < self.min {
+            self.min = hit.alpha;
+            let (min, band) = (self.min, self.band);
+            let mut k = 0;
+            for i in 0..self.len {
+                if in_tie_window(self.hits[i].alpha, min, band) {
+                    self.hits[k] = self.hits[i];
+                    k += 1;
                 }
-                self.len = k;
             }
-            if self.len < WINDOW {
-                self.window[self.len] = (c.alpha, position as u32);
+            self.len = k;
+        }
+        if in_tie_window(hit.alpha, self.min, self.band) {
+            if self.len < CAPACITY {
+                self.hits[self.len] = hit;
                 self.len += 1;
             } else {
                 self.overflow = true;
+            }
+        }
+    }
+
+    #[inline]
+    fn near_miss(&mut self, reason: FragileReason, alpha: f64) {
+        let earliest = &mut self.near_misses[reason as usize];
+        *earliest = earliest.min(alpha);
+    }
+}
+
+/// Decides from the hits within the band of the final minimum, seen grouped
+/// by triangle in mesh order: the primary, the normal sum and the flags.
+struct Decision<'a> {
+    triangles: &'a [Triangle],
+    path: &'a Path,
+    min: f64,
+    window: f64,
+    band: f64,
+    primary: Option<Hit>,
+    normal_sum: Vector3<f64>,
+    last_position: Option<u32>,
+    in_band: usize,
+    fragile: Fragility,
+}
+
+impl Sink for Decision<'_> {
+    fn hit(&mut self, h: Hit) {
+        if !in_tie_window(h.alpha, self.min, self.band) {
+            return;
+        }
+        self.in_band += 1;
+        let f = &mut self.fragile;
+        if h.kind == Kind::Face {
+            if h.cosine < GRAZING_COSINE {
+                f.insert(FragileReason::Grazing);
+            }
+        } else if h.cosine < GRAZING_COSINE {
+            f.insert(FragileReason::NearTangent);
+        }
+        if h.facing_cosine < GRAZING_COSINE {
+            f.insert(FragileReason::Grazing);
+        }
+        if h.boundary < self.path.fragile_distance() {
+            f.insert(FragileReason::NearBoundary);
+        }
+        if h.alpha <= self.band {
+            f.insert(FragileReason::StartTouching);
+        }
+        if h.alpha >= 1.0 - self.band {
+            f.insert(FragileReason::NearEnd);
+        }
+        if self.path.rounding() > ALPHA_SENSITIVITY * self.path.length * h.cosine {
+            f.insert(FragileReason::ImpreciseAlpha);
+        }
+        if in_tie_window(h.alpha, self.min, self.window) {
+            if self.primary.is_none_or(|p| h.order() < p.order()) {
+                self.primary = Some(h);
+            }
+            if self.last_position != Some(h.position) {
+                self.normal_sum += self.triangles[h.position as usize].normal;
+                self.last_position = Some(h.position);
             }
         }
     }
@@ -214,14 +590,33 @@ pub fn sweep_mesh_with<O: Observer>(
     broadphase: Broadphase,
     observer: &mut O,
 ) -> Result<Outcome, SweepError> {
-    let path = Path::new(sweep, options)?;
-    Ok(sweep_path(mesh, &path, options, broadphase, observer))
+    let (lo, hi) = mesh.bounds();
+    let path = Path::new(sweep, options)?.with_mesh_scale(&lo, &hi);
+    Ok(sweep_path(
+        mesh,
+        &path,
+        options.facing,
+        broadphase,
+        observer,
+    ))
+}
+
+/// Whether the fast query may skip a triangle without testing it: every
+/// test would end back-facing, and its facing value is far enough from 0
+/// that rounding cannot turn the rule (near 0 it is tested for the
+/// `grazing` flag).
+#[inline]
+fn skip<O: Observer>(triangle: &Triangle, path: &Path, facing: Facing) -> bool {
+    let facing_value = triangle.normal.dot(&path.d);
+    !O::WANTS_RECORDS
+        && !facing.allows(facing_value)
+        && facing_value.abs() >= GRAZING_COSINE * path.length
 }
 
 fn visit_triangles<O: Observer>(
     mesh: &Mesh,
     path: &Path,
-    options: &Options,
+    facing: Facing,
     broadphase: Broadphase,
     observer: &mut O,
     combiner: &mut Combiner,
@@ -229,12 +624,8 @@ fn visit_triangles<O: Observer>(
     let triangles = mesh.triangles();
     let run = |position: usize, combiner: &mut Combiner, observer: &mut O| {
         let t = &triangles[position];
-        if !O::WANTS_RECORDS && !options.facing.allows(t.normal.dot(&path.d)) {
-            // Every test of a back-facing triangle ends back-facing.
-            return;
-        }
-        if let Some(c) = test_triangle(t, path, options, observer) {
-            combiner.add(c, t.index, position);
+        if !skip::<O>(t, path, facing) {
+            test_triangle(t, position, path, facing, observer, combiner);
         }
     };
     match broadphase {
@@ -244,28 +635,16 @@ fn visit_triangles<O: Observer>(
             }
         }
         Broadphase::Bvh => {
-            let (lo, hi) = mesh.bounds();
-            let scale = [
-                lo.coords.amax(),
-                hi.coords.amax(),
-                path.p0.coords.amax(),
-                path.p1.coords.amax(),
-            ]
-            .into_iter()
-            .fold(path.rho, f64::max);
-            let grow = path.rho + 1e-9 * scale;
-            mesh.bvh().traverse(
-                &path.p0,
-                &path.d,
-                grow,
-                1.0 + SIMULTANEOUS_TOLERANCE,
-                |range| {
+            // Boxes grown by ρ plus a margin far above the fragility band,
+            // so every hit and near miss that matters is visited.
+            let grow = path.rho + 1e-9 * path.scale;
+            mesh.bvh()
+                .traverse(&path.p0, &path.d, grow, combiner.cutoff(), |range| {
                     for position in range {
                         run(position, combiner, observer);
                     }
-                    combiner.best_alpha() + SIMULTANEOUS_TOLERANCE
-                },
-            );
+                    combiner.cutoff()
+                });
         }
     }
 }
@@ -273,50 +652,78 @@ fn visit_triangles<O: Observer>(
 fn sweep_path<O: Observer>(
     mesh: &Mesh,
     path: &Path,
-    options: &Options,
+    facing: Facing,
     broadphase: Broadphase,
     observer: &mut O,
 ) -> Outcome {
-    let mut combiner = Combiner::new();
-    visit_triangles(mesh, path, options, broadphase, observer, &mut combiner);
-    let Some((best, triangle_index, position)) = combiner.best else {
-        return Outcome::NONE;
-    };
-    let limit = best.alpha + SIMULTANEOUS_TOLERANCE;
+    let band = path.fragile_window();
+    let mut combiner = Combiner::new(band);
+    visit_triangles(mesh, path, facing, broadphase, observer, &mut combiner);
     let triangles = mesh.triangles();
-    let mut sum = Vector3::zeros();
+    let reference = combiner.min.min(1.0);
+    let mut fragile = Fragility::ROBUST;
+    for reason in FragileReason::ALL {
+        if combiner.near_misses[reason as usize] <= reference + band {
+            fragile.insert(reason);
+        }
+    }
+    if combiner.min == f64::INFINITY {
+        return Outcome {
+            tie_window: path.tie_window(),
+            fragile,
+            ..Outcome::NONE
+        };
+    }
+    let mut decision = Decision {
+        triangles,
+        path,
+        min: combiner.min,
+        window: path.tie_window(),
+        band,
+        primary: None,
+        normal_sum: Vector3::zeros(),
+        last_position: None,
+        in_band: 0,
+        fragile,
+    };
     if combiner.overflow {
-        // More simultaneous triangles than the window holds: a second pass.
-        for t in triangles {
-            if let Some(c) = test_triangle(t, path, options, &mut NoObserver)
-                && c.alpha <= limit
-            {
-                sum += t.normal;
+        // More hits within the band than the combiner holds: test every
+        // triangle again, in mesh order.
+        for (position, t) in triangles.iter().enumerate() {
+            if !skip::<NoObserver>(t, path, facing) {
+                test_triangle(t, position, path, facing, &mut NoObserver, &mut decision);
             }
         }
     } else {
-        // Sum in mesh order so the bits do not depend on the traversal order.
-        let window = &mut combiner.window[..combiner.len];
-        window.sort_unstable_by_key(|w| w.1);
-        for &(alpha, position) in window.iter() {
-            if alpha <= limit {
-                sum += triangles[position as usize].normal;
-            }
+        // In mesh order so the normal's bits do not depend on the traversal.
+        let hits = &mut combiner.hits[..combiner.len];
+        hits.sort_unstable_by_key(|h| (h.position, h.order()));
+        for h in hits.iter() {
+            decision.hit(*h);
         }
     }
-    let primary_normal = triangles[position].normal;
+    if decision.in_band > 1 {
+        decision.fragile.insert(FragileReason::Tie);
+    }
+    let Some(primary) = decision.primary else {
+        // Unreachable: the minimum is itself a hit within the window.
+        return Outcome::NONE;
+    };
+    let sum = decision.normal_sum;
     let norm = sum.norm();
     let normal = if norm > 1e-9 {
         sum / norm
     } else {
-        primary_normal
+        triangles[primary.position as usize].normal
     };
     Outcome {
-        alpha: best.alpha,
-        kind: best.kind,
-        triangle: Some(triangle_index),
-        feature: Some(best.feature),
+        alpha: combiner.min,
+        kind: primary.kind,
+        triangle: Some(primary.triangle),
+        feature: (primary.kind != Kind::Face).then_some(primary.feature),
         normal: Some(normal),
-        contact: Some(best.contact),
+        contact: Some(primary.contact),
+        tie_window: decision.window,
+        fragile: decision.fragile,
     }
 }

@@ -25,7 +25,7 @@ use crate::run::RunOutcome;
 use crate::trace::messages::{EXPECTED_TOPIC, OutcomeMsg};
 use crate::trace::{TraceError, TraceEvent, TraceReader};
 
-use super::compare::{FieldDiff, Tolerances, compare};
+use super::compare::{Agreement, FieldDiff, Tolerances, agreement};
 use super::explain::{ExpectedTest, expected_tests, explain_outcome, explained_records};
 
 /// Default number of divergences described in detail per trace.
@@ -46,6 +46,8 @@ pub struct Divergence {
     pub expected: OutcomeMsg,
     /// The core's outcome.
     pub got: OutcomeMsg,
+    /// Why the core's decision is fragile (empty when robust).
+    pub fragile: crate::core::Fragility,
     /// The margin and facing rule the core used.
     pub margin: f64,
     /// The facing rule the core used.
@@ -120,6 +122,8 @@ pub struct CheckOptions {
     pub tolerances: Tolerances,
     /// How many divergences are described in detail.
     pub max_details: usize,
+    /// Whether a divergence on a fragile decision fails the check too.
+    pub strict: bool,
     /// The replay's options (frames, ball, overrides). `explain` and
     /// `detail` are ignored: the check runs the fast query and explains
     /// only the detailed divergences.
@@ -131,6 +135,7 @@ impl Default for CheckOptions {
         CheckOptions {
             tolerances: Tolerances::default(),
             max_details: DEFAULT_MAX_DETAILS,
+            strict: false,
             replay: ReplayOptions::default(),
         }
     }
@@ -147,8 +152,23 @@ pub struct TraceReport {
     pub sweeps: u64,
     /// Sweeps compared with an expectation.
     pub compared: u64,
-    /// Sweeps whose outcome differs from its expectation.
+    /// Sweeps whose outcome differs from its expectation (on a robust
+    /// decision; with `strict`, on any decision). These fail the check.
     pub divergent: u64,
+    /// Sweeps whose expectation names another member of the replayed
+    /// decision's tie set: an equally valid answer to the rules, counted
+    /// as a match.
+    pub ties: u64,
+    /// Sweeps that diverge on a fragile decision (rounding at the level of
+    /// the inputs could change it); they fail the check only with `strict`,
+    /// where they are also counted in `divergent`.
+    pub fragile_divergent: u64,
+    /// Fragile divergences by reason (one sweep can have several).
+    pub fragile_by_reason: BTreeMap<String, u64>,
+    /// The first fragile divergences, in detail (without `strict`).
+    pub fragile_divergences: Vec<Divergence>,
+    /// Whether fragile divergences fail the check (`--strict`).
+    pub strict: bool,
     /// Replayed sweeps without an expectation.
     pub sweeps_without_expectation: u64,
     /// Expectations that match no replayed sweep (or arrived after theirs was
@@ -215,6 +235,11 @@ where
         sweeps: 0,
         compared: 0,
         divergent: 0,
+        ties: 0,
+        fragile_divergent: 0,
+        fragile_by_reason: BTreeMap::new(),
+        fragile_divergences: Vec::new(),
+        strict: options.strict,
         sweeps_without_expectation: 0,
         expectations_without_sweep: 0,
         expectations: 0,
@@ -238,10 +263,37 @@ where
                     continue;
                 };
                 report.compared += 1;
+                let mesh = scene.as_deref().map(|s| &s.mesh);
+                let (fields, fragile) =
+                    match agreement(expected, &result, mesh, &options.tolerances) {
+                        Agreement::Match => continue,
+                        Agreement::Tie => {
+                            report.ties += 1;
+                            continue;
+                        }
+                        Agreement::Diverges { fields, fragile } => (fields, fragile),
+                    };
                 let got = result.outcome_msg();
-                let fields = compare(expected, &got, &options.tolerances);
-                if fields.is_empty() {
-                    continue;
+                if !fragile.is_robust() {
+                    report.fragile_divergent += 1;
+                    for reason in fragile.iter() {
+                        *report
+                            .fragile_by_reason
+                            .entry(reason.as_str().to_string())
+                            .or_default() += 1;
+                    }
+                    if !options.strict {
+                        if report.fragile_divergences.len() < options.max_details {
+                            report.fragile_divergences.push(divergence(
+                                &result,
+                                scene.as_deref(),
+                                *expected,
+                                got,
+                                fields,
+                            ));
+                        }
+                        continue;
+                    }
                 }
                 report.divergent += 1;
                 *report
@@ -322,6 +374,7 @@ fn divergence(
         fields,
         expected,
         got,
+        fragile: result.outcome.fragile,
         margin: result.options.margin,
         facing: result.options.facing.to_string(),
         got_explanation: explain_outcome(&result.outcome, &records),

@@ -13,7 +13,9 @@ use serde::Serialize;
 use serde_json::{Value, json};
 
 use crate::core::explain::num;
+use crate::core::{Fragility, Kind, Mesh, sweep_ties};
 use crate::numbers::{self, Rule};
+use crate::replay::SweepResult;
 use crate::trace::messages::OutcomeMsg;
 
 /// Default absolute tolerance on `α` (a fraction of the path, unitless).
@@ -172,7 +174,10 @@ pub fn compare(expected: &OutcomeMsg, got: &OutcomeMsg, tol: &Tolerances) -> Vec
             });
         }
     }
-    if let Some(want) = expected.feature {
+    // A face has no feature: an expected face hit matches a face hit whatever
+    // feature it names (`null`, or the 0 older recordings wrote).
+    let both_faces = expected.kind == Kind::Face && got.kind == Kind::Face;
+    if let Some(want) = expected.feature.filter(|_| !both_faces) {
         let have = got.feature.flatten();
         if want != have {
             out.push(FieldDiff {
@@ -238,4 +243,79 @@ pub fn compare(expected: &OutcomeMsg, got: &OutcomeMsg, tol: &Tolerances) -> Vec
         }
     }
     out
+}
+
+/// How a replayed sweep stands against its expectation: the one judgement
+/// used by `check`, `diff` and the viewer's decision line.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Agreement {
+    /// Every field the expectation holds matches within the tolerances.
+    Match,
+    /// The expectation names another member of the replayed decision's tie
+    /// set (its kind, triangle or feature differ, every other field
+    /// matches): an equally valid answer to the rules' tie order, reached by
+    /// different rounding. Not a divergence.
+    Tie,
+    /// Fields differ. When the replayed decision is fragile (rounding at the
+    /// level of the inputs could change it), `fragile` names why; `check`
+    /// counts such divergences apart and fails on them only with
+    /// `--strict`.
+    Diverges {
+        /// The fields that differ (identity fields left out when the
+        /// expectation names a member of the tie set).
+        fields: Vec<FieldDiff>,
+        /// Why the replayed decision is fragile; empty when robust.
+        fragile: Fragility,
+    },
+}
+
+impl Agreement {
+    /// Whether the sweep diverges (robust or fragile).
+    pub fn is_divergent(&self) -> bool {
+        matches!(self, Agreement::Diverges { .. })
+    }
+
+    /// Whether the sweep fails a check: a divergence on a robust decision,
+    /// or any divergence when `strict`.
+    pub fn fails(&self, strict: bool) -> bool {
+        match self {
+            Agreement::Diverges { fragile, .. } => strict || fragile.is_robust(),
+            Agreement::Match | Agreement::Tie => false,
+        }
+    }
+}
+
+/// Judges `result` against `expected` ([`compare`] over the fields the
+/// expectation holds; see [`Agreement`]). `mesh` is the scene the sweep was
+/// replayed against: with it, an expectation naming another member of the
+/// tie set is a [`Agreement::Tie`]; without it ties cannot be recognised.
+pub fn agreement(
+    expected: &OutcomeMsg,
+    result: &SweepResult,
+    mesh: Option<&Mesh>,
+    tol: &Tolerances,
+) -> Agreement {
+    let got = result.outcome_msg();
+    let mut fields = compare(expected, &got, tol);
+    if fields.is_empty() {
+        return Agreement::Match;
+    }
+    let identity =
+        |f: &FieldDiff| matches!(f.field, Field::Kind | Field::Triangle | Field::Feature);
+    if fields.iter().any(identity)
+        && let Some(mesh) = mesh
+        && sweep_ties(mesh, &result.sweep, &result.options).is_ok_and(|(_, ties)| {
+            ties.iter()
+                .any(|t| t.matches(expected.kind, expected.triangle, expected.feature))
+        })
+    {
+        fields.retain(|f| !identity(f));
+        if fields.is_empty() {
+            return Agreement::Tie;
+        }
+    }
+    Agreement::Diverges {
+        fields,
+        fragile: result.outcome.fragile,
+    }
 }

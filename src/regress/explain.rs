@@ -5,8 +5,7 @@ use serde::Serialize;
 
 use crate::core::explain::{describe, label, nearest_miss, num};
 use crate::core::{
-    Broadphase, CollectRecords, Kind, Outcome, SIMULTANEOUS_TOLERANCE, TestRecord, Verdict,
-    sweep_mesh_with,
+    Broadphase, CollectRecords, Kind, Outcome, TestRecord, Verdict, sweep_mesh_with,
 };
 use crate::replay::{SceneState, SweepResult, primary_records};
 use crate::trace::messages::OutcomeMsg;
@@ -40,7 +39,7 @@ pub fn explained_records(result: &SweepResult, scene: &SceneState) -> Vec<TestRe
 }
 
 /// The records that decided `outcome`, described: the primary test then the
-/// other hits within [`SIMULTANEOUS_TOLERANCE`] of its `α`; when nothing is
+/// other hits tied with it ([`Outcome::ties_with`]); when nothing is
 /// hit, the nearest miss.
 pub fn explain_outcome(outcome: &Outcome, records: &[TestRecord]) -> Vec<String> {
     if !outcome.is_hit() {
@@ -130,10 +129,7 @@ pub fn expected_tests(
 
 fn expected_test(r: &TestRecord, expected: &OutcomeMsg, got: &Outcome) -> ExpectedTest {
     let verdict = r.verdict();
-    let decides = got.is_hit()
-        && Some(r.triangle()) == got.triangle
-        && r.kind() == got.kind
-        && Some(r.feature()) == got.feature;
+    let decides = got.is_reported_by(r);
     let why_not = match r.alpha() {
         None => format!("it reports no collision ({verdict})"),
         Some(a) if decides => format!(
@@ -142,7 +138,7 @@ fn expected_test(r: &TestRecord, expected: &OutcomeMsg, got: &Outcome) -> Expect
             num(a),
             num(expected.alpha)
         ),
-        Some(a) if got.is_hit() && a > got.alpha + SIMULTANEOUS_TOLERANCE => format!(
+        Some(a) if got.is_hit() && !got.ties_with(a) => format!(
             "it hits at α = {}, later than the primary collision at α = {}",
             num(a),
             num(got.alpha)

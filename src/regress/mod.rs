@@ -23,8 +23,9 @@ pub use check::{
     check_reader, find_traces, frames_around,
 };
 pub use compare::{
-    DEFAULT_ALPHA_TOLERANCE, DEFAULT_CONTACT_TOLERANCE, DEFAULT_NORMAL_TOLERANCE_DEGREES, Field,
-    FieldDiff, Tolerances, angle_degrees, compare,
+    Agreement, DEFAULT_ALPHA_TOLERANCE, DEFAULT_CONTACT_TOLERANCE,
+    DEFAULT_NORMAL_TOLERANCE_DEGREES, Field, FieldDiff, Tolerances, agreement, angle_degrees,
+    compare,
 };
 pub use diff::{DiffReport, FirstDifference, Side, diff};
 pub use explain::{ExpectedTest, expected_tests, explain_outcome, explained_records};

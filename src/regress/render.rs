@@ -29,7 +29,7 @@ pub fn render_divergence(d: &Divergence, indent: &str) -> String {
     let mut s = String::new();
     let _ = writeln!(
         s,
-        "{indent}frame {}, ball {}: {} differ (margin {}, facing {})",
+        "{indent}frame {}, ball {}: {} differ (margin {}, facing {}{})",
         d.frame,
         d.ball,
         d.fields
@@ -38,7 +38,12 @@ pub fn render_divergence(d: &Divergence, indent: &str) -> String {
             .collect::<Vec<_>>()
             .join(", "),
         num(d.margin),
-        d.facing
+        d.facing,
+        if d.fragile.is_robust() {
+            String::new()
+        } else {
+            format!("; the core's decision is fragile: {}", d.fragile)
+        }
     );
     for f in &d.fields {
         let _ = write!(
@@ -78,13 +83,48 @@ pub fn render_divergence(d: &Divergence, indent: &str) -> String {
 /// divergences in detail.
 pub fn render_text(r: &TraceReport) -> String {
     let mut s = String::new();
-    let counts = format!(
+    let mut counts = format!(
         "{} sweeps, {} compared, {} without expectation, {} expectations without a sweep",
         r.sweeps, r.compared, r.sweeps_without_expectation, r.expectations_without_sweep
     );
+    if r.ties > 0 {
+        let _ = write!(
+            counts,
+            ", {} ties (the expectation names another member of the tie set: a match)",
+            r.ties
+        );
+    }
+    if r.fragile_divergent > 0 {
+        let reasons = r
+            .fragile_by_reason
+            .iter()
+            .map(|(k, n)| format!("{k}: {n}"))
+            .collect::<Vec<_>>()
+            .join(", ");
+        let _ = write!(
+            counts,
+            ", {} fragile divergences ({reasons}){}",
+            r.fragile_divergent,
+            if r.strict {
+                ", failures under --strict"
+            } else {
+                ", not failures without --strict"
+            }
+        );
+    }
+    let fragile_details = |s: &mut String| {
+        for d in &r.fragile_divergences {
+            let _ = writeln!(
+                s,
+                "  fragile divergence (not a failure; rounding could change this decision):"
+            );
+            s.push_str(&render_divergence(d, "    "));
+        }
+    };
     match r.status {
         Status::Ok => {
             let _ = writeln!(s, "ok {}: {counts}", r.trace);
+            fragile_details(&mut s);
         }
         Status::Fail => {
             let kinds = r

@@ -7,8 +7,8 @@ use std::time::{Duration, Instant};
 
 use crate::core::explain::nearest_miss;
 use crate::core::{
-    Broadphase, CollectRecords, Mesh, Options, Outcome, SIMULTANEOUS_TOLERANCE, Sweep, TestRecord,
-    Verdict, sweep_mesh, sweep_mesh_with,
+    Broadphase, CollectRecords, Mesh, Options, Outcome, Sweep, TestRecord, Verdict, sweep_mesh,
+    sweep_mesh_with,
 };
 use crate::trace::TraceEvent;
 use crate::trace::messages::{OutcomeMsg, SceneMsg, SweepMsg};
@@ -63,6 +63,22 @@ impl SweepResult {
     /// The outcome as the record of SEMANTICS.md (every field present).
     pub fn outcome_msg(&self) -> OutcomeMsg {
         OutcomeMsg::from_outcome(self.frame, self.ball, &self.outcome)
+    }
+
+    /// The line `replay --outcomes` writes: the outcome record, then the
+    /// additive `fragile` field (the reasons the decision is fragile, `[]`
+    /// when it is robust; see [`crate::core::FragileReason`]).
+    pub fn outcome_line(&self) -> Result<String, serde_json::Error> {
+        #[derive(serde::Serialize)]
+        struct Line {
+            #[serde(flatten)]
+            outcome: OutcomeMsg,
+            fragile: crate::core::Fragility,
+        }
+        serde_json::to_string(&Line {
+            outcome: self.outcome_msg(),
+            fragile: self.outcome.fragile,
+        })
     }
 
     /// The record that decided the sweep: the primary test when something is
@@ -416,7 +432,7 @@ pub fn compute_sweep(
 }
 
 /// The records of [`Detail::Primary`]: the primary test, then every other
-/// hit within [`SIMULTANEOUS_TOLERANCE`] of its `α`; when nothing is hit,
+/// hit tied with it ([`Outcome::ties_with`]); when nothing is hit,
 /// the nearest miss.
 pub fn primary_records(outcome: &Outcome, records: Vec<TestRecord>) -> Vec<TestRecord> {
     if !outcome.is_hit() {
@@ -428,11 +444,10 @@ pub fn primary_records(outcome: &Outcome, records: Vec<TestRecord>) -> Vec<TestR
         .take(1)
         .copied()
         .collect();
-    let limit = outcome.alpha + SIMULTANEOUS_TOLERANCE;
     out.extend(
-        records
-            .into_iter()
-            .filter(|r| r.alpha().is_some_and(|a| a <= limit) && !outcome.is_reported_by(r)),
+        records.into_iter().filter(|r| {
+            r.alpha().is_some_and(|a| outcome.ties_with(a)) && !outcome.is_reported_by(r)
+        }),
     );
     out
 }

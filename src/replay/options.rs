@@ -20,8 +20,8 @@ use crate::core::Facing;
 #[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
 pub enum Detail {
     /// The tests that report the primary collision (the primary test first,
-    /// then every other hit at the same `α` within
-    /// [`crate::core::SIMULTANEOUS_TOLERANCE`], which share the averaged
+    /// then every other hit tied with it
+    /// ([`crate::core::Outcome::ties_with`]), which share the averaged
     /// normal); when nothing hits, the one test that came nearest
     /// ([`crate::core::explain::miss_distance`]) among the BVH candidates.
     #[default]

@@ -116,10 +116,7 @@ where
                     batch
                         .par_iter()
                         .with_min_len(64)
-                        .map(|event| {
-                            sweep_of(event)
-                                .and_then(|r| serde_json::to_string(&r.outcome_msg()).ok())
-                        })
+                        .map(|event| sweep_of(event).and_then(|r| r.outcome_line().ok()))
                         .collect()
                 },
                 || {

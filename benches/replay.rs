@@ -83,7 +83,7 @@ fn rrd(bytes: &[u8], detail: Detail, path: &std::path::Path) -> u64 {
     let id = viz::recording_id(&[bytes, detail.as_str().as_bytes()]);
     let rec = viz::builder(&id, "bench").save(path).expect("rrd file");
     let mut logger = viz::Logger::new(rec, true).expect("recording");
-    let max = logger.max_edge_frames();
+    let prepare_options = logger.prepare_options();
     let read_ahead = prefetch(
         TraceReader::new(std::io::Cursor::new(bytes.to_vec()), "bench.mcap"),
         prefetch::DEFAULT_CHUNK,
@@ -129,7 +129,7 @@ fn rrd(bytes: &[u8], detail: Detail, path: &std::path::Path) -> u64 {
                     ReplayEvent::Sweep(r) => Some(&**r),
                     ReplayEvent::Scene(_) => None,
                 });
-                viz::prepare_sweeps_into(&mut p, &scenes, sweeps, max);
+                viz::prepare_sweeps_into(&mut p, &scenes, sweeps, &prepare_options);
                 p
             })
             .collect();

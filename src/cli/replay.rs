@@ -201,7 +201,15 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         let rec = viz::builder(&id, &name)
             .set_sinks(sinks)
             .context("creating the recording")?;
-        logger = Some(viz::Logger::new(rec, !args.no_blueprint).context("starting the recording")?);
+        let logger_options = viz::LoggerOptions {
+            blueprint: !args.no_blueprint,
+            prepare: viz::PrepareOptions {
+                follow_ball: args.ball.unwrap_or(0),
+                ..viz::PrepareOptions::default()
+            },
+        };
+        logger =
+            Some(viz::Logger::with_options(rec, logger_options).context("starting the recording")?);
     }
 
     // The outcomes.
@@ -249,7 +257,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     let mut trace_error = None;
     let mut last_frame = None;
     let mut scenes: Vec<Arc<SceneState>> = Vec::new();
-    let max_edge_frames = logger.as_ref().map(|l| l.max_edge_frames());
+    let prepare_options = logger.as_ref().map(|l| l.prepare_options());
     let write_outcomes = outcomes.is_some();
     let mut batch = Vec::with_capacity(DEFAULT_BATCH_EVENTS);
     loop {
@@ -302,7 +310,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
                             .collect()
                     },
                     || {
-                        let Some(max) = max_edge_frames else {
+                        let Some(prepare_options) = prepare_options else {
                             return Vec::new();
                         };
                         groups
@@ -313,7 +321,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
                                     &mut p,
                                     &scenes,
                                     batch[g.clone()].iter().filter_map(sweep_of),
-                                    max,
+                                    &prepare_options,
                                 );
                                 p
                             })

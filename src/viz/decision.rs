@@ -1,0 +1,126 @@
+//! The decision line: one sentence per sweep, and whether the sweep
+//! diverges from the trace's expectation (by [`crate::check::compare`], the
+//! rule `check` uses).
+
+use std::fmt::{self, Write as _};
+
+use crate::check::{FieldDiff, Tolerances, compare};
+use crate::core::TestRecord;
+use crate::core::explain::{Num, write_describe};
+use crate::replay::SweepResult;
+
+/// The fields in which the sweep's outcome differs from the trace's expected
+/// outcome, compared as `check` compares them (empty when it matches or has
+/// no expectation).
+pub fn divergence(r: &SweepResult, tolerances: &Tolerances) -> Vec<FieldDiff> {
+    match &r.expected {
+        Some(expected) => compare(expected, &r.outcome_msg(), tolerances),
+        None => Vec::new(),
+    }
+}
+
+/// The text line of one sweep, and whether it diverges from the trace's
+/// expected outcome (by [`divergence`] with `tolerances`).
+pub fn decision_line(
+    r: &SweepResult,
+    decisive: Option<&TestRecord>,
+    tolerances: &Tolerances,
+) -> (String, bool) {
+    let mut s = String::new();
+    let diffs = divergence(r, tolerances);
+    write_decision_line(&mut s, r, decisive, &diffs);
+    (s, !diffs.is_empty())
+}
+
+/// Appends [`decision_line`]'s line to `s`; `diffs` are the sweep's
+/// [`divergence`].
+pub(crate) fn write_decision_line(
+    s: &mut String,
+    r: &SweepResult,
+    decisive: Option<&TestRecord>,
+    diffs: &[FieldDiff],
+) {
+    let o = &r.outcome;
+    let _ = write!(s, "frame {} ball {}: ", r.frame, r.ball);
+    if o.is_hit() {
+        let _ = write!(
+            s,
+            "{} collision at α = {} (triangle {}, feature {})",
+            o.kind,
+            Num(o.alpha),
+            OrDash(o.triangle),
+            OrDash(o.feature)
+        );
+        if let Some(t) = decisive {
+            s.push_str(" — ");
+            let _ = write_describe(s, t);
+        }
+    } else {
+        s.push_str("no collision");
+        match decisive {
+            Some(t) => {
+                s.push_str("; closest candidate rejected: ");
+                let _ = write_describe(s, t);
+            }
+            None if r.records.is_empty() => {
+                s.push_str(" (no triangle's box comes within ρ of the path)")
+            }
+            None => {}
+        }
+    }
+    if let (false, Some(e)) = (diffs.is_empty(), &r.expected) {
+        s.push_str(" [differs from the expected outcome in ");
+        write_fields(s, diffs);
+        let _ = write!(s, "; expected {} at α = {}]", e.kind, Num(e.alpha));
+    }
+}
+
+/// The line of the `divergences` log: what was expected, what was found,
+/// which fields differ.
+pub(crate) fn write_divergence_line(s: &mut String, r: &SweepResult, diffs: &[FieldDiff]) {
+    let o = &r.outcome;
+    let _ = write!(s, "frame {} ball {}: ", r.frame, r.ball);
+    write_fields(s, diffs);
+    s.push_str(if diffs.len() == 1 {
+        " differs"
+    } else {
+        " differ"
+    });
+    if let Some(e) = &r.expected {
+        let _ = write!(s, ": expected {} at α = {}", e.kind, Num(e.alpha));
+        if let (Some(Some(t)), Some(Some(f))) = (e.triangle, e.feature) {
+            let _ = write!(s, " (triangle {t}, feature {f})");
+        }
+    }
+    let _ = write!(s, ", replayed {} at α = {}", o.kind, Num(o.alpha));
+    if let (Some(t), Some(f)) = (o.triangle, o.feature) {
+        let _ = write!(s, " (triangle {t}, feature {f})");
+    }
+    let _ = write!(
+        s,
+        " (margin {}, facing {})",
+        Num(r.options.margin),
+        r.options.facing
+    );
+}
+
+fn write_fields(s: &mut String, diffs: &[FieldDiff]) {
+    for (i, d) in diffs.iter().enumerate() {
+        if i > 0 {
+            s.push_str(", ");
+        }
+        s.push_str(d.field.as_str());
+    }
+}
+
+/// A number, or `-` for `None`.
+struct OrDash<T>(Option<T>);
+
+impl<T: fmt::Display> fmt::Display for OrDash<T> {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match &self.0 {
+            Some(v) => v.fmt(f),
+            None => f.write_str("-"),
+        }
+    }
+}

@@ -47,7 +47,7 @@ trap 'rm -rf "$out"' EXIT
 failed=0
 for trace in "${traces[@]}"; do
     name="$(basename "$trace" .mcap)"
-    for detail in primary candidates; do
+    for detail in primary candidates all; do
         rrd="$out/$name.$detail.rrd"
         if ! "$BIN" replay "$trace" --rrd "$rrd" --detail "$detail" >"$out/log" 2>&1; then
             # Exit code 1 is a trace that ends early: its recording is still complete.

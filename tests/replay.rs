@@ -74,6 +74,14 @@ pub fn tests() -> Vec<Trial> {
             "replay::parallel_iterator_equals_sequential",
             parallel_iterator_equals_sequential,
         ),
+        trial(
+            "replay::rrd_shows_edges_features_and_explanations",
+            rrd_shows_edges_features_and_explanations,
+        ),
+        trial(
+            "replay::viewer_and_check_agree_on_divergences",
+            viewer_and_check_agree_on_divergences,
+        ),
     ]
 }
 
@@ -489,9 +497,14 @@ fn expected_attached_before_and_after() -> Result<(), String> {
         summary.expected_matched == 2 && summary.expected_unmatched == 1,
         "summary {summary:?}"
     );
-    let (line, mismatch) = viz::decision_line(&results[0], results[0].decisive_record());
+    let (line, mismatch) = viz::decision_line(
+        &results[0],
+        None,
+        results[0].decisive_record(),
+        &sweeptrace::regress::Tolerances::default(),
+    );
     ensure!(
-        mismatch && line.contains("[expected face at α = 0.1]"),
+        mismatch && line.contains("expected face at α = 0.1]"),
         "mismatch shown: {line}"
     );
     Ok(())
@@ -656,6 +669,36 @@ struct Decoded {
     recording_ids: std::collections::BTreeSet<String>,
     blueprint_stores: usize,
     static_entities: std::collections::BTreeSet<String>,
+    /// Per entity and frame, the components of its rows there (a `Clear`
+    /// row shows as `Clear:is_recursive`).
+    components: BTreeMap<String, BTreeMap<i64, std::collections::BTreeSet<String>>>,
+    /// Blueprint entity paths, per blueprint store (in the order received).
+    blueprint_paths: Vec<Vec<String>>,
+}
+
+impl Decoded {
+    /// The frames at which `entity` has a row with `component` (with
+    /// values).
+    fn frames_with(&self, entity: &str, component: &str) -> std::collections::BTreeSet<i64> {
+        self.components
+            .get(entity)
+            .map(|m| {
+                m.iter()
+                    .filter(|(_, c)| c.contains(component))
+                    .map(|(f, _)| *f)
+                    .collect()
+            })
+            .unwrap_or_default()
+    }
+
+    /// The texts of `entity`'s `component` at `frame` (empty when none).
+    fn texts_at(&self, entity: &str, component: &str, frame: i64) -> Vec<String> {
+        self.texts
+            .get(&(entity.to_string(), component.to_string()))
+            .and_then(|m| m.get(&frame))
+            .cloned()
+            .unwrap_or_default()
+    }
 }
 
 fn decode_rrd(path: &std::path::Path) -> Result<Decoded, String> {
@@ -669,16 +712,20 @@ fn decode_rrd(path: &std::path::Path) -> Result<Decoded, String> {
             LogMsg::SetStoreInfo(info) => {
                 if info.info.store_id.kind() == rerun::StoreKind::Blueprint {
                     d.blueprint_stores += 1;
+                    d.blueprint_paths.push(Vec::new());
                 } else {
                     d.recording_ids
                         .insert(info.info.store_id.recording_id().to_string());
                 }
             }
             LogMsg::ArrowMsg(store, arrow) => {
+                let chunk = Chunk::from_arrow_msg(arrow).map_err(|e| e.to_string())?;
                 if store.kind() != rerun::StoreKind::Recording {
+                    if let Some(paths) = d.blueprint_paths.last_mut() {
+                        paths.push(chunk.entity_path().to_string());
+                    }
                     continue;
                 }
-                let chunk = Chunk::from_arrow_msg(arrow).map_err(|e| e.to_string())?;
                 let entity = chunk.entity_path().to_string();
                 for t in chunk.timelines().keys() {
                     d.timelines.insert(t.to_string());
@@ -715,7 +762,28 @@ fn decode_rrd(path: &std::path::Path) -> Result<Decoded, String> {
                                 .insert(frames[*row], v.clone());
                         }
                     }
+                    for row in &rows {
+                        d.components
+                            .entry(entity.clone())
+                            .or_default()
+                            .entry(frames[*row])
+                            .or_default()
+                            .insert(name.clone());
+                    }
+                    if name == "TextLog:level" {
+                        let texts: Vec<Vec<String>> = chunk
+                            .iter_component::<rerun::components::TextLogLevel>(*id)
+                            .map(|b| b.iter().map(|s| s.0.to_string()).collect())
+                            .collect();
+                        for (row, v) in rows.iter().zip(texts.iter().filter(|v| !v.is_empty())) {
+                            d.texts
+                                .entry(key.clone())
+                                .or_default()
+                                .insert(frames[*row], v.clone());
+                        }
+                    }
                     if name.ends_with("text")
+                        || name.ends_with("labels")
                         || name == "kind"
                         || name == "verdict"
                         || name == "test"
@@ -772,13 +840,21 @@ fn write_rrd(
     detail: Detail,
     path: &std::path::Path,
 ) -> Result<Vec<SweepResult>, String> {
+    write_rrd_with(results_of.into_iter(), detail, path)
+}
+
+fn write_rrd_with(
+    results_of: impl Iterator<Item = Result<TraceEvent, TraceError>>,
+    detail: Detail,
+    path: &std::path::Path,
+) -> Result<Vec<SweepResult>, String> {
     let id = viz::recording_id(&[b"test trace", detail.as_str().as_bytes()]);
     let rec = viz::builder(&id, "test")
         .save(path)
         .map_err(|e| e.to_string())?;
     let mut logger = viz::Logger::new(rec, true).map_err(|e| e.to_string())?;
     let mut results = Vec::new();
-    for e in replay_events(results_of.into_iter(), explained(detail)) {
+    for e in replay_events(results_of, explained(detail)) {
         let e = e.map_err(|e| e.to_string())?;
         logger.log(&e).map_err(|e| e.to_string())?;
         if let ReplayEvent::Sweep(r) = e {
@@ -1228,8 +1304,9 @@ fn rrd_messages(path: &std::path::Path) -> Result<Vec<Message>, String> {
 /// The same trace written twice gives the same blueprint (store id, store
 /// info with its row id, every chunk with its chunk and row ids, the
 /// activation command) and the same recording chunks, in the same order; the
-/// layout is the default one (three containers, six views, the viewport,
-/// the panels). Only the recording's store-info row id differs.
+/// layout is the default one (three containers, eight views with the
+/// followed ball's camera and the plots' time axes, the viewport, the
+/// panels). Only the recording's store-info row id differs.
 fn blueprint_is_reproducible() -> Result<(), String> {
     use rerun::StoreKind;
     let dir = tempfile::tempdir().map_err(|e| e.to_string())?;
@@ -1271,8 +1348,16 @@ fn blueprint_is_reproducible() -> Result<(), String> {
             .count()
     };
     ensure!(count("/container/", "") == 3, "containers: {paths:?}");
-    ensure!(count("/view/", "/ViewContents") == 6, "views: {paths:?}");
-    ensure!(count("/view/", "") == 12, "views: {paths:?}");
+    ensure!(count("/view/", "/ViewContents") == 8, "views: {paths:?}");
+    ensure!(
+        count("/view/", "/EyeControls3D") == 1,
+        "follow view: {paths:?}"
+    );
+    ensure!(
+        count("/view/", "/TimeAxis") == 4,
+        "plot time axes: {paths:?}"
+    );
+    ensure!(count("/view/", "") == 21, "views: {paths:?}");
     for p in [
         "/viewport",
         "/blueprint_panel",
@@ -1391,5 +1476,260 @@ fn parallel_iterator_equals_sequential() -> Result<(), String> {
             "batch {batch}: summary {summary:?}"
         );
     }
+    Ok(())
+}
+
+/// The picture of the worked examples (face, edge, vertex, miss on the
+/// triangle T): the static wireframe; the primary triangle outlined at
+/// every decided frame; one label per frame, on the decisive feature, and
+/// none naming p0, p1 or α; the edge frame at every frame with an edge test
+/// (the nearest one for the face and vertex decisions, labelled as such),
+/// with its axes, and cleared when no test ran; plot values cleared where
+/// they stop existing; the followed ball's focus at every frame.
+fn rrd_shows_edges_features_and_explanations() -> Result<(), String> {
+    let dir = tempfile::tempdir().map_err(|e| e.to_string())?;
+    let path = dir.path().join("worked.rrd");
+    let results = write_rrd(
+        events_for(triangle_scene(), &worked_sweeps()),
+        Detail::Primary,
+        &path,
+    )?;
+    let d = decode_rrd(&path)?;
+    ensure!(
+        d.static_entities.contains("/world/mesh/0/wireframe"),
+        "no static wireframe: {:?}",
+        d.static_entities
+    );
+    let frames = |v: &[i64]| {
+        v.iter()
+            .copied()
+            .collect::<std::collections::BTreeSet<i64>>()
+    };
+
+    // The primary triangle and its feature.
+    let outline = "/world/ball/0/primary/outline";
+    ensure!(
+        d.frames_with(outline, "LineStrips3D:strips") == frames(&[0, 1, 2]),
+        "outline at {:?}",
+        d.frames_with(outline, "LineStrips3D:strips")
+    );
+    ensure!(
+        d.frames_with(outline, "Clear:is_recursive") == frames(&[3]),
+        "outline not cleared at the miss"
+    );
+    let mut labels: BTreeMap<i64, Vec<String>> = BTreeMap::new();
+    for ((entity, component), by_frame) in &d.texts {
+        if entity.starts_with("/world") && component.ends_with("labels") {
+            for (f, v) in by_frame {
+                labels.entry(*f).or_default().extend(v.iter().cloned());
+            }
+        }
+    }
+    for v in labels.values_mut() {
+        v.sort();
+    }
+    ensure!(
+        labels.get(&1) == Some(&vec!["edge 0.0".to_string()]),
+        "labels at frame 1: {:?}",
+        labels.get(&1)
+    );
+    ensure!(
+        labels
+            .get(&2)
+            .is_some_and(|v| v.contains(&"vertex 0.0".to_string())),
+        "labels at frame 2: {:?}",
+        labels.get(&2)
+    );
+    let at0 = labels.get(&0).cloned().unwrap_or_default();
+    ensure!(
+        at0.len() == 2
+            && at0.contains(&"face 0".to_string())
+            && at0
+                .iter()
+                .any(|l| l.starts_with("nearest edge test: edge 0.")),
+        "labels at frame 0: {at0:?}"
+    );
+    for l in labels.values().flatten() {
+        ensure!(
+            !(l == "p0" || l == "p1" || l.contains('α') || l.contains("s0")),
+            "a number label in 3D: {l}"
+        );
+    }
+
+    // The edge frame: slot 0 at every frame with an edge test, cleared at
+    // the miss (no test ran).
+    let slot0 = "/world/ball/0/edge/0";
+    ensure!(
+        d.translations
+            .get(slot0)
+            .map(|m| m.keys().copied().collect())
+            == Some(frames(&[0, 1, 2])),
+        "edge frame at {:?}",
+        d.translations
+            .get(slot0)
+            .map(|m| m.keys().collect::<Vec<_>>())
+    );
+    ensure!(
+        d.frames_with(&format!("{slot0}/axes"), "Arrows3D:vectors") == frames(&[0, 1, 2]),
+        "edge frame axes"
+    );
+    ensure!(
+        d.frames_with(slot0, "Clear:is_recursive") == frames(&[3]),
+        "edge frame not cleared at the miss"
+    );
+    ensure!(
+        d.texts_at(&format!("{slot0}/edge"), "LineStrips3D:labels", 1)
+            .is_empty(),
+        "the decisive edge is labelled twice"
+    );
+
+    // Plot values exist where they exist, and are cleared after.
+    let q = "/plots/ball/0/quadratic/a";
+    let h = "/plots/ball/0/face/h0";
+    ensure!(
+        d.frames_with(q, "Scalars:scalars") == frames(&[1, 2]),
+        "quadratic at {:?}",
+        d.frames_with(q, "Scalars:scalars")
+    );
+    ensure!(
+        d.frames_with(q, "Clear:is_recursive") == frames(&[3]),
+        "quadratic not cleared"
+    );
+    ensure!(
+        d.frames_with(h, "Scalars:scalars") == frames(&[0])
+            && d.frames_with(h, "Clear:is_recursive") == frames(&[1]),
+        "face values"
+    );
+
+    // The followed ball's focus: at the contact when hit.
+    let focus = d
+        .translations
+        .get("/world/ball/0/focus")
+        .ok_or("no focus transform")?;
+    ensure!(
+        focus
+            .keys()
+            .copied()
+            .collect::<std::collections::BTreeSet<i64>>()
+            == frames(&[0, 1, 2, 3]),
+        "focus at {:?}",
+        focus.keys().collect::<Vec<_>>()
+    );
+    let r = &results[1];
+    let c = r.sweep.p0 + (r.sweep.p1 - r.sweep.p0) * r.outcome.alpha;
+    let f = focus[&1];
+    ensure!(
+        (f[0] as f64 - c.x).abs() < 1e-5
+            && (f[1] as f64 - c.y).abs() < 1e-5
+            && (f[2] as f64 - c.z).abs() < 1e-5,
+        "focus {f:?}, contact position {c:?}"
+    );
+
+    // No expectations: no status, no divergences, one layout.
+    ensure!(
+        !d.components.contains_key("/status/ball/0") && !d.components.contains_key("/divergences"),
+        "status or divergences without expectations"
+    );
+    ensure!(d.blueprint_stores == 1, "{} layouts", d.blueprint_stores);
+    Ok(())
+}
+
+/// On a trace whose expectations came from another engine configuration,
+/// the viewer's decision line, its status series and its divergences log
+/// flag exactly the frames `check` reports; the expected outcome is drawn
+/// at those frames and cleared after; the recording ends with the layout
+/// that leads with the divergences.
+fn viewer_and_check_agree_on_divergences() -> Result<(), String> {
+    use std::collections::BTreeSet;
+    use sweeptrace::regress::{CheckOptions, Tolerances, check_file};
+    let fixture = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/fixtures/wrong_engine_config.mcap");
+    let report = check_file(&fixture, &CheckOptions::default());
+    ensure!(
+        report.divergent == 2,
+        "the fixture has {} divergent sweeps",
+        report.divergent
+    );
+    let check_frames: BTreeSet<i64> = report.divergent_frames.iter().map(|&f| f as i64).collect();
+
+    let bytes = std::fs::read(&fixture).map_err(|e| e.to_string())?;
+    let dir = tempfile::tempdir().map_err(|e| e.to_string())?;
+    let path = dir.path().join("fixture.rrd");
+    let results = write_rrd_with(
+        TraceReader::new(bytes.as_slice(), "fixture.mcap"),
+        Detail::Primary,
+        &path,
+    )?;
+    let d = decode_rrd(&path)?;
+
+    let line_frames: BTreeSet<i64> = results
+        .iter()
+        .filter(|r| viz::decision_line(r, None, r.decisive_record(), &Tolerances::default()).1)
+        .map(|r| r.frame as i64)
+        .collect();
+    ensure!(
+        line_frames == check_frames,
+        "decision line {line_frames:?}, check {check_frames:?}"
+    );
+    let all: BTreeSet<i64> = results.iter().map(|r| r.frame as i64).collect();
+    let warn: BTreeSet<i64> = all
+        .iter()
+        .copied()
+        .filter(|&f| d.texts_at("/log", "TextLog:level", f) == ["WARN"])
+        .collect();
+    ensure!(
+        warn == check_frames,
+        "WARN lines at {warn:?}, check {check_frames:?}"
+    );
+    ensure!(
+        d.frames_with("/divergences", "TextLog:text") == check_frames,
+        "divergences log at {:?}",
+        d.frames_with("/divergences", "TextLog:text")
+    );
+    let status = d
+        .scalars
+        .get(&("/status/ball/0".to_string(), "Scalars:scalars".to_string()))
+        .ok_or("no status series")?;
+    for f in &all {
+        let want = if check_frames.contains(f) { 1.0 } else { 0.0 };
+        ensure!(
+            status.get(f) == Some(&vec![want]),
+            "status at frame {f}: {:?}",
+            status.get(f)
+        );
+    }
+    ensure!(
+        d.frames_with("/world/ball/0/expected/ball", "Ellipsoids3D:centers") == check_frames,
+        "expected ball at {:?}",
+        d.frames_with("/world/ball/0/expected/ball", "Ellipsoids3D:centers")
+    );
+    for f in &check_frames {
+        if all.contains(&(f + 1)) && !check_frames.contains(&(f + 1)) {
+            ensure!(
+                d.frames_with("/world/ball/0/expected", "Clear:is_recursive")
+                    .contains(&(f + 1)),
+                "expected outcome not cleared at frame {}",
+                f + 1
+            );
+        }
+    }
+    // Every frame's edge frame explains something, even where no test ran
+    // (the expected edge test).
+    ensure!(
+        d.translations
+            .get("/world/ball/0/edge/0")
+            .is_some_and(|m| check_frames.iter().all(|f| m.contains_key(f))),
+        "no edge frame at a divergent frame"
+    );
+    ensure!(
+        d.blueprint_stores == 2
+            && d.blueprint_paths[1]
+                .iter()
+                .filter(|p| p.ends_with("/ViewContents"))
+                .count()
+                == 9,
+        "the divergences layout: {} stores",
+        d.blueprint_stores
+    );
     Ok(())
 }

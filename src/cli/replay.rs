@@ -195,7 +195,15 @@ pub fn run(args: Args) -> anyhow::Result<RunOutcome> {
         let rec = viz::builder(&id, &name)
             .set_sinks(sinks)
             .context("creating the recording")?;
-        logger = Some(viz::Logger::new(rec, !args.no_blueprint).context("starting the recording")?);
+        let logger_options = viz::LoggerOptions {
+            blueprint: !args.no_blueprint,
+            prepare: viz::PrepareOptions {
+                follow_ball: args.ball.unwrap_or(0),
+                ..viz::PrepareOptions::default()
+            },
+        };
+        logger =
+            Some(viz::Logger::with_options(rec, logger_options).context("starting the recording")?);
     }
 
     // The outcomes.

@@ -1,4 +1,4 @@
-//! The default blueprint, with fixed ids.
+//! The default layouts, with fixed ids.
 //!
 //! The SDK's `Blueprint::send` builds its messages in a fresh blueprint
 //! stream with `RecordingId::random()`, and every container and view gets
@@ -7,32 +7,46 @@
 //! `view/<uuid>`, the viewport's root container). Here the same archetypes
 //! are logged by hand, as `Blueprint::send` logs them, into messages of a
 //! blueprint store whose id, container and view ids, row ids and chunk ids
-//! all derive from the recording id, and are handed to the recording with
-//! [`RecordingStream::send_blueprint`]. The same recording id gives the same
-//! blueprint, byte for byte.
+//! all derive from the recording id and the [`Layout`], and are handed to
+//! the recording with [`RecordingStream::send_blueprint`]. The same
+//! recording id gives the same blueprint, byte for byte.
+//!
+//! Two layouts, over the same views:
+//!
+//! - [`Layout::FollowBall`], sent at the start: on top the view that follows
+//!   the ball, the overview of the world and the edge frame; below them the
+//!   plots (α, the quadratic, the face test, the divergence status); at the
+//!   bottom the decisions.
+//! - [`Layout::Divergences`], sent by [`super::Logger::finish`] when some
+//!   sweep diverged from its expectation, as the active layout: the
+//!   divergences log on top, then the same views.
+//!
+//! Every plot shows the same window of frames around the time cursor
+//! (`TimeAxis` with a cursor-relative view range), so a frame reads across
+//! them.
 //!
 //! ```text
-//! container/<uuid>                 ContainerBlueprint (vertical: top, plots, log)
-//! container/<uuid>                 ContainerBlueprint (horizontal: world, edge frame)
-//! container/<uuid>                 ContainerBlueprint (horizontal: α, quadratic, face)
+//! container/<uuid>                 ContainerBlueprint (vertical, then horizontal rows)
 //! view/<uuid>, view/<uuid>/ViewContents   ViewBlueprint and ViewContents of each view
+//! view/<uuid>/EyeControls3D        the followed ball's camera, in the ball's frame
+//! view/<uuid>/TimeAxis             each plot's time range around the cursor
 //! viewport                         ViewportBlueprint (root container)
 //! blueprint_panel, selection_panel PanelBlueprint (collapsed)
 //! time_panel                       TimePanelBlueprint (collapsed, `frame`, 10 fps)
 //! ```
 
 use rerun::blueprint::components::{
-    ColumnShare, ContainerKind, Fps, IncludedContent, PanelState, QueryExpression, RootContainer,
-    RowShare, TimelineName, ViewClass,
+    ColumnShare, ContainerKind, Eye3DKind, Fps, IncludedContent, LinkAxis, PanelState,
+    QueryExpression, RootContainer, RowShare, TimelineName, ViewClass,
 };
-use rerun::components::Name;
-use rerun::datatypes::{Float32, Float64};
+use rerun::components::{Name, Position3D, Vector3D};
+use rerun::datatypes::{Float32, Float64, TimeInt, TimeRange, TimeRangeBoundary};
 use rerun::external::re_log_types::{
     BlueprintActivationCommand, LogMsg, RecordingId, SetStoreInfo, StoreId, StoreInfo, StoreKind,
 };
 use rerun::external::re_sdk_types::blueprint::archetypes::{
-    ContainerBlueprint, PanelBlueprint, TimePanelBlueprint, ViewBlueprint, ViewContents,
-    ViewportBlueprint,
+    ContainerBlueprint, EyeControls3D, PanelBlueprint, TimeAxis, TimePanelBlueprint, ViewBlueprint,
+    ViewContents, ViewportBlueprint,
 };
 use rerun::log::{Chunk, ChunkId, RowId};
 use rerun::{AsComponents, RecordingStream, RecordingStreamError, TimePoint, Timeline};
@@ -43,19 +57,48 @@ use super::{FRAME_TIMELINE, IdHasher, paths};
 /// nanoseconds (as for the recording's rows).
 const ID_BASE_NANOS: u64 = 1_577_836_800_000_000_000;
 
-/// How long [`send_default_blueprint`] waits for the blueprint to reach the
-/// sink.
+/// How long [`send_blueprint`] waits for the blueprint to reach the sink.
 const FLUSH_TIMEOUT: std::time::Duration = std::time::Duration::from_secs(10);
 
-/// Sends the default layout (see [`super::default_blueprint`] for what it
-/// shows) to `rec` as its active and default blueprint, with ids that depend
-/// only on the recording id.
-pub fn send_default_blueprint(rec: &RecordingStream) -> Result<(), RecordingStreamError> {
+/// Frames shown before and after the time cursor in every plot.
+pub const PLOT_WINDOW_FRAMES: i64 = 60;
+
+/// Where the followed ball's camera sits, in the ball's frame (one unit is
+/// about four ball radii, see `rows::focus_rows`): in front, to the side
+/// and above, looking at the ball.
+const FOLLOW_EYE: [f32; 3] = [0.8, -1.7, 1.0];
+
+/// Which default layout.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Layout {
+    /// Leads with the view that follows the ball.
+    FollowBall,
+    /// Leads with the log of divergent sweeps.
+    Divergences,
+}
+
+impl Layout {
+    fn name(self) -> &'static str {
+        match self {
+            Layout::FollowBall => "blueprint",
+            Layout::Divergences => "blueprint-divergences",
+        }
+    }
+}
+
+/// Sends `layout` (following ball `follow_ball`) to `rec` as its active and
+/// default blueprint, with ids that depend only on the recording id and the
+/// layout.
+pub fn send_blueprint(
+    rec: &RecordingStream,
+    layout: Layout,
+    follow_ball: u32,
+) -> Result<(), RecordingStreamError> {
     let Some(info) = rec.store_info() else {
         // A disabled stream: nothing is recorded.
         return Ok(());
     };
-    let (msgs, activation) = default_blueprint_messages(&info)?;
+    let (msgs, activation) = blueprint_messages(&info, layout, follow_ball)?;
     rec.send_blueprint(msgs, activation);
     // The blueprint's messages go to the sink through the stream's command
     // channel, the recording's chunks through its batcher; the thread that
@@ -68,14 +111,16 @@ pub fn send_default_blueprint(rec: &RecordingStream) -> Result<(), RecordingStre
     Ok(())
 }
 
-/// The messages of the default blueprint of the recording `info` (store
-/// info first, then one chunk per blueprint entity), and the command that
-/// makes it the active and default blueprint.
-pub fn default_blueprint_messages(
+/// The messages of `layout` for the recording `info` (store info first,
+/// then one chunk per blueprint entity), and the command that makes it the
+/// active and default blueprint.
+pub fn blueprint_messages(
     info: &StoreInfo,
+    layout: Layout,
+    follow_ball: u32,
 ) -> Result<(Vec<LogMsg>, BlueprintActivationCommand), RecordingStreamError> {
     let recording_id = info.store_id.recording_id().to_string();
-    let ids = Ids::new(&recording_id);
+    let ids = Ids::new(&recording_id, layout.name());
     let store_id = StoreId::new(
         StoreKind::Blueprint,
         info.store_id.application_id().clone(),
@@ -92,42 +137,89 @@ pub fn default_blueprint_messages(
         items: 0,
     };
 
-    let world = b.view("3D", "World", paths::WORLD)?;
+    let ball = follow_ball;
+    let follow = b.view(
+        "3D",
+        &format!("Ball {ball} (the view follows it)"),
+        &paths::focus(ball),
+        &["/world/**"],
+    )?;
+    b.property(
+        follow,
+        "EyeControls3D",
+        &EyeControls3D::new()
+            .with_kind(Eye3DKind::Orbital)
+            .with_position(Position3D::from(FOLLOW_EYE))
+            .with_look_target(Position3D::from([0.0, 0.0, 0.0]))
+            .with_eye_up(Vector3D::from([0.0, 0.0, 1.0])),
+    )?;
+    let world = b.view("3D", "World (overview)", paths::WORLD, &["$origin/**"])?;
     let edge = b.view(
         "3D",
-        "Edge frame (ball 0, decisive edge)",
-        &paths::edge_frame(0, 0),
+        &format!("Edge frame: ball {ball}'s decisive or nearest edge test"),
+        &paths::edge_frame(ball, 0),
+        &["$origin/**"],
     )?;
-    let top = b.container(
-        ContainerKind::Horizontal,
-        &[world, edge],
-        Some(&[3.0, 2.0]),
-        None,
+    let alpha = b.plot(&format!("α (ball {ball})"), &paths::alpha(ball))?;
+    let quadratic = b.plot(
+        &format!("Quadratic A, B, C, disc, s0, s1 (ball {ball})"),
+        &format!("{}/ball/{ball}/quadratic", paths::PLOTS),
     )?;
-    let alpha = b.view("TimeSeries", "α (ball 0)", &paths::alpha(0))?;
-    let quadratic = b.view(
-        "TimeSeries",
-        "Quadratic A, B, C, disc, s0, s1 (ball 0)",
-        &format!("{}/ball/0/quadratic", paths::PLOTS),
+    let face = b.plot(
+        &format!("Face h0, h1, β (ball {ball})"),
+        &format!("{}/ball/{ball}/face", paths::PLOTS),
     )?;
-    let face = b.view(
-        "TimeSeries",
-        "Face h0, h1, β (ball 0)",
-        &format!("{}/ball/0/face", paths::PLOTS),
-    )?;
-    let plots = b.container(
-        ContainerKind::Horizontal,
-        &[alpha, quadratic, face],
-        None,
-        None,
-    )?;
-    let log = b.view("TextLog", "Decisions", paths::LOG)?;
-    let root = b.container(
-        ContainerKind::Vertical,
-        &[top, plots, log],
-        None,
-        Some(&[3.0, 1.4, 1.2]),
-    )?;
+    let status = b.plot("Divergent (1) per ball", paths::STATUS)?;
+    let log = b.view("TextLog", "Decisions", paths::LOG, &["$origin/**"])?;
+
+    let root = match layout {
+        Layout::FollowBall => {
+            let top = b.container(
+                ContainerKind::Horizontal,
+                &[follow, world, edge],
+                Some(&[3.0, 2.2, 2.0]),
+                None,
+            )?;
+            let plots = b.container(
+                ContainerKind::Horizontal,
+                &[alpha, quadratic, face, status],
+                None,
+                None,
+            )?;
+            b.container(
+                ContainerKind::Vertical,
+                &[top, plots, log],
+                None,
+                Some(&[3.0, 1.4, 1.2]),
+            )?
+        }
+        Layout::Divergences => {
+            let divergences = b.view(
+                "TextLog",
+                "Divergences from the expected outcomes",
+                paths::DIVERGENCES,
+                &["$origin/**"],
+            )?;
+            let top = b.container(
+                ContainerKind::Horizontal,
+                &[follow, world, edge],
+                Some(&[3.0, 2.2, 2.0]),
+                None,
+            )?;
+            let plots = b.container(
+                ContainerKind::Horizontal,
+                &[status, alpha, quadratic, face],
+                None,
+                None,
+            )?;
+            b.container(
+                ContainerKind::Vertical,
+                &[divergences, top, plots, log],
+                None,
+                Some(&[1.0, 3.0, 1.3, 1.0]),
+            )?
+        }
+    };
 
     let root_uuid = match root {
         Item::Container(uuid) => uuid,
@@ -166,12 +258,14 @@ pub fn default_blueprint_messages(
 /// The ids of one blueprint: hashes of the recording id and a name.
 struct Ids {
     recording_id: String,
+    layout: &'static str,
 }
 
 impl Ids {
-    fn new(recording_id: &str) -> Ids {
+    fn new(recording_id: &str, layout: &'static str) -> Ids {
         Ids {
             recording_id: recording_id.to_string(),
+            layout,
         }
     }
 
@@ -179,18 +273,23 @@ impl Ids {
         let mut h = IdHasher::new();
         for part in [
             self.recording_id.as_bytes(),
+            self.layout.as_bytes(),
             what.as_bytes(),
             &n.to_le_bytes(),
         ] {
             h.update(&(part.len() as u64).to_le_bytes());
             h.update(part);
         }
-        h.0
+        h.value()
     }
 
     /// The blueprint store's recording id.
     fn store_recording_id(&self) -> String {
-        format!("sweeptrace-blueprint-{:032x}", self.hash("blueprint", 0))
+        format!(
+            "sweeptrace-{}-{:032x}",
+            self.layout,
+            self.hash("blueprint", 0)
+        )
     }
 
     /// The `n`-th container or view id: a version 4 UUID (by its bits).
@@ -280,12 +379,13 @@ impl Builder {
         class: &str,
         name: &str,
         origin: &str,
+        contents: &[&str],
     ) -> Result<Item, RecordingStreamError> {
         let view = Item::View(self.next_uuid());
         let path = view.path();
         self.log(
             &format!("{path}/ViewContents"),
-            &ViewContents::new([QueryExpression("$origin/**".into())]),
+            &ViewContents::new(contents.iter().map(|q| QueryExpression((*q).into()))),
         )?;
         let origin = rerun::EntityPath::from(origin).to_string();
         self.log(
@@ -295,6 +395,35 @@ impl Builder {
                 .with_space_origin(origin),
         )?;
         Ok(view)
+    }
+
+    /// A time-series view of `origin/**` whose time axis shows
+    /// [`PLOT_WINDOW_FRAMES`] frames either side of the time cursor.
+    fn plot(&mut self, name: &str, origin: &str) -> Result<Item, RecordingStreamError> {
+        let view = self.view("TimeSeries", name, origin, &["$origin/**"])?;
+        let window = TimeRange {
+            start: TimeRangeBoundary::CursorRelative(TimeInt(-PLOT_WINDOW_FRAMES)),
+            end: TimeRangeBoundary::CursorRelative(TimeInt(PLOT_WINDOW_FRAMES)),
+        };
+        self.property(
+            view,
+            "TimeAxis",
+            &TimeAxis::new()
+                .with_link(LinkAxis::Independent)
+                .with_view_range(window),
+        )?;
+        Ok(view)
+    }
+
+    /// A property archetype of a view (logged at `view/<uuid>/<name>`, as
+    /// the SDK logs view properties).
+    fn property(
+        &mut self,
+        view: Item,
+        name: &str,
+        archetype: &dyn AsComponents,
+    ) -> Result<(), RecordingStreamError> {
+        self.log(&format!("{}/{name}", view.path()), archetype)
     }
 
     /// A container of `kind` holding `contents` (already logged).

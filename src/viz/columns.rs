@@ -624,11 +624,6 @@ pub(crate) struct Texts<'a> {
 }
 
 impl Texts<'_> {
-    /// Adds a string.
-    pub(crate) fn push(&mut self, s: &str) -> &mut Self {
-        self.push_with(|b| b.push_str(s))
-    }
-
     /// Adds a formatted string.
     pub(crate) fn push_fmt(&mut self, args: fmt::Arguments<'_>) -> &mut Self {
         self.push_with(|b| fmt::Write::write_fmt(b, args).expect("writing to a String"))

@@ -3,31 +3,46 @@
 //! ```text
 //! world                               view coordinates (right-handed, z up), static
 //! world/mesh/{scene}                  Mesh3D of each scene, static
+//! world/mesh/{scene}/wireframe        LineStrips3D: every triangle edge once, static
 //! world/ball/{ball}/spheres           Ellipsoids3D: the ball at p0, at the contact, at p1
 //! world/ball/{ball}/sweep             Capsules3D: the volume swept with radius ρ (wireframe)
 //! world/ball/{ball}/contact           Points3D: the contact point
 //! world/ball/{ball}/normal            Arrows3D: the reported normal, from the contact
+//! world/ball/{ball}/focus             Transform3D: the ball at the decision (at α), scaled
+//!                                     to its surroundings; the origin of the view that
+//!                                     follows the ball (logged for the followed ball only)
 //! world/ball/{ball}/primary/triangle  Mesh3D: the primary (or nearest-miss) triangle
-//! world/ball/{ball}/primary/edge      LineStrips3D: its edge, when the test is an edge test
+//! world/ball/{ball}/primary/outline   LineStrips3D: its three edges (labelled for a face test)
+//! world/ball/{ball}/primary/edge      LineStrips3D: its edge, bold, when the test is an edge test
 //! world/ball/{ball}/primary/vertex    Points3D: its vertex, when the test is a vertex test
+//! world/ball/{ball}/expected/ball     Ellipsoids3D: the ball at the expected α, when the
+//!                                     sweep diverges from the trace's expectation
+//! world/ball/{ball}/expected/contact  Points3D: the expected contact (idem)
+//! world/ball/{ball}/expected/normal   Arrows3D: the expected normal (idem)
 //! world/ball/{ball}/edge/{slot}       Transform3D world_from_edge of one logged edge test,
 //!                                     plus its numbers (AnyValues: triangle, edge, A, B, C,
 //!                                     discriminant, s0, s1, xc, verdict)
 //! world/ball/{ball}/edge/{slot}/edge      LineStrips3D (0,0,0)→(L,0,0) in the edge frame
 //! world/ball/{ball}/edge/{slot}/cylinder  Capsules3D of radius ρ around the edge
 //! world/ball/{ball}/edge/{slot}/path      LineStrips3D p0_in_edge→p1_in_edge
-//! world/ball/{ball}/edge/{slot}/points    Points3D p0_in_edge, p1_in_edge (and the ball's
-//!                                         center at s0 when real)
+//! world/ball/{ball}/edge/{slot}/points    Points3D p0_in_edge, p1_in_edge, the ball's
+//!                                         center at s0 and s1 (when real), xc on the edge
+//! world/ball/{ball}/edge/0/axes           Arrows3D: the frame's x, y (front normal), z axes
 //! plots/ball/{ball}/alpha             Scalars: the chosen α (AnyValues `kind` alongside)
 //! plots/ball/{ball}/quadratic/{a,b,c,discriminant,s0,s1}
 //!                                     Scalars of the decisive edge or vertex test
 //! plots/ball/{ball}/face/{h0,h1,beta} Scalars of the decisive face test
+//! status/ball/{ball}                  Scalars: 0 when the sweep matches its expectation,
+//!                                     1 when it diverges (sweeps with an expectation only)
 //! log                                 TextLog: one line per sweep, the decision in words
+//! divergences                         TextLog: one line per divergent sweep only
 //! ```
 //!
 //! Slot 0 of `edge` is the decisive test when it is an edge test (the
-//! primary test, or the nearest miss); the edge-frame view of the default
-//! blueprint looks at `world/ball/0/edge/0`.
+//! primary test, or the nearest miss); when the decision was a face or
+//! vertex test (or the nearest miss was one), it is the nearest edge test of
+//! the same triangle. The edge-frame view of the default blueprint looks at
+//! `world/ball/{followed}/edge/0`.
 
 /// Root of the 3D world.
 pub const WORLD: &str = "world";
@@ -35,6 +50,55 @@ pub const WORLD: &str = "world";
 pub const LOG: &str = "log";
 /// Root of the time-series plots.
 pub const PLOTS: &str = "plots";
+/// Root of the per-ball divergence status series.
+pub const STATUS: &str = "status";
+/// The log of divergent sweeps.
+pub const DIVERGENCES: &str = "divergences";
+
+/// The static wireframe of scene `scene`.
+pub fn wireframe(scene: usize) -> String {
+    format!("world/mesh/{scene}/wireframe")
+}
+
+/// The view-following transform of one ball.
+pub fn focus(ball: u32) -> String {
+    format!("world/ball/{ball}/focus")
+}
+
+/// The outline of the primary triangle.
+pub fn primary_outline(ball: u32) -> String {
+    format!("world/ball/{ball}/primary/outline")
+}
+
+/// Root of the expected outcome drawn for a divergent sweep.
+pub fn expected(ball: u32) -> String {
+    format!("world/ball/{ball}/expected")
+}
+
+/// The ball at the expected α.
+pub fn expected_ball(ball: u32) -> String {
+    format!("world/ball/{ball}/expected/ball")
+}
+
+/// The expected contact point.
+pub fn expected_contact(ball: u32) -> String {
+    format!("world/ball/{ball}/expected/contact")
+}
+
+/// The expected normal.
+pub fn expected_normal(ball: u32) -> String {
+    format!("world/ball/{ball}/expected/normal")
+}
+
+/// The divergence status series of one ball.
+pub fn status(ball: u32) -> String {
+    format!("status/ball/{ball}")
+}
+
+/// Under [`edge_frame`]: the frame's axes.
+pub fn edge_axes(ball: u32, slot: usize) -> String {
+    format!("world/ball/{ball}/edge/{slot}/axes")
+}
 
 /// The mesh of scene `scene` (0-based).
 pub fn mesh(scene: usize) -> String {
@@ -135,7 +199,9 @@ pub(crate) enum Entity {
     Sweep(u32),
     Contact(u32),
     Normal(u32),
+    Focus(u32),
     PrimaryTriangle(u32),
+    PrimaryOutline(u32),
     PrimaryEdge(u32),
     PrimaryVertex(u32),
     EdgeFrame(u32, usize),
@@ -143,6 +209,13 @@ pub(crate) enum Entity {
     EdgeCylinder(u32, usize),
     EdgePath(u32, usize),
     EdgePoints(u32, usize),
+    EdgeAxes(u32, usize),
+    Expected(u32),
+    ExpectedBall(u32),
+    ExpectedContact(u32),
+    ExpectedNormal(u32),
+    Status(u32),
+    Divergences,
     Alpha(u32),
     /// Index into [`QUADRATIC_NAMES`].
     Quadratic(u32, usize),
@@ -159,7 +232,9 @@ impl Entity {
             Entity::Sweep(b) => sweep(b),
             Entity::Contact(b) => contact(b),
             Entity::Normal(b) => normal(b),
+            Entity::Focus(b) => focus(b),
             Entity::PrimaryTriangle(b) => primary_triangle(b),
+            Entity::PrimaryOutline(b) => primary_outline(b),
             Entity::PrimaryEdge(b) => primary_edge(b),
             Entity::PrimaryVertex(b) => primary_vertex(b),
             Entity::EdgeFrame(b, s) => edge_frame(b, s),
@@ -167,6 +242,13 @@ impl Entity {
             Entity::EdgeCylinder(b, s) => edge_cylinder(b, s),
             Entity::EdgePath(b, s) => edge_path(b, s),
             Entity::EdgePoints(b, s) => edge_points(b, s),
+            Entity::EdgeAxes(b, s) => edge_axes(b, s),
+            Entity::Expected(b) => expected(b),
+            Entity::ExpectedBall(b) => expected_ball(b),
+            Entity::ExpectedContact(b) => expected_contact(b),
+            Entity::ExpectedNormal(b) => expected_normal(b),
+            Entity::Status(b) => status(b),
+            Entity::Divergences => DIVERGENCES.to_string(),
             Entity::Alpha(b) => alpha(b),
             Entity::Quadratic(b, i) => quadratic(b, QUADRATIC_NAMES[i]),
             Entity::Face(b, i) => face(b, FACE_NAMES[i]),

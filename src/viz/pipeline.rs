@@ -83,7 +83,7 @@ where
         n => n,
     };
     let mut scenes: Vec<Arc<SceneState>> = Vec::new();
-    let max_edge_frames = logger.as_ref().map(|l| l.max_edge_frames());
+    let prepare_options = logger.as_ref().map(|l| l.prepare_options());
     let mut batch = Vec::with_capacity(batch_events);
     loop {
         batch.clear();
@@ -98,7 +98,7 @@ where
         }
         // Runs of consecutive sweeps: the rows of each run are built on one
         // worker.
-        let groups: Vec<Range<usize>> = match max_edge_frames {
+        let groups: Vec<Range<usize>> = match prepare_options {
             Some(_) => sweep_runs(&batch),
             None => Vec::new(),
         };
@@ -120,7 +120,7 @@ where
                         .collect()
                 },
                 || {
-                    let Some(max) = max_edge_frames else {
+                    let Some(prepare_options) = &prepare_options else {
                         return Vec::new();
                     };
                     groups
@@ -131,7 +131,7 @@ where
                                 &mut p,
                                 &scenes,
                                 batch[g.clone()].iter().filter_map(sweep_of),
-                                max,
+                                prepare_options,
                             );
                             p
                         })

@@ -1,0 +1,133 @@
+//! The decision line: one sentence per sweep, and whether the sweep
+//! diverges from the trace's expectation (by [`crate::regress::agreement`],
+//! the judgement `check` uses: ties are matches, and a divergence on a
+//! fragile decision is not a failure, as in `check` without `--strict`).
+
+use std::fmt::{self, Write as _};
+
+use crate::core::explain::{Num, write_describe};
+use crate::core::{Mesh, TestRecord};
+use crate::regress::{Agreement, FieldDiff, Tolerances, agreement};
+use crate::replay::SweepResult;
+
+/// The fields in which the sweep's outcome differs from the trace's expected
+/// outcome when `check` counts the sweep as a failure (empty when it
+/// matches, ties, diverges only on a fragile decision, or has no
+/// expectation). `mesh` is the scene the sweep was replayed against (for
+/// the tie set).
+pub fn divergence(r: &SweepResult, mesh: Option<&Mesh>, tolerances: &Tolerances) -> Vec<FieldDiff> {
+    let Some(expected) = &r.expected else {
+        return Vec::new();
+    };
+    match agreement(expected, r, mesh, tolerances) {
+        Agreement::Diverges { fields, fragile } if fragile.is_robust() => fields,
+        Agreement::Diverges { .. } | Agreement::Match | Agreement::Tie => Vec::new(),
+    }
+}
+
+/// The text line of one sweep, and whether it diverges from the trace's
+/// expected outcome (by [`divergence`] with `tolerances`).
+pub fn decision_line(
+    r: &SweepResult,
+    mesh: Option<&Mesh>,
+    decisive: Option<&TestRecord>,
+    tolerances: &Tolerances,
+) -> (String, bool) {
+    let mut s = String::new();
+    let diffs = divergence(r, mesh, tolerances);
+    write_decision_line(&mut s, r, decisive, &diffs);
+    (s, !diffs.is_empty())
+}
+
+/// Appends [`decision_line`]'s line to `s`; `diffs` are the sweep's
+/// [`divergence`].
+pub(crate) fn write_decision_line(
+    s: &mut String,
+    r: &SweepResult,
+    decisive: Option<&TestRecord>,
+    diffs: &[FieldDiff],
+) {
+    let o = &r.outcome;
+    let _ = write!(s, "frame {} ball {}: ", r.frame, r.ball);
+    if o.is_hit() {
+        let _ = write!(
+            s,
+            "{} collision at α = {} (triangle {}, feature {})",
+            o.kind,
+            Num(o.alpha),
+            OrDash(o.triangle),
+            OrDash(o.feature)
+        );
+        if let Some(t) = decisive {
+            s.push_str(" — ");
+            let _ = write_describe(s, t);
+        }
+    } else {
+        s.push_str("no collision");
+        match decisive {
+            Some(t) => {
+                s.push_str("; closest candidate rejected: ");
+                let _ = write_describe(s, t);
+            }
+            None if r.records.is_empty() => {
+                s.push_str(" (no triangle's box comes within ρ of the path)")
+            }
+            None => {}
+        }
+    }
+    if let (false, Some(e)) = (diffs.is_empty(), &r.expected) {
+        s.push_str(" [differs from the expected outcome in ");
+        write_fields(s, diffs);
+        let _ = write!(s, "; expected {} at α = {}]", e.kind, Num(e.alpha));
+    }
+}
+
+/// The line of the `divergences` log: what was expected, what was found,
+/// which fields differ.
+pub(crate) fn write_divergence_line(s: &mut String, r: &SweepResult, diffs: &[FieldDiff]) {
+    let o = &r.outcome;
+    let _ = write!(s, "frame {} ball {}: ", r.frame, r.ball);
+    write_fields(s, diffs);
+    s.push_str(if diffs.len() == 1 {
+        " differs"
+    } else {
+        " differ"
+    });
+    if let Some(e) = &r.expected {
+        let _ = write!(s, ": expected {} at α = {}", e.kind, Num(e.alpha));
+        if let (Some(Some(t)), Some(Some(f))) = (e.triangle, e.feature) {
+            let _ = write!(s, " (triangle {t}, feature {f})");
+        }
+    }
+    let _ = write!(s, ", replayed {} at α = {}", o.kind, Num(o.alpha));
+    if let (Some(t), Some(f)) = (o.triangle, o.feature) {
+        let _ = write!(s, " (triangle {t}, feature {f})");
+    }
+    let _ = write!(
+        s,
+        " (margin {}, facing {})",
+        Num(r.options.margin),
+        r.options.facing
+    );
+}
+
+fn write_fields(s: &mut String, diffs: &[FieldDiff]) {
+    for (i, d) in diffs.iter().enumerate() {
+        if i > 0 {
+            s.push_str(", ");
+        }
+        s.push_str(d.field.as_str());
+    }
+}
+
+/// A number, or `-` for `None`.
+struct OrDash<T>(Option<T>);
+
+impl<T: fmt::Display> fmt::Display for OrDash<T> {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match &self.0 {
+            Some(v) => v.fmt(f),
+            None => f.write_str("-"),
+        }
+    }
+}

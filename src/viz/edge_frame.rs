@@ -1,0 +1,292 @@
+//! The edge tests of a sweep, each in its standard frame (v0 at the origin,
+//! the edge on +x, +y the triangle's front normal).
+//!
+//! Slot 0 always explains the decision when an edge test can: the decisive
+//! edge test, or, when the decision was a face or vertex test (or a miss
+//! decided by one), the nearest edge test of the same triangle (from the
+//! records when they hold one, else run here: three edge tests). When no
+//! test ran at all and the expectation names a triangle, slot 0 is the edge
+//! test the expectation names (or the nearest edge test of its triangle),
+//! run here: it says why the expected collision was not found. The other
+//! slots hold the remaining recorded edge tests, hits first, then the
+//! nearest misses.
+
+use rerun::components::{
+    Color, FillMode, Length, Position3D, Radius, RotationQuat, Scalar, Text, Translation3D,
+    Vector3D,
+};
+use rerun::{Arrows3D, Capsules3D, LineStrips3D, Points3D, Transform3D};
+
+use super::convert::{
+    AXIS_COLORS, CYLINDER_COLOR, EDGE_COLOR, HIT_COLOR, MISS_COLOR, PATH_COLOR, any_value, f32x3,
+    quaternion, rgba, ui_points,
+};
+use super::paths::Entity;
+use super::rows::{Out, set};
+use crate::core::explain::{Label, miss_distance};
+use crate::core::{EdgeRecord, Kind, Path, TestRecord, sweep_edge};
+use crate::replay::{SceneState, SweepResult};
+
+/// How an edge test ranks for a slot: hits by α, then misses by how near
+/// they came.
+fn rank(e: &EdgeRecord) -> (u8, f64) {
+    let t = TestRecord::Edge(*e);
+    match t.alpha() {
+        Some(a) => (0, a),
+        None => (1, miss_distance(&t).unwrap_or(f64::INFINITY)),
+    }
+}
+
+fn better(x: &EdgeRecord, y: &EdgeRecord) -> bool {
+    let (a, b) = (rank(x), rank(y));
+    a.0 < b.0 || (a.0 == b.0 && a.1 < b.1)
+}
+
+/// What slot 0 is.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Slot0 {
+    /// The decisive test (labelled on the primary edge already).
+    Decisive,
+    /// The nearest edge test (of the decisive triangle).
+    Nearest,
+    /// The edge test of the expected outcome.
+    Expected,
+}
+
+/// Chooses the edge tests to show into `edges` (slot order, at most `max`).
+/// Returns what slot 0 is.
+pub(crate) fn choose_edges(
+    edges: &mut Vec<EdgeRecord>,
+    scene: Option<&SceneState>,
+    r: &SweepResult,
+    decisive: Option<&TestRecord>,
+    max: usize,
+) -> Slot0 {
+    edges.clear();
+    if max == 0 {
+        return Slot0::Nearest;
+    }
+    let recorded = r.records.iter().filter_map(|t| match t {
+        TestRecord::Edge(e) => Some(e),
+        _ => None,
+    });
+    // Slot 0.
+    let mut first: Option<EdgeRecord> = None;
+    let mut what = Slot0::Nearest;
+    match decisive {
+        Some(TestRecord::Edge(e)) => {
+            first = Some(*e);
+            what = Slot0::Decisive;
+        }
+        Some(t) => {
+            let triangle = t.triangle();
+            for e in recorded.clone().filter(|e| e.triangle == triangle) {
+                if first.as_ref().is_none_or(|f| better(e, f)) {
+                    first = Some(*e);
+                }
+            }
+            if first.is_none() {
+                first = nearest_edge_of(scene, r, triangle);
+            }
+        }
+        None => {
+            for e in recorded.clone() {
+                if first.as_ref().is_none_or(|f| better(e, f)) {
+                    first = Some(*e);
+                }
+            }
+            if first.is_none()
+                && let Some(e) = r.expected
+                && let Some(Some(triangle)) = e.triangle
+            {
+                first = match (e.kind, e.feature) {
+                    (Kind::Edge, Some(Some(edge))) if edge < 3 => edge_of(scene, r, triangle, edge),
+                    _ => nearest_edge_of(scene, r, triangle),
+                };
+                what = Slot0::Expected;
+            }
+        }
+    }
+    let Some(first) = first else {
+        return Slot0::Nearest;
+    };
+    edges.push(first);
+    let start = edges.len();
+    edges.extend(recorded.filter(|e| !(e.triangle == first.triangle && e.edge == first.edge)));
+    edges[start..].sort_by(|x, y| {
+        let (a, b) = (rank(x), rank(y));
+        a.0.cmp(&b.0).then(a.1.total_cmp(&b.1))
+    });
+    edges.truncate(max);
+    what
+}
+
+/// Edge test `edge` of `triangle`, run here.
+fn edge_of(
+    scene: Option<&SceneState>,
+    r: &SweepResult,
+    triangle: u32,
+    edge: u8,
+) -> Option<EdgeRecord> {
+    let t = scene
+        .filter(|s| s.number == r.scene)?
+        .mesh
+        .triangle_by_index(triangle)?;
+    let path = Path::new(&r.sweep, &r.options).ok()?;
+    Some(sweep_edge(t, edge, &path, r.options.facing))
+}
+
+/// The nearest of the three edge tests of `triangle`, run here.
+fn nearest_edge_of(
+    scene: Option<&SceneState>,
+    r: &SweepResult,
+    triangle: u32,
+) -> Option<EdgeRecord> {
+    let t = scene
+        .filter(|s| s.number == r.scene)?
+        .mesh
+        .triangle_by_index(triangle)?;
+    let path = Path::new(&r.sweep, &r.options).ok()?;
+    (0..3u8)
+        .map(|i| sweep_edge(t, i, &path, r.options.facing))
+        .reduce(|a, b| if better(&b, &a) { b } else { a })
+}
+
+/// The rows of the chosen edge tests; `slot0` as [`choose_edges`]
+/// returned. Slot 0 is labelled only for the followed ball (`followed`).
+pub(crate) fn edge_frame_rows(
+    out: &mut Out<'_>,
+    r: &SweepResult,
+    edges: &[EdgeRecord],
+    slot0: Slot0,
+    followed: bool,
+) {
+    let b = r.ball;
+    let rho = r.rho();
+    for (slot, e) in edges.iter().enumerate() {
+        let world_from_edge = e.frame.world_from_edge();
+        out.row(Entity::EdgeFrame(b, slot), set::TRANSFORM)
+            .put::<Translation3D>(
+                Transform3D::descriptor_translation,
+                [f32x3(world_from_edge.translation.vector).into()],
+            )
+            .put::<RotationQuat>(
+                Transform3D::descriptor_quaternion,
+                [quaternion(&world_from_edge.rotation).into()],
+            );
+        edge_values(out, Entity::EdgeFrame(b, slot), e);
+        let hit = e.alpha().is_some();
+        let length = e.length as f32;
+        // The edge, on +x. Slot 0 is labelled when it is not the decisive
+        // test (whose label is on the primary edge already): it then says
+        // which edge test it is and how it ended.
+        let label = match slot0 {
+            _ if slot > 0 || !followed => None,
+            Slot0::Decisive => None,
+            Slot0::Nearest => Some("nearest edge test"),
+            Slot0::Expected => Some("expected edge test"),
+        };
+        out.row(Entity::EdgeSegment(b, slot), set::LABELED_STRIP)
+            .put_strip(
+                LineStrips3D::descriptor_strips,
+                &[[0.0, 0.0, 0.0], [length, 0.0, 0.0]],
+            )
+            .put::<Radius>(LineStrips3D::descriptor_radii, [ui_points(3.0)])
+            .put::<Color>(LineStrips3D::descriptor_colors, [rgba(EDGE_COLOR)])
+            .put_texts(LineStrips3D::descriptor_labels, |t| {
+                if let Some(what) = label {
+                    t.push_fmt(format_args!(
+                        "{what}: {} ({})",
+                        Label(&TestRecord::Edge(*e)),
+                        e.verdict
+                    ));
+                }
+            });
+        // A capsule lies along +z; turn it onto +x (90° about +y).
+        let half = std::f32::consts::FRAC_1_SQRT_2;
+        out.row(Entity::EdgeCylinder(b, slot), set::CYLINDER)
+            .put::<Length>(Capsules3D::descriptor_lengths, [length.into()])
+            .put::<Radius>(Capsules3D::descriptor_radii, [(rho as f32).into()])
+            .put::<RotationQuat>(
+                Capsules3D::descriptor_quaternions,
+                [rerun::Quaternion::from_xyzw([0.0, half, 0.0, half]).into()],
+            )
+            .put::<Color>(Capsules3D::descriptor_colors, [rgba(CYLINDER_COLOR)])
+            .put::<FillMode>(Capsules3D::descriptor_fill_mode, [FillMode::MajorWireframe]);
+        let p0e = f32x3(e.p0_in_edge.coords);
+        let p1e = f32x3(e.p1_in_edge.coords);
+        out.row(Entity::EdgePath(b, slot), set::STRIP)
+            .put_strip(LineStrips3D::descriptor_strips, &[p0e, p1e])
+            .put::<Radius>(LineStrips3D::descriptor_radii, [ui_points(1.5)])
+            .put::<Color>(LineStrips3D::descriptor_colors, [rgba(PATH_COLOR)]);
+        // p0, p1, the centers at s0 and s1, xc on the edge.
+        let at = |s: f64| f32x3((e.p0_in_edge + (e.p1_in_edge - e.p0_in_edge) * s).coords);
+        let roots = e
+            .roots
+            .filter(|(s0, s1)| s0.is_finite() && s1.is_finite() && *s0 > -2.0 && *s1 < 3.0);
+        let root_color = rgba(if hit { HIT_COLOR } else { MISS_COLOR });
+        let xc = e.xc.filter(|x| x.is_finite());
+        out.row(Entity::EdgePoints(b, slot), set::EDGE_POINTS)
+            .put::<Position3D>(
+                Points3D::descriptor_positions,
+                [p0e, p1e]
+                    .into_iter()
+                    .chain(roots.map(|(s0, _)| at(s0)))
+                    .chain(roots.map(|(_, s1)| at(s1)))
+                    .chain(xc.map(|x| [x as f32, 0.0, 0.0]))
+                    .map(Position3D::from),
+            )
+            .put::<Radius>(
+                Points3D::descriptor_radii,
+                [ui_points(4.0), ui_points(4.0)]
+                    .into_iter()
+                    .chain(roots.map(|_| ui_points(5.0)))
+                    .chain(roots.map(|_| ui_points(3.0)))
+                    .chain(xc.map(|_| ui_points(6.0))),
+            )
+            .put::<Color>(
+                Points3D::descriptor_colors,
+                [rgba(PATH_COLOR), rgba(PATH_COLOR)]
+                    .into_iter()
+                    .chain(roots.map(|_| root_color))
+                    .chain(roots.map(|_| rgba([150, 150, 150, 255])))
+                    .chain(xc.map(|_| root_color)),
+            );
+        if slot == 0 {
+            let a = (rho.max(e.length * 0.25)) as f32;
+            out.row(Entity::EdgeAxes(b, slot), set::AXES)
+                .put::<Vector3D>(
+                    Arrows3D::descriptor_vectors,
+                    [[a, 0.0, 0.0], [0.0, a, 0.0], [0.0, 0.0, a]].map(Vector3D::from),
+                )
+                .put::<Color>(Arrows3D::descriptor_colors, AXIS_COLORS.map(rgba));
+        }
+    }
+}
+
+/// The numbers of an edge test (as `AnyValues`: test, verdict, length, a,
+/// b, c, discriminant, and s0, s1, xc when known).
+fn edge_values(out: &mut Out<'_>, entity: Entity, e: &EdgeRecord) {
+    let set = set::EDGE_VALUES + u8::from(e.roots.is_some()) + 2 * u8::from(e.xc.is_some());
+    let mut row = out.row(entity, set);
+    row.put_fmt(
+        || any_value::<Text>("test"),
+        format_args!("edge {}.{}", e.triangle, e.edge),
+    )
+    .put_strs(|| any_value::<Text>("verdict"), [e.verdict.as_str()])
+    .put::<Scalar>(|| any_value::<Scalar>("length"), [e.length.into()])
+    .put::<Scalar>(|| any_value::<Scalar>("a"), [e.a.into()])
+    .put::<Scalar>(|| any_value::<Scalar>("b"), [e.b.into()])
+    .put::<Scalar>(|| any_value::<Scalar>("c"), [e.c.into()])
+    .put::<Scalar>(
+        || any_value::<Scalar>("discriminant"),
+        [e.discriminant.into()],
+    );
+    if let Some((s0, s1)) = e.roots {
+        row.put::<Scalar>(|| any_value::<Scalar>("s0"), [s0.into()])
+            .put::<Scalar>(|| any_value::<Scalar>("s1"), [s1.into()]);
+    }
+    if let Some(xc) = e.xc {
+        row.put::<Scalar>(|| any_value::<Scalar>("xc"), [xc.into()]);
+    }
+}

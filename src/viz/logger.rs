@@ -1,0 +1,479 @@
+//! [`Logger`]: replay events into a recording stream, through typed
+//! columns; [`prepare_sweeps`] builds the rows of a run of sweeps without
+//! the logger, so that runs can be prepared in parallel.
+
+use std::collections::BTreeMap;
+use std::sync::Arc;
+
+use rerun::components::Radius;
+use rerun::{
+    AsComponents as _, LineStrips3D, Mesh3D, RecordingStream, RecordingStreamError, SeriesLines,
+    SeriesPoints, ViewCoordinates,
+};
+
+use super::blueprint::{self, Layout};
+use super::columns;
+use super::convert::{MESH_COLOR, WIREFRAME_COLOR, WIREFRAME_POINTS, albedo, f32x3, rgba};
+use super::decision::divergence;
+use super::edge_frame::{choose_edges, edge_frame_rows};
+use super::paths::{self, Entity};
+use super::rows::{
+    Out, PLOT_BITS, expected_rows, focus_rows, plot_entity, plot_rows, primary_rows, sweep_rows,
+    text_rows,
+};
+use super::{MAX_EDGE_FRAMES, TIMESTAMP_THRESHOLD_NANOS};
+use crate::core::{EdgeRecord, Triangle};
+use crate::regress::Tolerances;
+use crate::replay::{ReplayEvent, SceneState, SweepResult};
+
+/// Rows buffered before the logger sends them (see [`Logger`]).
+pub const DEFAULT_FLUSH_ROWS: usize = 1 << 17;
+
+/// Sweeps per [`PreparedSweeps`] that the command and the bench prepare on
+/// one worker (runs of consecutive sweeps of a batch, cut at this length).
+pub const PREPARE_GROUP_SWEEPS: usize = 1024;
+
+/// At most this many emptied [`PreparedSweeps`] are kept for reuse.
+const MAX_SPARE_PREPARED: usize = 16;
+
+/// What the rows of a sweep depend on besides the sweep: the same for every
+/// sweep of a recording ([`Logger::prepare_options`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PrepareOptions {
+    /// At most this many edge tests per sweep get an edge frame.
+    pub max_edge_frames: usize,
+    /// When a sweep diverges from its expectation: `check`'s comparison
+    /// with these tolerances.
+    pub tolerances: Tolerances,
+    /// The ball the "follow" view follows: only it gets a focus transform.
+    pub follow_ball: u32,
+}
+
+impl Default for PrepareOptions {
+    fn default() -> Self {
+        PrepareOptions {
+            max_edge_frames: MAX_EDGE_FRAMES,
+            tolerances: Tolerances::default(),
+            follow_ball: 0,
+        }
+    }
+}
+
+/// Options of a [`Logger`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LoggerOptions {
+    /// Whether to send the default layout (blueprint).
+    pub blueprint: bool,
+    /// What each sweep's rows depend on.
+    pub prepare: PrepareOptions,
+}
+
+impl Default for LoggerOptions {
+    fn default() -> Self {
+        LoggerOptions {
+            blueprint: true,
+            prepare: PrepareOptions::default(),
+        }
+    }
+}
+
+/// What the logger remembers of a ball's previous sweep, to clear what the
+/// next one no longer shows.
+#[derive(Debug, Default)]
+struct BallState {
+    /// Edge slots logged.
+    edge_slots: usize,
+    /// Plot entities that got a value (bits of `rows::plot_entity`).
+    plotted: u16,
+    /// Whether the expected outcome was drawn.
+    expected: bool,
+}
+
+/// What [`Logger::log_prepared`] needs of each prepared sweep.
+#[derive(Clone, Copy, Debug)]
+struct Mark {
+    ball: u32,
+    edge_slots: usize,
+    plotted: u16,
+    expected: bool,
+    frame: i64,
+    time: columns::Time,
+}
+
+/// Logs replay events to a recording stream.
+///
+/// Rows are not sent one by one: they are buffered per entity as typed
+/// columns (plain values, see `columns`), and sent as one chunk per entity
+/// every [`DEFAULT_FLUSH_ROWS`] rows (and by [`Logger::flush`] and
+/// [`Logger::finish`]). What the recording holds is what logging each row
+/// on its own would give, with ids that depend only on the order of the
+/// rows, so the same events give the same chunks.
+///
+/// The layout sent at the start leads with the followed ball; when some
+/// sweep diverged from its expectation, [`Logger::finish`] sends a second
+/// one that leads with the divergences and makes it the active one.
+#[derive(Debug)]
+pub struct Logger {
+    rec: RecordingStream,
+    balls: BTreeMap<u32, BallState>,
+    scenes: Vec<Arc<SceneState>>,
+    options: LoggerOptions,
+    columns: columns::Columns,
+    flush_rows: usize,
+    /// Divergent sweeps logged.
+    divergent: u64,
+    /// Emptied [`PreparedSweeps`], handed out again by
+    /// [`Logger::spare_prepared`] so that their buffers are reused.
+    spare: Vec<PreparedSweeps>,
+}
+
+/// What a run of consecutive sweeps logs, built without the logger
+/// ([`prepare_sweeps`]), so that runs can be prepared in parallel and logged
+/// in order with [`Logger::log_prepared`].
+#[derive(Debug, Default)]
+pub struct PreparedSweeps {
+    columns: columns::Columns,
+    marks: Vec<Mark>,
+    divergent: u64,
+    /// Scratch: the edge tests of one sweep.
+    edges: Vec<EdgeRecord>,
+}
+
+impl PreparedSweeps {
+    /// Sweeps prepared.
+    pub fn len(&self) -> usize {
+        self.marks.len()
+    }
+
+    /// Whether no sweep was prepared.
+    pub fn is_empty(&self) -> bool {
+        self.marks.is_empty()
+    }
+}
+
+/// Prepares what [`Logger::log_sweep`] logs for each of `results` (in
+/// order): `scenes` holds (at least) the scenes they were swept against,
+/// `options` are the logger's ([`Logger::prepare_options`]).
+pub fn prepare_sweeps<'r>(
+    scenes: &[Arc<SceneState>],
+    results: impl IntoIterator<Item = &'r SweepResult>,
+    options: &PrepareOptions,
+) -> PreparedSweeps {
+    let mut p = PreparedSweeps::default();
+    prepare_sweeps_into(&mut p, scenes, results, options);
+    p
+}
+
+/// [`prepare_sweeps`] into `p` (an empty one, for example from
+/// [`Logger::spare_prepared`], whose buffers are reused).
+pub fn prepare_sweeps_into<'r>(
+    p: &mut PreparedSweeps,
+    scenes: &[Arc<SceneState>],
+    results: impl IntoIterator<Item = &'r SweepResult>,
+    options: &PrepareOptions,
+) {
+    debug_assert!(p.is_empty() && p.columns.rows() == 0);
+    for r in results {
+        let scene = scenes.iter().find(|s| s.number == r.scene).map(|s| &**s);
+        let frame = i64::try_from(r.frame).unwrap_or(i64::MAX);
+        let time = time_of(r.log_time_nanos);
+        let mut out = Out {
+            columns: &mut p.columns,
+            frame,
+            time,
+        };
+        let decisive = r.decisive_record().copied();
+        let diffs = divergence(r, scene.map(|s| &s.mesh), &options.tolerances);
+        sweep_rows(&mut out, r);
+        let followed = r.ball == options.follow_ball;
+        if followed {
+            focus_rows(&mut out, scene, r, decisive.as_ref(), !diffs.is_empty());
+        }
+        primary_rows(&mut out, scene, r, decisive.as_ref(), followed);
+        let slot0 = choose_edges(
+            &mut p.edges,
+            scene,
+            r,
+            decisive.as_ref(),
+            options.max_edge_frames,
+        );
+        edge_frame_rows(&mut out, r, &p.edges, slot0, followed);
+        let plotted = plot_rows(&mut out, r, decisive.as_ref());
+        let expected = match (&r.expected, diffs.is_empty()) {
+            (Some(e), false) => {
+                expected_rows(&mut out, r, e);
+                true
+            }
+            _ => false,
+        };
+        text_rows(&mut out, r, decisive.as_ref(), &diffs);
+        p.divergent += u64::from(!diffs.is_empty());
+        p.marks.push(Mark {
+            ball: r.ball,
+            edge_slots: p.edges.len(),
+            plotted,
+            expected,
+            frame,
+            time,
+        });
+    }
+}
+
+/// The static style of ball `b`'s plots of the decisive test's numbers:
+/// named series drawn as lines with a marker at each value, so that a value
+/// with no neighbour (the lines break where a value stops existing) is
+/// still seen.
+fn series_styles(
+    columns: &mut columns::Columns,
+    rec: &RecordingStream,
+    b: u32,
+) -> Result<(), RecordingStreamError> {
+    for bit in 0..PLOT_BITS {
+        let entity = plot_entity(b, bit);
+        let name = match entity {
+            Entity::Quadratic(_, i) => ["A", "B", "C", "discriminant", "s0", "s1"][i],
+            Entity::Face(_, i) => ["h0", "h1", "β"][i],
+            _ => continue,
+        };
+        let mut batches = SeriesLines::new()
+            .with_names([name])
+            .as_serialized_batches();
+        batches.extend(
+            SeriesPoints::new()
+                .with_names([name])
+                .with_marker_sizes([2.5])
+                .as_serialized_batches(),
+        );
+        columns.send_static(rec, entity.path(), batches)?;
+    }
+    Ok(())
+}
+
+/// The `time` timeline's value of a `log_time`.
+fn time_of(log_time_nanos: u64) -> columns::Time {
+    let clamp = |n: u64| i64::try_from(n).unwrap_or(i64::MAX);
+    if log_time_nanos >= TIMESTAMP_THRESHOLD_NANOS {
+        columns::Time::Timestamp(clamp(log_time_nanos))
+    } else {
+        columns::Time::Duration(clamp(log_time_nanos))
+    }
+}
+
+impl Logger {
+    /// Takes over `rec`: switches off the wall-clock timelines, sends the
+    /// default blueprint (when `blueprint`) and the static world settings;
+    /// the other options are the defaults (follows ball 0).
+    pub fn new(rec: RecordingStream, blueprint: bool) -> Result<Logger, RecordingStreamError> {
+        Logger::with_options(
+            rec,
+            LoggerOptions {
+                blueprint,
+                ..LoggerOptions::default()
+            },
+        )
+    }
+
+    /// [`Logger::new`] with every option.
+    pub fn with_options(
+        rec: RecordingStream,
+        options: LoggerOptions,
+    ) -> Result<Logger, RecordingStreamError> {
+        rec.set_log_time_enabled(false);
+        rec.set_log_tick_enabled(false);
+        if options.blueprint {
+            blueprint::send_blueprint(&rec, Layout::FollowBall, options.prepare.follow_ball)?;
+        }
+        let mut logger = Logger {
+            rec,
+            balls: BTreeMap::new(),
+            scenes: Vec::new(),
+            options,
+            columns: columns::Columns::default(),
+            flush_rows: DEFAULT_FLUSH_ROWS,
+            divergent: 0,
+            spare: Vec::new(),
+        };
+        logger.log_static(paths::WORLD, &ViewCoordinates::RIGHT_HAND_Z_UP())?;
+        // The followed ball's frame has the world's axes (only moved and
+        // scaled), so the view that looks from it keeps z up.
+        logger.log_static(
+            paths::focus(options.prepare.follow_ball),
+            &ViewCoordinates::RIGHT_HAND_Z_UP(),
+        )?;
+        Ok(logger)
+    }
+
+    /// Sets how many rows are buffered before they are sent (at least 1).
+    pub fn with_flush_rows(mut self, rows: usize) -> Logger {
+        self.flush_rows = rows.max(1);
+        self
+    }
+
+    /// How many edge tests per sweep get an edge frame.
+    pub fn max_edge_frames(&self) -> usize {
+        self.options.prepare.max_edge_frames
+    }
+
+    /// Sets how many edge tests per sweep get an edge frame.
+    pub fn with_max_edge_frames(mut self, n: usize) -> Logger {
+        self.options.prepare.max_edge_frames = n;
+        self
+    }
+
+    /// What [`prepare_sweeps`] needs to prepare rows for this logger.
+    pub fn prepare_options(&self) -> PrepareOptions {
+        self.options.prepare
+    }
+
+    /// Divergent sweeps logged so far.
+    pub fn divergent_sweeps(&self) -> u64 {
+        self.divergent
+    }
+
+    /// Sends every buffered row.
+    pub fn flush(&mut self) -> Result<(), RecordingStreamError> {
+        self.columns.send(&self.rec)
+    }
+
+    fn log_static(
+        &mut self,
+        path: impl Into<String>,
+        value: &dyn rerun::AsComponents,
+    ) -> Result<(), RecordingStreamError> {
+        self.columns
+            .send_static(&self.rec, path.into(), value.as_serialized_batches())
+    }
+
+    /// The stream.
+    pub fn stream(&self) -> &RecordingStream {
+        &self.rec
+    }
+
+    /// Logs one event.
+    pub fn log(&mut self, event: &ReplayEvent) -> Result<(), RecordingStreamError> {
+        match event {
+            ReplayEvent::Scene(scene) => self.log_scene(scene),
+            ReplayEvent::Sweep(result) => self.log_sweep(result),
+        }
+    }
+
+    /// Sends what is buffered, flushes and hands the stream back (drop it,
+    /// and every clone, to finish a file). When some sweep diverged from
+    /// its expectation, first sends the layout that leads with the
+    /// divergences, as the active one. Use [`Logger::flush`] first to see
+    /// an error of the last rows.
+    pub fn finish(mut self) -> RecordingStream {
+        let _ = self.flush();
+        if self.options.blueprint && self.divergent > 0 {
+            // Every chunk before the second layout, so that the order of
+            // the file's messages does not vary.
+            let _ = self.rec.flush_blocking();
+            let _ = blueprint::send_blueprint(
+                &self.rec,
+                Layout::Divergences,
+                self.options.prepare.follow_ball,
+            );
+        }
+        let _ = self.rec.flush_blocking();
+        self.rec
+    }
+
+    /// Logs a scene's mesh (static, one Mesh3D, flat-shaded) and its
+    /// wireframe (static, one LineStrips3D with every edge once).
+    pub fn log_scene(&mut self, scene: &Arc<SceneState>) -> Result<(), RecordingStreamError> {
+        let mut triangles: Vec<&Triangle> = scene.mesh.triangles().iter().collect();
+        triangles.sort_by_key(|t| t.index);
+        let mut positions = Vec::with_capacity(triangles.len() * 3);
+        let mut normals = Vec::with_capacity(triangles.len() * 3);
+        for t in &triangles {
+            for v in &t.vertices {
+                positions.push(f32x3(v.coords));
+                normals.push(f32x3(t.normal));
+            }
+        }
+        let indices = (0..triangles.len() as u32).map(|i| [3 * i, 3 * i + 1, 3 * i + 2]);
+        let mesh = Mesh3D::new(positions)
+            .with_vertex_normals(normals)
+            .with_triangle_indices(indices)
+            .with_albedo_factor(albedo(MESH_COLOR));
+        self.log_static(paths::mesh(scene.number), &mesh)?;
+
+        // Every edge once, by its vertex indices.
+        let mut edges: Vec<(u32, u32)> = triangles
+            .iter()
+            .flat_map(|t| {
+                let v = t.vertex_indices;
+                [(v[0], v[1]), (v[1], v[2]), (v[2], v[0])].map(|(a, b)| (a.min(b), a.max(b)))
+            })
+            .collect();
+        edges.sort_unstable();
+        edges.dedup();
+        let vertices = scene.mesh.vertices();
+        let strips = edges
+            .iter()
+            .map(|&(a, b)| [a, b].map(|i| f32x3(vertices[i as usize].coords)));
+        let wireframe = LineStrips3D::new(strips)
+            .with_radii([Radius::new_ui_points(WIREFRAME_POINTS)])
+            .with_colors([rgba(WIREFRAME_COLOR)]);
+        self.log_static(paths::wireframe(scene.number), &wireframe)?;
+        self.scenes.push(scene.clone());
+        Ok(())
+    }
+
+    /// Logs one sweep's result at its frame.
+    pub fn log_sweep(&mut self, r: &SweepResult) -> Result<(), RecordingStreamError> {
+        let prepared = prepare_sweeps(&self.scenes, [r], &self.options.prepare);
+        self.log_prepared(prepared)
+    }
+
+    /// Logs sweeps prepared by [`prepare_sweeps`] (sweeps must be logged in
+    /// trace order).
+    pub fn log_prepared(&mut self, mut p: PreparedSweeps) -> Result<(), RecordingStreamError> {
+        self.columns.append(&mut p.columns);
+        self.divergent += std::mem::take(&mut p.divergent);
+        // Clear what a ball showed at its previous sweep and no longer
+        // shows: edge frames, plot values (so that a plot has a gap rather
+        // than a line to a distant frame), the expected outcome.
+        for m in p.marks.drain(..) {
+            let b = m.ball;
+            if !self.balls.contains_key(&b) {
+                series_styles(&mut self.columns, &self.rec, b)?;
+            }
+            let state = self.balls.entry(b).or_default();
+            let edge_slots = std::mem::replace(&mut state.edge_slots, m.edge_slots);
+            let plotted = std::mem::replace(&mut state.plotted, m.plotted);
+            let expected = std::mem::replace(&mut state.expected, m.expected);
+            let mut out = Out {
+                columns: &mut self.columns,
+                frame: m.frame,
+                time: m.time,
+            };
+            for slot in m.edge_slots..edge_slots {
+                out.clear(Entity::EdgeFrame(b, slot), true);
+            }
+            let gone = plotted & !m.plotted;
+            if gone != 0 {
+                for bit in (0..PLOT_BITS).filter(|bit| gone & (1 << bit) != 0) {
+                    out.clear(plot_entity(b, bit), false);
+                }
+            }
+            if expected && !m.expected {
+                out.clear(Entity::Expected(b), true);
+            }
+        }
+        if self.spare.len() < MAX_SPARE_PREPARED {
+            self.spare.push(p);
+        }
+        if self.columns.rows() >= self.flush_rows {
+            self.flush()?;
+        }
+        Ok(())
+    }
+
+    /// An empty [`PreparedSweeps`] to fill with [`prepare_sweeps_into`]:
+    /// one handed back by [`Logger::log_prepared`] (buffers kept) when
+    /// there is one.
+    pub fn spare_prepared(&mut self) -> PreparedSweeps {
+        self.spare.pop().unwrap_or_default()
+    }
+}

@@ -1,0 +1,456 @@
+//! The rows one sweep logs: the ball, its sweep, contact and normal, the
+//! primary feature, the expected outcome when it differs, the plots, the
+//! status series and the text lines. (The edge frames are in
+//! `edge_frame`.)
+
+use std::iter::once;
+
+use rerun::components::{
+    AlbedoFactor, ClearIsRecursive, FillMode, HalfSize3D, Length, Position3D, Radius, RotationQuat,
+    Scalar, Scale3D, Text, TextLogLevel, Translation3D, TriangleIndices, Vector3D,
+};
+use rerun::{
+    Arrows3D, Capsules3D, Clear, Color, Ellipsoids3D, LineStrips3D, Mesh3D, Points3D, Scalars,
+    TextLog, Transform3D,
+};
+
+use super::columns::{self, Row};
+use super::convert::{
+    BOLD_EDGE_POINTS, CONTACT_BALL_COLOR, EXPECTED_COLOR, HIT_COLOR, MISS_COLOR, NORMAL_COLOR,
+    OUTLINE_POINTS, P0_COLOR, P1_COLOR, SWEEP_COLOR, VERTEX_POINTS, albedo, any_value,
+    capsule_pose, f32x3, rgba, ui_points,
+};
+use super::decision::{write_decision_line, write_divergence_line};
+use super::paths::{Entity, FACE_NAMES, QUADRATIC_NAMES};
+use crate::core::explain::Label;
+use crate::core::{Kind, TestRecord};
+use crate::regress::FieldDiff;
+use crate::replay::{SceneState, SweepResult};
+use crate::trace::messages::OutcomeMsg;
+
+/// Component sets: the rows of one entity with the same set number have the
+/// same components (see `columns::Columns::row`).
+pub(crate) mod set {
+    pub const SPHERES: u8 = 0;
+    pub const SWEEP: u8 = 1;
+    pub const CONTACT: u8 = 2;
+    pub const NORMAL: u8 = 3;
+    pub const CLEAR: u8 = 4;
+    pub const TRIANGLE: u8 = 5;
+    pub const LABELED_STRIP: u8 = 6;
+    pub const LABELED_POINT: u8 = 7;
+    pub const TRANSFORM: u8 = 8;
+    pub const STRIP: u8 = 9;
+    pub const CYLINDER: u8 = 10;
+    pub const EDGE_POINTS: u8 = 11;
+    pub const SCALAR: u8 = 12;
+    pub const KIND: u8 = 13;
+    pub const TEXT_LOG: u8 = 14;
+    pub const FOCUS: u8 = 15;
+    /// Plus 1 with roots, plus 2 with xc.
+    pub const EDGE_VALUES: u8 = 16;
+    pub const AXES: u8 = 20;
+    pub const EXPECTED_BALL: u8 = 21;
+}
+
+/// Where the rows of one sweep go.
+pub(crate) struct Out<'a> {
+    pub(crate) columns: &'a mut columns::Columns,
+    pub(crate) frame: i64,
+    pub(crate) time: columns::Time,
+}
+
+impl Out<'_> {
+    pub(crate) fn row(&mut self, entity: Entity, set: u8) -> Row<'_> {
+        self.columns.row(entity, set, self.frame, self.time)
+    }
+
+    pub(crate) fn clear(&mut self, entity: Entity, recursive: bool) {
+        self.row(entity, set::CLEAR)
+            .put::<ClearIsRecursive>(Clear::descriptor_is_recursive, [recursive.into()]);
+    }
+}
+
+/// Bits of [`plot_rows`]'s answer: which plot entities got a value.
+pub(crate) const QUADRATIC_BITS: u16 = 0;
+pub(crate) const FACE_BITS: u16 = QUADRATIC_NAMES.len() as u16;
+
+/// The plot entity of bit `bit` (see [`plot_rows`]).
+pub(crate) fn plot_entity(ball: u32, bit: u16) -> Entity {
+    if bit < FACE_BITS {
+        Entity::Quadratic(ball, (bit - QUADRATIC_BITS) as usize)
+    } else {
+        Entity::Face(ball, (bit - FACE_BITS) as usize)
+    }
+}
+
+/// How many plot bits there are.
+pub(crate) const PLOT_BITS: u16 = FACE_BITS + FACE_NAMES.len() as u16;
+
+/// The ball at p0, at the contact and at p1, the swept volume, the contact
+/// and the normal. No labels: the numbers are in the decision line.
+pub(crate) fn sweep_rows(out: &mut Out<'_>, r: &SweepResult) {
+    let b = r.ball;
+    let o = &r.outcome;
+    let p0 = r.sweep.p0;
+    let d = r.sweep.p1 - p0;
+    let rho = r.rho();
+    let radius = r.sweep.radius as f32;
+    let at_contact = p0 + d * o.alpha;
+
+    let hit = o.is_hit();
+    let n = if hit { 3 } else { 2 };
+    let contact_center = hit.then(|| f32x3(at_contact.coords));
+    let contact_color = hit.then(|| rgba(CONTACT_BALL_COLOR));
+    out.row(Entity::Spheres(b), set::SPHERES)
+        .put::<HalfSize3D>(
+            Ellipsoids3D::descriptor_half_sizes,
+            std::iter::repeat_n(HalfSize3D::splat(radius), n),
+        )
+        .put::<Translation3D>(
+            Ellipsoids3D::descriptor_centers,
+            once(f32x3(p0.coords))
+                .chain(contact_center)
+                .chain(once(f32x3(r.sweep.p1.coords)))
+                .map(Translation3D::from),
+        )
+        .put::<Color>(
+            Ellipsoids3D::descriptor_colors,
+            once(rgba(P0_COLOR))
+                .chain(contact_color)
+                .chain(once(rgba(P1_COLOR))),
+        )
+        .put::<FillMode>(Ellipsoids3D::descriptor_fill_mode, [FillMode::Solid]);
+
+    // The swept volume at the detection radius.
+    let (length, rotation) = capsule_pose(&d);
+    out.row(Entity::Sweep(b), set::SWEEP)
+        .put::<Length>(Capsules3D::descriptor_lengths, [length.into()])
+        .put::<Radius>(Capsules3D::descriptor_radii, [(rho as f32).into()])
+        .put::<Translation3D>(
+            Capsules3D::descriptor_translations,
+            [f32x3(p0.coords).into()],
+        )
+        .put::<RotationQuat>(Capsules3D::descriptor_quaternions, [rotation.into()])
+        .put::<Color>(Capsules3D::descriptor_colors, [rgba(SWEEP_COLOR)])
+        .put::<FillMode>(Capsules3D::descriptor_fill_mode, [FillMode::MajorWireframe]);
+
+    match (o.contact, o.normal) {
+        (Some(c), Some(nrm)) => {
+            contact_row(out, Entity::Contact(b), f32x3(c.coords), HIT_COLOR);
+            normal_row(
+                out,
+                Entity::Normal(b),
+                f32x3(c.coords),
+                f32x3(nrm * (r.sweep.radius.max(1e-3) * 1.5)),
+                NORMAL_COLOR,
+            );
+        }
+        _ => {
+            out.clear(Entity::Contact(b), false);
+            out.clear(Entity::Normal(b), false);
+        }
+    }
+}
+
+fn contact_row(out: &mut Out<'_>, entity: Entity, at: [f32; 3], color: [u8; 4]) {
+    out.row(entity, set::CONTACT)
+        .put::<Position3D>(Points3D::descriptor_positions, [at.into()])
+        .put::<Radius>(Points3D::descriptor_radii, [ui_points(5.0)])
+        .put::<Color>(Points3D::descriptor_colors, [rgba(color)]);
+}
+
+fn normal_row(out: &mut Out<'_>, entity: Entity, from: [f32; 3], v: [f32; 3], color: [u8; 4]) {
+    out.row(entity, set::NORMAL)
+        .put::<Vector3D>(Arrows3D::descriptor_vectors, [v.into()])
+        .put::<Position3D>(Arrows3D::descriptor_origins, [from.into()])
+        .put::<Color>(Arrows3D::descriptor_colors, [rgba(color)]);
+}
+
+/// The transform the view that follows ball `r.ball` looks from: at the
+/// ball where the decision happens, scaled so that one unit is five ball
+/// radii. Where: at α when something is hit; else at the expected α when
+/// the expectation is a hit; else where the path comes nearest to the
+/// decisive (nearest-miss) triangle; else at p1.
+pub(crate) fn focus_rows(
+    out: &mut Out<'_>,
+    scene: Option<&SceneState>,
+    r: &SweepResult,
+    decisive: Option<&TestRecord>,
+    divergent: bool,
+) {
+    let p0 = r.sweep.p0;
+    let d = r.sweep.p1 - p0;
+    let alpha = if r.outcome.is_hit() {
+        r.outcome.alpha
+    } else if let Some(e) = r.expected.filter(|e| divergent && e.kind != Kind::None) {
+        e.alpha
+    } else if let Some(t) = decisive.and_then(|t| {
+        scene
+            .filter(|s| s.number == r.scene)
+            .and_then(|s| s.mesh.triangle_by_index(t.triangle()))
+    }) {
+        let centroid = (t.vertices[0].coords + t.vertices[1].coords + t.vertices[2].coords) / 3.0;
+        let dd = d.norm_squared();
+        if dd > 0.0 {
+            (centroid - p0.coords).dot(&d) / dd
+        } else {
+            0.0
+        }
+    } else {
+        1.0
+    };
+    let alpha = if alpha.is_finite() {
+        alpha.clamp(0.0, 1.0)
+    } else {
+        1.0
+    };
+    let center = p0 + d * alpha;
+    let size = 5.0 * r.sweep.radius.max(1e-6);
+    out.row(Entity::Focus(r.ball), set::FOCUS)
+        .put::<Translation3D>(
+            Transform3D::descriptor_translation,
+            [f32x3(center.coords).into()],
+        )
+        .put::<Scale3D>(
+            Transform3D::descriptor_scale,
+            [Scale3D::uniform(size as f32)],
+        );
+}
+
+/// The primary (or nearest-miss) triangle: filled, its three edges
+/// outlined, its decisive edge bold or its vertex as a point; one label, on
+/// the decisive feature.
+///
+/// A nearest miss is labelled only for the followed ball (`followed`), so
+/// that the balls that hit nothing do not cover the picture with labels.
+pub(crate) fn primary_rows(
+    out: &mut Out<'_>,
+    scene: Option<&SceneState>,
+    r: &SweepResult,
+    decisive: Option<&TestRecord>,
+    followed: bool,
+) {
+    let b = r.ball;
+    let scene = scene.filter(|s| s.number == r.scene);
+    let triangle =
+        decisive.and_then(|t| scene.and_then(|s| s.mesh.triangle_by_index(t.triangle())));
+    let (Some(t), Some(test)) = (triangle, decisive) else {
+        out.clear(Entity::PrimaryTriangle(b), false);
+        out.clear(Entity::PrimaryOutline(b), false);
+        out.clear(Entity::PrimaryEdge(b), false);
+        out.clear(Entity::PrimaryVertex(b), false);
+        return;
+    };
+    let hit = test.alpha().is_some();
+    let color = if hit { HIT_COLOR } else { MISS_COLOR };
+    // Lift the highlight a little off the mesh so it is not hidden by it.
+    let lift = t.normal * (r.rho() * 0.02);
+    let verts: [[f32; 3]; 3] = std::array::from_fn(|i| f32x3(t.vertices[i].coords + lift));
+    out.row(Entity::PrimaryTriangle(b), set::TRIANGLE)
+        .put::<Position3D>(
+            Mesh3D::descriptor_vertex_positions,
+            verts.map(Position3D::from),
+        )
+        .put::<TriangleIndices>(Mesh3D::descriptor_triangle_indices, [[0u32, 1, 2].into()])
+        .put::<AlbedoFactor>(
+            Mesh3D::descriptor_albedo_factor,
+            [albedo([color[0], color[1], color[2], 90]).into()],
+        );
+    let label = Label(test);
+    let prefix = if hit { "" } else { "nearest miss: " };
+    let labelled = hit || followed;
+    let is_face = labelled && matches!(test, TestRecord::Face(_));
+    out.row(Entity::PrimaryOutline(b), set::LABELED_STRIP)
+        .put_strip(
+            LineStrips3D::descriptor_strips,
+            &[verts[0], verts[1], verts[2], verts[0]],
+        )
+        .put::<Radius>(LineStrips3D::descriptor_radii, [ui_points(OUTLINE_POINTS)])
+        .put::<Color>(LineStrips3D::descriptor_colors, [rgba(color)])
+        .put_texts(LineStrips3D::descriptor_labels, |s| {
+            if is_face {
+                s.push_fmt(format_args!("{prefix}{label}"));
+            }
+        });
+    let f = test.feature() as usize % 3;
+    match test {
+        TestRecord::Edge(_) => {
+            out.row(Entity::PrimaryEdge(b), set::LABELED_STRIP)
+                .put_strip(
+                    LineStrips3D::descriptor_strips,
+                    &[verts[f], verts[(f + 1) % 3]],
+                )
+                .put::<Radius>(
+                    LineStrips3D::descriptor_radii,
+                    [ui_points(BOLD_EDGE_POINTS)],
+                )
+                .put::<Color>(LineStrips3D::descriptor_colors, [rgba(color)])
+                .put_texts(LineStrips3D::descriptor_labels, |s| {
+                    if labelled {
+                        s.push_fmt(format_args!("{prefix}{label}"));
+                    }
+                });
+            out.clear(Entity::PrimaryVertex(b), false);
+        }
+        TestRecord::Vertex(_) => {
+            out.row(Entity::PrimaryVertex(b), set::LABELED_POINT)
+                .put::<Position3D>(Points3D::descriptor_positions, [verts[f].into()])
+                .put::<Radius>(Points3D::descriptor_radii, [ui_points(VERTEX_POINTS)])
+                .put::<Color>(Points3D::descriptor_colors, [rgba(color)])
+                .put_texts(Points3D::descriptor_labels, |s| {
+                    if labelled {
+                        s.push_fmt(format_args!("{prefix}{label}"));
+                    }
+                });
+            out.clear(Entity::PrimaryEdge(b), false);
+        }
+        TestRecord::Face(_) => {
+            out.clear(Entity::PrimaryEdge(b), false);
+            out.clear(Entity::PrimaryVertex(b), false);
+        }
+    }
+}
+
+/// The expected outcome beside the replayed one, for a divergent sweep:
+/// the ball at the expected α, the expected contact and normal (when the
+/// expectation names them).
+pub(crate) fn expected_rows(out: &mut Out<'_>, r: &SweepResult, e: &OutcomeMsg) {
+    let b = r.ball;
+    let p0 = r.sweep.p0;
+    let d = r.sweep.p1 - p0;
+    let alpha = if e.alpha.is_finite() {
+        e.alpha.clamp(0.0, 1.0)
+    } else {
+        1.0
+    };
+    let center = p0 + d * alpha;
+    out.row(Entity::ExpectedBall(b), set::EXPECTED_BALL)
+        .put::<HalfSize3D>(
+            Ellipsoids3D::descriptor_half_sizes,
+            [HalfSize3D::splat(r.sweep.radius as f32)],
+        )
+        .put::<Translation3D>(
+            Ellipsoids3D::descriptor_centers,
+            [f32x3(center.coords).into()],
+        )
+        .put::<Color>(Ellipsoids3D::descriptor_colors, [rgba(EXPECTED_COLOR)])
+        .put::<FillMode>(
+            Ellipsoids3D::descriptor_fill_mode,
+            [FillMode::MajorWireframe],
+        )
+        .put_fmt(
+            Ellipsoids3D::descriptor_labels,
+            format_args!("expected: {}", e.kind),
+        );
+    let contact = e.contact.flatten();
+    match contact {
+        Some(c) => contact_row(
+            out,
+            Entity::ExpectedContact(b),
+            c.map(|x| x as f32),
+            EXPECTED_COLOR,
+        ),
+        None => out.clear(Entity::ExpectedContact(b), false),
+    }
+    match (e.normal.flatten(), contact) {
+        (Some(n), Some(c)) => {
+            let len = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
+            if len > 0.0 && len.is_finite() {
+                let k = r.sweep.radius.max(1e-3) * 1.5 / len;
+                normal_row(
+                    out,
+                    Entity::ExpectedNormal(b),
+                    c.map(|x| x as f32),
+                    n.map(|x| (x * k) as f32),
+                    EXPECTED_COLOR,
+                );
+            } else {
+                out.clear(Entity::ExpectedNormal(b), false);
+            }
+        }
+        _ => out.clear(Entity::ExpectedNormal(b), false),
+    }
+}
+
+/// A `Scalars` row.
+fn scalar(out: &mut Out<'_>, entity: Entity, v: f64) {
+    out.row(entity, set::SCALAR)
+        .put::<Scalar>(Scalars::descriptor_scalars, [v.into()]);
+}
+
+/// The α plot and the decisive test's numbers; returns which plot entities
+/// got a value (bit `i` for `plot_entity(ball, i)`).
+pub(crate) fn plot_rows(out: &mut Out<'_>, r: &SweepResult, decisive: Option<&TestRecord>) -> u16 {
+    let b = r.ball;
+    scalar(out, Entity::Alpha(b), r.outcome.alpha);
+    out.row(Entity::Alpha(b), set::KIND)
+        .put_strs(|| any_value::<Text>("kind"), [r.outcome.kind.as_str()]);
+    let mut plotted = 0u16;
+    let mut quadratic = |a: f64, bb: f64, c: f64, disc: f64, roots: Option<(f64, f64)>| {
+        let (s0, s1) = roots.unzip();
+        for (i, v) in [Some(a), Some(bb), Some(c), Some(disc), s0, s1]
+            .into_iter()
+            .enumerate()
+        {
+            if let Some(v) = v.filter(|v| v.is_finite()) {
+                scalar(out, Entity::Quadratic(b, i), v);
+                plotted |= 1 << (QUADRATIC_BITS + i as u16);
+            }
+        }
+    };
+    match decisive {
+        Some(TestRecord::Edge(e)) => quadratic(e.a, e.b, e.c, e.discriminant, e.roots),
+        Some(TestRecord::Vertex(v)) => quadratic(v.a, v.b, v.c, v.discriminant, v.roots),
+        Some(TestRecord::Face(f)) => {
+            for (i, v) in [Some(f.h0), Some(f.h1), f.beta].into_iter().enumerate() {
+                if let Some(v) = v.filter(|v| v.is_finite()) {
+                    scalar(out, Entity::Face(b, i), v);
+                    plotted |= 1 << (FACE_BITS + i as u16);
+                }
+            }
+        }
+        None => {}
+    }
+    plotted
+}
+
+/// The decision in words; for a divergent sweep (`diffs` not empty) also
+/// the status series at 1 and a line in the divergences log (the status is
+/// 0 for a sweep that matches its expectation, absent without one).
+pub(crate) fn text_rows(
+    out: &mut Out<'_>,
+    r: &SweepResult,
+    decisive: Option<&TestRecord>,
+    diffs: &[FieldDiff],
+) {
+    let divergent = !diffs.is_empty();
+    {
+        let mut row = out.row(Entity::Log, set::TEXT_LOG);
+        row.put_texts(TextLog::descriptor_text, |t| {
+            t.push_with(|s| write_decision_line(s, r, decisive, diffs));
+        });
+        let level = if divergent {
+            TextLogLevel::WARN
+        } else if r.outcome.is_hit() {
+            TextLogLevel::INFO
+        } else {
+            TextLogLevel::DEBUG
+        };
+        row.put_strs(TextLog::descriptor_level, [level]);
+    }
+    if r.expected.is_some() {
+        scalar(
+            out,
+            Entity::Status(r.ball),
+            if divergent { 1.0 } else { 0.0 },
+        );
+    }
+    if divergent {
+        out.row(Entity::Divergences, set::TEXT_LOG)
+            .put_texts(TextLog::descriptor_text, |t| {
+                t.push_with(|s| write_divergence_line(s, r, diffs));
+            })
+            .put_strs(TextLog::descriptor_level, [TextLogLevel::WARN]);
+    }
+}

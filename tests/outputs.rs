@@ -16,6 +16,10 @@ pub fn tests() -> Vec<Trial> {
             "outputs::named_pipe_is_written_directly",
             named_pipe_is_written_directly,
         ),
+        trial(
+            "outputs::full_disk_is_a_clear_error",
+            full_disk_is_a_clear_error,
+        ),
     ]
 }
 
@@ -93,6 +97,55 @@ fn named_pipe_is_written_directly() -> Result<(), String> {
     }
     if text.lines().count() < 100 {
         return Err(format!("the reader got {} lines", text.lines().count()));
+    }
+    Ok(())
+}
+
+/// `replay` with every output on a full device (`/dev/full` fails every
+/// write with "No space left on device"): it ends within seconds (the SDK's
+/// own file writer used to hang here), exits 2 and names the file and the
+/// operating system's reason.
+fn full_disk_is_a_clear_error() -> Result<(), String> {
+    if !std::path::Path::new("/dev/full").exists() {
+        return Err("/dev/full is missing: this test needs a Linux system".into());
+    }
+    for args in [["--rrd", "/dev/full"], ["--outcomes", "/dev/full"]] {
+        let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_sweeptrace"))
+            .arg("replay")
+            .arg(sample_trace())
+            .args(args)
+            .stdout(std::process::Stdio::null())
+            .stderr(std::process::Stdio::piped())
+            .spawn()
+            .map_err(|e| e.to_string())?;
+        // Not a measurement: a bound that only a hang exceeds.
+        let deadline = std::time::Instant::now() + std::time::Duration::from_secs(120);
+        let status = loop {
+            if let Some(status) = child.try_wait().map_err(|e| e.to_string())? {
+                break status;
+            }
+            if std::time::Instant::now() > deadline {
+                let _ = child.kill();
+                return Err(format!("replay {args:?} hangs on a full device"));
+            }
+            std::thread::sleep(std::time::Duration::from_millis(50));
+        };
+        let mut stderr = String::new();
+        if let Some(mut e) = child.stderr.take() {
+            use std::io::Read;
+            e.read_to_string(&mut stderr).map_err(|e| e.to_string())?;
+        }
+        if status.code() != Some(2) {
+            return Err(format!(
+                "replay {args:?}: exit {:?}: {stderr}",
+                status.code()
+            ));
+        }
+        if !(stderr.contains("/dev/full") && stderr.contains("No space left on device")) {
+            return Err(format!(
+                "replay {args:?}: the error names neither file nor cause: {stderr}"
+            ));
+        }
     }
     Ok(())
 }

@@ -46,9 +46,9 @@ impl PendingFile {
             .file_name()
             .map(|n| n.to_string_lossy().into_owned())
             .unwrap_or_default();
-        let prefix = format!(".{name}.");
+        let prefix = temporary_prefix(&name);
         let mut builder = tempfile::Builder::new();
-        builder.prefix(&prefix).suffix(".tmp");
+        builder.prefix(&prefix);
         // An ordinary file once renamed (temporary files are private by default).
         #[cfg(unix)]
         builder.permissions(std::os::unix::fs::PermissionsExt::from_mode(0o644));
@@ -85,6 +85,33 @@ impl PendingFile {
             None => Ok(()),
         }
     }
+}
+
+/// The start of a temporary file's name for a target named `name`: it says
+/// what the file is (`.golf.rrd.partial-Ab3dE1`).
+fn temporary_prefix(name: &str) -> String {
+    format!(".{name}.partial-")
+}
+
+/// Temporary files next to `target` left by earlier runs that never
+/// finished (a run killed while writing): `.{name}.partial-*`. Another run
+/// writing the same target at this moment also has one, so they are
+/// reported, not removed.
+pub fn unfinished_temporaries(target: &Path) -> Vec<PathBuf> {
+    let Some(name) = target.file_name().map(|n| n.to_string_lossy().into_owned()) else {
+        return Vec::new();
+    };
+    let prefix = temporary_prefix(&name);
+    let Ok(entries) = std::fs::read_dir(dir_of(target)) else {
+        return Vec::new();
+    };
+    let mut found: Vec<PathBuf> = entries
+        .filter_map(Result::ok)
+        .filter(|e| e.file_name().to_string_lossy().starts_with(&prefix))
+        .map(|e| e.path())
+        .collect();
+    found.sort();
+    found
 }
 
 fn dir_of(target: &Path) -> &Path {

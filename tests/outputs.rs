@@ -20,6 +20,10 @@ pub fn tests() -> Vec<Trial> {
             "outputs::full_disk_is_a_clear_error",
             full_disk_is_a_clear_error,
         ),
+        trial(
+            "outputs::killed_mid_write_leaves_the_target_intact",
+            killed_mid_write_leaves_the_target_intact,
+        ),
     ]
 }
 
@@ -145,6 +149,81 @@ fn full_disk_is_a_clear_error() -> Result<(), String> {
             return Err(format!(
                 "replay {args:?}: the error names neither file nor cause: {stderr}"
             ));
+        }
+    }
+    Ok(())
+}
+
+/// `replay --rrd` killed (SIGKILL) at several moments: the earlier recording
+/// under the target name is intact or replaced by a complete new one (never
+/// a partial file), and what is left over is a temporary file whose name
+/// says what it is, which the next run reports with how to remove it.
+fn killed_mid_write_leaves_the_target_intact() -> Result<(), String> {
+    let dir = tempfile::tempdir().map_err(|e| e.to_string())?;
+    let target = dir.path().join("golf.rrd");
+    let trace =
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("traces/record_mini_golf.mcap");
+    let replay = |extra: &[&str]| {
+        let mut command = std::process::Command::new(env!("CARGO_BIN_EXE_sweeptrace"));
+        command
+            .arg("replay")
+            .arg(&trace)
+            .arg("--rrd")
+            .arg(&target)
+            .args(extra)
+            .stdout(std::process::Stdio::null())
+            .stderr(std::process::Stdio::piped());
+        command
+    };
+    let first = replay(&[]).output().map_err(|e| e.to_string())?;
+    if !first.status.success() {
+        return Err(String::from_utf8_lossy(&first.stderr).into_owned());
+    }
+    let complete = std::fs::read(&target).map_err(|e| e.to_string())?;
+    // Kill at several points of a run (the delays only vary where the run
+    // is when killed; the property must hold at any of them).
+    for delay_ms in [0u64, 20, 60, 150, 400] {
+        let mut child = replay(&["--detail", "all"])
+            .spawn()
+            .map_err(|e| e.to_string())?;
+        std::thread::sleep(std::time::Duration::from_millis(delay_ms));
+        let _ = child.kill();
+        let _ = child.wait();
+        let now = std::fs::read(&target).map_err(|e| e.to_string())?;
+        // Intact, or a complete recording of the new run (Rerun's decoder
+        // reads it to its end): never a partial file.
+        if now != complete {
+            crate::replay::decode_rrd(&target).map_err(|e| {
+                format!("after a kill at {delay_ms} ms the target does not decode: {e}")
+            })?;
+        }
+        let leftovers: Vec<String> = std::fs::read_dir(dir.path())
+            .map_err(|e| e.to_string())?
+            .filter_map(Result::ok)
+            .map(|e| e.file_name().to_string_lossy().into_owned())
+            .filter(|n| n != "golf.rrd")
+            .collect();
+        if let Some(odd) = leftovers
+            .iter()
+            .find(|n| !n.starts_with(".golf.rrd.partial-"))
+        {
+            return Err(format!("an unexpected file is left: {odd}"));
+        }
+        if !leftovers.is_empty() {
+            // The next run names them and says how to remove them.
+            let next = replay(&[]).output().map_err(|e| e.to_string())?;
+            let stderr = String::from_utf8_lossy(&next.stderr);
+            if !(next.status.success()
+                && stderr.contains("unfinished temporary file")
+                && stderr.contains("rm "))
+            {
+                return Err(format!(
+                    "the next run does not report the leftovers: {stderr}"
+                ));
+            }
+            for name in leftovers {
+                std::fs::remove_file(dir.path().join(name)).map_err(|e| e.to_string())?;
+            }
         }
     }
     Ok(())

@@ -664,7 +664,7 @@ fn worked_sweeps() -> Vec<SweepMsg> {
 /// Values decoded from an `.rrd`: per entity and component, the values at
 /// each frame (static data at frame `i64::MIN`).
 #[derive(Default)]
-struct Decoded {
+pub(crate) struct Decoded {
     scalars: BTreeMap<(String, String), BTreeMap<i64, Vec<f64>>>,
     texts: BTreeMap<(String, String), BTreeMap<i64, Vec<String>>>,
     translations: BTreeMap<String, BTreeMap<i64, [f32; 3]>>,
@@ -705,7 +705,7 @@ impl Decoded {
     }
 }
 
-fn decode_rrd(path: &std::path::Path) -> Result<Decoded, String> {
+pub(crate) fn decode_rrd(path: &std::path::Path) -> Result<Decoded, String> {
     use rerun::external::re_log_encoding::DecoderApp;
     use rerun::log::{Chunk, LogMsg};
     let file = std::fs::File::open(path).map_err(|e| e.to_string())?;

@@ -96,6 +96,7 @@ impl<R: Read> Read for CountingReader<R> {
 
 /// A temporary file next to `target`, with the error naming where.
 fn pending_file(target: &Path) -> anyhow::Result<PendingFile> {
+    super::warn_unfinished(target);
     PendingFile::new(target)
         .with_context(|| format!("creating a temporary file next to {}", target.display()))
 }
@@ -218,6 +219,7 @@ pub fn run(args: Args) -> anyhow::Result<RunOutcome> {
             Some(OutcomeSink::Stdout(BufWriter::new(std::io::stdout())))
         }
         Some(p) => {
+            super::warn_unfinished(p);
             let (pending, f) = PendingFile::create(p)
                 .with_context(|| format!("creating a temporary file next to {}", p.display()))?;
             Some(OutcomeSink::File(BufWriter::new(f), pending))

@@ -15,6 +15,7 @@ mod record;
 mod replay;
 mod support;
 mod trace_io;
+mod tunnel;
 
 /// Builds a trial from a function returning `Result<(), String>`.
 pub fn trial(name: &str, f: impl FnOnce() -> Result<(), String> + Send + 'static) -> Trial {
@@ -33,5 +34,6 @@ fn main() {
     trials.extend(replay::tests());
     trials.extend(record::tests());
     trials.extend(prefetch::tests());
+    trials.extend(tunnel::tests());
     libtest_mimic::run(&args, trials).exit();
 }

@@ -692,6 +692,30 @@ fn recording() -> Result<(), String> {
             .any(|s| s.starts_with("tunnel: frame 4, ball 0: through triangle 0"))),
         "divergences log: {lines:?}"
     );
+    // The decision line (the decoder keeps the last row of a frame: ball 0
+    // only).
+    let rrd0 = dir.path().join("floor0.rrd");
+    let (code, _, err) = run_bin(&[
+        "replay".as_ref(),
+        path.as_os_str(),
+        "--ball".as_ref(),
+        "0".as_ref(),
+        "--rrd".as_ref(),
+        rrd0.as_os_str(),
+    ])?;
+    ensure!(code == 0, "exit {code}\n{err}");
+    let d0 = crate::replay::decode_rrd(&rrd0)?;
+    let log = d0
+        .texts
+        .get(&("/log".to_string(), "TextLog:text".to_string()))
+        .ok_or("no log")?;
+    ensure!(
+        log.get(&4)
+            .is_some_and(|l| l.iter().any(|s| s.starts_with("frame 4 ball 0:")
+                && s.ends_with("[tunnel: through triangle 0 during the sweep]"))),
+        "decision line: {:?}",
+        log.get(&4)
+    );
     ensure!(
         d.frames_with("/world/ball/1/tunnel", "Points3D:positions")
             .is_empty(),

@@ -431,7 +431,7 @@ pub(crate) fn text_rows(
         row.put_texts(TextLog::descriptor_text, |t| {
             t.push_with(|s| write_decision_line(s, r, decisive, diffs));
         });
-        let level = if divergent {
+        let level = if divergent || !r.tunnels.is_empty() {
             TextLogLevel::WARN
         } else if r.outcome.is_hit() {
             TextLogLevel::INFO

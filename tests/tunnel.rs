@@ -64,6 +64,7 @@ pub fn tests() -> Vec<Trial> {
         trial("tunnel::filters_and_scenes_reset_the_jump", filters_reset),
         trial("tunnel::recording_marks_the_tunnel", recording),
         trial("tunnel::sample_traces_have_none", sample_traces),
+        trial("tunnel::simulation_has_none", simulation),
         Trial::test("tunnel::generate_fixtures", || {
             generate_fixtures().map_err(Failed::from)
         })
@@ -733,5 +734,82 @@ fn sample_traces() -> Result<(), String> {
         let found = tunnels_of(&replay_all(&bytes, ReplayOptions::default())?);
         ensure!(found.is_empty(), "{}: {found:?}", path.display());
     }
+    Ok(())
+}
+
+/// The `record` simulation on every built-in scene, under both facing rules
+/// and with and without a margin, several seeds: its response never moves a
+/// ball through a surface, and no sweep starts where the tests let it
+/// through.
+fn simulation() -> Result<(), String> {
+    use sweeptrace::sim::{BuiltinScene, SimError, SimOptions, scene_message, simulate};
+    use sweeptrace::trace::{TraceError, TraceEvent};
+    let (mut sweeps, mut hits) = (0u64, 0u64);
+    for scene in BuiltinScene::all() {
+        let shape = scene.mesh_with_terrain_cells(12);
+        let m = mesh(&shape.vertices, &shape.triangles);
+        let (lo, hi) = m.bounds();
+        let centre = (lo + hi.coords) / 2.0;
+        // Dropped from above, or inside the closed box.
+        let z = if scene == BuiltinScene::Box {
+            centre.z
+        } else {
+            hi.z + 0.5
+        };
+        for (seed, margin, facing) in [
+            (1, 0.0, Facing::NonStrict),
+            (2, 0.05, Facing::NonStrict),
+            (3, 0.0, Facing::Strict),
+            (4, 0.05, Facing::Strict),
+        ] {
+            let options = SimOptions {
+                frames: 240,
+                seed,
+                balls: 6,
+                radius: 0.25,
+                position: [centre.x, centre.y, z],
+                velocity: [0.5, 0.2, 0.0],
+                position_jitter: 0.3 * (hi.x - lo.x).min(hi.y - lo.y),
+                velocity_jitter: 0.5,
+                margin,
+                facing,
+                ..SimOptions::default()
+            };
+            let mut events: Vec<Result<TraceEvent, TraceError>> = vec![Ok(TraceEvent::Scene {
+                log_time_nanos: 0,
+                index: 0,
+                scene: scene_message(&shape, &options),
+            })];
+            simulate::<SimError>(&m, &options, |e| {
+                events.push(Ok(TraceEvent::Sweep {
+                    log_time_nanos: e.log_time_nanos,
+                    index: events.len() as u64,
+                    sweep: e.sweep,
+                }));
+                Ok(())
+            })
+            .map_err(|e| e.to_string())?;
+            sweeps += events.len() as u64 - 1;
+            let mut found = Vec::new();
+            for e in replay_events(events.into_iter(), ReplayOptions::default()) {
+                if let ReplayEvent::Sweep(r) = e.map_err(|e| e.to_string())? {
+                    hits += u64::from(r.outcome.is_hit());
+                    found.extend(r.tunnels.iter().map(|t| (r.frame, r.ball, *t)));
+                }
+            }
+            ensure!(
+                found.is_empty(),
+                "{} seed {seed} margin {margin} {facing}: {} tunnels, first {:?}",
+                scene.name(),
+                found.len(),
+                found.first()
+            );
+        }
+    }
+    ensure!(
+        sweeps > 10_000 && hits > 1_000,
+        "only {sweeps} sweeps, {hits} collisions"
+    );
+    eprintln!("    {sweeps} simulated sweeps, {hits} collisions: no tunnel");
     Ok(())
 }

@@ -16,6 +16,7 @@ mod record;
 mod replay;
 mod support;
 mod trace_io;
+mod tunnel;
 
 /// Builds a trial from a function returning `Result<(), String>`.
 pub fn trial(name: &str, f: impl FnOnce() -> Result<(), String> + Send + 'static) -> Trial {
@@ -35,5 +36,6 @@ fn main() {
     trials.extend(record::tests());
     trials.extend(prefetch::tests());
     trials.extend(outputs::tests());
+    trials.extend(tunnel::tests());
     libtest_mimic::run(&args, trials).exit();
 }

@@ -30,8 +30,9 @@ Per trace: `ok`, `FAIL` (with the first divergences explained, and every
 tunnel: a ball's centre that went through a triangle from its front to its
 back, named by frame, ball, triangle and point), `NO EXPECTATIONS` (no
 /expected channel, or none matches a sweep: never a pass) or `ERROR`. Exit
-status: 0 every trace matches, 1 a divergence or a tunnel was found, 2
-something could not be checked (bad input, I/O error, no expectations).")]
+status: 0 every trace matches (ties and fragile divergences included, unless
+--strict), 1 a divergence or a tunnel was found, 2 something could not be
+checked (bad input, I/O error, no expectations), 3 a trace ends early.")]
 pub struct Args {
     /// Trace files, or directories searched recursively for `*.mcap`.
     #[arg(value_name = "TRACE|DIR", required = true)]

@@ -109,7 +109,7 @@ fn trace_trials() -> Vec<Trial> {
                 })
             })
             .collect(),
-        Err(e) => vec![trial("check::trace::discovery", move || Err(e))],
+        Err(e) => vec![trial("check::trace::discovery", move || Err::<(), _>(e))],
     }
 }
 

@@ -3,7 +3,7 @@
 //! Each module exposes `tests() -> Vec<Trial>`; trace files under `traces/`
 //! are found at run time and become test cases of their own.
 
-use libtest_mimic::{Arguments, Failed, Trial};
+use libtest_mimic::{Arguments, Completion, Failed, Trial};
 
 mod check;
 mod core_cases;
@@ -16,9 +16,35 @@ mod replay;
 mod support;
 mod trace_io;
 
-/// Builds a trial from a function returning `Result<(), String>`.
-pub fn trial(name: &str, f: impl FnOnce() -> Result<(), String> + Send + 'static) -> Trial {
-    Trial::test(name, move || f().map_err(Failed::from))
+/// What a test function returns on success: `()`, or a [`Completion`] for a
+/// test that finds at run time that it cannot run here and says why
+/// (shown as `ignored (reason)` and counted as ignored).
+pub trait TrialResult {
+    /// Whether the test ran to the end or was skipped.
+    fn into_completion(self) -> Completion;
+}
+
+impl TrialResult for () {
+    fn into_completion(self) -> Completion {
+        Completion::Completed
+    }
+}
+
+impl TrialResult for Completion {
+    fn into_completion(self) -> Completion {
+        self
+    }
+}
+
+/// Builds a trial from a function returning `Result<(), String>` (or
+/// `Result<Completion, String>`).
+pub fn trial<T: TrialResult>(
+    name: &str,
+    f: impl FnOnce() -> Result<T, String> + Send + 'static,
+) -> Trial {
+    Trial::ignorable_test(name, move || {
+        f().map(TrialResult::into_completion).map_err(Failed::from)
+    })
 }
 
 fn main() {

@@ -47,6 +47,32 @@ pub fn trial<T: TrialResult>(
     })
 }
 
+/// Registers the test function `f` under the name `module::f`, so that the
+/// name a run prints and filters on is the function's own:
+/// `trial!(f)`, or `trial!(f, timeout = LIMIT)` to fail a test that has not
+/// returned after `LIMIT` instead of hanging the run.
+#[macro_export]
+macro_rules! trial {
+    ($f:ident) => {
+        $crate::trial(&$crate::test_name(module_path!(), stringify!($f)), $f)
+    };
+    ($f:ident, timeout = $limit:expr) => {
+        $crate::trial(
+            &$crate::test_name(module_path!(), stringify!($f)),
+            move || $crate::support::with_timeout($limit, $f),
+        )
+    };
+}
+
+/// `module::function`, from `module_path!()` (which starts with this
+/// binary's crate name, left out) and the function's name.
+pub fn test_name(module_path: &str, function: &str) -> String {
+    let module = module_path
+        .split_once("::")
+        .map_or(module_path, |(_, module)| module);
+    format!("{module}::{function}")
+}
+
 fn main() {
     let args = Arguments::from_args();
     let mut trials: Vec<Trial> = Vec::new();

@@ -8,7 +8,6 @@ use sweeptrace::trace::TraceReader;
 use sweeptrace::trace::prefetch::prefetch;
 
 use crate::ensure;
-use crate::support::with_timeout;
 use crate::trial;
 
 /// Far above what any of these takes: reaching it means the prefetching
@@ -17,15 +16,9 @@ const LIMIT: Duration = Duration::from_secs(60);
 
 pub fn tests() -> Vec<Trial> {
     vec![
-        trial("prefetch::keeps_order_and_errors", || {
-            with_timeout(LIMIT, keeps_order_and_errors)
-        }),
-        trial("prefetch::dropping_stops_the_thread", || {
-            with_timeout(LIMIT, dropping_stops_the_thread)
-        }),
-        trial("prefetch::same_events_as_the_reader", || {
-            with_timeout(LIMIT, same_events_as_the_reader)
-        }),
+        trial!(keeps_order_and_errors, timeout = LIMIT),
+        trial!(dropping_stops_the_thread, timeout = LIMIT),
+        trial!(same_events_as_the_reader, timeout = LIMIT),
     ]
 }
 

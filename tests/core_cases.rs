@@ -1067,7 +1067,7 @@ fn zero_q_gives_a_double_root_only_when_c_is_zero() -> Result<(), String> {
 /// subtracted) and `-(n · d)` disagree in their last bits and sometimes in
 /// sign; every verdict must follow `n · d`.
 fn face_decides_direction_by_n_dot_d_alone() -> Result<(), String> {
-    use sweeptrace::core::{PARALLEL_TOLERANCE, Path, sweep_face};
+    use sweeptrace::core::{PARALLEL_TOLERANCE, SweptPath, sweep_face};
     let mut state = 0x9e37_79b9_7f4a_7c15u64;
     let mut next = move || {
         state ^= state << 13;
@@ -1087,7 +1087,7 @@ fn face_decides_direction_by_n_dot_d_alone() -> Result<(), String> {
         let p0 = nalgebra::Point3::new(next(), next(), next()) + n * (0.5 + next());
         let d = (along + n * (1e-8 * next())) * 1e-3;
         let p1 = p0 + d;
-        let path = Path::new(&Sweep::new(p0.into(), p1.into(), 0.25), &Options::default())
+        let path = SweptPath::new(&Sweep::new(p0.into(), p1.into(), 0.25), &Options::default())
             .map_err(|e| e.to_string())?;
         let r = sweep_face(&t, &path, NS);
         let nd = r.normal_dot_d;

@@ -463,7 +463,6 @@ fn expected_attached_before_and_after() -> Result<(), String> {
     );
     let (line, mismatch) = viz::decision_line(
         &results[0],
-        None,
         results[0].decisive_record(),
         &sweeptrace::regress::Tolerances::default(),
     );
@@ -1628,7 +1627,7 @@ fn viewer_and_check_agree_on_divergences() -> Result<(), String> {
 
     let line_frames: BTreeSet<i64> = results
         .iter()
-        .filter(|r| viz::decision_line(r, None, r.decisive_record(), &Tolerances::default()).1)
+        .filter(|r| viz::decision_line(r, r.decisive_record(), &Tolerances::default()).1)
         .map(|r| r.frame as i64)
         .collect();
     ensure!(

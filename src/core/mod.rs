@@ -33,7 +33,7 @@ pub use options::{
     ALPHA_SENSITIVITY, DEGENERATE_TOLERANCE, FRAGILE_ULPS, Facing, GRAZING_COSINE, Options,
     PARALLEL_TOLERANCE, TIE_WINDOW_ULPS,
 };
-pub use path::{Path, Sweep};
+pub use path::{Sweep, SweptPath};
 pub use record::{
     CollectRecords, EdgeRecord, FaceRecord, Kind, NoObserver, Observer, TestRecord, Verdict,
     VertexRecord,

@@ -35,8 +35,8 @@ pub use options::{
 };
 pub use path::{Sweep, SweptPath};
 pub use record::{
-    CollectRecords, EdgeRecord, FaceRecord, Kind, NoObserver, Observer, TestRecord, Verdict,
-    VertexRecord,
+    CollectRecords, EdgeHit, EdgeRecord, FaceHit, FaceRecord, Kind, NoObserver, Observer,
+    TestRecord, Verdict, VertexRecord,
 };
 pub use sweep_edge::sweep_edge;
 pub use sweep_face::{barycentric, barycentric_and_distance, sweep_face};

@@ -302,14 +302,14 @@ fn test_triangle<O: Observer, S: Sink>(
     observer.face(&face);
     match face.verdict {
         Verdict::Hit => {
-            if let (Some(beta), Some(touch)) = (face.beta, face.touch) {
+            if let Some(h) = face.hit() {
                 sink.hit(hit(
-                    beta,
+                    h.alpha,
                     Kind::Face,
                     0,
-                    touch,
+                    h.touch,
                     facing_cosine,
-                    face.boundary_distance.unwrap_or(0.0),
+                    h.boundary_distance,
                 ));
             }
         }
@@ -396,14 +396,14 @@ fn test_triangle<O: Observer, S: Sink>(
         };
         match r.verdict {
             Verdict::Hit => {
-                if let (Some((s0, _)), Some(xc)) = (r.roots, r.xc) {
+                if let Some(h) = r.hit() {
                     sink.hit(hit(
-                        s0,
+                        h.alpha,
                         Kind::Edge,
                         e,
-                        r.frame.to_world(&Point3::new(xc, 0.0, 0.0)),
+                        r.frame.to_world(&Point3::new(h.xc, 0.0, 0.0)),
                         approach(r.discriminant),
-                        xc.min(r.length - xc),
+                        h.xc.min(r.length - h.xc),
                     ));
                 }
             }
@@ -429,9 +429,9 @@ fn test_triangle<O: Observer, S: Sink>(
         observer.vertex(&r);
         match r.verdict {
             Verdict::Hit => {
-                if let Some((s0, _)) = r.roots {
+                if let Some(alpha) = r.alpha() {
                     sink.hit(hit(
-                        s0,
+                        alpha,
                         Kind::Vertex,
                         v,
                         r.position,

@@ -1,4 +1,5 @@
-//! The edge test, in the edge's standard frame (the seed's algorithm).
+//! The edge test, in the edge's standard frame (the algorithm of the CS121
+//! edge collision notes that SEMANTICS.md follows).
 
 use super::mesh::Triangle;
 use super::options::{Facing, PARALLEL_TOLERANCE};

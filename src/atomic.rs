@@ -2,6 +2,11 @@
 //! temporary name in the target's directory (so the final rename stays on
 //! one file system) and renamed into place only when finished. A pending
 //! file that is dropped without [`PendingFile::commit`] is removed.
+//!
+//! A target that exists and is not a regular file (`/dev/null`, a named
+//! pipe, a terminal) is written directly: renaming a file over it would
+//! replace the device. A target that is a symbolic link is resolved, so the
+//! link keeps pointing at the finished file.
 
 use std::fs::File;
 use std::io;
@@ -10,26 +15,46 @@ use std::path::{Path, PathBuf};
 /// A file being written next to its target.
 #[derive(Debug)]
 pub struct PendingFile {
-    temp: tempfile::TempPath,
+    /// `None` when the target is written directly (not a regular file).
+    temp: Option<tempfile::TempPath>,
     target: PathBuf,
 }
 
 impl PendingFile {
     /// Creates the temporary file next to `target` and opens it for writing.
     pub fn create(target: &Path) -> io::Result<(PendingFile, File)> {
+        if let Ok(meta) = std::fs::metadata(target)
+            && !meta.is_file()
+            && !meta.is_dir()
+        {
+            let file = std::fs::OpenOptions::new().write(true).open(target)?;
+            let pending = PendingFile {
+                temp: None,
+                target: target.to_path_buf(),
+            };
+            return Ok((pending, file));
+        }
+        let resolved;
+        let target = match std::fs::symlink_metadata(target) {
+            Ok(meta) if meta.file_type().is_symlink() => {
+                resolved = std::fs::canonicalize(target)?;
+                resolved.as_path()
+            }
+            _ => target,
+        };
         let name = target
             .file_name()
             .map(|n| n.to_string_lossy().into_owned())
             .unwrap_or_default();
-        let prefix = format!(".{name}.");
+        let prefix = temporary_prefix(&name);
         let mut builder = tempfile::Builder::new();
-        builder.prefix(&prefix).suffix(".tmp");
+        builder.prefix(&prefix);
         // An ordinary file once renamed (temporary files are private by default).
         #[cfg(unix)]
         builder.permissions(std::os::unix::fs::PermissionsExt::from_mode(0o644));
         let (file, temp) = builder.tempfile_in(dir_of(target))?.into_parts();
         let pending = PendingFile {
-            temp,
+            temp: Some(temp),
             target: target.to_path_buf(),
         };
         Ok((pending, file))
@@ -42,9 +67,10 @@ impl PendingFile {
         Ok(pending)
     }
 
-    /// The temporary file's path.
+    /// The path to write to: the temporary file's, or the target's when it
+    /// is written directly.
     pub fn path(&self) -> &Path {
-        &self.temp
+        self.temp.as_deref().unwrap_or(&self.target)
     }
 
     /// The final path.
@@ -54,8 +80,38 @@ impl PendingFile {
 
     /// Renames the finished file to its target.
     pub fn commit(self) -> io::Result<()> {
-        self.temp.persist(&self.target).map_err(|e| e.error)
+        match self.temp {
+            Some(temp) => temp.persist(&self.target).map_err(|e| e.error),
+            None => Ok(()),
+        }
     }
+}
+
+/// The start of a temporary file's name for a target named `name`: it says
+/// what the file is (`.golf.rrd.partial-Ab3dE1`).
+fn temporary_prefix(name: &str) -> String {
+    format!(".{name}.partial-")
+}
+
+/// Temporary files next to `target` left by earlier runs that never
+/// finished (a run killed while writing): `.{name}.partial-*`. Another run
+/// writing the same target at this moment also has one, so they are
+/// reported, not removed.
+pub fn unfinished_temporaries(target: &Path) -> Vec<PathBuf> {
+    let Some(name) = target.file_name().map(|n| n.to_string_lossy().into_owned()) else {
+        return Vec::new();
+    };
+    let prefix = temporary_prefix(&name);
+    let Ok(entries) = std::fs::read_dir(dir_of(target)) else {
+        return Vec::new();
+    };
+    let mut found: Vec<PathBuf> = entries
+        .filter_map(Result::ok)
+        .filter(|e| e.file_name().to_string_lossy().starts_with(&prefix))
+        .map(|e| e.path())
+        .collect();
+    found.sort();
+    found
 }
 
 fn dir_of(target: &Path) -> &Path {

@@ -798,7 +798,7 @@ fn bless_binary_requires_output_and_keeps_input() -> Result<(), String> {
     let leftovers: Vec<_> = std::fs::read_dir(dir.path())
         .map_err(|e| e.to_string())?
         .filter_map(Result::ok)
-        .filter(|e| e.file_name().to_string_lossy().ends_with(".tmp"))
+        .filter(|e| e.file_name().to_string_lossy().contains(".partial-"))
         .collect();
     ensure!(leftovers.is_empty(), "temporary files left: {leftovers:?}");
     // A trace that cannot be replayed is refused and nothing is written.

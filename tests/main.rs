@@ -10,6 +10,7 @@ mod core_cases;
 mod core_decisions;
 mod core_random;
 mod oracle;
+mod outputs;
 mod prefetch;
 mod record;
 mod replay;
@@ -85,5 +86,6 @@ fn main() {
     trials.extend(replay::tests());
     trials.extend(record::tests());
     trials.extend(prefetch::tests());
+    trials.extend(outputs::tests());
     libtest_mimic::run(&args, trials).exit();
 }

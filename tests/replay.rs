@@ -45,6 +45,7 @@ pub fn tests() -> Vec<Trial> {
         trial!(blueprint_is_reproducible),
         trial!(parallel_iterator_equals_sequential),
         trial!(rrd_shows_edges_features_and_explanations),
+        trial!(rrd_marks_fragile_decisions),
         trial!(viewer_and_check_agree_on_divergences),
     ]
 }
@@ -623,7 +624,7 @@ fn worked_sweeps() -> Vec<SweepMsg> {
 /// Values decoded from an `.rrd`: per entity and component, the values at
 /// each frame (static data at frame `i64::MIN`).
 #[derive(Default)]
-struct Decoded {
+pub(crate) struct Decoded {
     scalars: BTreeMap<(String, String), BTreeMap<i64, Vec<f64>>>,
     texts: BTreeMap<(String, String), BTreeMap<i64, Vec<String>>>,
     translations: BTreeMap<String, BTreeMap<i64, [f32; 3]>>,
@@ -664,7 +665,7 @@ impl Decoded {
     }
 }
 
-fn decode_rrd(path: &std::path::Path) -> Result<Decoded, String> {
+pub(crate) fn decode_rrd(path: &std::path::Path) -> Result<Decoded, String> {
     use rerun::external::re_log_encoding::DecoderApp;
     use rerun::log::{Chunk, LogMsg};
     let file = std::fs::File::open(path).map_err(|e| e.to_string())?;
@@ -1439,6 +1440,42 @@ fn parallel_iterator_equals_sequential() -> Result<(), String> {
             "batch {batch}: summary {summary:?}"
         );
     }
+    Ok(())
+}
+
+/// Fragile decisions are marked on the timeline, and only they: on the
+/// cube, a drop onto the shared edge `x = 1, z = 1` (two triangles tie, the
+/// path parallel to the `+x` face) and a drop onto the middle of a face.
+fn rrd_marks_fragile_decisions() -> Result<(), String> {
+    let dir = tempfile::tempdir().map_err(|e| e.to_string())?;
+    let path = dir.path().join("cube.rrd");
+    let s = |frame, p0, p1| SweepMsg {
+        frame,
+        ball: 0,
+        radius: 0.5,
+        p0,
+        p1,
+    };
+    let sweeps = [
+        s(0, [1.25, 0.125, 3.0], [1.25, 0.125, -3.0]),
+        s(1, [0.3, 0.2, 3.0], [0.3, 0.2, 0.0]),
+    ];
+    let results = write_rrd(events_for(cube_scene(), &sweeps), Detail::Primary, &path)?;
+    let d = decode_rrd(&path)?;
+    let fragile: std::collections::BTreeSet<i64> = results
+        .iter()
+        .filter(|r| !r.outcome.fragile.is_robust())
+        .map(|r| r.frame as i64)
+        .collect();
+    ensure!(
+        fragile == [0].into_iter().collect(),
+        "fragile decisions at {fragile:?}"
+    );
+    ensure!(
+        d.frames_with("/status/ball/0/fragile", "Scalars:scalars") == fragile,
+        "fragile marks at {:?}",
+        d.frames_with("/status/ball/0/fragile", "Scalars:scalars")
+    );
     Ok(())
 }
 

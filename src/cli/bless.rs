@@ -44,6 +44,7 @@ pub fn run(args: Args) -> anyhow::Result<RunOutcome> {
         (None, true) => args.trace.clone(),
         _ => bail!("say where the blessed trace goes: -o OUT, or --in-place"),
     };
+    super::warn_unfinished(&output);
     let summary = bless_file(&args.trace, &output, ReplayOptions::default())
         .with_context(|| format!("blessing {}", args.trace.display()))?;
     eprintln!(

@@ -142,8 +142,10 @@ fn write_failure_rrd(trace: &Path, dir: &Path, report: &TraceReport) -> anyhow::
     let bytes = std::fs::read(trace).with_context(|| format!("reading {name}"))?;
     let id = super::recording_id(bytes.as_slice(), "check", &options)
         .with_context(|| format!("reading {name}"))?;
-    let sink = rerun::sink::FileSink::new(temp.path())
-        .with_context(|| format!("opening {} for writing", temp.path().display()))?;
+    let rrd_error = |e: viz::rrd_file::RrdFileError| {
+        anyhow::anyhow!("writing {}: {}", target.display(), e.reason)
+    };
+    let (sink, writer) = viz::rrd_file::create(temp.path()).map_err(rrd_error)?;
     let rec = viz::builder(&id, &format!("{name} (check, frames {frames})"))
         .set_sinks(vec![Box::new(sink) as Box<dyn rerun::sink::LogSink>])
         .context("creating the recording")?;
@@ -164,6 +166,7 @@ fn write_failure_rrd(trace: &Path, dir: &Path, report: &TraceReport) -> anyhow::
     let rec = logger.finish();
     rec.flush_blocking().context("flushing the recording")?;
     drop(rec);
+    writer.finish().map_err(rrd_error)?;
     temp.commit()
         .with_context(|| format!("renaming the finished file to {}", target.display()))?;
     Ok(target)

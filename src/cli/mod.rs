@@ -108,6 +108,23 @@ pub fn recording_id(
     Ok(hasher.finish())
 }
 
+/// Warns about temporary files an interrupted earlier run left next to
+/// `target`, and says how to remove them.
+pub fn warn_unfinished(target: &std::path::Path) {
+    let found = sweeptrace::atomic::unfinished_temporaries(target);
+    if found.is_empty() {
+        return;
+    }
+    let names: Vec<String> = found.iter().map(|p| p.display().to_string()).collect();
+    eprintln!(
+        "warning: {} unfinished temporary file(s) of {} from an interrupted earlier run \
+         (the target itself was not touched); remove them with: rm {}",
+        found.len(),
+        target.display(),
+        names.join(" ")
+    );
+}
+
 /// Parses `x,y,z` into three finite numbers.
 pub fn parse_point(s: &str) -> Result<[f64; 3], String> {
     let parts: Vec<&str> = s.split(',').map(str::trim).collect();

@@ -158,6 +158,7 @@ pub fn run(args: Args) -> anyhow::Result<RunOutcome> {
     let scene_msg = sim::scene_message(&scene, &options);
 
     let bar = progress_bar(options.frames);
+    super::warn_unfinished(&output);
     let summary = write_trace_file(&output, |writer| -> anyhow::Result<SimSummary> {
         writer.scene(0, &scene_msg)?;
         let mut shown = 0;

@@ -96,6 +96,7 @@ impl<R: Read> Read for CountingReader<R> {
 
 /// A temporary file next to `target`, with the error naming where.
 fn pending_file(target: &Path) -> anyhow::Result<PendingFile> {
+    super::warn_unfinished(target);
     PendingFile::new(target)
         .with_context(|| format!("creating a temporary file next to {}", target.display()))
 }
@@ -169,10 +170,11 @@ pub fn run(args: Args) -> anyhow::Result<RunOutcome> {
         let mut sinks: Vec<Box<dyn rerun::sink::LogSink>> = Vec::new();
         if let Some(path) = &rrd_path {
             let pending = pending_file(path)?;
-            let sink = rerun::sink::FileSink::new(pending.path())
-                .with_context(|| format!("opening {} for writing", pending.path().display()))?;
+            let (sink, writer) = viz::rrd_file::create(pending.path()).map_err(|e| {
+                anyhow::anyhow!("writing the recording {}: {}", path.display(), e.reason)
+            })?;
             sinks.push(Box::new(sink));
-            rrd_file = Some(pending);
+            rrd_file = Some((pending, writer));
         }
         if args.spawn {
             let info = rerun::spawn(&rerun::SpawnOptions::default())
@@ -207,12 +209,17 @@ pub fn run(args: Args) -> anyhow::Result<RunOutcome> {
     }
 
     // The outcomes.
+    let writing_outcomes = match &args.outcomes {
+        Some(p) if p.as_os_str() != "-" => format!("writing the outcomes to {}", p.display()),
+        _ => "writing the outcomes to stdout".to_string(),
+    };
     let mut outcomes = match &args.outcomes {
         None => None,
         Some(p) if p.as_os_str() == "-" => {
             Some(OutcomeSink::Stdout(BufWriter::new(std::io::stdout())))
         }
         Some(p) => {
+            super::warn_unfinished(p);
             let (pending, f) = PendingFile::create(p)
                 .with_context(|| format!("creating a temporary file next to {}", p.display()))?;
             Some(OutcomeSink::File(BufWriter::new(f), pending))
@@ -276,7 +283,7 @@ pub fn run(args: Args) -> anyhow::Result<RunOutcome> {
                             Some(line) => line,
                             None => result.outcome_line().context("serializing an outcome")?,
                         };
-                        writeln!(o.writer(), "{line}").context("writing outcomes")?;
+                        writeln!(o.writer(), "{line}").with_context(|| writing_outcomes.clone())?;
                     }
                 }
                 Err(ReplayError::Trace(err)) => {
@@ -305,20 +312,26 @@ pub fn run(args: Args) -> anyhow::Result<RunOutcome> {
         rec.flush_blocking().context("flushing the recording")?;
         drop(rec);
     }
-    if let Some(pending) = rrd_file {
+    if let Some((pending, writer)) = rrd_file {
         let target = pending.target().to_path_buf();
+        writer.finish().map_err(|e| {
+            anyhow::anyhow!("writing the recording {}: {}", target.display(), e.reason)
+        })?;
         complete(pending)?;
         eprintln!("wrote the recording to {}", target.display());
     }
     match outcomes {
-        Some(OutcomeSink::Stdout(mut w)) => w.flush().context("writing outcomes")?,
+        Some(OutcomeSink::Stdout(mut w)) => w.flush().context(writing_outcomes.clone())?,
         Some(OutcomeSink::File(mut w, pending)) => {
-            w.flush().context("writing outcomes")?;
-            w.into_inner()
+            w.flush().context(writing_outcomes.clone())?;
+            let file = w
+                .into_inner()
                 .map_err(|e| e.into_error())
-                .context("writing outcomes")?
-                .sync_all()
-                .ok();
+                .context(writing_outcomes.clone())?;
+            // A device or a pipe cannot be synced; a file must reach the disk.
+            if file.metadata().is_ok_and(|m| m.is_file()) {
+                file.sync_all().context(writing_outcomes.clone())?;
+            }
             let target = pending.target().to_path_buf();
             complete(pending)?;
             eprintln!("wrote the outcomes to {}", target.display());

@@ -46,6 +46,7 @@ pub fn outcome_json(o: &Outcome) -> serde_json::Value {
     if let Some(object) = value.as_object_mut() {
         object.remove("frame");
         object.remove("ball");
+        object.insert("fragile".into(), json!(o.fragile));
     }
     value
 }
@@ -123,6 +124,17 @@ pub fn sweep_text(r: &SweepReport) -> String {
     )
     .unwrap();
     writeln!(s, "outcome: {}", outcome_line(r.outcome)).unwrap();
+    if r.outcome.fragile.is_robust() {
+        writeln!(s, "decision: robust").unwrap();
+    } else {
+        writeln!(
+            s,
+            "decision: fragile ({}): a change of the inputs at the level of their rounding \
+             could change it (docs/SEMANTICS.md, \"Fragile decisions\")",
+            r.outcome.fragile
+        )
+        .unwrap();
+    }
     let shown = shown_records(r);
     let hidden = r.records.len() - shown.len();
     if shown.is_empty() {

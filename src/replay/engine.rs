@@ -277,6 +277,12 @@ impl Replay {
         self.summary.sweeps += 1;
         self.summary.elapsed += elapsed;
         *self.summary.outcomes.entry(outcome.kind).or_default() += 1;
+        if !outcome.fragile.is_robust() {
+            self.summary.fragile += 1;
+            for reason in outcome.fragile.iter() {
+                *self.summary.fragile_by_reason.entry(reason).or_default() += 1;
+            }
+        }
         self.pending.push(SweepResult {
             frame: msg.frame,
             ball: msg.ball,

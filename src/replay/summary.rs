@@ -3,7 +3,7 @@
 use std::collections::BTreeMap;
 use std::time::Duration;
 
-use crate::core::{Kind, Verdict};
+use crate::core::{FragileReason, Kind, Verdict};
 
 /// Counts of a replay.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -27,6 +27,11 @@ pub struct ReplaySummary {
     /// `/expected` messages for a replayed `(frame, ball)` that arrived too
     /// late to be attached, or that match no sweep at all.
     pub expected_unmatched: u64,
+    /// Replayed sweeps whose decision is fragile (rounding at the level of
+    /// the inputs could change it; see [`crate::core::FragileReason`]).
+    pub fragile: u64,
+    /// Fragile decisions by reason (a decision can have several).
+    pub fragile_by_reason: BTreeMap<FragileReason, u64>,
     /// Time spent in the collision core and the bookkeeping (not reading).
     pub elapsed: Duration,
 }
@@ -73,6 +78,19 @@ impl ReplaySummary {
                 s,
                 "expected outcomes: {} attached, {} unmatched",
                 self.expected_matched, self.expected_unmatched
+            );
+        }
+        if self.fragile > 0 {
+            let reasons = self
+                .fragile_by_reason
+                .iter()
+                .map(|(r, n)| format!("{} {n}", r.as_str()))
+                .collect::<Vec<_>>()
+                .join(", ");
+            let _ = writeln!(
+                s,
+                "fragile decisions: {} of {} ({reasons})",
+                self.fragile, self.sweeps
             );
         }
         if self.degenerate_triangles > 0 {

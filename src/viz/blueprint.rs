@@ -170,7 +170,10 @@ pub fn blueprint_messages(
         &format!("Face h0, h1, β (ball {ball})"),
         &format!("{}/ball/{ball}/face", paths::PLOTS),
     )?;
-    let status = b.plot("Divergent (1) per ball", paths::STATUS)?;
+    let status = b.plot(
+        "Divergent (1) and fragile decisions (…/fragile) per ball",
+        paths::STATUS,
+    )?;
     let log = b.view("TextLog", "Decisions", paths::LOG, &["$origin/**"])?;
 
     let root = match layout {

@@ -73,6 +73,9 @@ pub(crate) fn write_decision_line(
             None => {}
         }
     }
+    if !o.fragile.is_robust() {
+        let _ = write!(s, " [fragile decision: {}]", o.fragile);
+    }
     if let (false, Some(e)) = (diffs.is_empty(), &r.expected) {
         s.push_str(" [differs from the expected outcome in ");
         write_fields(s, diffs);

@@ -33,6 +33,7 @@ mod logger;
 pub mod paths;
 pub mod pipeline;
 mod rows;
+pub mod rrd_file;
 
 use rerun::RecordingStreamBuilder;
 

@@ -34,6 +34,7 @@
 //! plots/ball/{ball}/face/{h0,h1,beta} Scalars of the decisive face test
 //! status/ball/{ball}                  Scalars: 0 when the sweep matches its expectation,
 //!                                     1 when it diverges (sweeps with an expectation only)
+//! status/ball/{ball}/fragile          Scalars: 1 at each fragile decision (absent elsewhere)
 //! log                                 TextLog: one line per sweep, the decision in words
 //! divergences                         TextLog: one line per divergent sweep only
 //! ```
@@ -93,6 +94,11 @@ pub fn expected_normal(ball: u32) -> String {
 /// The divergence status series of one ball.
 pub fn status(ball: u32) -> String {
     format!("status/ball/{ball}")
+}
+
+/// The fragile-decision marks of one ball.
+pub fn fragile(ball: u32) -> String {
+    format!("status/ball/{ball}/fragile")
 }
 
 /// Under [`edge_frame`]: the frame's axes.
@@ -215,6 +221,7 @@ pub(crate) enum Entity {
     ExpectedContact(u32),
     ExpectedNormal(u32),
     Status(u32),
+    Fragile(u32),
     Divergences,
     Alpha(u32),
     /// Index into [`QUADRATIC_NAMES`].
@@ -248,6 +255,7 @@ impl Entity {
             Entity::ExpectedContact(b) => expected_contact(b),
             Entity::ExpectedNormal(b) => expected_normal(b),
             Entity::Status(b) => status(b),
+            Entity::Fragile(b) => fragile(b),
             Entity::Divergences => DIVERGENCES.to_string(),
             Entity::Alpha(b) => alpha(b),
             Entity::Quadratic(b, i) => quadratic(b, QUADRATIC_NAMES[i]),

@@ -438,6 +438,9 @@ pub(crate) fn text_rows(
             if divergent { 1.0 } else { 0.0 },
         );
     }
+    if !r.outcome.fragile.is_robust() {
+        scalar(out, Entity::Fragile(r.ball), 1.0);
+    }
     if divergent {
         out.row(Entity::Divergences, set::TEXT_LOG)
             .put_texts(TextLog::descriptor_text, |t| {

@@ -1,0 +1,230 @@
+//! Output files: written under a temporary name and renamed, except where
+//! renaming would do harm (a device or a named pipe is written directly; a
+//! symbolic link keeps pointing at the finished file).
+
+use libtest_mimic::Trial;
+
+use crate::trial;
+
+pub fn tests() -> Vec<Trial> {
+    vec![
+        trial(
+            "outputs::symlink_target_keeps_the_link",
+            symlink_target_keeps_the_link,
+        ),
+        trial(
+            "outputs::named_pipe_is_written_directly",
+            named_pipe_is_written_directly,
+        ),
+        trial(
+            "outputs::full_disk_is_a_clear_error",
+            full_disk_is_a_clear_error,
+        ),
+        trial(
+            "outputs::killed_mid_write_leaves_the_target_intact",
+            killed_mid_write_leaves_the_target_intact,
+        ),
+    ]
+}
+
+fn sample_trace() -> std::path::PathBuf {
+    std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("traces/record_cube_corner_margin.mcap")
+}
+
+fn replay_outcomes(target: &std::path::Path) -> Result<std::process::Output, String> {
+    std::process::Command::new(env!("CARGO_BIN_EXE_sweeptrace"))
+        .arg("replay")
+        .arg(sample_trace())
+        .arg("--outcomes")
+        .arg(target)
+        .output()
+        .map_err(|e| e.to_string())
+}
+
+/// `--outcomes link.jsonl` where the link points at another file: the link
+/// stays a link and the file it points at holds the outcomes.
+fn symlink_target_keeps_the_link() -> Result<(), String> {
+    let dir = tempfile::tempdir().map_err(|e| e.to_string())?;
+    let real = dir.path().join("real.jsonl");
+    let link = dir.path().join("link.jsonl");
+    std::fs::write(&real, "old\n").map_err(|e| e.to_string())?;
+    std::os::unix::fs::symlink(&real, &link).map_err(|e| e.to_string())?;
+    let out = replay_outcomes(&link)?;
+    if !out.status.success() {
+        return Err(format!(
+            "replay failed: {}",
+            String::from_utf8_lossy(&out.stderr)
+        ));
+    }
+    let meta = std::fs::symlink_metadata(&link).map_err(|e| e.to_string())?;
+    if !meta.file_type().is_symlink() {
+        return Err("the symbolic link was replaced by a file".into());
+    }
+    let text = std::fs::read_to_string(&real).map_err(|e| e.to_string())?;
+    if !(text.starts_with("{\"frame\":") && text.lines().count() > 100) {
+        return Err(format!(
+            "the linked file holds {} lines",
+            text.lines().count()
+        ));
+    }
+    Ok(())
+}
+
+/// `--outcomes fifo`: the pipe is written to (a reader receives every line)
+/// and is still a pipe afterwards, not a regular file renamed over it.
+fn named_pipe_is_written_directly() -> Result<(), String> {
+    let dir = tempfile::tempdir().map_err(|e| e.to_string())?;
+    let fifo = dir.path().join("outcomes.fifo");
+    let status = std::process::Command::new("mkfifo")
+        .arg(&fifo)
+        .status()
+        .map_err(|e| format!("mkfifo: {e}"))?;
+    if !status.success() {
+        return Err("mkfifo failed".into());
+    }
+    let reader = {
+        let fifo = fifo.clone();
+        std::thread::spawn(move || std::fs::read_to_string(fifo).map_err(|e| e.to_string()))
+    };
+    let out = replay_outcomes(&fifo)?;
+    let text = reader.join().map_err(|_| "reader panicked")??;
+    if !out.status.success() {
+        return Err(format!(
+            "replay failed: {}",
+            String::from_utf8_lossy(&out.stderr)
+        ));
+    }
+    use std::os::unix::fs::FileTypeExt;
+    let meta = std::fs::symlink_metadata(&fifo).map_err(|e| e.to_string())?;
+    if !meta.file_type().is_fifo() {
+        return Err("the named pipe was replaced by a file".into());
+    }
+    if text.lines().count() < 100 {
+        return Err(format!("the reader got {} lines", text.lines().count()));
+    }
+    Ok(())
+}
+
+/// `replay` with every output on a full device (`/dev/full` fails every
+/// write with "No space left on device"): it ends within seconds (the SDK's
+/// own file writer used to hang here), exits 2 and names the file and the
+/// operating system's reason.
+fn full_disk_is_a_clear_error() -> Result<(), String> {
+    if !std::path::Path::new("/dev/full").exists() {
+        return Err("/dev/full is missing: this test needs a Linux system".into());
+    }
+    for args in [["--rrd", "/dev/full"], ["--outcomes", "/dev/full"]] {
+        let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_sweeptrace"))
+            .arg("replay")
+            .arg(sample_trace())
+            .args(args)
+            .stdout(std::process::Stdio::null())
+            .stderr(std::process::Stdio::piped())
+            .spawn()
+            .map_err(|e| e.to_string())?;
+        // Not a measurement: a bound that only a hang exceeds.
+        let deadline = std::time::Instant::now() + std::time::Duration::from_secs(120);
+        let status = loop {
+            if let Some(status) = child.try_wait().map_err(|e| e.to_string())? {
+                break status;
+            }
+            if std::time::Instant::now() > deadline {
+                let _ = child.kill();
+                return Err(format!("replay {args:?} hangs on a full device"));
+            }
+            std::thread::sleep(std::time::Duration::from_millis(50));
+        };
+        let mut stderr = String::new();
+        if let Some(mut e) = child.stderr.take() {
+            use std::io::Read;
+            e.read_to_string(&mut stderr).map_err(|e| e.to_string())?;
+        }
+        if status.code() != Some(2) {
+            return Err(format!(
+                "replay {args:?}: exit {:?}: {stderr}",
+                status.code()
+            ));
+        }
+        if !(stderr.contains("/dev/full") && stderr.contains("No space left on device")) {
+            return Err(format!(
+                "replay {args:?}: the error names neither file nor cause: {stderr}"
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// `replay --rrd` killed (SIGKILL) at several moments: the earlier recording
+/// under the target name is intact or replaced by a complete new one (never
+/// a partial file), and what is left over is a temporary file whose name
+/// says what it is, which the next run reports with how to remove it.
+fn killed_mid_write_leaves_the_target_intact() -> Result<(), String> {
+    let dir = tempfile::tempdir().map_err(|e| e.to_string())?;
+    let target = dir.path().join("golf.rrd");
+    let trace =
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("traces/record_mini_golf.mcap");
+    let replay = |extra: &[&str]| {
+        let mut command = std::process::Command::new(env!("CARGO_BIN_EXE_sweeptrace"));
+        command
+            .arg("replay")
+            .arg(&trace)
+            .arg("--rrd")
+            .arg(&target)
+            .args(extra)
+            .stdout(std::process::Stdio::null())
+            .stderr(std::process::Stdio::piped());
+        command
+    };
+    let first = replay(&[]).output().map_err(|e| e.to_string())?;
+    if !first.status.success() {
+        return Err(String::from_utf8_lossy(&first.stderr).into_owned());
+    }
+    let complete = std::fs::read(&target).map_err(|e| e.to_string())?;
+    // Kill at several points of a run (the delays only vary where the run
+    // is when killed; the property must hold at any of them).
+    for delay_ms in [0u64, 20, 60, 150, 400] {
+        let mut child = replay(&["--detail", "all"])
+            .spawn()
+            .map_err(|e| e.to_string())?;
+        std::thread::sleep(std::time::Duration::from_millis(delay_ms));
+        let _ = child.kill();
+        let _ = child.wait();
+        let now = std::fs::read(&target).map_err(|e| e.to_string())?;
+        // Intact, or a complete recording of the new run (Rerun's decoder
+        // reads it to its end): never a partial file.
+        if now != complete {
+            crate::replay::decode_rrd(&target).map_err(|e| {
+                format!("after a kill at {delay_ms} ms the target does not decode: {e}")
+            })?;
+        }
+        let leftovers: Vec<String> = std::fs::read_dir(dir.path())
+            .map_err(|e| e.to_string())?
+            .filter_map(Result::ok)
+            .map(|e| e.file_name().to_string_lossy().into_owned())
+            .filter(|n| n != "golf.rrd")
+            .collect();
+        if let Some(odd) = leftovers
+            .iter()
+            .find(|n| !n.starts_with(".golf.rrd.partial-"))
+        {
+            return Err(format!("an unexpected file is left: {odd}"));
+        }
+        if !leftovers.is_empty() {
+            // The next run names them and says how to remove them.
+            let next = replay(&[]).output().map_err(|e| e.to_string())?;
+            let stderr = String::from_utf8_lossy(&next.stderr);
+            if !(next.status.success()
+                && stderr.contains("unfinished temporary file")
+                && stderr.contains("rm "))
+            {
+                return Err(format!(
+                    "the next run does not report the leftovers: {stderr}"
+                ));
+            }
+            for name in leftovers {
+                std::fs::remove_file(dir.path().join(name)).map_err(|e| e.to_string())?;
+            }
+        }
+    }
+    Ok(())
+}

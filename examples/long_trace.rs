@@ -11,6 +11,10 @@
 //! frame, starting up to 0.6 above the ground and moving up to 0.3 sideways
 //! and 0.5 down, so that some sweeps hit and most do not. Seeded: the same
 //! arguments give the same file.
+//!
+//! Each sweep starts at a new random place, so the balls jump between
+//! sweeps and often start within ρ of the ground: replaying it reports many
+//! tunnels, on purpose (it measures the work, not a plausible engine).
 
 use std::io::{Seek, Write};
 

@@ -16,6 +16,7 @@ mod record;
 mod replay;
 mod support;
 mod trace_io;
+mod tunnel;
 
 /// What a test function returns on success: `()`, or a [`Completion`] for a
 /// test that finds at run time that it cannot run here and says why
@@ -87,5 +88,6 @@ fn main() {
     trials.extend(record::tests());
     trials.extend(prefetch::tests());
     trials.extend(outputs::tests());
+    trials.extend(tunnel::tests());
     libtest_mimic::run(&args, trials).exit();
 }

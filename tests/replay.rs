@@ -626,7 +626,7 @@ fn worked_sweeps() -> Vec<SweepMsg> {
 #[derive(Default)]
 pub(crate) struct Decoded {
     scalars: BTreeMap<(String, String), BTreeMap<i64, Vec<f64>>>,
-    texts: BTreeMap<(String, String), BTreeMap<i64, Vec<String>>>,
+    pub(crate) texts: BTreeMap<(String, String), BTreeMap<i64, Vec<String>>>,
     translations: BTreeMap<String, BTreeMap<i64, [f32; 3]>>,
     quaternions: BTreeMap<String, BTreeMap<i64, [f32; 4]>>,
     timelines: std::collections::BTreeSet<String>,
@@ -635,7 +635,7 @@ pub(crate) struct Decoded {
     static_entities: std::collections::BTreeSet<String>,
     /// Per entity and frame, the components of its rows there (a `Clear`
     /// row shows as `Clear:is_recursive`).
-    components: BTreeMap<String, BTreeMap<i64, std::collections::BTreeSet<String>>>,
+    pub(crate) components: BTreeMap<String, BTreeMap<i64, std::collections::BTreeSet<String>>>,
     /// Blueprint entity paths, per blueprint store (in the order received).
     blueprint_paths: Vec<Vec<String>>,
 }
@@ -643,7 +643,11 @@ pub(crate) struct Decoded {
 impl Decoded {
     /// The frames at which `entity` has a row with `component` (with
     /// values).
-    fn frames_with(&self, entity: &str, component: &str) -> std::collections::BTreeSet<i64> {
+    pub(crate) fn frames_with(
+        &self,
+        entity: &str,
+        component: &str,
+    ) -> std::collections::BTreeSet<i64> {
         self.components
             .get(entity)
             .map(|m| {
@@ -1055,7 +1059,7 @@ fn cli_writes_outcomes_and_rrd() -> Result<(), String> {
             sorted
                 == [
                     "alpha", "ball", "contact", "feature", "fragile", "frame", "kind", "normal",
-                    "triangle"
+                    "triangle", "tunnel"
                 ],
             "fields {keys:?}"
         );
@@ -1065,6 +1069,7 @@ fn cli_writes_outcomes_and_rrd() -> Result<(), String> {
             .as_object_mut()
             .and_then(|o| o.remove("fragile"))
             .ok_or("no fragile field")?;
+        value.as_object_mut().and_then(|o| o.remove("tunnel"));
         let o: OutcomeMsg = serde_json::from_value(value).map_err(|e| e.to_string())?;
         let want = sweep_mesh(
             &mesh,

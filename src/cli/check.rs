@@ -26,11 +26,12 @@ Examples:
   sweeptrace check run.mcap --tolerance 1e-4 --normal-tolerance 0.5
   sweeptrace check traces/ --json --rrd-on-failure /tmp/failures
 
-Per trace: `ok`, `FAIL` (with the first divergences explained),
-`NO EXPECTATIONS` (no /expected channel, or none matches a sweep: never a
-pass) or `ERROR`. Exit status: 0 every trace matches, 1 a divergence was
-found, 2 something could not be checked (bad input, I/O error, no
-expectations).")]
+Per trace: `ok`, `FAIL` (with the first divergences explained, and every
+tunnel: a ball's centre that went through a triangle from its front to its
+back, named by frame, ball, triangle and point), `NO EXPECTATIONS` (no
+/expected channel, or none matches a sweep: never a pass) or `ERROR`. Exit
+status: 0 every trace matches, 1 a divergence or a tunnel was found, 2
+something could not be checked (bad input, I/O error, no expectations).")]
 pub struct Args {
     /// Trace files, or directories searched recursively for `*.mcap`.
     #[arg(value_name = "TRACE|DIR", required = true)]
@@ -46,6 +47,12 @@ pub struct Args {
     /// and do not fail the check.
     #[arg(long)]
     pub strict: bool,
+    /// Count and list tunnels (a ball's centre through a triangle, front to
+    /// back, during a sweep or between two sweeps of a ball) without failing
+    /// the check. Without it a tunnel fails the check: it is a bug of the
+    /// engine that recorded the trace, whatever its expectations say.
+    #[arg(long)]
+    pub allow_tunnels: bool,
     /// How many divergences per trace are explained in detail.
     #[arg(long, value_name = "N", default_value_t = DEFAULT_MAX_DETAILS)]
     pub max_details: usize,
@@ -77,6 +84,7 @@ pub fn run(args: Args) -> anyhow::Result<RunOutcome> {
         tolerances,
         max_details: args.max_details,
         strict: args.strict,
+        fail_on_tunnel: !args.allow_tunnels,
         replay: ReplayOptions::default(),
     };
     let mut reports: Vec<TraceReport> = Vec::new();
@@ -124,7 +132,7 @@ pub fn run(args: Args) -> anyhow::Result<RunOutcome> {
 /// `dir/<stem>.rrd` (written under a temporary name and renamed).
 fn write_failure_rrd(trace: &Path, dir: &Path, report: &TraceReport) -> anyhow::Result<PathBuf> {
     let frames = frames_around(report, RRD_CONTEXT_FRAMES, RRD_CONTEXT_FRAMES)
-        .context("no divergence to record")?;
+        .context("no divergence or tunnel to record")?;
     let stem = trace
         .file_stem()
         .map(|s| s.to_string_lossy().into_owned())

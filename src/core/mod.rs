@@ -11,8 +11,13 @@
 //! Two entry points share one implementation: [`sweep_mesh`] (fast, no
 //! allocation) and [`sweep_mesh_with`] (hands every test's record to an
 //! [`Observer`]).
+//!
+//! [`first_crossing`] is a separate query: where a segment (a ball's centre
+//! moving) passes through a triangle from its front to its back, the fact
+//! behind a tunnel.
 
 mod bvh;
+mod crossing;
 mod error;
 pub mod explain;
 mod fragility;
@@ -26,6 +31,7 @@ mod sweep_face;
 mod sweep_mesh;
 mod sweep_vertex;
 
+pub use crossing::{Crossing, crossing_tolerance, first_crossing, triangle_crossing};
 pub use error::{MeshError, SweepError};
 pub use fragility::{FragileReason, Fragility};
 pub use mesh::{DegenerateReason, DegenerateTriangle, Mesh, StandardFrame, Triangle};

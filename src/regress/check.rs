@@ -19,7 +19,7 @@ use std::fmt::Write as _;
 
 use serde::Serialize;
 
-use crate::replay::{ReplayError, ReplayEvent, ReplayOptions, SweepResult};
+use crate::replay::{ReplayError, ReplayEvent, ReplayOptions, SweepResult, Tunnel, TunnelAt};
 use crate::run::RunOutcome;
 use crate::trace::messages::{EXPECTED_TOPIC, OutcomeMsg};
 use crate::trace::{TraceError, TraceEvent, TraceReader};
@@ -29,6 +29,37 @@ use super::explain::{ExpectedTest, expected_tests, explain_outcome, explained_re
 
 /// Default number of divergences described in detail per trace.
 pub const DEFAULT_MAX_DETAILS: usize = 3;
+/// How many tunnels a report lists, one line each.
+pub const MAX_LISTED_TUNNELS: usize = 10;
+
+/// A tunnel found in a trace: a ball's centre went through a triangle from
+/// its front to its back, during a sweep or between two of its sweeps (see
+/// [`crate::replay::Tunnel`]).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct TunnelReport {
+    /// Frame of the sweep.
+    pub frame: u64,
+    /// Ball.
+    pub ball: u32,
+    /// `log_time` of the sweep, in nanoseconds.
+    pub log_time_nanos: u64,
+    /// The tunnel: kind, triangle, point, fraction, from, to,
+    /// previous_frame.
+    #[serde(flatten)]
+    pub tunnel: Tunnel,
+}
+
+impl TunnelReport {
+    /// One line for people: frame, ball, triangle, where.
+    pub fn line(&self) -> String {
+        TunnelAt {
+            frame: self.frame,
+            ball: self.ball,
+            tunnel: self.tunnel,
+        }
+        .to_string()
+    }
+}
 
 /// One sweep whose outcome differs from its expectation.
 #[derive(Clone, Debug, PartialEq, Serialize)]
@@ -75,10 +106,11 @@ pub struct Divergence {
 )]
 #[serde(rename_all = "snake_case")]
 pub enum Status {
-    /// Every expectation matched.
+    /// Every expectation matched, and no tunnel was found (or tunnels do
+    /// not fail the check).
     #[strum(serialize = "ok")]
     Ok,
-    /// At least one sweep diverged.
+    /// At least one sweep diverged, or a tunnel was found.
     #[strum(serialize = "FAIL")]
     Fail,
     /// Nothing to compare: no `/expected` channel, or no expectation matches
@@ -98,6 +130,11 @@ impl Status {
 }
 
 impl TraceReport {
+    /// Whether tunnels were found and fail the check.
+    pub fn fails_on_tunnels(&self) -> bool {
+        self.tunnels > 0 && self.fail_on_tunnel
+    }
+
     /// What the check of this trace came to: a divergence is
     /// [`RunOutcome::Differences`]; a trace that ends early
     /// [`RunOutcome::IncompleteInput`]; any other error, or nothing to
@@ -123,6 +160,9 @@ pub struct CheckOptions {
     pub max_details: usize,
     /// Whether a divergence on a fragile decision fails the check too.
     pub strict: bool,
+    /// Whether a tunnel fails the check (the default: it is a bug of the
+    /// recording engine, whatever the expectations say).
+    pub fail_on_tunnel: bool,
     /// The replay's options (frames, ball, overrides). `explain` and
     /// `detail` are ignored: the check runs the fast query and explains
     /// only the detailed divergences.
@@ -135,6 +175,7 @@ impl Default for CheckOptions {
             tolerances: Tolerances::default(),
             max_details: DEFAULT_MAX_DETAILS,
             strict: false,
+            fail_on_tunnel: true,
             replay: ReplayOptions::default(),
         }
     }
@@ -168,6 +209,16 @@ pub struct TraceReport {
     pub fragile_divergences: Vec<Divergence>,
     /// Whether fragile divergences fail the check (`--strict`).
     pub strict: bool,
+    /// Tunnels found: a ball's centre through a triangle, front to back,
+    /// during a sweep or between two sweeps of the ball. They fail the
+    /// check unless `fail_on_tunnel` is off.
+    pub tunnels: u64,
+    /// Tunnels by kind (`during_sweep`, `between_sweeps`).
+    pub tunnels_by_kind: BTreeMap<String, u64>,
+    /// The first tunnels (at most [`MAX_LISTED_TUNNELS`]), in trace order.
+    pub tunnel_details: Vec<TunnelReport>,
+    /// Whether tunnels fail the check.
+    pub fail_on_tunnel: bool,
     /// Replayed sweeps without an expectation.
     pub sweeps_without_expectation: u64,
     /// Expectations that match no replayed sweep (or arrived after theirs was
@@ -239,6 +290,10 @@ where
         fragile_by_reason: BTreeMap::new(),
         fragile_divergences: Vec::new(),
         strict: options.strict,
+        tunnels: 0,
+        tunnels_by_kind: BTreeMap::new(),
+        tunnel_details: Vec::new(),
+        fail_on_tunnel: options.fail_on_tunnel,
         sweeps_without_expectation: 0,
         expectations_without_sweep: 0,
         expectations: 0,
@@ -256,6 +311,21 @@ where
             Ok(ReplayEvent::Scene(_)) => {}
             Ok(ReplayEvent::Sweep(result)) => {
                 report.sweeps += 1;
+                for t in &result.tunnels {
+                    report.tunnels += 1;
+                    *report
+                        .tunnels_by_kind
+                        .entry(t.kind.as_str().to_string())
+                        .or_default() += 1;
+                    if report.tunnel_details.len() < MAX_LISTED_TUNNELS {
+                        report.tunnel_details.push(TunnelReport {
+                            frame: result.frame,
+                            ball: result.ball,
+                            log_time_nanos: result.log_time_nanos,
+                            tunnel: *t,
+                        });
+                    }
+                }
                 let Some(expected) = &result.expected else {
                     report.sweeps_without_expectation += 1;
                     continue;
@@ -336,7 +406,7 @@ fn error_text(err: &ReplayError) -> String {
 fn status_of(r: &TraceReport) -> Status {
     if !r.errors.is_empty() {
         Status::Error
-    } else if r.divergent > 0 {
+    } else if r.divergent > 0 || r.fails_on_tunnels() {
         Status::Fail
     } else if r.compared == 0 {
         Status::NoExpectations
@@ -367,24 +437,26 @@ fn divergence(
     }
 }
 
-/// A frame range around the first divergences: from `before` frames
-/// before the first divergent frame to `after` frames after the last one
-/// kept in detail (or the first, when none is kept in detail). `None` when
-/// there is no divergence.
+/// A frame range around the first failures: from `before` frames before
+/// the first divergent frame (or the first tunnel, or the sweep before a
+/// tunnel between sweeps) to `after` frames after the last divergence kept
+/// in detail (or the first, when none is kept in detail) and the first
+/// tunnel. `None` when there is neither a divergence nor a tunnel.
 pub fn frames_around(
     r: &TraceReport,
     before: u64,
     after: u64,
 ) -> Option<crate::replay::FrameRange> {
-    let first = *r.divergent_frames.first()?;
     let kept = r.divergences.len().max(1);
-    let last = r
-        .divergent_frames
-        .iter()
-        .take(kept)
-        .copied()
-        .max()
-        .unwrap_or(first);
+    let divergent = r.divergent_frames.iter().take(kept).copied();
+    let tunnel = r.tunnel_details.first().map(|t| t.frame).into_iter().chain(
+        r.tunnel_details
+            .first()
+            .and_then(|t| t.tunnel.previous_frame),
+    );
+    let frames: Vec<u64> = divergent.chain(tunnel).collect();
+    let first = frames.iter().copied().min()?;
+    let last = frames.iter().copied().max().unwrap_or(first);
     Some(crate::replay::FrameRange {
         start: Some(first.saturating_sub(before)),
         end: Some(last.saturating_add(after).saturating_add(1)),

@@ -19,8 +19,8 @@ mod render;
 
 pub use bless::{BlessError, BlessSummary, bless_bytes, bless_file};
 pub use check::{
-    CheckOptions, DEFAULT_MAX_DETAILS, Divergence, Status, TraceReport, check_events, check_file,
-    check_reader, find_traces, frames_around,
+    CheckOptions, DEFAULT_MAX_DETAILS, Divergence, MAX_LISTED_TUNNELS, Status, TraceReport,
+    TunnelReport, check_events, check_file, check_reader, find_traces, frames_around,
 };
 pub use compare::{
     Agreement, DEFAULT_ALPHA_TOLERANCE, DEFAULT_CONTACT_TOLERANCE,

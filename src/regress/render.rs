@@ -112,6 +112,26 @@ pub fn render_text(r: &TraceReport) -> String {
             }
         );
     }
+    if r.tunnels > 0 && !r.fail_on_tunnel {
+        let _ = write!(
+            counts,
+            ", {} {} (not failures: tunnels allowed)",
+            r.tunnels,
+            tunnel_words(r.tunnels)
+        );
+    }
+    let tunnel_lines = |s: &mut String| {
+        for t in &r.tunnel_details {
+            let _ = writeln!(s, "  tunnel: {}", t.line());
+        }
+        if r.tunnels as usize > r.tunnel_details.len() {
+            let _ = writeln!(
+                s,
+                "  ... {} more tunnels",
+                r.tunnels as usize - r.tunnel_details.len()
+            );
+        }
+    };
     let fragile_details = |s: &mut String| {
         for d in &r.fragile_divergences {
             let _ = writeln!(
@@ -124,20 +144,37 @@ pub fn render_text(r: &TraceReport) -> String {
     match r.status {
         Status::Ok => {
             let _ = writeln!(s, "ok {}: {counts}", r.trace);
+            tunnel_lines(&mut s);
             fragile_details(&mut s);
         }
         Status::Fail => {
-            let kinds = r
-                .by_kind
-                .iter()
-                .map(|(k, n)| format!("{k}: {n}"))
-                .collect::<Vec<_>>()
-                .join(", ");
-            let _ = writeln!(
-                s,
-                "FAIL {}: {} of {} compared sweeps diverge ({kinds}); {counts}",
-                r.trace, r.divergent, r.compared
-            );
+            let mut failures: Vec<String> = Vec::new();
+            if r.divergent > 0 || !r.fails_on_tunnels() {
+                let kinds = r
+                    .by_kind
+                    .iter()
+                    .map(|(k, n)| format!("{k}: {n}"))
+                    .collect::<Vec<_>>()
+                    .join(", ");
+                failures.push(format!(
+                    "{} of {} compared sweeps diverge ({kinds})",
+                    r.divergent, r.compared
+                ));
+            }
+            if r.fails_on_tunnels() {
+                failures.push(format!(
+                    "{} {} (a ball's centre went through a triangle from its front to its back: {})",
+                    r.tunnels,
+                    tunnel_words(r.tunnels),
+                    r.tunnels_by_kind
+                        .iter()
+                        .map(|(k, n)| format!("{k}: {n}"))
+                        .collect::<Vec<_>>()
+                        .join(", ")
+                ));
+            }
+            let _ = writeln!(s, "FAIL {}: {}; {counts}", r.trace, failures.join("; "));
+            tunnel_lines(&mut s);
             if r.divergences.is_empty()
                 && let Some(frame) = r.divergent_frames.first()
             {
@@ -192,6 +229,7 @@ pub fn render_text(r: &TraceReport) -> String {
                 )
             };
             let _ = writeln!(s, "NO EXPECTATIONS {}: {why}; {counts}", r.trace);
+            tunnel_lines(&mut s);
         }
         Status::Error => {
             let _ = writeln!(
@@ -204,12 +242,17 @@ pub fn render_text(r: &TraceReport) -> String {
             for e in r.errors.iter().skip(1) {
                 let _ = writeln!(s, "  also: {e}");
             }
+            tunnel_lines(&mut s);
             for d in &r.divergences {
                 s.push_str(&render_divergence(d, "  "));
             }
         }
     }
     s
+}
+
+fn tunnel_words(n: u64) -> &'static str {
+    if n == 1 { "tunnel" } else { "tunnels" }
 }
 
 /// The reports as one JSON document: `{"status": ..., "traces": [...]}`

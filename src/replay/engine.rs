@@ -13,6 +13,7 @@ use crate::core::{
 use crate::trace::TraceEvent;
 use crate::trace::messages::{OutcomeMsg, SceneMsg, SweepMsg};
 
+use super::tunnel::{BallEnds, Tunnel, sweep_end, tunnel_during_sweep};
 use super::{Detail, ReplayError, ReplayOptions, ReplaySummary};
 
 /// A scene of the trace, built into a mesh.
@@ -70,6 +71,10 @@ pub struct SweepResult {
     pub records: Vec<TestRecord>,
     /// The trace's `/expected` outcome for this `(frame, ball)`, if any.
     pub expected: Option<OutcomeMsg>,
+    /// Where the ball's centre went through a triangle front to back, in
+    /// the order it happened: between its previous sweep and this one, then
+    /// during this one (empty when it did not; see [`Tunnel`]).
+    pub tunnels: Vec<Tunnel>,
 }
 
 impl SweepResult {
@@ -79,18 +84,21 @@ impl SweepResult {
     }
 
     /// The line `replay --outcomes` writes: the outcome record, then the
-    /// additive `fragile` field (the reasons the decision is fragile, `[]`
-    /// when it is robust; see [`crate::core::FragileReason`]).
+    /// additive fields `fragile` (the reasons the decision is fragile, `[]`
+    /// when it is robust; see [`crate::core::FragileReason`]) and `tunnel`
+    /// (the first of [`SweepResult::tunnels`], `null` when there is none).
     pub fn outcome_line(&self) -> Result<String, serde_json::Error> {
         #[derive(serde::Serialize)]
-        struct Line {
+        struct Line<'a> {
             #[serde(flatten)]
             outcome: OutcomeMsg,
             fragile: crate::core::Fragility,
+            tunnel: Option<&'a Tunnel>,
         }
         serde_json::to_string(&Line {
             outcome: self.outcome_msg(),
             fragile: self.outcome.fragile,
+            tunnel: self.tunnels.first(),
         })
     }
 
@@ -130,6 +138,8 @@ pub struct Replay {
     early_expected: HashMap<(u64, u32), OutcomeMsg>,
     ready: VecDeque<ReplayEvent>,
     summary: ReplaySummary,
+    /// Where each ball's last replayed sweep left it.
+    ends: BallEnds,
 }
 
 impl Replay {
@@ -142,6 +152,7 @@ impl Replay {
             early_expected: HashMap::new(),
             ready: VecDeque::new(),
             summary: ReplaySummary::default(),
+            ends: BallEnds::default(),
         }
     }
 
@@ -189,6 +200,8 @@ impl Replay {
             options,
         });
         self.scene = Some(state.clone());
+        // A jump across a change of scene is not a move through a surface.
+        self.ends.clear();
         self.ready.push_back(ReplayEvent::Scene(state));
         self.summary.elapsed += start.elapsed();
         Ok(())
@@ -206,6 +219,8 @@ impl Replay {
         }
         if !self.wanted(msg.frame, msg.ball) {
             self.summary.filtered_out += 1;
+            // Where this sweep left the ball is not computed.
+            self.ends.forget(msg.ball);
             self.early_expected.remove(&(msg.frame, msg.ball));
             return Ok(());
         }
@@ -265,8 +280,25 @@ impl Replay {
             outcome,
             records,
             verdicts,
+            during,
             elapsed,
         } = computed;
+        let start = Instant::now();
+        let mut tunnels = Vec::new();
+        tunnels.extend(
+            self.ends
+                .jump(msg.ball, scene.number, &scene.mesh, &sweep.p0),
+        );
+        tunnels.extend(during);
+        self.ends.set(
+            msg.ball,
+            msg.frame,
+            scene.number,
+            sweep_end(&sweep, &outcome),
+        );
+        for t in &tunnels {
+            self.summary.tunnel(msg.frame, msg.ball, t);
+        }
         for (v, n) in verdicts {
             *self.summary.verdicts.entry(v).or_default() += n;
         }
@@ -275,7 +307,7 @@ impl Replay {
             self.summary.expected_matched += 1;
         }
         self.summary.sweeps += 1;
-        self.summary.elapsed += elapsed;
+        self.summary.elapsed += elapsed + start.elapsed();
         *self.summary.outcomes.entry(outcome.kind).or_default() += 1;
         if !outcome.fragile.is_robust() {
             self.summary.fragile += 1;
@@ -294,6 +326,7 @@ impl Replay {
             outcome,
             records,
             expected,
+            tunnels,
         });
     }
 
@@ -389,6 +422,8 @@ pub struct ComputedSweep {
     outcome: Outcome,
     records: Vec<TestRecord>,
     verdicts: Vec<(Verdict, u64)>,
+    /// The tunnel during the sweep, if any.
+    during: Option<Tunnel>,
     elapsed: Duration,
 }
 
@@ -441,11 +476,13 @@ pub fn compute_sweep(
             Vec::new(),
         )
     };
+    let during = tunnel_during_sweep(&scene.mesh, &sweep, &outcome);
     Ok(ComputedSweep {
         sweep,
         outcome,
         records,
         verdicts,
+        during,
         elapsed: start.elapsed(),
     })
 }

@@ -10,6 +10,10 @@
 //! scene, or the end) arrives, so that an `/expected` message logged just
 //! after its sweep is still attached to it.
 //!
+//! Each result also says whether the ball's centre went through a triangle
+//! front to back ([`Tunnel`]): during the sweep, or since the ball's
+//! previous sweep (the engine keeps where each ball's last sweep left it).
+//!
 //! Nothing here knows about the viewer: `viz` turns results into a Rerun
 //! recording, `check`-like commands compare [`SweepResult::outcome_msg`]
 //! with [`SweepResult::expected`].
@@ -19,6 +23,7 @@ mod error;
 mod iter;
 mod options;
 mod summary;
+mod tunnel;
 
 pub use engine::{
     ComputedSweep, Replay, ReplayEvent, SceneState, SweepResult, compute_sweep, primary_records,
@@ -28,4 +33,5 @@ pub use iter::{
     DEFAULT_BATCH_EVENTS, ParallelReplayIter, ReplayIter, replay_events, replay_events_parallel,
 };
 pub use options::{Detail, FrameRange, ReplayOptions};
-pub use summary::ReplaySummary;
+pub use summary::{ReplaySummary, TunnelAt};
+pub use tunnel::{Tunnel, TunnelKind, sweep_end, tunnel_during_sweep};

@@ -3,7 +3,46 @@
 use std::collections::BTreeMap;
 use std::time::Duration;
 
+use crate::core::explain::num;
 use crate::core::{FragileReason, Kind, Verdict};
+
+use super::tunnel::{Tunnel, TunnelKind};
+
+/// How many tunnels the summary lists.
+pub const LISTED_TUNNELS: usize = 5;
+
+/// A tunnel with the sweep it was found at.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TunnelAt {
+    /// Frame of the sweep.
+    pub frame: u64,
+    /// Ball.
+    pub ball: u32,
+    /// The tunnel.
+    pub tunnel: Tunnel,
+}
+
+impl std::fmt::Display for TunnelAt {
+    /// `frame F, ball B: through triangle T during its sweep at (x, y, z)`
+    /// (or `between its sweeps of frames P and F`).
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let t = &self.tunnel;
+        write!(
+            f,
+            "frame {}, ball {}: through triangle {} ",
+            self.frame, self.ball, t.triangle
+        )?;
+        match (t.kind, t.previous_frame) {
+            (TunnelKind::DuringSweep, _) => write!(f, "during its sweep")?,
+            (TunnelKind::BetweenSweeps, Some(p)) => {
+                write!(f, "between its sweeps of frames {p} and {}", self.frame)?
+            }
+            (TunnelKind::BetweenSweeps, None) => write!(f, "between sweeps")?,
+        }
+        let [x, y, z] = t.point;
+        write!(f, " at ({}, {}, {})", num(x), num(y), num(z))
+    }
+}
 
 /// Counts of a replay.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -27,13 +66,17 @@ pub struct ReplaySummary {
     /// `/expected` messages for a replayed `(frame, ball)` that arrived too
     /// late to be attached, or that match no sweep at all.
     pub expected_unmatched: u64,
+    /// Time spent in the collision core and the bookkeeping (not reading).
+    pub elapsed: Duration,
     /// Replayed sweeps whose decision is fragile (rounding at the level of
     /// the inputs could change it; see [`crate::core::FragileReason`]).
     pub fragile: u64,
     /// Fragile decisions by reason (a decision can have several).
     pub fragile_by_reason: BTreeMap<FragileReason, u64>,
-    /// Time spent in the collision core and the bookkeeping (not reading).
-    pub elapsed: Duration,
+    /// Tunnels found, by kind.
+    pub tunnels: BTreeMap<TunnelKind, u64>,
+    /// The first tunnels (at most [`LISTED_TUNNELS`]), in trace order.
+    pub first_tunnels: Vec<TunnelAt>,
 }
 
 impl ReplaySummary {
@@ -44,6 +87,23 @@ impl ReplaySummary {
             .filter(|(k, _)| **k != Kind::None)
             .map(|(_, n)| n)
             .sum()
+    }
+
+    /// Tunnels found, of every kind.
+    pub fn tunnel_count(&self) -> u64 {
+        self.tunnels.values().sum()
+    }
+
+    /// Counts one tunnel found at `(frame, ball)`.
+    pub(crate) fn tunnel(&mut self, frame: u64, ball: u32, tunnel: &Tunnel) {
+        *self.tunnels.entry(tunnel.kind).or_default() += 1;
+        if self.first_tunnels.len() < LISTED_TUNNELS {
+            self.first_tunnels.push(TunnelAt {
+                frame,
+                ball,
+                tunnel: *tunnel,
+            });
+        }
     }
 
     /// A few lines for people.
@@ -92,6 +152,29 @@ impl ReplaySummary {
                 "fragile decisions: {} of {} ({reasons})",
                 self.fragile, self.sweeps
             );
+        }
+        let tunnels = self.tunnel_count();
+        if tunnels > 0 {
+            let kinds = self
+                .tunnels
+                .iter()
+                .map(|(k, n)| format!("{n} {k}"))
+                .collect::<Vec<_>>()
+                .join(", ");
+            let _ = writeln!(
+                s,
+                "tunnels (a ball's centre through a triangle, front to back): {tunnels} ({kinds})"
+            );
+            for t in &self.first_tunnels {
+                let _ = writeln!(s, "  {t}");
+            }
+            if tunnels > self.first_tunnels.len() as u64 {
+                let _ = writeln!(
+                    s,
+                    "  ... {} more",
+                    tunnels - self.first_tunnels.len() as u64
+                );
+            }
         }
         if self.degenerate_triangles > 0 {
             let _ = writeln!(

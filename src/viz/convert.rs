@@ -13,6 +13,8 @@ pub(crate) const HIT_COLOR: [u8; 4] = [230, 40, 40, 255];
 pub(crate) const MISS_COLOR: [u8; 4] = [240, 200, 40, 255];
 pub(crate) const NORMAL_COLOR: [u8; 4] = [40, 200, 80, 255];
 pub(crate) const EXPECTED_COLOR: [u8; 4] = [230, 60, 230, 255];
+/// The marker where a ball's centre went through a triangle.
+pub(crate) const TUNNEL_COLOR: [u8; 4] = [255, 0, 90, 255];
 pub(crate) const EDGE_COLOR: [u8; 4] = [230, 40, 40, 255];
 pub(crate) const CYLINDER_COLOR: [u8; 4] = [255, 120, 120, 255];
 pub(crate) const PATH_COLOR: [u8; 4] = [80, 140, 255, 255];

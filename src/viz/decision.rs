@@ -81,6 +81,15 @@ pub(crate) fn write_decision_line(
         write_fields(s, diffs);
         let _ = write!(s, "; expected {} at α = {}]", e.kind, Num(e.alpha));
     }
+    for t in &r.tunnels {
+        let _ = write!(s, " [tunnel: through triangle {} ", t.triangle);
+        match t.previous_frame {
+            Some(p) => {
+                let _ = write!(s, "since the sweep of frame {p}]");
+            }
+            None => s.push_str("during the sweep]"),
+        }
+    }
 }
 
 /// The line of the `divergences` log: what was expected, what was found,

@@ -19,7 +19,7 @@ use super::edge_frame::{choose_edges, edge_frame_rows};
 use super::paths::{self, Entity};
 use super::rows::{
     Out, PLOT_BITS, expected_rows, focus_rows, plot_entity, plot_rows, primary_rows, sweep_rows,
-    text_rows,
+    text_rows, tunnel_rows,
 };
 use super::{MAX_EDGE_FRAMES, TIMESTAMP_THRESHOLD_NANOS};
 use crate::core::{EdgeRecord, Triangle};
@@ -87,6 +87,8 @@ struct BallState {
     plotted: u16,
     /// Whether the expected outcome was drawn.
     expected: bool,
+    /// Whether a tunnel marker was drawn.
+    tunnel: bool,
 }
 
 /// What [`Logger::log_prepared`] needs of each prepared sweep.
@@ -96,6 +98,7 @@ struct Mark {
     edge_slots: usize,
     plotted: u16,
     expected: bool,
+    tunnel: bool,
     frame: i64,
     time: columns::Time,
 }
@@ -121,6 +124,8 @@ pub struct Logger {
     flush_rows: usize,
     /// Divergent sweeps logged.
     divergent: u64,
+    /// Tunnels logged.
+    tunnels: u64,
     /// Emptied [`PreparedSweeps`], handed out again by
     /// [`Logger::spare_prepared`] so that their buffers are reused.
     spare: Vec<PreparedSweeps>,
@@ -134,6 +139,7 @@ pub struct PreparedSweeps {
     columns: columns::Columns,
     marks: Vec<Mark>,
     divergent: u64,
+    tunnels: u64,
     /// Scratch: the edge tests of one sweep.
     edges: Vec<EdgeRecord>,
 }
@@ -196,12 +202,15 @@ pub fn prepare_sweeps_into<'r>(
             _ => false,
         };
         text_rows(&mut out, r, decisive.as_ref(), &diffs);
+        let tunnel = tunnel_rows(&mut out, r);
         p.divergent += u64::from(!diffs.is_empty());
+        p.tunnels += r.tunnels.len() as u64;
         p.marks.push(Mark {
             ball: r.ball,
             edge_slots: p.edges.len(),
             plotted,
             expected,
+            tunnel,
             frame,
             time,
         });
@@ -279,6 +288,7 @@ impl Logger {
             columns: columns::Columns::default(),
             flush_rows: DEFAULT_FLUSH_ROWS,
             divergent: 0,
+            tunnels: 0,
             spare: Vec::new(),
         };
         logger.log_static(paths::WORLD, &ViewCoordinates::RIGHT_HAND_Z_UP())?;
@@ -318,6 +328,11 @@ impl Logger {
         self.divergent
     }
 
+    /// Tunnels logged so far.
+    pub fn tunnels(&self) -> u64 {
+        self.tunnels
+    }
+
     /// Sends every buffered row.
     pub fn flush(&mut self) -> Result<(), RecordingStreamError> {
         self.columns.send(&self.rec)
@@ -348,11 +363,11 @@ impl Logger {
     /// Sends what is buffered, flushes and hands the stream back (drop it,
     /// and every clone, to finish a file). When some sweep diverged from
     /// its expectation, first sends the layout that leads with the
-    /// divergences, as the active one. Use [`Logger::flush`] first to see
+    /// divergences (and tunnels), as the active one. Use [`Logger::flush`] first to see
     /// an error of the last rows.
     pub fn finish(mut self) -> RecordingStream {
         let _ = self.flush();
-        if self.options.blueprint && self.divergent > 0 {
+        if self.options.blueprint && self.divergent + self.tunnels > 0 {
             // Every chunk before the second layout, so that the order of
             // the file's messages does not vary.
             let _ = self.rec.flush_blocking();
@@ -418,6 +433,7 @@ impl Logger {
     pub fn log_prepared(&mut self, mut p: PreparedSweeps) -> Result<(), RecordingStreamError> {
         self.columns.append(&mut p.columns);
         self.divergent += std::mem::take(&mut p.divergent);
+        self.tunnels += std::mem::take(&mut p.tunnels);
         // Clear what a ball showed at its previous sweep and no longer
         // shows: edge frames, plot values (so that a plot has a gap rather
         // than a line to a distant frame), the expected outcome.
@@ -430,6 +446,7 @@ impl Logger {
             let edge_slots = std::mem::replace(&mut state.edge_slots, m.edge_slots);
             let plotted = std::mem::replace(&mut state.plotted, m.plotted);
             let expected = std::mem::replace(&mut state.expected, m.expected);
+            let tunnel = std::mem::replace(&mut state.tunnel, m.tunnel);
             let mut out = Out {
                 columns: &mut self.columns,
                 frame: m.frame,
@@ -446,6 +463,9 @@ impl Logger {
             }
             if expected && !m.expected {
                 out.clear(Entity::Expected(b), true);
+            }
+            if tunnel && !m.tunnel {
+                out.clear(Entity::Tunnel(b), false);
             }
         }
         if self.spare.len() < MAX_SPARE_PREPARED {

@@ -19,6 +19,9 @@
 //!                                     sweep diverges from the trace's expectation
 //! world/ball/{ball}/expected/contact  Points3D: the expected contact (idem)
 //! world/ball/{ball}/expected/normal   Arrows3D: the expected normal (idem)
+//! world/ball/{ball}/tunnel           Points3D: where the ball's centre went through a
+//!                                     triangle front to back (during this sweep or since
+//!                                     its previous one), labelled with the triangle
 //! world/ball/{ball}/edge/{slot}       Transform3D world_from_edge of one logged edge test,
 //!                                     plus its numbers (AnyValues: triangle, edge, A, B, C,
 //!                                     discriminant, s0, s1, xc, verdict)
@@ -36,7 +39,8 @@
 //!                                     1 when it diverges (sweeps with an expectation only)
 //! status/ball/{ball}/fragile          Scalars: 1 at each fragile decision (absent elsewhere)
 //! log                                 TextLog: one line per sweep, the decision in words
-//! divergences                         TextLog: one line per divergent sweep only
+//! divergences                         TextLog: one line per divergent sweep and one
+//!                                     WARN line per tunnel
 //! ```
 //!
 //! Slot 0 of `edge` is the decisive test when it is an edge test (the
@@ -89,6 +93,11 @@ pub fn expected_contact(ball: u32) -> String {
 /// The expected normal.
 pub fn expected_normal(ball: u32) -> String {
     format!("world/ball/{ball}/expected/normal")
+}
+
+/// Where the ball's centre went through a triangle.
+pub fn tunnel(ball: u32) -> String {
+    format!("world/ball/{ball}/tunnel")
 }
 
 /// The divergence status series of one ball.
@@ -220,6 +229,7 @@ pub(crate) enum Entity {
     ExpectedBall(u32),
     ExpectedContact(u32),
     ExpectedNormal(u32),
+    Tunnel(u32),
     Status(u32),
     Fragile(u32),
     Divergences,
@@ -254,6 +264,7 @@ impl Entity {
             Entity::ExpectedBall(b) => expected_ball(b),
             Entity::ExpectedContact(b) => expected_contact(b),
             Entity::ExpectedNormal(b) => expected_normal(b),
+            Entity::Tunnel(b) => tunnel(b),
             Entity::Status(b) => status(b),
             Entity::Fragile(b) => fragile(b),
             Entity::Divergences => DIVERGENCES.to_string(),

@@ -17,8 +17,8 @@ use rerun::{
 use super::columns::{self, Row};
 use super::convert::{
     BOLD_EDGE_POINTS, CONTACT_BALL_COLOR, EXPECTED_COLOR, HIT_COLOR, MISS_COLOR, NORMAL_COLOR,
-    OUTLINE_POINTS, P0_COLOR, P1_COLOR, SWEEP_COLOR, VERTEX_POINTS, albedo, any_value,
-    capsule_pose, f32x3, rgba, ui_points,
+    OUTLINE_POINTS, P0_COLOR, P1_COLOR, SWEEP_COLOR, TUNNEL_COLOR, VERTEX_POINTS, albedo,
+    any_value, capsule_pose, f32x3, rgba, ui_points,
 };
 use super::decision::{write_decision_line, write_divergence_line};
 use super::paths::{Entity, FACE_NAMES, QUADRATIC_NAMES};
@@ -51,6 +51,7 @@ pub(crate) mod set {
     pub const EDGE_VALUES: u8 = 16;
     pub const AXES: u8 = 20;
     pub const EXPECTED_BALL: u8 = 21;
+    pub const TUNNEL: u8 = 22;
 }
 
 /// Where the rows of one sweep go.
@@ -422,7 +423,7 @@ pub(crate) fn text_rows(
         row.put_texts(TextLog::descriptor_text, |t| {
             t.push_with(|s| write_decision_line(s, r, decisive, diffs));
         });
-        let level = if divergent {
+        let level = if divergent || !r.tunnels.is_empty() {
             TextLogLevel::WARN
         } else if r.outcome.is_hit() {
             TextLogLevel::INFO
@@ -448,4 +449,42 @@ pub(crate) fn text_rows(
             })
             .put_strs(TextLog::descriptor_level, [TextLogLevel::WARN]);
     }
+}
+
+/// The tunnels of a sweep (a ball's centre through a triangle, front to
+/// back): a marker where each crossed the triangle's plane and a WARN line
+/// each in the divergences log. Returns whether there was one (the marker
+/// is cleared at the ball's next sweep without one).
+pub(crate) fn tunnel_rows(out: &mut Out<'_>, r: &SweepResult) -> bool {
+    if r.tunnels.is_empty() {
+        return false;
+    }
+    out.row(Entity::Tunnel(r.ball), set::TUNNEL)
+        .put::<Position3D>(
+            Points3D::descriptor_positions,
+            r.tunnels.iter().map(|t| {
+                let [x, y, z] = t.point;
+                Position3D::new(x as f32, y as f32, z as f32)
+            }),
+        )
+        .put::<Radius>(Points3D::descriptor_radii, [ui_points(9.0)])
+        .put::<Color>(Points3D::descriptor_colors, [rgba(TUNNEL_COLOR)])
+        .put_texts(Points3D::descriptor_labels, |t| {
+            for tunnel in &r.tunnels {
+                t.push_fmt(format_args!("tunnel: triangle {}", tunnel.triangle));
+            }
+        });
+    for tunnel in &r.tunnels {
+        let at = crate::replay::TunnelAt {
+            frame: r.frame,
+            ball: r.ball,
+            tunnel: *tunnel,
+        };
+        out.row(Entity::Divergences, set::TEXT_LOG)
+            .put_texts(TextLog::descriptor_text, |t| {
+                t.push_fmt(format_args!("tunnel: {at}"));
+            })
+            .put_strs(TextLog::descriptor_level, [TextLogLevel::WARN]);
+    }
+    true
 }

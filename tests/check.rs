@@ -18,7 +18,7 @@ use std::io::Cursor;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-use libtest_mimic::{Failed, Trial};
+use libtest_mimic::Trial;
 use sweeptrace::core::{Facing, Kind};
 use sweeptrace::regress::bless_bytes;
 use sweeptrace::regress::{
@@ -37,50 +37,23 @@ const FIXTURE: &str = "tests/fixtures/wrong_engine_config.mcap";
 
 pub fn tests() -> Vec<Trial> {
     let mut trials = vec![
-        trial(
-            "check::compare_only_fields_present",
-            compare_only_fields_present,
-        ),
-        trial("check::compare_null_is_compared", compare_null_is_compared),
-        trial("check::compare_tolerances", compare_tolerances),
-        trial(
-            "check::compare_nan_never_matches",
-            compare_nan_never_matches,
-        ),
-        trial("check::blessed_trace_passes", blessed_trace_passes),
-        trial(
-            "check::wrong_engine_config_fixture_fails_with_frame_and_reason",
-            fixture_fails_through_library,
-        ),
-        trial(
-            "check::wrong_engine_config_fixture_binary_exit_1",
-            fixture_fails_through_binary,
-        ),
-        trial("check::no_expected_channel_is_not_a_pass", no_expectations),
-        trial("check::binary_errors_exit_2", binary_errors_exit_2),
-        trial("check::trace_discovery_in_directories", discovery),
-        trial(
-            "check::bless_round_trip_fixes_wrong_expectations",
-            bless_round_trip,
-        ),
-        trial(
-            "check::bless_keeps_foreign_channel_metadata_attachment",
-            bless_keeps_foreign,
-        ),
-        trial(
-            "check::bless_binary_requires_output_and_keeps_input",
-            bless_binary,
-        ),
-        trial("check::diff_same_trace_is_same", diff_same),
-        trial(
-            "check::diff_strict_facing_reports_first_divergence",
-            diff_facing,
-        ),
-        trial("check::diff_binary_exit_codes", diff_binary),
-        Trial::test("check::generate_wrong_engine_config", || {
-            generate_fixture().map_err(Failed::from)
-        })
-        .with_ignored_flag(true),
+        trial!(compare_only_fields_present),
+        trial!(compare_null_is_compared),
+        trial!(compare_tolerances),
+        trial!(compare_nan_never_matches),
+        trial!(blessed_trace_passes),
+        trial!(wrong_engine_config_fixture_fails_with_frame_and_reason),
+        trial!(wrong_engine_config_fixture_binary_exit_1),
+        trial!(no_expected_channel_is_not_a_pass),
+        trial!(binary_errors_exit_2),
+        trial!(trace_discovery_in_directories),
+        trial!(bless_round_trip_fixes_wrong_expectations),
+        trial!(bless_keeps_foreign_channel_metadata_attachment),
+        trial!(bless_binary_requires_output_and_keeps_input),
+        trial!(diff_same_trace_is_same),
+        trial!(diff_strict_facing_reports_first_divergence),
+        trial!(diff_binary_exit_codes),
+        trial!(generate_wrong_engine_config).with_ignored_flag(true),
     ];
     trials.extend(trace_trials());
     trials
@@ -109,7 +82,7 @@ fn trace_trials() -> Vec<Trial> {
                 })
             })
             .collect(),
-        Err(e) => vec![trial("check::trace::discovery", move || Err(e))],
+        Err(e) => vec![trial("check::trace::discovery", move || Err::<(), _>(e))],
     }
 }
 
@@ -391,7 +364,7 @@ fn check_fixture_report(report: &sweeptrace::regress::TraceReport) -> Result<(),
     Ok(())
 }
 
-fn fixture_fails_through_library() -> Result<(), String> {
+fn wrong_engine_config_fixture_fails_with_frame_and_reason() -> Result<(), String> {
     let report = check_file(&fixture_path(), &CheckOptions::default());
     check_fixture_report(&report)?;
     // The committed fixture is what the generator makes.
@@ -407,7 +380,7 @@ fn fixture_fails_through_library() -> Result<(), String> {
     Ok(())
 }
 
-fn fixture_fails_through_binary() -> Result<(), String> {
+fn wrong_engine_config_fixture_binary_exit_1() -> Result<(), String> {
     let fixture = fixture_path();
     let (code, out, err) = run_bin(os!["check", fixture.as_os_str()])?;
     ensure!(code == 1, "exit {code}\n{out}\n{err}");
@@ -423,7 +396,7 @@ fn fixture_fails_through_binary() -> Result<(), String> {
     Ok(())
 }
 
-fn no_expectations() -> Result<(), String> {
+fn no_expected_channel_is_not_a_pass() -> Result<(), String> {
     let plain = write_trace(&scene_t(0.0), &fixture_sweeps(), &[]);
     let report = check_bytes(&plain);
     ensure!(
@@ -505,7 +478,7 @@ fn binary_errors_exit_2() -> Result<(), String> {
     Ok(())
 }
 
-fn discovery() -> Result<(), String> {
+fn trace_discovery_in_directories() -> Result<(), String> {
     let dir = tempfile::tempdir().map_err(|e| e.to_string())?;
     let sub = dir.path().join("b");
     std::fs::create_dir_all(&sub).map_err(|e| e.to_string())?;
@@ -555,7 +528,7 @@ fn discovery() -> Result<(), String> {
 
 // ---------------------------------------------------------------- bless
 
-fn bless_round_trip() -> Result<(), String> {
+fn bless_round_trip_fixes_wrong_expectations() -> Result<(), String> {
     let wrong = fixture_bytes()?;
     ensure!(
         check_bytes(&wrong).status == Status::Fail,
@@ -756,7 +729,7 @@ fn contents(bytes: &[u8]) -> Result<Contents, String> {
     Ok((schemas, channels, messages, metadata, attachments, header))
 }
 
-fn bless_keeps_foreign() -> Result<(), String> {
+fn bless_keeps_foreign_channel_metadata_attachment() -> Result<(), String> {
     let input = foreign_trace()?;
     ensure!(
         check_bytes(&input).status == Status::Fail,
@@ -798,7 +771,7 @@ fn bless_keeps_foreign() -> Result<(), String> {
     Ok(())
 }
 
-fn bless_binary() -> Result<(), String> {
+fn bless_binary_requires_output_and_keeps_input() -> Result<(), String> {
     let dir = tempfile::tempdir().map_err(|e| e.to_string())?;
     let input = dir.path().join("wrong.mcap");
     std::fs::copy(fixture_path(), &input).map_err(|e| e.to_string())?;
@@ -850,7 +823,7 @@ fn facing_trace() -> Vec<u8> {
     write_trace(&scene_t(0.0), &sweeps, &[])
 }
 
-fn diff_same() -> Result<(), String> {
+fn diff_same_trace_is_same() -> Result<(), String> {
     let bytes = facing_trace();
     let side = |o| Side::replay(TraceReader::new(bytes.as_slice(), "t"), "t", o);
     let a = side(ReplayOptions::default()).map_err(|e| e.to_string())?;
@@ -860,7 +833,7 @@ fn diff_same() -> Result<(), String> {
     Ok(())
 }
 
-fn diff_facing() -> Result<(), String> {
+fn diff_strict_facing_reports_first_divergence() -> Result<(), String> {
     let bytes = facing_trace();
     let side = |o| Side::replay(TraceReader::new(bytes.as_slice(), "t"), "t", o);
     let a = side(ReplayOptions::default()).map_err(|e| e.to_string())?;
@@ -883,7 +856,7 @@ fn diff_facing() -> Result<(), String> {
     Ok(())
 }
 
-fn diff_binary() -> Result<(), String> {
+fn diff_binary_exit_codes() -> Result<(), String> {
     let dir = tempfile::tempdir().map_err(|e| e.to_string())?;
     let t = dir.path().join("t.mcap");
     std::fs::write(&t, facing_trace()).map_err(|e| e.to_string())?;
@@ -923,7 +896,7 @@ fn diff_binary() -> Result<(), String> {
 
 // ---------------------------------------------------------------- fixture
 
-fn generate_fixture() -> Result<(), String> {
+fn generate_wrong_engine_config() -> Result<(), String> {
     let bytes = fixture_bytes()?;
     std::fs::write(fixture_path(), bytes).map_err(|e| e.to_string())
 }

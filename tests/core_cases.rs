@@ -21,77 +21,47 @@ const TOL: f64 = 1e-12;
 
 pub fn tests() -> Vec<Trial> {
     vec![
-        trial("core::face_hit_worked_example_1", face_hit),
-        trial("core::face_starts_too_close", face_starts_too_close),
-        trial("core::face_parallel", face_parallel),
-        trial("core::face_back_facing", face_back_facing),
-        trial("core::face_beyond_end", face_beyond_end),
-        trial("core::face_outside_triangle", face_outside_triangle),
-        trial("core::edge_hit_worked_example_2_start_before_s0", edge_hit),
-        trial("core::edge_start_between_s0_and_s1", edge_between_roots),
-        trial("core::edge_start_after_s1", edge_after_roots),
-        trial("core::edge_beyond_end", edge_beyond_end),
-        trial("core::edge_double_root_tangent", edge_tangent),
-        trial("core::edge_parallel_path", edge_parallel),
-        trial("core::edge_no_real_roots", edge_no_real_roots),
-        trial("core::edge_off_edge", edge_off_edge),
-        trial("core::edge_back_facing", edge_back_facing),
-        trial(
-            "core::edge_strict_facing_rejects_n_dot_d_zero",
-            edge_strict_facing,
-        ),
-        trial(
-            "core::hit_exactly_at_alpha_1_worked_example_4",
-            hit_at_alpha_one,
-        ),
-        trial("core::zero_length_path", zero_length_path),
-        trial("core::vertex_hit_worked_example_3", vertex_hit),
-        trial("core::vertex_no_real_roots", vertex_no_real_roots),
-        trial("core::vertex_before_start", vertex_before_start),
-        trial("core::vertex_beyond_end", vertex_beyond_end),
-        trial("core::vertex_back_facing", vertex_back_facing),
-        trial(
-            "core::endpoint_contact_exactly_at_xc_eq_l_is_edge",
-            endpoint_tie_is_edge,
-        ),
-        trial("core::shared_edge_reported_for_both", shared_edge_both),
-        trial("core::shared_edge_reported_for_one", shared_edge_one),
-        trial(
-            "core::shared_edge_reported_for_neither",
-            shared_edge_neither,
-        ),
-        trial(
-            "core::cube_shared_edge_averaged_normal_worked_example_5",
-            cube_averaged_normal,
-        ),
-        trial("core::margin_shrinks_detection_radius", margin_case),
-        trial("core::standard_frame_round_trip", standard_frame_round_trip),
-        trial("core::bad_input_errors", bad_input),
-        trial(
-            "core::degenerate_triangles_reported_and_skipped",
-            degenerate,
-        ),
-        trial(
-            "core::edge_far_start_small_radius_discriminant_without_cancellation",
-            edge_far_start_small_radius,
-        ),
-        trial("core::very_long_path_never_nan", very_long_path_never_nan),
-        trial(
-            "core::sliver_triangle_face_hit_barycentric_without_cancellation",
-            sliver_face_hit,
-        ),
-        trial(
-            "core::zero_q_gives_a_double_root_only_when_c_is_zero",
-            zero_q_gives_a_double_root_only_when_c_is_zero,
-        ),
-        trial(
-            "core::face_decides_direction_by_n_dot_d_alone",
-            face_decides_direction_by_n_dot_d_alone,
-        ),
+        trial!(face_hit_worked_example_1),
+        trial!(face_starts_too_close),
+        trial!(face_parallel),
+        trial!(face_back_facing),
+        trial!(face_beyond_end),
+        trial!(face_outside_triangle),
+        trial!(edge_hit_worked_example_2_start_before_s0),
+        trial!(edge_start_between_s0_and_s1),
+        trial!(edge_start_after_s1),
+        trial!(edge_beyond_end),
+        trial!(edge_double_root_tangent),
+        trial!(edge_parallel_path),
+        trial!(edge_no_real_roots),
+        trial!(edge_off_edge),
+        trial!(edge_back_facing),
+        trial!(edge_strict_facing_rejects_n_dot_d_zero),
+        trial!(hit_exactly_at_alpha_1_worked_example_4),
+        trial!(zero_length_path),
+        trial!(vertex_hit_worked_example_3),
+        trial!(vertex_no_real_roots),
+        trial!(vertex_before_start),
+        trial!(vertex_beyond_end),
+        trial!(vertex_back_facing),
+        trial!(endpoint_contact_exactly_at_xc_eq_l_is_edge),
+        trial!(shared_edge_reported_for_both),
+        trial!(shared_edge_reported_for_one),
+        trial!(shared_edge_reported_for_neither),
+        trial!(cube_shared_edge_averaged_normal_worked_example_5),
+        trial!(margin_shrinks_detection_radius),
+        trial!(standard_frame_round_trip),
+        trial!(bad_input_errors),
+        trial!(degenerate_triangles_reported_and_skipped),
+        trial!(edge_far_start_small_radius_discriminant_without_cancellation),
+        trial!(very_long_path_never_nan),
+        trial!(sliver_triangle_face_hit_barycentric_without_cancellation),
+        trial!(zero_q_gives_a_double_root_only_when_c_is_zero),
+        trial!(face_decides_direction_by_n_dot_d_alone),
     ]
 }
 
-fn face_hit() -> Result<(), String> {
+fn face_hit_worked_example_1() -> Result<(), String> {
     // h0 = 3, h1 = -3, β = (3 - 0.5) / 6 = 5/12, touch (1,1,0), barycentric
     // (1 - 0.25 - 0.25, 0.25, 0.25).
     let (o, recs) = run(
@@ -209,7 +179,7 @@ fn face_outside_triangle() -> Result<(), String> {
     close("bary a", f.barycentric.ok_or("no bary")?[0], -0.5, TOL)
 }
 
-fn edge_hit() -> Result<(), String> {
+fn edge_hit_worked_example_2_start_before_s0() -> Result<(), String> {
     // Worked example 2. p0 → (2, 3, 0.3), p1 → (2, -3, 0.3). A = 36, B = -36,
     // C = 9 + 0.09 - 0.25 = 8.84, disc = 1296 - 1272.96 = 23.04 (√ = 4.8),
     // roots (36 ∓ 4.8) / 72 = 0.43333, 0.56667; xc = 2; n·d = -6: α = 13/30.
@@ -251,7 +221,7 @@ fn edge_hit() -> Result<(), String> {
     close("contact y", c.y, 0.0, 1e-12)
 }
 
-fn edge_between_roots() -> Result<(), String> {
+fn edge_start_between_s0_and_s1() -> Result<(), String> {
     // Start between S0 and S1 (the ball starts within ρ of the edge's line).
     // p0 → (2, 0.2, 0.3), p1 → (2, -3, 0.3): dy = -3.2, A = 10.24,
     // B = 2 (0.2 · -3.2) = -1.28, C = 0.04 + 0.09 - 0.25 = -0.12,
@@ -273,7 +243,7 @@ fn edge_between_roots() -> Result<(), String> {
     Ok(())
 }
 
-fn edge_after_roots() -> Result<(), String> {
+fn edge_start_after_s1() -> Result<(), String> {
     // Start after S1: p0 → (2, -3, 0.3), p1 → (2, -6, 0.3): A = 9, B = 18,
     // C = 8.84, disc = 324 - 318.24 = 5.76 (√ = 2.4), roots (-18 ∓ 2.4) / 18
     // = -1.13333, -0.86667: both negative.
@@ -310,7 +280,7 @@ fn edge_beyond_end() -> Result<(), String> {
     Ok(())
 }
 
-fn edge_tangent() -> Result<(), String> {
+fn edge_double_root_tangent() -> Result<(), String> {
     // The path passes at exactly ρ from the edge's line: p0 → (2, 3, 0.5),
     // p1 → (2, -3, 0.5): A = 36, B = -36, C = 9 + 0.25 - 0.25 = 9,
     // disc = 1296 - 1296 = 0 (every value exact in binary): a double root
@@ -331,7 +301,7 @@ fn edge_tangent() -> Result<(), String> {
     Ok(())
 }
 
-fn edge_parallel() -> Result<(), String> {
+fn edge_parallel_path() -> Result<(), String> {
     // Rolling along edge 0: p0 → (1, 0.2, 0.3), p1 → (3, 0.2, 0.3), A = 0.
     let (_, recs) = run(
         &triangle_t(),
@@ -402,7 +372,7 @@ fn edge_back_facing() -> Result<(), String> {
     Ok(())
 }
 
-fn edge_strict_facing() -> Result<(), String> {
+fn edge_strict_facing_rejects_n_dot_d_zero() -> Result<(), String> {
     // Edge 0 approached sideways within the plane's parallel: p0 = (2, -3, 0),
     // p1 = (2, 3, 0): n·d = 0. Frame: p0 → (2, 0, 3), p1 → (2, 0, -3);
     // A = 36, B = -36, C = 9 - 0.25 = 8.75, disc = 36, roots (36 ∓ 6)/72 =
@@ -438,7 +408,7 @@ fn edge_strict_facing() -> Result<(), String> {
     Ok(())
 }
 
-fn hit_at_alpha_one() -> Result<(), String> {
+fn hit_exactly_at_alpha_1_worked_example_4() -> Result<(), String> {
     // Worked example 4: r = 0.625, p0 = (2, -0.375, 3), p1 = (2, -0.375, 0.5).
     // Frame: (2, 3, 0.375) → (2, 0.5, 0.375). A = 2.5² = 6.25,
     // B = 2 · 3 · -2.5 = -15, C = 9 + 0.140625 - 0.390625 = 8.75,
@@ -491,7 +461,7 @@ fn zero_length_path() -> Result<(), String> {
     Ok(())
 }
 
-fn vertex_hit() -> Result<(), String> {
+fn vertex_hit_worked_example_3() -> Result<(), String> {
     // Worked example 3: p0 = (-0.3, -0.2, 3), p1 = (-0.3, -0.2, -3).
     // Edge 0 touches its line at s ≈ 0.4236 with xc = -0.3 < 0 (off the edge);
     // edge 2 (from (0,4,0) to (0,0,0)) touches its line beyond its end;
@@ -609,7 +579,7 @@ fn vertex_back_facing() -> Result<(), String> {
     Ok(())
 }
 
-fn endpoint_tie_is_edge() -> Result<(), String> {
+fn endpoint_contact_exactly_at_xc_eq_l_is_edge() -> Result<(), String> {
     // Example 4 moved to x = 4 = L: edge 0 gives s0 = 1 with xc = 4 = L
     // (accepted, boundary included); vertex 1 = (4,0,0) gives A = 6.25,
     // B = 2 (0,0,-2.5)·(0,-0.375,3) = -15, C = 0.140625 + 9 - 0.390625 = 8.75:
@@ -660,7 +630,7 @@ fn ridge_path(u: [f64; 2], d: [f64; 3]) -> ([f64; 3], [f64; 3]) {
     (p0, p1)
 }
 
-fn shared_edge_both() -> Result<(), String> {
+fn shared_edge_reported_for_both() -> Result<(), String> {
     // Contact direction u = (0, -1/2, √3/2) lies between both front normals;
     // d = (0,0,-6): n0·d = -6, n1·d = -6/√2: both front-facing. The ball
     // reaches the line at β = 0.5 (entering: u·d < 0). The faces' touch
@@ -688,7 +658,7 @@ fn shared_edge_both() -> Result<(), String> {
     close("normal z", n.z, want.z, 1e-12)
 }
 
-fn shared_edge_one() -> Result<(), String> {
+fn shared_edge_reported_for_one() -> Result<(), String> {
     // u = (0, -1/2, √3/2), d = (0, -2, -1.8): n0·d = -1.8 ≤ 0 (front),
     // n1·d = (2 - 1.8)/√2 > 0 (back-facing); u·d = 1 - 1.56 < 0 (entering).
     let (p0, p1) = ridge_path([-0.5, 3f64.sqrt() / 2.0], [0.0, -2.0, -1.8]);
@@ -710,7 +680,7 @@ fn shared_edge_one() -> Result<(), String> {
     close("normal z", n.z, 1.0, 1e-12)
 }
 
-fn shared_edge_neither() -> Result<(), String> {
+fn shared_edge_reported_for_neither() -> Result<(), String> {
     // From behind: u = (0, √3/2, -1/2), d = (0,0,2): n0·d = 2 > 0,
     // n1·d = 2/√2 > 0, u·d = -1 < 0: the line is reached at β = 0.5 within
     // the edge, and both triangles reject it as back-facing.
@@ -729,7 +699,7 @@ fn shared_edge_neither() -> Result<(), String> {
     Ok(())
 }
 
-fn cube_averaged_normal() -> Result<(), String> {
+fn cube_shared_edge_averaged_normal_worked_example_5() -> Result<(), String> {
     // Worked example 5: distance to the edge x = 1, z = 1 is 0.5 when
     // 0.0625 + (z - 1)² = 0.25, z = 1.43301, β = (3 - 1.43301)/6 = 0.26116.
     let cube = sweeptrace::sim::scenes::cube()
@@ -755,7 +725,7 @@ fn cube_averaged_normal() -> Result<(), String> {
     close("normal z", n.z, s, 1e-12)
 }
 
-fn margin_case() -> Result<(), String> {
+fn margin_shrinks_detection_radius() -> Result<(), String> {
     // Example 1 with r = 0.5, ε = 0.25: ρ = 0.25, β = (3 - 0.25)/6 = 11/24;
     // the contact is on the plane.
     let (o, _) = run(
@@ -800,7 +770,7 @@ fn standard_frame_round_trip() -> Result<(), String> {
     Ok(())
 }
 
-fn bad_input() -> Result<(), String> {
+fn bad_input_errors() -> Result<(), String> {
     let m = triangle_t();
     let opts = Options::default();
     let e = sweep_mesh(&m, &Sweep::new([f64::NAN, 0.0, 0.0], [0.0; 3], 0.5), &opts).err();
@@ -873,7 +843,7 @@ fn bad_input() -> Result<(), String> {
     Ok(())
 }
 
-fn degenerate() -> Result<(), String> {
+fn degenerate_triangles_reported_and_skipped() -> Result<(), String> {
     // Triangle 1 repeats an index, triangle 2 is collinear; both are left
     // out and never produce NaN; triangle 0 still works.
     let m = Mesh::new(
@@ -935,7 +905,7 @@ fn both_broadphases(m: &Mesh, p0: [f64; 3], p1: [f64; 3], r: f64) -> Result<Outc
     Ok(all)
 }
 
-fn edge_far_start_small_radius() -> Result<(), String> {
+fn edge_far_start_small_radius_discriminant_without_cancellation() -> Result<(), String> {
     // r = 1e-3, a path of length 2e5 straight down past edge 0 of T
     // (p0 = (2, -y, 1e5), p1 = (2, -y, -1e5)), so |p0| / ρ = 1e8.
     // In edge 0's frame p0 → (2, 1e5, y), p1 → (2, -1e5, y):
@@ -1024,7 +994,7 @@ fn very_long_path_never_nan() -> Result<(), String> {
     close("alpha", o.alpha, 0.5, 1e-15)
 }
 
-fn sliver_face_hit() -> Result<(), String> {
+fn sliver_triangle_face_hit_barycentric_without_cancellation() -> Result<(), String> {
     // A sliver a = (0,0,0), b = (1,0,0), c = (0.3, h, 0), h = 1e-9: |(b-a)×(c-a)|
     // = 1e-9 > DEGENERATE_TOLERANCE · longest² = 1e-12, so it is usable.
     // r = 0.25, p0 = (0.4, h/3, 2), p1 = (0.4, h/3, -2): h0 = 2, h1 = -2,
@@ -1097,7 +1067,7 @@ fn zero_q_gives_a_double_root_only_when_c_is_zero() -> Result<(), String> {
 /// subtracted) and `-(n · d)` disagree in their last bits and sometimes in
 /// sign; every verdict must follow `n · d`.
 fn face_decides_direction_by_n_dot_d_alone() -> Result<(), String> {
-    use sweeptrace::core::{PARALLEL_TOLERANCE, Path, sweep_face};
+    use sweeptrace::core::{PARALLEL_TOLERANCE, SweptPath, sweep_face};
     let mut state = 0x9e37_79b9_7f4a_7c15u64;
     let mut next = move || {
         state ^= state << 13;
@@ -1117,7 +1087,7 @@ fn face_decides_direction_by_n_dot_d_alone() -> Result<(), String> {
         let p0 = nalgebra::Point3::new(next(), next(), next()) + n * (0.5 + next());
         let d = (along + n * (1e-8 * next())) * 1e-3;
         let p1 = p0 + d;
-        let path = Path::new(&Sweep::new(p0.into(), p1.into(), 0.25), &Options::default())
+        let path = SweptPath::new(&Sweep::new(p0.into(), p1.into(), 0.25), &Options::default())
             .map_err(|e| e.to_string())?;
         let r = sweep_face(&t, &path, NS);
         let nd = r.normal_dot_d;

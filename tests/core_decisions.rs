@@ -17,34 +17,13 @@ use crate::trial;
 
 pub fn tests() -> Vec<Trial> {
     vec![
-        trial(
-            "core_decisions::shared_edge_tie_goes_to_the_lower_triangle",
-            shared_edge_tie_goes_to_the_lower_triangle,
-        ),
-        trial(
-            "core_decisions::quad_centre_drop_is_a_face_hit",
-            quad_centre_drop_is_a_face_hit,
-        ),
-        trial(
-            "core_decisions::tie_set_lists_every_tied_hit_primary_first",
-            tie_set_lists_every_tied_hit_primary_first,
-        ),
-        trial(
-            "core_decisions::clear_hit_is_robust_with_a_single_member_tie_set",
-            clear_hit_is_robust_with_a_single_member_tie_set,
-        ),
-        trial(
-            "core_decisions::exact_ties_on_boxes_and_terrains_follow_the_rules",
-            exact_ties_on_boxes_and_terrains_follow_the_rules,
-        ),
-        trial(
-            "core_decisions::unflagged_decisions_survive_one_ulp_changes",
-            unflagged_decisions_survive_one_ulp_changes,
-        ),
-        trial(
-            "core_decisions::fragile_serializes_as_reason_names",
-            fragile_serializes_as_reason_names,
-        ),
+        trial!(shared_edge_tie_goes_to_the_lower_triangle),
+        trial!(quad_centre_drop_is_a_face_hit),
+        trial!(tie_set_lists_every_tied_hit_primary_first),
+        trial!(clear_hit_is_robust_with_a_single_member_tie_set),
+        trial!(exact_ties_on_boxes_and_terrains_follow_the_rules),
+        trial!(unflagged_decisions_survive_one_ulp_changes),
+        trial!(fragile_serializes_as_reason_names),
     ]
 }
 

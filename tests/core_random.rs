@@ -16,12 +16,9 @@ use crate::trial;
 
 pub fn tests() -> Vec<Trial> {
     vec![
-        trial(
-            "core_random::oracle_agreement_100k_sweeps",
-            oracle_agreement,
-        ),
-        trial("core_random::parry_agreement_front_facing", parry_agreement),
-        trial("core_random::bvh_equals_exhaustive", bvh_equals_exhaustive),
+        trial!(oracle_agreement_100k_sweeps),
+        trial!(parry_agreement_front_facing),
+        trial!(bvh_equals_exhaustive),
     ]
 }
 
@@ -190,7 +187,7 @@ fn describe(case: &Case, o: &Outcome) -> String {
     )
 }
 
-fn oracle_agreement() -> Result<(), String> {
+fn oracle_agreement_100k_sweeps() -> Result<(), String> {
     let mut rng = ChaCha8Rng::seed_from_u64(0x5EED_0001);
     const N: usize = 100_000;
     let mut excluded: std::collections::BTreeMap<&str, usize> = Default::default();
@@ -256,7 +253,7 @@ fn oracle_agreement() -> Result<(), String> {
     Ok(())
 }
 
-fn parry_agreement() -> Result<(), String> {
+fn parry_agreement_front_facing() -> Result<(), String> {
     use parry3d_f64::math::{Pose, Vector};
     use parry3d_f64::query::{ShapeCastOptions, cast_shapes};
     use parry3d_f64::shape::{Ball, Triangle};

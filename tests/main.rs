@@ -3,7 +3,7 @@
 //! Each module exposes `tests() -> Vec<Trial>`; trace files under `traces/`
 //! are found at run time and become test cases of their own.
 
-use libtest_mimic::{Arguments, Failed, Trial};
+use libtest_mimic::{Arguments, Completion, Failed, Trial};
 
 mod check;
 mod core_cases;
@@ -18,9 +18,61 @@ mod support;
 mod trace_io;
 mod tunnel;
 
-/// Builds a trial from a function returning `Result<(), String>`.
-pub fn trial(name: &str, f: impl FnOnce() -> Result<(), String> + Send + 'static) -> Trial {
-    Trial::test(name, move || f().map_err(Failed::from))
+/// What a test function returns on success: `()`, or a [`Completion`] for a
+/// test that finds at run time that it cannot run here and says why
+/// (shown as `ignored (reason)` and counted as ignored).
+pub trait TrialResult {
+    /// Whether the test ran to the end or was skipped.
+    fn into_completion(self) -> Completion;
+}
+
+impl TrialResult for () {
+    fn into_completion(self) -> Completion {
+        Completion::Completed
+    }
+}
+
+impl TrialResult for Completion {
+    fn into_completion(self) -> Completion {
+        self
+    }
+}
+
+/// Builds a trial from a function returning `Result<(), String>` (or
+/// `Result<Completion, String>`).
+pub fn trial<T: TrialResult>(
+    name: &str,
+    f: impl FnOnce() -> Result<T, String> + Send + 'static,
+) -> Trial {
+    Trial::ignorable_test(name, move || {
+        f().map(TrialResult::into_completion).map_err(Failed::from)
+    })
+}
+
+/// Registers the test function `f` under the name `module::f`, so that the
+/// name a run prints and filters on is the function's own:
+/// `trial!(f)`, or `trial!(f, timeout = LIMIT)` to fail a test that has not
+/// returned after `LIMIT` instead of hanging the run.
+#[macro_export]
+macro_rules! trial {
+    ($f:ident) => {
+        $crate::trial(&$crate::test_name(module_path!(), stringify!($f)), $f)
+    };
+    ($f:ident, timeout = $limit:expr) => {
+        $crate::trial(
+            &$crate::test_name(module_path!(), stringify!($f)),
+            move || $crate::support::with_timeout($limit, $f),
+        )
+    };
+}
+
+/// `module::function`, from `module_path!()` (which starts with this
+/// binary's crate name, left out) and the function's name.
+pub fn test_name(module_path: &str, function: &str) -> String {
+    let module = module_path
+        .split_once("::")
+        .map_or(module_path, |(_, module)| module);
+    format!("{module}::{function}")
 }
 
 fn main() {

@@ -8,22 +8,10 @@ use crate::trial;
 
 pub fn tests() -> Vec<Trial> {
     vec![
-        trial(
-            "outputs::symlink_target_keeps_the_link",
-            symlink_target_keeps_the_link,
-        ),
-        trial(
-            "outputs::named_pipe_is_written_directly",
-            named_pipe_is_written_directly,
-        ),
-        trial(
-            "outputs::full_disk_is_a_clear_error",
-            full_disk_is_a_clear_error,
-        ),
-        trial(
-            "outputs::killed_mid_write_leaves_the_target_intact",
-            killed_mid_write_leaves_the_target_intact,
-        ),
+        trial!(symlink_target_keeps_the_link),
+        trial!(named_pipe_is_written_directly),
+        trial!(full_disk_is_a_clear_error),
+        trial!(killed_mid_write_leaves_the_target_intact),
     ]
 }
 

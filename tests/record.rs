@@ -18,45 +18,18 @@ use crate::{ensure, trial};
 
 pub fn tests() -> Vec<Trial> {
     vec![
-        trial(
-            "record::same_seed_gives_identical_bytes",
-            same_seed_gives_identical_bytes,
-        ),
-        trial(
-            "record::expected_equals_sweep_mesh_rerun_on_recorded_sweeps",
-            expected_equals_rerun,
-        ),
-        trial(
-            "record::no_nan_and_balls_stay_in_the_play_volume",
-            no_nan_and_bounded,
-        ),
-        trial(
-            "record::runaway_balls_are_stopped_not_nan",
-            runaway_balls_are_stopped,
-        ),
-        trial(
-            "record::sub_steps_are_separate_frames_in_time_order",
-            sub_steps_are_separate_frames,
-        ),
-        trial(
-            "record::invalid_options_are_errors",
-            invalid_options_are_errors,
-        ),
-        trial(
-            "record::scenes_have_no_degenerate_triangles",
-            scenes_have_no_degenerate_triangles,
-        ),
-        trial(
-            "record::scenes_face_the_play_side",
-            scenes_face_the_play_side,
-        ),
-        trial("record::terrain_has_at_least_100k_triangles", terrain_size),
-        trial("record::obj_loads", obj_loads),
-        trial("record::bad_obj_is_a_clear_error", bad_obj_errors),
-        trial(
-            "record::sample_traces_cover_every_kind",
-            sample_traces_cover_every_kind,
-        ),
+        trial!(same_seed_gives_identical_bytes),
+        trial!(expected_equals_sweep_mesh_rerun_on_recorded_sweeps),
+        trial!(no_nan_and_balls_stay_in_the_play_volume),
+        trial!(runaway_balls_are_stopped_not_nan),
+        trial!(sub_steps_are_separate_frames_in_time_order),
+        trial!(invalid_options_are_errors),
+        trial!(scenes_have_no_degenerate_triangles),
+        trial!(scenes_face_the_play_side),
+        trial!(terrain_has_at_least_100k_triangles),
+        trial!(obj_loads),
+        trial!(bad_obj_is_a_clear_error),
+        trial!(sample_traces_cover_every_kind),
     ]
 }
 
@@ -153,7 +126,7 @@ fn same_seed_gives_identical_bytes() -> Result<(), String> {
     Ok(())
 }
 
-fn expected_equals_rerun() -> Result<(), String> {
+fn expected_equals_sweep_mesh_rerun_on_recorded_sweeps() -> Result<(), String> {
     for (name, margin, facing) in [
         ("bowl", 0.02, Facing::NonStrict),
         ("cube", 0.05, Facing::NonStrict),
@@ -256,7 +229,7 @@ fn check_bounded(name: &str, mesh: &Mesh, options: &SimOptions) -> Result<sim::S
     Ok(summary)
 }
 
-fn no_nan_and_bounded() -> Result<(), String> {
+fn no_nan_and_balls_stay_in_the_play_volume() -> Result<(), String> {
     for name in BuiltinScene::all().map(BuiltinScene::name) {
         let s = scene(name);
         let mesh = s.to_mesh().map_err(|e| e.to_string())?;
@@ -278,7 +251,7 @@ fn no_nan_and_bounded() -> Result<(), String> {
     Ok(())
 }
 
-fn runaway_balls_are_stopped() -> Result<(), String> {
+fn runaway_balls_are_stopped_not_nan() -> Result<(), String> {
     let s = scene("triangle");
     let mesh = s.to_mesh().map_err(|e| e.to_string())?;
     let options = SimOptions {
@@ -302,7 +275,7 @@ fn runaway_balls_are_stopped() -> Result<(), String> {
     Ok(())
 }
 
-fn sub_steps_are_separate_frames() -> Result<(), String> {
+fn sub_steps_are_separate_frames_in_time_order() -> Result<(), String> {
     let s = scene("box");
     let mesh = s.to_mesh().map_err(|e| e.to_string())?;
     let options = SimOptions {
@@ -541,7 +514,7 @@ fn scenes_face_the_play_side() -> Result<(), String> {
     Ok(())
 }
 
-fn terrain_size() -> Result<(), String> {
+fn terrain_has_at_least_100k_triangles() -> Result<(), String> {
     let t = BuiltinScene::from_name("terrain")
         .map(BuiltinScene::mesh)
         .ok_or("terrain missing")?;
@@ -623,7 +596,7 @@ fn obj_loads() -> Result<(), String> {
     Ok(())
 }
 
-fn bad_obj_errors() -> Result<(), String> {
+fn bad_obj_is_a_clear_error() -> Result<(), String> {
     let dir = tempfile::tempdir().map_err(|e| e.to_string())?;
     let cases = [
         (

@@ -30,62 +30,23 @@ use crate::trial;
 
 pub fn tests() -> Vec<Trial> {
     vec![
-        trial(
-            "replay::outcomes_equal_sweep_mesh",
-            outcomes_equal_sweep_mesh,
-        ),
-        trial(
-            "replay::outcomes_equal_without_explanation",
-            outcomes_equal_without_explanation,
-        ),
-        trial("replay::frame_and_ball_filters", frame_and_ball_filters),
-        trial("replay::frame_range_parsing", frame_range_parsing),
-        trial(
-            "replay::detail_levels_choose_records",
-            detail_levels_choose_records,
-        ),
-        trial(
-            "replay::expected_attached_before_and_after",
-            expected_attached_before_and_after,
-        ),
-        trial("replay::scene_overrides_apply", scene_overrides_apply),
-        trial(
-            "replay::sweep_before_scene_is_an_error",
-            sweep_before_scene_is_an_error,
-        ),
-        trial("replay::through_an_mcap_trace", through_an_mcap_trace),
-        trial(
-            "replay::rrd_reads_back_through_rerun",
-            rrd_reads_back_through_rerun,
-        ),
-        trial(
-            "replay::cli_writes_outcomes_and_rrd",
-            cli_writes_outcomes_and_rrd,
-        ),
-        trial(
-            "replay::threads_do_not_change_the_outputs",
-            threads_do_not_change_the_outputs,
-        ),
-        trial(
-            "replay::blueprint_is_reproducible",
-            blueprint_is_reproducible,
-        ),
-        trial(
-            "replay::parallel_iterator_equals_sequential",
-            parallel_iterator_equals_sequential,
-        ),
-        trial(
-            "replay::rrd_shows_edges_features_and_explanations",
-            rrd_shows_edges_features_and_explanations,
-        ),
-        trial(
-            "replay::rrd_marks_fragile_decisions",
-            rrd_marks_fragile_decisions,
-        ),
-        trial(
-            "replay::viewer_and_check_agree_on_divergences",
-            viewer_and_check_agree_on_divergences,
-        ),
+        trial!(outcomes_equal_sweep_mesh),
+        trial!(outcomes_equal_without_explanation),
+        trial!(frame_and_ball_filters),
+        trial!(frame_range_parsing),
+        trial!(detail_levels_choose_records),
+        trial!(expected_attached_before_and_after),
+        trial!(scene_overrides_apply),
+        trial!(sweep_before_scene_is_an_error),
+        trial!(through_an_mcap_trace),
+        trial!(rrd_reads_back_through_rerun),
+        trial!(cli_writes_outcomes_and_rrd),
+        trial!(threads_do_not_change_the_outputs),
+        trial!(blueprint_is_reproducible),
+        trial!(parallel_iterator_equals_sequential),
+        trial!(rrd_shows_edges_features_and_explanations),
+        trial!(rrd_marks_fragile_decisions),
+        trial!(viewer_and_check_agree_on_divergences),
     ]
 }
 
@@ -503,7 +464,6 @@ fn expected_attached_before_and_after() -> Result<(), String> {
     );
     let (line, mismatch) = viz::decision_line(
         &results[0],
-        None,
         results[0].decisive_record(),
         &sweeptrace::regress::Tolerances::default(),
     );
@@ -1709,7 +1669,7 @@ fn viewer_and_check_agree_on_divergences() -> Result<(), String> {
 
     let line_frames: BTreeSet<i64> = results
         .iter()
-        .filter(|r| viz::decision_line(r, None, r.decisive_record(), &Tolerances::default()).1)
+        .filter(|r| viz::decision_line(r, r.decisive_record(), &Tolerances::default()).1)
         .map(|r| r.frame as i64)
         .collect();
     ensure!(

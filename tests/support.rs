@@ -1,5 +1,8 @@
 //! Helpers shared by the test modules.
 
+use std::sync::mpsc::{self, RecvTimeoutError};
+use std::time::Duration;
+
 use sweeptrace::core::{
     Broadphase, CollectRecords, EdgeRecord, FaceRecord, Facing, Mesh, Options, Outcome, Sweep,
     TestRecord, VertexRecord, sweep_mesh_with,
@@ -14,6 +17,32 @@ macro_rules! ensure {
             return Err(format!($($arg)+));
         }
     };
+}
+
+/// Runs `f` on a thread of its own and fails if it has not returned within
+/// `limit`, so that a test whose code under test hangs fails instead of
+/// hanging the whole run (the stuck thread is left behind; the test binary
+/// ends with the run).
+pub fn with_timeout<T: Send + 'static>(
+    limit: Duration,
+    f: impl FnOnce() -> Result<T, String> + Send + 'static,
+) -> Result<T, String> {
+    let (tx, rx) = mpsc::channel();
+    std::thread::Builder::new()
+        .name("test body".to_string())
+        .spawn(move || {
+            // The receiver is gone only after a timeout: nobody is listening.
+            let _ = tx.send(f());
+        })
+        .map_err(|e| format!("cannot start the test thread: {e}"))?;
+    match rx.recv_timeout(limit) {
+        Ok(result) => result,
+        Err(RecvTimeoutError::Timeout) => Err(format!(
+            "did not finish within {} s (hangs?)",
+            limit.as_secs_f64()
+        )),
+        Err(RecvTimeoutError::Disconnected) => Err("the test body panicked".to_string()),
+    }
 }
 
 /// `|a - b| ≤ tol`, or an error naming `what`.

@@ -5,7 +5,7 @@ use std::collections::BTreeMap;
 use std::io::Cursor;
 use std::path::Path;
 
-use libtest_mimic::Trial;
+use libtest_mimic::{Completion, Trial};
 use mcap::records::MessageHeader;
 use mcap::{Compression, WriteOptions};
 use rand::{Rng, SeedableRng};
@@ -21,71 +21,40 @@ use crate::trial;
 
 pub fn tests() -> Vec<Trial> {
     vec![
-        trial(
-            "trace_io::round_trip_default_writer",
-            round_trip_default_writer,
-        ),
-        trial(
-            "trace_io::writer_output_is_deterministic",
-            writer_is_deterministic,
-        ),
-        trial("trace_io::reads_unchunked", || flavour(unchunked(), &[])),
-        trial("trace_io::reads_lz4_chunks", || flavour(lz4(), &["lz4"])),
-        trial("trace_io::reads_uncompressed_chunks", || {
-            flavour(uncompressed_chunks(), &["none"])
-        }),
-        trial("trace_io::reads_without_summary_or_indexes", || {
-            flavour(no_summary(), &["zstd"])
-        }),
-        trial("trace_io::reads_unchunked_without_summary", || {
-            flavour(no_summary().use_chunks(false), &[])
-        }),
-        trial("trace_io::python_fixture_exact_values", python_fixture),
-        trial(
-            "trace_io::foreign_channels_skipped_and_counted",
-            foreign_channels,
-        ),
-        trial("trace_io::error_truncated_every_cut", truncated_every_cut),
-        trial("trace_io::error_truncated_chunked", truncated_chunked),
-        trial("trace_io::error_corrupt_zstd_chunk", || {
-            corrupt_chunk(default_opts())
-        }),
-        trial("trace_io::error_corrupt_uncompressed_chunk", || {
-            corrupt_chunk(uncompressed_chunks())
-        }),
-        trial("trace_io::error_not_json", not_json),
-        trial("trace_io::error_missing_field", missing_field),
-        trial("trace_io::error_mistyped_field", mistyped_field),
-        trial("trace_io::error_null_for_number", null_for_number),
-        trial("trace_io::error_number_out_of_range", number_out_of_range),
-        trial(
-            "trace_io::error_vertex_index_out_of_range",
-            vertex_out_of_range,
-        ),
-        trial("trace_io::error_radius_not_positive", radius_not_positive),
-        trial(
-            "trace_io::error_margin_not_below_radius",
-            margin_not_below_radius,
-        ),
-        trial("trace_io::error_sweep_before_scene", sweep_before_scene),
-        trial("trace_io::error_oversized_scene", oversized_scene),
-        trial("trace_io::error_huge_declared_record", huge_declared_record),
-        trial("trace_io::error_huge_declared_chunk", huge_declared_chunk),
-        trial("trace_io::error_out_of_order_log_time", out_of_order),
-        trial("trace_io::error_wrong_message_encoding", wrong_encoding),
-        trial("trace_io::error_bad_outcome_alpha", bad_outcome),
-        trial(
-            "trace_io::random_corruption_never_panics",
-            random_corruption,
-        ),
-        trial(
-            "trace_io::writer_refuses_invalid_messages",
-            writer_refuses_invalid,
-        ),
-        trial("trace_io::write_trace_file_is_atomic", write_file_atomic),
-        trial("trace_io::info_renders_python_fixture", info_render),
-        trial("trace_io::info_reports_partial_trace", info_partial),
-        trial("trace_io::python_reads_our_trace", python_reads_our_trace),
+        trial!(round_trip_default_writer),
+        trial!(writer_output_is_deterministic),
+        trial!(reads_unchunked),
+        trial!(reads_lz4_chunks),
+        trial!(reads_uncompressed_chunks),
+        trial!(reads_without_summary_or_indexes),
+        trial!(reads_unchunked_without_summary),
+        trial!(python_fixture_exact_values),
+        trial!(foreign_channels_skipped_and_counted),
+        trial!(error_truncated_every_cut),
+        trial!(error_truncated_chunked),
+        trial!(error_corrupt_zstd_chunk),
+        trial!(error_corrupt_uncompressed_chunk),
+        trial!(error_not_json),
+        trial!(error_missing_field),
+        trial!(error_mistyped_field),
+        trial!(error_null_for_number),
+        trial!(error_number_out_of_range),
+        trial!(error_vertex_index_out_of_range),
+        trial!(error_radius_not_positive),
+        trial!(error_margin_not_below_radius),
+        trial!(error_sweep_before_scene),
+        trial!(error_oversized_scene),
+        trial!(error_huge_declared_record),
+        trial!(error_huge_declared_chunk),
+        trial!(error_out_of_order_log_time),
+        trial!(error_wrong_message_encoding),
+        trial!(error_bad_outcome_alpha),
+        trial!(random_corruption_never_panics),
+        trial!(writer_refuses_invalid_messages),
+        trial!(write_trace_file_is_atomic),
+        trial!(info_renders_python_fixture),
+        trial!(info_reports_partial_trace),
+        trial!(python_reads_our_trace),
     ]
 }
 
@@ -399,12 +368,32 @@ fn round_trip_default_writer() -> Result<(), String> {
     Ok(())
 }
 
-fn writer_is_deterministic() -> Result<(), String> {
+fn writer_output_is_deterministic() -> Result<(), String> {
     let events = sample_events(50);
     let a = write_events(&events, default_opts())?;
     let b = write_events(&events, default_opts())?;
     ensure!(a == b, "two writes of the same trace differ");
     Ok(())
+}
+
+fn reads_unchunked() -> Result<(), String> {
+    flavour(unchunked(), &[])
+}
+
+fn reads_lz4_chunks() -> Result<(), String> {
+    flavour(lz4(), &["lz4"])
+}
+
+fn reads_uncompressed_chunks() -> Result<(), String> {
+    flavour(uncompressed_chunks(), &["none"])
+}
+
+fn reads_without_summary_or_indexes() -> Result<(), String> {
+    flavour(no_summary(), &["zstd"])
+}
+
+fn reads_unchunked_without_summary() -> Result<(), String> {
+    flavour(no_summary().use_chunks(false), &[])
 }
 
 fn flavour(opts: WriteOptions, compression: &[&str]) -> Result<(), String> {
@@ -432,7 +421,7 @@ fn flavour(opts: WriteOptions, compression: &[&str]) -> Result<(), String> {
     Ok(())
 }
 
-fn python_fixture() -> Result<(), String> {
+fn python_fixture_exact_values() -> Result<(), String> {
     let bytes = std::fs::read(FIXTURE).map_err(|e| format!("{FIXTURE}: {e}"))?;
     let (events, error, stats) = read_all(&bytes);
     ensure!(error.is_none(), "error: {error:?}");
@@ -589,7 +578,7 @@ fn python_fixture() -> Result<(), String> {
     Ok(())
 }
 
-fn foreign_channels() -> Result<(), String> {
+fn foreign_channels_skipped_and_counted() -> Result<(), String> {
     let bytes = raw_trace(&[
         ("/foreign", 0, b"\x00\x01binary"),
         ("/scene", 1, SCENE_JSON),
@@ -624,7 +613,7 @@ fn foreign_channels() -> Result<(), String> {
 
 // ---------------------------------------------------------------- errors
 
-fn truncated_every_cut() -> Result<(), String> {
+fn error_truncated_every_cut() -> Result<(), String> {
     let events = sample_events(4);
     let bytes = write_events(&events, unchunked())?;
     let mut saw_partial = false;
@@ -660,7 +649,7 @@ fn truncated_every_cut() -> Result<(), String> {
     Ok(())
 }
 
-fn truncated_chunked() -> Result<(), String> {
+fn error_truncated_chunked() -> Result<(), String> {
     let events = sample_events(400);
     let bytes = write_events(&events, lz4())?;
     let (full, _, stats) = read_all(&bytes);
@@ -704,6 +693,14 @@ fn first_chunk(bytes: &[u8]) -> Option<(usize, usize)> {
     None
 }
 
+fn error_corrupt_zstd_chunk() -> Result<(), String> {
+    corrupt_chunk(default_opts())
+}
+
+fn error_corrupt_uncompressed_chunk() -> Result<(), String> {
+    corrupt_chunk(uncompressed_chunks())
+}
+
 fn corrupt_chunk(opts: WriteOptions) -> Result<(), String> {
     let events = sample_events(30);
     let mut bytes = write_events(&events, opts)?;
@@ -721,7 +718,7 @@ fn corrupt_chunk(opts: WriteOptions) -> Result<(), String> {
     Ok(())
 }
 
-fn not_json() -> Result<(), String> {
+fn error_not_json() -> Result<(), String> {
     let bytes = raw_trace(&[
         ("/scene", 0, SCENE_JSON),
         ("/sweep", 1, b"{frame: 3, radius"),
@@ -737,7 +734,7 @@ fn not_json() -> Result<(), String> {
     Ok(())
 }
 
-fn missing_field() -> Result<(), String> {
+fn error_missing_field() -> Result<(), String> {
     let bytes = raw_trace(&[
         ("/scene", 0, SCENE_JSON),
         ("/sweep", 1, br#"{"frame":3,"p0":[0,0,1],"p1":[0,0,0]}"#),
@@ -758,7 +755,7 @@ fn missing_field() -> Result<(), String> {
     Ok(())
 }
 
-fn mistyped_field() -> Result<(), String> {
+fn error_mistyped_field() -> Result<(), String> {
     let bytes = raw_trace(&[
         ("/scene", 0, SCENE_JSON),
         (
@@ -786,7 +783,7 @@ fn mistyped_field() -> Result<(), String> {
     Ok(())
 }
 
-fn null_for_number() -> Result<(), String> {
+fn error_null_for_number() -> Result<(), String> {
     let bytes = raw_trace(&[
         ("/scene", 0, SCENE_JSON),
         (
@@ -805,7 +802,7 @@ fn null_for_number() -> Result<(), String> {
     Ok(())
 }
 
-fn number_out_of_range() -> Result<(), String> {
+fn error_number_out_of_range() -> Result<(), String> {
     let bytes = raw_trace(&[
         ("/scene", 0, SCENE_JSON),
         (
@@ -818,7 +815,7 @@ fn number_out_of_range() -> Result<(), String> {
     Ok(())
 }
 
-fn vertex_out_of_range() -> Result<(), String> {
+fn error_vertex_index_out_of_range() -> Result<(), String> {
     let bytes = raw_trace(&[(
         "/scene",
         0,
@@ -838,7 +835,7 @@ fn vertex_out_of_range() -> Result<(), String> {
     Ok(())
 }
 
-fn radius_not_positive() -> Result<(), String> {
+fn error_radius_not_positive() -> Result<(), String> {
     for radius in ["0", "-0.5", "0.0"] {
         let sweep = format!(r#"{{"frame":11,"radius":{radius},"p0":[0,0,1],"p1":[0,0,0]}}"#);
         let bytes = raw_trace(&[("/scene", 0, SCENE_JSON), ("/sweep", 1, sweep.as_bytes())]);
@@ -850,7 +847,7 @@ fn radius_not_positive() -> Result<(), String> {
     Ok(())
 }
 
-fn margin_not_below_radius() -> Result<(), String> {
+fn error_margin_not_below_radius() -> Result<(), String> {
     let scene = br#"{"vertices":[[0,0,0],[4,0,0],[0,4,0]],"triangles":[[0,1,2]],"margin":0.5}"#;
     let bytes = raw_trace(&[
         ("/scene", 0, scene),
@@ -870,7 +867,7 @@ fn margin_not_below_radius() -> Result<(), String> {
     Ok(())
 }
 
-fn sweep_before_scene() -> Result<(), String> {
+fn error_sweep_before_scene() -> Result<(), String> {
     let bytes = raw_trace(&[
         (
             "/sweep",
@@ -890,7 +887,7 @@ fn sweep_before_scene() -> Result<(), String> {
     Ok(())
 }
 
-fn oversized_scene() -> Result<(), String> {
+fn error_oversized_scene() -> Result<(), String> {
     let mut scene = triangle_scene();
     scene.vertices = (0..200).map(|i| [i as f64, 0.5, 0.25]).collect();
     let mut w = TraceWriter::new(Cursor::new(Vec::new())).map_err(|e| e.to_string())?;
@@ -934,7 +931,7 @@ fn magic_and_header() -> Vec<u8> {
     out
 }
 
-fn huge_declared_record() -> Result<(), String> {
+fn error_huge_declared_record() -> Result<(), String> {
     // A message record declaring a terabyte (a scene "with a billion triangles").
     let mut bytes = magic_and_header();
     bytes.push(0x05);
@@ -948,7 +945,7 @@ fn huge_declared_record() -> Result<(), String> {
     Ok(())
 }
 
-fn huge_declared_chunk() -> Result<(), String> {
+fn error_huge_declared_chunk() -> Result<(), String> {
     let mut chunk = Vec::new();
     chunk.extend(0u64.to_le_bytes()); // message start time
     chunk.extend(0u64.to_le_bytes()); // message end time
@@ -968,7 +965,7 @@ fn huge_declared_chunk() -> Result<(), String> {
     Ok(())
 }
 
-fn out_of_order() -> Result<(), String> {
+fn error_out_of_order_log_time() -> Result<(), String> {
     let bytes = raw_trace(&[
         ("/scene", 0, SCENE_JSON),
         (
@@ -991,13 +988,13 @@ fn out_of_order() -> Result<(), String> {
     Ok(())
 }
 
-fn wrong_encoding() -> Result<(), String> {
+fn error_wrong_message_encoding() -> Result<(), String> {
     let bytes = raw_trace_with(&[("/scene", 0, SCENE_JSON)], "cbor");
     expect_error(&bytes, &["test.mcap", "`/scene`", "cbor", "json"])?;
     Ok(())
 }
 
-fn bad_outcome() -> Result<(), String> {
+fn error_bad_outcome_alpha() -> Result<(), String> {
     let bytes = raw_trace(&[
         ("/scene", 0, SCENE_JSON),
         ("/expected", 1, br#"{"frame":6,"alpha":1.5,"kind":"none"}"#),
@@ -1015,9 +1012,10 @@ fn bad_outcome() -> Result<(), String> {
     Ok(())
 }
 
-fn random_corruption() -> Result<(), String> {
+fn random_corruption_never_panics() -> Result<(), String> {
     let events = sample_events(40);
     let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(0x5eed_7ace);
+    let mut seen = BTreeMap::new();
     for opts in [default_opts(), unchunked(), lz4(), uncompressed_chunks()] {
         let bytes = write_events(&events, opts)?;
         for _ in 0..300 {
@@ -1029,14 +1027,79 @@ fn random_corruption() -> Result<(), String> {
             if rng.random_bool(0.3) {
                 b.truncate(rng.random_range(0..b.len()));
             }
-            // Must terminate without panicking; errors are fine.
-            let _ = read_all(&b);
+            // Must terminate without panicking; errors are fine, as long as
+            // each says where it happened.
+            let (events, error, _) = read_all(&b);
+            if let Some(error) = error {
+                error_names_where(&error, events.len() as u64)?;
+                *seen.entry(variant_name(&error)).or_insert(0) += 1;
+            }
         }
+    }
+    // The corruption reaches every layer: the container, the end of the
+    // file and the messages.
+    ensure!(
+        ["Corrupt", "Truncated", "Json"]
+            .iter()
+            .all(|v| seen.contains_key(*v)),
+        "errors seen: {seen:?}"
+    );
+    Ok(())
+}
+
+/// The name of the error's variant, from its `Debug` form (`Corrupt { .. }`).
+fn variant_name(error: &TraceError) -> String {
+    let debug = format!("{error:?}");
+    debug
+        .split([' ', '{', '('])
+        .next()
+        .unwrap_or("")
+        .to_string()
+}
+
+/// The error read from `test.mcap` after `read` good messages names the
+/// file and, where it has one, the message (channel and index, which is at
+/// least `read`) or the number of complete messages before it.
+fn error_names_where(error: &TraceError, read: u64) -> Result<(), String> {
+    let text = error.to_string();
+    ensure!(
+        text.starts_with("test.mcap: "),
+        "does not start with the file name: {text}"
+    );
+    if let Some(at) = error.message_at() {
+        ensure!(
+            at.file == "test.mcap"
+                && at.index >= read
+                && text.contains(&format!("channel `{}`", at.channel))
+                && text.contains(&format!("message {}", at.index)),
+            "the message is not named: {text} ({at:?}, {read} read)"
+        );
+        return Ok(());
+    }
+    match error {
+        TraceError::Io { messages, .. }
+        | TraceError::Truncated { messages, .. }
+        | TraceError::Corrupt { messages, .. } => ensure!(
+            *messages >= read && text.contains(&format!("after {messages} complete messages")),
+            "the position is not named: {text} ({read} read)"
+        ),
+        TraceError::TooLarge { what, .. } => {
+            ensure!(!what.is_empty(), "what is too large is not named: {text}")
+        }
+        TraceError::WrongEncoding { channel, .. } => ensure!(
+            text.contains(&format!("channel `{channel}`")),
+            "the channel is not named: {text}"
+        ),
+        TraceError::UnknownChannel { index, .. } => ensure!(
+            *index >= read && text.contains(&format!("message {index}")),
+            "the message is not named: {text} ({read} read)"
+        ),
+        _ => return Err(format!("unexpected error while reading: {text}")),
     }
     Ok(())
 }
 
-fn writer_refuses_invalid() -> Result<(), String> {
+fn writer_refuses_invalid_messages() -> Result<(), String> {
     let mut w = TraceWriter::new(Cursor::new(Vec::new())).map_err(|e| e.to_string())?;
     let e = w
         .sweep(0, &sweep(3, 0))
@@ -1075,7 +1138,7 @@ fn writer_refuses_invalid() -> Result<(), String> {
     Ok(())
 }
 
-fn write_file_atomic() -> Result<(), String> {
+fn write_trace_file_is_atomic() -> Result<(), String> {
     let dir = tempfile::tempdir().map_err(|e| e.to_string())?;
     let path = dir.path().join("run.mcap");
     let events = sample_events(5);
@@ -1147,7 +1210,7 @@ fn write_file_atomic() -> Result<(), String> {
     Ok(())
 }
 
-fn info_render() -> Result<(), String> {
+fn info_renders_python_fixture() -> Result<(), String> {
     let bytes = std::fs::read(FIXTURE).map_err(|e| format!("{FIXTURE}: {e}"))?;
     let (info, error) = collect(TraceReader::new(bytes.as_slice(), "python_written.mcap"));
     ensure!(error.is_none(), "{error:?}");
@@ -1203,7 +1266,7 @@ fn info_render() -> Result<(), String> {
     Ok(())
 }
 
-fn info_partial() -> Result<(), String> {
+fn info_reports_partial_trace() -> Result<(), String> {
     let bytes = write_events(&sample_events(10), unchunked())?;
     let cut = &bytes[..bytes.len() / 2];
     let (info, error) = collect(TraceReader::new(cut, "cut.mcap"));
@@ -1218,17 +1281,35 @@ fn info_partial() -> Result<(), String> {
     Ok(())
 }
 
-fn python_reads_our_trace() -> Result<(), String> {
-    let has_mcap = std::process::Command::new("python3")
+/// Set to `1` (CI does) to make the Python cross-check fail, instead of
+/// being skipped, when Python's `mcap` package cannot be imported.
+const REQUIRE_PYTHON: &str = "SWEEPTRACE_REQUIRE_PYTHON";
+
+fn python_reads_our_trace() -> Result<Completion, String> {
+    let missing = match std::process::Command::new("python3")
         .args(["-c", "import mcap"])
         .output()
-        .map(|o| o.status.success())
-        .unwrap_or(false);
-    if !has_mcap {
-        println!(
-            "note: python3 with the `mcap` package not found; skipping scripts/read_with_python.py"
-        );
-        return Ok(());
+    {
+        Ok(o) if o.status.success() => None,
+        Ok(o) => Some(format!(
+            "python3 cannot import the `mcap` package ({})",
+            String::from_utf8_lossy(&o.stderr)
+                .lines()
+                .last()
+                .unwrap_or("no message")
+        )),
+        Err(e) => Some(format!("python3 cannot be run ({e})")),
+    };
+    if let Some(missing) = missing {
+        if std::env::var_os(REQUIRE_PYTHON).is_some_and(|v| v == "1") {
+            return Err(format!(
+                "{missing}, and {REQUIRE_PYTHON}=1 requires this cross-check \
+                 (`pip install mcap==1.6.0` and put that Python first on PATH)"
+            ));
+        }
+        return Ok(Completion::ignored_with(format!(
+            "skipped: {missing}; {REQUIRE_PYTHON}=1 makes this a failure"
+        )));
     }
     let dir = tempfile::tempdir().map_err(|e| e.to_string())?;
     let path = dir.path().join("py.mcap");
@@ -1253,5 +1334,5 @@ fn python_reads_our_trace() -> Result<(), String> {
     // And it can fail.
     let bad = run(&["--sweeps", "61"]).map_err(|e| e.to_string())?;
     ensure!(!bad.status.success(), "script accepted a wrong count");
-    Ok(())
+    Ok(Completion::Completed)
 }

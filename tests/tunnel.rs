@@ -49,22 +49,22 @@ const WALL: &str = "tests/fixtures/tunnel_wall_teleport.mcap";
 
 pub fn tests() -> Vec<Trial> {
     vec![
-        trial("tunnel::crossing_front_to_back", crossing_front_to_back),
-        trial("tunnel::crossing_back_to_front_is_none", back_to_front),
-        trial("tunnel::crossing_parallel_is_none", parallel),
-        trial("tunnel::crossing_touching_the_plane", touching_the_plane),
-        trial("tunnel::crossing_edge_and_vertex", edge_and_vertex),
-        trial("tunnel::crossing_first_of_several", first_of_several),
-        trial("tunnel::crossing_bvh_matches_every_triangle", bvh_matches),
-        trial("tunnel::floor_fixture_check", floor_check),
-        trial("tunnel::wall_fixture_check", wall_check),
-        trial("tunnel::fixtures_binary_check_exit_1", binary_check),
-        trial("tunnel::fixtures_binary_replay_outcomes", binary_replay),
-        trial("tunnel::parallel_replay_same_tunnels", parallel_replay),
-        trial("tunnel::filters_and_scenes_reset_the_jump", filters_reset),
-        trial("tunnel::recording_marks_the_tunnel", recording),
-        trial("tunnel::sample_traces_have_none", sample_traces),
-        trial("tunnel::simulation_has_none", simulation),
+        trial!(crossing_front_to_back),
+        trial!(crossing_back_to_front_is_none),
+        trial!(crossing_parallel_is_none),
+        trial!(crossing_touching_the_plane),
+        trial!(crossing_edge_and_vertex),
+        trial!(crossing_first_of_several),
+        trial!(crossing_bvh_matches_every_triangle),
+        trial!(floor_fixture_check),
+        trial!(wall_fixture_check),
+        trial!(fixtures_binary_check_exit_1),
+        trial!(fixtures_binary_replay_outcomes),
+        trial!(parallel_replay_same_tunnels),
+        trial!(filters_and_scenes_reset_the_jump),
+        trial!(recording_marks_the_tunnel),
+        trial!(sample_traces_have_none),
+        trial!(simulation_has_none),
         Trial::test("tunnel::generate_fixtures", || {
             generate_fixtures().map_err(Failed::from)
         })
@@ -107,7 +107,7 @@ fn crossing_front_to_back() -> Result<(), String> {
     Ok(())
 }
 
-fn back_to_front() -> Result<(), String> {
+fn crossing_back_to_front_is_none() -> Result<(), String> {
     let m = floor_mesh();
     ensure!(
         first_crossing(&m, &p(1.0, -2.0, -1.0), &p(1.0, -2.0, 3.0)).is_none(),
@@ -125,7 +125,7 @@ fn back_to_front() -> Result<(), String> {
     Ok(())
 }
 
-fn parallel() -> Result<(), String> {
+fn crossing_parallel_is_none() -> Result<(), String> {
     let m = floor_mesh();
     for z in [1.0, 0.0, -1.0, 1e-300, -1e-300] {
         ensure!(
@@ -141,7 +141,7 @@ fn parallel() -> Result<(), String> {
     Ok(())
 }
 
-fn touching_the_plane() -> Result<(), String> {
+fn crossing_touching_the_plane() -> Result<(), String> {
     let m = floor_mesh();
     // Ends on the plane: not behind it.
     ensure!(
@@ -170,7 +170,7 @@ fn touching_the_plane() -> Result<(), String> {
     Ok(())
 }
 
-fn edge_and_vertex() -> Result<(), String> {
+fn crossing_edge_and_vertex() -> Result<(), String> {
     let m = floor_mesh();
     // Through the shared diagonal: both triangles, the lower one reported.
     let c = first_crossing(&m, &p(1.0, 1.0, 1.0), &p(1.0, 1.0, -1.0)).ok_or("diagonal")?;
@@ -206,7 +206,7 @@ fn edge_and_vertex() -> Result<(), String> {
     Ok(())
 }
 
-fn first_of_several() -> Result<(), String> {
+fn crossing_first_of_several() -> Result<(), String> {
     // Two floors, at z = 0 and z = -1, both front +z.
     let m = mesh(
         &[
@@ -228,7 +228,7 @@ fn first_of_several() -> Result<(), String> {
 }
 
 /// The BVH query against every triangle tested in turn, on a terrain.
-fn bvh_matches() -> Result<(), String> {
+fn crossing_bvh_matches_every_triangle() -> Result<(), String> {
     let t = scenes::terrain(16);
     let m = mesh(&t.vertices, &t.triangles);
     let (lo, hi) = m.bounds();
@@ -432,7 +432,7 @@ fn check_floor_report(report: &sweeptrace::regress::TraceReport) -> Result<(), S
     Ok(())
 }
 
-fn floor_check() -> Result<(), String> {
+fn floor_fixture_check() -> Result<(), String> {
     let report = check_file(&fixture(FLOOR), &CheckOptions::default());
     check_floor_report(&report)?;
     // The committed fixture is what the generator makes.
@@ -508,7 +508,7 @@ fn check_wall_report(report: &sweeptrace::regress::TraceReport) -> Result<(), St
     Ok(())
 }
 
-fn wall_check() -> Result<(), String> {
+fn wall_fixture_check() -> Result<(), String> {
     check_wall_report(&check_file(&fixture(WALL), &CheckOptions::default()))?;
     check_wall_report(&check_reader(
         wall_bytes()?.as_slice(),
@@ -533,7 +533,7 @@ fn run_bin(args: &[&std::ffi::OsStr]) -> Result<(i32, String, String), String> {
     ))
 }
 
-fn binary_check() -> Result<(), String> {
+fn fixtures_binary_check_exit_1() -> Result<(), String> {
     let (floor, wall) = (fixture(FLOOR), fixture(WALL));
     let (code, out, err) = run_bin(&["check".as_ref(), floor.as_os_str(), wall.as_os_str()])?;
     ensure!(code == 1, "exit {code}\n{out}\n{err}");
@@ -573,7 +573,7 @@ fn binary_check() -> Result<(), String> {
     Ok(())
 }
 
-fn binary_replay() -> Result<(), String> {
+fn fixtures_binary_replay_outcomes() -> Result<(), String> {
     for (name, frame, kind) in [(FLOOR, 4, "during_sweep"), (WALL, 2, "between_sweeps")] {
         let path = fixture(name);
         let (code, out, err) = run_bin(&[
@@ -610,7 +610,7 @@ fn binary_replay() -> Result<(), String> {
     Ok(())
 }
 
-fn parallel_replay() -> Result<(), String> {
+fn parallel_replay_same_tunnels() -> Result<(), String> {
     for bytes in [floor_bytes()?, wall_bytes()?] {
         let sequential = replay_all(&bytes, ReplayOptions::default())?;
         for batch in [1, 2, 3, 1000] {
@@ -636,7 +636,7 @@ fn parallel_replay() -> Result<(), String> {
     Ok(())
 }
 
-fn filters_reset() -> Result<(), String> {
+fn filters_and_scenes_reset_the_jump() -> Result<(), String> {
     let bytes = wall_bytes()?;
     let with = |frames: &str| -> Result<Vec<(u64, u32, TunnelKind, u32)>, String> {
         let options = ReplayOptions {
@@ -665,7 +665,7 @@ fn filters_reset() -> Result<(), String> {
     Ok(())
 }
 
-fn recording() -> Result<(), String> {
+fn recording_marks_the_tunnel() -> Result<(), String> {
     let dir = tempfile::tempdir().map_err(|e| e.to_string())?;
     let rrd = dir.path().join("floor.rrd");
     let path = fixture(FLOOR);
@@ -725,7 +725,7 @@ fn recording() -> Result<(), String> {
     Ok(())
 }
 
-fn sample_traces() -> Result<(), String> {
+fn sample_traces_have_none() -> Result<(), String> {
     let dir = root().join("traces");
     let traces = sweeptrace::regress::find_traces(&[dir]).map_err(|e| e.to_string())?;
     ensure!(!traces.is_empty(), "no sample trace");
@@ -741,7 +741,7 @@ fn sample_traces() -> Result<(), String> {
 /// and with and without a margin, several seeds: its response never moves a
 /// ball through a surface, and no sweep starts where the tests let it
 /// through.
-fn simulation() -> Result<(), String> {
+fn simulation_has_none() -> Result<(), String> {
     use sweeptrace::sim::{BuiltinScene, SimError, SimOptions, scene_message, simulate};
     use sweeptrace::trace::{TraceError, TraceEvent};
     let (mut sweeps, mut hits) = (0u64, 0u64);

@@ -39,10 +39,10 @@ pub use options::{
     ALPHA_SENSITIVITY, DEGENERATE_TOLERANCE, FRAGILE_ULPS, Facing, GRAZING_COSINE, Options,
     PARALLEL_TOLERANCE, TIE_WINDOW_ULPS,
 };
-pub use path::{Path, Sweep};
+pub use path::{Sweep, SweptPath};
 pub use record::{
-    CollectRecords, EdgeRecord, FaceRecord, Kind, NoObserver, Observer, TestRecord, Verdict,
-    VertexRecord,
+    CollectRecords, EdgeHit, EdgeRecord, FaceHit, FaceRecord, Kind, NoObserver, Observer,
+    TestRecord, Verdict, VertexRecord,
 };
 pub use sweep_edge::sweep_edge;
 pub use sweep_face::{barycentric, barycentric_and_distance, sweep_face};

@@ -13,7 +13,8 @@ pub enum Facing {
     /// `n · d ≤ 0`: moving toward the front, or parallel to the plane.
     #[default]
     NonStrict,
-    /// `n · d < 0`: strictly toward the front (the course FAQ's wording).
+    /// `n · d < 0`: strictly toward the front (the condition as
+    /// the FAQ of the CS121 project that SEMANTICS.md follows states it).
     Strict,
 }
 

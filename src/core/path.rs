@@ -29,7 +29,7 @@ impl Sweep {
 
 /// A sweep checked against the options, with the values every test uses.
 #[derive(Clone, Copy, Debug)]
-pub struct Path {
+pub struct SweptPath {
     /// Start.
     pub p0: Point3<f64>,
     /// End.
@@ -42,13 +42,13 @@ pub struct Path {
     pub rho: f64,
     /// The magnitude `S` the tests' rounding is relative to:
     /// `max(|p0|∞, |p1|∞) + ρ`, raised to the mesh's bounds by
-    /// [`Path::with_mesh_scale`] (the mesh sweep does that).
+    /// [`SweptPath::with_mesh_scale`] (the mesh sweep does that).
     pub scale: f64,
 }
 
-impl Path {
+impl SweptPath {
     /// Validates `sweep` under `options`: finite values, `r > 0`, `0 ≤ ε < r`.
-    pub fn new(sweep: &Sweep, options: &Options) -> Result<Path, SweepError> {
+    pub fn new(sweep: &Sweep, options: &Options) -> Result<SweptPath, SweepError> {
         for (field, p) in [("p0", &sweep.p0), ("p1", &sweep.p1)] {
             for &v in p.iter() {
                 if !v.is_finite() {
@@ -89,7 +89,7 @@ impl Path {
             });
         }
         let rho = sweep.radius - options.margin;
-        Ok(Path {
+        Ok(SweptPath {
             p0: sweep.p0,
             p1: sweep.p1,
             d,
@@ -99,9 +99,9 @@ impl Path {
         })
     }
 
-    /// The path with [`Path::scale`] raised to cover a mesh whose
+    /// The path with [`SweptPath::scale`] raised to cover a mesh whose
     /// axis-aligned bounds are `(lo, hi)`.
-    pub fn with_mesh_scale(mut self, lo: &Point3<f64>, hi: &Point3<f64>) -> Path {
+    pub fn with_mesh_scale(mut self, lo: &Point3<f64>, hi: &Point3<f64>) -> SweptPath {
         let coordinates = self.p0.coords.amax().max(self.p1.coords.amax());
         self.scale = coordinates.max(lo.coords.amax()).max(hi.coords.amax()) + self.rho;
         self

@@ -196,24 +196,88 @@ pub struct VertexRecord {
     pub verdict: Verdict,
 }
 
+/// What a face test that hit found.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FaceHit {
+    /// `α` of the collision (the record's `β`).
+    pub alpha: f64,
+    /// The touch point on the triangle.
+    pub touch: Point3<f64>,
+    /// The touch point's signed distance from the triangle's boundary
+    /// ([`FaceRecord::boundary_distance`]).
+    pub boundary_distance: f64,
+}
+
+/// What an edge test that hit found.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct EdgeHit {
+    /// `α` of the collision (the smaller root `s0`).
+    pub alpha: f64,
+    /// The contact on the edge's line, `xc`, in the standard frame.
+    pub xc: f64,
+}
+
 impl FaceRecord {
+    /// What the test found, if its verdict is a hit (a face test that hits
+    /// has computed `β`, the touch point and its distance from the
+    /// boundary; a record that says hit without them is not a hit).
+    #[inline]
+    pub fn hit(&self) -> Option<FaceHit> {
+        match (self.verdict, self.beta, self.touch, self.boundary_distance) {
+            (Verdict::Hit, Some(alpha), Some(touch), Some(boundary_distance)) => Some(FaceHit {
+                alpha,
+                touch,
+                boundary_distance,
+            }),
+            (verdict, ..) => {
+                debug_assert!(verdict != Verdict::Hit, "face hit without its values");
+                None
+            }
+        }
+    }
+
     /// `α` of the collision, if the verdict is a hit.
+    #[inline]
     pub fn alpha(&self) -> Option<f64> {
-        (self.verdict == Verdict::Hit).then(|| self.beta.unwrap_or(1.0))
+        self.hit().map(|h| h.alpha)
     }
 }
 
 impl EdgeRecord {
+    /// What the test found, if its verdict is a hit (an edge test that hits
+    /// has computed its roots and `xc`; a record that says hit without them
+    /// is not a hit).
+    #[inline]
+    pub fn hit(&self) -> Option<EdgeHit> {
+        match (self.verdict, self.roots, self.xc) {
+            (Verdict::Hit, Some((s0, _)), Some(xc)) => Some(EdgeHit { alpha: s0, xc }),
+            (verdict, ..) => {
+                debug_assert!(verdict != Verdict::Hit, "edge hit without its values");
+                None
+            }
+        }
+    }
+
     /// `α` of the collision, if the verdict is a hit.
+    #[inline]
     pub fn alpha(&self) -> Option<f64> {
-        (self.verdict == Verdict::Hit).then(|| self.roots.map_or(1.0, |r| r.0))
+        self.hit().map(|h| h.alpha)
     }
 }
 
 impl VertexRecord {
-    /// `α` of the collision, if the verdict is a hit.
+    /// `α` of the collision, if the verdict is a hit (a vertex test that
+    /// hits has computed its roots; a record that says hit without them is
+    /// not a hit).
+    #[inline]
     pub fn alpha(&self) -> Option<f64> {
-        (self.verdict == Verdict::Hit).then(|| self.roots.map_or(1.0, |r| r.0))
+        match (self.verdict, self.roots) {
+            (Verdict::Hit, Some((s0, _))) => Some(s0),
+            (verdict, _) => {
+                debug_assert!(verdict != Verdict::Hit, "vertex hit without its roots");
+                None
+            }
+        }
     }
 }
 

@@ -1,14 +1,15 @@
-//! The edge test, in the edge's standard frame (the seed's algorithm).
+//! The edge test, in the edge's standard frame (the algorithm of the CS121
+//! edge collision notes that SEMANTICS.md follows).
 
 use super::mesh::Triangle;
 use super::options::{Facing, PARALLEL_TOLERANCE};
-use super::path::Path;
+use super::path::SweptPath;
 use super::quadratic;
 use super::record::{EdgeRecord, Verdict};
 
 /// Runs the edge test of SEMANTICS.md on edge `edge` (0..3) of `triangle`.
 #[inline]
-pub fn sweep_edge(triangle: &Triangle, edge: u8, path: &Path, facing: Facing) -> EdgeRecord {
+pub fn sweep_edge(triangle: &Triangle, edge: u8, path: &SweptPath, facing: Facing) -> EdgeRecord {
     let frame = triangle.edges[edge as usize];
     let p0_in_edge = frame.to_edge(&path.p0);
     let p1_in_edge = frame.to_edge(&path.p1);

@@ -2,7 +2,7 @@
 
 use super::mesh::Triangle;
 use super::options::{Facing, PARALLEL_TOLERANCE};
-use super::path::Path;
+use super::path::SweptPath;
 use super::record::{FaceRecord, Verdict};
 
 /// Runs the face test of SEMANTICS.md on `triangle`.
@@ -14,11 +14,11 @@ use super::record::{FaceRecord, Verdict};
 /// `h1` is recorded for the explanation only.
 ///
 /// The touch point counts as inside when its signed distance from the
-/// triangle's boundary is at least `-`[`Path::tie_distance`] (rounding
+/// triangle's boundary is at least `-`[`SweptPath::tie_distance`] (rounding
 /// level; the exact contact just outside is an edge or vertex at the same
 /// `α` within the tie window, which the tie order gives to the face).
 #[inline]
-pub fn sweep_face(triangle: &Triangle, path: &Path, facing: Facing) -> FaceRecord {
+pub fn sweep_face(triangle: &Triangle, path: &SweptPath, facing: Facing) -> FaceRecord {
     let n = triangle.normal;
     let a = triangle.vertices[0];
     let h0 = n.dot(&(path.p0 - a));

@@ -8,7 +8,7 @@ use super::error::SweepError;
 use super::fragility::{FragileReason, Fragility};
 use super::mesh::{Mesh, Triangle};
 use super::options::{ALPHA_SENSITIVITY, Facing, GRAZING_COSINE, Options};
-use super::path::{Path, Sweep};
+use super::path::{Sweep, SweptPath};
 use super::record::{Kind, NoObserver, Observer, TestRecord, Verdict};
 use super::sweep_edge::sweep_edge;
 use super::sweep_face::{barycentric_and_distance, sweep_face};
@@ -37,7 +37,7 @@ pub struct Outcome {
     /// The point of the mesh the primary test touches (at its own `α`,
     /// which is tied with `alpha`).
     pub contact: Option<Point3<f64>>,
-    /// The tie window of this sweep, in `α` ([`Path::tie_window`]): a hit
+    /// The tie window of this sweep, in `α` ([`SweptPath::tie_window`]): a hit
     /// at `α ≤ alpha + tie_window` is tied with the primary.
     pub tie_window: f64,
     /// Why the decision may not survive a change of the inputs at the level
@@ -265,7 +265,7 @@ trait Sink {
 fn test_triangle<O: Observer, S: Sink>(
     triangle: &Triangle,
     position: usize,
-    path: &Path,
+    path: &SweptPath,
     facing: Facing,
     observer: &mut O,
     sink: &mut S,
@@ -302,14 +302,14 @@ fn test_triangle<O: Observer, S: Sink>(
     observer.face(&face);
     match face.verdict {
         Verdict::Hit => {
-            if let (Some(beta), Some(touch)) = (face.beta, face.touch) {
+            if let Some(h) = face.hit() {
                 sink.hit(hit(
-                    beta,
+                    h.alpha,
                     Kind::Face,
                     0,
-                    touch,
+                    h.touch,
                     facing_cosine,
-                    face.boundary_distance.unwrap_or(0.0),
+                    h.boundary_distance,
                 ));
             }
         }
@@ -396,14 +396,14 @@ fn test_triangle<O: Observer, S: Sink>(
         };
         match r.verdict {
             Verdict::Hit => {
-                if let (Some((s0, _)), Some(xc)) = (r.roots, r.xc) {
+                if let Some(h) = r.hit() {
                     sink.hit(hit(
-                        s0,
+                        h.alpha,
                         Kind::Edge,
                         e,
-                        r.frame.to_world(&Point3::new(xc, 0.0, 0.0)),
+                        r.frame.to_world(&Point3::new(h.xc, 0.0, 0.0)),
                         approach(r.discriminant),
-                        xc.min(r.length - xc),
+                        h.xc.min(r.length - h.xc),
                     ));
                 }
             }
@@ -429,9 +429,9 @@ fn test_triangle<O: Observer, S: Sink>(
         observer.vertex(&r);
         match r.verdict {
             Verdict::Hit => {
-                if let Some((s0, _)) = r.roots {
+                if let Some(alpha) = r.alpha() {
                     sink.hit(hit(
-                        s0,
+                        alpha,
                         Kind::Vertex,
                         v,
                         r.position,
@@ -522,7 +522,7 @@ impl Sink for Combiner {
 /// by triangle in mesh order: the primary, the normal sum and the flags.
 struct Decision<'a> {
     triangles: &'a [Triangle],
-    path: &'a Path,
+    path: &'a SweptPath,
     min: f64,
     window: f64,
     band: f64,
@@ -591,7 +591,7 @@ pub fn sweep_mesh_with<O: Observer>(
     observer: &mut O,
 ) -> Result<Outcome, SweepError> {
     let (lo, hi) = mesh.bounds();
-    let path = Path::new(sweep, options)?.with_mesh_scale(&lo, &hi);
+    let path = SweptPath::new(sweep, options)?.with_mesh_scale(&lo, &hi);
     Ok(sweep_path(
         mesh,
         &path,
@@ -606,7 +606,7 @@ pub fn sweep_mesh_with<O: Observer>(
 /// that rounding cannot turn the rule (near 0 it is tested for the
 /// `grazing` flag).
 #[inline]
-fn skip<O: Observer>(triangle: &Triangle, path: &Path, facing: Facing) -> bool {
+fn skip<O: Observer>(triangle: &Triangle, path: &SweptPath, facing: Facing) -> bool {
     let facing_value = triangle.normal.dot(&path.d);
     !O::WANTS_RECORDS
         && !facing.allows(facing_value)
@@ -615,7 +615,7 @@ fn skip<O: Observer>(triangle: &Triangle, path: &Path, facing: Facing) -> bool {
 
 fn visit_triangles<O: Observer>(
     mesh: &Mesh,
-    path: &Path,
+    path: &SweptPath,
     facing: Facing,
     broadphase: Broadphase,
     observer: &mut O,
@@ -651,7 +651,7 @@ fn visit_triangles<O: Observer>(
 
 fn sweep_path<O: Observer>(
     mesh: &Mesh,
-    path: &Path,
+    path: &SweptPath,
     facing: Facing,
     broadphase: Broadphase,
     observer: &mut O,

@@ -2,13 +2,18 @@
 
 use super::mesh::Triangle;
 use super::options::Facing;
-use super::path::Path;
+use super::path::SweptPath;
 use super::quadratic;
 use super::record::{Verdict, VertexRecord};
 
 /// Runs the vertex test of SEMANTICS.md on vertex `vertex` (0..3) of `triangle`.
 #[inline]
-pub fn sweep_vertex(triangle: &Triangle, vertex: u8, path: &Path, facing: Facing) -> VertexRecord {
+pub fn sweep_vertex(
+    triangle: &Triangle,
+    vertex: u8,
+    path: &SweptPath,
+    facing: Facing,
+) -> VertexRecord {
     let position = triangle.vertices[vertex as usize];
     let m = path.p0 - position;
     let a = path.d.dot(&path.d);

@@ -1,10 +1,12 @@
 //! Blessing a trace: replacing its `/expected` channel with the current
 //! core's outcomes, keeping everything else.
 //!
-//! Two passes over the input bytes:
+//! Three passes over the input bytes:
 //! 1. the trace is replayed (the same [`crate::replay`] engine as `check`)
 //!    and every sweep's outcome is kept, by `(frame, ball)`;
-//! 2. the file's records are copied in order with the `mcap` crate's raw
+//! 2. a quick scan reads the header and which schemas only `/expected`
+//!    channels use (those are not copied);
+//! 3. the file's records are copied in order with the `mcap` crate's raw
 //!    reader: every schema, channel, message, metadata record and attachment
 //!    is kept verbatim (channel and schema ids may be renumbered), except the
 //!    messages of `/expected` channels, which are dropped; after each `/sweep`
@@ -71,7 +73,7 @@ pub enum BlessError {
         source: std::io::Error,
     },
     /// A `/sweep` message found in the copy pass has no outcome from the
-    /// replay pass (the two passes disagree on the file).
+    /// replay pass (the replay and the copy disagree on the file).
     #[error("{file}: channel `/sweep`, message {index}: no replayed outcome for this sweep")]
     Unmatched {
         /// The input's name.
@@ -153,7 +155,8 @@ pub fn bless_bytes<W: Write + Seek>(
         source,
     };
 
-    // Pass 1 (cheap): the header, and which schemas only `/expected` uses.
+    // Pass 2 (cheap; pass 1 was the replay): the header, and which schemas
+    // only `/expected` uses.
     let mut write_options = default_write_options();
     let mut used_by_others: HashSet<u16> = HashSet::new();
     let mut used_by_expected: HashSet<u16> = HashSet::new();
@@ -173,6 +176,7 @@ pub fn bless_bytes<W: Write + Seek>(
         }
     }
 
+    // Pass 3: the copy.
     let mut writer = write_options.create(output).map_err(write_err)?;
     let mut summary = BlessSummary::default();
     let mut schema_ids: HashMap<u16, u16> = HashMap::new();

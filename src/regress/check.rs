@@ -16,13 +16,10 @@
 
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
-use std::sync::Arc;
 
 use serde::Serialize;
 
-use crate::replay::{
-    ReplayError, ReplayEvent, ReplayOptions, SceneState, SweepResult, Tunnel, TunnelAt,
-};
+use crate::replay::{ReplayError, ReplayEvent, ReplayOptions, SweepResult, Tunnel, TunnelAt};
 use crate::run::RunOutcome;
 use crate::trace::messages::{EXPECTED_TOPIC, OutcomeMsg};
 use crate::trace::{TraceError, TraceEvent, TraceReader};
@@ -308,11 +305,10 @@ where
         incomplete: false,
         tolerances: options.tolerances,
     };
-    let mut scene: Option<Arc<SceneState>> = None;
     let mut replay = crate::replay::replay_events(events, replay_options);
     for event in replay.by_ref() {
         match event {
-            Ok(ReplayEvent::Scene(s)) => scene = Some(s),
+            Ok(ReplayEvent::Scene(_)) => {}
             Ok(ReplayEvent::Sweep(result)) => {
                 report.sweeps += 1;
                 for t in &result.tunnels {
@@ -335,16 +331,14 @@ where
                     continue;
                 };
                 report.compared += 1;
-                let mesh = scene.as_deref().map(|s| &s.mesh);
-                let (fields, fragile) =
-                    match agreement(expected, &result, mesh, &options.tolerances) {
-                        Agreement::Match => continue,
-                        Agreement::Tie => {
-                            report.ties += 1;
-                            continue;
-                        }
-                        Agreement::Diverges { fields, fragile } => (fields, fragile),
-                    };
+                let (fields, fragile) = match agreement(expected, &result, &options.tolerances) {
+                    Agreement::Match => continue,
+                    Agreement::Tie => {
+                        report.ties += 1;
+                        continue;
+                    }
+                    Agreement::Diverges { fields, fragile } => (fields, fragile),
+                };
                 let got = result.outcome_msg();
                 if !fragile.is_robust() {
                     report.fragile_divergent += 1;
@@ -356,13 +350,9 @@ where
                     }
                     if !options.strict {
                         if report.fragile_divergences.len() < options.max_details {
-                            report.fragile_divergences.push(divergence(
-                                &result,
-                                scene.as_deref(),
-                                *expected,
-                                got,
-                                fields,
-                            ));
+                            report
+                                .fragile_divergences
+                                .push(divergence(&result, *expected, got, fields));
                         }
                         continue;
                     }
@@ -376,13 +366,9 @@ where
                     report.divergent_frames.push(result.frame);
                 }
                 if report.divergences.len() < options.max_details {
-                    report.divergences.push(divergence(
-                        &result,
-                        scene.as_deref(),
-                        *expected,
-                        got,
-                        fields,
-                    ));
+                    report
+                        .divergences
+                        .push(divergence(&result, *expected, got, fields));
                 }
             }
             Err(err) => {
@@ -431,14 +417,11 @@ fn status_of(r: &TraceReport) -> Status {
 
 fn divergence(
     result: &SweepResult,
-    scene: Option<&SceneState>,
     expected: OutcomeMsg,
     got: OutcomeMsg,
     fields: Vec<FieldDiff>,
 ) -> Divergence {
-    let records = scene
-        .map(|s| explained_records(result, s))
-        .unwrap_or_default();
+    let records = explained_records(result);
     Divergence {
         frame: result.frame,
         ball: result.ball,
@@ -450,7 +433,7 @@ fn divergence(
         margin: result.options.margin,
         facing: result.options.facing.to_string(),
         got_explanation: explain_outcome(&result.outcome, &records),
-        expected_tests: expected_tests(&expected, &result.outcome, &records, scene),
+        expected_tests: expected_tests(&expected, &result.outcome, &records, Some(&result.scene)),
     }
 }
 

@@ -13,7 +13,7 @@ use serde::Serialize;
 use serde_json::{Value, json};
 
 use crate::core::explain::num;
-use crate::core::{Fragility, Kind, Mesh, sweep_ties};
+use crate::core::{Fragility, Kind, sweep_ties};
 use crate::numbers::{self, Rule};
 use crate::replay::SweepResult;
 use crate::trace::messages::OutcomeMsg;
@@ -286,15 +286,10 @@ impl Agreement {
 }
 
 /// Judges `result` against `expected` ([`compare`] over the fields the
-/// expectation holds; see [`Agreement`]). `mesh` is the scene the sweep was
-/// replayed against: with it, an expectation naming another member of the
-/// tie set is a [`Agreement::Tie`]; without it ties cannot be recognised.
-pub fn agreement(
-    expected: &OutcomeMsg,
-    result: &SweepResult,
-    mesh: Option<&Mesh>,
-    tol: &Tolerances,
-) -> Agreement {
+/// expectation holds; see [`Agreement`]). An expectation naming another
+/// member of the tie set in the scene the sweep was replayed against is a
+/// [`Agreement::Tie`].
+pub fn agreement(expected: &OutcomeMsg, result: &SweepResult, tol: &Tolerances) -> Agreement {
     let got = result.outcome_msg();
     let mut fields = compare(expected, &got, tol);
     if fields.is_empty() {
@@ -303,8 +298,7 @@ pub fn agreement(
     let identity =
         |f: &FieldDiff| matches!(f.field, Field::Kind | Field::Triangle | Field::Feature);
     if fields.iter().any(identity)
-        && let Some(mesh) = mesh
-        && sweep_ties(mesh, &result.sweep, &result.options).is_ok_and(|(_, ties)| {
+        && sweep_ties(&result.scene.mesh, &result.sweep, &result.options).is_ok_and(|(_, ties)| {
             ties.iter()
                 .any(|t| t.matches(expected.kind, expected.triangle, expected.feature))
         })

@@ -10,7 +10,6 @@
 
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
-use std::sync::Arc;
 
 use serde::Serialize;
 use serde_json::json;
@@ -20,9 +19,7 @@ use crate::regress::{
     ExpectedTest, FieldDiff, Tolerances, compare, expected_tests, explain_outcome,
     explained_records,
 };
-use crate::replay::{
-    ReplayError, ReplayEvent, ReplayOptions, SceneState, SweepResult, replay_events,
-};
+use crate::replay::{ReplayError, ReplayEvent, ReplayOptions, SweepResult, replay_events};
 use crate::trace::messages::OutcomeMsg;
 use crate::trace::{TraceError, TraceEvent};
 
@@ -32,7 +29,7 @@ pub struct Side {
     pub name: String,
     /// The options it was replayed with.
     pub options: ReplayOptions,
-    sweeps: BTreeMap<(u64, u32), (Box<SweepResult>, Arc<SceneState>)>,
+    sweeps: BTreeMap<(u64, u32), Box<SweepResult>>,
     /// Sweeps that share a `(frame, ball)` with an earlier one (only the
     /// first is compared).
     pub duplicates: u64,
@@ -55,16 +52,13 @@ impl Side {
             sweeps: BTreeMap::new(),
             duplicates: 0,
         };
-        let mut scene: Option<Arc<SceneState>> = None;
         for event in replay_events(events, options) {
             match event? {
-                ReplayEvent::Scene(s) => scene = Some(s),
+                ReplayEvent::Scene(_) => {}
                 ReplayEvent::Sweep(r) => {
-                    // A sweep is only yielded after a scene.
-                    let Some(s) = scene.clone() else { continue };
                     let key = (r.frame, r.ball);
                     if let std::collections::btree_map::Entry::Vacant(e) = side.sweeps.entry(key) {
-                        e.insert((r, s));
+                        e.insert(r);
                     } else {
                         side.duplicates += 1;
                     }
@@ -182,8 +176,8 @@ pub fn diff(a: &Side, b: &Side, tolerances: &Tolerances) -> DiffReport {
             report.first_unmatched = Some((key.0, key.1, side));
         }
     };
-    for (key, (ra, sa)) in &a.sweeps {
-        let Some((rb, sb)) = b.sweeps.get(key) else {
+    for (key, ra) in &a.sweeps {
+        let Some(rb) = b.sweeps.get(key) else {
             report.only_in_a += 1;
             unmatched(*key, 'A', &mut report);
             continue;
@@ -205,8 +199,8 @@ pub fn diff(a: &Side, b: &Side, tolerances: &Tolerances) -> DiffReport {
             *report.by_field.entry(f.field.to_string()).or_default() += 1;
         }
         if report.first.is_none() {
-            let records_a = explained_records(ra, sa);
-            let records_b = explained_records(rb, sb);
+            let records_a = explained_records(ra);
+            let records_b = explained_records(rb);
             report.first = Some(FirstDifference {
                 frame: key.0,
                 ball: key.1,
@@ -215,8 +209,8 @@ pub fn diff(a: &Side, b: &Side, tolerances: &Tolerances) -> DiffReport {
                 b: ob,
                 a_explanation: explain_outcome(&ra.outcome, &records_a),
                 b_explanation: explain_outcome(&rb.outcome, &records_b),
-                a_test_in_b: expected_tests(&oa, &rb.outcome, &records_b, Some(sb)),
-                b_test_in_a: expected_tests(&ob, &ra.outcome, &records_a, Some(sa)),
+                a_test_in_b: expected_tests(&oa, &rb.outcome, &records_b, Some(&rb.scene)),
+                b_test_in_a: expected_tests(&ob, &ra.outcome, &records_a, Some(&ra.scene)),
             });
         }
     }

@@ -23,11 +23,12 @@ pub struct ExpectedTest {
     pub why_not: String,
 }
 
-/// Re-runs a sweep with every test recorded (the same core, every triangle).
-pub fn explained_records(result: &SweepResult, scene: &SceneState) -> Vec<TestRecord> {
+/// Re-runs a sweep with every test recorded (the same core, every triangle
+/// of the scene it was swept against).
+pub fn explained_records(result: &SweepResult) -> Vec<TestRecord> {
     let mut collect = CollectRecords::default();
     match sweep_mesh_with(
-        &scene.mesh,
+        &result.scene.mesh,
         &result.sweep,
         &result.options,
         Broadphase::Exhaustive,

@@ -33,6 +33,18 @@ pub struct SceneState {
     pub options: Options,
 }
 
+/// Two states are equal when they come from the same scene message with the
+/// same options: the mesh is built from that message.
+impl PartialEq for SceneState {
+    fn eq(&self, other: &SceneState) -> bool {
+        self.number == other.number
+            && self.index == other.index
+            && self.log_time_nanos == other.log_time_nanos
+            && self.name == other.name
+            && self.options == other.options
+    }
+}
+
 /// The result of one sweep.
 #[derive(Clone, Debug, PartialEq)]
 pub struct SweepResult {
@@ -44,8 +56,9 @@ pub struct SweepResult {
     pub log_time_nanos: u64,
     /// Index of the sweep message in the trace.
     pub index: u64,
-    /// [`SceneState::number`] of the scene it was swept against.
-    pub scene: usize,
+    /// The scene it was swept against (the one its
+    /// [`ReplayEvent::Scene`] announced, shared).
+    pub scene: Arc<SceneState>,
     /// The sweep.
     pub sweep: Sweep,
     /// The options used.
@@ -259,7 +272,7 @@ impl Replay {
         log_time_nanos: u64,
         index: u64,
         msg: SweepMsg,
-        scene: &SceneState,
+        scene: &Arc<SceneState>,
         computed: ComputedSweep,
     ) {
         let ComputedSweep {
@@ -307,7 +320,7 @@ impl Replay {
             ball: msg.ball,
             log_time_nanos,
             index,
-            scene: scene.number,
+            scene: Arc::clone(scene),
             sweep,
             options: scene.options,
             outcome,

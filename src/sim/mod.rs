@@ -1,7 +1,8 @@
 //! A small ball simulation that records sweeps: balls under gravity through a
 //! scene, every move a sweep answered by [`core::sweep_mesh`](crate::core::sweep_mesh).
 //!
-//! The response is the course's: at a collision at `α` the ball moves to
+//! The response is the one of the CS121 physics notes that SEMANTICS.md
+//! follows: at a collision at `α` the ball moves to
 //! `p0 + α d`, its velocity is reflected about the reported normal with a
 //! restitution factor (only when it moves into that normal), it is pushed out
 //! along the normal by the margin `ε` plus a tiny [`SimOptions::separation`],

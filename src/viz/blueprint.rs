@@ -50,6 +50,7 @@ use rerun::external::re_sdk_types::blueprint::archetypes::{
 };
 use rerun::log::{Chunk, ChunkId, RowId};
 use rerun::{AsComponents, RecordingStream, RecordingStreamError, TimePoint, Timeline};
+use uuid::Uuid;
 
 use super::{FRAME_TIMELINE, IdHasher, paths};
 
@@ -231,7 +232,7 @@ pub fn blueprint_messages(
     b.log(
         "viewport",
         &ViewportBlueprint::new().with_root_container(RootContainer(rerun::datatypes::Uuid {
-            bytes: root_uuid.to_be_bytes(),
+            bytes: root_uuid.into_bytes(),
         })),
     )?;
     b.log(
@@ -295,40 +296,27 @@ impl Ids {
         )
     }
 
-    /// The `n`-th container or view id: a version 4 UUID (by its bits).
-    fn uuid(&self, n: u64) -> u128 {
-        let h = self.hash("uuid", n);
-        (h & !(0xf << 76) & !(0b11 << 62)) | (0x4 << 76) | (0b10 << 62)
+    /// The `n`-th container or view id: a version 4 UUID whose "random"
+    /// bits are a hash.
+    fn uuid(&self, n: u64) -> Uuid {
+        uuid::Builder::from_random_bytes(self.hash("uuid", n).to_be_bytes()).into_uuid()
     }
 }
 
 /// A container or a view, by its id.
 #[derive(Clone, Copy)]
 enum Item {
-    Container(u128),
-    View(u128),
+    Container(Uuid),
+    View(Uuid),
 }
 
 impl Item {
     fn path(self) -> String {
         match self {
-            Item::Container(uuid) => format!("container/{}", uuid_string(uuid)),
-            Item::View(uuid) => format!("view/{}", uuid_string(uuid)),
+            Item::Container(uuid) => format!("container/{uuid}"),
+            Item::View(uuid) => format!("view/{uuid}"),
         }
     }
-}
-
-/// `8-4-4-4-12` lowercase hex digits, as `uuid::Uuid` prints.
-fn uuid_string(uuid: u128) -> String {
-    let h = format!("{uuid:032x}");
-    format!(
-        "{}-{}-{}-{}-{}",
-        &h[0..8],
-        &h[8..12],
-        &h[12..16],
-        &h[16..20],
-        &h[20..32]
-    )
 }
 
 /// The row id of the `n`-th message of the blueprint (0 is the store info).
@@ -369,7 +357,7 @@ impl Builder {
 
     /// The id of the next container or view: numbered in the order they
     /// are made, so the same layout gets the same ids.
-    fn next_uuid(&mut self) -> u128 {
+    fn next_uuid(&mut self) -> Uuid {
         self.items += 1;
         self.ids.uuid(self.items)
     }

@@ -22,9 +22,7 @@
 //! and the same rows give the same chunks.
 
 use std::any::Any;
-use std::collections::HashMap;
 use std::fmt;
-use std::hash::{BuildHasherDefault, Hasher};
 use std::sync::Arc;
 
 use rerun::components::LineStrip3D;
@@ -38,6 +36,7 @@ use rerun::{
     Component, ComponentDescriptor, EntityPath, RecordingStream, RecordingStreamError,
     SerializedComponentBatch,
 };
+use rustc_hash::FxHashMap;
 
 use super::paths::Entity;
 use super::{FRAME_TIMELINE, TIME_TIMELINE};
@@ -322,48 +321,12 @@ fn row_id(n: u64) -> RowId {
     RowId::from_u128(((ID_BASE_NANOS as u128) << 64) | (n as u128 + 1))
 }
 
-/// FxHash (rustc's): the keys are a few small integers.
-#[derive(Default)]
-pub(crate) struct FxHasher(u64);
-
-impl FxHasher {
-    #[inline]
-    fn add(&mut self, word: u64) {
-        self.0 = (self.0.rotate_left(5) ^ word).wrapping_mul(0x51_7c_c1_b7_27_22_0a_95);
-    }
-}
-
-impl Hasher for FxHasher {
-    fn write(&mut self, bytes: &[u8]) {
-        for &b in bytes {
-            self.add(b as u64);
-        }
-    }
-    fn write_u8(&mut self, i: u8) {
-        self.add(i as u64);
-    }
-    fn write_u32(&mut self, i: u32) {
-        self.add(i as u64);
-    }
-    fn write_u64(&mut self, i: u64) {
-        self.add(i);
-    }
-    fn write_usize(&mut self, i: usize) {
-        self.add(i as u64);
-    }
-    fn write_isize(&mut self, i: isize) {
-        self.add(i as u64);
-    }
-    fn finish(&self) -> u64 {
-        self.0
-    }
-}
-
 /// Rows not yet sent.
 #[derive(Debug, Default)]
 pub struct Columns {
     entities: Vec<EntityColumns>,
-    index: HashMap<Key, usize, BuildHasherDefault<FxHasher>>,
+    /// FxHash: the keys are a few small integers.
+    index: FxHashMap<Key, usize>,
     /// Rows buffered.
     rows: usize,
     /// Rows numbered so far (buffered or sent).

@@ -5,21 +5,20 @@
 
 use std::fmt::{self, Write as _};
 
+use crate::core::TestRecord;
 use crate::core::explain::{Num, write_describe};
-use crate::core::{Mesh, TestRecord};
 use crate::regress::{Agreement, FieldDiff, Tolerances, agreement};
 use crate::replay::SweepResult;
 
 /// The fields in which the sweep's outcome differs from the trace's expected
 /// outcome when `check` counts the sweep as a failure (empty when it
 /// matches, ties, diverges only on a fragile decision, or has no
-/// expectation). `mesh` is the scene the sweep was replayed against (for
-/// the tie set).
-pub fn divergence(r: &SweepResult, mesh: Option<&Mesh>, tolerances: &Tolerances) -> Vec<FieldDiff> {
+/// expectation).
+pub fn divergence(r: &SweepResult, tolerances: &Tolerances) -> Vec<FieldDiff> {
     let Some(expected) = &r.expected else {
         return Vec::new();
     };
-    match agreement(expected, r, mesh, tolerances) {
+    match agreement(expected, r, tolerances) {
         Agreement::Diverges { fields, fragile } if fragile.is_robust() => fields,
         Agreement::Diverges { .. } | Agreement::Match | Agreement::Tie => Vec::new(),
     }
@@ -29,12 +28,11 @@ pub fn divergence(r: &SweepResult, mesh: Option<&Mesh>, tolerances: &Tolerances)
 /// expected outcome (by [`divergence`] with `tolerances`).
 pub fn decision_line(
     r: &SweepResult,
-    mesh: Option<&Mesh>,
     decisive: Option<&TestRecord>,
     tolerances: &Tolerances,
 ) -> (String, bool) {
     let mut s = String::new();
-    let diffs = divergence(r, mesh, tolerances);
+    let diffs = divergence(r, tolerances);
     write_decision_line(&mut s, r, decisive, &diffs);
     (s, !diffs.is_empty())
 }

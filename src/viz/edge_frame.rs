@@ -24,8 +24,8 @@ use super::convert::{
 use super::paths::Entity;
 use super::rows::{Out, set};
 use crate::core::explain::{Label, miss_distance};
-use crate::core::{EdgeRecord, Kind, Path, TestRecord, sweep_edge};
-use crate::replay::{SceneState, SweepResult};
+use crate::core::{EdgeRecord, Kind, SweptPath, TestRecord, sweep_edge};
+use crate::replay::SweepResult;
 
 /// How an edge test ranks for a slot: hits by α, then misses by how near
 /// they came.
@@ -57,7 +57,6 @@ pub(crate) enum Slot0 {
 /// Returns what slot 0 is.
 pub(crate) fn choose_edges(
     edges: &mut Vec<EdgeRecord>,
-    scene: Option<&SceneState>,
     r: &SweepResult,
     decisive: Option<&TestRecord>,
     max: usize,
@@ -86,7 +85,7 @@ pub(crate) fn choose_edges(
                 }
             }
             if first.is_none() {
-                first = nearest_edge_of(scene, r, triangle);
+                first = nearest_edge_of(r, triangle);
             }
         }
         None => {
@@ -100,8 +99,8 @@ pub(crate) fn choose_edges(
                 && let Some(Some(triangle)) = e.triangle
             {
                 first = match (e.kind, e.feature) {
-                    (Kind::Edge, Some(Some(edge))) if edge < 3 => edge_of(scene, r, triangle, edge),
-                    _ => nearest_edge_of(scene, r, triangle),
+                    (Kind::Edge, Some(Some(edge))) if edge < 3 => edge_of(r, triangle, edge),
+                    _ => nearest_edge_of(r, triangle),
                 };
                 what = Slot0::Expected;
             }
@@ -122,31 +121,16 @@ pub(crate) fn choose_edges(
 }
 
 /// Edge test `edge` of `triangle`, run here.
-fn edge_of(
-    scene: Option<&SceneState>,
-    r: &SweepResult,
-    triangle: u32,
-    edge: u8,
-) -> Option<EdgeRecord> {
-    let t = scene
-        .filter(|s| s.number == r.scene)?
-        .mesh
-        .triangle_by_index(triangle)?;
-    let path = Path::new(&r.sweep, &r.options).ok()?;
+fn edge_of(r: &SweepResult, triangle: u32, edge: u8) -> Option<EdgeRecord> {
+    let t = r.scene.mesh.triangle_by_index(triangle)?;
+    let path = SweptPath::new(&r.sweep, &r.options).ok()?;
     Some(sweep_edge(t, edge, &path, r.options.facing))
 }
 
 /// The nearest of the three edge tests of `triangle`, run here.
-fn nearest_edge_of(
-    scene: Option<&SceneState>,
-    r: &SweepResult,
-    triangle: u32,
-) -> Option<EdgeRecord> {
-    let t = scene
-        .filter(|s| s.number == r.scene)?
-        .mesh
-        .triangle_by_index(triangle)?;
-    let path = Path::new(&r.sweep, &r.options).ok()?;
+fn nearest_edge_of(r: &SweepResult, triangle: u32) -> Option<EdgeRecord> {
+    let t = r.scene.mesh.triangle_by_index(triangle)?;
+    let path = SweptPath::new(&r.sweep, &r.options).ok()?;
     (0..3u8)
         .map(|i| sweep_edge(t, i, &path, r.options.facing))
         .reduce(|a, b| if better(&b, &a) { b } else { a })

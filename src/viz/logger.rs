@@ -119,7 +119,6 @@ struct Mark {
 pub struct Logger {
     rec: RecordingStream,
     balls: BTreeMap<u32, BallState>,
-    scenes: Vec<Arc<SceneState>>,
     options: LoggerOptions,
     columns: columns::Columns,
     flush_rows: usize,
@@ -158,15 +157,13 @@ impl PreparedSweeps {
 }
 
 /// Prepares what [`Logger::log_sweep`] logs for each of `results` (in
-/// order): `scenes` holds (at least) the scenes they were swept against,
-/// `options` are the logger's ([`Logger::prepare_options`]).
+/// order); `options` are the logger's ([`Logger::prepare_options`]).
 pub fn prepare_sweeps<'r>(
-    scenes: &[Arc<SceneState>],
     results: impl IntoIterator<Item = &'r SweepResult>,
     options: &PrepareOptions,
 ) -> PreparedSweeps {
     let mut p = PreparedSweeps::default();
-    prepare_sweeps_into(&mut p, scenes, results, options);
+    prepare_sweeps_into(&mut p, results, options);
     p
 }
 
@@ -174,13 +171,11 @@ pub fn prepare_sweeps<'r>(
 /// [`Logger::spare_prepared`], whose buffers are reused).
 pub fn prepare_sweeps_into<'r>(
     p: &mut PreparedSweeps,
-    scenes: &[Arc<SceneState>],
     results: impl IntoIterator<Item = &'r SweepResult>,
     options: &PrepareOptions,
 ) {
     debug_assert!(p.is_empty() && p.columns.rows() == 0);
     for r in results {
-        let scene = scenes.iter().find(|s| s.number == r.scene).map(|s| &**s);
         let frame = i64::try_from(r.frame).unwrap_or(i64::MAX);
         let time = time_of(r.log_time_nanos);
         let mut out = Out {
@@ -189,20 +184,14 @@ pub fn prepare_sweeps_into<'r>(
             time,
         };
         let decisive = r.decisive_record().copied();
-        let diffs = divergence(r, scene.map(|s| &s.mesh), &options.tolerances);
+        let diffs = divergence(r, &options.tolerances);
         sweep_rows(&mut out, r);
         let followed = r.ball == options.follow_ball;
         if followed {
-            focus_rows(&mut out, scene, r, decisive.as_ref(), !diffs.is_empty());
+            focus_rows(&mut out, r, decisive.as_ref(), !diffs.is_empty());
         }
-        primary_rows(&mut out, scene, r, decisive.as_ref(), followed);
-        let slot0 = choose_edges(
-            &mut p.edges,
-            scene,
-            r,
-            decisive.as_ref(),
-            options.max_edge_frames,
-        );
+        primary_rows(&mut out, r, decisive.as_ref(), followed);
+        let slot0 = choose_edges(&mut p.edges, r, decisive.as_ref(), options.max_edge_frames);
         edge_frame_rows(&mut out, r, &p.edges, slot0, followed);
         let plotted = plot_rows(&mut out, r, decisive.as_ref());
         let expected = match (&r.expected, diffs.is_empty()) {
@@ -295,7 +284,6 @@ impl Logger {
         let mut logger = Logger {
             rec,
             balls: BTreeMap::new(),
-            scenes: Vec::new(),
             options,
             columns: columns::Columns::default(),
             flush_rows: DEFAULT_FLUSH_ROWS,
@@ -431,13 +419,12 @@ impl Logger {
             .with_radii([Radius::new_ui_points(WIREFRAME_POINTS)])
             .with_colors([rgba(WIREFRAME_COLOR)]);
         self.log_static(paths::wireframe(scene.number), &wireframe)?;
-        self.scenes.push(scene.clone());
         Ok(())
     }
 
     /// Logs one sweep's result at its frame.
     pub fn log_sweep(&mut self, r: &SweepResult) -> Result<(), RecordingStreamError> {
-        let prepared = prepare_sweeps(&self.scenes, [r], &self.options.prepare);
+        let prepared = prepare_sweeps([r], &self.options.prepare);
         self.log_prepared(prepared)
     }
 

@@ -10,12 +10,11 @@
 //! batch of events and their rows, whatever the trace's length.
 
 use std::ops::Range;
-use std::sync::Arc;
 
 use rayon::prelude::*;
 use thiserror::Error;
 
-use crate::replay::{DEFAULT_BATCH_EVENTS, ReplayError, ReplayEvent, SceneState, SweepResult};
+use crate::replay::{DEFAULT_BATCH_EVENTS, ReplayError, ReplayEvent, SweepResult};
 
 use super::{
     Logger, PREPARE_GROUP_SWEEPS, PreparedSweeps, RecordingStreamError, prepare_sweeps_into,
@@ -28,7 +27,7 @@ pub enum LogError {
     /// Logging a scene's mesh.
     #[error("logging scene {scene}")]
     Scene {
-        /// [`SceneState::number`] of the scene.
+        /// [`crate::replay::SceneState::number`] of the scene.
         scene: usize,
         /// The SDK's error.
         #[source]
@@ -82,7 +81,6 @@ where
         0 => DEFAULT_BATCH_EVENTS,
         n => n,
     };
-    let mut scenes: Vec<Arc<SceneState>> = Vec::new();
     let prepare_options = logger.as_ref().map(|l| l.prepare_options());
     let mut batch = Vec::with_capacity(batch_events);
     loop {
@@ -90,11 +88,6 @@ where
         batch.extend(events.by_ref().take(batch_events));
         if batch.is_empty() {
             return Ok(());
-        }
-        for event in &batch {
-            if let Ok(ReplayEvent::Scene(scene)) = event {
-                scenes.push(scene.clone());
-            }
         }
         // Runs of consecutive sweeps: the rows of each run are built on one
         // worker.
@@ -129,7 +122,6 @@ where
                         .map(|(g, mut p)| {
                             prepare_sweeps_into(
                                 &mut p,
-                                &scenes,
                                 batch[g.clone()].iter().filter_map(sweep_of),
                                 prepare_options,
                             );

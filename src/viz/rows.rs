@@ -25,7 +25,7 @@ use super::paths::{Entity, FACE_NAMES, QUADRATIC_NAMES};
 use crate::core::explain::Label;
 use crate::core::{Kind, TestRecord};
 use crate::regress::FieldDiff;
-use crate::replay::{SceneState, SweepResult};
+use crate::replay::SweepResult;
 use crate::trace::messages::OutcomeMsg;
 
 /// Component sets: the rows of one entity with the same set number have the
@@ -175,7 +175,6 @@ fn normal_row(out: &mut Out<'_>, entity: Entity, from: [f32; 3], v: [f32; 3], co
 /// decisive (nearest-miss) triangle; else at p1.
 pub(crate) fn focus_rows(
     out: &mut Out<'_>,
-    scene: Option<&SceneState>,
     r: &SweepResult,
     decisive: Option<&TestRecord>,
     divergent: bool,
@@ -186,11 +185,7 @@ pub(crate) fn focus_rows(
         r.outcome.alpha
     } else if let Some(e) = r.expected.filter(|e| divergent && e.kind != Kind::None) {
         e.alpha
-    } else if let Some(t) = decisive.and_then(|t| {
-        scene
-            .filter(|s| s.number == r.scene)
-            .and_then(|s| s.mesh.triangle_by_index(t.triangle()))
-    }) {
+    } else if let Some(t) = decisive.and_then(|t| r.scene.mesh.triangle_by_index(t.triangle())) {
         let centroid = (t.vertices[0].coords + t.vertices[1].coords + t.vertices[2].coords) / 3.0;
         let dd = d.norm_squared();
         if dd > 0.0 {
@@ -227,15 +222,12 @@ pub(crate) fn focus_rows(
 /// that the balls that hit nothing do not cover the picture with labels.
 pub(crate) fn primary_rows(
     out: &mut Out<'_>,
-    scene: Option<&SceneState>,
     r: &SweepResult,
     decisive: Option<&TestRecord>,
     followed: bool,
 ) {
     let b = r.ball;
-    let scene = scene.filter(|s| s.number == r.scene);
-    let triangle =
-        decisive.and_then(|t| scene.and_then(|s| s.mesh.triangle_by_index(t.triangle())));
+    let triangle = decisive.and_then(|t| r.scene.mesh.triangle_by_index(t.triangle()));
     let (Some(t), Some(test)) = (triangle, decisive) else {
         out.clear(Entity::PrimaryTriangle(b), false);
         out.clear(Entity::PrimaryOutline(b), false);

@@ -46,6 +46,10 @@ pub struct Args {
     /// and do not fail the check.
     #[arg(long)]
     pub strict: bool,
+    /// Also give each divergence's inputs as hexadecimal floating point
+    /// (`0x1.5555555555555p-2`), besides the shortest round-trip decimals.
+    #[arg(long)]
+    pub hex: bool,
     /// How many divergences per trace are explained in detail.
     #[arg(long, value_name = "N", default_value_t = DEFAULT_MAX_DETAILS)]
     pub max_details: usize,
@@ -77,6 +81,7 @@ pub fn run(args: Args) -> anyhow::Result<RunOutcome> {
         tolerances,
         max_details: args.max_details,
         strict: args.strict,
+        hex: args.hex,
         replay: ReplayOptions::default(),
     };
     let mut reports: Vec<TraceReport> = Vec::new();

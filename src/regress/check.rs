@@ -27,6 +27,7 @@ use crate::trace::{TraceError, TraceEvent, TraceReader};
 
 use super::compare::{Agreement, FieldDiff, Tolerances, agreement};
 use super::explain::{ExpectedTest, expected_tests, explain_outcome, explained_records};
+use super::repro::{HexInputs, SweepInputs};
 
 /// Default number of divergences described in detail per trace.
 pub const DEFAULT_MAX_DETAILS: usize = 3;
@@ -48,6 +49,12 @@ pub struct Divergence {
     pub got: OutcomeMsg,
     /// Why the core's decision is fragile (empty when robust).
     pub fragile: crate::core::Fragility,
+    /// The sweep's inputs, exactly (shortest round-trip decimals in the
+    /// JSON): with them the core makes the same decision.
+    pub inputs: SweepInputs,
+    /// The inputs as hexadecimal floating point (`check --hex`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub inputs_hex: Option<HexInputs>,
     /// The margin and facing rule the core used.
     pub margin: f64,
     /// The facing rule the core used.
@@ -124,6 +131,9 @@ pub struct CheckOptions {
     pub max_details: usize,
     /// Whether a divergence on a fragile decision fails the check too.
     pub strict: bool,
+    /// Whether divergences also give their inputs as hexadecimal floating
+    /// point ([`Divergence::inputs_hex`]).
+    pub hex: bool,
     /// The replay's options (frames, ball, overrides). `explain` and
     /// `detail` are ignored: the check runs the fast query and explains
     /// only the detailed divergences.
@@ -136,6 +146,7 @@ impl Default for CheckOptions {
             tolerances: Tolerances::default(),
             max_details: DEFAULT_MAX_DETAILS,
             strict: false,
+            hex: false,
             replay: ReplayOptions::default(),
         }
     }
@@ -290,6 +301,7 @@ where
                                 *expected,
                                 got,
                                 fields,
+                                options.hex,
                             ));
                         }
                         continue;
@@ -310,6 +322,7 @@ where
                         *expected,
                         got,
                         fields,
+                        options.hex,
                     ));
                 }
             }
@@ -363,11 +376,15 @@ fn divergence(
     expected: OutcomeMsg,
     got: OutcomeMsg,
     fields: Vec<FieldDiff>,
+    hex: bool,
 ) -> Divergence {
     let records = scene
         .map(|s| explained_records(result, s))
         .unwrap_or_default();
+    let inputs = SweepInputs::of(&result.sweep, &result.options);
     Divergence {
+        inputs,
+        inputs_hex: hex.then(|| inputs.hex()),
         frame: result.frame,
         ball: result.ball,
         log_time_nanos: result.log_time_nanos,

@@ -13,6 +13,7 @@ mod oracle;
 mod prefetch;
 mod record;
 mod replay;
+mod repro;
 mod support;
 mod trace_io;
 
@@ -33,5 +34,6 @@ fn main() {
     trials.extend(replay::tests());
     trials.extend(record::tests());
     trials.extend(prefetch::tests());
+    trials.extend(repro::tests());
     libtest_mimic::run(&args, trials).exit();
 }

@@ -40,7 +40,7 @@ pub struct Args {
     #[arg(long, requires = "trace")]
     pub frame: Option<u64>,
     /// Ball of the sweep to take from --trace.
-    #[arg(long, requires = "trace", default_value_t = 0)]
+    #[arg(long, default_value_t = 0)]
     pub ball: u32,
     /// Radius r of the ball [default: 0.5].
     #[arg(long, allow_negative_numbers = true, value_parser = super::parse_number, conflicts_with = "trace")]
@@ -96,6 +96,11 @@ pub fn run(args: Args) -> anyhow::Result<RunOutcome> {
             .unwrap_or_else(|| "(unnamed)".into());
         (name, mesh, found.core_sweep(), options)
     } else {
+        // clap lets `requires` pass when the required flag conflicts with
+        // another one present (here --from/--to): say it ourselves.
+        if args.frame.is_some() {
+            anyhow::bail!("--frame needs --trace (the trace to take the sweep from)");
+        }
         let scene = match &args.mesh {
             Some(path) => load_obj(path)?,
             None => args.scene.unwrap_or(BuiltinScene::Cube).mesh(),

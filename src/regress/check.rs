@@ -27,6 +27,7 @@ use crate::trace::{TraceError, TraceEvent, TraceReader};
 
 use super::compare::{Agreement, FieldDiff, Tolerances, agreement};
 use super::explain::{ExpectedTest, expected_tests, explain_outcome, explained_records};
+use super::infer::{ComparedSweep, Inferred, infer};
 use super::repro::{HexInputs, SweepInputs};
 
 /// Default number of divergences described in detail per trace.
@@ -203,6 +204,11 @@ pub struct TraceReport {
     pub incomplete: bool,
     /// The tolerances used.
     pub tolerances: Tolerances,
+    /// When expectations fail: the recording engine's margin and facing
+    /// rule as its expectations imply them, and how many expectations
+    /// match when the trace is replayed with them ([`Inferred`]).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub inferred: Option<Inferred>,
 }
 
 /// How many divergent frames a report lists.
@@ -261,7 +267,9 @@ where
         errors: Vec::new(),
         incomplete: false,
         tolerances: options.tolerances,
+        inferred: None,
     };
+    let mut compared: Vec<ComparedSweep> = Vec::new();
     let mut scene: Option<Arc<SceneState>> = None;
     let mut replay = crate::replay::replay_events(events, replay_options);
     for event in replay.by_ref() {
@@ -274,6 +282,18 @@ where
                     continue;
                 };
                 report.compared += 1;
+                if let Some(s) = &scene {
+                    compared.push(ComparedSweep {
+                        scene: s.clone(),
+                        frame: result.frame,
+                        ball: result.ball,
+                        sweep: result.sweep,
+                        expected: *expected,
+                        replayed_face: (result.outcome.kind == crate::core::Kind::Face)
+                            .then_some(result.outcome.triangle)
+                            .flatten(),
+                    });
+                }
                 let mesh = scene.as_deref().map(|s| &s.mesh);
                 let (fields, fragile) =
                     match agreement(expected, &result, mesh, &options.tolerances) {
@@ -341,6 +361,9 @@ where
     report.expectations_without_sweep = summary.expected_unmatched;
     report.expectations = summary.expected_matched + summary.expected_unmatched;
     report.has_expected_channel = saw_expected;
+    if report.divergent + report.fragile_divergent > 0 {
+        report.inferred = infer(&compared, &options.tolerances);
+    }
     report.status = status_of(&report);
     report
 }

@@ -17,6 +17,7 @@ pub mod check;
 pub mod compare;
 pub mod diff;
 pub mod explain;
+pub mod infer;
 mod render;
 pub mod repro;
 
@@ -32,5 +33,6 @@ pub use compare::{
 };
 pub use diff::{DiffReport, FirstDifference, Side, diff};
 pub use explain::{ExpectedTest, expected_tests, explain_outcome, explained_records};
+pub use infer::{Inferred, Spread, infer};
 pub use render::{render_divergence, render_json, render_text, value_text};
 pub use repro::{HexInputs, ReproCase, ReproError, SweepInputs, TraceSweep, find_sweep};

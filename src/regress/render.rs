@@ -213,6 +213,11 @@ pub fn render_text(r: &TraceReport) -> String {
             }
         }
     }
+    if let Some(inferred) = &r.inferred {
+        for line in inferred.lines() {
+            let _ = writeln!(s, "  {line}");
+        }
+    }
     s
 }
 

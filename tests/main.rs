@@ -5,6 +5,7 @@
 
 use libtest_mimic::{Arguments, Failed, Trial};
 
+mod alt_engine;
 mod check;
 mod core_cases;
 mod core_decisions;
@@ -35,5 +36,6 @@ fn main() {
     trials.extend(record::tests());
     trials.extend(prefetch::tests());
     trials.extend(repro::tests());
+    trials.extend(alt_engine::tests());
     libtest_mimic::run(&args, trials).exit();
 }

@@ -28,7 +28,10 @@ Examples:
 
 Per trace: `ok`, `FAIL` (with the first divergences explained),
 `NO EXPECTATIONS` (no /expected channel, or none matches a sweep: never a
-pass) or `ERROR`. Exit status: 0 every trace matches, 1 a divergence was
+pass) or `ERROR`. Each divergence gives the sweep's inputs exactly (--hex:
+also as hex floats). When expectations fail, the recording engine's margin
+and facing rule are inferred from them, with how many expectations match
+when replayed with them. Exit status: 0 every trace matches, 1 a divergence was
 found, 2 something could not be checked (bad input, I/O error, no
 expectations).")]
 pub struct Args {

@@ -53,3 +53,121 @@ pub fn check_margin(margin: f64, radius: f64) -> Result<(), String> {
         ))
     }
 }
+
+/// `x` as a hexadecimal floating-point literal, as C's `%a` writes it:
+/// `0x1.5555555555555p-2`, `-0x1.8p+1`, `0x0p+0`; subnormals as
+/// `0x0.0000000000001p-1022`. Exact: [`parse_f64`] reads it back to the
+/// same bits. Infinities and NaN are written `inf`, `-inf`, `NaN`.
+pub fn hex_float(x: f64) -> String {
+    if x.is_nan() {
+        return "NaN".to_string();
+    }
+    let sign = if x.is_sign_negative() { "-" } else { "" };
+    if x.is_infinite() {
+        return format!("{sign}inf");
+    }
+    let bits = x.to_bits();
+    let exponent_bits = ((bits >> 52) & 0x7ff) as i64;
+    let mantissa = bits & ((1u64 << 52) - 1);
+    let (lead, exponent) = match exponent_bits {
+        0 if mantissa == 0 => return format!("{sign}0x0p+0"),
+        0 => (0, -1022),
+        e => (1, e - 1023),
+    };
+    let mut fraction = format!("{mantissa:013x}");
+    while fraction.ends_with('0') {
+        fraction.pop();
+    }
+    let dot = if fraction.is_empty() { "" } else { "." };
+    let exponent_sign = if exponent >= 0 { "+" } else { "-" };
+    format!(
+        "{sign}0x{lead}{dot}{fraction}p{exponent_sign}{}",
+        exponent.abs()
+    )
+}
+
+/// Reads a number written as a decimal (`0.1`, `-3e-5`, Rust's `{}` and
+/// `{:?}` of an `f64`) or as a hexadecimal floating-point literal
+/// (`0x1.5555555555555p-2`, as [`hex_float`] writes it). Both are read
+/// exactly: a shortest round-trip decimal or a hex float gives back the
+/// bits it was written from. A hex float needs at most 53 significant
+/// bits.
+pub fn parse_f64(s: &str) -> Option<f64> {
+    let s = s.trim();
+    let (negative, body) = match s.as_bytes().first() {
+        Some(b'-') => (true, &s[1..]),
+        Some(b'+') => (false, &s[1..]),
+        _ => (false, s),
+    };
+    let Some(hex) = body.strip_prefix("0x").or_else(|| body.strip_prefix("0X")) else {
+        return s.parse().ok();
+    };
+    let (digits, exponent) = hex.split_once(['p', 'P'])?;
+    let exponent: i32 = exponent.parse().ok()?;
+    let (int, frac) = digits.split_once('.').unwrap_or((digits, ""));
+    if int.is_empty() && frac.is_empty() {
+        return None;
+    }
+    let mut mantissa: u64 = 0;
+    for c in int.chars().chain(frac.chars()) {
+        let d = c.to_digit(16)?;
+        mantissa = mantissa.checked_mul(16)?.checked_add(u64::from(d))?;
+    }
+    if mantissa > 1u64 << 53 {
+        return None;
+    }
+    let mut scale = i64::from(exponent) - 4 * frac.len() as i64;
+    // Exact: the mantissa has at most 53 bits, and powers of two scale it
+    // without rounding until the final step lands on a representable value.
+    let mut value = mantissa as f64;
+    while scale != 0 && value != 0.0 {
+        let step = scale.clamp(-1000, 1000);
+        value *= 2f64.powi(step as i32);
+        scale -= step;
+    }
+    value
+        .is_finite()
+        .then_some(if negative { -value } else { value })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{hex_float, parse_f64};
+
+    #[test]
+    fn hex_floats_round_trip() {
+        assert_eq!(hex_float(1.0 / 3.0), "0x1.5555555555555p-2");
+        assert_eq!(hex_float(-3.0), "-0x1.8p+1");
+        assert_eq!(hex_float(0.0), "0x0p+0");
+        assert_eq!(hex_float(-0.0), "-0x0p+0");
+        assert_eq!(hex_float(f64::from_bits(1)), "0x0.0000000000001p-1022");
+        for x in [
+            1.0 / 3.0,
+            -0.1,
+            0.0,
+            -0.0,
+            f64::MAX,
+            f64::MIN_POSITIVE,
+            f64::from_bits(1),
+            f64::from_bits(0x000f_ffff_ffff_ffff),
+            123456.789,
+            1e-300,
+        ] {
+            let back = parse_f64(&hex_float(x)).expect("parses");
+            assert_eq!(back.to_bits(), x.to_bits(), "{x} via {}", hex_float(x));
+            assert_eq!(
+                parse_f64(&format!("{x}")).map(f64::to_bits),
+                Some(x.to_bits())
+            );
+            assert_eq!(
+                parse_f64(&format!("{x:?}")).map(f64::to_bits),
+                Some(x.to_bits())
+            );
+        }
+        assert_eq!(parse_f64("0x1p-1074"), Some(f64::from_bits(1)));
+        assert_eq!(parse_f64("0xAp0"), Some(10.0));
+        assert_eq!(parse_f64("0x.p0"), None);
+        assert_eq!(parse_f64("0x1.0"), None);
+        assert_eq!(parse_f64("0x1p+1024"), None);
+    }
+}

@@ -5,6 +5,7 @@
 
 use libtest_mimic::{Arguments, Completion, Failed, Trial};
 
+mod alt_engine;
 mod check;
 mod core_cases;
 mod core_decisions;
@@ -14,6 +15,7 @@ mod outputs;
 mod prefetch;
 mod record;
 mod replay;
+mod repro;
 mod support;
 mod trace_io;
 mod tunnel;
@@ -89,5 +91,7 @@ fn main() {
     trials.extend(prefetch::tests());
     trials.extend(outputs::tests());
     trials.extend(tunnel::tests());
+    trials.extend(repro::tests());
+    trials.extend(alt_engine::tests());
     libtest_mimic::run(&args, trials).exit();
 }

@@ -29,10 +29,14 @@ Examples:
 Per trace: `ok`, `FAIL` (with the first divergences explained, and every
 tunnel: a ball's centre that went through a triangle from its front to its
 back, named by frame, ball, triangle and point), `NO EXPECTATIONS` (no
-/expected channel, or none matches a sweep: never a pass) or `ERROR`. Exit
-status: 0 every trace matches (ties and fragile divergences included, unless
---strict), 1 a divergence or a tunnel was found, 2 something could not be
-checked (bad input, I/O error, no expectations), 3 a trace ends early.")]
+/expected channel, or none matches a sweep: never a pass) or `ERROR`. Each
+divergence gives the sweep's inputs exactly (--hex: also as hex floats).
+When expectations fail, the recording engine's margin and facing rule are
+inferred from them, with how many expectations match when replayed with
+them. Exit status: 0 every trace matches (ties and fragile divergences
+included, unless --strict), 1 a divergence or a tunnel was found, 2
+something could not be checked (bad input, I/O error, no expectations), 3 a
+trace ends early.")]
 pub struct Args {
     /// Trace files, or directories searched recursively for `*.mcap`.
     #[arg(value_name = "TRACE|DIR", required = true)]
@@ -54,6 +58,10 @@ pub struct Args {
     /// engine that recorded the trace, whatever its expectations say.
     #[arg(long)]
     pub allow_tunnels: bool,
+    /// Also give each divergence's inputs as hexadecimal floating point
+    /// (`0x1.5555555555555p-2`), besides the shortest round-trip decimals.
+    #[arg(long)]
+    pub hex: bool,
     /// How many divergences per trace are explained in detail.
     #[arg(long, value_name = "N", default_value_t = DEFAULT_MAX_DETAILS)]
     pub max_details: usize,
@@ -86,6 +94,7 @@ pub fn run(args: Args) -> anyhow::Result<RunOutcome> {
         max_details: args.max_details,
         strict: args.strict,
         fail_on_tunnel: !args.allow_tunnels,
+        hex: args.hex,
         replay: ReplayOptions::default(),
     };
     let mut reports: Vec<TraceReport> = Vec::new();

@@ -11,6 +11,7 @@ pub mod info;
 pub mod record;
 pub mod replay;
 pub mod report;
+pub mod repro;
 pub mod sweep;
 
 /// Replay recorded ball trajectories through a swept-sphere vs triangle-mesh
@@ -25,7 +26,7 @@ pub struct Cli {
 
 #[derive(Debug, Subcommand)]
 pub enum Command {
-    /// Run one sweep against a built-in scene and explain every test that came close.
+    /// Run one sweep (against a built-in scene, an OBJ mesh, or a trace's scene) and explain every test that came close.
     Sweep(sweep::Args),
     /// Summarise a trace: scenes, sweeps, frames, channels, compression, metadata.
     Info(info::Args),
@@ -37,6 +38,8 @@ pub enum Command {
     Bless(bless::Args),
     /// Compare the outcomes of two traces, or of one trace replayed with different options.
     Diff(diff::Args),
+    /// Cut one sweep out of a trace: a minimal trace and a ready-to-paste Rust test, bit-exact.
+    Repro(repro::Args),
     /// Simulate balls through a scene and record their sweeps and expected outcomes as a trace.
     Record(record::Args),
 }
@@ -53,6 +56,7 @@ pub fn run(cli: Cli) -> anyhow::Result<RunOutcome> {
         Command::Check(args) => check::run(args),
         Command::Bless(args) => bless::run(args),
         Command::Diff(args) => diff::run(args),
+        Command::Repro(args) => repro::run(args),
     }
 }
 
@@ -125,7 +129,8 @@ pub fn warn_unfinished(target: &std::path::Path) {
     );
 }
 
-/// Parses `x,y,z` into three finite numbers.
+/// Parses `x,y,z` into three finite numbers (decimal, or hexadecimal
+/// floating point such as `0x1.8p+1`, read exactly).
 pub fn parse_point(s: &str) -> Result<[f64; 3], String> {
     let parts: Vec<&str> = s.split(',').map(str::trim).collect();
     if parts.len() != 3 {
@@ -135,10 +140,18 @@ pub fn parse_point(s: &str) -> Result<[f64; 3], String> {
     }
     let mut out = [0.0; 3];
     for (o, p) in out.iter_mut().zip(&parts) {
-        let v: f64 = p.parse().map_err(|_| format!("`{p}` is not a number"))?;
+        let v =
+            sweeptrace::numbers::parse_f64(p).ok_or_else(|| format!("`{p}` is not a number"))?;
         sweeptrace::numbers::check(v, sweeptrace::numbers::Rule::Finite)
             .map_err(|e| format!("`{p}`: {e}"))?;
         *o = v;
     }
     Ok(out)
+}
+
+/// Parses one finite number (decimal, or hexadecimal floating point).
+pub fn parse_number(s: &str) -> Result<f64, String> {
+    let v = sweeptrace::numbers::parse_f64(s).ok_or_else(|| format!("`{s}` is not a number"))?;
+    sweeptrace::numbers::check(v, sweeptrace::numbers::Rule::Finite)?;
+    Ok(v)
 }

@@ -6,6 +6,7 @@ use serde_json::json;
 
 use sweeptrace::core::explain::{describe, num};
 use sweeptrace::core::{Options, Outcome, Sweep, TestRecord, Verdict};
+use sweeptrace::regress::SweepInputs;
 use sweeptrace::trace::messages::OutcomeMsg;
 
 /// Formats `[x, y, z]` compactly.
@@ -33,6 +34,34 @@ pub fn outcome_line(o: &Outcome) -> String {
     }
     if let Some(c) = o.contact {
         write!(s, ", contact {}", vec3(c.coords.as_slice())).unwrap();
+    }
+    s
+}
+
+/// An expectation in words (only the fields it holds).
+pub fn expected_line(e: &OutcomeMsg) -> String {
+    let mut s = format!("{} at alpha = {}", e.kind, num(e.alpha));
+    if let Some(t) = e.triangle {
+        write!(
+            s,
+            ", triangle {}",
+            t.map_or("null".into(), |t| t.to_string())
+        )
+        .unwrap();
+    }
+    if let Some(f) = e.feature {
+        write!(
+            s,
+            ", feature {}",
+            f.map_or("null".into(), |f| f.to_string())
+        )
+        .unwrap();
+    }
+    if let Some(n) = e.normal {
+        write!(s, ", normal {}", n.map_or("null".into(), |n| vec3(&n))).unwrap();
+    }
+    if let Some(c) = e.contact {
+        write!(s, ", contact {}", c.map_or("null".into(), |c| vec3(&c))).unwrap();
     }
     s
 }
@@ -89,6 +118,10 @@ pub struct SweepReport<'a> {
     pub scene: &'a str,
     /// Usable triangles.
     pub triangles: usize,
+    /// Where the sweep comes from, when it was taken from a trace.
+    pub source: Option<&'a str>,
+    /// The trace's expectation for the sweep, if any.
+    pub expected: Option<&'a OutcomeMsg>,
     /// The sweep.
     pub sweep: &'a Sweep,
     /// The options.
@@ -105,6 +138,9 @@ pub struct SweepReport<'a> {
 pub fn sweep_text(r: &SweepReport) -> String {
     let mut s = String::new();
     let rho = r.sweep.radius - r.options.margin;
+    if let Some(source) = r.source {
+        writeln!(s, "{source}").unwrap();
+    }
     writeln!(
         s,
         "scene {} ({} triangles), radius {}, margin {} (ρ = {}), facing {}",
@@ -123,7 +159,11 @@ pub fn sweep_text(r: &SweepReport) -> String {
         vec3(r.sweep.p1.coords.as_slice())
     )
     .unwrap();
+    writeln!(s, "inputs: {}", SweepInputs::of(r.sweep, r.options).text()).unwrap();
     writeln!(s, "outcome: {}", outcome_line(r.outcome)).unwrap();
+    if let Some(e) = r.expected {
+        writeln!(s, "expected (the trace's /expected): {}", expected_line(e)).unwrap();
+    }
     if r.outcome.fragile.is_robust() {
         writeln!(s, "decision: robust").unwrap();
     } else {
@@ -193,5 +233,14 @@ pub fn sweep_json(r: &SweepReport) -> String {
         "outcome": outcome_json(r.outcome),
         "tests": tests,
     });
+    let mut value = value;
+    if let Some(object) = value.as_object_mut() {
+        if let Some(source) = r.source {
+            object.insert("source".into(), json!(source));
+        }
+        if let Some(e) = r.expected {
+            object.insert("expected".into(), json!(e));
+        }
+    }
     serde_json::to_string_pretty(&value).unwrap_or_default()
 }

@@ -1,38 +1,66 @@
-//! `sweeptrace sweep`: one sweep against a built-in scene, explained.
+//! `sweeptrace sweep`: one sweep against a built-in scene, an OBJ mesh, or
+//! the scene of a trace, explained.
+
+use std::path::PathBuf;
 
 use anyhow::Context;
 
 use super::report;
 use sweeptrace::core::{Broadphase, CollectRecords, Facing, Options, Sweep, sweep_mesh_with};
+use sweeptrace::regress::find_sweep;
 use sweeptrace::run::RunOutcome;
-use sweeptrace::sim::BuiltinScene;
+use sweeptrace::sim::{BuiltinScene, load_obj};
+use sweeptrace::trace::TraceReader;
+use sweeptrace::trace::messages::OutcomeMsg;
 
 /// Arguments of `sweep`.
 #[derive(Debug, clap::Args)]
-#[command(
-    after_help = "Example:\n  sweeptrace sweep --scene cube --radius 0.5 --from 0,3,0.2 --to 0.9,-3,0.2"
-)]
+#[command(after_help = "Examples:
+  sweeptrace sweep --scene cube --radius 0.5 --from 0,3,0.2 --to 0.9,-3,0.2
+  sweeptrace sweep --mesh level.obj --radius 0.2 --from 1,2,5 --to 1,2,-1 --margin 0.01
+  sweeptrace sweep --trace run.mcap --frame 120 --ball 0      # that sweep, its scene, margin, facing
+
+Numbers may be written in hexadecimal floating point (0x1.8p+1), read exactly.")]
 pub struct Args {
     /// Built-in scene: `cube` (the cube [-1,1]³, 12 outward triangles),
     /// `triangle` ((0,0,0), (4,0,0), (0,4,0), front +z), `mini_golf`, `bowl`,
     /// `box` (closed, faces inward) or `terrain` (100,352 triangles).
-    #[arg(long, value_enum, default_value_t = BuiltinScene::Cube)]
-    pub scene: BuiltinScene,
-    /// Radius r of the ball.
-    #[arg(long, default_value_t = 0.5, allow_negative_numbers = true)]
-    pub radius: f64,
+    /// Default `cube` when neither --mesh nor --trace is given.
+    #[arg(long, value_enum, conflicts_with_all = ["mesh", "trace"])]
+    pub scene: Option<BuiltinScene>,
+    /// A Wavefront OBJ file (faces counter-clockwise seen from the front).
+    #[arg(long, value_name = "FILE.obj", conflicts_with = "trace")]
+    pub mesh: Option<PathBuf>,
+    /// Take the sweep of --frame and --ball from this trace, with the
+    /// trace's scene, margin and facing rule (--margin and --facing
+    /// override them).
+    #[arg(long, value_name = "TRACE", requires = "frame")]
+    pub trace: Option<PathBuf>,
+    /// Frame of the sweep to take from --trace.
+    #[arg(long, requires = "trace")]
+    pub frame: Option<u64>,
+    /// Ball of the sweep to take from --trace.
+    #[arg(long, default_value_t = 0)]
+    pub ball: u32,
+    /// Radius r of the ball [default: 0.5].
+    #[arg(long, allow_negative_numbers = true, value_parser = super::parse_number, conflicts_with = "trace")]
+    pub radius: Option<f64>,
     /// Start of the ball's center, `x,y,z`.
-    #[arg(long, value_parser = super::parse_point, allow_hyphen_values = true)]
-    pub from: [f64; 3],
+    #[arg(long, value_parser = super::parse_point, allow_hyphen_values = true,
+          required_unless_present = "trace", conflicts_with = "trace")]
+    pub from: Option<[f64; 3]>,
     /// End of the ball's center, `x,y,z`.
-    #[arg(long, value_parser = super::parse_point, allow_hyphen_values = true)]
-    pub to: [f64; 3],
-    /// Margin ε: tests use the detection radius ρ = r - ε (0 ≤ ε < r).
-    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
-    pub margin: f64,
-    /// Facing rule: `non_strict` (n·d ≤ 0) or `strict` (n·d < 0).
-    #[arg(long, default_value = "non_strict")]
-    pub facing: Facing,
+    #[arg(long, value_parser = super::parse_point, allow_hyphen_values = true,
+          required_unless_present = "trace", conflicts_with = "trace")]
+    pub to: Option<[f64; 3]>,
+    /// Margin ε: tests use the detection radius ρ = r - ε (0 ≤ ε < r)
+    /// [default: 0, or the trace's].
+    #[arg(long, allow_negative_numbers = true, value_parser = super::parse_number)]
+    pub margin: Option<f64>,
+    /// Facing rule: `non_strict` (n·d ≤ 0) or `strict` (n·d < 0)
+    /// [default: non_strict, or the trace's].
+    #[arg(long)]
+    pub facing: Option<Facing>,
     /// Explain every test, not only those that came close.
     #[arg(long)]
     pub all: bool,
@@ -43,15 +71,58 @@ pub struct Args {
 
 /// Runs the sweep and prints the outcome and explanations.
 pub fn run(args: Args) -> anyhow::Result<RunOutcome> {
-    let scene = args.scene.mesh();
-    let mesh = scene
-        .to_mesh()
-        .with_context(|| format!("building scene `{}`", scene.name))?;
-    let options = Options {
-        margin: args.margin,
-        facing: args.facing,
+    let mut source: Option<String> = None;
+    let mut expected: Option<OutcomeMsg> = None;
+    let (name, mesh, sweep, options) = if let Some(path) = &args.trace {
+        let frame = args.frame.context("--trace needs --frame")?;
+        let shown = path.display().to_string();
+        let file = std::fs::File::open(path).with_context(|| format!("cannot open {shown}"))?;
+        let reader = TraceReader::new(std::io::BufReader::new(file), &shown);
+        let found = find_sweep(reader, &shown, frame, args.ball)?;
+        let mesh = sweeptrace::Mesh::new(found.scene.vertices.clone(), &found.scene.triangles)
+            .with_context(|| format!("{shown}: building the scene of frame {frame}"))?;
+        let mut options = found.options();
+        options.margin = args.margin.unwrap_or(options.margin);
+        options.facing = args.facing.unwrap_or(options.facing);
+        source = Some(format!(
+            "trace {shown}, frame {frame}, ball {} (the trace's margin {}, facing {})",
+            args.ball, found.scene.margin, found.scene.facing
+        ));
+        expected = found.expected;
+        let name = found
+            .scene
+            .name
+            .clone()
+            .unwrap_or_else(|| "(unnamed)".into());
+        (name, mesh, found.core_sweep(), options)
+    } else {
+        // clap lets `requires` pass when the required flag conflicts with
+        // another one present (here --from/--to): say it ourselves.
+        if args.frame.is_some() {
+            anyhow::bail!("--frame needs --trace (the trace to take the sweep from)");
+        }
+        let scene = match &args.mesh {
+            Some(path) => load_obj(path)?,
+            None => args.scene.unwrap_or(BuiltinScene::Cube).mesh(),
+        };
+        let mesh = scene
+            .to_mesh()
+            .with_context(|| format!("building scene `{}`", scene.name))?;
+        let (from, to) = args
+            .from
+            .zip(args.to)
+            .context("--from and --to are required without --trace")?;
+        let options = Options {
+            margin: args.margin.unwrap_or(0.0),
+            facing: args.facing.unwrap_or_default(),
+        };
+        (
+            scene.name,
+            mesh,
+            Sweep::new(from, to, args.radius.unwrap_or(0.5)),
+            options,
+        )
     };
-    let sweep = Sweep::new(args.from, args.to, args.radius);
     let mut records = CollectRecords::default();
     let outcome = sweep_mesh_with(
         &mesh,
@@ -62,8 +133,10 @@ pub fn run(args: Args) -> anyhow::Result<RunOutcome> {
     )
     .context("invalid sweep")?;
     let explained = report::SweepReport {
-        scene: &scene.name,
+        scene: &name,
         triangles: mesh.triangles().len(),
+        source: source.as_deref(),
+        expected: expected.as_ref(),
         sweep: &sweep,
         options: &options,
         outcome: &outcome,

@@ -26,6 +26,8 @@ use crate::trace::{TraceError, TraceEvent, TraceReader};
 
 use super::compare::{Agreement, FieldDiff, Tolerances, agreement};
 use super::explain::{ExpectedTest, expected_tests, explain_outcome, explained_records};
+use super::infer::{ComparedSweep, Inferred, infer};
+use super::repro::{HexInputs, SweepInputs};
 
 /// Default number of divergences described in detail per trace.
 pub const DEFAULT_MAX_DETAILS: usize = 3;
@@ -78,6 +80,12 @@ pub struct Divergence {
     pub got: OutcomeMsg,
     /// Why the core's decision is fragile (empty when robust).
     pub fragile: crate::core::Fragility,
+    /// The sweep's inputs, exactly (shortest round-trip decimals in the
+    /// JSON): with them the core makes the same decision.
+    pub inputs: SweepInputs,
+    /// The inputs as hexadecimal floating point (`check --hex`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub inputs_hex: Option<HexInputs>,
     /// The margin and facing rule the core used.
     pub margin: f64,
     /// The facing rule the core used.
@@ -163,6 +171,9 @@ pub struct CheckOptions {
     /// Whether a tunnel fails the check (the default: it is a bug of the
     /// recording engine, whatever the expectations say).
     pub fail_on_tunnel: bool,
+    /// Whether divergences also give their inputs as hexadecimal floating
+    /// point ([`Divergence::inputs_hex`]).
+    pub hex: bool,
     /// The replay's options (frames, ball, overrides). `explain` and
     /// `detail` are ignored: the check runs the fast query and explains
     /// only the detailed divergences.
@@ -176,6 +187,7 @@ impl Default for CheckOptions {
             max_details: DEFAULT_MAX_DETAILS,
             strict: false,
             fail_on_tunnel: true,
+            hex: false,
             replay: ReplayOptions::default(),
         }
     }
@@ -242,6 +254,11 @@ pub struct TraceReport {
     pub incomplete: bool,
     /// The tolerances used.
     pub tolerances: Tolerances,
+    /// When expectations fail: the recording engine's margin and facing
+    /// rule as its expectations imply them, and how many expectations
+    /// match when the trace is replayed with them ([`Inferred`]).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub inferred: Option<Inferred>,
 }
 
 /// How many divergent frames a report lists.
@@ -304,7 +321,9 @@ where
         errors: Vec::new(),
         incomplete: false,
         tolerances: options.tolerances,
+        inferred: None,
     };
+    let mut compared: Vec<ComparedSweep> = Vec::new();
     let mut replay = crate::replay::replay_events(events, replay_options);
     for event in replay.by_ref() {
         match event {
@@ -331,6 +350,18 @@ where
                     continue;
                 };
                 report.compared += 1;
+                {
+                    compared.push(ComparedSweep {
+                        scene: result.scene.clone(),
+                        frame: result.frame,
+                        ball: result.ball,
+                        sweep: result.sweep,
+                        expected: *expected,
+                        replayed_face: (result.outcome.kind == crate::core::Kind::Face)
+                            .then_some(result.outcome.triangle)
+                            .flatten(),
+                    });
+                }
                 let (fields, fragile) = match agreement(expected, &result, &options.tolerances) {
                     Agreement::Match => continue,
                     Agreement::Tie => {
@@ -350,9 +381,13 @@ where
                     }
                     if !options.strict {
                         if report.fragile_divergences.len() < options.max_details {
-                            report
-                                .fragile_divergences
-                                .push(divergence(&result, *expected, got, fields));
+                            report.fragile_divergences.push(divergence(
+                                &result,
+                                *expected,
+                                got,
+                                fields,
+                                options.hex,
+                            ));
                         }
                         continue;
                     }
@@ -366,9 +401,13 @@ where
                     report.divergent_frames.push(result.frame);
                 }
                 if report.divergences.len() < options.max_details {
-                    report
-                        .divergences
-                        .push(divergence(&result, *expected, got, fields));
+                    report.divergences.push(divergence(
+                        &result,
+                        *expected,
+                        got,
+                        fields,
+                        options.hex,
+                    ));
                 }
             }
             Err(err) => {
@@ -386,6 +425,9 @@ where
     report.expectations_without_sweep = summary.expected_unmatched;
     report.expectations = summary.expected_matched + summary.expected_unmatched;
     report.has_expected_channel = saw_expected;
+    if report.divergent + report.fragile_divergent > 0 {
+        report.inferred = infer(&compared, &options.tolerances);
+    }
     report.status = status_of(&report);
     report
 }
@@ -420,9 +462,13 @@ fn divergence(
     expected: OutcomeMsg,
     got: OutcomeMsg,
     fields: Vec<FieldDiff>,
+    hex: bool,
 ) -> Divergence {
     let records = explained_records(result);
+    let inputs = SweepInputs::of(&result.sweep, &result.options);
     Divergence {
+        inputs,
+        inputs_hex: hex.then(|| inputs.hex()),
         frame: result.frame,
         ball: result.ball,
         log_time_nanos: result.log_time_nanos,

@@ -13,7 +13,7 @@ use serde::Serialize;
 use serde_json::{Value, json};
 
 use crate::core::explain::num;
-use crate::core::{Fragility, Kind, sweep_ties};
+use crate::core::{Broadphase, CollectRecords, Fragility, Kind, TestRecord, Tie, sweep_mesh_with};
 use crate::numbers::{self, Rule};
 use crate::replay::SweepResult;
 use crate::trace::messages::OutcomeMsg;
@@ -252,17 +252,19 @@ pub enum Agreement {
     /// Every field the expectation holds matches within the tolerances.
     Match,
     /// The expectation names another member of the replayed decision's tie
-    /// set (its kind, triangle or feature differ, every other field
-    /// matches): an equally valid answer to the rules' tie order, reached by
-    /// different rounding. Not a divergence.
+    /// set (its kind, triangle or feature differ) and every other field it
+    /// holds matches that member (the contact is the member's own: a ball
+    /// touching two faces at once touches them at two points; α and the
+    /// averaged normal are the decision's): an equally valid answer to the
+    /// rules' tie order, reached by different rounding. Not a divergence.
     Tie,
     /// Fields differ. When the replayed decision is fragile (rounding at the
     /// level of the inputs could change it), `fragile` names why; `check`
     /// counts such divergences apart and fails on them only with
     /// `--strict`.
     Diverges {
-        /// The fields that differ (identity fields left out when the
-        /// expectation names a member of the tie set).
+        /// The fields that differ (when the expectation names a member of
+        /// the tie set: those that differ from that member).
         fields: Vec<FieldDiff>,
         /// Why the replayed decision is fragile; empty when robust.
         fragile: Fragility,
@@ -297,19 +299,76 @@ pub fn agreement(expected: &OutcomeMsg, result: &SweepResult, tol: &Tolerances) 
     }
     let identity =
         |f: &FieldDiff| matches!(f.field, Field::Kind | Field::Triangle | Field::Feature);
-    if fields.iter().any(identity)
-        && sweep_ties(&result.scene.mesh, &result.sweep, &result.options).is_ok_and(|(_, ties)| {
-            ties.iter()
-                .any(|t| t.matches(expected.kind, expected.triangle, expected.feature))
-        })
-    {
-        fields.retain(|f| !identity(f));
-        if fields.is_empty() {
-            return Agreement::Tie;
+    if fields.iter().any(identity) {
+        match tie_member(expected, result, &result.scene.mesh, tol) {
+            Some(TieMember::Agrees) => return Agreement::Tie,
+            // Judged against the member it names: its fields that differ.
+            Some(TieMember::Named(differ)) => fields = differ,
+            None => {}
         }
     }
     Agreement::Diverges {
         fields,
         fragile: result.outcome.fragile,
     }
+}
+
+/// How an expectation relates to the replayed decision's tie set.
+enum TieMember {
+    /// It names a member of the tie set, and every field it holds matches
+    /// that member (the contact is the member's own: two faces touched at
+    /// once touch at two points).
+    Agrees,
+    /// It names a member, but some other field differs from every member
+    /// it names: the fields that differ from the first of them.
+    Named(Vec<FieldDiff>),
+}
+
+/// The point of the mesh a hit's test touches.
+fn contact_of(record: &TestRecord) -> Option<[f64; 3]> {
+    let p = match record {
+        TestRecord::Face(r) => r.touch?,
+        TestRecord::Edge(r) => r.frame.to_world(&nalgebra::Point3::new(r.xc?, 0.0, 0.0)),
+        TestRecord::Vertex(r) => r.position,
+    };
+    Some([p.x, p.y, p.z])
+}
+
+/// Whether `expected` names a member of the tie set of `result`'s decision
+/// (re-run with every hit recorded), and whether it matches that member.
+fn tie_member(
+    expected: &OutcomeMsg,
+    result: &SweepResult,
+    mesh: &crate::core::Mesh,
+    tol: &Tolerances,
+) -> Option<TieMember> {
+    let mut records = CollectRecords::default();
+    let outcome = sweep_mesh_with(
+        mesh,
+        &result.sweep,
+        &result.options,
+        Broadphase::Bvh,
+        &mut records,
+    )
+    .ok()?;
+    let mut named: Option<Vec<FieldDiff>> = None;
+    for r in &records.records {
+        let Some(tie) = Tie::of(r) else { continue };
+        if !outcome.ties_with(tie.alpha)
+            || !tie.matches(expected.kind, expected.triangle, expected.feature)
+        {
+            continue;
+        }
+        let mut member = OutcomeMsg::from_outcome(result.frame, result.ball, &outcome);
+        member.kind = tie.kind;
+        member.triangle = Some(Some(tie.triangle));
+        member.feature = Some(tie.feature);
+        member.contact = Some(contact_of(r));
+        let differ = compare(expected, &member, tol);
+        if differ.is_empty() {
+            return Some(TieMember::Agrees);
+        }
+        named.get_or_insert(differ);
+    }
+    named.map(TieMember::Named)
 }

@@ -8,14 +8,18 @@
 //! - [`check`](mod@check): a whole trace checked ([`check_file`]), and
 //!   [`render_text`] / [`render_json`] for its report;
 //! - [`diff`](mod@diff): two traces, or one under two configurations;
-//! - [`bless`](mod@bless): a trace's expectations rewritten from the core.
+//! - [`bless`](mod@bless): a trace's expectations rewritten from the core;
+//! - [`repro`]: one sweep taken out of its trace, bit-exactly: a minimal
+//!   trace and a Rust test.
 
 pub mod bless;
 pub mod check;
 pub mod compare;
 pub mod diff;
 pub mod explain;
+pub mod infer;
 mod render;
+pub mod repro;
 
 pub use bless::{BlessError, BlessSummary, bless_bytes, bless_file};
 pub use check::{
@@ -29,4 +33,6 @@ pub use compare::{
 };
 pub use diff::{DiffReport, FirstDifference, Side, diff};
 pub use explain::{ExpectedTest, expected_tests, explain_outcome, explained_records};
+pub use infer::{Inferred, Spread, infer};
 pub use render::{render_divergence, render_json, render_text, value_text};
+pub use repro::{HexInputs, ReproCase, ReproError, SweepInputs, TraceSweep, find_sweep};

@@ -45,6 +45,10 @@ pub fn render_divergence(d: &Divergence, indent: &str) -> String {
             format!("; the core's decision is fragile: {}", d.fragile)
         }
     );
+    let _ = writeln!(s, "{indent}  inputs: {}", d.inputs.text());
+    if let Some(hex) = &d.inputs_hex {
+        let _ = writeln!(s, "{indent}  inputs (hex): {}", hex.text());
+    }
     for f in &d.fields {
         let _ = write!(
             s,
@@ -246,6 +250,11 @@ pub fn render_text(r: &TraceReport) -> String {
             for d in &r.divergences {
                 s.push_str(&render_divergence(d, "  "));
             }
+        }
+    }
+    if let Some(inferred) = &r.inferred {
+        for line in inferred.lines() {
+            let _ = writeln!(s, "  {line}");
         }
     }
     s

@@ -173,6 +173,24 @@ impl<W: Write + Seek> TraceWriter<W> {
         Ok(())
     }
 
+    /// Writes a metadata record `name` (besides the `sweeptrace` record
+    /// every trace has), e.g. where a trace was cut from.
+    pub fn metadata(
+        &mut self,
+        name: &str,
+        entries: BTreeMap<String, String>,
+    ) -> Result<(), TraceError> {
+        self.writer
+            .write_metadata(&Metadata {
+                name: name.to_string(),
+                metadata: entries,
+            })
+            .map_err(|source| TraceError::Write {
+                file: self.name.clone(),
+                source,
+            })
+    }
+
     /// Writes a `/scene` message; it applies to the sweeps written after it.
     pub fn scene(&mut self, log_time_nanos: u64, scene: &SceneMsg) -> Result<(), TraceError> {
         self.check_time(SCENE_TOPIC, None, log_time_nanos)?;

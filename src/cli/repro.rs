@@ -1,0 +1,60 @@
+//! `sweeptrace repro`: one sweep of a trace as a minimal trace and a
+//! ready-to-paste Rust test (the library's [`sweeptrace::regress::repro`]).
+
+use std::path::PathBuf;
+
+use anyhow::Context;
+
+use sweeptrace::regress::{ReproCase, find_sweep};
+use sweeptrace::run::RunOutcome;
+use sweeptrace::trace::{TraceReader, write_trace_file};
+
+/// Arguments of `repro`.
+#[derive(Debug, clap::Args)]
+#[command(after_help = "Example:
+  sweeptrace repro run.mcap --frame 120 --ball 0 -o case.mcap > repro_test.rs
+
+Writes OUT: the sweep, the triangles within its reach (renumbered in their
+order; the scene's name and a `sweeptrace.repro` metadata record give each
+one's index in the trace), the scene's margin and facing, the expectation.
+`sweeptrace check OUT` gives the same verdict for that sweep as the whole
+trace. Prints on stdout a Rust test asserting the expected outcome (or the
+replayed one, when the trace has no expectation) against the core, every
+number bit-exact; on stderr what was written. Exit status 0, or 2 when the
+reduced case does not make the same decision (please report it).")]
+pub struct Args {
+    /// The trace.
+    #[arg(value_name = "TRACE")]
+    pub trace: PathBuf,
+    /// Frame of the sweep.
+    #[arg(long)]
+    pub frame: u64,
+    /// Ball of the sweep.
+    #[arg(long, default_value_t = 0)]
+    pub ball: u32,
+    /// The minimal trace to write (atomically).
+    #[arg(short, long, value_name = "OUT")]
+    pub output: PathBuf,
+    #[command(flatten)]
+    pub tolerances: super::ToleranceArgs,
+}
+
+/// Writes the case and prints the test.
+pub fn run(args: Args) -> anyhow::Result<RunOutcome> {
+    let tolerances = args.tolerances.to_tolerances()?;
+    let shown = args.trace.display().to_string();
+    let file = std::fs::File::open(&args.trace).with_context(|| format!("cannot open {shown}"))?;
+    let reader = TraceReader::new(std::io::BufReader::new(file), &shown);
+    let found = find_sweep(reader, &shown, args.frame, args.ball)?;
+    let case = ReproCase::build(&shown, &found, &tolerances)?;
+    write_trace_file(&args.output, |w| case.write(w))
+        .with_context(|| format!("writing {}", args.output.display()))?;
+    eprint!("{}", case.summary());
+    eprintln!("wrote {}", args.output.display());
+    print!("{}", case.rust_test(&tolerances));
+    Ok(if case.reproduces() {
+        RunOutcome::Success
+    } else {
+        RunOutcome::Error
+    })
+}

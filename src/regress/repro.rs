@@ -1,0 +1,1004 @@
+//! Reproducing one sweep outside its trace: its inputs bit-exactly
+//! ([`SweepInputs`]), the sweep found in a trace ([`find_sweep`]), and a
+//! minimal case ([`ReproCase`]): that sweep, the triangles within its
+//! reach, its expectation, written as a trace of its own and as a Rust
+//! test against the public API.
+//!
+//! Numbers are written so that they read back to the same bits: Rust's
+//! `{}`/`{:?}` of an `f64` is the shortest decimal that round-trips, and
+//! [`hex_float`] writes the exact binary value.
+
+use std::collections::BTreeMap;
+use std::fmt::Write as _;
+
+use serde::Serialize;
+
+use crate::core::explain::num;
+use crate::core::{Facing, Kind, Mesh, MeshError, Options, Outcome, Sweep, SweepError, sweep_ties};
+use crate::numbers::hex_float;
+use crate::trace::messages::{OutcomeMsg, SceneMsg, SweepMsg};
+use crate::trace::{TraceError, TraceEvent, TraceWriter};
+
+use super::compare::{Agreement, Tolerances, agreement};
+
+/// The inputs of one sweep, exactly: with these numbers the core makes the
+/// same decision.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct SweepInputs {
+    /// Start of the ball's centre.
+    pub p0: [f64; 3],
+    /// End of the ball's centre.
+    pub p1: [f64; 3],
+    /// Radius `r`.
+    pub radius: f64,
+    /// Margin `ε` used.
+    pub margin: f64,
+    /// Facing rule used.
+    pub facing: Facing,
+}
+
+/// [`SweepInputs`] as hexadecimal floating-point literals ([`hex_float`]).
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct HexInputs {
+    /// Start of the ball's centre.
+    pub p0: [String; 3],
+    /// End of the ball's centre.
+    pub p1: [String; 3],
+    /// Radius `r`.
+    pub radius: String,
+    /// Margin `ε`.
+    pub margin: String,
+}
+
+impl SweepInputs {
+    /// The inputs of `sweep` under `options`.
+    pub fn of(sweep: &Sweep, options: &Options) -> SweepInputs {
+        SweepInputs {
+            p0: sweep.p0.coords.into(),
+            p1: sweep.p1.coords.into(),
+            radius: sweep.radius,
+            margin: options.margin,
+            facing: options.facing,
+        }
+    }
+
+    /// The sweep.
+    pub fn sweep(&self) -> Sweep {
+        Sweep::new(self.p0, self.p1, self.radius)
+    }
+
+    /// The options.
+    pub fn options(&self) -> Options {
+        Options {
+            margin: self.margin,
+            facing: self.facing,
+        }
+    }
+
+    /// `p0 (x, y, z), p1 (x, y, z), radius r, margin ε, facing f`, every
+    /// number the shortest decimal that reads back to the same bits.
+    pub fn text(&self) -> String {
+        let v = |p: &[f64; 3]| format!("({}, {}, {})", p[0], p[1], p[2]);
+        format!(
+            "p0 {}, p1 {}, radius {}, margin {}, facing {}",
+            v(&self.p0),
+            v(&self.p1),
+            self.radius,
+            self.margin,
+            self.facing
+        )
+    }
+
+    /// The numbers as hexadecimal floating point.
+    pub fn hex(&self) -> HexInputs {
+        HexInputs {
+            p0: self.p0.map(hex_float),
+            p1: self.p1.map(hex_float),
+            radius: hex_float(self.radius),
+            margin: hex_float(self.margin),
+        }
+    }
+}
+
+impl HexInputs {
+    /// `p0 (0x..., ...), p1 (...), radius 0x..., margin 0x...`.
+    pub fn text(&self) -> String {
+        let v = |p: &[String; 3]| format!("({}, {}, {})", p[0], p[1], p[2]);
+        format!(
+            "p0 {}, p1 {}, radius {}, margin {}",
+            v(&self.p0),
+            v(&self.p1),
+            self.radius,
+            self.margin
+        )
+    }
+}
+
+/// Why a sweep could not be taken out of a trace.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum ReproError {
+    /// The trace could not be read up to the sweep.
+    #[error(transparent)]
+    Trace(#[from] TraceError),
+    /// No sweep has that frame and ball.
+    #[error("{trace} has no sweep of frame {frame}, ball {ball} ({sweeps} sweeps read)")]
+    NotFound {
+        /// The trace.
+        trace: String,
+        /// Frame asked for.
+        frame: u64,
+        /// Ball asked for.
+        ball: u32,
+        /// Sweeps in the trace.
+        sweeps: u64,
+    },
+    /// The sweep has no scene before it.
+    #[error("{trace}: the sweep of frame {frame}, ball {ball} has no scene before it")]
+    NoScene {
+        /// The trace.
+        trace: String,
+        /// Frame.
+        frame: u64,
+        /// Ball.
+        ball: u32,
+    },
+    /// The scene is not a valid mesh.
+    #[error("{trace}: the scene of frame {frame}: {source}")]
+    Mesh {
+        /// The trace.
+        trace: String,
+        /// Frame.
+        frame: u64,
+        /// The cause.
+        source: MeshError,
+    },
+    /// The sweep is invalid.
+    #[error("{trace}: the sweep of frame {frame}, ball {ball}: {source}")]
+    Sweep {
+        /// The trace.
+        trace: String,
+        /// Frame.
+        frame: u64,
+        /// Ball.
+        ball: u32,
+        /// The cause.
+        source: SweepError,
+    },
+}
+
+/// One sweep of a trace with the scene in force and its expectation.
+#[derive(Clone, Debug, PartialEq)]
+pub struct TraceSweep {
+    /// The scene in force at the sweep (its margin and facing are the
+    /// trace's configuration).
+    pub scene: SceneMsg,
+    /// The sweep.
+    pub sweep: SweepMsg,
+    /// Its `log_time`.
+    pub log_time_nanos: u64,
+    /// The `/expected` outcome matched to it, as `replay` matches them (an
+    /// expectation before the sweep, or after it until a sweep of another
+    /// frame or a new scene).
+    pub expected: Option<OutcomeMsg>,
+}
+
+impl TraceSweep {
+    /// The options of the scene: its margin and facing rule.
+    pub fn options(&self) -> Options {
+        Options {
+            margin: self.scene.margin,
+            facing: self.scene.facing,
+        }
+    }
+
+    /// The core's sweep.
+    pub fn core_sweep(&self) -> Sweep {
+        Sweep::new(self.sweep.p0, self.sweep.p1, self.sweep.radius)
+    }
+}
+
+/// Finds the first sweep of `frame` and `ball` in a trace's events. Stops
+/// reading once its expectation can no longer follow. `name` names the
+/// trace in errors.
+pub fn find_sweep<I>(events: I, name: &str, frame: u64, ball: u32) -> Result<TraceSweep, ReproError>
+where
+    I: IntoIterator<Item = Result<TraceEvent, TraceError>>,
+{
+    let mut scene: Option<SceneMsg> = None;
+    let mut early: Option<OutcomeMsg> = None;
+    let mut found: Option<TraceSweep> = None;
+    let mut sweeps = 0u64;
+    for event in events {
+        let event = match event {
+            Ok(e) => e,
+            // After the sweep, a damaged rest only loses a late expectation.
+            Err(_) if found.is_some() => break,
+            Err(e) => return Err(e.into()),
+        };
+        match event {
+            TraceEvent::Scene { scene: s, .. } => {
+                if found.is_some() {
+                    break;
+                }
+                scene = Some(s);
+            }
+            TraceEvent::Sweep {
+                sweep,
+                log_time_nanos,
+                ..
+            } => {
+                sweeps += 1;
+                if let Some(f) = &found {
+                    if sweep.frame != f.sweep.frame {
+                        break;
+                    }
+                    continue;
+                }
+                if sweep.frame == frame && sweep.ball == ball {
+                    let Some(s) = scene.take() else {
+                        return Err(ReproError::NoScene {
+                            trace: name.to_string(),
+                            frame,
+                            ball,
+                        });
+                    };
+                    found = Some(TraceSweep {
+                        scene: s,
+                        sweep,
+                        log_time_nanos,
+                        expected: early.take(),
+                    });
+                }
+            }
+            TraceEvent::Expected { outcome, .. } => {
+                if outcome.frame != frame || outcome.ball != ball {
+                    continue;
+                }
+                match &mut found {
+                    Some(f) if f.expected.is_none() => f.expected = Some(outcome),
+                    Some(_) => {}
+                    None => early = early.or(Some(outcome)),
+                }
+            }
+        }
+    }
+    found.ok_or_else(|| ReproError::NotFound {
+        trace: name.to_string(),
+        frame,
+        ball,
+        sweeps,
+    })
+}
+
+/// A minimal case reproducing one sweep of a trace.
+#[derive(Clone, Debug)]
+pub struct ReproCase {
+    /// The trace's name, as given.
+    pub source: String,
+    /// The scene's name in the trace, if it has one.
+    pub scene_name: Option<String>,
+    /// Frame of the sweep.
+    pub frame: u64,
+    /// Ball of the sweep.
+    pub ball: u32,
+    /// The sweep's inputs.
+    pub inputs: SweepInputs,
+    /// Vertices of the reduced scene (those its triangles use, in their
+    /// original order).
+    pub vertices: Vec<[f64; 3]>,
+    /// Triangles of the reduced scene, indexing [`ReproCase::vertices`].
+    pub triangles: Vec<[u64; 3]>,
+    /// For each triangle of the reduced scene, its index in the trace's
+    /// scene (increasing, so the tie order is the same).
+    pub original_triangles: Vec<u32>,
+    /// Triangles in the trace's scene.
+    pub original_triangle_count: usize,
+    /// A triangle out of reach kept only because it holds the scene's
+    /// largest coordinate, which sets the sweep's rounding unit (and so the
+    /// tie window and the fragility bands); its original index.
+    pub extent_triangle: Option<u32>,
+    /// The expectation, with its triangle renumbered for the reduced scene.
+    pub expected: Option<OutcomeMsg>,
+    /// The expectation as the trace has it.
+    pub original_expected: Option<OutcomeMsg>,
+    /// The core's outcome on the trace's whole scene.
+    pub outcome: Outcome,
+    /// The core's outcome on the reduced scene (triangle renumbered).
+    pub reduced_outcome: Outcome,
+    /// How the whole scene's outcome stands against the expectation.
+    pub agreement: Option<Agreement>,
+    /// How the reduced scene's outcome stands against the renumbered
+    /// expectation.
+    pub reduced_agreement: Option<Agreement>,
+}
+
+/// A short name of an agreement: `match`, `tie`, `diverges (kind, alpha)`,
+/// `fragile divergence (...)`.
+pub fn agreement_text(a: &Agreement) -> String {
+    match a {
+        Agreement::Match => "match".to_string(),
+        Agreement::Tie => "tie (the expectation names another member of the tie set)".to_string(),
+        Agreement::Diverges { fields, fragile } => {
+            let names = fields
+                .iter()
+                .map(|f| f.field.as_str())
+                .collect::<Vec<_>>()
+                .join(", ");
+            if fragile.is_robust() {
+                format!("diverges ({names})")
+            } else {
+                format!("fragile divergence ({names}; {fragile})")
+            }
+        }
+    }
+}
+
+fn same_verdict(a: &Agreement, b: &Agreement) -> bool {
+    match (a, b) {
+        (Agreement::Match, Agreement::Match) | (Agreement::Tie, Agreement::Tie) => true,
+        (
+            Agreement::Diverges {
+                fields: fa,
+                fragile: xa,
+            },
+            Agreement::Diverges {
+                fields: fb,
+                fragile: xb,
+            },
+        ) => {
+            fa.iter().map(|f| f.field).eq(fb.iter().map(|f| f.field))
+                && xa.is_robust() == xb.is_robust()
+        }
+        _ => false,
+    }
+}
+
+fn result_of(
+    mesh: &Mesh,
+    frame: u64,
+    ball: u32,
+    sweep: Sweep,
+    options: Options,
+    outcome: Outcome,
+    expected: Option<OutcomeMsg>,
+) -> crate::replay::SweepResult {
+    crate::replay::SweepResult {
+        frame,
+        ball,
+        log_time_nanos: 0,
+        index: 0,
+        scene: std::sync::Arc::new(crate::replay::SceneState {
+            number: 0,
+            index: 0,
+            log_time_nanos: 0,
+            name: None,
+            mesh: mesh.clone(),
+            options,
+        }),
+        sweep,
+        options,
+        outcome,
+        records: Vec::new(),
+        expected,
+        tunnels: Vec::new(),
+    }
+}
+
+/// Distance from `c` to the segment `p0 → p1`.
+fn segment_distance(p0: &[f64; 3], p1: &[f64; 3], c: &[f64; 3]) -> f64 {
+    let d = [p1[0] - p0[0], p1[1] - p0[1], p1[2] - p0[2]];
+    let m = [c[0] - p0[0], c[1] - p0[1], c[2] - p0[2]];
+    let dd = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+    let t = if dd > 0.0 {
+        ((m[0] * d[0] + m[1] * d[1] + m[2] * d[2]) / dd).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    let q = [m[0] - t * d[0], m[1] - t * d[1], m[2] - t * d[2]];
+    (q[0] * q[0] + q[1] * q[1] + q[2] * q[2]).sqrt()
+}
+
+impl ReproCase {
+    /// Builds the minimal case of `found` (a sweep of the trace `source`).
+    ///
+    /// A triangle is *within reach* when its bounding sphere (centred on
+    /// its centroid) and its bounding box both come within `r` (plus
+    /// `1e-9` of the scene's extent, far above the rounding of the tests)
+    /// of the segment `p0 → p1`: every triangle the ball can touch, or
+    /// miss by rounding, is kept. The expected triangle is always kept.
+    /// Triangles keep their order, vertices their order within each
+    /// triangle, so the tie order and the feature numbers are the same.
+    pub fn build(
+        trace: &str,
+        found: &TraceSweep,
+        tol: &Tolerances,
+    ) -> Result<ReproCase, ReproError> {
+        let frame = found.sweep.frame;
+        let ball = found.sweep.ball;
+        let scene = &found.scene;
+        let mesh = Mesh::new(scene.vertices.clone(), &scene.triangles).map_err(|source| {
+            ReproError::Mesh {
+                trace: trace.to_string(),
+                frame,
+                source,
+            }
+        })?;
+        let sweep = found.core_sweep();
+        let options = found.options();
+        let sweep_error = |source| ReproError::Sweep {
+            trace: trace.to_string(),
+            frame,
+            ball,
+            source,
+        };
+        let (outcome, _) = sweep_ties(&mesh, &sweep, &options).map_err(sweep_error)?;
+
+        let (lo, hi) = mesh.bounds();
+        let extent = lo.coords.amax().max(hi.coords.amax());
+        let (p0, p1) = (found.sweep.p0, found.sweep.p1);
+        let scale = extent
+            .max(p0.map(f64::abs).into_iter().fold(0.0, f64::max))
+            .max(p1.map(f64::abs).into_iter().fold(0.0, f64::max))
+            + sweep.radius;
+        let reach = sweep.radius + 1e-9 * scale;
+        let box_lo: [f64; 3] = std::array::from_fn(|k| p0[k].min(p1[k]) - reach);
+        let box_hi: [f64; 3] = std::array::from_fn(|k| p0[k].max(p1[k]) + reach);
+        let expected_triangle = found.expected.and_then(|e| e.triangle.flatten());
+        let degenerate: std::collections::HashSet<usize> =
+            mesh.degenerate().iter().map(|d| d.index).collect();
+        let corners = |t: &[u64; 3]| t.map(|i| scene.vertices[i as usize]);
+        let mut keep: Vec<u32> = Vec::new();
+        for (i, t) in scene.triangles.iter().enumerate() {
+            let wanted = expected_triangle == Some(i as u32) || outcome.triangle == Some(i as u32);
+            if !wanted && degenerate.contains(&i) {
+                continue;
+            }
+            let v = corners(t);
+            let in_box = (0..3).all(|k| {
+                let lo = v.iter().map(|p| p[k]).fold(f64::INFINITY, f64::min);
+                let hi = v.iter().map(|p| p[k]).fold(f64::NEG_INFINITY, f64::max);
+                hi >= box_lo[k] && lo <= box_hi[k]
+            });
+            let centroid: [f64; 3] = std::array::from_fn(|k| (v[0][k] + v[1][k] + v[2][k]) / 3.0);
+            let bound = v
+                .iter()
+                .map(|p| {
+                    ((p[0] - centroid[0]).powi(2)
+                        + (p[1] - centroid[1]).powi(2)
+                        + (p[2] - centroid[2]).powi(2))
+                    .sqrt()
+                })
+                .fold(0.0, f64::max);
+            let near = segment_distance(&p0, &p1, &centroid) <= bound * (1.0 + 1e-12) + reach;
+            if wanted || (in_box && near) {
+                keep.push(i as u32);
+            }
+        }
+        // The scene's largest coordinate sets the rounding unit of the
+        // sweep: keep a triangle that holds it when the kept ones do not.
+        let kept_extent = keep
+            .iter()
+            .flat_map(|&i| corners(&scene.triangles[i as usize]))
+            .flat_map(|p| p.map(f64::abs))
+            .fold(0.0, f64::max);
+        let mut extent_triangle = None;
+        if kept_extent < extent {
+            let holder = mesh
+                .triangles()
+                .iter()
+                .filter(|t| t.vertices.iter().any(|p| p.coords.amax() == extent))
+                .map(|t| t.index)
+                .min();
+            if let Some(h) = holder {
+                let at = keep.partition_point(|&k| k < h);
+                keep.insert(at, h);
+                extent_triangle = Some(h);
+            }
+        }
+        // Vertices used, in their original order.
+        let mut used: Vec<u64> = keep
+            .iter()
+            .flat_map(|&i| scene.triangles[i as usize])
+            .collect();
+        used.sort_unstable();
+        used.dedup();
+        let new_vertex: BTreeMap<u64, u64> = used
+            .iter()
+            .enumerate()
+            .map(|(n, &o)| (o, n as u64))
+            .collect();
+        let vertices: Vec<[f64; 3]> = used.iter().map(|&o| scene.vertices[o as usize]).collect();
+        let triangles: Vec<[u64; 3]> = keep
+            .iter()
+            .map(|&i| scene.triangles[i as usize].map(|o| new_vertex[&o]))
+            .collect();
+        let to_new = |t: u32| -> u32 {
+            match keep.binary_search(&t) {
+                Ok(n) => n as u32,
+                // A triangle the scene does not have stays one the reduced
+                // scene does not have.
+                Err(_) => (keep.len() + (t as usize).saturating_sub(scene.triangles.len())) as u32,
+            }
+        };
+        let expected = found.expected.map(|mut e| {
+            if let Some(Some(t)) = e.triangle {
+                e.triangle = Some(Some(to_new(t)));
+            }
+            e
+        });
+
+        let reduced =
+            Mesh::new(vertices.clone(), &triangles).map_err(|source| ReproError::Mesh {
+                trace: format!("the reduced case of {trace}"),
+                frame,
+                source,
+            })?;
+        let reduced_outcome_local =
+            crate::core::sweep_mesh(&reduced, &sweep, &options).map_err(|source| {
+                ReproError::Sweep {
+                    trace: format!("the reduced case of {trace}"),
+                    frame,
+                    ball,
+                    source,
+                }
+            })?;
+        let agreement_on = |mesh: &Mesh, outcome: Outcome, expected: Option<OutcomeMsg>| {
+            expected.map(|e| {
+                let r = result_of(mesh, frame, ball, sweep, options, outcome, Some(e));
+                agreement(&e, &r, tol)
+            })
+        };
+        let full_agreement = agreement_on(&mesh, outcome, found.expected);
+        let reduced_agreement = agreement_on(&reduced, reduced_outcome_local, expected);
+        Ok(ReproCase {
+            source: trace.to_string(),
+            scene_name: scene.name.clone(),
+            frame,
+            ball,
+            inputs: SweepInputs::of(&sweep, &options),
+            vertices,
+            triangles,
+            original_triangles: keep,
+            original_triangle_count: scene.triangles.len(),
+            extent_triangle,
+            expected,
+            original_expected: found.expected,
+            outcome,
+            reduced_outcome: reduced_outcome_local,
+            agreement: full_agreement,
+            reduced_agreement,
+        })
+    }
+
+    /// The reduced scene's triangle `t` as the trace's scene numbers it.
+    pub fn original_triangle(&self, t: u32) -> Option<u32> {
+        self.original_triangles.get(t as usize).copied()
+    }
+
+    /// Whether the reduced case makes the same decision as the whole
+    /// scene: same kind, triangle (renumbered), feature, `α` to the bit,
+    /// the normal within 1e-12 (its average is summed in another order),
+    /// the same fragility, and the same verdict against the expectation.
+    pub fn reproduces(&self) -> bool {
+        let (a, b) = (&self.outcome, &self.reduced_outcome);
+        let normal_close = match (a.normal, b.normal) {
+            (Some(x), Some(y)) => (x - y).norm() <= 1e-12,
+            (None, None) => true,
+            _ => false,
+        };
+        let verdicts = match (&self.agreement, &self.reduced_agreement) {
+            (Some(x), Some(y)) => same_verdict(x, y),
+            (None, None) => true,
+            _ => false,
+        };
+        a.kind == b.kind
+            && a.triangle == b.triangle.and_then(|t| self.original_triangle(t))
+            && a.feature == b.feature
+            && a.alpha.to_bits() == b.alpha.to_bits()
+            && normal_close
+            && a.fragile == b.fragile
+            && verdicts
+    }
+
+    /// The trace's file name (without its directory).
+    pub fn source_file_name(&self) -> String {
+        std::path::Path::new(&self.source)
+            .file_name()
+            .map_or_else(|| self.source.clone(), |n| n.to_string_lossy().into_owned())
+    }
+
+    /// The reduced scene's name: the original's, and where it was cut from.
+    pub fn scene_message_name(&self) -> String {
+        format!(
+            "{} (frame {}, ball {} of {}: triangles {} of its {} as 0..{})",
+            self.scene_name.as_deref().unwrap_or("scene"),
+            self.frame,
+            self.ball,
+            self.source_file_name(),
+            list(&self.original_triangles),
+            self.original_triangle_count,
+            self.original_triangles.len()
+        )
+    }
+
+    /// Writes the case as a trace: the reduced scene (with the sweep's
+    /// margin and facing), the sweep, the expectation if any, and a
+    /// metadata record `sweeptrace.repro` naming the source, the frame and
+    /// ball, and the original index of each triangle.
+    pub fn write<W: std::io::Write + std::io::Seek>(
+        &self,
+        w: &mut TraceWriter<W>,
+    ) -> Result<(), TraceError> {
+        w.metadata(
+            "sweeptrace.repro",
+            BTreeMap::from([
+                ("source".to_string(), self.source_file_name()),
+                ("frame".to_string(), self.frame.to_string()),
+                ("ball".to_string(), self.ball.to_string()),
+                (
+                    "original_triangles".to_string(),
+                    list(&self.original_triangles),
+                ),
+                (
+                    "original_triangle_count".to_string(),
+                    self.original_triangle_count.to_string(),
+                ),
+            ]),
+        )?;
+        w.scene(
+            0,
+            &SceneMsg {
+                name: Some(self.scene_message_name()),
+                vertices: self.vertices.clone(),
+                triangles: self.triangles.clone(),
+                margin: self.inputs.margin,
+                facing: self.inputs.facing,
+            },
+        )?;
+        w.sweep(
+            1,
+            &SweepMsg {
+                frame: self.frame,
+                ball: self.ball,
+                radius: self.inputs.radius,
+                p0: self.inputs.p0,
+                p1: self.inputs.p1,
+            },
+        )?;
+        if let Some(e) = &self.expected {
+            w.expected(1, e)?;
+        }
+        Ok(())
+    }
+
+    /// What the case asserts: the expectation (renumbered), or, when the
+    /// trace has none, the core's outcome on the whole scene with every
+    /// field.
+    pub fn asserted(&self) -> OutcomeMsg {
+        self.expected.unwrap_or_else(|| {
+            let mut o = OutcomeMsg::from_outcome(self.frame, self.ball, &self.reduced_outcome);
+            o.alpha = self.outcome.alpha;
+            o
+        })
+    }
+
+    /// The numbers of the Rust test ([`ReproCase::rust_test`]) in the order
+    /// its code writes them: vertices, `p0`, `p1`, radius, margin, then the
+    /// asserted `α` and its tolerance, normal and its tolerance, contact
+    /// and its tolerance (those the assertion holds).
+    pub fn test_numbers(&self, tol: &Tolerances) -> Vec<f64> {
+        let mut out: Vec<f64> = self.vertices.iter().flatten().copied().collect();
+        out.extend(self.inputs.p0);
+        out.extend(self.inputs.p1);
+        out.push(self.inputs.radius);
+        out.push(self.inputs.margin);
+        let a = self.asserted();
+        out.push(a.alpha);
+        out.push(tol.alpha);
+        if let Some(Some(n)) = a.normal {
+            out.extend(n);
+            out.push(tol.normal_degrees);
+        }
+        if let Some(Some(c)) = a.contact {
+            out.extend(c);
+            out.push(tol.contact);
+        }
+        out
+    }
+
+    /// Whether the test asserts membership of the tie set rather than the
+    /// primary: the expectation names another member of the tie set.
+    pub fn asserts_tie(&self) -> bool {
+        matches!(self.agreement, Some(Agreement::Tie))
+    }
+
+    /// A ready-to-paste Rust test asserting [`ReproCase::asserted`] against
+    /// the core through the public API, every number written as the
+    /// shortest decimal that reads back to the same bits.
+    pub fn rust_test(&self, tol: &Tolerances) -> String {
+        let mut s = String::new();
+        let f = |x: f64| format!("{x:?}");
+        let v3 = |p: &[f64; 3]| format!("[{}, {}, {}]", f(p[0]), f(p[1]), f(p[2]));
+        let a = self.asserted();
+        let stem = std::path::Path::new(&self.source)
+            .file_stem()
+            .map(|s| s.to_string_lossy().into_owned())
+            .unwrap_or_else(|| "trace".into());
+        let ident: String = stem
+            .chars()
+            .map(|c| {
+                if c.is_ascii_alphanumeric() {
+                    c.to_ascii_lowercase()
+                } else {
+                    '_'
+                }
+            })
+            .collect();
+        let what = if self.expected.is_some() {
+            "the outcome the trace expects"
+        } else {
+            "the outcome the core replays (the trace has no expectation for it)"
+        };
+        let _ = writeln!(
+            s,
+            "/// Frame {}, ball {} of `{}` (scene `{}`): {what}.",
+            self.frame,
+            self.ball,
+            stem,
+            self.scene_name.as_deref().unwrap_or("unnamed")
+        );
+        let _ = writeln!(
+            s,
+            "/// Triangles within reach of the sweep: {} of the scene's {}; triangle i here",
+            self.original_triangles.len(),
+            self.original_triangle_count
+        );
+        let _ = writeln!(
+            s,
+            "/// is triangle [{}][i] there.",
+            list_commas(&self.original_triangles)
+        );
+        if let Some(agreement) = &self.agreement {
+            let _ = writeln!(
+                s,
+                "/// The core on the whole scene: {}.",
+                agreement_text(agreement)
+            );
+        }
+        let _ = writeln!(s, "#[test]");
+        let _ = writeln!(
+            s,
+            "fn repro_{ident}_frame_{}_ball_{}() {{",
+            self.frame, self.ball
+        );
+        let _ = writeln!(
+            s,
+            "    use sweeptrace::{{Facing, Kind, Mesh, Options, Sweep}};"
+        );
+        let _ = writeln!(s, "    let mesh = Mesh::new(");
+        let _ = writeln!(s, "        vec![");
+        for v in &self.vertices {
+            let _ = writeln!(s, "            {},", v3(v));
+        }
+        let _ = writeln!(s, "        ],");
+        let _ = writeln!(s, "        &[");
+        for (t, o) in self.triangles.iter().zip(&self.original_triangles) {
+            let note = if Some(*o) == self.extent_triangle {
+                " (kept for the scene's extent, which sets the rounding unit)"
+            } else {
+                ""
+            };
+            let _ = writeln!(
+                s,
+                "            [{}, {}, {}], // triangle {o} of the trace's scene{note}",
+                t[0], t[1], t[2]
+            );
+        }
+        let _ = writeln!(s, "        ],");
+        let _ = writeln!(s, "    )");
+        let _ = writeln!(s, "    .expect(\"valid mesh\");");
+        let _ = writeln!(
+            s,
+            "    let sweep = Sweep::new({}, {}, {});",
+            v3(&self.inputs.p0),
+            v3(&self.inputs.p1),
+            f(self.inputs.radius)
+        );
+        let facing = match self.inputs.facing {
+            Facing::NonStrict => "NonStrict",
+            Facing::Strict => "Strict",
+        };
+        let _ = writeln!(
+            s,
+            "    let options = Options {{ margin: {}, facing: Facing::{facing} }};",
+            f(self.inputs.margin)
+        );
+        let kind = match a.kind {
+            Kind::None => "None",
+            Kind::Face => "Face",
+            Kind::Edge => "Edge",
+            Kind::Vertex => "Vertex",
+        };
+        let triangle_note = |t: u32| match self.original_triangle(t) {
+            Some(o) => format!(" // triangle {o} of the trace's scene"),
+            None => " // not a triangle of the trace's scene".to_string(),
+        };
+        if self.asserts_tie() {
+            let _ = writeln!(
+                s,
+                "    let (outcome, ties) = sweeptrace::core::sweep_ties(&mesh, &sweep, &options).expect(\"valid sweep\");"
+            );
+            let _ = writeln!(
+                s,
+                "    // The expectation names a member of the tie set (an equally valid answer to the tie order)."
+            );
+            let triangle = match a.triangle {
+                Some(t) => format!("Some({t:?})"),
+                None => "None".into(),
+            };
+            let feature = match a.feature {
+                Some(f) => format!("Some({f:?})"),
+                None => "None".into(),
+            };
+            let _ = writeln!(
+                s,
+                "    assert!(ties.iter().any(|t| t.matches(Kind::{kind}, {triangle}, {feature})), \"tie set {{ties:?}}\");"
+            );
+        } else {
+            let _ = writeln!(
+                s,
+                "    let outcome = sweeptrace::sweep_mesh(&mesh, &sweep, &options).expect(\"valid sweep\");"
+            );
+            let _ = writeln!(s, "    assert_eq!(outcome.kind, Kind::{kind});");
+            if let Some(t) = a.triangle {
+                match t {
+                    Some(t) => {
+                        let _ = writeln!(
+                            s,
+                            "    assert_eq!(outcome.triangle, Some({t})); {}",
+                            triangle_note(t).trim_start()
+                        );
+                    }
+                    None => {
+                        let _ = writeln!(s, "    assert_eq!(outcome.triangle, None);");
+                    }
+                }
+            }
+            if let Some(feature) = a.feature
+                && a.kind != Kind::Face
+            {
+                match feature {
+                    Some(x) => {
+                        let _ = writeln!(s, "    assert_eq!(outcome.feature, Some({x}));");
+                    }
+                    None => {
+                        let _ = writeln!(s, "    assert_eq!(outcome.feature, None);");
+                    }
+                }
+            }
+        }
+        let _ = writeln!(
+            s,
+            "    let (alpha, tolerance) = ({}, {});",
+            f(a.alpha),
+            f(tol.alpha)
+        );
+        let _ = writeln!(
+            s,
+            "    assert!((outcome.alpha - alpha).abs() <= tolerance, \"α = {{}}, expected {{alpha}}\", outcome.alpha);"
+        );
+        match a.normal {
+            Some(Some(n)) => {
+                let _ = writeln!(
+                    s,
+                    "    let (want, degrees) = ({}, {});",
+                    v3(&n),
+                    f(tol.normal_degrees)
+                );
+                let _ = writeln!(s, "    let n = outcome.normal.expect(\"a normal\");");
+                let _ = writeln!(
+                    s,
+                    "    let cross = [n.y * want[2] - n.z * want[1], n.z * want[0] - n.x * want[2], n.x * want[1] - n.y * want[0]];"
+                );
+                let _ = writeln!(
+                    s,
+                    "    let angle = cross[0].hypot(cross[1]).hypot(cross[2]).atan2(n.x * want[0] + n.y * want[1] + n.z * want[2]).to_degrees();"
+                );
+                let _ = writeln!(
+                    s,
+                    "    assert!(angle <= degrees, \"normal {{n:?}} is {{angle}}° from {{want:?}}\");"
+                );
+            }
+            Some(None) => {
+                let _ = writeln!(s, "    assert_eq!(outcome.normal, None);");
+            }
+            None => {}
+        }
+        match a.contact {
+            Some(Some(c)) => {
+                let _ = writeln!(
+                    s,
+                    "    let (want, distance) = ({}, {});",
+                    v3(&c),
+                    f(tol.contact)
+                );
+                let _ = writeln!(
+                    s,
+                    "    let c = outcome.contact.expect(\"a contact point\");"
+                );
+                let _ = writeln!(
+                    s,
+                    "    let d = (c.x - want[0]).hypot(c.y - want[1]).hypot(c.z - want[2]);"
+                );
+                let _ = writeln!(
+                    s,
+                    "    assert!(d <= distance, \"contact {{c:?}} is {{d}} from {{want:?}}\");"
+                );
+            }
+            Some(None) => {
+                let _ = writeln!(s, "    assert_eq!(outcome.contact, None);");
+            }
+            None => {}
+        }
+        let _ = writeln!(s, "}}");
+        s
+    }
+
+    /// A few lines on stderr's side: what was written and whether it
+    /// reproduces the decision.
+    pub fn summary(&self) -> String {
+        let mut s = String::new();
+        let _ = writeln!(
+            s,
+            "frame {}, ball {}: {} of {} triangles within reach{}",
+            self.frame,
+            self.ball,
+            self.original_triangles.len(),
+            self.original_triangle_count,
+            match self.extent_triangle {
+                Some(t) => format!(" (with triangle {t}, kept for the scene's extent)"),
+                None => String::new(),
+            }
+        );
+        let _ = writeln!(s, "inputs: {}", self.inputs.text());
+        let _ = writeln!(s, "inputs (hex): {}", self.inputs.hex().text());
+        let o = &self.outcome;
+        let _ = writeln!(
+            s,
+            "the core decides: {} at α = {}{}{}",
+            o.kind,
+            num(o.alpha),
+            o.triangle
+                .map_or(String::new(), |t| format!(", triangle {t}")),
+            o.feature
+                .map_or(String::new(), |f| format!(", feature {f}"))
+        );
+        match &self.agreement {
+            Some(a) => {
+                let _ = writeln!(s, "against the expectation: {}", agreement_text(a));
+            }
+            None => {
+                let _ = writeln!(s, "the trace has no expectation for this sweep");
+            }
+        }
+        let _ = writeln!(
+            s,
+            "the reduced case {}",
+            if self.reproduces() {
+                "makes the same decision"
+            } else {
+                "does NOT make the same decision (please report it)"
+            }
+        );
+        s
+    }
+}
+
+fn list(v: &[u32]) -> String {
+    v.iter().map(u32::to_string).collect::<Vec<_>>().join(" ")
+}
+
+fn list_commas(v: &[u32]) -> String {
+    v.iter().map(u32::to_string).collect::<Vec<_>>().join(", ")
+}

@@ -54,7 +54,7 @@ fn scale(mesh: &Mesh, p: &Point3<f64>, q: &Point3<f64>) -> f64 {
 /// tie distance `TIE_WINDOW_ULPS · u`, with `u = f64::EPSILON · S` and
 /// `S = max(|p|∞, |q|∞, |mesh bounds|∞)`, the rounding unit of the heights
 /// and barycentric distances computed (the unit of the sweep's tie
-/// distance, [`Path::tie_distance`](super::Path::tie_distance)).
+/// distance, [`SweptPath::tie_distance`](super::SweptPath::tie_distance)).
 pub fn crossing_tolerance(mesh: &Mesh, p: &Point3<f64>, q: &Point3<f64>) -> f64 {
     TIE_WINDOW_ULPS * f64::EPSILON * scale(mesh, p, q)
 }

@@ -30,6 +30,7 @@ mod sweep_edge;
 mod sweep_face;
 mod sweep_mesh;
 mod sweep_vertex;
+mod ties;
 
 pub use crossing::{Crossing, crossing_tolerance, first_crossing, triangle_crossing};
 pub use error::{MeshError, SweepError};
@@ -46,7 +47,6 @@ pub use record::{
 };
 pub use sweep_edge::sweep_edge;
 pub use sweep_face::{barycentric, barycentric_and_distance, sweep_face};
-pub use sweep_mesh::{
-    Broadphase, CollectTies, Outcome, Tie, in_tie_window, sweep_mesh, sweep_mesh_with, sweep_ties,
-};
+pub use sweep_mesh::{Broadphase, Outcome, sweep_mesh, sweep_mesh_with};
 pub use sweep_vertex::sweep_vertex;
+pub use ties::{CollectTies, Tie, in_tie_window, sweep_ties};

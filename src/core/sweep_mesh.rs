@@ -13,6 +13,7 @@ use super::record::{Kind, NoObserver, Observer, TestRecord, Verdict};
 use super::sweep_edge::sweep_edge;
 use super::sweep_face::{barycentric_and_distance, sweep_face};
 use super::sweep_vertex::sweep_vertex;
+use super::ties::{Tie, in_tie_window};
 
 /// The result of one sweep.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
@@ -82,7 +83,7 @@ impl Outcome {
     }
 
     /// The tie set among `records` (the records of this sweep, e.g. from
-    /// [`CollectRecords`](super::CollectRecords) or [`CollectTies`]): every
+    /// [`CollectRecords`](super::CollectRecords) or [`CollectTies`](super::CollectTies)): every
     /// hit tied with this outcome, in the tie order (the primary first).
     pub fn tie_set(&self, records: &[TestRecord]) -> Vec<Tie> {
         let mut ties: Vec<Tie> = records
@@ -94,113 +95,6 @@ impl Outcome {
         ties.dedup_by_key(|t| t.order());
         ties
     }
-}
-
-/// Whether a hit at `alpha` lies in the tie window `window` of the minimum
-/// `min_alpha`: `alpha ≤ min_alpha + window`. The one definition of "tied"
-/// (the combiner, [`Outcome::ties_with`] and every consumer use it).
-#[inline]
-pub fn in_tie_window(alpha: f64, min_alpha: f64, window: f64) -> bool {
-    alpha <= min_alpha + window
-}
-
-/// One member of a decision's tie set: a hit, named as an outcome names it.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
-pub struct Tie {
-    /// Kind of the hit.
-    pub kind: Kind,
-    /// Input index of its triangle.
-    pub triangle: u32,
-    /// Edge or vertex index; `None` for a face.
-    pub feature: Option<u8>,
-    /// Its own `α`.
-    pub alpha: f64,
-}
-
-impl Tie {
-    /// The tie-set entry of a record, if it is a hit.
-    pub fn of(record: &TestRecord) -> Option<Tie> {
-        Some(Tie {
-            kind: record.kind(),
-            triangle: record.triangle(),
-            feature: record.reported_feature(),
-            alpha: record.alpha()?,
-        })
-    }
-
-    /// The tie order: face < edge < vertex, then triangle, then feature.
-    pub fn order(&self) -> (Kind, u32, Option<u8>) {
-        (self.kind, self.triangle, self.feature)
-    }
-
-    /// Whether an expectation naming `kind` and, when known, `triangle`
-    /// and `feature` names this hit (`None`: not named, so any value;
-    /// `Some(None)`: null). A face has no feature: any feature an expected
-    /// face names is accepted.
-    pub fn matches(
-        &self,
-        kind: Kind,
-        triangle: Option<Option<u32>>,
-        feature: Option<Option<u8>>,
-    ) -> bool {
-        kind == self.kind
-            && triangle.is_none_or(|t| t == Some(self.triangle))
-            && (self.kind == Kind::Face || feature.is_none_or(|f| f == self.feature))
-    }
-}
-
-/// An observer that keeps the hits of an explained sweep, from which
-/// [`CollectTies::tie_set`] gives the decision's tie set. Cheaper than
-/// [`CollectRecords`](super::CollectRecords): only hits are kept.
-#[derive(Clone, Debug, Default)]
-pub struct CollectTies {
-    /// Every hit, in the order the tests ran.
-    pub hits: Vec<Tie>,
-}
-
-impl CollectTies {
-    /// The hits tied with `outcome`, in the tie order (the primary first).
-    pub fn tie_set(&self, outcome: &Outcome) -> Vec<Tie> {
-        let mut ties: Vec<Tie> = self
-            .hits
-            .iter()
-            .copied()
-            .filter(|t| outcome.ties_with(t.alpha))
-            .collect();
-        ties.sort_by_key(|t| t.order());
-        ties
-    }
-
-    fn keep(&mut self, record: TestRecord) {
-        if let Some(t) = Tie::of(&record) {
-            self.hits.push(t);
-        }
-    }
-}
-
-impl Observer for CollectTies {
-    fn face(&mut self, r: &super::record::FaceRecord) {
-        self.keep(TestRecord::Face(*r));
-    }
-    fn edge(&mut self, r: &super::record::EdgeRecord) {
-        self.keep(TestRecord::Edge(*r));
-    }
-    fn vertex(&mut self, r: &super::record::VertexRecord) {
-        self.keep(TestRecord::Vertex(*r));
-    }
-}
-
-/// The outcome of `sweep` and its tie set (every hit tied with the primary,
-/// in the tie order, the primary first; empty when nothing is hit).
-pub fn sweep_ties(
-    mesh: &Mesh,
-    sweep: &Sweep,
-    options: &Options,
-) -> Result<(Outcome, Vec<Tie>), SweepError> {
-    let mut ties = CollectTies::default();
-    let outcome = sweep_mesh_with(mesh, sweep, options, Broadphase::Bvh, &mut ties)?;
-    let set = ties.tie_set(&outcome);
-    Ok((outcome, set))
 }
 
 /// How the candidate triangles are chosen.

@@ -33,5 +33,5 @@ pub use iter::{
     DEFAULT_BATCH_EVENTS, ParallelReplayIter, ReplayIter, replay_events, replay_events_parallel,
 };
 pub use options::{Detail, FrameRange, ReplayOptions};
-pub use summary::{ReplaySummary, TunnelAt};
+pub use summary::{LISTED_TUNNELS, ReplaySummary, TunnelAt};
 pub use tunnel::{Tunnel, TunnelKind, sweep_end, tunnel_during_sweep};

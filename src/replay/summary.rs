@@ -75,7 +75,7 @@ pub struct ReplaySummary {
     pub fragile_by_reason: BTreeMap<FragileReason, u64>,
     /// Tunnels found, by kind.
     pub tunnels: BTreeMap<TunnelKind, u64>,
-    /// The first tunnels (at most [`LISTED_TUNNELS`]), in trace order.
+    /// The first tunnels (at most `LISTED_TUNNELS`, 5), in trace order.
     pub first_tunnels: Vec<TunnelAt>,
 }
 

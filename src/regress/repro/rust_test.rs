@@ -1,0 +1,273 @@
+//! The ready-to-paste Rust test of a [`ReproCase`].
+
+use std::fmt::Write as _;
+
+use crate::regress::compare::{Agreement, Tolerances};
+
+use crate::core::{Facing, Kind};
+
+use super::case::{ReproCase, agreement_text, list_commas};
+
+impl ReproCase {
+    /// The numbers of the Rust test ([`ReproCase::rust_test`]) in the order
+    /// its code writes them: vertices, `p0`, `p1`, radius, margin, then the
+    /// asserted `α` and its tolerance, normal and its tolerance, contact
+    /// and its tolerance (those the assertion holds).
+    pub fn test_numbers(&self, tol: &Tolerances) -> Vec<f64> {
+        let mut out: Vec<f64> = self.vertices.iter().flatten().copied().collect();
+        out.extend(self.inputs.p0);
+        out.extend(self.inputs.p1);
+        out.push(self.inputs.radius);
+        out.push(self.inputs.margin);
+        let a = self.asserted();
+        out.push(a.alpha);
+        out.push(tol.alpha);
+        if let Some(Some(n)) = a.normal {
+            out.extend(n);
+            out.push(tol.normal_degrees);
+        }
+        if let Some(Some(c)) = a.contact {
+            out.extend(c);
+            out.push(tol.contact);
+        }
+        out
+    }
+
+    /// Whether the test asserts membership of the tie set rather than the
+    /// primary: the expectation names another member of the tie set.
+    pub fn asserts_tie(&self) -> bool {
+        matches!(self.agreement, Some(Agreement::Tie))
+    }
+
+    /// A ready-to-paste Rust test asserting [`ReproCase::asserted`] against
+    /// the core through the public API, every number written as the
+    /// shortest decimal that reads back to the same bits.
+    pub fn rust_test(&self, tol: &Tolerances) -> String {
+        let mut s = String::new();
+        let f = |x: f64| format!("{x:?}");
+        let v3 = |p: &[f64; 3]| format!("[{}, {}, {}]", f(p[0]), f(p[1]), f(p[2]));
+        let a = self.asserted();
+        let stem = std::path::Path::new(&self.source)
+            .file_stem()
+            .map(|s| s.to_string_lossy().into_owned())
+            .unwrap_or_else(|| "trace".into());
+        let ident: String = stem
+            .chars()
+            .map(|c| {
+                if c.is_ascii_alphanumeric() {
+                    c.to_ascii_lowercase()
+                } else {
+                    '_'
+                }
+            })
+            .collect();
+        let what = if self.expected.is_some() {
+            "the outcome the trace expects"
+        } else {
+            "the outcome the core replays (the trace has no expectation for it)"
+        };
+        let _ = writeln!(
+            s,
+            "/// Frame {}, ball {} of `{}` (scene `{}`): {what}.",
+            self.frame,
+            self.ball,
+            stem,
+            self.scene_name.as_deref().unwrap_or("unnamed")
+        );
+        let _ = writeln!(
+            s,
+            "/// Triangles within reach of the sweep: {} of the scene's {}; triangle i here",
+            self.original_triangles.len(),
+            self.original_triangle_count
+        );
+        let _ = writeln!(
+            s,
+            "/// is triangle [{}][i] there.",
+            list_commas(&self.original_triangles)
+        );
+        if let Some(agreement) = &self.agreement {
+            let _ = writeln!(
+                s,
+                "/// The core on the whole scene: {}.",
+                agreement_text(agreement)
+            );
+        }
+        let _ = writeln!(s, "#[test]");
+        let _ = writeln!(
+            s,
+            "fn repro_{ident}_frame_{}_ball_{}() {{",
+            self.frame, self.ball
+        );
+        let _ = writeln!(
+            s,
+            "    use sweeptrace::{{Facing, Kind, Mesh, Options, Sweep}};"
+        );
+        let _ = writeln!(s, "    let mesh = Mesh::new(");
+        let _ = writeln!(s, "        vec![");
+        for v in &self.vertices {
+            let _ = writeln!(s, "            {},", v3(v));
+        }
+        let _ = writeln!(s, "        ],");
+        let _ = writeln!(s, "        &[");
+        for (t, o) in self.triangles.iter().zip(&self.original_triangles) {
+            let note = if Some(*o) == self.extent_triangle {
+                " (kept for the scene's extent, which sets the rounding unit)"
+            } else {
+                ""
+            };
+            let _ = writeln!(
+                s,
+                "            [{}, {}, {}], // triangle {o} of the trace's scene{note}",
+                t[0], t[1], t[2]
+            );
+        }
+        let _ = writeln!(s, "        ],");
+        let _ = writeln!(s, "    )");
+        let _ = writeln!(s, "    .expect(\"valid mesh\");");
+        let _ = writeln!(
+            s,
+            "    let sweep = Sweep::new({}, {}, {});",
+            v3(&self.inputs.p0),
+            v3(&self.inputs.p1),
+            f(self.inputs.radius)
+        );
+        let facing = match self.inputs.facing {
+            Facing::NonStrict => "NonStrict",
+            Facing::Strict => "Strict",
+        };
+        let _ = writeln!(
+            s,
+            "    let options = Options {{ margin: {}, facing: Facing::{facing} }};",
+            f(self.inputs.margin)
+        );
+        let kind = match a.kind {
+            Kind::None => "None",
+            Kind::Face => "Face",
+            Kind::Edge => "Edge",
+            Kind::Vertex => "Vertex",
+        };
+        let triangle_note = |t: u32| match self.original_triangle(t) {
+            Some(o) => format!(" // triangle {o} of the trace's scene"),
+            None => " // not a triangle of the trace's scene".to_string(),
+        };
+        if self.asserts_tie() {
+            let _ = writeln!(
+                s,
+                "    let (outcome, ties) = sweeptrace::core::sweep_ties(&mesh, &sweep, &options).expect(\"valid sweep\");"
+            );
+            let _ = writeln!(
+                s,
+                "    // The expectation names a member of the tie set (an equally valid answer to the tie order)."
+            );
+            let triangle = match a.triangle {
+                Some(t) => format!("Some({t:?})"),
+                None => "None".into(),
+            };
+            let feature = match a.feature {
+                Some(f) => format!("Some({f:?})"),
+                None => "None".into(),
+            };
+            let _ = writeln!(
+                s,
+                "    assert!(ties.iter().any(|t| t.matches(Kind::{kind}, {triangle}, {feature})), \"tie set {{ties:?}}\");"
+            );
+        } else {
+            let _ = writeln!(
+                s,
+                "    let outcome = sweeptrace::sweep_mesh(&mesh, &sweep, &options).expect(\"valid sweep\");"
+            );
+            let _ = writeln!(s, "    assert_eq!(outcome.kind, Kind::{kind});");
+            if let Some(t) = a.triangle {
+                match t {
+                    Some(t) => {
+                        let _ = writeln!(
+                            s,
+                            "    assert_eq!(outcome.triangle, Some({t})); {}",
+                            triangle_note(t).trim_start()
+                        );
+                    }
+                    None => {
+                        let _ = writeln!(s, "    assert_eq!(outcome.triangle, None);");
+                    }
+                }
+            }
+            if let Some(feature) = a.feature
+                && a.kind != Kind::Face
+            {
+                match feature {
+                    Some(x) => {
+                        let _ = writeln!(s, "    assert_eq!(outcome.feature, Some({x}));");
+                    }
+                    None => {
+                        let _ = writeln!(s, "    assert_eq!(outcome.feature, None);");
+                    }
+                }
+            }
+        }
+        let _ = writeln!(
+            s,
+            "    let (alpha, tolerance) = ({}, {});",
+            f(a.alpha),
+            f(tol.alpha)
+        );
+        let _ = writeln!(
+            s,
+            "    assert!((outcome.alpha - alpha).abs() <= tolerance, \"α = {{}}, expected {{alpha}}\", outcome.alpha);"
+        );
+        match a.normal {
+            Some(Some(n)) => {
+                let _ = writeln!(
+                    s,
+                    "    let (want, degrees) = ({}, {});",
+                    v3(&n),
+                    f(tol.normal_degrees)
+                );
+                let _ = writeln!(s, "    let n = outcome.normal.expect(\"a normal\");");
+                let _ = writeln!(
+                    s,
+                    "    let cross = [n.y * want[2] - n.z * want[1], n.z * want[0] - n.x * want[2], n.x * want[1] - n.y * want[0]];"
+                );
+                let _ = writeln!(
+                    s,
+                    "    let angle = cross[0].hypot(cross[1]).hypot(cross[2]).atan2(n.x * want[0] + n.y * want[1] + n.z * want[2]).to_degrees();"
+                );
+                let _ = writeln!(
+                    s,
+                    "    assert!(angle <= degrees, \"normal {{n:?}} is {{angle}}° from {{want:?}}\");"
+                );
+            }
+            Some(None) => {
+                let _ = writeln!(s, "    assert_eq!(outcome.normal, None);");
+            }
+            None => {}
+        }
+        match a.contact {
+            Some(Some(c)) => {
+                let _ = writeln!(
+                    s,
+                    "    let (want, distance) = ({}, {});",
+                    v3(&c),
+                    f(tol.contact)
+                );
+                let _ = writeln!(
+                    s,
+                    "    let c = outcome.contact.expect(\"a contact point\");"
+                );
+                let _ = writeln!(
+                    s,
+                    "    let d = (c.x - want[0]).hypot(c.y - want[1]).hypot(c.z - want[2]);"
+                );
+                let _ = writeln!(
+                    s,
+                    "    assert!(d <= distance, \"contact {{c:?}} is {{d}} from {{want:?}}\");"
+                );
+            }
+            Some(None) => {
+                let _ = writeln!(s, "    assert_eq!(outcome.contact, None);");
+            }
+            None => {}
+        }
+        let _ = writeln!(s, "}}");
+        s
+    }
+}

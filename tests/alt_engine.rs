@@ -261,7 +261,7 @@ fn alt_sweep(mesh: &[AltTriangle], s: &SweepMsg, margin: f64, facing: Facing) ->
 
 /// A trace of `scene` and `sweeps` with the alternative engine's outcomes
 /// as expectations.
-fn alt_trace(scene: &SceneMsg, sweeps: &[SweepMsg]) -> Result<Vec<u8>, String> {
+pub(crate) fn alt_trace(scene: &SceneMsg, sweeps: &[SweepMsg]) -> Result<Vec<u8>, String> {
     let mesh = alt_mesh(scene);
     let mut w = TraceWriter::new(Cursor::new(Vec::new())).map_err(|e| e.to_string())?;
     w.scene(0, scene).map_err(|e| e.to_string())?;

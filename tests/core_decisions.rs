@@ -29,7 +29,7 @@ pub fn tests() -> Vec<Trial> {
 
 const NS: Facing = Facing::NonStrict;
 
-fn options() -> Options {
+pub(crate) fn options() -> Options {
     Options {
         margin: 0.0,
         facing: NS,
@@ -209,13 +209,13 @@ struct IntMesh {
     terrain: Option<(i64, i64, i64, i64)>,
 }
 
-fn sub3(a: [i64; 3], b: [i64; 3]) -> [i64; 3] {
+pub(crate) fn sub3(a: [i64; 3], b: [i64; 3]) -> [i64; 3] {
     [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
 }
-fn dot3(a: [i64; 3], b: [i64; 3]) -> i64 {
+pub(crate) fn dot3(a: [i64; 3], b: [i64; 3]) -> i64 {
     a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 }
-fn cross3(a: [i64; 3], b: [i64; 3]) -> [i64; 3] {
+pub(crate) fn cross3(a: [i64; 3], b: [i64; 3]) -> [i64; 3] {
     [
         a[1] * b[2] - a[2] * b[1],
         a[2] * b[0] - a[0] * b[2],
@@ -314,7 +314,7 @@ fn rational_length_vectors() -> Vec<([i64; 3], i64)> {
 }
 
 /// Whether `x` lies on the closed segment `a b` (exact).
-fn on_segment(x: [i64; 3], a: [i64; 3], b: [i64; 3]) -> bool {
+pub(crate) fn on_segment(x: [i64; 3], a: [i64; 3], b: [i64; 3]) -> bool {
     let (ab, ax) = (sub3(b, a), sub3(x, a));
     cross3(ab, ax) == [0, 0, 0] && dot3(ax, ab) >= 0 && dot3(ax, ab) <= dot3(ab, ab)
 }

@@ -16,6 +16,7 @@ mod prefetch;
 mod record;
 mod replay;
 mod repro;
+mod scanned;
 mod support;
 mod trace_io;
 mod tunnel;
@@ -93,5 +94,6 @@ fn main() {
     trials.extend(tunnel::tests());
     trials.extend(repro::tests());
     trials.extend(alt_engine::tests());
+    trials.extend(scanned::tests());
     libtest_mimic::run(&args, trials).exit();
 }

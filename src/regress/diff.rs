@@ -16,8 +16,8 @@ use serde_json::json;
 
 use crate::core::explain::num;
 use crate::regress::{
-    ExpectedTest, FieldDiff, Tolerances, compare, expected_tests, explain_outcome,
-    explained_records,
+    Agreement, ExpectedTest, FieldDiff, Tolerances, agreement, compare, expected_tests,
+    explain_outcome, explained_records,
 };
 use crate::replay::{ReplayError, ReplayEvent, ReplayOptions, SweepResult, replay_events};
 use crate::trace::messages::OutcomeMsg;
@@ -115,6 +115,9 @@ pub struct DiffReport {
     pub compared: u64,
     /// Sweeps whose outcomes match.
     pub same: u64,
+    /// Sweeps whose outcomes differ only in which member of the tie set
+    /// was chosen (an equally valid answer to the rules): counted as same.
+    pub ties: u64,
     /// Sweeps whose outcomes differ.
     pub different: u64,
     /// Sweeps only in A.
@@ -162,6 +165,7 @@ pub fn diff(a: &Side, b: &Side, tolerances: &Tolerances) -> DiffReport {
         b: describe_side(b),
         compared: 0,
         same: 0,
+        ties: 0,
         different: 0,
         only_in_a: 0,
         only_in_b: 0,
@@ -188,6 +192,15 @@ pub fn diff(a: &Side, b: &Side, tolerances: &Tolerances) -> DiffReport {
         let fields = compare(&oa, &ob, tolerances);
         if fields.is_empty() {
             report.same += 1;
+            continue;
+        }
+        // Each side's answer judged against the other's decision: naming
+        // another member of its tie set is the same decision by the rules.
+        if matches!(agreement(&ob, ra, tolerances), Agreement::Tie)
+            || matches!(agreement(&oa, rb, tolerances), Agreement::Tie)
+        {
+            report.same += 1;
+            report.ties += 1;
             continue;
         }
         report.different += 1;
@@ -228,7 +241,16 @@ pub fn render_text(r: &DiffReport) -> String {
     let mut s = String::new();
     let _ = writeln!(s, "A: {}\nB: {}", r.a, r.b);
     if r.is_same() {
-        let _ = writeln!(s, "same: {} sweeps, identical outcomes", r.compared);
+        if r.ties > 0 {
+            let _ = writeln!(
+                s,
+                "same: {} sweeps, identical outcomes ({} of them ties: another member of the \
+                 tie set, equally valid by the rules)",
+                r.compared, r.ties
+            );
+        } else {
+            let _ = writeln!(s, "same: {} sweeps, identical outcomes", r.compared);
+        }
         return s;
     }
     let _ = writeln!(

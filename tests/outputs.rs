@@ -12,6 +12,7 @@ pub fn tests() -> Vec<Trial> {
         trial!(named_pipe_is_written_directly),
         trial!(full_disk_is_a_clear_error),
         trial!(killed_mid_write_leaves_the_target_intact),
+        trial!(unreachable_viewer_is_a_clear_error),
     ]
 }
 
@@ -213,6 +214,42 @@ fn killed_mid_write_leaves_the_target_intact() -> Result<(), String> {
                 std::fs::remove_file(dir.path().join(name)).map_err(|e| e.to_string())?;
             }
         }
+    }
+    Ok(())
+}
+
+/// `replay --connect` to a viewer that is not there (nothing listens on
+/// port 1): the command ends (it used to wait forever), exits 2 and names
+/// the address.
+fn unreachable_viewer_is_a_clear_error() -> Result<(), String> {
+    let url = "rerun+http://127.0.0.1:1/proxy";
+    let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_sweeptrace"))
+        .arg("replay")
+        .arg(sample_trace())
+        .args(["--connect", url])
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .map_err(|e| e.to_string())?;
+    // Not a measurement: a bound that only a hang exceeds.
+    let deadline = std::time::Instant::now() + std::time::Duration::from_secs(180);
+    let status = loop {
+        if let Some(status) = child.try_wait().map_err(|e| e.to_string())? {
+            break status;
+        }
+        if std::time::Instant::now() > deadline {
+            let _ = child.kill();
+            return Err("replay --connect hangs on an unreachable viewer".into());
+        }
+        std::thread::sleep(std::time::Duration::from_millis(100));
+    };
+    let mut stderr = String::new();
+    if let Some(mut e) = child.stderr.take() {
+        use std::io::Read;
+        e.read_to_string(&mut stderr).map_err(|e| e.to_string())?;
+    }
+    if status.code() != Some(2) || !stderr.contains(url) {
+        return Err(format!("exit {:?}: {stderr}", status.code()));
     }
     Ok(())
 }

@@ -23,6 +23,10 @@ use sweeptrace::trace::prefetch::{self, prefetch};
 use sweeptrace::viz;
 use sweeptrace::viz::pipeline::{PipelineOptions, run_pipeline};
 
+/// How long the end of a replay waits for a viewer (`--spawn`, `--connect`)
+/// to take the last messages before saying it cannot be reached.
+const VIEWER_FLUSH_TIMEOUT: std::time::Duration = std::time::Duration::from_secs(5);
+
 /// The viewer address `--connect` uses when given no URL.
 pub const DEFAULT_CONNECT_URL: &str = "rerun+http://127.0.0.1:9876/proxy";
 
@@ -203,6 +207,7 @@ pub fn run(args: Args) -> anyhow::Result<RunOutcome> {
                 follow_ball: args.ball.unwrap_or(0),
                 ..viz::PrepareOptions::default()
             },
+            flush_timeout: (args.spawn || args.connect.is_some()).then_some(VIEWER_FLUSH_TIMEOUT),
         };
         logger =
             Some(viz::Logger::with_options(rec, logger_options).context("starting the recording")?);
@@ -309,7 +314,21 @@ pub fn run(args: Args) -> anyhow::Result<RunOutcome> {
     if let Some(mut l) = logger {
         l.flush().context("logging the last frames")?;
         let rec = l.finish();
-        rec.flush_blocking().context("flushing the recording")?;
+        if args.spawn || args.connect.is_some() {
+            // A viewer that cannot be reached would make a blocking flush
+            // (and dropping the stream) wait forever.
+            if let Err(err) = rec.flush_with_timeout(VIEWER_FLUSH_TIMEOUT) {
+                std::mem::forget(rec);
+                bail!(
+                    "streaming to the viewer at {}: {err} within {} s; is a Rerun viewer \
+                     running there? (start one with `rerun`, or write a file with --rrd)",
+                    args.connect.as_deref().unwrap_or("the spawned viewer"),
+                    VIEWER_FLUSH_TIMEOUT.as_secs()
+                );
+            }
+        } else {
+            rec.flush_blocking().context("flushing the recording")?;
+        }
         drop(rec);
     }
     if let Some((pending, writer)) = rrd_file {

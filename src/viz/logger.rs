@@ -66,6 +66,9 @@ pub struct LoggerOptions {
     pub blueprint: bool,
     /// What each sweep's rows depend on.
     pub prepare: PrepareOptions,
+    /// How long [`Logger::finish`] waits for the stream's sinks (a viewer
+    /// that may not be reachable); `None` waits as long as it takes.
+    pub flush_timeout: Option<std::time::Duration>,
 }
 
 impl Default for LoggerOptions {
@@ -73,6 +76,7 @@ impl Default for LoggerOptions {
         LoggerOptions {
             blueprint: true,
             prepare: PrepareOptions::default(),
+            flush_timeout: None,
         }
     }
 }
@@ -370,15 +374,23 @@ impl Logger {
         if self.options.blueprint && self.divergent + self.tunnels > 0 {
             // Every chunk before the second layout, so that the order of
             // the file's messages does not vary.
-            let _ = self.rec.flush_blocking();
+            let _ = self.flush_stream();
             let _ = blueprint::send_blueprint(
                 &self.rec,
                 Layout::Divergences,
                 self.options.prepare.follow_ball,
             );
         }
-        let _ = self.rec.flush_blocking();
+        let _ = self.flush_stream();
         self.rec
+    }
+
+    /// Flushes the stream to its sinks, within the options' timeout.
+    fn flush_stream(&self) -> Result<(), rerun::sink::SinkFlushError> {
+        match self.options.flush_timeout {
+            Some(timeout) => self.rec.flush_with_timeout(timeout),
+            None => self.rec.flush_blocking(),
+        }
     }
 
     /// Logs a scene's mesh (static, one Mesh3D, flat-shaded) and its

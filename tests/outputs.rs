@@ -13,6 +13,7 @@ pub fn tests() -> Vec<Trial> {
         trial!(full_disk_is_a_clear_error),
         trial!(killed_mid_write_leaves_the_target_intact),
         trial!(unreachable_viewer_is_a_clear_error),
+        trial!(closed_stdout_ends_quietly),
     ]
 }
 
@@ -253,3 +254,43 @@ fn unreachable_viewer_is_a_clear_error() -> Result<(), String> {
     }
     Ok(())
 }
+
+/// `replay --outcomes -` whose reader goes away at once (`| head -0`): the
+/// command ends like other command-line tools, by SIGPIPE, without an
+/// error message and without waiting.
+fn closed_stdout_ends_quietly() -> Result<(), String> {
+    let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_sweeptrace"))
+        .arg("replay")
+        .arg(sample_trace())
+        .args(["--outcomes", "-"])
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .map_err(|e| e.to_string())?;
+    drop(child.stdout.take());
+    // Not a measurement: a bound that only a hang exceeds.
+    let deadline = std::time::Instant::now() + std::time::Duration::from_secs(60);
+    let status = loop {
+        if let Some(status) = child.try_wait().map_err(|e| e.to_string())? {
+            break status;
+        }
+        if std::time::Instant::now() > deadline {
+            let _ = child.kill();
+            return Err("replay hangs when its stdout is closed".into());
+        }
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    };
+    let mut stderr = String::new();
+    if let Some(mut e) = child.stderr.take() {
+        use std::io::Read;
+        e.read_to_string(&mut stderr).map_err(|e| e.to_string())?;
+    }
+    use std::os::unix::process::ExitStatusExt;
+    if status.signal() != Some(SIGPIPE) || stderr.contains("error") {
+        return Err(format!("status {status:?}, stderr: {stderr}"));
+    }
+    Ok(())
+}
+
+/// SIGPIPE's number on Linux.
+const SIGPIPE: i32 = 13;

@@ -60,6 +60,22 @@ impl PendingFile {
         Ok((pending, file))
     }
 
+    /// Like [`PendingFile::create`], for formats whose writer seeks (MCAP):
+    /// a target that exists and is not a regular file (a device, a pipe)
+    /// is refused with [`io::ErrorKind::InvalidInput`] instead of being
+    /// written directly.
+    pub fn create_seekable(target: &Path) -> io::Result<(PendingFile, File)> {
+        if let Ok(meta) = std::fs::metadata(target)
+            && !meta.is_file()
+        {
+            return Err(io::Error::new(
+                io::ErrorKind::InvalidInput,
+                "not a regular file: an MCAP trace is written with seeks, so it needs one",
+            ));
+        }
+        PendingFile::create(target)
+    }
+
     /// Creates the temporary file next to `target`, for writers that open
     /// it by its path ([`PendingFile::path`]).
     pub fn new(target: &Path) -> io::Result<PendingFile> {
@@ -112,6 +128,16 @@ pub fn unfinished_temporaries(target: &Path) -> Vec<PathBuf> {
         .collect();
     found.sort();
     found
+}
+
+/// Makes a finished output durable: syncs a regular file to the disk; a
+/// device or a pipe (written directly, see the module documentation)
+/// cannot be synced and needs not be.
+pub fn sync(file: &File) -> io::Result<()> {
+    if file.metadata()?.is_file() {
+        file.sync_all()?;
+    }
+    Ok(())
 }
 
 fn dir_of(target: &Path) -> &Path {

@@ -14,6 +14,7 @@ pub fn tests() -> Vec<Trial> {
         trial!(killed_mid_write_leaves_the_target_intact),
         trial!(unreachable_viewer_is_a_clear_error),
         trial!(closed_stdout_ends_quietly),
+        trial!(trace_to_a_pipe_is_refused),
     ]
 }
 
@@ -294,3 +295,55 @@ fn closed_stdout_ends_quietly() -> Result<(), String> {
 
 /// SIGPIPE's number on Linux.
 const SIGPIPE: i32 = 13;
+
+/// `record -o` and `bless -o` to a named pipe: an MCAP trace is written
+/// with seeks, so the pipe is refused with exit 2 and a message naming it
+/// (the MCAP writer used to panic on a target that cannot seek), and the
+/// pipe is left as it was.
+fn trace_to_a_pipe_is_refused() -> Result<(), String> {
+    let dir = tempfile::tempdir().map_err(|e| e.to_string())?;
+    let fifo = dir.path().join("trace.mcap");
+    let status = std::process::Command::new("mkfifo")
+        .arg(&fifo)
+        .status()
+        .map_err(|e| format!("mkfifo: {e}"))?;
+    if !status.success() {
+        return Err("mkfifo failed".into());
+    }
+    let commands: [Vec<std::ffi::OsString>; 2] = [
+        vec![
+            "record".into(),
+            "--scene".into(),
+            "cube".into(),
+            "--frames".into(),
+            "3".into(),
+            "-o".into(),
+            fifo.clone().into(),
+        ],
+        vec![
+            "bless".into(),
+            sample_trace().into(),
+            "-o".into(),
+            fifo.clone().into(),
+        ],
+    ];
+    for args in commands {
+        let out = std::process::Command::new(env!("CARGO_BIN_EXE_sweeptrace"))
+            .args(&args)
+            .output()
+            .map_err(|e| e.to_string())?;
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        if out.status.code() != Some(2)
+            || !stderr.contains("trace.mcap")
+            || !stderr.contains("not a regular file")
+        {
+            return Err(format!("{args:?}: exit {:?}: {stderr}", out.status.code()));
+        }
+        use std::os::unix::fs::FileTypeExt;
+        let meta = std::fs::symlink_metadata(&fifo).map_err(|e| e.to_string())?;
+        if !meta.file_type().is_fifo() {
+            return Err(format!("{args:?} replaced the pipe"));
+        }
+    }
+    Ok(())
+}

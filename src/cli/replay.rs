@@ -347,10 +347,7 @@ pub fn run(args: Args) -> anyhow::Result<RunOutcome> {
                 .into_inner()
                 .map_err(|e| e.into_error())
                 .context(writing_outcomes.clone())?;
-            // A device or a pipe cannot be synced; a file must reach the disk.
-            if file.metadata().is_ok_and(|m| m.is_file()) {
-                file.sync_all().context(writing_outcomes.clone())?;
-            }
+            sweeptrace::atomic::sync(&file).context(writing_outcomes.clone())?;
             let target = pending.target().to_path_buf();
             complete(pending)?;
             eprintln!("wrote the outcomes to {}", target.display());

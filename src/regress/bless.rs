@@ -350,7 +350,7 @@ pub fn bless_file(
         move |source| BlessError::Io { file, what, source }
     };
     let bytes = std::fs::read(input).map_err(io(&in_name, "reading"))?;
-    let (pending, file) = PendingFile::create(output)
+    let (pending, file) = PendingFile::create_seekable(output)
         .map_err(io(&out_name, "creating a temporary file next to it"))?;
     let (summary, buffered) = bless_bytes(&bytes, &in_name, BufWriter::new(file), options)?;
     let file = buffered.into_inner().map_err(|e| BlessError::Io {
@@ -358,7 +358,7 @@ pub fn bless_file(
         what: "writing".to_string(),
         source: e.into_error(),
     })?;
-    file.sync_all().map_err(io(&out_name, "writing"))?;
+    crate::atomic::sync(&file).map_err(io(&out_name, "writing"))?;
     drop(file);
     pending
         .commit()

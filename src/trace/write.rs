@@ -262,7 +262,7 @@ pub fn write_trace_file<T, E: From<TraceError>>(
         messages: 0,
         source,
     };
-    let (pending, file) = PendingFile::create(path).map_err(io)?;
+    let (pending, file) = PendingFile::create_seekable(path).map_err(io)?;
     let mut writer =
         TraceWriter::build(BufWriter::new(file), default_write_options(), name.clone())?;
     let value = f(&mut writer)?;
@@ -273,7 +273,7 @@ pub fn write_trace_file<T, E: From<TraceError>>(
         messages,
         source: e.into_error(),
     })?;
-    file.sync_all().map_err(|source| TraceError::Io {
+    crate::atomic::sync(&file).map_err(|source| TraceError::Io {
         file: name.clone(),
         messages,
         source,

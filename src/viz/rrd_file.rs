@@ -149,11 +149,7 @@ impl RrdFileWriter {
             let mut writer = encoder.into_inner().map_err(|e| reason_of(&e))?;
             writer.flush().map_err(|e| e.to_string())?;
             let file = writer.into_inner().map_err(|e| e.error().to_string())?;
-            // A device or a pipe cannot be synced; a file must be.
-            match file.sync_all() {
-                Err(e) if file.metadata().is_ok_and(|m| m.is_file()) => Err(e.to_string()),
-                _ => Ok(()),
-            }
+            crate::atomic::sync(&file).map_err(|e| e.to_string())
         })();
         result.map_err(|reason| RrdFileError {
             path: self.path.clone(),

@@ -16,7 +16,6 @@ use std::borrow::Cow;
 use std::collections::BTreeMap;
 use std::io::Cursor;
 use std::path::{Path, PathBuf};
-use std::process::Command;
 
 use libtest_mimic::Trial;
 use sweeptrace::core::{Facing, Kind};
@@ -31,6 +30,8 @@ use sweeptrace::trace::messages::{OutcomeMsg, SceneMsg, SweepMsg};
 use sweeptrace::trace::{TraceReader, TraceWriter};
 
 use crate::ensure;
+use crate::os;
+use crate::support::run_bin;
 use crate::trial;
 
 const FIXTURE: &str = "tests/fixtures/wrong_engine_config.mcap";
@@ -164,26 +165,6 @@ fn check_bytes(bytes: &[u8]) -> sweeptrace::regress::TraceReport {
 
 fn fixture_path() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join(FIXTURE)
-}
-
-fn bin() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_sweeptrace"))
-}
-
-fn run_bin(args: &[&std::ffi::OsStr]) -> Result<(i32, String, String), String> {
-    let out = bin()
-        .args(args)
-        .output()
-        .map_err(|e| format!("running sweeptrace: {e}"))?;
-    Ok((
-        out.status.code().unwrap_or(-1),
-        String::from_utf8_lossy(&out.stdout).into_owned(),
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-    ))
-}
-
-macro_rules! os {
-    ($($a:expr),* $(,)?) => { &[$(std::ffi::OsStr::new($a)),*] };
 }
 
 fn full(frame: u64, alpha: f64, kind: Kind) -> OutcomeMsg {

@@ -5,7 +5,6 @@
 
 use std::io::Cursor;
 use std::path::{Path, PathBuf};
-use std::process::Command;
 
 use libtest_mimic::Trial;
 use sweeptrace::core::{Facing, Kind, Mesh, Sweep, sweep_mesh};
@@ -19,6 +18,8 @@ use sweeptrace::trace::messages::{OutcomeMsg, SceneMsg, SweepMsg};
 use sweeptrace::trace::{TraceReader, TraceWriter};
 
 use crate::ensure;
+use crate::os;
+use crate::support::run_bin;
 use crate::trial;
 
 pub fn tests() -> Vec<Trial> {
@@ -57,26 +58,6 @@ fn root() -> &'static Path {
 
 fn fixture() -> PathBuf {
     root().join("tests/fixtures/wrong_engine_config.mcap")
-}
-
-fn bin() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_sweeptrace"))
-}
-
-fn run_bin(args: &[&std::ffi::OsStr]) -> Result<(i32, String, String), String> {
-    let out = bin()
-        .args(args)
-        .output()
-        .map_err(|e| format!("running sweeptrace: {e}"))?;
-    Ok((
-        out.status.code().unwrap_or(-1),
-        String::from_utf8_lossy(&out.stdout).into_owned(),
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-    ))
-}
-
-macro_rules! os {
-    ($($a:expr),* $(,)?) => { &[$(std::ffi::OsStr::new($a)),*] };
 }
 
 /// The numbers of a `(a, b, c)` group following `label` in `text`.

@@ -19,6 +19,31 @@ macro_rules! ensure {
     };
 }
 
+/// The `sweeptrace` binary of this build.
+pub fn bin() -> std::process::Command {
+    std::process::Command::new(env!("CARGO_BIN_EXE_sweeptrace"))
+}
+
+/// Runs the binary with `args`: exit code (-1 when killed by a signal),
+/// stdout, stderr.
+pub fn run_bin(args: &[&std::ffi::OsStr]) -> Result<(i32, String, String), String> {
+    let out = bin()
+        .args(args)
+        .output()
+        .map_err(|e| format!("running sweeptrace: {e}"))?;
+    Ok((
+        out.status.code().unwrap_or(-1),
+        String::from_utf8_lossy(&out.stdout).into_owned(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    ))
+}
+
+/// `&[&OsStr]` of the arguments, for [`run_bin`].
+#[macro_export]
+macro_rules! os {
+    ($($a:expr),* $(,)?) => { &[$(std::ffi::OsStr::new($a)),*] };
+}
+
 /// Runs `f` on a thread of its own and fails if it has not returned within
 /// `limit`, so that a test whose code under test hangs fails instead of
 /// hanging the whole run (the stuck thread is left behind; the test binary

@@ -21,7 +21,6 @@
 
 use std::io::Cursor;
 use std::path::{Path, PathBuf};
-use std::process::Command;
 
 use libtest_mimic::{Failed, Trial};
 use nalgebra::Point3;
@@ -42,6 +41,7 @@ use sweeptrace::trace::{TraceReader, TraceWriter};
 
 use crate::ensure;
 use crate::support::mesh;
+use crate::support::run_bin;
 use crate::trial;
 
 const FLOOR: &str = "tests/fixtures/tunnel_floor.mcap";
@@ -514,22 +514,6 @@ fn wall_fixture_check() -> Result<(), String> {
         wall_bytes()?.as_slice(),
         "<memory>",
         &CheckOptions::default(),
-    ))
-}
-
-fn bin() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_sweeptrace"))
-}
-
-fn run_bin(args: &[&std::ffi::OsStr]) -> Result<(i32, String, String), String> {
-    let out = bin()
-        .args(args)
-        .output()
-        .map_err(|e| format!("running sweeptrace: {e}"))?;
-    Ok((
-        out.status.code().unwrap_or(-1),
-        String::from_utf8_lossy(&out.stdout).into_owned(),
-        String::from_utf8_lossy(&out.stderr).into_owned(),
     ))
 }
 

@@ -176,14 +176,14 @@ pub fn blueprint_messages(
     )?;
     let log = b.view("TextLog", "Decisions", paths::LOG, &["$origin/**"])?;
 
+    let top = b.container(
+        ContainerKind::Horizontal,
+        &[follow, world, edge],
+        Some(&[3.0, 2.2, 2.0]),
+        None,
+    )?;
     let root = match layout {
         Layout::FollowBall => {
-            let top = b.container(
-                ContainerKind::Horizontal,
-                &[follow, world, edge],
-                Some(&[3.0, 2.2, 2.0]),
-                None,
-            )?;
             let plots = b.container(
                 ContainerKind::Horizontal,
                 &[alpha, quadratic, face, status],
@@ -203,12 +203,6 @@ pub fn blueprint_messages(
                 "Divergences from the expected outcomes",
                 paths::DIVERGENCES,
                 &["$origin/**"],
-            )?;
-            let top = b.container(
-                ContainerKind::Horizontal,
-                &[follow, world, edge],
-                Some(&[3.0, 2.2, 2.0]),
-                None,
             )?;
             let plots = b.container(
                 ContainerKind::Horizontal,

@@ -9,8 +9,10 @@
 //! [`crate::numbers::hex_float`] writes the exact binary value.
 
 mod case;
+mod find;
 mod inputs;
 mod rust_test;
 
-pub use case::{ReproCase, ReproError, TraceSweep, agreement_text, find_sweep};
+pub use case::{ReproCase, agreement_text};
+pub use find::{ReproError, TraceSweep, find_sweep};
 pub use inputs::{HexInputs, SweepInputs};

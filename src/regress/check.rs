@@ -261,6 +261,11 @@ pub struct TraceReport {
     pub inferred: Option<Inferred>,
 }
 
+/// How many compared sweeps (the first ones) the inference of the
+/// recording engine's configuration looks at and replays, so that a
+/// check's memory stays bounded whatever the trace's length (about 20 MB).
+pub const MAX_INFERENCE_SWEEPS: usize = 100_000;
+
 /// How many divergent frames a report lists.
 const MAX_DIVERGENT_FRAMES: usize = 100;
 /// How many errors a report keeps.
@@ -350,7 +355,9 @@ where
                     continue;
                 };
                 report.compared += 1;
-                {
+                // Kept for the inference of the engine's configuration; the
+                // first ones only, so memory stays bounded on long traces.
+                if compared.len() < MAX_INFERENCE_SWEEPS {
                     compared.push(ComparedSweep {
                         scene: result.scene.clone(),
                         frame: result.frame,

@@ -91,7 +91,9 @@ pub struct Inferred {
     /// Expectations that match (or name a member of the tie set) when the
     /// trace is replayed with what was inferred.
     pub matches: u64,
-    /// Expectations compared.
+    /// Expectations compared: the first
+    /// [`MAX_INFERENCE_SWEEPS`](super::check::MAX_INFERENCE_SWEEPS) of the
+    /// trace at most.
     pub compared: u64,
     /// With the other facing rule, when both were replayed: how many match.
     pub other_facing_matches: Option<u64>,
@@ -151,8 +153,15 @@ impl Inferred {
             None => "the scenes' margins".to_string(),
         };
         lines.push(format!(
-            "expectations match with {with_margin} and facing {}: {} of {}",
-            self.facing, self.matches, self.compared
+            "expectations match with {with_margin} and facing {}: {} of {}{}",
+            self.facing,
+            self.matches,
+            self.compared,
+            if self.compared as usize >= super::check::MAX_INFERENCE_SWEEPS {
+                " (the first ones of the trace)"
+            } else {
+                ""
+            }
         ));
         lines
     }

@@ -25,7 +25,9 @@
 
 pub mod atomic;
 pub mod core;
+pub mod foxglove;
 pub mod numbers;
+pub mod palette;
 pub mod regress;
 pub mod replay;
 pub mod run;

@@ -12,7 +12,9 @@ use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 
 use sweeptrace::atomic::PendingFile;
 use sweeptrace::core::Facing;
+use sweeptrace::foxglove::{FoxgloveFile, FoxgloveOptions};
 use sweeptrace::numbers::{self, Rule};
+use sweeptrace::regress::Tolerances;
 use sweeptrace::replay::{
     DEFAULT_BATCH_EVENTS, Detail, FrameRange, ReplayError, ReplayEvent, ReplayOptions,
     replay_events_parallel,
@@ -37,9 +39,11 @@ Examples:
   sweeptrace replay traces/bowl.mcap                      # writes ./bowl.rrd
   sweeptrace replay traces/bowl.mcap --spawn --frames 100..200 --detail candidates
   sweeptrace replay traces/bowl.mcap --outcomes - --rrd /tmp/bowl.rrd --ball 0
+  sweeptrace replay traces/bowl.mcap --foxglove bowl.foxglove.mcap   # open in Foxglove
 
-Without --outcomes, --rrd, --spawn or --connect the recording is written to
-<trace stem>.rrd in the current directory. Files are written under a
+Without --outcomes, --rrd, --foxglove, --spawn or --connect the recording is
+written to <trace stem>.rrd in the current directory. The outputs combine:
+one replay can write outcomes, a Rerun recording and a Foxglove file. Files are written under a
 temporary name next to the target and renamed once complete.")]
 pub struct Args {
     /// The trace (an MCAP file).
@@ -52,6 +56,13 @@ pub struct Args {
     /// Write the Rerun recording to this `.rrd` file.
     #[arg(long, value_name = "FILE")]
     pub rrd: Option<PathBuf>,
+    /// Write the replay as an MCAP file for Foxglove (`--foxglove run.fg.mcap`):
+    /// the mesh, balls, sweeps, contacts and normals as 3D scene entities
+    /// (`foxglove.SceneUpdate`, frame `world`), the decision per sweep as
+    /// `foxglove.Log` on /decisions, α and the decisive test's numbers on
+    /// /numbers for the Plot panel (`/numbers{ball==0}.alpha`).
+    #[arg(long, value_name = "FILE")]
+    pub foxglove: Option<PathBuf>,
     /// Start a Rerun viewer (the `rerun` executable on PATH) and stream to it.
     #[arg(long)]
     pub spawn: bool,
@@ -136,8 +147,11 @@ pub fn run(args: Args) -> anyhow::Result<RunOutcome> {
     let total_bytes = file.metadata().map(|m| m.len()).unwrap_or(0);
     let source_name = trace_path.display().to_string();
 
-    let no_output =
-        args.outcomes.is_none() && args.rrd.is_none() && !args.spawn && args.connect.is_none();
+    let no_output = args.outcomes.is_none()
+        && args.rrd.is_none()
+        && args.foxglove.is_none()
+        && !args.spawn
+        && args.connect.is_none();
     let rrd_path = match (&args.rrd, no_output) {
         (Some(p), _) => Some(p.clone()),
         (None, true) => {
@@ -158,7 +172,9 @@ pub fn run(args: Args) -> anyhow::Result<RunOutcome> {
         frames: args.frames.unwrap_or_default(),
         ball: args.ball,
         detail: args.detail,
-        explain: record,
+        // The decision lines of the recording and of the Foxglove file
+        // describe the decisive test: keep the records.
+        explain: record || args.foxglove.is_some(),
         margin: args.margin,
         facing: args.facing,
     };
@@ -231,6 +247,22 @@ pub fn run(args: Args) -> anyhow::Result<RunOutcome> {
         }
     };
 
+    // The Foxglove file.
+    let mut foxglove = match &args.foxglove {
+        None => None,
+        Some(p) => {
+            super::warn_unfinished(p);
+            let options = FoxgloveOptions {
+                trace_name: trace_path
+                    .file_name()
+                    .map(|n| n.to_string_lossy().into_owned())
+                    .unwrap_or_default(),
+                tolerances: Tolerances::default(),
+            };
+            Some(FoxgloveFile::create(p, options)?)
+        }
+    };
+
     if args.threads == Some(0) {
         bail!("--threads must be at least 1");
     }
@@ -273,6 +305,9 @@ pub fn run(args: Args) -> anyhow::Result<RunOutcome> {
         pipeline,
         |event, line| -> anyhow::Result<()> {
             progress.set_position(count.load(Ordering::Relaxed));
+            if let (Some(file), Ok(event)) = (foxglove.as_mut(), &event) {
+                file.writer().event(event)?;
+            }
             match event {
                 Ok(ReplayEvent::Scene(scene)) => {
                     for d in scene.mesh.degenerate() {
@@ -338,6 +373,14 @@ pub fn run(args: Args) -> anyhow::Result<RunOutcome> {
         })?;
         complete(pending)?;
         eprintln!("wrote the recording to {}", target.display());
+    }
+    if let Some(file) = foxglove {
+        let target = args.foxglove.as_deref().unwrap_or(Path::new("")).display();
+        let counts = file.commit()?;
+        eprintln!(
+            "wrote the Foxglove file {target} ({} scenes, {} sweeps, {} messages)",
+            counts.scenes, counts.sweeps, counts.messages
+        );
     }
     match outcomes {
         Some(OutcomeSink::Stdout(mut w)) => w.flush().context(writing_outcomes.clone())?,

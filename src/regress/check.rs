@@ -388,7 +388,7 @@ where
                     }
                     if !options.strict {
                         if report.fragile_divergences.len() < options.max_details {
-                            report.fragile_divergences.push(divergence(
+                            report.fragile_divergences.push(divergence_details(
                                 &result,
                                 *expected,
                                 got,
@@ -408,7 +408,7 @@ where
                     report.divergent_frames.push(result.frame);
                 }
                 if report.divergences.len() < options.max_details {
-                    report.divergences.push(divergence(
+                    report.divergences.push(divergence_details(
                         &result,
                         *expected,
                         got,
@@ -464,7 +464,11 @@ fn status_of(r: &TraceReport) -> Status {
     }
 }
 
-fn divergence(
+/// A divergent sweep explained as `check` reports it (render it with
+/// [`super::render_divergence`]): `fields` are the fields that differ
+/// between `expected` and `got` (the sweep's outcome); the core's tests are
+/// run again with every record kept. `hex` adds the inputs in hexadecimal.
+pub fn divergence_details(
     result: &SweepResult,
     expected: OutcomeMsg,
     got: OutcomeMsg,

@@ -4,6 +4,8 @@
 //! - [`compare`](mod@compare): the one rule deciding whether an outcome diverges from its
 //!   expectation ([`compare()`], [`Tolerances`]), shared by `check`, `diff`
 //!   and the viewer;
+//! - [`decision`](mod@decision): the decision line of a sweep in words, and
+//!   whether it diverges (used by the viewer and the Foxglove output);
 //! - [`explain`](mod@explain): why a divergent sweep came out as it did;
 //! - [`check`](mod@check): a whole trace checked ([`check_file`]), and
 //!   [`render_text`] / [`render_json`] for its report;
@@ -15,6 +17,7 @@
 pub mod bless;
 pub mod check;
 pub mod compare;
+pub mod decision;
 pub mod diff;
 pub mod explain;
 pub mod infer;
@@ -24,7 +27,8 @@ pub mod repro;
 pub use bless::{BlessError, BlessSummary, bless_bytes, bless_file};
 pub use check::{
     CheckOptions, DEFAULT_MAX_DETAILS, Divergence, MAX_LISTED_TUNNELS, Status, TraceReport,
-    TunnelReport, check_events, check_file, check_reader, find_traces, frames_around,
+    TunnelReport, check_events, check_file, check_reader, divergence_details, find_traces,
+    frames_around,
 };
 pub use compare::{
     Agreement, DEFAULT_ALPHA_TOLERANCE, DEFAULT_CONTACT_TOLERANCE,

@@ -1,20 +1,13 @@
-//! Conversions from the core's types to Rerun's, and the colors.
+//! Conversions from the core's types to Rerun's, and the colors (those
+//! shared with the Foxglove output are in [`crate::palette`]).
 
 use nalgebra::{UnitQuaternion, Vector3};
 use rerun::{Color, ComponentDescriptor};
 
-pub(crate) const MESH_COLOR: [u8; 4] = [170, 175, 185, 255];
-pub(crate) const WIREFRAME_COLOR: [u8; 4] = [45, 50, 60, 255];
-pub(crate) const P0_COLOR: [u8; 4] = [80, 140, 255, 90];
-pub(crate) const P1_COLOR: [u8; 4] = [160, 160, 160, 60];
-pub(crate) const CONTACT_BALL_COLOR: [u8; 4] = [255, 140, 0, 140];
-pub(crate) const SWEEP_COLOR: [u8; 4] = [120, 170, 255, 255];
-pub(crate) const HIT_COLOR: [u8; 4] = [230, 40, 40, 255];
-pub(crate) const MISS_COLOR: [u8; 4] = [240, 200, 40, 255];
-pub(crate) const NORMAL_COLOR: [u8; 4] = [40, 200, 80, 255];
-pub(crate) const EXPECTED_COLOR: [u8; 4] = [230, 60, 230, 255];
-/// The marker where a ball's centre went through a triangle.
-pub(crate) const TUNNEL_COLOR: [u8; 4] = [255, 0, 90, 255];
+pub(crate) use crate::palette::{
+    CONTACT_BALL_COLOR, EXPECTED_COLOR, HIT_COLOR, MESH_COLOR, MISS_COLOR, NORMAL_COLOR, P0_COLOR,
+    P1_COLOR, SWEEP_COLOR, TUNNEL_COLOR, WIREFRAME_COLOR,
+};
 pub(crate) const EDGE_COLOR: [u8; 4] = [230, 40, 40, 255];
 pub(crate) const CYLINDER_COLOR: [u8; 4] = [255, 120, 120, 255];
 pub(crate) const PATH_COLOR: [u8; 4] = [80, 140, 255, 255];

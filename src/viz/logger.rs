@@ -14,7 +14,6 @@ use rerun::{
 use super::blueprint::{self, Layout};
 use super::columns;
 use super::convert::{MESH_COLOR, WIREFRAME_COLOR, WIREFRAME_POINTS, albedo, f32x3, rgba};
-use super::decision::divergence;
 use super::edge_frame::{choose_edges, edge_frame_rows};
 use super::paths::{self, Entity};
 use super::rows::{
@@ -24,6 +23,7 @@ use super::rows::{
 use super::{MAX_EDGE_FRAMES, TIMESTAMP_THRESHOLD_NANOS};
 use crate::core::{EdgeRecord, Triangle};
 use crate::regress::Tolerances;
+use crate::regress::decision::divergence;
 use crate::replay::{ReplayEvent, SceneState, SweepResult};
 
 /// Rows buffered before the logger sends them (see [`Logger`]).

@@ -15,8 +15,8 @@
 //! - `rows`: the rows of one sweep (ball, sweep, contact, primary feature,
 //!   expected outcome, plots, status, text); `edge_frame`: its edge tests in
 //!   their standard frames;
-//! - `decision`: the decision line, and whether a sweep diverges (`check`'s
-//!   judgement, [`crate::regress::agreement`]);
+//! - the decision line, and whether a sweep diverges, are
+//!   [`crate::regress::decision`] (shared with the Foxglove output);
 //! - `convert`: conversions to Rerun types, colors and sizes;
 //! - [`blueprint`]: the default layouts, with fixed ids; `columns`: rows
 //!   buffered as typed columns and sent as chunks (both use SDK internals
@@ -26,7 +26,6 @@
 pub mod blueprint;
 mod columns;
 mod convert;
-mod decision;
 mod edge_frame;
 mod ids;
 mod logger;
@@ -37,7 +36,7 @@ pub mod rrd_file;
 
 use rerun::RecordingStreamBuilder;
 
-pub use decision::{decision_line, divergence};
+pub use crate::regress::decision::{decision_line, divergence};
 pub use ids::{IdHasher, recording_id};
 pub use logger::{
     DEFAULT_FLUSH_ROWS, Logger, LoggerOptions, PREPARE_GROUP_SWEEPS, PrepareOptions,

@@ -20,11 +20,11 @@ use super::convert::{
     OUTLINE_POINTS, P0_COLOR, P1_COLOR, SWEEP_COLOR, TUNNEL_COLOR, VERTEX_POINTS, albedo,
     any_value, capsule_pose, f32x3, rgba, ui_points,
 };
-use super::decision::{write_decision_line, write_divergence_line};
 use super::paths::{Entity, FACE_NAMES, QUADRATIC_NAMES};
 use crate::core::explain::Label;
 use crate::core::{Kind, TestRecord};
 use crate::regress::FieldDiff;
+use crate::regress::decision::{write_decision_line, write_divergence_line};
 use crate::replay::SweepResult;
 use crate::trace::messages::OutcomeMsg;
 

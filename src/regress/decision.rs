@@ -39,7 +39,7 @@ pub fn decision_line(
 
 /// Appends [`decision_line`]'s line to `s`; `diffs` are the sweep's
 /// [`divergence`].
-pub(crate) fn write_decision_line(
+pub fn write_decision_line(
     s: &mut String,
     r: &SweepResult,
     decisive: Option<&TestRecord>,
@@ -94,7 +94,7 @@ pub(crate) fn write_decision_line(
 
 /// The line of the `divergences` log: what was expected, what was found,
 /// which fields differ.
-pub(crate) fn write_divergence_line(s: &mut String, r: &SweepResult, diffs: &[FieldDiff]) {
+pub fn write_divergence_line(s: &mut String, r: &SweepResult, diffs: &[FieldDiff]) {
     let o = &r.outcome;
     let _ = write!(s, "frame {} ball {}: ", r.frame, r.ball);
     write_fields(s, diffs);

@@ -1,0 +1,109 @@
+#!/usr/bin/env python3
+"""Read a Foxglove file written by `sweeptrace replay --foxglove` with Python's `mcap` package.
+
+Checks the channels (topic, schema name, encodings), that the summary's
+statistics match the messages read, that messages are in log_time order and
+that every message and schema is JSON; with --sweeps/--scenes, the counts.
+With --dump FILE, writes one JSON line per schema record
+({"schema", "encoding", "data"}) and then one per message ({"topic",
+"schema", "log_time", "data"}) for tests/foxglove/validate.mjs. Exits 1 on
+any problem.
+
+    python3 scripts/foxglove_dump.py OUT.mcap [--sweeps N] [--scenes N] [--dump FILE.jsonl]
+"""
+
+import argparse
+import json
+import sys
+
+from mcap.reader import make_reader
+
+CHANNELS = {
+    "/mesh": "foxglove.SceneUpdate",
+    "/balls": "foxglove.SceneUpdate",
+    "/sweeps": "foxglove.SceneUpdate",
+    "/contacts": "foxglove.SceneUpdate",
+    "/expected_outcome": "foxglove.SceneUpdate",
+    "/decisions": "foxglove.Log",
+    "/numbers": "sweeptrace.SweepNumbers",
+}
+PER_SWEEP = ["/balls", "/sweeps", "/contacts", "/expected_outcome", "/decisions", "/numbers"]
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("file")
+    parser.add_argument("--sweeps", type=int)
+    parser.add_argument("--scenes", type=int)
+    parser.add_argument("--dump")
+    args = parser.parse_args()
+    problems = []
+    dump = open(args.dump, "w", encoding="utf-8") if args.dump else None
+
+    with open(args.file, "rb") as f:
+        reader = make_reader(f)
+        summary = reader.get_summary()
+        if summary is None:
+            print(f"{args.file}: no summary", file=sys.stderr)
+            return 1
+        topics = {}
+        for channel in summary.channels.values():
+            schema = summary.schemas.get(channel.schema_id)
+            topics[channel.topic] = schema.name if schema else None
+            if schema is not None and schema.encoding != "jsonschema":
+                problems.append(f"{channel.topic}: schema encoding {schema.encoding!r}")
+            if channel.message_encoding != "json":
+                problems.append(f"{channel.topic}: message encoding {channel.message_encoding!r}")
+        if topics != CHANNELS:
+            problems.append(f"channels {topics}, expected {CHANNELS}")
+        for schema in summary.schemas.values():
+            try:
+                data = json.loads(schema.data)
+            except ValueError as e:
+                problems.append(f"schema {schema.name}: not JSON: {e}")
+                continue
+            if dump:
+                dump.write(json.dumps({"schema": schema.name, "encoding": schema.encoding, "data": data}) + "\n")
+
+        counts = {}
+        last = None
+        for schema, channel, message in reader.iter_messages(log_time_order=False):
+            counts[channel.topic] = counts.get(channel.topic, 0) + 1
+            if last is not None and message.log_time < last:
+                problems.append(f"{channel.topic}: message at log_time {message.log_time} after one at {last}")
+            last = message.log_time
+            try:
+                data = json.loads(message.data)
+            except ValueError as e:
+                problems.append(f"{channel.topic}: message at log_time {message.log_time} is not JSON: {e}")
+                continue
+            if dump:
+                dump.write(json.dumps({"topic": channel.topic, "schema": schema.name,
+                                       "log_time": message.log_time, "data": data}) + "\n")
+        stats = summary.statistics.channel_message_counts if summary.statistics else {}
+        for cid, n in stats.items():
+            topic = summary.channels[cid].topic
+            if counts.get(topic, 0) != n:
+                problems.append(f"{topic}: {counts.get(topic, 0)} messages read, statistics say {n}")
+
+    if dump:
+        dump.close()
+    if args.sweeps is not None:
+        for topic in PER_SWEEP:
+            # After the first scene, each scene also clears the four scene-entity channels.
+            extra = max((args.scenes or 1) - 1, 0) if topic not in ("/decisions", "/numbers") else 0
+            if counts.get(topic, 0) != args.sweeps + extra:
+                problems.append(f"{topic}: {counts.get(topic, 0)} messages, expected {args.sweeps + extra}")
+    if args.scenes is not None and counts.get("/mesh", 0) != args.scenes:
+        problems.append(f"/mesh: {counts.get('/mesh', 0)} messages, expected {args.scenes}")
+
+    for p in problems:
+        print(f"{args.file}: {p}", file=sys.stderr)
+    if problems:
+        return 1
+    print(f"{args.file}: ok ({', '.join(f'{t} {n}' for t, n in sorted(counts.items()))})")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

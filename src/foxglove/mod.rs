@@ -1,0 +1,54 @@
+//! A replay as an MCAP file for [Foxglove](https://foxglove.dev): Foxglove's
+//! own schemas, JSON-encoded, each channel's JSON Schema embedded in its
+//! schema record (self-contained, no `$ref`), so Foxglove (and any MCAP
+//! reader) needs nothing else to show it.
+//!
+//! Channels, all in the frame [`FRAME_ID`], every message at the `log_time`
+//! of the trace message it comes from:
+//!
+//! | topic | schema | what |
+//! |---|---|---|
+//! | [`MESH_TOPIC`] | `foxglove.SceneUpdate` | the scene's mesh (triangle list and edges), once per scene |
+//! | [`BALLS_TOPIC`] | `foxglove.SceneUpdate` | per sweep, entity `ball/{ball}`: the ball at `p0`, at the contact, at `p1` |
+//! | [`SWEEPS_TOPIC`] | `foxglove.SceneUpdate` | per sweep, entity `sweep/{ball}`: the path, and the swept sphere (radius ρ) at the contact |
+//! | [`CONTACTS_TOPIC`] | `foxglove.SceneUpdate` | per sweep, entity `contact/{ball}`: the contact point and the reported normal (deleted at a miss) |
+//! | [`EXPECTED_TOPIC`] | `foxglove.SceneUpdate` | per sweep, entity `expected/{ball}`: the expected ball, contact and normal where the sweep diverges (deleted elsewhere) |
+//! | [`DECISIONS_TOPIC`] | `foxglove.Log` | per sweep, the decision in words; WARNING where `check` fails it |
+//! | [`NUMBERS_TOPIC`] | `sweeptrace.SweepNumbers` | per sweep, `α` and the decisive test's numbers, for the Plot panel |
+//!
+//! - `schemas`: the embedded JSON Schemas;
+//! - `messages`: the messages as serde types;
+//! - `convert`: pure functions from a scene or a sweep's result to each
+//!   channel's message (the decision text is
+//!   [`crate::regress::decision`]'s and `check`'s, shared with the viewer);
+//! - `writer`: [`FoxgloveWriter`] over any `Write + Seek`, and
+//!   [`FoxgloveFile`], written under a temporary name and renamed.
+
+pub mod convert;
+pub mod messages;
+pub mod schemas;
+mod writer;
+
+pub use writer::{
+    FoxgloveCounts, FoxgloveError, FoxgloveFile, FoxgloveOptions, FoxgloveWriter, write_options,
+};
+
+/// The fixed frame of every entity (choose it as the 3D panel's display
+/// frame).
+pub const FRAME_ID: &str = "world";
+/// The mesh.
+pub const MESH_TOPIC: &str = "/mesh";
+/// The balls.
+pub const BALLS_TOPIC: &str = "/balls";
+/// The sweeps.
+pub const SWEEPS_TOPIC: &str = "/sweeps";
+/// The contacts and normals.
+pub const CONTACTS_TOPIC: &str = "/contacts";
+/// The expected outcomes where a sweep diverges.
+pub const EXPECTED_TOPIC: &str = "/expected_outcome";
+/// The decisions (Log).
+pub const DECISIONS_TOPIC: &str = "/decisions";
+/// The numbers (Plot).
+pub const NUMBERS_TOPIC: &str = "/numbers";
+/// Name of the metadata record (`trace`: the trace's file name, `writer`).
+pub const METADATA_NAME: &str = "sweeptrace.foxglove";

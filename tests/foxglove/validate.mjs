@@ -98,7 +98,7 @@ function validateDump(path) {
         fail(`${path}:${i + 1}: ${record.topic} (${record.schema}, log_time ${record.log_time}) against the ${variant} schema: ${JSON.stringify(validate.errors.slice(0, 3))}`);
       }
     }
-    counts.set(record.topic, (counts.get(record.topic) ?? 0) + 1);
+    counts.set(record.topic, (counts.get(record.topic) || 0) + 1);
   }
   const total = [...counts.values()].reduce((a, b) => a + b, 0);
   if (total === 0) fail(`${path}: no messages`);

@@ -1,0 +1,628 @@
+//! `replay --foxglove`: the Foxglove file reads back with the mcap crate
+//! (channels, schemas, every message's content) and with Python's `mcap`;
+//! when Node and tests/foxglove's packages are installed, every message is
+//! validated against Foxglove's published schemas; the command leaves no
+//! file behind on error.
+
+use std::collections::BTreeMap;
+use std::io::Cursor;
+use std::path::{Path, PathBuf};
+
+use libtest_mimic::{Completion, Trial};
+use serde_json::Value;
+
+use sweeptrace::core::{Facing, Kind};
+use sweeptrace::foxglove::convert::rotation_from_x;
+use sweeptrace::foxglove::schemas::{
+    LOG_SCHEMA_JSON, SCENE_UPDATE_SCHEMA_JSON, SWEEP_NUMBERS_SCHEMA_JSON,
+};
+use sweeptrace::foxglove::{FoxgloveOptions, FoxgloveWriter};
+use sweeptrace::replay::{ReplayOptions, replay_events};
+use sweeptrace::trace::messages::{OutcomeMsg, SceneMsg, SweepMsg};
+use sweeptrace::trace::{TraceReader, TraceWriter};
+
+use crate::support::run_bin;
+use crate::{ensure, os, trial};
+
+pub fn tests() -> Vec<Trial> {
+    vec![
+        trial!(foxglove_file_reads_back_with_the_mcap_crate),
+        trial!(arrow_rotation_takes_x_to_the_normal),
+        trial!(python_and_node_read_and_validate_the_foxglove_file),
+        trial!(replay_foxglove_writes_only_the_foxglove_file),
+        trial!(replay_foxglove_errors_name_the_file_and_leave_no_partial_file),
+        trial!(replay_foxglove_keeps_what_was_read_of_a_truncated_trace),
+    ]
+}
+
+/// Set to `1` (CI does, after `npm ci` in tests/foxglove) to make the
+/// schema validation with Node fail, instead of being skipped, when Node or
+/// the packages are missing.
+const REQUIRE_NODE: &str = "SWEEPTRACE_REQUIRE_NODE";
+/// As in trace_io: Python's `mcap` must be importable when set to `1`.
+const REQUIRE_PYTHON: &str = "SWEEPTRACE_REQUIRE_PYTHON";
+
+const TRACE_NAME: &str = "two_scenes.mcap";
+
+fn triangle(name: &str, size: f64) -> SceneMsg {
+    SceneMsg {
+        name: Some(name.to_string()),
+        vertices: vec![[0.0, 0.0, 0.0], [size, 0.0, 0.0], [0.0, size, 0.0]],
+        triangles: vec![[0, 1, 2]],
+        margin: 0.0,
+        facing: Facing::NonStrict,
+    }
+}
+
+fn down(frame: u64, ball: u32, x: f64) -> SweepMsg {
+    SweepMsg {
+        frame,
+        ball,
+        radius: 0.5,
+        p0: [x, 1.0, 3.0],
+        p1: [x, 1.0, -3.0],
+    }
+}
+
+fn expected(frame: u64, ball: u32, alpha: f64, kind: Kind) -> OutcomeMsg {
+    OutcomeMsg {
+        frame,
+        ball,
+        alpha,
+        kind,
+        triangle: None,
+        feature: None,
+        normal: None,
+        contact: None,
+    }
+}
+
+/// Two scenes; ball 0 hits the triangle's face at α = 5/12 each frame,
+/// ball 1 misses. Frame 1's expectation for ball 0 (α = 0.3) diverges.
+fn two_scene_trace() -> Result<Vec<u8>, String> {
+    let e = |e: sweeptrace::trace::TraceError| e.to_string();
+    let mut w = TraceWriter::new(Cursor::new(Vec::new())).map_err(e)?;
+    w.scene(0, &triangle("first", 4.0)).map_err(e)?;
+    for frame in 0..3u64 {
+        let t = 1_000_000_000 + frame * 500_000_000;
+        if frame == 2 {
+            w.scene(t, &triangle("second", 8.0)).map_err(e)?;
+        }
+        w.sweep(t, &down(frame, 0, 1.0)).map_err(e)?;
+        let alpha = if frame == 1 { 0.3 } else { 5.0 / 12.0 };
+        w.expected(t, &expected(frame, 0, alpha, Kind::Face))
+            .map_err(e)?;
+        if frame < 2 {
+            w.sweep(t, &down(frame, 1, 10.0)).map_err(e)?;
+            w.expected(t, &expected(frame, 1, 1.0, Kind::None))
+                .map_err(e)?;
+        }
+    }
+    Ok(w.finish().map_err(e)?.into_inner())
+}
+
+/// The Foxglove file of `trace`, through the library.
+fn foxglove_bytes(trace: &[u8]) -> Result<Vec<u8>, String> {
+    let options = ReplayOptions {
+        explain: true,
+        ..ReplayOptions::default()
+    };
+    let mut writer = FoxgloveWriter::new(
+        Cursor::new(Vec::new()),
+        "test.foxglove.mcap",
+        FoxgloveOptions {
+            trace_name: TRACE_NAME.to_string(),
+            ..FoxgloveOptions::default()
+        },
+    )
+    .map_err(|e| e.to_string())?;
+    for event in replay_events(TraceReader::new(trace, TRACE_NAME), options) {
+        let event = event.map_err(|e| e.to_string())?;
+        writer.event(&event).map_err(|e| e.to_string())?;
+    }
+    Ok(writer.finish().map_err(|e| e.to_string())?.into_inner())
+}
+
+/// Every message: (topic, schema name, log_time, JSON).
+fn messages(bytes: &[u8]) -> Result<Vec<(String, String, u64, Value)>, String> {
+    let mut out = Vec::new();
+    for m in mcap::MessageStream::new(bytes).map_err(|e| e.to_string())? {
+        let m = m.map_err(|e| e.to_string())?;
+        let schema = m
+            .channel
+            .schema
+            .as_ref()
+            .map(|s| s.name.clone())
+            .unwrap_or_default();
+        let json: Value = serde_json::from_slice(&m.data)
+            .map_err(|e| format!("{}: not JSON: {e}", m.channel.topic))?;
+        out.push((m.channel.topic.clone(), schema, m.log_time, json));
+    }
+    Ok(out)
+}
+
+fn on<'a>(all: &'a [(String, String, u64, Value)], topic: &str) -> Vec<&'a Value> {
+    all.iter()
+        .filter(|(t, ..)| t == topic)
+        .map(|(.., v)| v)
+        .collect()
+}
+
+fn foxglove_file_reads_back_with_the_mcap_crate() -> Result<(), String> {
+    let bytes = foxglove_bytes(&two_scene_trace()?)?;
+
+    // Channels, schemas, encodings; the embedded schemas are the checked-in copies.
+    let summary = mcap::Summary::read(&bytes)
+        .map_err(|e| e.to_string())?
+        .ok_or("no summary")?;
+    let channels: BTreeMap<String, (String, String, String)> = summary
+        .channels
+        .values()
+        .map(|c| {
+            let s = c.schema.as_ref().expect("schema");
+            (
+                c.topic.clone(),
+                (
+                    s.name.clone(),
+                    s.encoding.clone(),
+                    c.message_encoding.clone(),
+                ),
+            )
+        })
+        .collect();
+    let want: BTreeMap<String, (String, String, String)> = [
+        ("/mesh", "foxglove.SceneUpdate"),
+        ("/balls", "foxglove.SceneUpdate"),
+        ("/sweeps", "foxglove.SceneUpdate"),
+        ("/contacts", "foxglove.SceneUpdate"),
+        ("/expected_outcome", "foxglove.SceneUpdate"),
+        ("/decisions", "foxglove.Log"),
+        ("/numbers", "sweeptrace.SweepNumbers"),
+    ]
+    .into_iter()
+    .map(|(t, s)| {
+        (
+            t.to_string(),
+            (s.to_string(), "jsonschema".to_string(), "json".to_string()),
+        )
+    })
+    .collect();
+    ensure!(channels == want, "channels {channels:?}, want {want:?}");
+    for schema in summary.schemas.values() {
+        let text = match schema.name.as_str() {
+            "foxglove.SceneUpdate" => SCENE_UPDATE_SCHEMA_JSON,
+            "foxglove.Log" => LOG_SCHEMA_JSON,
+            "sweeptrace.SweepNumbers" => SWEEP_NUMBERS_SCHEMA_JSON,
+            other => return Err(format!("unexpected schema {other}")),
+        };
+        ensure!(
+            schema.data.as_ref() == text.as_bytes(),
+            "schema {} is not the embedded copy",
+            schema.name
+        );
+    }
+
+    let all = messages(&bytes)?;
+    let times: Vec<u64> = all.iter().map(|(_, _, t, _)| *t).collect();
+    ensure!(
+        times.windows(2).all(|w| w[0] <= w[1]),
+        "messages not in log_time order: {times:?}"
+    );
+    // 5 sweeps; the second scene also clears the 4 per-sweep scene channels.
+    for (topic, n) in [
+        ("/mesh", 2),
+        ("/balls", 6),
+        ("/sweeps", 6),
+        ("/contacts", 6),
+        ("/expected_outcome", 6),
+        ("/decisions", 5),
+        ("/numbers", 5),
+    ] {
+        ensure!(
+            on(&all, topic).len() == n,
+            "{topic}: {} messages, want {n}",
+            on(&all, topic).len()
+        );
+    }
+
+    // The meshes: one entity `mesh`, frame-locked, three indices, three points.
+    let meshes = on(&all, "/mesh");
+    for (m, size) in meshes.iter().zip([4.0, 8.0]) {
+        let e = &m["entities"][0];
+        ensure!(
+            e["id"] == "mesh" && e["frame_id"] == "world",
+            "mesh entity {e}"
+        );
+        ensure!(e["frame_locked"] == true, "mesh not frame-locked");
+        ensure!(
+            e["lifetime"] == serde_json::json!({"sec": 0, "nsec": 0}),
+            "mesh lifetime {}",
+            e["lifetime"]
+        );
+        let t = &e["triangles"][0];
+        ensure!(
+            t["indices"] == serde_json::json!([0, 1, 2]),
+            "indices {}",
+            t["indices"]
+        );
+        ensure!(t["points"][1]["x"] == size, "points {}", t["points"]);
+        ensure!(
+            e["lines"][0]["indices"] == serde_json::json!([0, 1, 0, 2, 1, 2]),
+            "edges {}",
+            e["lines"][0]["indices"]
+        );
+    }
+    ensure!(
+        meshes[0]["entities"][0]["timestamp"] == serde_json::json!({"sec": 0, "nsec": 0}),
+        "first mesh timestamp"
+    );
+    // The clear at the second scene.
+    let balls = on(&all, "/balls");
+    let clears: Vec<&&Value> = balls
+        .iter()
+        .filter(|b| b["deletions"].as_array().is_some_and(|d| !d.is_empty()))
+        .collect();
+    ensure!(
+        clears.len() == 1 && clears[0]["deletions"][0]["type"] == 1,
+        "want one delete-all on /balls, got {clears:?}"
+    );
+
+    // Ball 0 of frame 0: at p0, at the contact (z = 3 - 6 · 5/12 = 0.5), at p1.
+    let first = &balls[0]["entities"][0];
+    ensure!(first["id"] == "ball/0", "first ball {}", first["id"]);
+    let zs: Vec<f64> = first["spheres"]
+        .as_array()
+        .ok_or("spheres")?
+        .iter()
+        .map(|s| s["pose"]["position"]["z"].as_f64().unwrap_or(f64::NAN))
+        .collect();
+    ensure!(zs == [3.0, 0.5, -3.0], "ball centres z {zs:?}");
+    ensure!(
+        first["spheres"][0]["size"]["x"] == 1.0,
+        "diameter {}",
+        first["spheres"][0]["size"]
+    );
+    // Ball 1 misses: two spheres, and its contact entity is deleted.
+    ensure!(
+        balls[1]["entities"][0]["spheres"].as_array().map(Vec::len) == Some(2),
+        "a miss draws the ball at p0 and p1 only"
+    );
+    let contacts = on(&all, "/contacts");
+    ensure!(
+        contacts[0]["entities"][0]["arrows"][0]["pose"]["position"]
+            == serde_json::json!({"x": 1.0, "y": 1.0, "z": 0.0}),
+        "normal arrow at the contact: {}",
+        contacts[0]["entities"][0]["arrows"][0]
+    );
+    ensure!(
+        contacts[1]["deletions"][0]["id"] == "contact/1"
+            && contacts[1]["deletions"][0]["type"] == 0,
+        "a miss deletes its contact: {}",
+        contacts[1]
+    );
+
+    // The decisions: WARNING only at the divergent sweep (frame 1, ball 0),
+    // with check's report of it.
+    let decisions = on(&all, "/decisions");
+    for (i, d) in decisions.iter().enumerate() {
+        let divergent = i == 2;
+        ensure!(
+            d["level"] == if divergent { 3 } else { 2 },
+            "decision {i}: level {} ({})",
+            d["level"],
+            d["message"]
+        );
+        ensure!(d["file"] == TRACE_NAME, "file {}", d["file"]);
+    }
+    let text = decisions[2]["message"].as_str().unwrap_or_default();
+    ensure!(
+        text.starts_with("frame 1 ball 0: face collision at α = 0.41667")
+            && text.contains("alpha: expected 0.3, got 0.41667")
+            && text.contains("why not:"),
+        "divergent decision text: {text}"
+    );
+    ensure!(
+        decisions[0]["name"] == "ball 0",
+        "name {}",
+        decisions[0]["name"]
+    );
+    let expected_outcome = on(&all, "/expected_outcome");
+    let e = &expected_outcome[2]["entities"][0];
+    ensure!(
+        e["id"] == "expected/0" && e["spheres"][0]["pose"]["position"]["z"] == 3.0 - 6.0 * 0.3,
+        "expected ball at α = 0.3: {e}"
+    );
+    ensure!(
+        expected_outcome[0]["entities"]
+            .as_array()
+            .is_some_and(Vec::is_empty),
+        "no expected entity where the sweep matches"
+    );
+
+    // The numbers: α and the face test's numbers; the miss has no test numbers.
+    let numbers = on(&all, "/numbers");
+    ensure!(
+        numbers[0]["alpha"] == 5.0 / 12.0 && numbers[0]["kind"] == "face",
+        "numbers {}",
+        numbers[0]
+    );
+    ensure!(
+        numbers[0]["face"]["h0"] == 3.0 && numbers[0]["face"]["beta"] == 5.0 / 12.0,
+        "face numbers {}",
+        numbers[0]["face"]
+    );
+    ensure!(
+        numbers[2]["failed"] == 1 && numbers[2]["expected_alpha"] == 0.3,
+        "divergent numbers {}",
+        numbers[2]
+    );
+    ensure!(
+        numbers[1]["kind"] == "none" && numbers[1]["alpha"] == 1.0 && numbers[1]["failed"] == 0,
+        "miss numbers {}",
+        numbers[1]
+    );
+    Ok(())
+}
+
+fn arrow_rotation_takes_x_to_the_normal() -> Result<(), String> {
+    use nalgebra::{Quaternion, UnitQuaternion, Vector3};
+    for n in [
+        Vector3::new(0.0, 0.0, 1.0),
+        Vector3::new(-1.0, 0.0, 0.0),
+        Vector3::new(1.0, 0.0, 0.0),
+        Vector3::new(0.6, -0.8, 0.0),
+        Vector3::new(1.0, 2.0, -2.0) / 3.0,
+    ] {
+        let q = rotation_from_x(&n);
+        let q = UnitQuaternion::from_quaternion(Quaternion::new(q.w, q.x, q.y, q.z));
+        let x = q * Vector3::x();
+        ensure!(
+            (x - n).norm() < 1e-12,
+            "rotation of +x is {x:?}, want {n:?}"
+        );
+    }
+    Ok(())
+}
+
+fn run(cmd: &mut std::process::Command) -> Result<std::process::Output, String> {
+    cmd.output().map_err(|e| format!("running {cmd:?}: {e}"))
+}
+
+fn output_text(o: &std::process::Output) -> String {
+    format!(
+        "{}{}",
+        String::from_utf8_lossy(&o.stdout),
+        String::from_utf8_lossy(&o.stderr)
+    )
+}
+
+/// Whether `var` is set to `1`.
+fn required(var: &str) -> bool {
+    std::env::var_os(var).is_some_and(|v| v == "1")
+}
+
+fn python_and_node_read_and_validate_the_foxglove_file() -> Result<Completion, String> {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let python_missing = match std::process::Command::new("python3")
+        .args(["-c", "import mcap"])
+        .output()
+    {
+        Ok(o) if o.status.success() => None,
+        Ok(_) => Some("python3 cannot import the `mcap` package".to_string()),
+        Err(e) => Some(format!("python3 cannot be run ({e})")),
+    };
+    if let Some(missing) = python_missing {
+        if required(REQUIRE_PYTHON) {
+            return Err(format!("{missing}, and {REQUIRE_PYTHON}=1 requires it"));
+        }
+        return Ok(Completion::ignored_with(format!(
+            "skipped: {missing}; {REQUIRE_PYTHON}=1 makes this a failure"
+        )));
+    }
+    let dir = tempfile::tempdir().map_err(|e| e.to_string())?;
+    let file = dir.path().join("two_scenes.foxglove.mcap");
+    std::fs::write(&file, foxglove_bytes(&two_scene_trace()?)?).map_err(|e| e.to_string())?;
+    let dump = dir.path().join("dump.jsonl");
+    let script = root.join("scripts/foxglove_dump.py");
+    let python = |extra: &[&str]| {
+        run(std::process::Command::new("python3")
+            .arg(&script)
+            .arg(&file)
+            .args(extra))
+    };
+    let dump_arg = dump.display().to_string();
+    let ok = python(&["--scenes", "2", "--sweeps", "5", "--dump", &dump_arg])?;
+    ensure!(
+        ok.status.success(),
+        "foxglove_dump.py: {}",
+        output_text(&ok)
+    );
+    let bad = python(&["--scenes", "2", "--sweeps", "6"])?;
+    ensure!(
+        !bad.status.success(),
+        "foxglove_dump.py accepted a wrong count"
+    );
+
+    // Node: every message against Foxglove's published schemas.
+    let packages = root.join("tests/foxglove/node_modules/@foxglove/schemas");
+    let node_missing = match std::process::Command::new("node").arg("--version").output() {
+        Ok(o) if o.status.success() && packages.is_dir() => None,
+        Ok(o) if o.status.success() => {
+            Some("tests/foxglove has no node_modules (run `npm ci` there)".to_string())
+        }
+        _ => Some("node cannot be run".to_string()),
+    };
+    if let Some(missing) = node_missing {
+        if required(REQUIRE_NODE) {
+            return Err(format!("{missing}, and {REQUIRE_NODE}=1 requires it"));
+        }
+        return Ok(Completion::ignored_with(format!(
+            "Python read the file; the schema validation was skipped: {missing}; \
+             {REQUIRE_NODE}=1 makes this a failure"
+        )));
+    }
+    let validate = root.join("tests/foxglove/validate.mjs");
+    let node = run(std::process::Command::new("node").arg(&validate).arg(&dump))?;
+    ensure!(
+        node.status.success(),
+        "validate.mjs: {}",
+        output_text(&node)
+    );
+    // And it can fail: a Log level outside the schema's.
+    let text = std::fs::read_to_string(&dump).map_err(|e| e.to_string())?;
+    let broken = dir.path().join("broken.jsonl");
+    std::fs::write(&broken, text.replacen("\"level\": 2", "\"level\": 7", 1))
+        .map_err(|e| e.to_string())?;
+    let node = run(std::process::Command::new("node")
+        .arg(&validate)
+        .arg(&broken))?;
+    ensure!(
+        !node.status.success(),
+        "validate.mjs accepted a Log level of 7: {}",
+        output_text(&node)
+    );
+    Ok(Completion::Completed)
+}
+
+fn sample_trace() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("traces/record_cube_corner_margin.mcap")
+}
+
+/// The names of the entries of `dir`, sorted.
+fn entries(dir: &Path) -> Result<Vec<String>, String> {
+    let mut names: Vec<String> = std::fs::read_dir(dir)
+        .map_err(|e| e.to_string())?
+        .filter_map(Result::ok)
+        .map(|e| e.file_name().to_string_lossy().into_owned())
+        .collect();
+    names.sort();
+    Ok(names)
+}
+
+fn replay_foxglove_writes_only_the_foxglove_file() -> Result<(), String> {
+    let dir = tempfile::tempdir().map_err(|e| e.to_string())?;
+    let out = run(crate::support::bin()
+        .current_dir(dir.path())
+        .arg("replay")
+        .arg(sample_trace())
+        .args(["--foxglove", "out.mcap", "--frames", "20..40"]))?;
+    ensure!(
+        out.status.code() == Some(0),
+        "exit {:?}: {}",
+        out.status.code(),
+        output_text(&out)
+    );
+    // No default .rrd besides it.
+    ensure!(
+        entries(dir.path())? == ["out.mcap"],
+        "files written: {:?}",
+        entries(dir.path())?
+    );
+    let bytes = std::fs::read(dir.path().join("out.mcap")).map_err(|e| e.to_string())?;
+    let all = messages(&bytes)?;
+    let frames: Vec<u64> = on(&all, "/numbers")
+        .iter()
+        .filter_map(|n| n["frame"].as_u64())
+        .collect();
+    ensure!(
+        !frames.is_empty() && frames.iter().all(|f| (20..40).contains(f)),
+        "frames {frames:?}"
+    );
+    ensure!(
+        output_text(&out).contains("wrote the Foxglove file out.mcap"),
+        "{}",
+        output_text(&out)
+    );
+    Ok(())
+}
+
+fn replay_foxglove_errors_name_the_file_and_leave_no_partial_file() -> Result<(), String> {
+    let dir = tempfile::tempdir().map_err(|e| e.to_string())?;
+    let bad = dir.path().join("bad.mcap");
+    let target = dir.path().join("out.mcap");
+    // A target in a directory that does not exist: an error naming it.
+    let nowhere = dir.path().join("missing/out.mcap");
+    let (code, _, stderr) = run_bin(os!(
+        "replay",
+        sample_trace().as_os_str(),
+        "--foxglove",
+        nowhere.as_os_str()
+    ))?;
+    ensure!(code == 2, "exit {code}: {stderr}");
+    ensure!(
+        stderr.contains("missing/out.mcap"),
+        "error does not name the target: {stderr}"
+    );
+    ensure!(
+        entries(dir.path())?.is_empty(),
+        "left behind: {:?}",
+        entries(dir.path())?
+    );
+    // Data that is not MCAP ends the reading like a corrupt record: as for
+    // every output of replay, the file holds what was read before (nothing)
+    // and is complete; the exit status is 2.
+    std::fs::write(&bad, b"this is not an MCAP file at all").map_err(|e| e.to_string())?;
+    let (code, _, stderr) = run_bin(os!(
+        "replay",
+        bad.as_os_str(),
+        "--foxglove",
+        target.as_os_str()
+    ))?;
+    ensure!(code == 2, "exit {code}: {stderr}");
+    ensure!(
+        stderr.contains("bad.mcap"),
+        "error does not name the trace: {stderr}"
+    );
+    let written = std::fs::read(&target).map_err(|e| e.to_string())?;
+    ensure!(
+        messages(&written)?.is_empty(),
+        "a file that is not MCAP gave messages"
+    );
+    std::fs::remove_file(&target).map_err(|e| e.to_string())?;
+    // A target that is a directory is refused, naming it.
+    let (code, _, stderr) = run_bin(os!(
+        "replay",
+        sample_trace().as_os_str(),
+        "--foxglove",
+        dir.path().as_os_str()
+    ))?;
+    ensure!(code == 2, "exit {code} for a directory target: {stderr}");
+    ensure!(
+        stderr.contains("not a regular file"),
+        "directory target: {stderr}"
+    );
+    ensure!(
+        entries(dir.path())? == ["bad.mcap"],
+        "left behind: {:?}",
+        entries(dir.path())?
+    );
+    Ok(())
+}
+
+fn replay_foxglove_keeps_what_was_read_of_a_truncated_trace() -> Result<(), String> {
+    let dir = tempfile::tempdir().map_err(|e| e.to_string())?;
+    let bytes = std::fs::read(sample_trace()).map_err(|e| e.to_string())?;
+    let cut = dir.path().join("cut.mcap");
+    std::fs::write(&cut, &bytes[..bytes.len() * 2 / 3]).map_err(|e| e.to_string())?;
+    let target = dir.path().join("out.mcap");
+    let (code, _, stderr) = run_bin(os!(
+        "replay",
+        cut.as_os_str(),
+        "--foxglove",
+        target.as_os_str()
+    ))?;
+    ensure!(code == 3, "exit {code}: {stderr}");
+    let written = std::fs::read(&target).map_err(|e| e.to_string())?;
+    let all = messages(&written)?;
+    ensure!(
+        !on(&all, "/numbers").is_empty() && on(&all, "/mesh").len() == 1,
+        "the sweeps read before the cut are in the file"
+    );
+    ensure!(
+        mcap::Summary::read(&written)
+            .map_err(|e| e.to_string())?
+            .is_some(),
+        "the file written from a truncated trace is complete (summary)"
+    );
+    Ok(())
+}

@@ -30,7 +30,7 @@ pub enum Command {
     Sweep(sweep::Args),
     /// Summarise a trace: scenes, sweeps, frames, channels, compression, metadata.
     Info(info::Args),
-    /// Replay a trace through the core: outcomes and a Rerun recording explaining each sweep.
+    /// Replay a trace through the core: outcomes, a Rerun recording or a Foxglove file explaining each sweep.
     Replay(replay::Args),
     /// Compare every sweep's outcome with the trace's /expected channel (regression check).
     Check(check::Args),

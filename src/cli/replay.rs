@@ -1,5 +1,6 @@
 //! `sweeptrace replay`: run every sweep of a trace through the core and
-//! write the outcomes and/or a Rerun recording that explains them.
+//! write the outcomes, a Rerun recording and/or a Foxglove file that
+//! explain them.
 
 use std::fs::File;
 use std::io::{BufReader, BufWriter, IsTerminal, Read, Write};

@@ -256,6 +256,13 @@ fn foxglove_file_reads_back_with_the_mcap_crate() -> Result<(), String> {
         meshes[0]["entities"][0]["timestamp"] == serde_json::json!({"sec": 0, "nsec": 0}),
         "first mesh timestamp"
     );
+    // Timestamps are the trace's log_time: frame 1 is at 1.5 s.
+    ensure!(
+        on(&all, "/decisions")[2]["timestamp"]
+            == serde_json::json!({"sec": 1, "nsec": 500_000_000}),
+        "timestamp of frame 1: {}",
+        on(&all, "/decisions")[2]["timestamp"]
+    );
     // The clear at the second scene.
     let balls = on(&all, "/balls");
     let clears: Vec<&&Value> = balls

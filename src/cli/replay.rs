@@ -44,8 +44,9 @@ Examples:
 
 Without --outcomes, --rrd, --foxglove, --spawn or --connect the recording is
 written to <trace stem>.rrd in the current directory. The outputs combine:
-one replay can write outcomes, a Rerun recording and a Foxglove file. Files are written under a
-temporary name next to the target and renamed once complete.")]
+one replay can write outcomes, a Rerun recording and a Foxglove file. Files
+are written under a temporary name next to the target and renamed once
+complete.")]
 pub struct Args {
     /// The trace (an MCAP file).
     #[arg(value_name = "TRACE")]

@@ -114,13 +114,13 @@ fn line(
     points: Vec<Point3>,
     indices: Vec<u32>,
     line_type: LineType,
-    pixels: f64,
+    thickness_pixels: f64,
     rgba: [u8; 4],
 ) -> LinePrimitive {
     LinePrimitive {
         line_type,
         pose: identity(),
-        thickness: pixels,
+        thickness: thickness_pixels,
         scale_invariant: true,
         points,
         color: color(rgba),

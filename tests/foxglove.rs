@@ -32,6 +32,7 @@ pub fn tests() -> Vec<Trial> {
         trial!(replay_foxglove_writes_only_the_foxglove_file),
         trial!(replay_foxglove_errors_name_the_file_and_leave_no_partial_file),
         trial!(replay_foxglove_keeps_what_was_read_of_a_truncated_trace),
+        trial!(replay_foxglove_killed_leaves_no_partial_target),
     ]
 }
 
@@ -631,5 +632,48 @@ fn replay_foxglove_keeps_what_was_read_of_a_truncated_trace() -> Result<(), Stri
             .is_some(),
         "the file written from a truncated trace is complete (summary)"
     );
+    Ok(())
+}
+
+/// `replay --foxglove` killed (SIGKILL) at several moments: the target is
+/// absent or a complete file (its summary reads), never a partial one; what
+/// is left besides is a temporary file named after the target.
+fn replay_foxglove_killed_leaves_no_partial_target() -> Result<(), String> {
+    let dir = tempfile::tempdir().map_err(|e| e.to_string())?;
+    let target = dir.path().join("golf.mcap");
+    let trace = Path::new(env!("CARGO_MANIFEST_DIR")).join("traces/record_mini_golf.mcap");
+    // The delays only vary where the run is when killed; the property must
+    // hold at any of them.
+    for delay_ms in [0u64, 20, 60, 150, 400] {
+        let mut child = crate::support::bin()
+            .arg("replay")
+            .arg(&trace)
+            .arg("--foxglove")
+            .arg(&target)
+            .stdout(std::process::Stdio::null())
+            .stderr(std::process::Stdio::null())
+            .spawn()
+            .map_err(|e| e.to_string())?;
+        std::thread::sleep(std::time::Duration::from_millis(delay_ms));
+        let _ = child.kill();
+        let _ = child.wait();
+        if target.exists() {
+            let bytes = std::fs::read(&target).map_err(|e| e.to_string())?;
+            ensure!(
+                mcap::Summary::read(&bytes).is_ok_and(|s| s.is_some()),
+                "after a kill at {delay_ms} ms the target is not a complete file"
+            );
+        }
+        for name in entries(dir.path())? {
+            if name == "golf.mcap" {
+                continue;
+            }
+            ensure!(
+                name.starts_with(".golf.mcap.partial-"),
+                "an unexpected file is left: {name}"
+            );
+            std::fs::remove_file(dir.path().join(name)).map_err(|e| e.to_string())?;
+        }
+    }
     Ok(())
 }

@@ -25,6 +25,7 @@
 
 pub mod atomic;
 pub mod core;
+pub mod engine;
 pub mod numbers;
 pub mod regress;
 pub mod replay;

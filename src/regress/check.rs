@@ -138,6 +138,15 @@ impl Status {
 }
 
 impl TraceReport {
+    /// Records something that could not be checked (the report becomes
+    /// [`Status::Error`]).
+    pub fn add_error(&mut self, message: String) {
+        if self.errors.len() < MAX_ERRORS {
+            self.errors.push(message);
+        }
+        self.status = status_of(self);
+    }
+
     /// Whether tunnels were found and fail the check.
     pub fn fails_on_tunnels(&self) -> bool {
         self.tunnels > 0 && self.fail_on_tunnel
@@ -259,6 +268,11 @@ pub struct TraceReport {
     /// match when the trace is replayed with them ([`Inferred`]).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub inferred: Option<Inferred>,
+    /// When the expectations are a running engine's answers (`check
+    /// --engine`): its command. The report's "expected" is then the
+    /// engine's answer, "got" the core's outcome.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub engine: Option<String>,
 }
 
 /// How many compared sweeps (the first ones) the inference of the
@@ -327,6 +341,7 @@ where
         incomplete: false,
         tolerances: options.tolerances,
         inferred: None,
+        engine: None,
     };
     let mut compared: Vec<ComparedSweep> = Vec::new();
     let mut replay = crate::replay::replay_events(events, replay_options);
@@ -464,7 +479,9 @@ fn status_of(r: &TraceReport) -> Status {
     }
 }
 
-fn divergence(
+/// The divergence of `result` from `expected`, explained: what the core
+/// found and the tests that would have produced `expected`.
+pub fn divergence(
     result: &SweepResult,
     expected: OutcomeMsg,
     got: OutcomeMsg,

@@ -24,6 +24,7 @@
 #![warn(missing_docs)]
 
 pub mod atomic;
+pub mod conform;
 pub mod core;
 pub mod engine;
 pub mod numbers;

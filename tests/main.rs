@@ -7,6 +7,7 @@ use libtest_mimic::{Arguments, Completion, Failed, Trial};
 
 mod alt_engine;
 mod check;
+mod conform;
 mod core_cases;
 mod core_decisions;
 mod core_random;
@@ -97,5 +98,6 @@ fn main() {
     trials.extend(alt_engine::tests());
     trials.extend(scanned::tests());
     trials.extend(engine::tests());
+    trials.extend(conform::tests());
     libtest_mimic::run(&args, trials).exit();
 }

@@ -6,6 +6,7 @@
 use libtest_mimic::{Arguments, Completion, Failed, Trial};
 
 mod alt_engine;
+mod bisect;
 mod check;
 mod conform;
 mod core_cases;
@@ -99,5 +100,6 @@ fn main() {
     trials.extend(scanned::tests());
     trials.extend(engine::tests());
     trials.extend(conform::tests());
+    trials.extend(bisect::tests());
     libtest_mimic::run(&args, trials).exit();
 }

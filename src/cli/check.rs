@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 use anyhow::{Context, bail};
 
 use sweeptrace::atomic::PendingFile;
-use sweeptrace::engine::{EngineCommand, EngineOptions, check_file_with_engine};
+use sweeptrace::engine::{Against, EngineCommand, EngineOptions, check_file_with_engine};
 use sweeptrace::regress::{
     CheckOptions, DEFAULT_MAX_DETAILS, Status, TraceReport, check_file, find_traces, frames_around,
     render_json, render_text,
@@ -32,8 +32,9 @@ Examples:
 With --engine, the engine runs as a child process and answers every sweep
 over stdin/stdout (docs/ENGINE_PROTOCOL.md); its answers are compared with
 the core's outcomes, as the expectations would be (in the report,
-`engine` is its answer and `core` the core's). The traces' /expected
-channels are not used. A fault of the engine (it crashes, prints something
+`engine` is its answer and `core` the core's); the traces' /expected
+channels are not used. With --against expected they are compared with the
+traces' /expected channels instead (`expected`, `engine`). A fault of the engine (it crashes, prints something
 that is not an outcome, answers another sweep, does not answer within
 --engine-timeout) is an error naming the sweep, with its last stderr lines.
 
@@ -91,6 +92,21 @@ pub struct Args {
     /// answer (and for it to exit at the end), e.g. `--engine-timeout 2.5`.
     #[arg(long, value_name = "SECONDS", default_value_t = sweeptrace::engine::DEFAULT_TIMEOUT.as_secs_f64(), requires = "engine")]
     pub engine_timeout: f64,
+    /// With --engine: what the engine's answers are compared with. `core`
+    /// (the default): the core's outcomes. `expected`: the traces' /expected
+    /// channels (does the engine still decide what it recorded?), e.g.
+    /// `--engine ./build/engine --against expected`.
+    #[arg(long, value_enum, default_value_t = AgainstArg::Core, requires = "engine")]
+    pub against: AgainstArg,
+}
+
+/// `--against`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum AgainstArg {
+    /// The core's outcomes.
+    Core,
+    /// The traces' /expected channels.
+    Expected,
 }
 
 /// Checks every trace, prints the reports, returns the exit code.
@@ -132,7 +148,11 @@ pub fn run(args: Args) -> anyhow::Result<RunOutcome> {
         let report = match &engine {
             None => check_file(path, &options),
             Some((command, engine_options)) => {
-                match check_file_with_engine(path, command, *engine_options, &options) {
+                let against = match args.against {
+                    AgainstArg::Core => Against::Core,
+                    AgainstArg::Expected => Against::Expected,
+                };
+                match check_file_with_engine(path, command, *engine_options, against, &options) {
                     Ok(report) => report,
                     Err(err) => {
                         eprintln!("error: {}: {err}", path.display());

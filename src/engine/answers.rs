@@ -1,6 +1,10 @@
 //! A trace's events with an engine's answers as the sweeps' expectations.
 
-use std::collections::VecDeque;
+use std::cell::RefCell;
+use std::collections::{HashMap, VecDeque};
+use std::rc::Rc;
+
+use crate::trace::messages::OutcomeMsg;
 
 use crate::trace::{TraceError, TraceEvent};
 
@@ -32,7 +36,13 @@ pub struct EngineAnswers<I> {
     error: Option<EngineError>,
     answered: u64,
     trace_expectations: u64,
+    /// When set, the answers go here and the trace's expectations pass.
+    sink: Option<AnswerSink>,
 }
+
+/// Where [`EngineAnswers::keeping_expectations`] puts the engine's
+/// answers, by `(frame, ball)`, for the consumer to take.
+pub type AnswerSink = Rc<RefCell<HashMap<(u64, u32), OutcomeMsg>>>;
 
 /// How an engine's run over a trace ended.
 #[derive(Debug)]
@@ -63,6 +73,23 @@ where
             error: None,
             answered: 0,
             trace_expectations: 0,
+            sink: None,
+        }
+    }
+
+    /// Like [`EngineAnswers::new`], but the trace's own `/expected`
+    /// messages pass unchanged and the engine's answers go into `sink`
+    /// instead (each in before its sweep is handed on): to compare the
+    /// engine with the trace's expectations.
+    pub fn keeping_expectations(
+        input: I,
+        session: EngineSession,
+        window: usize,
+        sink: AnswerSink,
+    ) -> Self {
+        EngineAnswers {
+            sink: Some(sink),
+            ..EngineAnswers::new(input, session, window)
         }
     }
 
@@ -100,7 +127,12 @@ where
         while !self.input_done && self.in_flight < self.window {
             match self.input.next() {
                 None => self.input_done = true,
-                Some(Ok(TraceEvent::Expected { .. })) => self.trace_expectations += 1,
+                Some(Ok(event @ TraceEvent::Expected { .. })) => {
+                    self.trace_expectations += 1;
+                    if self.sink.is_some() {
+                        self.queue.push_back(Queued::Ready(Ok(event)));
+                    }
+                }
                 Some(Ok(event @ TraceEvent::Scene { .. })) => {
                     if let TraceEvent::Scene { scene, .. } = &event {
                         session.send_scene(scene)?;
@@ -151,6 +183,17 @@ where
                 let (key, log_time_nanos, index) = (*key, event.log_time_nanos(), event.index());
                 let session = self.session.as_mut()?;
                 match session.next_answer(key) {
+                    Ok(outcome) if self.sink.is_some() => {
+                        self.answered += 1;
+                        if let Some(sink) = &self.sink {
+                            sink.borrow_mut().insert(key, outcome);
+                        }
+                        self.in_flight -= 1;
+                        match self.queue.pop_front() {
+                            Some(Queued::Sweep(event, _)) => Some(Ok(event)),
+                            _ => None,
+                        }
+                    }
                     Ok(outcome) => {
                         self.front_answered = true;
                         self.answered += 1;

@@ -27,7 +27,7 @@ mod error;
 mod process;
 pub mod protocol;
 
-pub use answers::{EngineAnswers, EngineRun};
+pub use answers::{AnswerSink, EngineAnswers, EngineRun};
 pub use command::EngineCommand;
 pub use error::EngineError;
 pub use process::EngineSession;
@@ -62,12 +62,36 @@ impl Default for EngineOptions {
     }
 }
 
+/// What an engine's answers are compared with.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum Against {
+    /// The core's outcomes: the answers are the sweeps' expectations.
+    #[default]
+    Core,
+    /// The trace's `/expected` channel: the answers are compared with it
+    /// (ties and fragility are the core's decision's).
+    Expected,
+}
+
+impl Against {
+    /// `core` or `expected`.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Against::Core => "core",
+            Against::Expected => "expected",
+        }
+    }
+}
+
 /// Checks the trace at `path` against a running engine: the engine answers
-/// every sweep ([`EngineAnswers`]) and the answers are the expectations of
-/// an ordinary check ([`crate::regress::check_events`]): the report counts
-/// and explains where the engine and the core differ, with ties and
-/// fragile decisions as `check` treats them. The trace's own `/expected`
-/// channel is not used.
+/// every sweep ([`EngineAnswers`]) and the answers are judged by an
+/// ordinary check ([`crate::regress::check_events_judged`]): with
+/// [`Against::Core`] they are the expectations and the core's outcomes
+/// are compared with them (the trace's `/expected` is not used); with
+/// [`Against::Expected`] they are compared with the trace's `/expected`
+/// ([`judge_answer_against_expected`]). Either way the report counts and
+/// explains the differences, with ties and fragile decisions as `check`
+/// treats them.
 ///
 /// `Err` only when the engine cannot be started; any later fault of the
 /// engine is an error of the report (what was answered before it is
@@ -76,25 +100,55 @@ pub fn check_file_with_engine(
     path: &std::path::Path,
     command: &EngineCommand,
     engine: EngineOptions,
+    against: Against,
     options: &crate::regress::CheckOptions,
 ) -> Result<crate::regress::TraceReport, EngineError> {
     let name = path.display().to_string();
+    let engine_check = crate::regress::EngineCheck {
+        command: command.text.clone(),
+        against: against.as_str(),
+    };
     let file = match std::fs::File::open(path) {
         Ok(file) => file,
         Err(_) => {
             let mut report = crate::regress::check_file(path, options);
-            report.engine = Some(command.text.clone());
+            report.engine = Some(engine_check);
             return Ok(report);
         }
     };
     let session = EngineSession::start(command, engine)?;
-    let reader =
+    let mut reader =
         crate::trace::TraceReader::new(std::io::BufReader::with_capacity(1 << 16, file), &name);
-    let mut answers = EngineAnswers::new(reader, session, engine.window);
-    let mut report = crate::regress::check_events(answers.by_ref(), &name, options);
-    let run = answers.finish();
-    report.engine = Some(command.text.clone());
-    report.has_expected_channel = true;
+    let (mut report, run) = match against {
+        Against::Core => {
+            let mut answers = EngineAnswers::new(reader.by_ref(), session, engine.window);
+            let report = crate::regress::check_events(answers.by_ref(), &name, options);
+            (report, answers.finish())
+        }
+        Against::Expected => {
+            let sink = AnswerSink::default();
+            let mut answers = EngineAnswers::keeping_expectations(
+                reader.by_ref(),
+                session,
+                engine.window,
+                sink.clone(),
+            );
+            let report =
+                crate::regress::check_events_judged(answers.by_ref(), &name, options, |result| {
+                    let answer = sink.borrow_mut().remove(&(result.frame, result.ball))?;
+                    judge_answer_against_expected(result, answer, &options.tolerances)
+                });
+            (report, answers.finish())
+        }
+    };
+    report.engine = Some(engine_check);
+    report.has_expected_channel = match against {
+        Against::Core => true,
+        Against::Expected => reader
+            .stats()
+            .channels
+            .contains_key(crate::trace::messages::EXPECTED_TOPIC),
+    };
     if let Some(error) = run.error {
         if error.cannot_start() {
             return Err(error);
@@ -102,4 +156,52 @@ pub fn check_file_with_engine(
         report.add_error(error.to_string());
     }
     Ok(report)
+}
+
+/// The trace's expectation of a sweep against an engine's answer to it:
+/// equal fields are a match; answers that differ only in which member of
+/// the core's tie set they name (kind, triangle, feature, and that member's
+/// own contact) are a tie; otherwise a divergence, fragile when the core's
+/// decision is. `None` when the sweep has no expectation.
+pub fn judge_answer_against_expected(
+    result: &crate::replay::SweepResult,
+    answer: crate::trace::messages::OutcomeMsg,
+    tolerances: &crate::regress::Tolerances,
+) -> Option<crate::regress::Judged> {
+    use crate::regress::{Agreement, Field, Judged, compare, explained_records};
+    let expected = result.expected?;
+    let fields = compare(&expected, &answer, tolerances);
+    let agreement = if fields.is_empty() {
+        Agreement::Match
+    } else {
+        let only_choice = fields.iter().all(|f| {
+            matches!(
+                f.field,
+                Field::Kind | Field::Triangle | Field::Feature | Field::Contact
+            )
+        });
+        let ties = if only_choice {
+            result.outcome.tie_set(&explained_records(result))
+        } else {
+            Vec::new()
+        };
+        let names_member = |o: &crate::trace::messages::OutcomeMsg| {
+            ties.iter()
+                .any(|t| t.matches(o.kind, o.triangle, o.feature))
+        };
+        if only_choice && names_member(&expected) && names_member(&answer) {
+            Agreement::Tie
+        } else {
+            Agreement::Diverges {
+                fields,
+                fragile: result.outcome.fragile,
+            }
+        }
+    };
+    Some(Judged {
+        expected,
+        got: answer,
+        agreement,
+        got_is_core: false,
+    })
 }

@@ -23,8 +23,9 @@ pub mod repro;
 
 pub use bless::{BlessError, BlessSummary, bless_bytes, bless_file};
 pub use check::{
-    CheckOptions, DEFAULT_MAX_DETAILS, Divergence, MAX_LISTED_TUNNELS, Status, TraceReport,
-    TunnelReport, check_events, check_file, check_reader, divergence, find_traces, frames_around,
+    CheckOptions, DEFAULT_MAX_DETAILS, Divergence, EngineCheck, Judged, MAX_LISTED_TUNNELS, Status,
+    TraceReport, TunnelReport, check_events, check_events_judged, check_file, check_reader,
+    divergence, find_traces, frames_around, judge_against_core,
 };
 pub use compare::{
     Agreement, DEFAULT_ALPHA_TOLERANCE, DEFAULT_CONTACT_TOLERANCE,

@@ -32,12 +32,15 @@ pub enum Sides {
     /// A running engine's answer against the core (`check --engine`,
     /// `conform`): "engine", "core".
     EngineAndCore,
+    /// A trace's `/expected` against a running engine's answer (`check
+    /// --engine --against expected`): "expected", "engine".
+    ExpectedAndEngine,
 }
 
 impl Sides {
     fn expected(self) -> &'static str {
         match self {
-            Sides::ExpectedAndCore => "expected",
+            Sides::ExpectedAndCore | Sides::ExpectedAndEngine => "expected",
             Sides::EngineAndCore => "engine",
         }
     }
@@ -46,6 +49,7 @@ impl Sides {
         match self {
             Sides::ExpectedAndCore => "got",
             Sides::EngineAndCore => "core",
+            Sides::ExpectedAndEngine => "engine",
         }
     }
 }
@@ -100,7 +104,7 @@ pub fn render_divergence_as(d: &Divergence, indent: &str, sides: Sides) -> Strin
         let _ = writeln!(s, "{indent}    {line}");
     }
     let (expected, whose) = match sides {
-        Sides::ExpectedAndCore => ("expected", "expected result's"),
+        Sides::ExpectedAndCore | Sides::ExpectedAndEngine => ("expected", "expected result's"),
         Sides::EngineAndCore => ("the engine answered", "the engine's result's"),
     };
     if d.expected.kind == Kind::None {
@@ -124,10 +128,10 @@ pub fn render_divergence_as(d: &Divergence, indent: &str, sides: Sides) -> Strin
 /// divergences in detail.
 pub fn render_text(r: &TraceReport) -> String {
     let mut s = String::new();
-    let sides = if r.engine.is_some() {
-        Sides::EngineAndCore
-    } else {
-        Sides::ExpectedAndCore
+    let sides = match &r.engine {
+        None => Sides::ExpectedAndCore,
+        Some(e) if e.against == "expected" => Sides::ExpectedAndEngine,
+        Some(_) => Sides::EngineAndCore,
     };
     let mut counts = format!(
         "{} sweeps, {} compared, {} without expectation, {} expectations without a sweep",

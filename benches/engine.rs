@@ -118,6 +118,19 @@ fn main() {
         floor.as_secs_f64() * 1e3,
         SWEEPS as f64 / floor.as_secs_f64()
     );
+    let core = median(|| {
+        let report = check_events(
+            TraceReader::new(bytes.as_slice(), "bench.mcap"),
+            "bench.mcap",
+            &CheckOptions::default(),
+        );
+        report.sweeps
+    });
+    println!(
+        "check without an engine (the core's replay alone): {:.0} ms ({:.0} sweeps/s)",
+        core.as_secs_f64() * 1e3,
+        SWEEPS as f64 / core.as_secs_f64()
+    );
     let options = EngineOptions::default();
     for text in &engines {
         let command = EngineCommand::parse(text).expect("engine command");

@@ -80,7 +80,7 @@ pub struct Args {
     pub max_details: usize,
     /// For each failing trace, write DIR/<trace stem>.rrd: a Rerun recording
     /// of the frames around its first divergences.
-    #[arg(long, value_name = "DIR")]
+    #[arg(long, value_name = "DIR", conflicts_with = "engine")]
     pub rrd_on_failure: Option<PathBuf>,
     /// Check a running engine instead of the traces' /expected channels:
     /// the command that starts it, split like a shell's words (no shell

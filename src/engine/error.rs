@@ -140,7 +140,7 @@ fn tail_text(tail: &[String]) -> String {
     if tail.is_empty() {
         return String::new();
     }
-    let mut s = String::from("; its last stderr lines:");
+    let mut s = String::from(" (its last stderr lines below)");
     for line in tail {
         s.push_str("\n    | ");
         s.push_str(line);

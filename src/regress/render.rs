@@ -282,13 +282,18 @@ pub fn render_text(r: &TraceReport) -> String {
             tunnel_lines(&mut s);
         }
         Status::Error => {
+            // A message of several lines (an engine's last stderr lines)
+            // keeps its first line with the counts, the rest below.
+            let first = r.errors.first().map(String::as_str).unwrap_or("error");
+            let (head, below) = first.split_once('\n').unwrap_or((first, ""));
             let _ = writeln!(
                 s,
-                "ERROR {}: {}; {counts}, {} diverge",
-                r.trace,
-                r.errors.first().map(String::as_str).unwrap_or("error"),
-                r.divergent
+                "ERROR {}: {head}; {counts}, {} diverge",
+                r.trace, r.divergent
             );
+            for line in below.lines() {
+                let _ = writeln!(s, "{line}");
+            }
             for e in r.errors.iter().skip(1) {
                 let _ = writeln!(s, "  also: {e}");
             }

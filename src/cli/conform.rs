@@ -34,7 +34,8 @@ pub struct Args {
     /// `--engine "python3 engine.py"` or `--engine ./build/engine`.
     #[arg(long, value_name = "COMMAND", required_unless_present = "list")]
     pub engine: Option<String>,
-    /// Run only this rule (`edge.hit`) or case (`edge.hit/2`).
+    /// Run only this case (`edge.hit/2`), rule (`edge.hit`) or group of
+    /// rules (`edge`, `edge.miss`).
     #[arg(long, value_name = "RULE[/INDEX]")]
     pub case: Option<String>,
     /// List the rules and their cases (no engine needed).

@@ -148,6 +148,14 @@ pub const RULES: &[Rule] = &[
         description: "a ball coming diagonally at a cube's corner: a vertex collision shared by the corner's triangles, averaged normal",
     },
     Rule {
+        name: "grazing.face-hit",
+        description: "a path descending onto the face at a grazing angle (cosine below 1e-3): still a face collision at β",
+    },
+    Rule {
+        name: "grazing.edge-tangent",
+        description: "a path that passes exactly ρ from an edge's line (a double root): a tangent edge collision",
+    },
+    Rule {
         name: "margin.face-hit",
         description: "with margin ε the face test detects at ρ = r - ε: α moves accordingly",
     },
@@ -573,6 +581,24 @@ pub fn cases() -> Vec<Case> {
             [-2.0, 2.0, -2.0],
             [0.0, 0.0, 0.0],
             Kind::Vertex,
+        ),
+        (
+            "grazing.face-hit",
+            "descends 2^-9 over a run of 2 onto the face",
+            t(),
+            0.5,
+            [0.5, 1.0, 0.5009765625],
+            [2.5, 1.0, 0.4990234375],
+            Kind::Face,
+        ),
+        (
+            "grazing.edge-tangent",
+            "down exactly ρ beside edge 0",
+            t(),
+            0.5,
+            [2.0, -0.5, 3.0],
+            [2.0, -0.5, -3.0],
+            Kind::Edge,
         ),
         (
             "margin.face-hit",

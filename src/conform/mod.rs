@@ -121,8 +121,9 @@ pub struct ConformOptions {
     pub only: Option<String>,
 }
 
-/// The cases `only` selects (every case when `None`); an error names the
-/// rules when nothing matches.
+/// The cases `only` selects (every case when `None`): a case
+/// (`edge.hit/2`), a rule (`edge.hit`) or a group of rules (`edge`,
+/// `edge.miss`); an error names the rules when nothing matches.
 pub fn select(only: Option<&str>) -> Result<Vec<Case>, String> {
     let all = cases();
     let Some(only) = only else {
@@ -130,7 +131,13 @@ pub fn select(only: Option<&str>) -> Result<Vec<Case>, String> {
     };
     let chosen: Vec<Case> = all
         .into_iter()
-        .filter(|c| c.rule == only || c.id() == only)
+        .filter(|c| {
+            c.rule == only
+                || c.id() == only
+                || c.rule
+                    .strip_prefix(only)
+                    .is_some_and(|rest| rest.starts_with('.'))
+        })
         .collect();
     if chosen.is_empty() {
         return Err(format!(

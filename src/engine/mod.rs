@@ -3,7 +3,7 @@
 //! JSON lines (the protocol of `docs/ENGINE_PROTOCOL.md`).
 //!
 //! - [`EngineCommand`]: the command line that starts the engine;
-//! - [`EngineSession`](process::EngineSession): the running engine: a
+//! - [`EngineSession`]: the running engine: a
 //!   writer thread feeding its stdin, a reader thread parsing its stdout,
 //!   the last lines of its stderr kept for the error messages, a timeout on
 //!   every answer;

@@ -7,8 +7,6 @@ use serde_json::{Map, Value};
 use crate::trace::messages::{OutcomeMsg, SceneMsg, SweepMsg};
 use crate::trace::validate::validate_outcome;
 
-/// The protocol's version, sent in no message: engines need not check it.
-pub const PROTOCOL_VERSION: u32 = 1;
 /// The longest output line accepted from an engine, in bytes.
 pub const MAX_ANSWER_BYTES: usize = 1 << 16;
 

@@ -32,6 +32,7 @@ pub fn tests() -> Vec<Trial> {
         ),
         trial!(repro_command_runs_one_case, timeout = LIMIT),
         trial!(conform_engine_not_found_exits_125, timeout = LIMIT),
+        trial!(cases_written_as_a_trace_check_the_same, timeout = LIMIT),
     ]
 }
 
@@ -205,6 +206,35 @@ fn conform_engine_not_found_exits_125() -> Result<(), String> {
     ensure!(
         code == 125 && stderr.contains("cannot be started"),
         "exit {code}: {stderr}"
+    );
+    Ok(())
+}
+
+fn cases_written_as_a_trace_check_the_same() -> Result<(), String> {
+    let dir = tempfile::tempdir().map_err(|e| e.to_string())?;
+    let trace = dir.path().join("vertex.mcap");
+    let (code, _, stderr) = run_bin(os!(
+        "conform",
+        "--case",
+        "vertex.hit",
+        "--write-trace",
+        trace.as_os_str()
+    ))?;
+    ensure!(code == 0, "exit {code}: {stderr}");
+    ensure!(
+        stderr.contains("2 cases; frame N is case N: 21 vertex.hit/0, 22 vertex.hit/1"),
+        "names the frames: {stderr}"
+    );
+    let (code, stdout, _) = run_bin(os!("sweep", "--trace", trace.as_os_str(), "--frame", "22"))?;
+    ensure!(
+        code == 0 && stdout.contains("outcome: vertex collision"),
+        "sweep --trace on case 22: exit {code}:\n{stdout}"
+    );
+    let engine = example_engine_command("--bug skip-vertex");
+    let (code, stdout, _) = run_bin(os!("check", trace.as_os_str(), "--engine", &engine))?;
+    ensure!(
+        code == 1 && stdout.contains("2 of 2 compared sweeps diverge (none -> vertex: 2)"),
+        "check --engine on the cases: exit {code}:\n{stdout}"
     );
     Ok(())
 }

@@ -1,11 +1,12 @@
 //! `sweeptrace conform`: the built-in conformance suite run through an
 //! engine (the library's [`sweeptrace::conform`]).
 
-use anyhow::bail;
+use anyhow::{Context, bail};
 
 use sweeptrace::conform::{self, ConformOptions, RULES};
 use sweeptrace::engine::EngineCommand;
 use sweeptrace::run::RunOutcome;
+use sweeptrace::trace::TraceEvent;
 
 /// Arguments of `conform`.
 #[derive(Debug, clap::Args)]
@@ -15,6 +16,7 @@ Examples:
   sweeptrace conform --engine ./build/engine --json
   sweeptrace conform --engine ./build/engine --case vertex.hit/1
   sweeptrace conform --list
+  sweeptrace conform --case vertex.hit --write-trace cases.mcap
 
 Every case is a small scene and one sweep (sent to the engine as in `check
 --engine`, docs/ENGINE_PROTOCOL.md), grouped by the rule of
@@ -32,7 +34,7 @@ of the engine or a bad argument, 125 the engine cannot be started.")]
 pub struct Args {
     /// The command that starts the engine, split like a shell's words, e.g.
     /// `--engine "python3 engine.py"` or `--engine ./build/engine`.
-    #[arg(long, value_name = "COMMAND", required_unless_present = "list")]
+    #[arg(long, value_name = "COMMAND", required_unless_present_any = ["list", "write_trace"])]
     pub engine: Option<String>,
     /// Run only this case (`edge.hit/2`), rule (`edge.hit`) or group of
     /// rules (`edge`, `edge.miss`).
@@ -41,6 +43,13 @@ pub struct Args {
     /// List the rules and their cases (no engine needed).
     #[arg(long)]
     pub list: bool,
+    /// Write the chosen cases as a trace (each case's scene, then its sweep
+    /// as frame N, the case's number), to look at them with the other
+    /// commands, e.g. `--case vertex.hit --write-trace cases.mcap`, then
+    /// `sweeptrace sweep --trace cases.mcap --frame 21` or `sweeptrace
+    /// replay cases.mcap --spawn`. No engine needed.
+    #[arg(long, value_name = "FILE")]
+    pub write_trace: Option<std::path::PathBuf>,
     /// Do not fail on divergences of fragile decisions (count them apart,
     /// as `check` does without --strict). By default they fail: every case
     /// is exact in binary, so the rules decide it; the `fragile` count says
@@ -65,6 +74,41 @@ pub fn run(args: Args) -> anyhow::Result<RunOutcome> {
     if args.list {
         print!("{}", list_text(&cases));
         return Ok(RunOutcome::Success);
+    }
+    if let Some(path) = &args.write_trace {
+        super::warn_unfinished(path);
+        sweeptrace::trace::write_trace_file(path, |w| {
+            for event in conform::case_events(&cases) {
+                match event {
+                    TraceEvent::Scene {
+                        log_time_nanos,
+                        scene,
+                        ..
+                    } => w.scene(log_time_nanos, &scene)?,
+                    TraceEvent::Sweep {
+                        log_time_nanos,
+                        sweep,
+                        ..
+                    } => w.sweep(log_time_nanos, &sweep)?,
+                    TraceEvent::Expected { .. } => {}
+                }
+            }
+            Ok::<_, sweeptrace::trace::TraceError>(())
+        })
+        .with_context(|| format!("writing {}", path.display()))?;
+        eprintln!(
+            "wrote {} ({} cases; frame N is case N: {})",
+            path.display(),
+            cases.len(),
+            cases
+                .iter()
+                .map(|c| format!("{} {}", c.sweep.frame, c.id()))
+                .collect::<Vec<_>>()
+                .join(", ")
+        );
+        if args.engine.is_none() {
+            return Ok(RunOutcome::Success);
+        }
     }
     let Some(text) = &args.engine else {
         bail!("--engine is required (or --list)");

@@ -24,7 +24,9 @@
 #![warn(missing_docs)]
 
 pub mod atomic;
+pub mod conform;
 pub mod core;
+pub mod engine;
 pub mod foxglove;
 pub mod numbers;
 pub mod palette;

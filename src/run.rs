@@ -22,17 +22,22 @@ pub enum RunOutcome {
     /// An input could not be processed (a bad argument, a file that cannot
     /// be read or written, an invalid trace, nothing to compare). Exit code 2.
     Error,
+    /// The engine to check (`check --engine`, `conform`) cannot be started:
+    /// its program is not found or not executable. Exit code 125, which
+    /// `git bisect run` takes as "this commit cannot be tested, skip it".
+    EngineUnavailable,
 }
 
 impl RunOutcome {
     /// The process exit code: 0 success, 1 differences found, 2 error,
-    /// 3 incomplete input.
+    /// 3 incomplete input, 125 the engine cannot be started.
     pub const fn exit_code(self) -> u8 {
         match self {
             RunOutcome::Success => 0,
             RunOutcome::Differences => 1,
             RunOutcome::Error => 2,
             RunOutcome::IncompleteInput => 3,
+            RunOutcome::EngineUnavailable => 125,
         }
     }
 

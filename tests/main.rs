@@ -6,10 +6,13 @@
 use libtest_mimic::{Arguments, Completion, Failed, Trial};
 
 mod alt_engine;
+mod bisect;
 mod check;
+mod conform;
 mod core_cases;
 mod core_decisions;
 mod core_random;
+mod engine;
 mod foxglove;
 mod oracle;
 mod outputs;
@@ -97,5 +100,8 @@ fn main() {
     trials.extend(alt_engine::tests());
     trials.extend(scanned::tests());
     trials.extend(foxglove::tests());
+    trials.extend(engine::tests());
+    trials.extend(conform::tests());
+    trials.extend(bisect::tests());
     libtest_mimic::run(&args, trials).exit();
 }

@@ -6,6 +6,7 @@ use std::path::{Path, PathBuf};
 use anyhow::{Context, bail};
 
 use sweeptrace::atomic::PendingFile;
+use sweeptrace::engine::{Against, EngineCommand, EngineOptions, check_file_with_engine};
 use sweeptrace::regress::{
     CheckOptions, DEFAULT_MAX_DETAILS, Status, TraceReport, check_file, find_traces, frames_around,
     render_json, render_text,
@@ -25,6 +26,17 @@ Examples:
   sweeptrace check traces/                     # every *.mcap under traces/
   sweeptrace check run.mcap --tolerance 1e-4 --normal-tolerance 0.5
   sweeptrace check traces/ --json --rrd-on-failure /tmp/failures
+  sweeptrace check traces/ --engine 'python3 examples/engines/sweep_engine.py'
+  git bisect run sweeptrace check traces/ --engine ./build/engine
+
+With --engine, the engine runs as a child process and answers every sweep
+over stdin/stdout (docs/ENGINE_PROTOCOL.md); its answers are compared with
+the core's outcomes, as the expectations would be (in the report,
+`engine` is its answer and `core` the core's); the traces' /expected
+channels are not used. With --against expected they are compared with the
+traces' /expected channels instead (`expected`, `engine`). A fault of the engine (it crashes, prints something
+that is not an outcome, answers another sweep, does not answer within
+--engine-timeout) is an error naming the sweep, with its last stderr lines.
 
 Per trace: `ok`, `FAIL` (with the first divergences explained, and every
 tunnel: a ball's centre that went through a triangle from its front to its
@@ -35,8 +47,9 @@ When expectations fail, the recording engine's margin and facing rule are
 inferred from them, with how many expectations match when replayed with
 them. Exit status: 0 every trace matches (ties and fragile divergences
 included, unless --strict), 1 a divergence or a tunnel was found, 2
-something could not be checked (bad input, I/O error, no expectations), 3 a
-trace ends early.")]
+something could not be checked (bad input, I/O error, no expectations, a
+fault of the engine), 3 a trace ends early, 125 the engine cannot be
+started (git bisect run skips that commit).")]
 pub struct Args {
     /// Trace files, or directories searched recursively for `*.mcap`.
     #[arg(value_name = "TRACE|DIR", required = true)]
@@ -67,8 +80,33 @@ pub struct Args {
     pub max_details: usize,
     /// For each failing trace, write DIR/<trace stem>.rrd: a Rerun recording
     /// of the frames around its first divergences.
-    #[arg(long, value_name = "DIR")]
+    #[arg(long, value_name = "DIR", conflicts_with = "engine")]
     pub rrd_on_failure: Option<PathBuf>,
+    /// Check a running engine instead of the traces' /expected channels:
+    /// the command that starts it, split like a shell's words (no shell
+    /// runs it), e.g. `--engine "python3 engine.py --margin 0.01"` or
+    /// `--engine ./build/engine`. One engine process per trace.
+    #[arg(long, value_name = "COMMAND")]
+    pub engine: Option<String>,
+    /// With --engine: the longest wait, in seconds, for the engine's next
+    /// answer (and for it to exit at the end), e.g. `--engine-timeout 2.5`.
+    #[arg(long, value_name = "SECONDS", default_value_t = sweeptrace::engine::DEFAULT_TIMEOUT.as_secs_f64(), requires = "engine")]
+    pub engine_timeout: f64,
+    /// With --engine: what the engine's answers are compared with. `core`
+    /// (the default): the core's outcomes. `expected`: the traces' /expected
+    /// channels (does the engine still decide what it recorded?), e.g.
+    /// `--engine ./build/engine --against expected`.
+    #[arg(long, value_enum, default_value_t = AgainstArg::Core, requires = "engine")]
+    pub against: AgainstArg,
+}
+
+/// `--against`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum AgainstArg {
+    /// The core's outcomes.
+    Core,
+    /// The traces' /expected channels.
+    Expected,
 }
 
 /// Checks every trace, prints the reports, returns the exit code.
@@ -97,10 +135,32 @@ pub fn run(args: Args) -> anyhow::Result<RunOutcome> {
         hex: args.hex,
         replay: ReplayOptions::default(),
     };
+    let engine = match &args.engine {
+        None => None,
+        Some(text) => Some((
+            EngineCommand::parse(text)?,
+            engine_options(args.engine_timeout)?,
+        )),
+    };
     let mut reports: Vec<TraceReport> = Vec::new();
     let mut rrd_error = false;
     for path in &traces {
-        let report = check_file(path, &options);
+        let report = match &engine {
+            None => check_file(path, &options),
+            Some((command, engine_options)) => {
+                let against = match args.against {
+                    AgainstArg::Core => Against::Core,
+                    AgainstArg::Expected => Against::Expected,
+                };
+                match check_file_with_engine(path, command, *engine_options, against, &options) {
+                    Ok(report) => report,
+                    Err(err) => {
+                        eprintln!("error: {}: {err}", path.display());
+                        return Ok(RunOutcome::EngineUnavailable);
+                    }
+                }
+            }
+        };
         if !args.json {
             print!("{}", render_text(&report));
         }
@@ -135,6 +195,17 @@ pub fn run(args: Args) -> anyhow::Result<RunOutcome> {
         RunOutcome::Error
     } else {
         outcome
+    })
+}
+
+/// The engine's options from `--engine-timeout`.
+pub fn engine_options(timeout_seconds: f64) -> anyhow::Result<EngineOptions> {
+    if !(timeout_seconds.is_finite() && timeout_seconds > 0.0 && timeout_seconds <= 1e6) {
+        bail!("--engine-timeout must be a number of seconds in (0, 1e6], got {timeout_seconds}");
+    }
+    Ok(EngineOptions {
+        timeout: std::time::Duration::from_secs_f64(timeout_seconds),
+        ..EngineOptions::default()
     })
 }
 

@@ -6,6 +6,7 @@ use sweeptrace::run::RunOutcome;
 
 pub mod bless;
 pub mod check;
+pub mod conform;
 pub mod diff;
 pub mod info;
 pub mod record;
@@ -34,6 +35,8 @@ pub enum Command {
     Replay(replay::Args),
     /// Compare every sweep's outcome with the trace's /expected channel (regression check).
     Check(check::Args),
+    /// Run the built-in conformance suite (a case per rule of SEMANTICS.md) through an engine: which rules it breaks, and why.
+    Conform(conform::Args),
     /// Rewrite a trace's /expected channel with the current core's outcomes, keeping everything else.
     Bless(bless::Args),
     /// Compare the outcomes of two traces, or of one trace replayed with different options.
@@ -54,6 +57,7 @@ pub fn run(cli: Cli) -> anyhow::Result<RunOutcome> {
         Command::Info(args) => info::run(args),
         Command::Replay(args) => replay::run(args),
         Command::Check(args) => check::run(args),
+        Command::Conform(args) => conform::run(args),
         Command::Bless(args) => bless::run(args),
         Command::Diff(args) => diff::run(args),
         Command::Repro(args) => repro::run(args),

@@ -98,6 +98,19 @@ pub struct Divergence {
     pub expected_tests: Vec<ExpectedTest>,
 }
 
+/// A running engine's part in a check.
+#[derive(Clone, Debug, PartialEq, Eq, Serialize)]
+pub struct EngineCheck {
+    /// The engine's command.
+    pub command: String,
+    /// `core`: the engine's answers are the expectations and the core's
+    /// outcomes are compared with them ("expected" is the engine's answer,
+    /// "got" the core's); `expected`: the trace's `/expected` is the
+    /// expectation and the engine's answers are compared with it ("got" is
+    /// the engine's answer).
+    pub against: &'static str,
+}
+
 /// The status of one trace.
 #[derive(
     Clone,
@@ -138,6 +151,15 @@ impl Status {
 }
 
 impl TraceReport {
+    /// Records something that could not be checked (the report becomes
+    /// [`Status::Error`]).
+    pub fn add_error(&mut self, message: String) {
+        if self.errors.len() < MAX_ERRORS {
+            self.errors.push(message);
+        }
+        self.status = status_of(self);
+    }
+
     /// Whether tunnels were found and fail the check.
     pub fn fails_on_tunnels(&self) -> bool {
         self.tunnels > 0 && self.fail_on_tunnel
@@ -259,6 +281,10 @@ pub struct TraceReport {
     /// match when the trace is replayed with them ([`Inferred`]).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub inferred: Option<Inferred>,
+    /// When a running engine was checked (`check --engine`): its command
+    /// and what its answers were compared with.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub engine: Option<EngineCheck>,
 }
 
 /// How many compared sweeps (the first ones) the inference of the
@@ -284,12 +310,57 @@ pub fn check_reader<R: std::io::Read>(
     report
 }
 
+/// One sweep judged: its expectation, the outcome it is compared with,
+/// and how they agree.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Judged {
+    /// The expectation.
+    pub expected: OutcomeMsg,
+    /// What it is compared with (the core's outcome, or an engine's answer).
+    pub got: OutcomeMsg,
+    /// How they agree.
+    pub agreement: Agreement,
+    /// Whether `got` is the core's outcome (the inference of the recording
+    /// engine's configuration replays the core, so it runs only then).
+    pub got_is_core: bool,
+}
+
+/// The judgement of `check`: the sweep's expectation against the core's
+/// outcome ([`agreement`]); `None` when the sweep has no expectation.
+pub fn judge_against_core(result: &SweepResult, tolerances: &Tolerances) -> Option<Judged> {
+    let expected = result.expected?;
+    Some(Judged {
+        agreement: agreement(&expected, result, tolerances),
+        expected,
+        got: result.outcome_msg(),
+        got_is_core: true,
+    })
+}
+
 /// Checks a trace given as a stream of events. `has_expected_channel` is
 /// set from the events (true when any `/expected` message was seen);
 /// [`check_reader`] sets it from the file's channels instead.
 pub fn check_events<I>(events: I, name: &str, options: &CheckOptions) -> TraceReport
 where
     I: Iterator<Item = Result<TraceEvent, TraceError>>,
+{
+    check_events_judged(events, name, options, |result| {
+        judge_against_core(result, &options.tolerances)
+    })
+}
+
+/// [`check_events`] with another judgement of each replayed sweep (`check
+/// --engine --against expected` compares an engine's answers with the
+/// trace's expectations): the counts, details and report are the same.
+pub fn check_events_judged<I, J>(
+    events: I,
+    name: &str,
+    options: &CheckOptions,
+    mut judge: J,
+) -> TraceReport
+where
+    I: Iterator<Item = Result<TraceEvent, TraceError>>,
+    J: FnMut(&SweepResult) -> Option<Judged>,
 {
     let mut saw_expected = false;
     let events = events.inspect(|e| {
@@ -327,6 +398,7 @@ where
         incomplete: false,
         tolerances: options.tolerances,
         inferred: None,
+        engine: None,
     };
     let mut compared: Vec<ComparedSweep> = Vec::new();
     let mut replay = crate::replay::replay_events(events, replay_options);
@@ -350,14 +422,15 @@ where
                         });
                     }
                 }
-                let Some(expected) = &result.expected else {
+                let Some(judged) = judge(&result) else {
                     report.sweeps_without_expectation += 1;
                     continue;
                 };
+                let expected = &judged.expected;
                 report.compared += 1;
                 // Kept for the inference of the engine's configuration; the
                 // first ones only, so memory stays bounded on long traces.
-                if compared.len() < MAX_INFERENCE_SWEEPS {
+                if judged.got_is_core && compared.len() < MAX_INFERENCE_SWEEPS {
                     compared.push(ComparedSweep {
                         scene: result.scene.clone(),
                         frame: result.frame,
@@ -369,7 +442,7 @@ where
                             .flatten(),
                     });
                 }
-                let (fields, fragile) = match agreement(expected, &result, &options.tolerances) {
+                let (fields, fragile) = match judged.agreement {
                     Agreement::Match => continue,
                     Agreement::Tie => {
                         report.ties += 1;
@@ -377,7 +450,7 @@ where
                     }
                     Agreement::Diverges { fields, fragile } => (fields, fragile),
                 };
-                let got = result.outcome_msg();
+                let got = judged.got;
                 if !fragile.is_robust() {
                     report.fragile_divergent += 1;
                     for reason in fragile.iter() {

@@ -26,9 +26,9 @@ pub mod repro;
 
 pub use bless::{BlessError, BlessSummary, bless_bytes, bless_file};
 pub use check::{
-    CheckOptions, DEFAULT_MAX_DETAILS, Divergence, MAX_LISTED_TUNNELS, Status, TraceReport,
-    TunnelReport, check_events, check_file, check_reader, divergence_details, find_traces,
-    frames_around,
+    CheckOptions, DEFAULT_MAX_DETAILS, Divergence, EngineCheck, Judged, MAX_LISTED_TUNNELS, Status,
+    TraceReport, TunnelReport, check_events, check_events_judged, check_file, check_reader,
+    divergence_details, find_traces, frames_around, judge_against_core,
 };
 pub use compare::{
     Agreement, DEFAULT_ALPHA_TOLERANCE, DEFAULT_CONTACT_TOLERANCE,
@@ -38,5 +38,7 @@ pub use compare::{
 pub use diff::{DiffReport, FirstDifference, Side, diff};
 pub use explain::{ExpectedTest, expected_tests, explain_outcome, explained_records};
 pub use infer::{Inferred, Spread, infer};
-pub use render::{render_divergence, render_json, render_text, value_text};
+pub use render::{
+    Sides, render_divergence, render_divergence_as, render_json, render_text, value_text,
+};
 pub use repro::{HexInputs, ReproCase, ReproError, SweepInputs, TraceSweep, find_sweep};

@@ -24,8 +24,43 @@ pub fn value_text(v: &Value) -> String {
     }
 }
 
+/// Who the two sides of a divergence are, in words.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Sides {
+    /// A trace's `/expected` against the core: "expected", "got".
+    ExpectedAndCore,
+    /// A running engine's answer against the core (`check --engine`,
+    /// `conform`): "engine", "core".
+    EngineAndCore,
+    /// A trace's `/expected` against a running engine's answer (`check
+    /// --engine --against expected`): "expected", "engine".
+    ExpectedAndEngine,
+}
+
+impl Sides {
+    fn expected(self) -> &'static str {
+        match self {
+            Sides::ExpectedAndCore | Sides::ExpectedAndEngine => "expected",
+            Sides::EngineAndCore => "engine",
+        }
+    }
+
+    fn got(self) -> &'static str {
+        match self {
+            Sides::ExpectedAndCore => "got",
+            Sides::EngineAndCore => "core",
+            Sides::ExpectedAndEngine => "engine",
+        }
+    }
+}
+
 /// One divergence in words, several lines, indented by `indent`.
 pub fn render_divergence(d: &Divergence, indent: &str) -> String {
+    render_divergence_as(d, indent, Sides::ExpectedAndCore)
+}
+
+/// One divergence in words, naming its two sides as `sides` says.
+pub fn render_divergence_as(d: &Divergence, indent: &str, sides: Sides) -> String {
     let mut s = String::new();
     let _ = writeln!(
         s,
@@ -52,9 +87,11 @@ pub fn render_divergence(d: &Divergence, indent: &str) -> String {
     for f in &d.fields {
         let _ = write!(
             s,
-            "{indent}  {}: expected {}, got {}",
+            "{indent}  {}: {} {}, {} {}",
             f.field,
+            sides.expected(),
             value_text(&f.expected),
+            sides.got(),
             value_text(&f.got)
         );
         if let Some(detail) = &f.detail {
@@ -66,17 +103,21 @@ pub fn render_divergence(d: &Divergence, indent: &str) -> String {
     for line in &d.got_explanation {
         let _ = writeln!(s, "{indent}    {line}");
     }
+    let (expected, whose) = match sides {
+        Sides::ExpectedAndCore | Sides::ExpectedAndEngine => ("expected", "expected result's"),
+        Sides::EngineAndCore => ("the engine answered", "the engine's result's"),
+    };
     if d.expected.kind == Kind::None {
-        let _ = writeln!(s, "{indent}  expected no collision");
+        let _ = writeln!(s, "{indent}  {expected} no collision");
     } else if d.expected_tests.is_empty() {
         let _ = writeln!(
             s,
-            "{indent}  expected a {} collision; no test of that kind hit",
+            "{indent}  {expected} a {} collision; no test of that kind hit",
             d.expected.kind
         );
     } else {
         for t in &d.expected_tests {
-            let _ = writeln!(s, "{indent}  expected result's test: {}", t.description);
+            let _ = writeln!(s, "{indent}  {whose} test: {}", t.description);
             let _ = writeln!(s, "{indent}    why not: {}", t.why_not);
         }
     }
@@ -87,6 +128,11 @@ pub fn render_divergence(d: &Divergence, indent: &str) -> String {
 /// divergences in detail.
 pub fn render_text(r: &TraceReport) -> String {
     let mut s = String::new();
+    let sides = match &r.engine {
+        None => Sides::ExpectedAndCore,
+        Some(e) if e.against == "expected" => Sides::ExpectedAndEngine,
+        Some(_) => Sides::EngineAndCore,
+    };
     let mut counts = format!(
         "{} sweeps, {} compared, {} without expectation, {} expectations without a sweep",
         r.sweeps, r.compared, r.sweeps_without_expectation, r.expectations_without_sweep
@@ -142,7 +188,7 @@ pub fn render_text(r: &TraceReport) -> String {
                 s,
                 "  fragile divergence (not a failure; rounding could change this decision):"
             );
-            s.push_str(&render_divergence(d, "    "));
+            s.push_str(&render_divergence_as(d, "    ", sides));
         }
     };
     match r.status {
@@ -199,7 +245,7 @@ pub fn render_text(r: &TraceReport) -> String {
                 );
             }
             for d in &r.divergences {
-                s.push_str(&render_divergence(d, "  "));
+                s.push_str(&render_divergence_as(d, "  ", sides));
             }
             if r.divergent as usize > r.divergences.len() {
                 let _ = writeln!(
@@ -236,19 +282,24 @@ pub fn render_text(r: &TraceReport) -> String {
             tunnel_lines(&mut s);
         }
         Status::Error => {
+            // A message of several lines (an engine's last stderr lines)
+            // keeps its first line with the counts, the rest below.
+            let first = r.errors.first().map(String::as_str).unwrap_or("error");
+            let (head, below) = first.split_once('\n').unwrap_or((first, ""));
             let _ = writeln!(
                 s,
-                "ERROR {}: {}; {counts}, {} diverge",
-                r.trace,
-                r.errors.first().map(String::as_str).unwrap_or("error"),
-                r.divergent
+                "ERROR {}: {head}; {counts}, {} diverge",
+                r.trace, r.divergent
             );
+            for line in below.lines() {
+                let _ = writeln!(s, "{line}");
+            }
             for e in r.errors.iter().skip(1) {
                 let _ = writeln!(s, "  also: {e}");
             }
             tunnel_lines(&mut s);
             for d in &r.divergences {
-                s.push_str(&render_divergence(d, "  "));
+                s.push_str(&render_divergence_as(d, "  ", sides));
             }
         }
     }

@@ -1,0 +1,162 @@
+//! `sweeptrace conform`: the built-in conformance suite run through an
+//! engine (the library's [`sweeptrace::conform`]).
+
+use anyhow::{Context, bail};
+
+use sweeptrace::conform::{self, ConformOptions, RULES};
+use sweeptrace::engine::EngineCommand;
+use sweeptrace::run::RunOutcome;
+use sweeptrace::trace::TraceEvent;
+
+/// Arguments of `conform`.
+#[derive(Debug, clap::Args)]
+#[command(after_help = "\
+Examples:
+  sweeptrace conform --engine 'python3 examples/engines/sweep_engine.py'
+  sweeptrace conform --engine ./build/engine --json
+  sweeptrace conform --engine ./build/engine --case vertex.hit/1
+  sweeptrace conform --list
+  sweeptrace conform --case vertex.hit --write-trace cases.mcap
+
+Every case is a small scene and one sweep (sent to the engine as in `check
+--engine`, docs/ENGINE_PROTOCOL.md), grouped by the rule of
+docs/SEMANTICS.md it exercises: face, edge and vertex hits and each way
+each can miss, shared edges and vertices with ties, cube corners, grazing
+and parallel paths, starts touching or inside ρ, zero-length paths,
+margins, strict and non-strict facing, degenerate triangles. The core's
+outcome is the expected answer; an answer naming another member of a tie
+counts as a pass. The cases are exact in binary, so a divergence fails even
+on a fragile decision (counted as `fragile` too; --lenient lets those
+pass). One line per rule with passed / failed / fragile counts,
+then each failing rule's first failing case explained, with a command that
+runs it alone. Exit status: 0 every case passes, 1 a case fails, 2 a fault
+of the engine or a bad argument, 125 the engine cannot be started.")]
+pub struct Args {
+    /// The command that starts the engine, split like a shell's words, e.g.
+    /// `--engine "python3 engine.py"` or `--engine ./build/engine`.
+    #[arg(long, value_name = "COMMAND", required_unless_present_any = ["list", "write_trace"])]
+    pub engine: Option<String>,
+    /// Run only this case (`edge.hit/2`), rule (`edge.hit`) or group of
+    /// rules (`edge`, `edge.miss`).
+    #[arg(long, value_name = "RULE[/INDEX]")]
+    pub case: Option<String>,
+    /// List the rules and their cases (no engine needed).
+    #[arg(long)]
+    pub list: bool,
+    /// Write the chosen cases as a trace (each case's scene, then its sweep
+    /// as frame N, the case's number), to look at them with the other
+    /// commands, e.g. `--case vertex.hit --write-trace cases.mcap`, then
+    /// `sweeptrace sweep --trace cases.mcap --frame 21` or `sweeptrace
+    /// replay cases.mcap --spawn`. No engine needed.
+    #[arg(long, value_name = "FILE")]
+    pub write_trace: Option<std::path::PathBuf>,
+    /// Do not fail on divergences of fragile decisions (count them apart,
+    /// as `check` does without --strict). By default they fail: every case
+    /// is exact in binary, so the rules decide it; the `fragile` count says
+    /// how many failures sit at a rounding boundary, where an engine that
+    /// computes in another order could differ.
+    #[arg(long)]
+    pub lenient: bool,
+    #[command(flatten)]
+    pub tolerances: super::ToleranceArgs,
+    /// The longest wait, in seconds, for the engine's next answer, e.g.
+    /// `--engine-timeout 2.5`.
+    #[arg(long, value_name = "SECONDS", default_value_t = sweeptrace::engine::DEFAULT_TIMEOUT.as_secs_f64())]
+    pub engine_timeout: f64,
+    /// Print one JSON document instead of text.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// Runs the suite, prints the report, returns the exit code.
+pub fn run(args: Args) -> anyhow::Result<RunOutcome> {
+    let cases = conform::select(args.case.as_deref()).map_err(anyhow::Error::msg)?;
+    if args.list {
+        print!("{}", list_text(&cases));
+        return Ok(RunOutcome::Success);
+    }
+    if let Some(path) = &args.write_trace {
+        super::warn_unfinished(path);
+        sweeptrace::trace::write_trace_file(path, |w| {
+            for event in conform::case_events(&cases) {
+                match event {
+                    TraceEvent::Scene {
+                        log_time_nanos,
+                        scene,
+                        ..
+                    } => w.scene(log_time_nanos, &scene)?,
+                    TraceEvent::Sweep {
+                        log_time_nanos,
+                        sweep,
+                        ..
+                    } => w.sweep(log_time_nanos, &sweep)?,
+                    TraceEvent::Expected { .. } => {}
+                }
+            }
+            Ok::<_, sweeptrace::trace::TraceError>(())
+        })
+        .with_context(|| format!("writing {}", path.display()))?;
+        eprintln!(
+            "wrote {} ({} cases; frame N is case N: {})",
+            path.display(),
+            cases.len(),
+            cases
+                .iter()
+                .map(|c| format!("{} {}", c.sweep.frame, c.id()))
+                .collect::<Vec<_>>()
+                .join(", ")
+        );
+        if args.engine.is_none() {
+            return Ok(RunOutcome::Success);
+        }
+    }
+    let Some(text) = &args.engine else {
+        bail!("--engine is required (or --list)");
+    };
+    let command = EngineCommand::parse(text)?;
+    let engine = super::check::engine_options(args.engine_timeout)?;
+    let options = ConformOptions {
+        tolerances: args.tolerances.to_tolerances()?,
+        strict: !args.lenient,
+        only: args.case.clone(),
+    };
+    let report = match conform::run(&command, engine, &cases, &options) {
+        Ok(report) => report,
+        Err(err) => {
+            eprintln!("error: {err}");
+            return Ok(RunOutcome::EngineUnavailable);
+        }
+    };
+    if args.json {
+        print!("{}", conform::render_json(&report));
+    } else {
+        print!("{}", conform::render_text(&report));
+    }
+    Ok(report.outcome())
+}
+
+/// The rules and their cases, one line each.
+fn list_text(cases: &[conform::Case]) -> String {
+    let mut s = String::new();
+    for rule in RULES {
+        let of_rule: Vec<&conform::Case> = cases.iter().filter(|c| c.rule == rule.name).collect();
+        if of_rule.is_empty() {
+            continue;
+        }
+        s.push_str(&format!("{}: {}\n", rule.name, rule.description));
+        for c in of_rule {
+            s.push_str(&format!(
+                "  {}: {} (radius {}, p0 {:?}, p1 {:?}, margin {}, facing {}; the core: {})\n",
+                c.id(),
+                c.what,
+                c.sweep.radius,
+                c.sweep.p0,
+                c.sweep.p1,
+                c.scene.margin,
+                c.scene.facing,
+                c.kind
+            ));
+        }
+    }
+    s
+}

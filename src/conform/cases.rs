@@ -1,0 +1,695 @@
+//! The conformance cases: small scenes and one sweep each, grouped by the
+//! rule of docs/SEMANTICS.md they exercise. Every number is exact in
+//! binary where the rule's boundary matters, so the rules, not rounding,
+//! decide.
+
+use crate::core::{Facing, Kind};
+use crate::sim::scenes;
+use crate::trace::messages::{SceneMsg, SweepMsg};
+
+/// One case: a scene, a sweep, and the kind the core decides (checked by
+/// the test suite, so a case cannot silently stop testing its rule).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Case {
+    /// The rule, e.g. `edge.miss.beyond-v1`.
+    pub rule: &'static str,
+    /// Index of the case within its rule, from 0.
+    pub index: usize,
+    /// What the case does, in words.
+    pub what: &'static str,
+    /// The scene.
+    pub scene: SceneMsg,
+    /// The sweep (its frame is the case's number in the suite, ball 0).
+    pub sweep: SweepMsg,
+    /// The kind of the core's outcome.
+    pub kind: Kind,
+}
+
+impl Case {
+    /// `rule/index`, the name `conform --case` takes.
+    pub fn id(&self) -> String {
+        format!("{}/{}", self.rule, self.index)
+    }
+}
+
+/// A rule and what it checks.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Rule {
+    /// Its name.
+    pub name: &'static str,
+    /// What it checks, in words (with the SEMANTICS.md step).
+    pub description: &'static str,
+}
+
+/// Every rule, in the order of docs/SEMANTICS.md.
+pub const RULES: &[Rule] = &[
+    Rule {
+        name: "face.hit",
+        description: "the ball reaches the plane at ρ with its touch point inside the triangle: a face collision at β (face, step 5)",
+    },
+    Rule {
+        name: "face.miss.outside-triangle",
+        description: "the touch point falls outside the triangle and no edge or vertex is within ρ: no collision (face, step 4)",
+    },
+    Rule {
+        name: "face.miss.beyond-end",
+        description: "the path ends before the ball reaches the plane at ρ: β > 1 (face, step 3)",
+    },
+    Rule {
+        name: "face.miss.parallel",
+        description: "the path runs parallel to the plane, farther than ρ: no collision (face, step 2)",
+    },
+    Rule {
+        name: "face.miss.back-facing",
+        description: "the ball comes from behind the triangle: the facing rule rejects every test",
+    },
+    Rule {
+        name: "start.inside",
+        description: "the ball starts within ρ of the plane (h0 < ρ) and moves through it: the face test ignores it (face, step 1)",
+    },
+    Rule {
+        name: "start.touching",
+        description: "the ball starts exactly ρ from the plane (h0 = ρ) moving toward it: a face collision at α = 0",
+    },
+    Rule {
+        name: "path.zero-length",
+        description: "p0 = p1: nothing moves, nothing is hit (vertex: not moving; face and edge: parallel)",
+    },
+    Rule {
+        name: "edge.hit",
+        description: "the path comes within ρ of an edge, between its ends, facing it: an edge collision at s0 (edge, step 7; each of the three edges)",
+    },
+    Rule {
+        name: "edge.miss.no-real-roots",
+        description: "the path never comes within ρ of the edge's line: B² - 4AC < 0 (edge, step 2)",
+    },
+    Rule {
+        name: "edge.miss.before-start",
+        description: "the ball starts within ρ of the edge's line and moves away: s0 < 0 (edge, step 4)",
+    },
+    Rule {
+        name: "edge.miss.beyond-end",
+        description: "the path ends before the ball comes within ρ of the edge: s0 > 1 (edge, step 4)",
+    },
+    Rule {
+        name: "edge.miss.beyond-v1",
+        description: "the contact on the edge's line lies beyond v1 (xc > L): not an edge collision, the vertex test finds it (edge, step 5)",
+    },
+    Rule {
+        name: "edge.miss.before-v0",
+        description: "the contact on the edge's line lies before v0 (xc < 0): the vertex test finds it (edge, step 5)",
+    },
+    Rule {
+        name: "edge.miss.parallel",
+        description: "the path runs parallel to the edge (A = 0): no edge collision (edge, step 1)",
+    },
+    Rule {
+        name: "edge.miss.back-facing",
+        description: "the ball comes at the edge from behind the triangle: back-facing (edge, step 6)",
+    },
+    Rule {
+        name: "vertex.hit",
+        description: "the path comes within ρ of a vertex, facing it: a vertex collision at the smaller root",
+    },
+    Rule {
+        name: "vertex.miss.no-real-roots",
+        description: "the path never comes within ρ of the vertex: no collision",
+    },
+    Rule {
+        name: "vertex.miss.before-start",
+        description: "the ball starts within ρ of the vertex and moves away: s0 < 0",
+    },
+    Rule {
+        name: "vertex.miss.beyond-end",
+        description: "the path ends before the ball comes within ρ of the vertex: s0 > 1",
+    },
+    Rule {
+        name: "end.exact-hit",
+        description: "the ball touches exactly at the end of the path: a collision at α = 1 with its kind set (worked example 4)",
+    },
+    Rule {
+        name: "tie.edge-end",
+        description: "a contact exactly at an edge's end is found by the edge and the vertex test at the same α: the tie order makes it an edge collision",
+    },
+    Rule {
+        name: "tie.shared-edge.planar",
+        description: "a touch point on the edge shared by two coplanar triangles: both faces tie, the lower triangle is primary",
+    },
+    Rule {
+        name: "tie.shared-edge.cube",
+        description: "a cube edge hit by both of its triangles at the same α: the lower triangle is primary, the normal the average of both faces' normals (worked example 5)",
+    },
+    Rule {
+        name: "tie.shared-vertex",
+        description: "the apex of a pyramid hit head-on: the vertex of four triangles ties, the normal averages their four normals",
+    },
+    Rule {
+        name: "cube.corner",
+        description: "a ball coming diagonally at a cube's corner: a vertex collision shared by the corner's triangles, averaged normal",
+    },
+    Rule {
+        name: "grazing.face-hit",
+        description: "a path descending onto the face at a grazing angle (cosine below 1e-3): still a face collision at β",
+    },
+    Rule {
+        name: "grazing.edge-tangent",
+        description: "a path that passes exactly ρ from an edge's line (a double root): a tangent edge collision",
+    },
+    Rule {
+        name: "margin.face-hit",
+        description: "with margin ε the face test detects at ρ = r - ε: α moves accordingly",
+    },
+    Rule {
+        name: "margin.edge-miss",
+        description: "a path that passes within r but farther than ρ = r - ε from an edge: no collision",
+    },
+    Rule {
+        name: "margin.vertex-hit",
+        description: "with margin ε the vertex test detects at ρ = r - ε",
+    },
+    Rule {
+        name: "facing.non-strict",
+        description: "a path in the triangle's plane (n·d = 0) toward an edge: the non-strict rule n·d ≤ 0 lets it hit",
+    },
+    Rule {
+        name: "facing.strict",
+        description: "the strict rule n·d < 0: the same in-plane path hits nothing; an ordinary approach still hits",
+    },
+    Rule {
+        name: "degenerate.skipped",
+        description: "degenerate triangles (a repeated index, zero area) are left out of every test; the others keep their indices",
+    },
+];
+
+/// Triangle T of the worked examples.
+fn triangle_t(margin: f64, facing: Facing) -> SceneMsg {
+    scene(
+        "triangle_t",
+        vec![[0.0, 0.0, 0.0], [4.0, 0.0, 0.0], [0.0, 4.0, 0.0]],
+        vec![[0, 1, 2]],
+        margin,
+        facing,
+    )
+}
+
+fn scene(
+    name: &str,
+    vertices: Vec<[f64; 3]>,
+    triangles: Vec<[u64; 3]>,
+    margin: f64,
+    facing: Facing,
+) -> SceneMsg {
+    SceneMsg {
+        name: Some(name.to_string()),
+        vertices,
+        triangles,
+        margin,
+        facing,
+    }
+}
+
+fn cube() -> SceneMsg {
+    let mesh = scenes::cube();
+    scene(
+        &mesh.name,
+        mesh.vertices,
+        mesh.triangles,
+        0.0,
+        Facing::NonStrict,
+    )
+}
+
+/// A square `[0, 2]²` at z = 0 as two triangles sharing the diagonal.
+fn quad() -> SceneMsg {
+    scene(
+        "quad",
+        vec![
+            [0.0, 0.0, 0.0],
+            [2.0, 0.0, 0.0],
+            [2.0, 2.0, 0.0],
+            [0.0, 2.0, 0.0],
+        ],
+        vec![[0, 1, 2], [0, 2, 3]],
+        0.0,
+        Facing::NonStrict,
+    )
+}
+
+/// A pyramid: apex (0, 0, 1) over the square `[-1, 1]²` at z = 0, four
+/// triangles facing up and out.
+fn pyramid() -> SceneMsg {
+    scene(
+        "pyramid",
+        vec![
+            [0.0, 0.0, 1.0],
+            [-1.0, -1.0, 0.0],
+            [1.0, -1.0, 0.0],
+            [1.0, 1.0, 0.0],
+            [-1.0, 1.0, 0.0],
+        ],
+        vec![[0, 1, 2], [0, 2, 3], [0, 3, 4], [0, 4, 1]],
+        0.0,
+        Facing::NonStrict,
+    )
+}
+
+/// Triangle T listed third, after a triangle with a repeated index and a
+/// zero-area one lying on T's edge 0.
+fn with_degenerate() -> SceneMsg {
+    scene(
+        "degenerate",
+        vec![
+            [0.0, 0.0, 0.0],
+            [4.0, 0.0, 0.0],
+            [0.0, 4.0, 0.0],
+            [2.0, 0.0, 0.0],
+        ],
+        vec![[0, 0, 1], [0, 3, 1], [0, 1, 2]],
+        0.0,
+        Facing::NonStrict,
+    )
+}
+
+/// Every case, in the order of [`RULES`], numbered as frames from 0.
+pub fn cases() -> Vec<Case> {
+    let t = || triangle_t(0.0, Facing::NonStrict);
+    let tm = || triangle_t(0.125, Facing::NonStrict);
+    let ts = || triangle_t(0.0, Facing::Strict);
+    type Spec = (
+        &'static str,
+        &'static str,
+        SceneMsg,
+        f64,
+        [f64; 3],
+        [f64; 3],
+        Kind,
+    );
+    let specs: Vec<Spec> = vec![
+        (
+            "face.hit",
+            "straight down onto the middle (worked example 1)",
+            t(),
+            0.5,
+            [1.0, 1.0, 3.0],
+            [1.0, 1.0, -3.0],
+            Kind::Face,
+        ),
+        (
+            "face.hit",
+            "slanted onto the face",
+            t(),
+            0.5,
+            [1.5, 0.75, 2.0],
+            [1.25, 1.0, -1.0],
+            Kind::Face,
+        ),
+        (
+            "face.hit",
+            "a small ball that stops just past the plane",
+            t(),
+            0.25,
+            [0.5, 2.5, 1.0],
+            [0.5, 2.5, 0.0],
+            Kind::Face,
+        ),
+        (
+            "face.miss.outside-triangle",
+            "down beside the hypotenuse, far from it",
+            t(),
+            0.5,
+            [3.0, 3.0, 3.0],
+            [3.0, 3.0, -3.0],
+            Kind::None,
+        ),
+        (
+            "face.miss.beyond-end",
+            "stops above the plane",
+            t(),
+            0.5,
+            [1.0, 1.0, 3.0],
+            [1.0, 1.0, 1.0],
+            Kind::None,
+        ),
+        (
+            "face.miss.parallel",
+            "flies over the face at height 2",
+            t(),
+            0.5,
+            [1.0, 1.0, 2.0],
+            [2.0, 1.0, 2.0],
+            Kind::None,
+        ),
+        (
+            "face.miss.back-facing",
+            "up through the triangle from behind",
+            t(),
+            0.5,
+            [1.0, 1.0, -3.0],
+            [1.0, 1.0, 3.0],
+            Kind::None,
+        ),
+        (
+            "start.inside",
+            "starts 0.25 above the face and moves down through it",
+            t(),
+            0.5,
+            [1.0, 1.0, 0.25],
+            [1.0, 1.0, -1.0],
+            Kind::None,
+        ),
+        (
+            "start.touching",
+            "starts exactly ρ above the face, moving down",
+            t(),
+            0.5,
+            [1.0, 1.0, 0.5],
+            [1.0, 1.0, -1.0],
+            Kind::Face,
+        ),
+        (
+            "path.zero-length",
+            "resting above the face",
+            t(),
+            0.5,
+            [1.0, 1.0, 3.0],
+            [1.0, 1.0, 3.0],
+            Kind::None,
+        ),
+        (
+            "path.zero-length",
+            "resting on the face, within ρ",
+            t(),
+            0.5,
+            [1.0, 1.0, 0.25],
+            [1.0, 1.0, 0.25],
+            Kind::None,
+        ),
+        (
+            "edge.hit",
+            "down past edge 0 (worked example 2)",
+            t(),
+            0.5,
+            [2.0, -0.3, 3.0],
+            [2.0, -0.3, -3.0],
+            Kind::Edge,
+        ),
+        (
+            "edge.hit",
+            "down past edge 1, the hypotenuse",
+            t(),
+            0.5,
+            [2.25, 2.0, 3.0],
+            [2.25, 2.0, -3.0],
+            Kind::Edge,
+        ),
+        (
+            "edge.hit",
+            "slanted onto edge 2",
+            t(),
+            0.5,
+            [-1.0, 2.0, 3.0],
+            [0.5, 2.0, -3.0],
+            Kind::Edge,
+        ),
+        (
+            "edge.miss.no-real-roots",
+            "down 0.75 beside edge 0",
+            t(),
+            0.5,
+            [2.0, -0.75, 3.0],
+            [2.0, -0.75, -3.0],
+            Kind::None,
+        ),
+        (
+            "edge.miss.before-start",
+            "starts against edge 0, moves away in the plane's direction",
+            t(),
+            0.5,
+            [2.0, -0.25, 0.125],
+            [2.0, -3.0, 0.125],
+            Kind::None,
+        ),
+        (
+            "edge.miss.beyond-end",
+            "stops above edge 0",
+            t(),
+            0.5,
+            [2.0, -0.3, 3.0],
+            [2.0, -0.3, 1.0],
+            Kind::None,
+        ),
+        (
+            "edge.miss.beyond-v1",
+            "down past the end v1 = (4, 0, 0) of edge 0: vertex 1",
+            t(),
+            0.5,
+            [4.25, -0.25, 3.0],
+            [4.25, -0.25, -3.0],
+            Kind::Vertex,
+        ),
+        (
+            "edge.miss.before-v0",
+            "down before the start v0 = (0, 0, 0) of edge 0: vertex 0 (worked example 3)",
+            t(),
+            0.5,
+            [-0.3, -0.2, 3.0],
+            [-0.3, -0.2, -3.0],
+            Kind::Vertex,
+        ),
+        (
+            "edge.miss.parallel",
+            "along edge 0's direction, 0.25 beside it and 0.125 above",
+            t(),
+            0.5,
+            [1.0, -0.25, 0.125],
+            [3.0, -0.25, 0.125],
+            Kind::None,
+        ),
+        (
+            "edge.miss.back-facing",
+            "up past edge 0 from behind",
+            t(),
+            0.5,
+            [2.0, -0.3, -3.0],
+            [2.0, -0.3, 3.0],
+            Kind::None,
+        ),
+        (
+            "vertex.hit",
+            "down by vertex 0",
+            t(),
+            0.5,
+            [-0.25, -0.25, 3.0],
+            [-0.25, -0.25, -3.0],
+            Kind::Vertex,
+        ),
+        (
+            "vertex.hit",
+            "slanted onto vertex 2",
+            t(),
+            0.5,
+            [-1.0, 5.0, 2.0],
+            [0.0, 4.0, -1.0],
+            Kind::Vertex,
+        ),
+        (
+            "vertex.miss.no-real-roots",
+            "down 0.75 diagonally away from vertex 0",
+            t(),
+            0.5,
+            [-0.625, -0.625, 3.0],
+            [-0.625, -0.625, -3.0],
+            Kind::None,
+        ),
+        (
+            "vertex.miss.before-start",
+            "starts against vertex 0 and moves away from it",
+            t(),
+            0.5,
+            [-0.25, -0.25, 0.125],
+            [-3.0, -3.0, 0.125],
+            Kind::None,
+        ),
+        (
+            "vertex.miss.beyond-end",
+            "stops above vertex 0",
+            t(),
+            0.5,
+            [-0.25, -0.25, 3.0],
+            [-0.25, -0.25, 1.0],
+            Kind::None,
+        ),
+        (
+            "end.exact-hit",
+            "touches edge 0 exactly at the end (worked example 4)",
+            t(),
+            0.625,
+            [2.0, -0.375, 3.0],
+            [2.0, -0.375, 0.5],
+            Kind::Edge,
+        ),
+        (
+            "tie.edge-end",
+            "down onto the end v1 of edge 0: edge and vertex at the same α",
+            t(),
+            0.5,
+            [4.0, -0.25, 3.0],
+            [4.0, -0.25, -3.0],
+            Kind::Edge,
+        ),
+        (
+            "tie.shared-edge.planar",
+            "down onto the diagonal of a square of two triangles",
+            quad(),
+            0.5,
+            [1.0, 1.0, 3.0],
+            [1.0, 1.0, -3.0],
+            Kind::Face,
+        ),
+        (
+            "tie.shared-edge.cube",
+            "down onto the cube's edge x = 1, z = 1 (worked example 5)",
+            cube(),
+            0.5,
+            [1.25, 0.125, 3.0],
+            [1.25, 0.125, -3.0],
+            Kind::Edge,
+        ),
+        (
+            "tie.shared-vertex",
+            "straight down onto a pyramid's apex",
+            pyramid(),
+            0.5,
+            [0.0, 0.0, 3.0],
+            [0.0, 0.0, -3.0],
+            Kind::Vertex,
+        ),
+        (
+            "cube.corner",
+            "diagonally at the cube's corner (1, 1, 1)",
+            cube(),
+            0.5,
+            [3.0, 3.0, 3.0],
+            [0.0, 0.0, 0.0],
+            Kind::Vertex,
+        ),
+        (
+            "cube.corner",
+            "diagonally at the cube's corner (-1, 1, -1)",
+            cube(),
+            0.25,
+            [-2.0, 2.0, -2.0],
+            [0.0, 0.0, 0.0],
+            Kind::Vertex,
+        ),
+        (
+            "grazing.face-hit",
+            "descends 2^-9 over a run of 2 onto the face",
+            t(),
+            0.5,
+            [0.5, 1.0, 0.5009765625],
+            [2.5, 1.0, 0.4990234375],
+            Kind::Face,
+        ),
+        (
+            "grazing.edge-tangent",
+            "down exactly ρ beside edge 0",
+            t(),
+            0.5,
+            [2.0, -0.5, 3.0],
+            [2.0, -0.5, -3.0],
+            Kind::Edge,
+        ),
+        (
+            "margin.face-hit",
+            "worked example 1 with ε = 0.125",
+            tm(),
+            0.5,
+            [1.0, 1.0, 3.0],
+            [1.0, 1.0, -3.0],
+            Kind::Face,
+        ),
+        (
+            "margin.edge-miss",
+            "down 0.4375 beside edge 0: within r = 0.5, beyond ρ = 0.375",
+            tm(),
+            0.5,
+            [2.0, -0.4375, 3.0],
+            [2.0, -0.4375, -3.0],
+            Kind::None,
+        ),
+        (
+            "margin.vertex-hit",
+            "down by vertex 0 with ε = 0.125",
+            tm(),
+            0.5,
+            [-0.25, -0.125, 3.0],
+            [-0.25, -0.125, -3.0],
+            Kind::Vertex,
+        ),
+        (
+            "facing.non-strict",
+            "in the plane toward edge 0 (n·d = 0)",
+            t(),
+            0.5,
+            [2.0, -3.0, 0.0],
+            [2.0, -0.25, 0.0],
+            Kind::Edge,
+        ),
+        (
+            "facing.strict",
+            "the same in-plane path under the strict rule",
+            ts(),
+            0.5,
+            [2.0, -3.0, 0.0],
+            [2.0, -0.25, 0.0],
+            Kind::None,
+        ),
+        (
+            "facing.strict",
+            "straight down onto the face under the strict rule",
+            ts(),
+            0.5,
+            [1.0, 1.0, 3.0],
+            [1.0, 1.0, -3.0],
+            Kind::Face,
+        ),
+        (
+            "degenerate.skipped",
+            "down onto triangle T, listed after two degenerate triangles",
+            with_degenerate(),
+            0.5,
+            [1.0, 1.0, 3.0],
+            [1.0, 1.0, -3.0],
+            Kind::Face,
+        ),
+        (
+            "degenerate.skipped",
+            "up at T's edge 0 from behind, where a zero-area triangle lies",
+            with_degenerate(),
+            0.5,
+            [2.0, -0.25, -3.0],
+            [2.0, -0.25, 3.0],
+            Kind::None,
+        ),
+    ];
+    let mut out: Vec<Case> = Vec::with_capacity(specs.len());
+    for (frame, (rule, what, scene, radius, p0, p1, kind)) in specs.into_iter().enumerate() {
+        let index = out.iter().filter(|c| c.rule == rule).count();
+        out.push(Case {
+            rule,
+            index,
+            what,
+            scene,
+            sweep: SweepMsg {
+                frame: frame as u64,
+                ball: 0,
+                radius,
+                p0,
+                p1,
+            },
+            kind,
+        });
+    }
+    out
+}

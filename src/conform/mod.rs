@@ -1,0 +1,402 @@
+//! The conformance suite: a built-in, generated set of cases that covers
+//! every verdict of every test of docs/SEMANTICS.md ([`cases()`]), run
+//! through a running engine ([`crate::engine`]) and judged against the
+//! core by check's comparison ([`crate::regress::agreement`]: ties are
+//! matches; a divergence on a fragile decision is counted as such).
+//!
+//! [`run`] returns a [`ConformReport`], one [`RuleReport`] per rule with
+//! its counts and its first failing case explained;
+//! [`render_text`] and [`render_json`] are pure functions of it.
+
+mod cases;
+
+pub use cases::{Case, RULES, Rule, cases};
+
+use std::fmt::Write as _;
+
+use serde::Serialize;
+
+use crate::engine::{EngineAnswers, EngineCommand, EngineError, EngineOptions, EngineSession};
+use crate::regress::{
+    Agreement, Divergence, Sides, Tolerances, agreement, divergence_details, render_divergence_as,
+};
+use crate::replay::{ReplayEvent, ReplayOptions, replay_events};
+use crate::run::RunOutcome;
+use crate::trace::TraceEvent;
+
+/// The first failing case of a rule, explained.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct CaseFailure {
+    /// `rule/index`.
+    pub case: String,
+    /// What the case does.
+    pub what: String,
+    /// The engine's answer against the core's outcome, explained
+    /// (`expected` is the engine's answer, `got` the core's).
+    pub divergence: Divergence,
+    /// A command that runs this case alone and explains it.
+    pub repro: String,
+}
+
+/// One rule's result.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct RuleReport {
+    /// The rule.
+    pub rule: &'static str,
+    /// What it checks.
+    pub description: &'static str,
+    /// Cases run.
+    pub cases: u64,
+    /// Cases the engine answered as the core did (a tie-set member counts).
+    pub passed: u64,
+    /// Cases whose answer diverges from the core's outcome, on a robust
+    /// decision (with `strict`: on any decision).
+    pub failed: u64,
+    /// Cases whose answer diverges on a fragile decision (a change at the
+    /// level of the inputs' rounding could change it); failures too with
+    /// `strict`, where they are also counted in `failed`.
+    pub fragile: u64,
+    /// The first failing case (or, when none fails, the first fragile one).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub first_failure: Option<CaseFailure>,
+}
+
+impl RuleReport {
+    /// `ok`, `FAIL`, or `fragile` (only fragile divergences, not failures).
+    pub fn status(&self) -> &'static str {
+        if self.failed > 0 {
+            "FAIL"
+        } else if self.fragile > 0 {
+            "fragile"
+        } else {
+            "ok"
+        }
+    }
+}
+
+/// The conformance of one engine.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct ConformReport {
+    /// The engine's command.
+    pub engine: String,
+    /// The rules, in the order of [`RULES`] (only those with a case run).
+    pub rules: Vec<RuleReport>,
+    /// Cases run.
+    pub cases: u64,
+    /// Cases passed.
+    pub passed: u64,
+    /// Cases failed.
+    pub failed: u64,
+    /// Fragile divergences.
+    pub fragile: u64,
+    /// Whether fragile divergences fail.
+    pub strict: bool,
+    /// A fault of the engine, if any (the cases before it are reported).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub error: Option<String>,
+}
+
+impl ConformReport {
+    /// What the run came to: a fault of the engine is an error, a failed
+    /// case a difference.
+    pub fn outcome(&self) -> RunOutcome {
+        if self.error.is_some() {
+            RunOutcome::Error
+        } else if self.failed > 0 {
+            RunOutcome::Differences
+        } else {
+            RunOutcome::Success
+        }
+    }
+}
+
+/// Options of a conformance run.
+#[derive(Clone, Debug, PartialEq, Default)]
+pub struct ConformOptions {
+    /// The comparison's tolerances.
+    pub tolerances: Tolerances,
+    /// Whether a divergence on a fragile decision fails.
+    pub strict: bool,
+    /// Run only the cases whose id (`rule/index`) or rule is this.
+    pub only: Option<String>,
+}
+
+/// The cases `only` selects (every case when `None`): a case
+/// (`edge.hit/2`), a rule (`edge.hit`) or a group of rules (`edge`,
+/// `edge.miss`); an error names the rules when nothing matches.
+pub fn select(only: Option<&str>) -> Result<Vec<Case>, String> {
+    let all = cases();
+    let Some(only) = only else {
+        return Ok(all);
+    };
+    let chosen: Vec<Case> = all
+        .into_iter()
+        .filter(|c| {
+            c.rule == only
+                || c.id() == only
+                || c.rule
+                    .strip_prefix(only)
+                    .is_some_and(|rest| rest.starts_with('.'))
+        })
+        .collect();
+    if chosen.is_empty() {
+        return Err(format!(
+            "no conformance case or rule `{only}`; the rules are: {}",
+            RULES.iter().map(|r| r.name).collect::<Vec<_>>().join(", ")
+        ));
+    }
+    Ok(chosen)
+}
+
+/// A trace's events for `cases`: each case's scene, then its sweep.
+pub fn case_events(cases: &[Case]) -> Vec<TraceEvent> {
+    let mut events = Vec::with_capacity(2 * cases.len());
+    for (i, case) in cases.iter().enumerate() {
+        let i = i as u64;
+        events.push(TraceEvent::Scene {
+            log_time_nanos: 2 * i,
+            index: 2 * i,
+            scene: case.scene.clone(),
+        });
+        events.push(TraceEvent::Sweep {
+            log_time_nanos: 2 * i + 1,
+            index: 2 * i + 1,
+            sweep: case.sweep,
+        });
+    }
+    events
+}
+
+/// Shell-quotes `s` for a command line to paste (`'...'` when needed).
+pub fn shell_quote(s: &str) -> String {
+    let plain = !s.is_empty()
+        && s.chars()
+            .all(|c| c.is_ascii_alphanumeric() || "-_./=:,+@%".contains(c));
+    if plain {
+        s.to_string()
+    } else {
+        format!("'{}'", s.replace('\'', "'\\''"))
+    }
+}
+
+/// Runs `cases` through the engine and judges every answer. `Err` only
+/// when the engine cannot be started; a later fault is the report's
+/// `error`.
+#[allow(clippy::result_large_err)] // once per run; see crate::engine
+pub fn run(
+    command: &EngineCommand,
+    engine: EngineOptions,
+    cases: &[Case],
+    options: &ConformOptions,
+) -> Result<ConformReport, EngineError> {
+    let session = EngineSession::start(command, engine)?;
+    let events = case_events(cases).into_iter().map(Ok);
+    let mut answers = EngineAnswers::new(events, session, engine.window);
+    let mut rules: Vec<RuleReport> = Vec::new();
+    let mut report = ConformReport {
+        engine: command.text.clone(),
+        rules: Vec::new(),
+        cases: 0,
+        passed: 0,
+        failed: 0,
+        fragile: 0,
+        strict: options.strict,
+        error: None,
+    };
+    let replay = replay_events(answers.by_ref(), ReplayOptions::default());
+    for event in replay {
+        let result = match event {
+            Ok(ReplayEvent::Sweep(result)) => result,
+            Ok(ReplayEvent::Scene(_)) => continue,
+            Err(e) => {
+                // The cases are valid; an error here is a bug of the suite.
+                report
+                    .error
+                    .get_or_insert_with(|| format!("conformance case: {e}"));
+                continue;
+            }
+        };
+        let Some(case) = cases.iter().find(|c| c.sweep.frame == result.frame) else {
+            continue;
+        };
+        let Some(answer) = result.expected else {
+            continue;
+        };
+        let rule = match rules.iter_mut().find(|r| r.rule == case.rule) {
+            Some(rule) => rule,
+            None => {
+                let description = RULES
+                    .iter()
+                    .find(|r| r.name == case.rule)
+                    .map_or("", |r| r.description);
+                rules.push(RuleReport {
+                    rule: case.rule,
+                    description,
+                    cases: 0,
+                    passed: 0,
+                    failed: 0,
+                    fragile: 0,
+                    first_failure: None,
+                });
+                rules.last_mut().expect("just pushed")
+            }
+        };
+        rule.cases += 1;
+        report.cases += 1;
+        let (fields, fragile) = match agreement(&answer, &result, &options.tolerances) {
+            Agreement::Match | Agreement::Tie => {
+                rule.passed += 1;
+                report.passed += 1;
+                continue;
+            }
+            Agreement::Diverges { fields, fragile } => (fields, fragile),
+        };
+        let is_fragile = !fragile.is_robust();
+        if is_fragile {
+            rule.fragile += 1;
+            report.fragile += 1;
+        }
+        let fails = !is_fragile || options.strict;
+        if fails {
+            rule.failed += 1;
+            report.failed += 1;
+        }
+        let replace = match &rule.first_failure {
+            None => true,
+            // A failure is shown before a fragile divergence.
+            Some(first) => fails && !first.divergence.fragile.is_robust() && !options.strict,
+        };
+        if replace {
+            let got = result.outcome_msg();
+            rule.first_failure = Some(CaseFailure {
+                case: case.id(),
+                what: case.what.to_string(),
+                divergence: divergence_details(&result, answer, got, fields, false),
+                repro: format!(
+                    "sweeptrace conform --engine {} --case {}",
+                    shell_quote(&command.text),
+                    case.id()
+                ),
+            });
+        }
+    }
+    let run = answers.finish();
+    if let Some(e) = run.error {
+        if e.cannot_start() {
+            return Err(e);
+        }
+        report.error = Some(e.to_string());
+    }
+    // In the order of RULES.
+    for r in RULES {
+        if let Some(pos) = rules.iter().position(|x| x.rule == r.name) {
+            report.rules.push(rules.swap_remove(pos));
+        }
+    }
+    report.rules.append(&mut rules);
+    Ok(report)
+}
+
+/// The report in words: one line per rule (status, counts, what it
+/// checks), then each failing rule's first failing case explained with the
+/// command that reproduces it, then the totals.
+pub fn render_text(r: &ConformReport) -> String {
+    let mut s = String::new();
+    let _ = writeln!(s, "conformance of `{}` to docs/SEMANTICS.md", r.engine);
+    let width = r.rules.iter().map(|x| x.rule.len()).max().unwrap_or(0);
+    for rule in &r.rules {
+        let _ = writeln!(
+            s,
+            "  {:<7} {:<width$}  {} passed, {} failed, {} fragile  ({} {})",
+            rule.status(),
+            rule.rule,
+            rule.passed,
+            rule.failed,
+            rule.fragile,
+            rule.cases,
+            if rule.cases == 1 { "case" } else { "cases" },
+        );
+    }
+    for rule in r.rules.iter().filter(|x| x.first_failure.is_some()) {
+        let Some(f) = &rule.first_failure else {
+            continue;
+        };
+        let _ = writeln!(s);
+        let _ = writeln!(
+            s,
+            "{} {}: {}",
+            if rule.failed > 0 { "FAIL" } else { "fragile" },
+            rule.rule,
+            rule.description
+        );
+        let _ = writeln!(
+            s,
+            "  first {}: {} ({})",
+            if rule.failed > 0 {
+                "failing case"
+            } else {
+                "fragile divergence"
+            },
+            f.case,
+            f.what
+        );
+        s.push_str(&render_divergence_as(
+            &f.divergence,
+            "  ",
+            Sides::EngineAndCore,
+        ));
+        let _ = writeln!(s, "  reproduce: {}", f.repro);
+    }
+    let _ = writeln!(s);
+    let failing = r.rules.iter().filter(|x| x.failed > 0).count();
+    let _ = writeln!(
+        s,
+        "{} rules, {} cases: {} passed, {} failed, {} fragile{}; {} {}",
+        r.rules.len(),
+        r.cases,
+        r.passed,
+        r.failed,
+        r.fragile,
+        match (r.fragile > 0, r.strict) {
+            (false, _) => "",
+            (true, true) => {
+                " (fragile: divergences on decisions rounding could change; they fail, --lenient lets them pass)"
+            }
+            (true, false) => {
+                " (fragile: divergences on decisions rounding could change; not failures under --lenient)"
+            }
+        },
+        failing,
+        if failing == 1 {
+            "rule fails"
+        } else {
+            "rules fail"
+        }
+    );
+    if let Some(e) = &r.error {
+        let _ = writeln!(s, "ERROR: {e}");
+    }
+    s
+}
+
+/// The report as one JSON document (pretty-printed, ending with a newline),
+/// with the exit code.
+pub fn render_json(r: &ConformReport) -> String {
+    let mut doc = serde_json::to_value(r)
+        .unwrap_or_else(|e| serde_json::json!({"error": format!("serializing the report: {e}")}));
+    if let Some(map) = doc.as_object_mut() {
+        map.insert("exit_code".into(), r.outcome().exit_code().into());
+        map.insert(
+            "failing_rules".into(),
+            r.rules
+                .iter()
+                .filter(|x| x.failed > 0)
+                .map(|x| x.rule)
+                .collect::<Vec<_>>()
+                .into(),
+        );
+    }
+    let mut s = serde_json::to_string_pretty(&doc).unwrap_or_default();
+    s.push('\n');
+    s
+}

@@ -1,0 +1,476 @@
+//! The running engine: a child process, a writer thread feeding its stdin,
+//! a reader thread splitting its stdout into lines, a thread keeping the
+//! last lines of its stderr.
+
+use std::collections::VecDeque;
+use std::io::{BufRead, BufReader, BufWriter, Read, Write};
+use std::process::{Child, ChildStdin, Command, ExitStatus, Stdio};
+use std::sync::mpsc::{self, Receiver, RecvTimeoutError, Sender};
+use std::sync::{Arc, Mutex};
+use std::time::{Duration, Instant};
+
+use crate::trace::messages::{OutcomeMsg, SceneMsg, SweepMsg};
+
+use super::protocol::{MAX_ANSWER_BYTES, parse_answer, scene_line, sweep_line};
+use super::{EngineCommand, EngineError, EngineOptions, STDERR_TAIL_LINES};
+
+/// What the reader thread saw on the engine's stdout.
+enum Output {
+    Line(Vec<u8>),
+    TooLong,
+    End,
+    Failed(std::io::Error),
+}
+
+/// The last lines of the engine's stderr, shared with the thread reading it.
+#[derive(Clone, Default)]
+struct StderrTail {
+    lines: Arc<Mutex<(VecDeque<String>, bool)>>,
+}
+
+impl StderrTail {
+    fn push(&self, line: String) {
+        if let Ok(mut guard) = self.lines.lock() {
+            let (lines, _) = &mut *guard;
+            if lines.len() == STDERR_TAIL_LINES {
+                lines.pop_front();
+            }
+            lines.push_back(line);
+        }
+    }
+
+    fn close(&self) {
+        if let Ok(mut guard) = self.lines.lock() {
+            guard.1 = true;
+        }
+    }
+
+    /// The lines so far, after waiting up to `wait` for the stream's end
+    /// (an engine that crashed has usually written its last words).
+    fn snapshot(&self, wait: Duration) -> Vec<String> {
+        let deadline = Instant::now() + wait;
+        loop {
+            let closed = self.lines.lock().map(|g| g.1).unwrap_or(true);
+            if closed || Instant::now() >= deadline {
+                break;
+            }
+            std::thread::sleep(Duration::from_millis(5));
+        }
+        self.lines
+            .lock()
+            .map(|g| g.0.iter().cloned().collect())
+            .unwrap_or_default()
+    }
+}
+
+/// A running engine. Dropping it stops the engine if it still runs.
+pub struct EngineSession {
+    command: EngineCommand,
+    options: EngineOptions,
+    child: Child,
+    to_engine: Option<Sender<String>>,
+    from_engine: Receiver<Output>,
+    stderr: StderrTail,
+    /// Output lines read, for messages.
+    lines_read: u64,
+    /// Answers read.
+    answered: u64,
+}
+
+impl std::fmt::Debug for EngineSession {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("EngineSession")
+            .field("command", &self.command.text)
+            .field("answered", &self.answered)
+            .finish_non_exhaustive()
+    }
+}
+
+impl EngineSession {
+    /// Starts the engine. [`EngineError::CannotStart`] when its program
+    /// cannot be run.
+    pub fn start(
+        command: &EngineCommand,
+        options: EngineOptions,
+    ) -> Result<EngineSession, EngineError> {
+        let mut child = Command::new(&command.program)
+            .args(&command.arguments)
+            .stdin(Stdio::piped())
+            .stdout(Stdio::piped())
+            .stderr(Stdio::piped())
+            .spawn()
+            .map_err(|e| EngineError::CannotStart {
+                command: command.text.clone(),
+                reason: format!("{}: {e}", command.program),
+                stderr_tail: Vec::new(),
+            })?;
+        let io_error = |what, source| EngineError::Io {
+            command: command.text.clone(),
+            what,
+            source,
+        };
+        let missing = || std::io::Error::other("the pipe was not created");
+        let stdin = child
+            .stdin
+            .take()
+            .ok_or_else(|| io_error("stdin", missing()))?;
+        let stdout = child
+            .stdout
+            .take()
+            .ok_or_else(|| io_error("stdout", missing()))?;
+        let stderr = child
+            .stderr
+            .take()
+            .ok_or_else(|| io_error("stderr", missing()))?;
+        let (to_engine, lines_to_write) = mpsc::channel::<String>();
+        let (output, from_engine) = mpsc::channel::<Output>();
+        let tail = StderrTail::default();
+        let spawn = |name: &str, f: Box<dyn FnOnce() + Send>| {
+            std::thread::Builder::new()
+                .name(name.to_string())
+                .spawn(f)
+                .map_err(|e| io_error("starting a thread", e))
+        };
+        let session = EngineSession {
+            command: command.clone(),
+            options,
+            child,
+            to_engine: Some(to_engine),
+            from_engine,
+            stderr: tail.clone(),
+            lines_read: 0,
+            answered: 0,
+        };
+        spawn(
+            "engine stdin",
+            Box::new(move || write_lines(stdin, lines_to_write)),
+        )?;
+        spawn(
+            "engine stdout",
+            Box::new(move || read_lines(stdout, output)),
+        )?;
+        spawn("engine stderr", Box::new(move || keep_tail(stderr, tail)))?;
+        // The threads run until the pipes close; a failure to start one
+        // drops the session, which stops the engine.
+        Ok(session)
+    }
+
+    /// The command.
+    pub fn command(&self) -> &EngineCommand {
+        &self.command
+    }
+
+    /// Answers read so far.
+    pub fn answered(&self) -> u64 {
+        self.answered
+    }
+
+    /// Sends a scene (the engine does not answer it).
+    pub fn send_scene(&mut self, scene: &SceneMsg) -> Result<(), EngineError> {
+        let line = scene_line(scene).map_err(|e| self.io("encoding a scene", e.into()))?;
+        self.send(line);
+        Ok(())
+    }
+
+    /// Sends a sweep; its answer comes later, in order ([`Self::next_answer`]).
+    pub fn send_sweep(&mut self, sweep: &SweepMsg) -> Result<(), EngineError> {
+        let line = sweep_line(sweep).map_err(|e| self.io("encoding a sweep", e.into()))?;
+        self.send(line);
+        Ok(())
+    }
+
+    fn send(&mut self, line: String) {
+        // A writer that has gone (the engine closed its input) shows up as
+        // the engine's exit or silence when its answer is awaited.
+        if let Some(tx) = &self.to_engine {
+            let _ = tx.send(line);
+        }
+    }
+
+    fn io(&self, what: &'static str, source: std::io::Error) -> EngineError {
+        EngineError::Io {
+            command: self.command.text.clone(),
+            what,
+            source,
+        }
+    }
+
+    /// The answer to the sweep `due` (frame, ball): the engine's next output
+    /// line, which must be an outcome of that sweep, within the timeout.
+    pub fn next_answer(&mut self, due: (u64, u32)) -> Result<OutcomeMsg, EngineError> {
+        match self.from_engine.recv_timeout(self.options.timeout) {
+            Ok(Output::Line(line)) => {
+                self.lines_read += 1;
+                let answer = parse_answer(&line)
+                    .map_err(|reason| self.not_an_outcome(&line, reason, Some(due)))?;
+                if (answer.frame, answer.ball) != due {
+                    return Err(EngineError::WrongSweep {
+                        command: self.command.text.clone(),
+                        line_number: self.lines_read,
+                        answered_frame: answer.frame,
+                        answered_ball: answer.ball,
+                        due_frame: due.0,
+                        due_ball: due.1,
+                    });
+                }
+                self.answered += 1;
+                Ok(answer)
+            }
+            Ok(Output::TooLong) => {
+                self.lines_read += 1;
+                Err(self.not_an_outcome(
+                    b"",
+                    format!("it is longer than {MAX_ANSWER_BYTES} bytes"),
+                    Some(due),
+                ))
+            }
+            Ok(Output::Failed(e)) => Err(self.io("reading its output", e)),
+            Ok(Output::End) | Err(RecvTimeoutError::Disconnected) => Err(self.ended(Some(due))),
+            Err(RecvTimeoutError::Timeout) => {
+                self.stop();
+                Err(EngineError::Timeout {
+                    command: self.command.text.clone(),
+                    seconds: self.options.timeout.as_secs_f64(),
+                    frame: due.0,
+                    ball: due.1,
+                    answered: self.answered,
+                    stderr_tail: self.stderr.snapshot(Duration::from_millis(200)),
+                })
+            }
+        }
+    }
+
+    fn not_an_outcome(
+        &mut self,
+        line: &[u8],
+        reason: String,
+        due: Option<(u64, u32)>,
+    ) -> EngineError {
+        let text = String::from_utf8_lossy(line);
+        let cut: String = text.trim_end().chars().take(200).collect();
+        self.stop();
+        EngineError::NotAnOutcome {
+            command: self.command.text.clone(),
+            line_number: self.lines_read,
+            line: cut,
+            reason,
+            due,
+            stderr_tail: self.stderr.snapshot(Duration::from_millis(200)),
+        }
+    }
+
+    /// The engine closed its output: how it ended.
+    fn ended(&mut self, due: Option<(u64, u32)>) -> EngineError {
+        let status = self.wait_for_exit(self.options.timeout);
+        let stderr_tail = self.stderr.snapshot(Duration::from_millis(500));
+        let how = match status {
+            Some(s) => describe_status(s),
+            None => {
+                self.stop();
+                "closed its output".to_string()
+            }
+        };
+        let shell_cannot_run = status
+            .and_then(|s| s.code())
+            .is_some_and(|c| c == 126 || c == 127);
+        if self.answered == 0 && shell_cannot_run {
+            return EngineError::CannotStart {
+                command: self.command.text.clone(),
+                reason: how,
+                stderr_tail,
+            };
+        }
+        EngineError::Exited {
+            command: self.command.text.clone(),
+            how,
+            answered: self.answered,
+            due,
+            stderr_tail,
+        }
+    }
+
+    /// Closes the engine's input and waits for it to exit: every sweep has
+    /// been answered, so any further output line, a failure status or not
+    /// exiting within the timeout is a fault.
+    pub fn finish(mut self) -> Result<(), EngineError> {
+        self.to_engine = None;
+        let deadline = Instant::now() + self.options.timeout;
+        let left = deadline.saturating_duration_since(Instant::now());
+        match self.from_engine.recv_timeout(left) {
+            Ok(Output::Line(line)) => {
+                self.lines_read += 1;
+                let reason = "every sweep was already answered".to_string();
+                return Err(self.not_an_outcome(&line, reason, None));
+            }
+            Ok(Output::TooLong) => {
+                self.lines_read += 1;
+                let reason = "every sweep was already answered".to_string();
+                return Err(self.not_an_outcome(b"", reason, None));
+            }
+            Ok(Output::Failed(e)) => return Err(self.io("reading its output", e)),
+            Ok(Output::End) | Err(RecvTimeoutError::Disconnected) => {}
+            Err(RecvTimeoutError::Timeout) => {
+                self.stop();
+                return Err(EngineError::DoesNotExit {
+                    command: self.command.text.clone(),
+                    seconds: self.options.timeout.as_secs_f64(),
+                });
+            }
+        }
+        let left = deadline.saturating_duration_since(Instant::now());
+        match self.wait_for_exit(left) {
+            Some(status) if status.success() => Ok(()),
+            Some(_) => Err(self.ended(None)),
+            None => {
+                self.stop();
+                Err(EngineError::DoesNotExit {
+                    command: self.command.text.clone(),
+                    seconds: self.options.timeout.as_secs_f64(),
+                })
+            }
+        }
+    }
+
+    /// Waits up to `limit` for the engine to exit.
+    fn wait_for_exit(&mut self, limit: Duration) -> Option<ExitStatus> {
+        let deadline = Instant::now() + limit;
+        loop {
+            match self.child.try_wait() {
+                Ok(Some(status)) => return Some(status),
+                Ok(None) if Instant::now() < deadline => {
+                    std::thread::sleep(Duration::from_millis(2));
+                }
+                _ => return None,
+            }
+        }
+    }
+
+    /// Stops the engine (if it still runs) and reaps it.
+    fn stop(&mut self) {
+        self.to_engine = None;
+        if let Ok(None) = self.child.try_wait() {
+            let _ = self.child.kill();
+        }
+        let _ = self.child.wait();
+    }
+}
+
+impl Drop for EngineSession {
+    fn drop(&mut self) {
+        self.stop();
+    }
+}
+
+/// `exited with status 1`, `was killed by signal 9 (SIGKILL)`.
+fn describe_status(status: ExitStatus) -> String {
+    if let Some(code) = status.code() {
+        return format!("exited with status {code}");
+    }
+    #[cfg(unix)]
+    {
+        use std::os::unix::process::ExitStatusExt;
+        if let Some(signal) = status.signal() {
+            let name = match signal {
+                6 => " (SIGABRT)",
+                9 => " (SIGKILL)",
+                11 => " (SIGSEGV)",
+                13 => " (SIGPIPE)",
+                15 => " (SIGTERM)",
+                _ => "",
+            };
+            return format!("was killed by signal {signal}{name}");
+        }
+    }
+    format!("ended ({status})")
+}
+
+/// The writer thread: lines to the engine's stdin, flushed whenever no
+/// further line is waiting, so the engine never waits for a sweep that sits
+/// in our buffer.
+fn write_lines(stdin: ChildStdin, lines: Receiver<String>) {
+    block_sigpipe_in_this_thread();
+    let mut out = BufWriter::with_capacity(1 << 16, stdin);
+    while let Ok(line) = lines.recv() {
+        if out.write_all(line.as_bytes()).is_err() {
+            return;
+        }
+        let mut more = true;
+        while more {
+            match lines.try_recv() {
+                Ok(line) => {
+                    if out.write_all(line.as_bytes()).is_err() {
+                        return;
+                    }
+                }
+                Err(_) => more = false,
+            }
+        }
+        if out.flush().is_err() {
+            return;
+        }
+    }
+    // The sender is gone: closing stdin tells the engine the input ended.
+    let _ = out.flush();
+}
+
+/// A write to an engine that has exited must fail with `EPIPE` here, not
+/// end this process: the command line restores SIGPIPE's default action
+/// (to end quietly under `| head`), and a write to a closed pipe raises
+/// SIGPIPE in the writing thread, where it is blocked.
+fn block_sigpipe_in_this_thread() {
+    #[cfg(unix)]
+    // SAFETY: `set` is initialised by sigemptyset before use; blocking a
+    // signal in the calling thread has no other effect.
+    unsafe {
+        let mut set: libc::sigset_t = std::mem::zeroed();
+        libc::sigemptyset(&mut set);
+        libc::sigaddset(&mut set, libc::SIGPIPE);
+        libc::pthread_sigmask(libc::SIG_BLOCK, &set, std::ptr::null_mut());
+    }
+}
+
+/// The reader thread: the engine's stdout, line by line.
+fn read_lines(stdout: impl Read, output: Sender<Output>) {
+    let mut reader = BufReader::with_capacity(1 << 16, stdout);
+    loop {
+        let mut line = Vec::new();
+        let limit = MAX_ANSWER_BYTES as u64 + 1;
+        match (&mut reader).take(limit).read_until(b'\n', &mut line) {
+            Ok(0) => {
+                let _ = output.send(Output::End);
+                return;
+            }
+            Ok(n) if n as u64 == limit && line.last() != Some(&b'\n') => {
+                let _ = output.send(Output::TooLong);
+                return;
+            }
+            Ok(_) => {
+                if output.send(Output::Line(line)).is_err() {
+                    return;
+                }
+            }
+            Err(e) if e.kind() == std::io::ErrorKind::Interrupted => {}
+            Err(e) => {
+                let _ = output.send(Output::Failed(e));
+                return;
+            }
+        }
+    }
+}
+
+/// The stderr thread: keeps the last lines (each cut to 300 characters).
+fn keep_tail(stderr: impl Read, tail: StderrTail) {
+    let mut reader = BufReader::new(stderr);
+    let mut line = Vec::new();
+    loop {
+        line.clear();
+        match (&mut reader).take(1 << 16).read_until(b'\n', &mut line) {
+            Ok(0) | Err(_) => break,
+            Ok(_) => {
+                let text = String::from_utf8_lossy(&line);
+                tail.push(text.trim_end().chars().take(300).collect());
+            }
+        }
+    }
+    tail.close();
+}

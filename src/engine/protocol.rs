@@ -1,0 +1,105 @@
+//! The lines of the engine protocol (`docs/ENGINE_PROTOCOL.md`): the trace
+//! format's JSON messages ([`SceneMsg`], [`SweepMsg`], [`OutcomeMsg`]) with
+//! a `type` tag, one per line.
+
+use serde_json::{Map, Value};
+
+use crate::trace::messages::{OutcomeMsg, SceneMsg, SweepMsg};
+use crate::trace::validate::validate_outcome;
+
+/// The longest output line accepted from an engine, in bytes.
+pub const MAX_ANSWER_BYTES: usize = 1 << 16;
+
+/// `{"type":"scene", ...the /scene fields}` and a newline.
+pub fn scene_line(scene: &SceneMsg) -> Result<String, serde_json::Error> {
+    tagged("scene", serde_json::to_string(scene)?)
+}
+
+/// `{"type":"sweep","frame":..,"ball":..,"radius":..,"p0":[..],"p1":[..]}`
+/// and a newline. Numbers are shortest round-trip decimals: an engine that
+/// parses them correctly gets the trace's bits.
+pub fn sweep_line(sweep: &SweepMsg) -> Result<String, serde_json::Error> {
+    tagged("sweep", serde_json::to_string(sweep)?)
+}
+
+fn tagged(tag: &str, object: String) -> Result<String, serde_json::Error> {
+    // `object` is a JSON object with at least one field: `{"..`.
+    let rest = object.strip_prefix('{').unwrap_or(&object);
+    Ok(format!("{{\"type\":\"{tag}\",{rest}\n"))
+}
+
+/// Parses one answer line: a JSON object with the fields of `/expected`
+/// (`frame`, `alpha` and `kind` required, the others optional) and
+/// optionally `"type": "outcome"`. The error says what is wrong, naming the
+/// field.
+pub fn parse_answer(line: &[u8]) -> Result<OutcomeMsg, String> {
+    let text = std::str::from_utf8(line).map_err(|_| "it is not UTF-8 text".to_string())?;
+    let text = text.trim();
+    let mut object: Map<String, Value> = match serde_json::from_str::<Value>(text) {
+        Ok(Value::Object(o)) => o,
+        Ok(_) => return Err("it is not a JSON object".to_string()),
+        Err(e) => return Err(format!("it is not valid JSON ({e})")),
+    };
+    match object.remove("type") {
+        None => {}
+        Some(Value::String(t)) if t == "outcome" => {}
+        Some(other) => {
+            return Err(format!(
+                "field `type`: an answer is of type \"outcome\", got {other}"
+            ));
+        }
+    }
+    let outcome: OutcomeMsg =
+        serde_path_to_error::deserialize(Value::Object(object)).map_err(|e| {
+            let path = e.path().to_string();
+            if path == "." {
+                e.inner().to_string()
+            } else {
+                format!("field `{path}`: {}", e.inner())
+            }
+        })?;
+    validate_outcome(&outcome).map_err(|p| format!("field `{}`: {}", p.field, p.problem))?;
+    Ok(outcome)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn lines_are_tagged_messages() {
+        let sweep = SweepMsg {
+            frame: 3,
+            ball: 1,
+            radius: 0.5,
+            p0: [0.1, 0.0, 3.0],
+            p1: [0.1, 0.0, -3.0],
+        };
+        assert_eq!(
+            sweep_line(&sweep).unwrap(),
+            "{\"type\":\"sweep\",\"frame\":3,\"ball\":1,\"radius\":0.5,\"p0\":[0.1,0.0,3.0],\"p1\":[0.1,0.0,-3.0]}\n"
+        );
+        let answer = parse_answer(
+            br#"{"type":"outcome","frame":3,"ball":1,"alpha":0.5,"kind":"face","triangle":0}"#,
+        )
+        .unwrap();
+        assert_eq!(answer.frame, 3);
+        assert_eq!(answer.triangle, Some(Some(0)));
+        assert_eq!(answer.normal, None);
+        assert!(
+            parse_answer(b"hello")
+                .unwrap_err()
+                .contains("not valid JSON")
+        );
+        assert!(
+            parse_answer(br#"{"frame":3,"alpha":2,"kind":"face"}"#)
+                .unwrap_err()
+                .contains("alpha")
+        );
+        assert!(
+            parse_answer(br#"{"frame":3,"alpha":0.5,"kind":"side"}"#)
+                .unwrap_err()
+                .contains("kind")
+        );
+    }
+}

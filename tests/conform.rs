@@ -1,0 +1,240 @@
+//! `conform`: the built-in suite is what it says (each case decides the
+//! kind its rule names), the example engine passes it, and each deliberate
+//! bug of the example engine fails exactly the rules it breaks.
+
+use std::time::Duration;
+
+use libtest_mimic::Trial;
+use sweeptrace::conform::{RULES, cases};
+use sweeptrace::core::{Mesh, Options, Sweep, sweep_mesh};
+
+use crate::engine::example_engine_command;
+use crate::support::run_bin;
+use crate::{ensure, os, trial};
+
+const LIMIT: Duration = Duration::from_secs(60);
+
+pub fn tests() -> Vec<Trial> {
+    vec![
+        trial!(every_case_decides_the_kind_of_its_rule),
+        trial!(example_engine_passes_every_rule, timeout = LIMIT),
+        trial!(
+            skip_vertex_bug_fails_exactly_the_vertex_rules,
+            timeout = LIMIT
+        ),
+        trial!(
+            ignore_margin_bug_fails_exactly_the_margin_rules,
+            timeout = LIMIT
+        ),
+        trial!(
+            strict_facing_bug_fails_exactly_the_in_plane_rules,
+            timeout = LIMIT
+        ),
+        trial!(repro_command_runs_one_case, timeout = LIMIT),
+        trial!(conform_engine_not_found_exits_125, timeout = LIMIT),
+        trial!(cases_written_as_a_trace_check_the_same, timeout = LIMIT),
+    ]
+}
+
+fn every_case_decides_the_kind_of_its_rule() -> Result<(), String> {
+    let all = cases();
+    for rule in RULES {
+        ensure!(
+            all.iter().any(|c| c.rule == rule.name),
+            "rule {} has no case",
+            rule.name
+        );
+    }
+    for (i, case) in all.iter().enumerate() {
+        ensure!(
+            RULES.iter().any(|r| r.name == case.rule),
+            "{}: not a listed rule",
+            case.id()
+        );
+        ensure!(
+            case.sweep.frame == i as u64,
+            "{}: frame {}",
+            case.id(),
+            case.sweep.frame
+        );
+        let mesh = Mesh::new(case.scene.vertices.clone(), &case.scene.triangles)
+            .map_err(|e| format!("{}: {e}", case.id()))?;
+        let options = Options {
+            margin: case.scene.margin,
+            facing: case.scene.facing,
+        };
+        let s = &case.sweep;
+        let outcome = sweep_mesh(&mesh, &Sweep::new(s.p0, s.p1, s.radius), &options)
+            .map_err(|e| format!("{}: {e}", case.id()))?;
+        ensure!(
+            outcome.kind == case.kind,
+            "{} ({}): the core decides {}, the case says {}",
+            case.id(),
+            case.what,
+            outcome.kind,
+            case.kind
+        );
+    }
+    Ok(())
+}
+
+/// `conform --json` with the example engine and `extra` arguments: exit
+/// code and the document.
+fn conform_json(extra: &str) -> Result<(i32, serde_json::Value), String> {
+    let engine = example_engine_command(extra);
+    let (code, stdout, stderr) = run_bin(os!("conform", "--engine", &engine, "--json"))?;
+    let doc =
+        serde_json::from_str(&stdout).map_err(|e| format!("not JSON ({e}): {stdout}\n{stderr}"))?;
+    Ok((code, doc))
+}
+
+fn failing_rules(doc: &serde_json::Value) -> Vec<String> {
+    doc["failing_rules"]
+        .as_array()
+        .map(|a| {
+            a.iter()
+                .filter_map(|v| v.as_str().map(str::to_string))
+                .collect()
+        })
+        .unwrap_or_default()
+}
+
+fn example_engine_passes_every_rule() -> Result<(), String> {
+    let (code, doc) = conform_json("")?;
+    ensure!(code == 0, "exit {code}: {doc}");
+    let total = cases().len() as u64;
+    ensure!(
+        doc["cases"] == total && doc["passed"] == total && doc["failed"] == 0,
+        "counts: {doc}"
+    );
+    ensure!(
+        doc["rules"].as_array().map(Vec::len) == Some(RULES.len()),
+        "one line per rule: {doc}"
+    );
+    Ok(())
+}
+
+fn expect_failing(bug: &str, want: &[&str]) -> Result<serde_json::Value, String> {
+    let (code, doc) = conform_json(&format!("--bug {bug}"))?;
+    ensure!(code == 1, "--bug {bug}: exit {code}, want 1");
+    let got = failing_rules(&doc);
+    ensure!(
+        got == want,
+        "--bug {bug}: failing rules {got:?}, want {want:?}"
+    );
+    for rule in doc["rules"].as_array().into_iter().flatten() {
+        let failed = rule["failed"].as_u64().unwrap_or(0);
+        let first = &rule["first_failure"];
+        ensure!(
+            failed == 0
+                || first["repro"]
+                    .as_str()
+                    .is_some_and(|r| r.contains("--case")),
+            "a failing rule shows its first case and a repro: {rule}"
+        );
+    }
+    Ok(doc)
+}
+
+fn skip_vertex_bug_fails_exactly_the_vertex_rules() -> Result<(), String> {
+    expect_failing(
+        "skip-vertex",
+        &[
+            "edge.miss.beyond-v1",
+            "edge.miss.before-v0",
+            "vertex.hit",
+            "tie.shared-vertex",
+            "cube.corner",
+            "margin.vertex-hit",
+        ],
+    )?;
+    Ok(())
+}
+
+fn ignore_margin_bug_fails_exactly_the_margin_rules() -> Result<(), String> {
+    expect_failing(
+        "ignore-margin",
+        &["margin.face-hit", "margin.edge-miss", "margin.vertex-hit"],
+    )?;
+    Ok(())
+}
+
+fn strict_facing_bug_fails_exactly_the_in_plane_rules() -> Result<(), String> {
+    // Both are paths with n·d = 0 for a triangle that must report the hit:
+    // the in-plane approach, and the cube edge whose +x triangle the path
+    // runs parallel to (its normal then misses from the average).
+    let doc = expect_failing(
+        "strict-facing",
+        &["tie.shared-edge.cube", "facing.non-strict"],
+    )?;
+    ensure!(
+        doc["fragile"] == 2,
+        "both on grazing (fragile) decisions: {doc}"
+    );
+    Ok(())
+}
+
+fn repro_command_runs_one_case() -> Result<(), String> {
+    let engine = example_engine_command("--bug skip-vertex");
+    let (code, stdout, stderr) = run_bin(os!(
+        "conform",
+        "--engine",
+        &engine,
+        "--case",
+        "vertex.hit/1"
+    ))?;
+    ensure!(code == 1, "exit {code}:\n{stdout}\n{stderr}");
+    for want in [
+        "FAIL    vertex.hit  0 passed, 1 failed, 0 fragile  (1 case)",
+        "first failing case: vertex.hit/1 (slanted onto vertex 2)",
+        "kind: engine none, core vertex",
+        "primary: vertex 0.2",
+        "1 rules, 1 cases",
+    ] {
+        ensure!(stdout.contains(want), "missing `{want}` in:\n{stdout}");
+    }
+    let (code, _, stderr) = run_bin(os!("conform", "--engine", &engine, "--case", "vertex.hop"))?;
+    ensure!(
+        code == 2 && stderr.contains("no conformance case or rule `vertex.hop`"),
+        "unknown case: exit {code}: {stderr}"
+    );
+    Ok(())
+}
+
+fn conform_engine_not_found_exits_125() -> Result<(), String> {
+    let (code, _, stderr) = run_bin(os!("conform", "--engine", "./no/such/engine"))?;
+    ensure!(
+        code == 125 && stderr.contains("cannot be started"),
+        "exit {code}: {stderr}"
+    );
+    Ok(())
+}
+
+fn cases_written_as_a_trace_check_the_same() -> Result<(), String> {
+    let dir = tempfile::tempdir().map_err(|e| e.to_string())?;
+    let trace = dir.path().join("vertex.mcap");
+    let (code, _, stderr) = run_bin(os!(
+        "conform",
+        "--case",
+        "vertex.hit",
+        "--write-trace",
+        trace.as_os_str()
+    ))?;
+    ensure!(code == 0, "exit {code}: {stderr}");
+    ensure!(
+        stderr.contains("2 cases; frame N is case N: 21 vertex.hit/0, 22 vertex.hit/1"),
+        "names the frames: {stderr}"
+    );
+    let (code, stdout, _) = run_bin(os!("sweep", "--trace", trace.as_os_str(), "--frame", "22"))?;
+    ensure!(
+        code == 0 && stdout.contains("outcome: vertex collision"),
+        "sweep --trace on case 22: exit {code}:\n{stdout}"
+    );
+    let engine = example_engine_command("--bug skip-vertex");
+    let (code, stdout, _) = run_bin(os!("check", trace.as_os_str(), "--engine", &engine))?;
+    ensure!(
+        code == 1 && stdout.contains("2 of 2 compared sweeps diverge (none -> vertex: 2)"),
+        "check --engine on the cases: exit {code}:\n{stdout}"
+    );
+    Ok(())
+}

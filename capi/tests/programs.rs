@@ -15,12 +15,12 @@ fn root() -> PathBuf {
         .to_path_buf()
 }
 
-/// Where cargo put this build's libraries: the test binary is in
-/// `<target>/<profile>/deps/`, the libraries in `<target>/<profile>/`.
+/// Where cargo put this build's libraries: beside the test binary, in
+/// `<target>/<profile>/deps/` (a test build does not copy them up to
+/// `<target>/<profile>/`, where an older build's may lie).
 fn library_dir() -> PathBuf {
     let exe = std::env::current_exe().expect("the test binary's path");
     exe.parent()
-        .and_then(Path::parent)
         .expect("the test binary is in <target>/<profile>/deps")
         .to_path_buf()
 }
@@ -148,5 +148,16 @@ fn process_ending_before_close_leaves_no_file_under_the_target_name() {
         !trace.exists(),
         "{} exists although the writer was never closed",
         trace.display()
+    );
+}
+
+#[test]
+fn readme_shows_the_tested_c_example_unchanged() {
+    let example = std::fs::read_to_string(root().join("examples/c/write_trace.c"))
+        .expect("reading examples/c/write_trace.c");
+    let readme = std::fs::read_to_string(root().join("README.md")).expect("reading README.md");
+    assert!(
+        readme.contains(&format!("```c\n{example}```\n")),
+        "README.md does not show examples/c/write_trace.c as it is: copy the file into its ```c block"
     );
 }

@@ -67,7 +67,8 @@ typedef enum SweeptraceFacing {
 } SweeptraceFacing;
 
 // A trace being written. Opaque: made by [`sweeptrace_writer_open`],
-// released by [`sweeptrace_writer_free`].
+// released by [`sweeptrace_writer_free`]. Use each writer from one thread
+// at a time; different writers may be used on different threads.
 typedef struct SweeptraceWriter SweeptraceWriter;
 
 // What an engine decided for one sweep: an `/expected` message.

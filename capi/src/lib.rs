@@ -132,7 +132,8 @@ enum State {
 }
 
 /// A trace being written. Opaque: made by [`sweeptrace_writer_open`],
-/// released by [`sweeptrace_writer_free`].
+/// released by [`sweeptrace_writer_free`]. Use each writer from one thread
+/// at a time; different writers may be used on different threads.
 pub struct SweeptraceWriter {
     state: State,
     /// Triangles of the current scene, for checking expected triangles.

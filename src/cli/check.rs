@@ -25,6 +25,7 @@ Examples:
   sweeptrace check traces/                     # every *.mcap under traces/
   sweeptrace check run.mcap --tolerance 1e-4 --normal-tolerance 0.5
   sweeptrace check traces/ --json --rrd-on-failure /tmp/failures
+  sweeptrace check rapier.mcap --fields kind,alpha --tolerance 1e-5
 
 Per trace: `ok`, `FAIL` (with the first divergences explained, and every
 tunnel: a ball's centre that went through a triangle from its front to its

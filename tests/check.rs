@@ -334,11 +334,13 @@ fn rapier_sample() -> PathBuf {
 /// field is a usage error (exit 2).
 fn check_fields_option_binary() -> Result<(), String> {
     let trace = rapier_sample();
+    // Before the path: the option takes one comma-separated value, not the
+    // path after it.
     let (code, out, err) = run_bin(os![
         "check",
-        trace.as_os_str(),
         "--fields",
         "kind,alpha",
+        trace.as_os_str(),
         "--tolerance",
         "1e-5"
     ])?;

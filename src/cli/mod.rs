@@ -77,7 +77,7 @@ pub struct ToleranceArgs {
     /// field the expectation holds). For engines whose answers differ from
     /// the core's by design in the others: `--fields kind,alpha` for an
     /// engine that reports the contact normal, not the face normal.
-    #[arg(long, value_name = "FIELD,...", value_delimiter = ',', num_args = 1..)]
+    #[arg(long, value_name = "FIELD,...", value_delimiter = ',')]
     pub fields: Vec<sweeptrace::regress::Field>,
 }
 

@@ -1,7 +1,8 @@
 /* Writes a small sweeptrace trace through the C API: one triangle, three
  * sweeps of a ball and, for each, what the engine decided.
  *
- *   cc write_trace.c -I capi/include -L target/release -lsweeptrace_capi -o write_trace
+ *   cc examples/c/write_trace.c -I capi/include -L target/release -lsweeptrace_capi \
+ *      -Wl,-rpath,"$PWD/target/release" -o write_trace
  *   ./write_trace run.mcap && sweeptrace check run.mcap
  */
 #include <stdio.h>

@@ -31,7 +31,8 @@
 //! built-in scene's defaults); `--mesh` uses `record`'s defaults with
 //! `--radius` and `--position`. The output is written atomically (a
 //! temporary file renamed when complete) and is deterministic for the same
-//! options on the same machine.
+//! options on the same machine. (The integration tests include this file
+//! as a module and run [`run`].)
 
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -65,11 +66,15 @@ usage: rapier_record (--scene NAME | --mesh FILE.obj) -o OUT.mcap [options]
 example: rapier_record --scene mini_golf --balls 2 --frames 240 -o rapier_mini_golf.mcap";
 
 /// The command line.
-struct Args {
-    scene: Option<BuiltinScene>,
-    mesh: Option<PathBuf>,
-    output: PathBuf,
-    options: SimOptions,
+pub struct Args {
+    /// The built-in scene, or
+    pub scene: Option<BuiltinScene>,
+    /// an OBJ mesh.
+    pub mesh: Option<PathBuf>,
+    /// The trace to write.
+    pub output: PathBuf,
+    /// Balls, frames, radius, time step, gravity, restitution.
+    pub options: SimOptions,
 }
 
 fn parse_args() -> Result<Args, String> {
@@ -182,7 +187,7 @@ fn classify(corners: [Vector; 3], witness: Vector, normal: Vector) -> (Kind, Opt
 
 /// Writes the trace; returns the sweeps, Rapier's hits, and the sweeps
 /// that start in contact (written without an expectation).
-fn run(args: Args) -> Result<(u64, u64, u64), String> {
+pub fn run(args: Args) -> Result<(u64, u64, u64), String> {
     let scene: SceneMesh = match (&args.scene, &args.mesh) {
         (Some(builtin), _) => builtin.mesh(),
         (None, Some(path)) => load_obj(path).map_err(|e| e.to_string())?,

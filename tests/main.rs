@@ -13,6 +13,11 @@ mod core_random;
 mod oracle;
 mod outputs;
 mod prefetch;
+mod rapier;
+// The Rapier recorder example, run by `rapier` (its `main` is unused here).
+#[allow(dead_code)]
+#[path = "../examples/rapier_record.rs"]
+mod rapier_record;
 mod record;
 mod replay;
 mod repro;
@@ -95,5 +100,6 @@ fn main() {
     trials.extend(repro::tests());
     trials.extend(alt_engine::tests());
     trials.extend(scanned::tests());
+    trials.extend(rapier::tests());
     libtest_mimic::run(&args, trials).exit();
 }

@@ -42,7 +42,7 @@ if [ "$#" -gt 0 ]; then
     traces=("$@")
 else
     shopt -s nullglob
-    traces=(traces/*.mcap tests/fixtures/wrong_engine_config.mcap tests/fixtures/tunnel_floor.mcap)
+    traces=(traces/*.mcap examples/rapier/rapier_mini_golf.mcap tests/fixtures/wrong_engine_config.mcap tests/fixtures/tunnel_floor.mcap)
     shopt -u nullglob
 fi
 if [ "${#traces[@]}" -eq 0 ]; then

@@ -1,8 +1,11 @@
 //! Regression checking, blessing and diffing.
 //!
-//! Every `*.mcap` under `traces/` (found at run time, so adding a trace
-//! needs no code) is a test case of its own, checked with the same library
-//! code as `sweeptrace check`.
+//! Every `*.mcap` under `traces/` and `examples/rapier/` (found at run
+//! time, so adding a trace needs no code) is a test case of its own, checked
+//! with the same library code as `sweeptrace check`; a trace with a
+//! `NAME.check-flags` file beside it (one line of `check` options, for a
+//! trace recorded by another engine, such as the Rapier sample) is checked
+//! by the binary with those options.
 //!
 //! The fixture `tests/fixtures/wrong_engine_config.mcap` is made by the
 //! ignored generator below, from the project's own writer:
@@ -14,6 +17,7 @@
 
 use std::borrow::Cow;
 use std::collections::BTreeMap;
+use std::ffi::{OsStr, OsString};
 use std::io::Cursor;
 use std::path::{Path, PathBuf};
 
@@ -21,8 +25,8 @@ use libtest_mimic::Trial;
 use sweeptrace::core::{Facing, Kind};
 use sweeptrace::regress::bless_bytes;
 use sweeptrace::regress::{
-    CheckOptions, Field, Status, Tolerances, check_file, check_reader, compare, find_traces,
-    render_json, render_text,
+    CheckOptions, Field, FieldSet, Status, Tolerances, check_file, check_reader, compare,
+    find_traces, render_json, render_text,
 };
 use sweeptrace::regress::{Side, diff};
 use sweeptrace::replay::ReplayOptions;
@@ -42,6 +46,9 @@ pub fn tests() -> Vec<Trial> {
         trial!(compare_null_is_compared),
         trial!(compare_tolerances),
         trial!(compare_nan_never_matches),
+        trial!(compare_only_selected_fields),
+        trial!(check_fields_option_binary),
+        trial!(rapier_sample_needs_its_check_flags),
         trial!(blessed_trace_passes),
         trial!(wrong_engine_config_fixture_fails_with_frame_and_reason),
         trial!(wrong_engine_config_fixture_binary_exit_1),
@@ -60,14 +67,19 @@ pub fn tests() -> Vec<Trial> {
     trials
 }
 
-/// One trial per `*.mcap` under `traces/`, found at run time.
+/// One trial per `*.mcap` under `traces/` and `examples/rapier/`, found at
+/// run time.
 fn trace_trials() -> Vec<Trial> {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
-    let dir = root.join("traces");
-    if !dir.is_dir() {
+    let dirs: Vec<PathBuf> = ["traces", "examples/rapier"]
+        .iter()
+        .map(|d| root.join(d))
+        .filter(|d| d.is_dir())
+        .collect();
+    if dirs.is_empty() {
         return Vec::new();
     }
-    match find_traces(&[dir]) {
+    match find_traces(&dirs) {
         Ok(paths) => paths
             .into_iter()
             .map(|path| {
@@ -77,6 +89,14 @@ fn trace_trials() -> Vec<Trial> {
                     .display()
                     .to_string();
                 trial(&format!("check::trace::{name}"), move || {
+                    if let Some(flags) = check_flags(&path)? {
+                        let mut args = vec![OsString::from("check"), path.clone().into()];
+                        args.extend(flags.into_iter().map(OsString::from));
+                        let args: Vec<&OsStr> = args.iter().map(OsString::as_os_str).collect();
+                        let (code, out, err) = run_bin(&args)?;
+                        ensure!(code == 0, "exit {code}: {out}{err}");
+                        return Ok(());
+                    }
                     let report = check_file(&path, &CheckOptions::default());
                     ensure!(report.status == Status::Ok, "{}", render_text(&report));
                     Ok(())
@@ -84,6 +104,17 @@ fn trace_trials() -> Vec<Trial> {
             })
             .collect(),
         Err(e) => vec![trial("check::trace::discovery", move || Err::<(), _>(e))],
+    }
+}
+
+/// The `check` options a sample trace is checked with: the words of
+/// `NAME.check-flags` beside `NAME.mcap`, or `None` when there is none.
+fn check_flags(trace: &Path) -> Result<Option<Vec<String>>, String> {
+    let sidecar = trace.with_extension("check-flags");
+    match std::fs::read_to_string(&sidecar) {
+        Ok(text) => Ok(Some(text.split_whitespace().map(str::to_string).collect())),
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => Ok(None),
+        Err(e) => Err(format!("{}: {e}", sidecar.display())),
     }
 }
 
@@ -233,6 +264,7 @@ fn compare_tolerances() -> Result<(), String> {
         alpha: 1e-3,
         normal_degrees: 1.0,
         contact: 0.01,
+        ..Tolerances::default()
     };
     let expected = full(0, 0.5, Kind::Face);
     // 0.5° off, α 5e-4 off, contact 0.005 off: all within.
@@ -260,6 +292,119 @@ fn compare_tolerances() -> Result<(), String> {
     ensure!(
         fields == vec![Field::Alpha, Field::Normal, Field::Contact],
         "outside tolerance: {fields:?}"
+    );
+    Ok(())
+}
+
+/// An engine that reports the contact normal at an edge hit (Rapier does):
+/// the normal differs from the core's face normal, and `--fields` leaves it
+/// out of the comparison.
+fn compare_only_selected_fields() -> Result<(), String> {
+    let got = full(0, 0.5, Kind::Edge);
+    let expected = OutcomeMsg {
+        normal: Some(Some([0.0, -0.6, 0.8])),
+        ..got
+    };
+    let all = compare(&expected, &got, &Tolerances::default());
+    ensure!(
+        all.len() == 1 && all[0].field == Field::Normal,
+        "every field: {all:?}"
+    );
+    let fields = FieldSet::of(&[Field::Kind, Field::Alpha]);
+    let tol = Tolerances {
+        fields,
+        ..Tolerances::default()
+    };
+    let some = compare(&expected, &got, &tol);
+    ensure!(some.is_empty(), "kind and alpha only: {some:?}");
+    // Outside the set nothing is compared, inside it still is.
+    let wrong_alpha = OutcomeMsg {
+        alpha: 0.75,
+        ..expected
+    };
+    let d = compare(&wrong_alpha, &got, &tol);
+    ensure!(d.len() == 1 && d[0].field == Field::Alpha, "alpha: {d:?}");
+    ensure!(
+        fields.names() == "kind,alpha" && !fields.is_all() && FieldSet::ALL.is_all(),
+        "names: {}",
+        fields.names()
+    );
+    Ok(())
+}
+
+fn rapier_sample() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/rapier/rapier_mini_golf.mcap")
+}
+
+/// `check --fields`: the report names the compared fields; an unknown
+/// field is a usage error (exit 2).
+fn check_fields_option_binary() -> Result<(), String> {
+    let trace = rapier_sample();
+    // Before the path: the option takes one comma-separated value, not the
+    // path after it.
+    let (code, out, err) = run_bin(os![
+        "check",
+        "--fields",
+        "kind,alpha",
+        trace.as_os_str(),
+        "--tolerance",
+        "1e-5"
+    ])?;
+    ensure!(code == 0, "exit {code}: {out}{err}");
+    ensure!(out.contains("fields compared: kind,alpha"), "{out}");
+    let (code, out, err) = run_bin(os!["check", trace.as_os_str(), "--fields", "kind,colour"])?;
+    ensure!(
+        code == 2 && err.contains("colour"),
+        "unknown field: exit {code}: {out}{err}"
+    );
+    Ok(())
+}
+
+/// The Rapier-recorded sample fails with the default options, and without
+/// either part of its `.check-flags` (Rapier reports the contact normal at
+/// an edge hit; its α and witness points are accurate to about 1e-5), so
+/// every flag is needed and the test of the sample can fail.
+fn rapier_sample_needs_its_check_flags() -> Result<(), String> {
+    let trace = rapier_sample();
+    let flags =
+        check_flags(&trace)?.ok_or("examples/rapier/rapier_mini_golf.check-flags is missing")?;
+    ensure!(
+        flags
+            == [
+                "--fields",
+                "kind,triangle,feature,alpha,contact",
+                "--tolerance",
+                "1e-5",
+                "--contact-tolerance",
+                "1e-5"
+            ],
+        "the flags changed ({flags:?}): update this test"
+    );
+    let (code, out, err) = run_bin(os!["check", trace.as_os_str()])?;
+    ensure!(code == 1, "default options: exit {code}: {out}{err}");
+    let (code, out, err) = run_bin(os![
+        "check",
+        trace.as_os_str(),
+        "--tolerance",
+        "1e-5",
+        "--contact-tolerance",
+        "1e-5"
+    ])?;
+    ensure!(
+        code == 1
+            && out.contains("1 of 556 compared sweeps diverge")
+            && out.contains("normal: expected"),
+        "every field: exit {code}: {out}{err}"
+    );
+    let (code, out, err) = run_bin(os![
+        "check",
+        trace.as_os_str(),
+        "--fields",
+        "kind,triangle,feature,alpha,contact"
+    ])?;
+    ensure!(
+        code == 1 && out.contains("alpha: expected"),
+        "default tolerances: exit {code}: {out}{err}"
     );
     Ok(())
 }

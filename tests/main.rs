@@ -17,6 +17,11 @@ mod foxglove;
 mod oracle;
 mod outputs;
 mod prefetch;
+mod rapier;
+// The Rapier recorder example, run by `rapier` (its `main` is unused here).
+#[allow(dead_code)]
+#[path = "../examples/rapier_record.rs"]
+mod rapier_record;
 mod record;
 mod replay;
 mod repro;
@@ -103,5 +108,6 @@ fn main() {
     trials.extend(engine::tests());
     trials.extend(conform::tests());
     trials.extend(bisect::tests());
+    trials.extend(rapier::tests());
     libtest_mimic::run(&args, trials).exit();
 }

@@ -28,15 +28,17 @@ Examples:
   sweeptrace check traces/ --json --rrd-on-failure /tmp/failures
   sweeptrace check traces/ --engine 'python3 examples/engines/sweep_engine.py'
   git bisect run sweeptrace check traces/ --engine ./build/engine
+  sweeptrace check rapier.mcap --fields kind,alpha --tolerance 1e-5
 
 With --engine, the engine runs as a child process and answers every sweep
 over stdin/stdout (docs/ENGINE_PROTOCOL.md); its answers are compared with
 the core's outcomes, as the expectations would be (in the report,
 `engine` is its answer and `core` the core's); the traces' /expected
 channels are not used. With --against expected they are compared with the
-traces' /expected channels instead (`expected`, `engine`). A fault of the engine (it crashes, prints something
-that is not an outcome, answers another sweep, does not answer within
---engine-timeout) is an error naming the sweep, with its last stderr lines.
+traces' /expected channels instead (`expected`, `engine`). A fault of the
+engine (it crashes, prints something that is not an outcome, answers
+another sweep, does not answer within --engine-timeout) is an error naming
+the sweep, with its last stderr lines.
 
 Per trace: `ok`, `FAIL` (with the first divergences explained, and every
 tunnel: a ball's centre that went through a triangle from its front to its

@@ -76,6 +76,13 @@ pub struct ToleranceArgs {
     /// Distance tolerance on the contact point, in scene units.
     #[arg(long, value_name = "D", default_value_t = sweeptrace::regress::DEFAULT_CONTACT_TOLERANCE)]
     pub contact_tolerance: f64,
+    /// Compare only these fields of each expectation (comma-separated:
+    /// kind, triangle, feature, alpha, normal, contact; default: every
+    /// field the expectation holds). For engines whose answers differ from
+    /// the core's by design in the others: `--fields kind,alpha` for an
+    /// engine that reports the contact normal, not the face normal.
+    #[arg(long, value_name = "FIELD,...", value_delimiter = ',')]
+    pub fields: Vec<sweeptrace::regress::Field>,
 }
 
 impl ToleranceArgs {
@@ -85,6 +92,11 @@ impl ToleranceArgs {
             alpha: self.tolerance,
             normal_degrees: self.normal_tolerance,
             contact: self.contact_tolerance,
+            fields: if self.fields.is_empty() {
+                sweeptrace::regress::FieldSet::ALL
+            } else {
+                sweeptrace::regress::FieldSet::of(&self.fields)
+            },
         };
         tolerances.validate().map_err(anyhow::Error::msg)?;
         Ok(tolerances)

@@ -36,7 +36,10 @@ pub const DEFAULT_CONTACT_TOLERANCE: f64 = 1e-6;
 /// - `contact`: the Euclidean distance is at most `contact`, in the scene's
 ///   length unit (default `1e-6`).
 ///
-/// `kind`, `triangle` and `feature` are compared exactly.
+/// `kind`, `triangle` and `feature` are compared exactly. `fields` limits
+/// the comparison to some fields (default: every field; `check --fields`),
+/// for engines whose answers differ from the core's by design in the others
+/// (a contact normal where the core reports the face normal, ...).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
 pub struct Tolerances {
     /// Absolute tolerance on `α`.
@@ -45,6 +48,8 @@ pub struct Tolerances {
     pub normal_degrees: f64,
     /// Distance tolerance on the contact point.
     pub contact: f64,
+    /// The fields compared (those the expectation holds among them).
+    pub fields: FieldSet,
 }
 
 impl Default for Tolerances {
@@ -53,7 +58,55 @@ impl Default for Tolerances {
             alpha: DEFAULT_ALPHA_TOLERANCE,
             normal_degrees: DEFAULT_NORMAL_TOLERANCE_DEGREES,
             contact: DEFAULT_CONTACT_TOLERANCE,
+            fields: FieldSet::ALL,
         }
+    }
+}
+
+/// A set of outcome [`Field`]s: which fields [`compare`] looks at.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct FieldSet(u8);
+
+impl FieldSet {
+    /// Every field.
+    pub const ALL: FieldSet = FieldSet(0b11_1111);
+
+    /// The set of `fields` (empty: no field).
+    pub fn of(fields: &[Field]) -> FieldSet {
+        FieldSet(fields.iter().fold(0, |bits, &f| bits | FieldSet::bit(f)))
+    }
+
+    fn bit(field: Field) -> u8 {
+        1 << field as u8
+    }
+
+    /// Whether `field` is in the set.
+    pub fn contains(self, field: Field) -> bool {
+        self.0 & FieldSet::bit(field) != 0
+    }
+
+    /// Whether the set holds every field.
+    pub fn is_all(self) -> bool {
+        self == FieldSet::ALL
+    }
+
+    /// The fields in the set, in the order of [`Field`].
+    pub fn fields(self) -> impl Iterator<Item = Field> {
+        <Field as strum::IntoEnumIterator>::iter().filter(move |&f| self.contains(f))
+    }
+
+    /// The names of the fields, comma-separated (`kind,alpha`).
+    pub fn names(self) -> String {
+        self.fields()
+            .map(Field::as_str)
+            .collect::<Vec<_>>()
+            .join(",")
+    }
+}
+
+impl Serialize for FieldSet {
+    fn serialize<S: serde::Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        serializer.collect_seq(self.fields())
     }
 }
 
@@ -152,8 +205,16 @@ fn distance(a: [f64; 3], b: [f64; 3]) -> f64 {
 /// [module documentation](self)). Returns the fields that differ, in the
 /// order kind, triangle, feature, alpha, normal, contact; empty when they
 /// match. `frame` and `ball` are not compared (they are the matching key).
-/// A NaN anywhere counts as a difference, never as a match.
+/// A NaN anywhere counts as a difference, never as a match. Fields outside
+/// `tol.fields` are not compared.
 pub fn compare(expected: &OutcomeMsg, got: &OutcomeMsg, tol: &Tolerances) -> Vec<FieldDiff> {
+    let mut out = compare_all(expected, got, tol);
+    out.retain(|d| tol.fields.contains(d.field));
+    out
+}
+
+/// [`compare`] over every field the expectation holds.
+fn compare_all(expected: &OutcomeMsg, got: &OutcomeMsg, tol: &Tolerances) -> Vec<FieldDiff> {
     let mut out = Vec::new();
     if expected.kind != got.kind {
         out.push(FieldDiff {

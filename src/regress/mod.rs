@@ -32,8 +32,8 @@ pub use check::{
 };
 pub use compare::{
     Agreement, DEFAULT_ALPHA_TOLERANCE, DEFAULT_CONTACT_TOLERANCE,
-    DEFAULT_NORMAL_TOLERANCE_DEGREES, Field, FieldDiff, Tolerances, agreement, angle_degrees,
-    compare,
+    DEFAULT_NORMAL_TOLERANCE_DEGREES, Field, FieldDiff, FieldSet, Tolerances, agreement,
+    angle_degrees, compare,
 };
 pub use diff::{DiffReport, FirstDifference, Side, diff};
 pub use explain::{ExpectedTest, expected_tests, explain_outcome, explained_records};

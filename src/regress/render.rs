@@ -137,6 +137,9 @@ pub fn render_text(r: &TraceReport) -> String {
         "{} sweeps, {} compared, {} without expectation, {} expectations without a sweep",
         r.sweeps, r.compared, r.sweeps_without_expectation, r.expectations_without_sweep
     );
+    if !r.tolerances.fields.is_all() {
+        let _ = write!(counts, ", fields compared: {}", r.tolerances.fields.names());
+    }
     if r.ties > 0 {
         let _ = write!(
             counts,

@@ -16,4 +16,4 @@ pub mod write;
 
 pub use error::{MessageAt, TraceError};
 pub use read::{ReadLimits, ReadStats, TraceEvent, TraceReader};
-pub use write::{TraceWriter, write_trace_file};
+pub use write::{PendingTrace, TraceWriter, write_trace_file};

@@ -5,7 +5,8 @@
 //! `sweeptrace` metadata record with `format_version = "1"`, the three JSON
 //! Schemas. Output is deterministic: no clock is read and zstd runs on the
 //! calling thread. Every message is checked with the reader's validation
-//! before it is written, so whatever this writer accepts, the reader reads.
+//! and size limits before it is written, so whatever this writer accepts,
+//! the reader reads.
 //!
 //! [`write_trace_file`] writes to a temporary file next to the destination
 //! and renames it only when everything succeeded: no half-written trace is
@@ -25,6 +26,7 @@ use super::messages::{
     EXPECTED_TOPIC, OUTCOME_SCHEMA, OutcomeMsg, SCENE_SCHEMA, SCENE_TOPIC, SWEEP_SCHEMA,
     SWEEP_TOPIC, SceneMsg, SweepMsg,
 };
+use super::read::{MAX_SCENE_BYTES, MAX_SMALL_MESSAGE_BYTES};
 use super::schemas::{
     FORMAT_VERSION, MESSAGE_ENCODING, METADATA_NAME, OUTCOME_SCHEMA_JSON, SCENE_SCHEMA_JSON,
     SCHEMA_ENCODING, SWEEP_SCHEMA_JSON,
@@ -156,6 +158,19 @@ impl<W: Write + Seek> TraceWriter<W> {
             field: ".".to_string(),
             detail: e.to_string(),
         })?;
+        // The reader's limits, so that whatever is written can be read.
+        let limit = if channel_id == self.scene_channel {
+            MAX_SCENE_BYTES
+        } else {
+            MAX_SMALL_MESSAGE_BYTES
+        };
+        if data.len() as u64 > limit {
+            return Err(TraceError::MessageTooLarge {
+                at: Box::new(self.at(channel, frame)),
+                bytes: data.len() as u64,
+                limit,
+            });
+        }
         let header = MessageHeader {
             channel_id,
             sequence: self.messages as u32,
@@ -247,42 +262,84 @@ impl<W: Write + Seek> TraceWriter<W> {
     }
 }
 
+/// A trace file being written: a [`TraceWriter`] on a temporary file next
+/// to the destination, renamed to the destination by
+/// [`PendingTrace::commit`] once the summary and footer are written and the
+/// data reached the disk. Dropped without a commit (an error, an abandoned
+/// writer), the temporary file is removed and the destination is untouched;
+/// a process killed while writing leaves only the temporary file
+/// (`.{name}.partial-*`, see [`crate::atomic`]), never a file under the
+/// destination name.
+pub struct PendingTrace {
+    pending: PendingFile,
+    writer: TraceWriter<BufWriter<File>>,
+    name: String,
+}
+
+impl PendingTrace {
+    /// Creates the temporary file next to `path` and starts the trace in
+    /// it (header, metadata, schemas, channels). Error messages name `path`.
+    pub fn create(path: impl AsRef<Path>) -> Result<PendingTrace, TraceError> {
+        let path = path.as_ref();
+        let name = path.display().to_string();
+        let (pending, file) =
+            PendingFile::create_seekable(path).map_err(|source| TraceError::Io {
+                file: name.clone(),
+                messages: 0,
+                source,
+            })?;
+        let writer =
+            TraceWriter::build(BufWriter::new(file), default_write_options(), name.clone())?;
+        Ok(PendingTrace {
+            pending,
+            writer,
+            name,
+        })
+    }
+
+    /// The writer, for the scenes, sweeps and outcomes.
+    pub fn writer(&mut self) -> &mut TraceWriter<BufWriter<File>> {
+        &mut self.writer
+    }
+
+    /// The destination's name, as error messages give it.
+    pub fn name(&self) -> &str {
+        &self.name
+    }
+
+    /// Finishes the trace (summary, footer), syncs it to the disk and
+    /// renames it to the destination.
+    pub fn commit(self) -> Result<(), TraceError> {
+        let PendingTrace {
+            pending,
+            writer,
+            name,
+        } = self;
+        let messages = writer.messages();
+        let io = |source: std::io::Error| TraceError::Io {
+            file: name.clone(),
+            messages,
+            source,
+        };
+        let buffered = writer.finish()?;
+        let file = buffered.into_inner().map_err(|e| io(e.into_error()))?;
+        crate::atomic::sync(&file).map_err(io)?;
+        drop(file);
+        pending.commit().map_err(io)
+    }
+}
+
 /// Writes a trace to `path` through `f`, atomically: the trace goes to a
 /// temporary file in the same directory, which is renamed to `path` only
 /// when `f` and the writer both succeeded (and the data reached the disk).
 /// On any error the temporary file is removed and `path` is untouched.
+/// ([`PendingTrace`] is the same without a closure.)
 pub fn write_trace_file<T, E: From<TraceError>>(
     path: impl AsRef<Path>,
     f: impl FnOnce(&mut TraceWriter<BufWriter<File>>) -> Result<T, E>,
 ) -> Result<T, E> {
-    let path = path.as_ref();
-    let name = path.display().to_string();
-    let io = |source: std::io::Error| TraceError::Io {
-        file: name.clone(),
-        messages: 0,
-        source,
-    };
-    let (pending, file) = PendingFile::create_seekable(path).map_err(io)?;
-    let mut writer =
-        TraceWriter::build(BufWriter::new(file), default_write_options(), name.clone())?;
-    let value = f(&mut writer)?;
-    let messages = writer.messages();
-    let buffered = writer.finish()?;
-    let file = buffered.into_inner().map_err(|e| TraceError::Io {
-        file: name.clone(),
-        messages,
-        source: e.into_error(),
-    })?;
-    crate::atomic::sync(&file).map_err(|source| TraceError::Io {
-        file: name.clone(),
-        messages,
-        source,
-    })?;
-    drop(file);
-    pending.commit().map_err(|source| TraceError::Io {
-        file: name.clone(),
-        messages,
-        source,
-    })?;
+    let mut trace = PendingTrace::create(path)?;
+    let value = f(trace.writer())?;
+    trace.commit()?;
     Ok(value)
 }

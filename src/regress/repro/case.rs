@@ -9,7 +9,7 @@ use crate::core::{Mesh, Options, Outcome, Sweep, sweep_ties};
 use crate::trace::messages::{OutcomeMsg, SceneMsg, SweepMsg};
 use crate::trace::{TraceError, TraceWriter};
 
-use crate::regress::compare::{Agreement, Tolerances, agreement};
+use crate::regress::compare::{Agreement, Field, FieldSet, Tolerances, agreement};
 
 use super::find::{ReproError, TraceSweep};
 use super::inputs::SweepInputs;
@@ -424,6 +424,25 @@ impl ReproCase {
             o.alpha = self.outcome.alpha;
             o
         })
+    }
+
+    /// [`ReproCase::asserted`] without the optional fields outside
+    /// `fields` (`--fields`): the Rust test does not assert them.
+    pub fn asserted_within(&self, fields: FieldSet) -> OutcomeMsg {
+        let mut o = self.asserted();
+        if !fields.contains(Field::Triangle) {
+            o.triangle = None;
+        }
+        if !fields.contains(Field::Feature) {
+            o.feature = None;
+        }
+        if !fields.contains(Field::Normal) {
+            o.normal = None;
+        }
+        if !fields.contains(Field::Contact) {
+            o.contact = None;
+        }
+        o
     }
 
     /// A few lines on stderr's side: what was written and whether it

@@ -19,7 +19,7 @@ impl ReproCase {
         out.extend(self.inputs.p1);
         out.push(self.inputs.radius);
         out.push(self.inputs.margin);
-        let a = self.asserted();
+        let a = self.asserted_within(tol.fields);
         out.push(a.alpha);
         out.push(tol.alpha);
         if let Some(Some(n)) = a.normal {
@@ -46,7 +46,7 @@ impl ReproCase {
         let mut s = String::new();
         let f = |x: f64| format!("{x:?}");
         let v3 = |p: &[f64; 3]| format!("[{}, {}, {}]", f(p[0]), f(p[1]), f(p[2]));
-        let a = self.asserted();
+        let a = self.asserted_within(tol.fields);
         let stem = std::path::Path::new(&self.source)
             .file_stem()
             .map(|s| s.to_string_lossy().into_owned())

@@ -1,0 +1,655 @@
+//! The C API of the sweeptrace trace writer, for engines written in C, C++,
+//! C# or Python (`ctypes`): open a trace file, add scenes, sweeps and
+//! expected outcomes, close.
+//!
+//! Every function returns a [`SweeptraceStatus`]; on an error,
+//! [`sweeptrace_writer_last_error`] gives the message (naming the file, the
+//! message's frame and the field). Nothing panics across the boundary:
+//! every function runs under `catch_unwind`, and a panic inside the library
+//! is returned as [`SweeptraceStatus::Panic`] (the writer is then unusable
+//! and its file is never completed). Pointers are checked for null, numbers
+//! for being finite, indices against the scene, with the same validation as
+//! the trace reader, so a trace written through this API always reads.
+//!
+//! The trace is written to a temporary file next to the target and renamed
+//! to the target by [`sweeptrace_writer_close`]: a writer that is freed
+//! without being closed, or a process that dies while writing, leaves no
+//! file under the target name.
+//!
+//! `include/sweeptrace.h` is generated from this file by cbindgen.
+
+#![warn(missing_docs)]
+
+use std::cell::RefCell;
+use std::ffi::{CStr, CString, c_char};
+use std::panic::{AssertUnwindSafe, catch_unwind};
+use std::path::PathBuf;
+
+use sweeptrace::core::{Facing, Kind};
+use sweeptrace::trace::messages::{OutcomeMsg, SceneMsg, SweepMsg};
+use sweeptrace::trace::{PendingTrace, TraceError};
+
+/// What a call came to.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SweeptraceStatus {
+    /// Success.
+    Ok = 0,
+    /// A pointer argument that must not be null is null.
+    NullPointer = 1,
+    /// An argument is invalid: a NaN or infinite number, a negative margin,
+    /// a radius not above the margin, an index out of range, an unknown
+    /// enum value, a path or name that is not valid text, a message above
+    /// the reader's size limit.
+    InvalidArgument = 2,
+    /// A call out of order: a sweep before any scene, a `log_time_nanos`
+    /// smaller than the previous call's.
+    WrongOrder = 3,
+    /// The writer was already closed, or an earlier error (I/O, panic)
+    /// left it unable to complete the trace.
+    Closed = 4,
+    /// The file could not be created, written or renamed.
+    Io = 5,
+    /// The library panicked (a bug); the writer is unusable.
+    Panic = 6,
+}
+
+/// The kind of a collision, for [`SweeptraceOutcome::kind`].
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SweeptraceKind {
+    /// Nothing touched: the ball moves all the way (`alpha` 1).
+    None = 0,
+    /// The inside of a triangle.
+    Face = 1,
+    /// An edge of a triangle.
+    Edge = 2,
+    /// A vertex of a triangle.
+    Vertex = 3,
+}
+
+/// The facing rule of a scene (docs/SEMANTICS.md): which direction of
+/// travel lets a triangle report a collision.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SweeptraceFacing {
+    /// `n · d ≤ 0`: toward the front, or parallel to the plane (default).
+    NonStrict = 0,
+    /// `n · d < 0`: strictly toward the front.
+    Strict = 1,
+}
+
+/// [`SweeptraceOutcome::fields`]: `triangle` is given.
+pub const SWEEPTRACE_FIELD_TRIANGLE: u32 = 1;
+/// [`SweeptraceOutcome::fields`]: `feature` is given.
+pub const SWEEPTRACE_FIELD_FEATURE: u32 = 2;
+/// [`SweeptraceOutcome::fields`]: `normal` is given.
+pub const SWEEPTRACE_FIELD_NORMAL: u32 = 4;
+/// [`SweeptraceOutcome::fields`]: `contact` is given.
+pub const SWEEPTRACE_FIELD_CONTACT: u32 = 8;
+const ALL_FIELDS: u32 = SWEEPTRACE_FIELD_TRIANGLE
+    | SWEEPTRACE_FIELD_FEATURE
+    | SWEEPTRACE_FIELD_NORMAL
+    | SWEEPTRACE_FIELD_CONTACT;
+
+/// What an engine decided for one sweep: an `/expected` message.
+///
+/// `frame`, `ball`, `kind` and `alpha` are always written. The other fields
+/// are written only when their bit is set in `fields` (a field left out is
+/// not compared by `sweeptrace check`). A given field is written as its
+/// value when the kind has one (`triangle`, `normal`, `contact` for a face,
+/// edge or vertex; `feature` for an edge or vertex: the edge from vertex
+/// `feature` to the next, or vertex `feature` of the triangle) and as
+/// `null` otherwise.
+#[repr(C)]
+#[derive(Clone, Copy, Debug)]
+pub struct SweeptraceOutcome {
+    /// The sweep's frame.
+    pub frame: u64,
+    /// The sweep's ball.
+    pub ball: u32,
+    /// A [`SweeptraceKind`] value.
+    pub kind: u32,
+    /// Fraction of the sweep travelled before the contact, in `[0, 1]`.
+    pub alpha: f64,
+    /// Which of the fields below are given: `SWEEPTRACE_FIELD_*` or-ed.
+    pub fields: u32,
+    /// Index of the triangle hit, in the current scene.
+    pub triangle: u32,
+    /// Edge or vertex of the triangle hit: 0, 1 or 2.
+    pub feature: u32,
+    /// Unit normal at the contact, pointing toward the ball.
+    pub normal: [f64; 3],
+    /// Contact point on the mesh.
+    pub contact: [f64; 3],
+}
+
+enum State {
+    Open(Box<PendingTrace>),
+    Closed,
+    /// An I/O error or a panic: the trace cannot be completed.
+    Broken,
+}
+
+/// A trace being written. Opaque: made by [`sweeptrace_writer_open`],
+/// released by [`sweeptrace_writer_free`]. Use each writer from one thread
+/// at a time; different writers may be used on different threads.
+pub struct SweeptraceWriter {
+    state: State,
+    /// Triangles of the current scene, for checking expected triangles.
+    scene_triangles: Option<usize>,
+    last_error: CString,
+}
+
+thread_local! {
+    static THREAD_LAST_ERROR: RefCell<CString> = RefCell::new(CString::default());
+}
+
+/// A failed call: its status and message.
+struct Failure {
+    status: SweeptraceStatus,
+    message: String,
+}
+
+impl Failure {
+    fn new(status: SweeptraceStatus, message: impl Into<String>) -> Failure {
+        Failure {
+            status,
+            message: message.into(),
+        }
+    }
+
+    fn null(argument: &str) -> Failure {
+        Failure::new(
+            SweeptraceStatus::NullPointer,
+            format!("`{argument}` is a null pointer"),
+        )
+    }
+
+    fn invalid(message: impl Into<String>) -> Failure {
+        Failure::new(SweeptraceStatus::InvalidArgument, message)
+    }
+}
+
+impl From<TraceError> for Failure {
+    fn from(error: TraceError) -> Failure {
+        let status = match &error {
+            TraceError::Invalid { .. }
+            | TraceError::Json { .. }
+            | TraceError::MessageTooLarge { .. } => SweeptraceStatus::InvalidArgument,
+            TraceError::SweepBeforeScene { .. } | TraceError::OutOfOrder { .. } => {
+                SweeptraceStatus::WrongOrder
+            }
+            _ => SweeptraceStatus::Io,
+        };
+        Failure::new(status, error.to_string())
+    }
+}
+
+/// A C string of `message` (an interior NUL, impossible in our messages,
+/// would end it there).
+fn c_message(message: &str) -> CString {
+    let bytes: Vec<u8> = message.bytes().take_while(|&b| b != 0).collect();
+    CString::new(bytes).unwrap_or_default()
+}
+
+fn set_thread_error(message: &str) {
+    THREAD_LAST_ERROR.with(|slot| *slot.borrow_mut() = c_message(message));
+}
+
+fn panic_message(payload: &(dyn std::any::Any + Send)) -> String {
+    let detail = payload
+        .downcast_ref::<&str>()
+        .map(|s| s.to_string())
+        .or_else(|| payload.downcast_ref::<String>().cloned())
+        .unwrap_or_else(|| "no message".to_string());
+    format!("internal error (a bug of sweeptrace, please report it): {detail}")
+}
+
+/// Runs `f` on the writer behind `writer`: catches panics, records the
+/// error message on the writer and the thread.
+///
+/// # Safety
+/// `writer` is null or a pointer from [`sweeptrace_writer_open`] not yet freed.
+unsafe fn with_writer(
+    writer: *mut SweeptraceWriter,
+    f: impl FnOnce(&mut SweeptraceWriter) -> Result<(), Failure>,
+) -> SweeptraceStatus {
+    if writer.is_null() {
+        let failure = Failure::null("writer");
+        set_thread_error(&failure.message);
+        return failure.status;
+    }
+    // SAFETY: non-null, and by the contract a live writer of ours.
+    let writer = unsafe { &mut *writer };
+    let result = catch_unwind(AssertUnwindSafe(|| f(writer)));
+    let failure = match result {
+        Ok(Ok(())) => {
+            writer.last_error = CString::default();
+            return SweeptraceStatus::Ok;
+        }
+        Ok(Err(failure)) => failure,
+        Err(payload) => {
+            writer.state = State::Broken;
+            Failure::new(SweeptraceStatus::Panic, panic_message(payload.as_ref()))
+        }
+    };
+    writer.last_error = c_message(&failure.message);
+    set_thread_error(&failure.message);
+    failure.status
+}
+
+impl SweeptraceWriter {
+    /// The open trace, or why there is none.
+    fn open_trace(&mut self) -> Result<&mut PendingTrace, Failure> {
+        match &mut self.state {
+            State::Open(trace) => Ok(trace),
+            State::Closed => Err(Failure::new(
+                SweeptraceStatus::Closed,
+                "the writer is closed; open a new one to write another trace",
+            )),
+            State::Broken => Err(Failure::new(
+                SweeptraceStatus::Closed,
+                "an earlier error (I/O or internal) left the trace unfinishable; \
+                 nothing was written under the target name",
+            )),
+        }
+    }
+
+    /// Runs a write; an I/O error breaks the writer (the container may be
+    /// half-written), other errors leave it usable (nothing was written).
+    fn write(
+        &mut self,
+        f: impl FnOnce(&mut PendingTrace) -> Result<(), TraceError>,
+    ) -> Result<(), Failure> {
+        let trace = self.open_trace()?;
+        f(trace).map_err(|error| {
+            let failure = Failure::from(error);
+            if failure.status == SweeptraceStatus::Io {
+                self.state = State::Broken;
+            }
+            failure
+        })
+    }
+}
+
+/// `count` triples of `T` at `pointer`, checked for null and size.
+///
+/// # Safety
+/// A non-null `pointer` points to `3 * count` readable values.
+unsafe fn triples<'a, T>(
+    pointer: *const T,
+    count: usize,
+    argument: &str,
+) -> Result<&'a [T], Failure> {
+    if count == 0 {
+        return Ok(&[]);
+    }
+    if pointer.is_null() {
+        return Err(Failure::null(argument));
+    }
+    let len = count
+        .checked_mul(3)
+        .filter(|&len| len <= isize::MAX as usize / std::mem::size_of::<T>().max(1))
+        .ok_or_else(|| Failure::invalid(format!("`{argument}`: count {count} is too large")))?;
+    // SAFETY: non-null, and by the contract `len` readable values.
+    Ok(unsafe { std::slice::from_raw_parts(pointer, len) })
+}
+
+/// Three numbers at `pointer`.
+///
+/// # Safety
+/// A non-null `pointer` points to 3 readable doubles.
+unsafe fn point(pointer: *const f64, argument: &str) -> Result<[f64; 3], Failure> {
+    if pointer.is_null() {
+        return Err(Failure::null(argument));
+    }
+    // SAFETY: non-null, and by the contract 3 readable doubles.
+    let values = unsafe { std::slice::from_raw_parts(pointer, 3) };
+    Ok([values[0], values[1], values[2]])
+}
+
+fn kind_from(value: u32) -> Result<Kind, Failure> {
+    Ok(match value {
+        0 => Kind::None,
+        1 => Kind::Face,
+        2 => Kind::Edge,
+        3 => Kind::Vertex,
+        _ => {
+            return Err(Failure::invalid(format!(
+                "`kind` must be a SweeptraceKind (0 none, 1 face, 2 edge, 3 vertex), got {value}"
+            )));
+        }
+    })
+}
+
+fn facing_from(value: u32) -> Result<Facing, Failure> {
+    match value {
+        0 => Ok(Facing::NonStrict),
+        1 => Ok(Facing::Strict),
+        _ => Err(Failure::invalid(format!(
+            "`facing` must be a SweeptraceFacing (0 non_strict, 1 strict), got {value}"
+        ))),
+    }
+}
+
+#[cfg(unix)]
+fn path_from(bytes: &CStr) -> Result<PathBuf, Failure> {
+    use std::os::unix::ffi::OsStrExt;
+    Ok(PathBuf::from(std::ffi::OsStr::from_bytes(bytes.to_bytes())))
+}
+
+#[cfg(not(unix))]
+fn path_from(bytes: &CStr) -> Result<PathBuf, Failure> {
+    bytes
+        .to_str()
+        .map(PathBuf::from)
+        .map_err(|e| Failure::invalid(format!("`path` is not valid UTF-8: {e}")))
+}
+
+/// Opens a trace to be written to `path` (UTF-8 or, on Unix, any bytes).
+///
+/// The file is written under a temporary name in the same directory
+/// (`.NAME.partial-XXXXXX`) and renamed to `path` by
+/// [`sweeptrace_writer_close`]. On success `*out_writer` is the new writer;
+/// on failure it is set to null and [`sweeptrace_last_error`] says why.
+///
+/// # Safety
+/// `path` is null or a NUL-terminated string; `out_writer` is null or
+/// points to writable storage for a pointer.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn sweeptrace_writer_open(
+    path: *const c_char,
+    out_writer: *mut *mut SweeptraceWriter,
+) -> SweeptraceStatus {
+    let result = catch_unwind(|| -> Result<*mut SweeptraceWriter, Failure> {
+        if out_writer.is_null() {
+            return Err(Failure::null("out_writer"));
+        }
+        // SAFETY: non-null, writable by the contract.
+        unsafe { *out_writer = std::ptr::null_mut() };
+        if path.is_null() {
+            return Err(Failure::null("path"));
+        }
+        // SAFETY: non-null, NUL-terminated by the contract.
+        let path = path_from(unsafe { CStr::from_ptr(path) })?;
+        if path.as_os_str().is_empty() {
+            return Err(Failure::invalid("`path` is empty"));
+        }
+        let trace = PendingTrace::create(&path).map_err(Failure::from)?;
+        Ok(Box::into_raw(Box::new(SweeptraceWriter {
+            state: State::Open(Box::new(trace)),
+            scene_triangles: None,
+            last_error: CString::default(),
+        })))
+    });
+    let failure = match result {
+        Ok(Ok(writer)) => {
+            // SAFETY: checked non-null above (an Ok implies it).
+            unsafe { *out_writer = writer };
+            return SweeptraceStatus::Ok;
+        }
+        Ok(Err(failure)) => failure,
+        Err(payload) => Failure::new(SweeptraceStatus::Panic, panic_message(payload.as_ref())),
+    };
+    set_thread_error(&failure.message);
+    failure.status
+}
+
+/// Adds a scene: the triangle mesh the sweeps after it are tested against.
+///
+/// `vertices` holds `vertex_count` points as `x, y, z` triples;
+/// `triangles` holds `triangle_count` triples of vertex indices,
+/// counter-clockwise seen from the front. `name` may be null. `margin` is
+/// the engine's margin `ε` (`≥ 0`), `facing` a [`SweeptraceFacing`].
+///
+/// # Safety
+/// `writer` is a live writer or null; `name` is null or NUL-terminated;
+/// `vertices` and `triangles` are null (only with a count of 0) or point
+/// to `3 * count` values.
+#[unsafe(no_mangle)]
+#[allow(clippy::too_many_arguments)]
+pub unsafe extern "C" fn sweeptrace_writer_add_scene(
+    writer: *mut SweeptraceWriter,
+    log_time_nanos: u64,
+    name: *const c_char,
+    vertices: *const f64,
+    vertex_count: usize,
+    triangles: *const u32,
+    triangle_count: usize,
+    margin: f64,
+    facing: u32,
+) -> SweeptraceStatus {
+    // SAFETY: the contract is the caller's.
+    unsafe {
+        with_writer(writer, |w| {
+            let name = if name.is_null() {
+                None
+            } else {
+                Some(
+                    CStr::from_ptr(name)
+                        .to_str()
+                        .map_err(|e| Failure::invalid(format!("`name` is not valid UTF-8: {e}")))?
+                        .to_string(),
+                )
+            };
+            let coordinates = triples(vertices, vertex_count, "vertices")?;
+            let indices = triples(triangles, triangle_count, "triangles")?;
+            let facing = facing_from(facing)?;
+            let scene = SceneMsg {
+                name,
+                vertices: coordinates
+                    .chunks_exact(3)
+                    .map(|v| [v[0], v[1], v[2]])
+                    .collect(),
+                triangles: indices
+                    .chunks_exact(3)
+                    .map(|t| [u64::from(t[0]), u64::from(t[1]), u64::from(t[2])])
+                    .collect(),
+                margin,
+                facing,
+            };
+            w.write(|trace| trace.writer().scene(log_time_nanos, &scene))?;
+            w.scene_triangles = Some(triangle_count);
+            Ok(())
+        })
+    }
+}
+
+/// Adds a sweep: ball `ball` of radius `radius` moving from `p0` to `p1`
+/// (3 doubles each) at frame `frame`. A scene must have been added before.
+///
+/// # Safety
+/// `writer` is a live writer or null; `p0` and `p1` are null or point to 3
+/// doubles.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn sweeptrace_writer_add_sweep(
+    writer: *mut SweeptraceWriter,
+    log_time_nanos: u64,
+    frame: u64,
+    ball: u32,
+    radius: f64,
+    p0: *const f64,
+    p1: *const f64,
+) -> SweeptraceStatus {
+    // SAFETY: the contract is the caller's.
+    unsafe {
+        with_writer(writer, |w| {
+            let sweep = SweepMsg {
+                frame,
+                ball,
+                radius,
+                p0: point(p0, "p0")?,
+                p1: point(p1, "p1")?,
+            };
+            w.write(|trace| trace.writer().sweep(log_time_nanos, &sweep))
+        })
+    }
+}
+
+/// Adds what the engine decided for a sweep (an `/expected` message), for
+/// `sweeptrace check` to compare with. See [`SweeptraceOutcome`] for which
+/// fields are written.
+///
+/// # Safety
+/// `writer` is a live writer or null; `outcome` is null or points to a
+/// [`SweeptraceOutcome`].
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn sweeptrace_writer_add_expected(
+    writer: *mut SweeptraceWriter,
+    log_time_nanos: u64,
+    outcome: *const SweeptraceOutcome,
+) -> SweeptraceStatus {
+    // SAFETY: the contract is the caller's.
+    unsafe {
+        with_writer(writer, |w| {
+            if outcome.is_null() {
+                return Err(Failure::null("outcome"));
+            }
+            let message = outcome_message(&*outcome, w.scene_triangles)?;
+            w.write(|trace| trace.writer().expected(log_time_nanos, &message))
+        })
+    }
+}
+
+/// The `/expected` message of `outcome`, its triangle checked against the
+/// current scene's `scene_triangles`.
+fn outcome_message(
+    outcome: &SweeptraceOutcome,
+    scene_triangles: Option<usize>,
+) -> Result<OutcomeMsg, Failure> {
+    let kind = kind_from(outcome.kind)?;
+    let at = format!("outcome of frame {}, ball {}", outcome.frame, outcome.ball);
+    if outcome.fields & !ALL_FIELDS != 0 {
+        return Err(Failure::invalid(format!(
+            "{at}: `fields` has unknown bits {:#x} (SWEEPTRACE_FIELD_* or-ed)",
+            outcome.fields & !ALL_FIELDS
+        )));
+    }
+    let given = |bit: u32| outcome.fields & bit != 0;
+    let hit = kind != Kind::None;
+    let on_feature = matches!(kind, Kind::Edge | Kind::Vertex);
+    if hit && given(SWEEPTRACE_FIELD_TRIANGLE) {
+        let Some(count) = scene_triangles else {
+            return Err(Failure::new(
+                SweeptraceStatus::WrongOrder,
+                format!("{at}: `triangle` is given but no scene was added yet"),
+            ));
+        };
+        if outcome.triangle as usize >= count {
+            return Err(Failure::invalid(format!(
+                "{at}: field `triangle`: index {} is out of range (the scene has {count} triangles)",
+                outcome.triangle
+            )));
+        }
+    }
+    if on_feature && given(SWEEPTRACE_FIELD_FEATURE) && outcome.feature > 2 {
+        return Err(Failure::invalid(format!(
+            "{at}: field `feature`: must be 0, 1 or 2, got {}",
+            outcome.feature
+        )));
+    }
+    fn field<T>(given: bool, meaningful: bool, value: T) -> Option<Option<T>> {
+        given.then_some(meaningful.then_some(value))
+    }
+    Ok(OutcomeMsg {
+        frame: outcome.frame,
+        ball: outcome.ball,
+        alpha: outcome.alpha,
+        kind,
+        triangle: field(given(SWEEPTRACE_FIELD_TRIANGLE), hit, outcome.triangle),
+        // Checked above to be at most 2.
+        feature: field(
+            given(SWEEPTRACE_FIELD_FEATURE),
+            on_feature,
+            outcome.feature as u8,
+        ),
+        normal: field(given(SWEEPTRACE_FIELD_NORMAL), hit, outcome.normal),
+        contact: field(given(SWEEPTRACE_FIELD_CONTACT), hit, outcome.contact),
+    })
+}
+
+/// Finishes the trace and renames it to its target path. After it (success
+/// or not) the writer accepts no more messages; it must still be released
+/// with [`sweeptrace_writer_free`]. Closing twice returns
+/// [`SweeptraceStatus::Closed`].
+///
+/// # Safety
+/// `writer` is a live writer or null.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn sweeptrace_writer_close(
+    writer: *mut SweeptraceWriter,
+) -> SweeptraceStatus {
+    // SAFETY: the contract is the caller's.
+    unsafe {
+        with_writer(writer, |w| {
+            w.open_trace()?;
+            match std::mem::replace(&mut w.state, State::Closed) {
+                State::Open(trace) => trace.commit().map_err(Failure::from),
+                _ => Ok(()),
+            }
+        })
+    }
+}
+
+/// Releases a writer. A writer that was not closed is abandoned: its
+/// temporary file is removed and nothing is written under the target name.
+/// Null is accepted and does nothing.
+///
+/// # Safety
+/// `writer` is null or a live writer, which must not be used afterwards.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn sweeptrace_writer_free(writer: *mut SweeptraceWriter) {
+    if writer.is_null() {
+        return;
+    }
+    // SAFETY: by the contract a live writer of ours, released once.
+    let writer = unsafe { Box::from_raw(writer) };
+    // Dropping removes the temporary file; a panic there is not let out.
+    let _ = catch_unwind(AssertUnwindSafe(move || drop(writer)));
+}
+
+/// The message of the writer's last failed call (naming the file, frame
+/// and field), or an empty string when its last call succeeded. Valid until
+/// the next call with this writer. With a null writer: the calling thread's
+/// last error, as [`sweeptrace_last_error`].
+///
+/// # Safety
+/// `writer` is null or a live writer.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn sweeptrace_writer_last_error(
+    writer: *const SweeptraceWriter,
+) -> *const c_char {
+    if writer.is_null() {
+        return sweeptrace_last_error();
+    }
+    // SAFETY: by the contract a live writer of ours.
+    unsafe { (*writer).last_error.as_ptr() }
+}
+
+/// The message of the calling thread's last failed call (any writer, and
+/// calls that have no writer: a failed [`sweeptrace_writer_open`], a null
+/// writer), or an empty string. Valid until the thread's next failing call.
+#[unsafe(no_mangle)]
+pub extern "C" fn sweeptrace_last_error() -> *const c_char {
+    THREAD_LAST_ERROR
+        .try_with(|slot| slot.borrow().as_ptr())
+        .unwrap_or(c"".as_ptr())
+}
+
+/// The name of a status (`"ok"`, `"null_pointer"`, ...), for messages.
+/// Unknown values give `"unknown"`.
+#[unsafe(no_mangle)]
+pub extern "C" fn sweeptrace_status_name(status: u32) -> *const c_char {
+    let name: &'static CStr = match status {
+        0 => c"ok",
+        1 => c"null_pointer",
+        2 => c"invalid_argument",
+        3 => c"wrong_order",
+        4 => c"closed",
+        5 => c"io",
+        6 => c"panic",
+        _ => c"unknown",
+    };
+    name.as_ptr()
+}

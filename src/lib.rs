@@ -25,6 +25,9 @@
 
 pub mod atomic;
 pub mod core;
+pub mod error_text;
+#[doc(hidden)]
+pub mod fuzzing;
 pub mod numbers;
 pub mod regress;
 pub mod replay;

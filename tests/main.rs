@@ -10,6 +10,7 @@ mod check;
 mod core_cases;
 mod core_decisions;
 mod core_random;
+mod faults;
 mod oracle;
 mod outputs;
 mod prefetch;
@@ -95,5 +96,6 @@ fn main() {
     trials.extend(repro::tests());
     trials.extend(alt_engine::tests());
     trials.extend(scanned::tests());
+    trials.extend(faults::tests());
     libtest_mimic::run(&args, trials).exit();
 }

@@ -1,6 +1,7 @@
 //! `sweeptrace check`: replay traces and compare every sweep's outcome with
 //! the trace's `/expected` channel (the library's [`sweeptrace::regress`]).
 
+use super::NameFileOnce;
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, bail};
@@ -178,7 +179,7 @@ fn write_failure_rrd(trace: &Path, dir: &Path, report: &TraceReport) -> anyhow::
                 .with_context(|| format!("logging frame {}", r.frame))?,
             // The check already reported read errors; record what was read.
             Err(ReplayError::Trace(_)) => break,
-            Err(err) => return Err(err).context(format!("replaying {name}")),
+            Err(err) => return Err(err).name_file_once("replaying", &name),
         }
     }
     let rec = logger.finish();

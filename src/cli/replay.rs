@@ -1,6 +1,7 @@
 //! `sweeptrace replay`: run every sweep of a trace through the core and
 //! write the outcomes and/or a Rerun recording that explains them.
 
+use super::NameFileOnce;
 use std::fs::File;
 use std::io::{BufReader, BufWriter, IsTerminal, Read, Write};
 use std::path::{Path, PathBuf};
@@ -296,7 +297,7 @@ pub fn run(args: Args) -> anyhow::Result<RunOutcome> {
                     trace_error = Some(err);
                 }
                 Err(err) => {
-                    return Err(anyhow::Error::new(err).context(format!("replaying {source_name}")));
+                    return Err(err).name_file_once("replaying", &source_name);
                 }
             }
             Ok(())

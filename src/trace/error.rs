@@ -1,11 +1,14 @@
 //! Errors of reading and writing traces.
 //!
-//! Every message names the file, and when a message is at fault its channel,
+//! Each message is whole (its cause's text included, no `source()`: see
+//! [`crate::error_text`]) and names the file, and when a message is at fault its channel,
 //! its index in the file, its frame when known, and the field.
 
 use std::fmt;
 
 use thiserror::Error;
+
+use crate::error_text::full_text;
 
 /// Where in a trace a message sits: its channel, its index in the file
 /// (counting every message, foreign topics included) and its frame when the
@@ -37,15 +40,14 @@ impl fmt::Display for MessageAt {
 #[non_exhaustive]
 pub enum TraceError {
     /// The underlying reader or writer failed.
-    #[error("{file}: I/O error after {messages} complete messages: {source}")]
+    #[error("{file}: I/O error after {messages} complete messages: {}", full_text(.cause))]
     Io {
         /// File name.
         file: String,
         /// Messages read (or written) before the error.
         messages: u64,
         /// The I/O error.
-        #[source]
-        source: std::io::Error,
+        cause: std::io::Error,
     },
     /// The file ends in the middle of a record (or before its footer).
     #[error(
@@ -59,7 +61,10 @@ pub enum TraceError {
         messages: u64,
     },
     /// The MCAP container is malformed (bad magic, bad chunk, CRC mismatch, ...).
-    #[error("{file}: corrupt MCAP data after {messages} complete messages ({context}): {source}")]
+    #[error(
+        "{file}: corrupt MCAP data after {messages} complete messages ({context}): {}",
+        full_text(.cause)
+    )]
     Corrupt {
         /// File name.
         file: String,
@@ -68,8 +73,7 @@ pub enum TraceError {
         /// What was being read (`chunk 3`, `record`, ...).
         context: String,
         /// The container error.
-        #[source]
-        source: mcap::McapError,
+        cause: mcap::McapError,
     },
     /// A chunk or record declares a size above the reader's limit.
     #[error(
@@ -161,13 +165,12 @@ pub enum TraceError {
         channel_id: u16,
     },
     /// The MCAP writer failed.
-    #[error("{file}: cannot write the trace: {source}")]
+    #[error("{file}: cannot write the trace: {}", full_text(.cause))]
     Write {
         /// File name.
         file: String,
         /// The container error.
-        #[source]
-        source: mcap::McapError,
+        cause: mcap::McapError,
     },
 }
 

@@ -264,11 +264,11 @@ impl<R: Read> TraceReader<R> {
                         match self.input.read(buf) {
                             Ok(n) => break n,
                             Err(e) if e.kind() == ErrorKind::Interrupted => continue,
-                            Err(source) => {
+                            Err(cause) => {
                                 return Err(TraceError::Io {
                                     file: self.state.source_name.clone(),
                                     messages: self.state.stats.messages,
-                                    source,
+                                    cause,
                                 });
                             }
                         }
@@ -341,11 +341,11 @@ impl State {
                 declared: len,
                 limit,
             },
-            source => TraceError::Corrupt {
+            cause => TraceError::Corrupt {
                 file,
                 messages,
                 context: context.to_string(),
-                source,
+                cause,
             },
         }
     }

@@ -73,9 +73,9 @@ impl<W: Write + Seek> TraceWriter<W> {
     }
 
     fn build(w: W, options: WriteOptions, name: String) -> Result<Self, TraceError> {
-        let error = |source| TraceError::Write {
+        let error = |cause| TraceError::Write {
             file: name.clone(),
-            source,
+            cause,
         };
         let mut writer = options.create(w).map_err(error)?;
         let metadata = BTreeMap::from([
@@ -164,9 +164,9 @@ impl<W: Write + Seek> TraceWriter<W> {
         };
         self.writer
             .write_to_known_channel(&header, &data)
-            .map_err(|source| TraceError::Write {
+            .map_err(|cause| TraceError::Write {
                 file: self.name.clone(),
-                source,
+                cause,
             })?;
         self.messages += 1;
         self.last_log_time = Some(log_time_nanos);
@@ -185,9 +185,9 @@ impl<W: Write + Seek> TraceWriter<W> {
                 name: name.to_string(),
                 metadata: entries,
             })
-            .map_err(|source| TraceError::Write {
+            .map_err(|cause| TraceError::Write {
                 file: self.name.clone(),
-                source,
+                cause,
             })
     }
 
@@ -239,9 +239,9 @@ impl<W: Write + Seek> TraceWriter<W> {
 
     /// Writes the summary and footer and returns the underlying writer.
     pub fn finish(mut self) -> Result<W, TraceError> {
-        self.writer.finish().map_err(|source| TraceError::Write {
+        self.writer.finish().map_err(|cause| TraceError::Write {
             file: self.name.clone(),
-            source,
+            cause,
         })?;
         Ok(self.writer.into_inner())
     }
@@ -257,10 +257,10 @@ pub fn write_trace_file<T, E: From<TraceError>>(
 ) -> Result<T, E> {
     let path = path.as_ref();
     let name = path.display().to_string();
-    let io = |source: std::io::Error| TraceError::Io {
+    let io = |cause: std::io::Error| TraceError::Io {
         file: name.clone(),
         messages: 0,
-        source,
+        cause,
     };
     let (pending, file) = PendingFile::create_seekable(path).map_err(io)?;
     let mut writer =
@@ -271,18 +271,18 @@ pub fn write_trace_file<T, E: From<TraceError>>(
     let file = buffered.into_inner().map_err(|e| TraceError::Io {
         file: name.clone(),
         messages,
-        source: e.into_error(),
+        cause: e.into_error(),
     })?;
-    crate::atomic::sync(&file).map_err(|source| TraceError::Io {
+    crate::atomic::sync(&file).map_err(|cause| TraceError::Io {
         file: name.clone(),
         messages,
-        source,
+        cause,
     })?;
     drop(file);
-    pending.commit().map_err(|source| TraceError::Io {
+    pending.commit().map_err(|cause| TraceError::Io {
         file: name.clone(),
         messages,
-        source,
+        cause,
     })?;
     Ok(value)
 }

@@ -27,15 +27,14 @@ pub fn full_text(err: &(dyn Error + 'static)) -> String {
 }
 
 /// A segment of an error message (the text between `": "` separators) of
-/// 12 characters or more that appears again later in the message, if any:
-/// the mark of a cause printed twice. The tests and fuzz checks use it.
+/// 12 characters or more that an earlier segment already says, if any:
+/// the mark of a cause or a file name printed twice (`blessing a.mcap:
+/// a.mcap: ...`, `I/O error: I/O error: ...`). The tests and fuzz checks
+/// use it.
 pub fn repeated_segment(text: &str) -> Option<String> {
     let segments: Vec<&str> = text.split(": ").map(str::trim).collect();
-    segments.iter().enumerate().find_map(|(i, segment)| {
-        (segment.len() >= 12
-            && segments[i + 1..]
-                .iter()
-                .any(|later| later.contains(segment)))
-        .then(|| (*segment).to_string())
+    segments.iter().enumerate().skip(1).find_map(|(j, later)| {
+        (later.len() >= 12 && segments[..j].iter().any(|earlier| earlier.contains(later)))
+            .then(|| (*later).to_string())
     })
 }

@@ -12,6 +12,7 @@ mod core_decisions;
 mod core_random;
 mod faults;
 mod oracle;
+mod out_of_order;
 mod outputs;
 mod prefetch;
 mod record;
@@ -97,5 +98,6 @@ fn main() {
     trials.extend(alt_engine::tests());
     trials.extend(scanned::tests());
     trials.extend(faults::tests());
+    trials.extend(out_of_order::tests());
     libtest_mimic::run(&args, trials).exit();
 }

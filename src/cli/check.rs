@@ -169,7 +169,10 @@ fn write_failure_rrd(trace: &Path, dir: &Path, report: &TraceReport) -> anyhow::
         .set_sinks(vec![Box::new(sink) as Box<dyn rerun::sink::LogSink>])
         .context("creating the recording")?;
     let mut logger = viz::Logger::new(rec, true).context("starting the recording")?;
-    for event in replay_events(TraceReader::new(bytes.as_slice(), &name), options) {
+    for event in replay_events(
+        TraceReader::new_indexed(std::io::Cursor::new(bytes.as_slice()), &name),
+        options,
+    ) {
         match event {
             Ok(ReplayEvent::Scene(scene)) => {
                 logger.log_scene(&scene).context("logging the scene")?

@@ -61,7 +61,7 @@ pub struct Args {
 fn side(path: &Path, options: ReplayOptions) -> anyhow::Result<Side> {
     let name = path.display().to_string();
     let file = File::open(path).with_context(|| format!("cannot open trace {name}"))?;
-    let reader = TraceReader::new(BufReader::with_capacity(1 << 16, file), &name);
+    let reader = TraceReader::new_indexed(BufReader::with_capacity(1 << 16, file), &name);
     Side::replay(reader, &name, options).name_file_once("replaying", &name)
 }
 

@@ -27,7 +27,7 @@ pub struct Args {
 pub fn run(args: Args) -> anyhow::Result<RunOutcome> {
     let name = args.trace.display().to_string();
     let file = File::open(&args.trace).with_context(|| format!("cannot open trace {name}"))?;
-    let (info, error) = collect(TraceReader::new(BufReader::new(file), &name));
+    let (info, error) = collect(TraceReader::new_indexed(BufReader::new(file), &name));
     let report = if args.json {
         render_json(&info)
     } else {

@@ -91,6 +91,14 @@ struct CountingReader<R> {
     count: Arc<AtomicU64>,
 }
 
+/// Seeking (to the summary, and to chunks when a trace is read through
+/// its chunk indexes) counts nothing: only bytes read.
+impl<R: std::io::Seek> std::io::Seek for CountingReader<R> {
+    fn seek(&mut self, to: std::io::SeekFrom) -> std::io::Result<u64> {
+        self.inner.seek(to)
+    }
+}
+
 impl<R: Read> Read for CountingReader<R> {
     fn read(&mut self, buf: &mut [u8]) -> std::io::Result<usize> {
         let n = self.inner.read(buf)?;
@@ -250,7 +258,7 @@ pub fn run(args: Args) -> anyhow::Result<RunOutcome> {
     let progress = progress_bar(total_bytes);
     // Decode on a thread of its own, so reading overlaps the core's work.
     let read_ahead = prefetch(
-        TraceReader::new(reader, &source_name),
+        TraceReader::new_indexed(reader, &source_name),
         prefetch::DEFAULT_CHUNK,
         prefetch::DEFAULT_DEPTH,
     )

@@ -45,7 +45,7 @@ pub fn run(args: Args) -> anyhow::Result<RunOutcome> {
     let tolerances = args.tolerances.to_tolerances()?;
     let shown = args.trace.display().to_string();
     let file = std::fs::File::open(&args.trace).with_context(|| format!("cannot open {shown}"))?;
-    let reader = TraceReader::new(std::io::BufReader::new(file), &shown);
+    let reader = TraceReader::new_indexed(std::io::BufReader::new(file), &shown);
     let found = find_sweep(reader, &shown, args.frame, args.ball)?;
     let case = ReproCase::build(&shown, &found, &tolerances)?;
     write_trace_file(&args.output, |w| case.write(w))

@@ -113,7 +113,10 @@ fn outcomes_of(
         ..options
     };
     let mut out: HashMap<(u64, u32), VecDeque<OutcomeMsg>> = HashMap::new();
-    for event in replay_events(TraceReader::new(input, name), options) {
+    for event in replay_events(
+        TraceReader::new_indexed(std::io::Cursor::new(input), name),
+        options,
+    ) {
         match event {
             Ok(ReplayEvent::Sweep(r)) => out
                 .entry((r.frame, r.ball))

@@ -236,15 +236,18 @@ pub fn render_text(r: &TraceReport) -> String {
             tunnel_lines(&mut s);
         }
         Status::Error => {
+            // The errors name the trace; the line names it once.
+            let prefix = format!("{}: ", r.trace);
+            let unnamed = |e: &str| e.strip_prefix(&prefix).unwrap_or(e).to_string();
             let _ = writeln!(
                 s,
                 "ERROR {}: {}; {counts}, {} diverge",
                 r.trace,
-                r.errors.first().map(String::as_str).unwrap_or("error"),
+                r.errors.first().map_or("error".to_string(), |e| unnamed(e)),
                 r.divergent
             );
             for e in r.errors.iter().skip(1) {
-                let _ = writeln!(s, "  also: {e}");
+                let _ = writeln!(s, "  also: {}", unnamed(e));
             }
             tunnel_lines(&mut s);
             for d in &r.divergences {

@@ -75,6 +75,24 @@ pub enum TraceError {
         /// The container error.
         cause: mcap::McapError,
     },
+    /// A record declares a field (a string, a map, a byte array) longer
+    /// than what is left of the record.
+    #[error(
+        "{file}: corrupt MCAP data after {messages} complete messages ({context}): a field \
+         declares {declared} bytes, but only {available} are left in the record"
+    )]
+    FieldTooLong {
+        /// File name.
+        file: String,
+        /// Complete messages read before the error.
+        messages: u64,
+        /// What was being read (`record with opcode 0x03`, `chunk 2`).
+        context: String,
+        /// The field's declared length.
+        declared: u64,
+        /// Bytes left in the record after the length.
+        available: u64,
+    },
     /// A chunk or record declares a size above the reader's limit.
     #[error(
         "{file}: {what} declares {declared} bytes, above the limit of {limit} bytes; refused before reading it"
@@ -132,7 +150,8 @@ pub enum TraceError {
     /// A message's `log_time` is smaller than that of an earlier message.
     #[error(
         "{at}: `log_time` {log_time_nanos} ns is earlier than the previous message's {previous_nanos} ns; \
-         trace messages must be written in `log_time` order"
+         trace messages must be written in `log_time` order (a file whose chunks overlap in time \
+         is read in log-time order only through the chunk indexes of its summary)"
     )]
     OutOfOrder {
         /// The message.

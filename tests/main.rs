@@ -10,6 +10,7 @@ mod check;
 mod core_cases;
 mod core_decisions;
 mod core_random;
+mod error_messages;
 mod faults;
 mod oracle;
 mod out_of_order;
@@ -98,6 +99,7 @@ fn main() {
     trials.extend(alt_engine::tests());
     trials.extend(scanned::tests());
     trials.extend(faults::tests());
+    trials.extend(error_messages::tests());
     trials.extend(out_of_order::tests());
     libtest_mimic::run(&args, trials).exit();
 }

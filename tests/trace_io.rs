@@ -220,7 +220,7 @@ fn read_all_with(
 
 /// A trace written with the raw `mcap` writer: our three channels plus
 /// `/foreign`; each message is (topic, log_time, JSON bytes).
-fn raw_trace(messages: &[(&str, u64, &[u8])]) -> Vec<u8> {
+pub fn raw_trace(messages: &[(&str, u64, &[u8])]) -> Vec<u8> {
     raw_trace_with(messages, "json")
 }
 
@@ -680,7 +680,7 @@ fn error_truncated_chunked() -> Result<(), String> {
 }
 
 /// Offset of the first chunk record (opcode 0x06) of a file.
-fn first_chunk(bytes: &[u8]) -> Option<(usize, usize)> {
+pub fn first_chunk(bytes: &[u8]) -> Option<(usize, usize)> {
     let mut at = 8;
     while at + 9 <= bytes.len() {
         let op = bytes[at];

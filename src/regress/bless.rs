@@ -43,7 +43,7 @@ use crate::trace::write::default_write_options;
 #[non_exhaustive]
 pub enum BlessError {
     /// The trace could not be replayed (read error, invalid scene or sweep).
-    #[error("{file}: cannot replay the trace: {cause}")]
+    #[error("{}", replay_error_text(file, cause))]
     Replay {
         /// The input's name.
         file: String,
@@ -79,6 +79,15 @@ pub enum BlessError {
         /// Index of the message in the file.
         index: u64,
     },
+}
+
+/// A replay error in words, naming the file once: a read error names it
+/// already; the other errors (an invalid scene or sweep) do not.
+fn replay_error_text(file: &str, cause: &ReplayError) -> String {
+    match cause {
+        ReplayError::Trace(_) => cause.to_string(),
+        _ => format!("{file}: cannot replay the trace: {cause}"),
+    }
 }
 
 /// Counts of a bless.

@@ -83,13 +83,16 @@ fn skip(field: Field, rest: &[u8]) -> Result<Option<&[u8]>, TooLong> {
     }
     let (inside, after) = after.split_at(length as usize);
     if let StringMap = field {
+        // The crate reads a key and its value while the map has bytes
+        // left, lengths included, even past the map's end: every length
+        // must lie inside the map, and every string too.
         let mut entries = inside;
         while !entries.is_empty() {
             for _ in 0..2 {
-                match skip(Bytes32, entries)? {
-                    Some(next) => entries = next,
-                    None => return Ok(Some(after)),
-                }
+                entries = match skip(Bytes32, entries)? {
+                    Some(next) => next,
+                    None => return Err((4, entries.len() as u64)),
+                };
             }
         }
     }
@@ -121,5 +124,16 @@ mod tests {
         metadata.extend_from_slice(&100u32.to_le_bytes());
         metadata.extend_from_slice(&[0; 4]);
         assert_eq!(check(op::METADATA, &metadata), Err((100, 4)));
+    }
+
+    #[test]
+    fn a_map_whose_last_length_lies_past_its_end_is_refused() {
+        // The fuzzer's find: the map ends two bytes into a key's length; the
+        // crate read that length from the bytes after the map.
+        let mut metadata = 1u32.to_le_bytes().to_vec();
+        metadata.push(b'n');
+        metadata.extend_from_slice(&2u32.to_le_bytes());
+        metadata.extend_from_slice(&[0xff; 6]);
+        assert_eq!(check(op::METADATA, &metadata), Err((4, 2)));
     }
 }

@@ -81,7 +81,12 @@ pub fn parse_message<T: DeserializeOwned>(data: &[u8], mut at: MessageAt) -> Res
                 Some(name) => format!("{path}.{name}"),
                 None => path,
             };
-            let detail = if inner.is_syntax() || inner.is_eof() {
+            let detail = if let Some(rest) = message.strip_prefix("unknown field `")
+                && let Some((_, expected)) = rest.split_once("`, ")
+            {
+                // The field's name is already given as the field.
+                format!("not a field of this message; {expected}")
+            } else if inner.is_syntax() || inner.is_eof() {
                 format!("the message is not valid JSON: {message}")
             } else if message.contains("invalid type: null") {
                 format!("{message} (`null` is not a number; JSON has no NaN or infinity)")

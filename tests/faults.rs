@@ -370,10 +370,10 @@ fn directory_removed_during_replay() -> Result<(), String> {
     let top = tempfile::tempdir().map_err(|e| e.to_string())?;
     let dir = top.path().join("out");
     std::fs::create_dir(&dir).map_err(|e| e.to_string())?;
-    let target = dir.join("terrain.rrd");
+    let target = dir.join("golf.rrd");
     let child = crate::support::bin()
         .arg("replay")
-        .arg(repository_file("traces/record_terrain.mcap"))
+        .arg(repository_file("traces/record_mini_golf.mcap"))
         .args(["--detail", "all", "--threads", "1", "--rrd"])
         .arg(&target)
         .stdout(Stdio::null())
@@ -384,7 +384,7 @@ fn directory_removed_during_replay() -> Result<(), String> {
     let deadline = Instant::now() + Duration::from_secs(60);
     loop {
         let names = files_in(&dir, &[])?;
-        if names.iter().any(|n| n.starts_with(".terrain.rrd.partial-")) {
+        if names.iter().any(|n| n.starts_with(".golf.rrd.partial-")) {
             break;
         }
         ensure!(

@@ -10,6 +10,8 @@
 
 use mcap::records::op;
 
+use super::TraceError;
+
 /// A field of a record's layout (docs: the MCAP specification's records).
 #[derive(Clone, Copy)]
 enum Field {
@@ -40,6 +42,25 @@ fn layout(opcode: u8) -> Option<&'static [Field]> {
         op::CHUNK_INDEX => &[Fixed(32), Bytes32, Fixed(8), Bytes32],
         op::STATISTICS => &[Fixed(8 + 2 + 4 * 4 + 8 + 8), Bytes32],
         _ => return None,
+    })
+}
+
+/// [`check`] as the reader's error: a record of `file` read after
+/// `messages` complete messages, described by `context` (called only on an
+/// error: this runs for every record).
+pub fn refuse(
+    opcode: u8,
+    data: &[u8],
+    file: &str,
+    messages: u64,
+    context: impl FnOnce() -> String,
+) -> Result<(), TraceError> {
+    check(opcode, data).map_err(|(declared, available)| TraceError::FieldTooLong {
+        file: file.to_string(),
+        messages,
+        context: context(),
+        declared,
+        available,
     })
 }
 

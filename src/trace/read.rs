@@ -378,25 +378,14 @@ impl State {
         }
     }
 
-    /// Refuses a record that declares a field longer than itself, before
-    /// the `mcap` crate reserves memory for it ([`super::lengths`]).
-    fn check_lengths(&self, opcode: u8, data: &[u8], context: &str) -> Result<(), TraceError> {
-        super::lengths::check(opcode, data).map_err(|(declared, available)| {
-            TraceError::FieldTooLong {
-                file: self.source_name.clone(),
-                messages: self.stats.messages,
-                context: context.to_string(),
-                declared,
-                available,
-            }
-        })
-    }
-
     /// Checks a chunk's declared sizes and returns a reader over its records.
     fn open_chunk(&mut self, data: &[u8]) -> Result<LinearReader, TraceError> {
         let index = self.stats.chunks;
         let context = format!("chunk {index}");
-        self.check_lengths(op::CHUNK, data, &context)?;
+        let messages = self.stats.messages;
+        super::lengths::refuse(op::CHUNK, data, &self.source_name, messages, || {
+            context.clone()
+        })?;
         let header = match mcap::parse_record(op::CHUNK, data) {
             Ok(Record::Chunk { header, .. }) => header,
             // `parse_record(op::CHUNK, ..)` always returns a chunk.
@@ -445,16 +434,17 @@ impl State {
             // Indexes, statistics, attachments and unknown records are not needed.
             _ => return Ok(None),
         }
-        self.check_lengths(opcode, data, &format!("record with opcode {opcode:#04x}"))?;
+        let context = || format!("record with opcode {opcode:#04x}");
+        super::lengths::refuse(
+            opcode,
+            data,
+            &self.source_name,
+            self.stats.messages,
+            context,
+        )?;
         let record = match mcap::parse_record(opcode, data) {
             Ok(record) => record,
-            Err(err) => {
-                return Err(self.mcap_error(
-                    err,
-                    &format!("record with opcode {opcode:#04x}"),
-                    false,
-                ));
-            }
+            Err(err) => return Err(self.mcap_error(err, &context(), false)),
         };
         match record {
             Record::Header(header) => {

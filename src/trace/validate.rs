@@ -82,10 +82,10 @@ pub fn parse_message<T: DeserializeOwned>(data: &[u8], mut at: MessageAt) -> Res
                 None => path,
             };
             let detail = if let Some(rest) = message.strip_prefix("unknown field `")
-                && let Some((_, expected)) = rest.split_once("`, ")
+                && let Some((_, expected)) = rest.rsplit_once("`, expected ")
             {
                 // The field's name is already given as the field.
-                format!("not a field of this message; {expected}")
+                format!("not a field of this message; expected {expected}")
             } else if inner.is_syntax() || inner.is_eof() {
                 format!("the message is not valid JSON: {message}")
             } else if message.contains("invalid type: null") {

@@ -12,6 +12,7 @@ mod core_decisions;
 mod core_random;
 mod error_messages;
 mod faults;
+mod fuzz_corpus;
 mod oracle;
 mod out_of_order;
 mod outputs;
@@ -101,5 +102,6 @@ fn main() {
     trials.extend(faults::tests());
     trials.extend(error_messages::tests());
     trials.extend(out_of_order::tests());
+    trials.extend(fuzz_corpus::tests());
     libtest_mimic::run(&args, trials).exit();
 }

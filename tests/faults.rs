@@ -220,68 +220,73 @@ fn files_in(dir: &Path, keep: &[&str]) -> Result<Vec<String>, String> {
 
 const FULL: &str = "No space left on device";
 
-/// `replay --rrd` onto a full tmpfs: it used to hang in the SDK's flush.
+/// `args` with `TARGET` replaced by `target`, `GOLF` by the mini-golf
+/// sample trace and `CUBE` by the cube sample trace.
+fn arguments(args: &[&str], target: &Path) -> Vec<std::ffi::OsString> {
+    args.iter()
+        .map(|a| match *a {
+            "TARGET" => target.as_os_str().to_owned(),
+            "GOLF" => repository_file("traces/record_mini_golf.mcap").into_os_string(),
+            "CUBE" => repository_file("traces/record_cube_corner_margin.mcap").into_os_string(),
+            other => other.into(),
+        })
+        .collect()
+}
+
+/// Runs `args` with `TARGET` a file named `target_name` on a tmpfs with
+/// about 64 KiB free (every output here is larger): exit 2, the file and
+/// "No space left on device" named once, nothing left on the disk.
+fn onto_full_disk(what: &str, target_name: &str, args: &[&str]) -> Result<Completion, String> {
+    let disk = mounted!(512);
+    disk.fill_leaving(64)?;
+    let target = disk.path().join(target_name);
+    let args = arguments(args, &target);
+    let args: Vec<&std::ffi::OsStr> = args.iter().map(|a| a.as_os_str()).collect();
+    let result = run_bounded(&args)?;
+    check_error(what, &result, &target, FULL)?;
+    let left = files_in(disk.path(), &["filler"])?;
+    ensure!(
+        left.is_empty(),
+        "{what}: files left on the full disk: {left:?}"
+    );
+    Ok(Completion::Completed)
+}
+
+/// `replay --rrd` onto a full disk: it used to hang in the SDK's flush.
 fn full_disk_replay_rrd() -> Result<Completion, String> {
-    let disk = mounted!(512);
-    let target = disk.path().join("golf.rrd");
-    let result = run_bounded(crate::os!(
-        "replay",
-        &repository_file("traces/record_mini_golf.mcap"),
-        "--rrd",
-        &target
-    ))?;
-    check_error("replay --rrd", &result, &target, FULL)?;
-    let left = files_in(disk.path(), &[])?;
-    ensure!(left.is_empty(), "files left on the full disk: {left:?}");
-    Ok(Completion::Completed)
+    onto_full_disk(
+        "replay --rrd",
+        "golf.rrd",
+        &["replay", "GOLF", "--rrd", "TARGET"],
+    )
 }
 
-/// `replay --outcomes` onto a tmpfs with 64 KiB free (the outcomes take
-/// about 340 KiB).
+/// `replay --outcomes` onto a full disk (the outcomes take about 340 KiB).
 fn full_disk_replay_outcomes() -> Result<Completion, String> {
-    let disk = mounted!(512);
-    disk.fill_leaving(64)?;
-    let target = disk.path().join("outcomes.jsonl");
-    let result = run_bounded(crate::os!(
-        "replay",
-        &repository_file("traces/record_mini_golf.mcap"),
-        "--outcomes",
-        &target
-    ))?;
-    check_error("replay --outcomes", &result, &target, FULL)?;
-    let left = files_in(disk.path(), &["filler"])?;
-    ensure!(left.is_empty(), "files left on the full disk: {left:?}");
-    Ok(Completion::Completed)
+    onto_full_disk(
+        "replay --outcomes",
+        "outcomes.jsonl",
+        &["replay", "GOLF", "--outcomes", "TARGET"],
+    )
 }
 
-/// `record` onto a tmpfs with 64 KiB free (the trace takes about 190 KiB).
+/// `record` onto a full disk (the trace takes about 190 KiB).
 fn full_disk_record() -> Result<Completion, String> {
-    let disk = mounted!(512);
-    disk.fill_leaving(64)?;
-    let target = disk.path().join("golf.mcap");
-    let result = run_bounded(crate::os!("record", "--scene", "mini_golf", "-o", &target))?;
-    check_error("record", &result, &target, FULL)?;
-    let left = files_in(disk.path(), &["filler"])?;
-    ensure!(left.is_empty(), "files left on the full disk: {left:?}");
-    Ok(Completion::Completed)
+    onto_full_disk(
+        "record",
+        "golf.mcap",
+        &["record", "--scene", "mini_golf", "-o", "TARGET"],
+    )
 }
 
-/// `bless -o` onto a tmpfs with 64 KiB free: the message names the output
-/// (it used to name the input).
+/// `bless -o` onto a full disk: the message names the output (it used to
+/// name the input).
 fn full_disk_bless() -> Result<Completion, String> {
-    let disk = mounted!(512);
-    disk.fill_leaving(64)?;
-    let target = disk.path().join("blessed.mcap");
-    let result = run_bounded(crate::os!(
-        "bless",
-        &repository_file("traces/record_mini_golf.mcap"),
-        "-o",
-        &target
-    ))?;
-    check_error("bless -o", &result, &target, FULL)?;
-    let left = files_in(disk.path(), &["filler"])?;
-    ensure!(left.is_empty(), "files left on the full disk: {left:?}");
-    Ok(Completion::Completed)
+    onto_full_disk(
+        "bless -o",
+        "blessed.mcap",
+        &["bless", "GOLF", "-o", "TARGET"],
+    )
 }
 
 /// `bless --in-place` of a trace on a disk with room for one copy only:
@@ -314,18 +319,17 @@ fn read_only_file_system() -> Result<Completion, String> {
     let trace = disk.path().join("cube.mcap");
     std::fs::write(&trace, &original).map_err(|e| e.to_string())?;
     disk.remount_read_only()?;
-    let sample = repository_file("traces/record_cube_corner_margin.mcap");
     let reason = "Read-only file system";
     for (what, target, args) in [
         (
             "replay --rrd",
             "out.rrd",
-            vec!["replay", "SAMPLE", "--rrd", "TARGET"],
+            vec!["replay", "CUBE", "--rrd", "TARGET"],
         ),
         (
             "replay --outcomes",
             "out.jsonl",
-            vec!["replay", "SAMPLE", "--outcomes", "TARGET"],
+            vec!["replay", "CUBE", "--outcomes", "TARGET"],
         ),
         (
             "record",
@@ -335,7 +339,7 @@ fn read_only_file_system() -> Result<Completion, String> {
         (
             "bless -o",
             "blessed.mcap",
-            vec!["bless", "SAMPLE", "-o", "TARGET"],
+            vec!["bless", "CUBE", "-o", "TARGET"],
         ),
         (
             "bless --in-place",
@@ -344,14 +348,8 @@ fn read_only_file_system() -> Result<Completion, String> {
         ),
     ] {
         let target = disk.path().join(target);
-        let args: Vec<&std::ffi::OsStr> = args
-            .iter()
-            .map(|a| match *a {
-                "SAMPLE" => sample.as_os_str(),
-                "TARGET" => target.as_os_str(),
-                other => std::ffi::OsStr::new(other),
-            })
-            .collect();
+        let args = arguments(&args, &target);
+        let args: Vec<&std::ffi::OsStr> = args.iter().map(|a| a.as_os_str()).collect();
         let result = run_bounded(&args)?;
         check_error(what, &result, &target, reason)?;
         let left = files_in(disk.path(), &["cube.mcap"])?;

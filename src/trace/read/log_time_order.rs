@@ -46,6 +46,11 @@ impl<R: Read + Seek> TraceReader<R> {
 
     /// [`TraceReader::new_indexed`] with the given limits.
     pub fn with_limits_indexed(mut reader: R, source_name: &str, limits: ReadLimits) -> Self {
+        // Offsets in the file count from its start: a reader elsewhere is
+        // read as it is, in file order.
+        if !matches!(reader.stream_position(), Ok(0)) {
+            return Self::with_limits(reader, source_name, limits);
+        }
         let indexed = overlapping_chunks(&mut reader, limits).and_then(|summary| {
             let options = IndexedReaderOptions::new()
                 .with_order(ReadOrder::LogTime)
@@ -101,9 +106,6 @@ fn overlapping_chunks<R: Read + Seek>(input: &mut R, limits: ReadLimits) -> Opti
 /// ([`crate::trace::lengths`]; the crate's reader would reserve a 4 GiB
 /// string a corrupt summary declares, as fuzzing found).
 fn chunk_indexes<R: Read + Seek>(input: &mut R, limits: ReadLimits) -> Option<Vec<ChunkIndex>> {
-    if input.stream_position().ok()? != 0 {
-        return None;
-    }
     let size = input.seek(SeekFrom::End(0)).ok()?;
     let footer_start = size.checked_sub(FOOTER_BYTES)?;
     let mut footer = [0u8; FOOTER_BYTES as usize];

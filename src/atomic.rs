@@ -52,7 +52,10 @@ impl PendingFile {
         // An ordinary file once renamed (temporary files are private by default).
         #[cfg(unix)]
         builder.permissions(std::os::unix::fs::PermissionsExt::from_mode(0o644));
-        let (file, temp) = builder.tempfile_in(dir_of(target))?.into_parts();
+        let (file, temp) = builder
+            .tempfile_in(dir_of(target))
+            .map_err(one_message)?
+            .into_parts();
         let pending = PendingFile {
             temp: Some(temp),
             target: target.to_path_buf(),
@@ -138,6 +141,17 @@ pub fn sync(file: &File) -> io::Result<()> {
         file.sync_all()?;
     }
     Ok(())
+}
+
+/// The `tempfile` crate's errors say the path in their text and also give
+/// the operating system's error as their source, so a chain printer would
+/// say the reason twice: keep one message with no source
+/// ([`crate::error_text`]).
+fn one_message(err: io::Error) -> io::Error {
+    if err.get_ref().is_none() {
+        return err;
+    }
+    io::Error::new(err.kind(), crate::error_text::full_text(&err))
 }
 
 fn dir_of(target: &Path) -> &Path {

@@ -27,7 +27,10 @@ pub mod atomic;
 pub mod conform;
 pub mod core;
 pub mod engine;
+pub mod error_text;
 pub mod foxglove;
+#[doc(hidden)]
+pub mod fuzzing;
 pub mod numbers;
 pub mod palette;
 pub mod regress;

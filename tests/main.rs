@@ -13,8 +13,12 @@ mod core_cases;
 mod core_decisions;
 mod core_random;
 mod engine;
+mod error_messages;
+mod faults;
 mod foxglove;
+mod fuzz_corpus;
 mod oracle;
+mod out_of_order;
 mod outputs;
 mod prefetch;
 mod rapier;
@@ -109,5 +113,9 @@ fn main() {
     trials.extend(conform::tests());
     trials.extend(bisect::tests());
     trials.extend(rapier::tests());
+    trials.extend(faults::tests());
+    trials.extend(error_messages::tests());
+    trials.extend(out_of_order::tests());
+    trials.extend(fuzz_corpus::tests());
     libtest_mimic::run(&args, trials).exit();
 }

@@ -12,6 +12,7 @@ pub fn tests() -> Vec<Trial> {
         trial!(named_pipe_is_written_directly),
         trial!(full_disk_is_a_clear_error),
         trial!(killed_mid_write_leaves_the_target_intact),
+        trial!(killed_bless_and_record_leave_the_target_intact),
         trial!(unreachable_viewer_is_a_clear_error),
         trial!(closed_stdout_ends_quietly),
         trial!(trace_to_a_pipe_is_refused),
@@ -214,6 +215,95 @@ fn killed_mid_write_leaves_the_target_intact() -> Result<(), String> {
             }
             for name in leftovers {
                 std::fs::remove_file(dir.path().join(name)).map_err(|e| e.to_string())?;
+            }
+        }
+    }
+    Ok(())
+}
+
+/// `bless --in-place` and `record -o` killed (SIGKILL) at several
+/// moments: the trace under the target name is the earlier one or a
+/// complete new one that reads to its end, and what is left over is a
+/// `.NAME.partial-*` temporary file, which the next run reports with how
+/// to remove it.
+fn killed_bless_and_record_leave_the_target_intact() -> Result<(), String> {
+    let dir = tempfile::tempdir().map_err(|e| e.to_string())?;
+    let target = dir.path().join("golf.mcap");
+    let terrain =
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("traces/record_terrain.mcap");
+    let commands: [(&str, Vec<std::ffi::OsString>); 2] = [
+        (
+            "bless --in-place",
+            vec!["bless".into(), target.clone().into(), "--in-place".into()],
+        ),
+        (
+            "record",
+            vec![
+                "record".into(),
+                "--scene".into(),
+                "terrain".into(),
+                "--frames".into(),
+                "300".into(),
+                "-o".into(),
+                target.clone().into(),
+            ],
+        ),
+    ];
+    for (what, args) in commands {
+        for delay_ms in [0u64, 20, 60, 150, 400] {
+            std::fs::copy(&terrain, &target).map_err(|e| e.to_string())?;
+            let before = std::fs::read(&target).map_err(|e| e.to_string())?;
+            let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_sweeptrace"))
+                .args(&args)
+                .stdout(std::process::Stdio::null())
+                .stderr(std::process::Stdio::null())
+                .spawn()
+                .map_err(|e| e.to_string())?;
+            std::thread::sleep(std::time::Duration::from_millis(delay_ms));
+            let _ = child.kill();
+            let _ = child.wait();
+            let now = std::fs::read(&target).map_err(|e| e.to_string())?;
+            if now != before {
+                // A complete new trace: it reads to its end without an error.
+                let name = target.display().to_string();
+                if let Some(err) =
+                    sweeptrace::TraceReader::new(now.as_slice(), &name).find_map(Result::err)
+                {
+                    return Err(format!(
+                        "{what} killed at {delay_ms} ms left a broken target: {err}"
+                    ));
+                }
+            }
+            let leftovers: Vec<String> = std::fs::read_dir(dir.path())
+                .map_err(|e| e.to_string())?
+                .filter_map(Result::ok)
+                .map(|e| e.file_name().to_string_lossy().into_owned())
+                .filter(|n| n != "golf.mcap")
+                .collect();
+            if let Some(odd) = leftovers
+                .iter()
+                .find(|n| !n.starts_with(".golf.mcap.partial-"))
+            {
+                return Err(format!("{what}: an unexpected file is left: {odd}"));
+            }
+            if !leftovers.is_empty() {
+                let next = std::process::Command::new(env!("CARGO_BIN_EXE_sweeptrace"))
+                    .args(["record", "--scene", "cube", "--frames", "3", "-o"])
+                    .arg(&target)
+                    .output()
+                    .map_err(|e| e.to_string())?;
+                let stderr = String::from_utf8_lossy(&next.stderr);
+                if !(next.status.success()
+                    && stderr.contains("unfinished temporary file")
+                    && stderr.contains("rm "))
+                {
+                    return Err(format!(
+                        "{what}: the next run does not report the leftovers: {stderr}"
+                    ));
+                }
+                for name in leftovers {
+                    std::fs::remove_file(dir.path().join(name)).map_err(|e| e.to_string())?;
+                }
             }
         }
     }

@@ -70,6 +70,39 @@ pub fn with_timeout<T: Send + 'static>(
     }
 }
 
+/// Set to `1` (CI does) to make the tests that need Python's `mcap`
+/// package fail, instead of being skipped, when it cannot be imported.
+pub const REQUIRE_PYTHON: &str = "SWEEPTRACE_REQUIRE_PYTHON";
+
+/// Whether `python3` on `PATH` can import `mcap`: `Ok(Ok(()))` when it
+/// can, `Ok(Err(completion))` for a test to skip with the reason, an error
+/// when [`REQUIRE_PYTHON`] requires it.
+pub fn python_with_mcap() -> Result<Result<(), libtest_mimic::Completion>, String> {
+    let missing = match std::process::Command::new("python3")
+        .args(["-c", "import mcap"])
+        .output()
+    {
+        Ok(o) if o.status.success() => return Ok(Ok(())),
+        Ok(o) => format!(
+            "python3 cannot import the `mcap` package ({})",
+            String::from_utf8_lossy(&o.stderr)
+                .lines()
+                .last()
+                .unwrap_or("no message")
+        ),
+        Err(e) => format!("python3 cannot be run ({e})"),
+    };
+    if std::env::var_os(REQUIRE_PYTHON).is_some_and(|v| v == "1") {
+        return Err(format!(
+            "{missing}, and {REQUIRE_PYTHON}=1 requires this cross-check \
+             (`pip install mcap==1.6.0` and put that Python first on PATH)"
+        ));
+    }
+    Ok(Err(libtest_mimic::Completion::ignored_with(format!(
+        "skipped: {missing}; {REQUIRE_PYTHON}=1 makes this a failure"
+    ))))
+}
+
 /// `|a - b| ≤ tol`, or an error naming `what`.
 pub fn close(what: &str, got: f64, want: f64, tol: f64) -> Result<(), String> {
     if (got - want).abs() <= tol {

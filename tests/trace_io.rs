@@ -220,7 +220,7 @@ fn read_all_with(
 
 /// A trace written with the raw `mcap` writer: our three channels plus
 /// `/foreign`; each message is (topic, log_time, JSON bytes).
-fn raw_trace(messages: &[(&str, u64, &[u8])]) -> Vec<u8> {
+pub fn raw_trace(messages: &[(&str, u64, &[u8])]) -> Vec<u8> {
     raw_trace_with(messages, "json")
 }
 
@@ -680,7 +680,7 @@ fn error_truncated_chunked() -> Result<(), String> {
 }
 
 /// Offset of the first chunk record (opcode 0x06) of a file.
-fn first_chunk(bytes: &[u8]) -> Option<(usize, usize)> {
+pub fn first_chunk(bytes: &[u8]) -> Option<(usize, usize)> {
     let mut at = 8;
     while at + 9 <= bytes.len() {
         let op = bytes[at];
@@ -1079,7 +1079,8 @@ fn error_names_where(error: &TraceError, read: u64) -> Result<(), String> {
     match error {
         TraceError::Io { messages, .. }
         | TraceError::Truncated { messages, .. }
-        | TraceError::Corrupt { messages, .. } => ensure!(
+        | TraceError::Corrupt { messages, .. }
+        | TraceError::FieldTooLong { messages, .. } => ensure!(
             *messages >= read && text.contains(&format!("after {messages} complete messages")),
             "the position is not named: {text} ({read} read)"
         ),
@@ -1281,35 +1282,9 @@ fn info_reports_partial_trace() -> Result<(), String> {
     Ok(())
 }
 
-/// Set to `1` (CI does) to make the Python cross-check fail, instead of
-/// being skipped, when Python's `mcap` package cannot be imported.
-const REQUIRE_PYTHON: &str = "SWEEPTRACE_REQUIRE_PYTHON";
-
 fn python_reads_our_trace() -> Result<Completion, String> {
-    let missing = match std::process::Command::new("python3")
-        .args(["-c", "import mcap"])
-        .output()
-    {
-        Ok(o) if o.status.success() => None,
-        Ok(o) => Some(format!(
-            "python3 cannot import the `mcap` package ({})",
-            String::from_utf8_lossy(&o.stderr)
-                .lines()
-                .last()
-                .unwrap_or("no message")
-        )),
-        Err(e) => Some(format!("python3 cannot be run ({e})")),
-    };
-    if let Some(missing) = missing {
-        if std::env::var_os(REQUIRE_PYTHON).is_some_and(|v| v == "1") {
-            return Err(format!(
-                "{missing}, and {REQUIRE_PYTHON}=1 requires this cross-check \
-                 (`pip install mcap==1.6.0` and put that Python first on PATH)"
-            ));
-        }
-        return Ok(Completion::ignored_with(format!(
-            "skipped: {missing}; {REQUIRE_PYTHON}=1 makes this a failure"
-        )));
+    if let Err(skipped) = crate::support::python_with_mcap()? {
+        return Ok(skipped);
     }
     let dir = tempfile::tempdir().map_err(|e| e.to_string())?;
     let path = dir.path().join("py.mcap");

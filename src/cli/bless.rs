@@ -2,9 +2,10 @@
 //! current core's outcomes, keeping every other channel, schema, metadata
 //! record and attachment (the library's [`sweeptrace::regress`]).
 
+use super::NameFileOnce;
 use std::path::PathBuf;
 
-use anyhow::{Context, bail};
+use anyhow::bail;
 
 use sweeptrace::regress::bless_file;
 use sweeptrace::replay::ReplayOptions;
@@ -46,7 +47,7 @@ pub fn run(args: Args) -> anyhow::Result<RunOutcome> {
     };
     super::warn_unfinished(&output);
     let summary = bless_file(&args.trace, &output, ReplayOptions::default())
-        .with_context(|| format!("blessing {}", args.trace.display()))?;
+        .name_file_once("blessing", args.trace.display())?;
     eprintln!(
         "wrote {}: {} expectations (replacing {}), {} other messages, {} channels, {} schemas, \
          {} metadata records and {} attachments kept",

@@ -1,6 +1,7 @@
 //! `sweeptrace check`: replay traces and compare every sweep's outcome with
 //! the trace's `/expected` channel (the library's [`sweeptrace::regress`]).
 
+use super::NameFileOnce;
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, bail};
@@ -241,7 +242,10 @@ fn write_failure_rrd(trace: &Path, dir: &Path, report: &TraceReport) -> anyhow::
         .set_sinks(vec![Box::new(sink) as Box<dyn rerun::sink::LogSink>])
         .context("creating the recording")?;
     let mut logger = viz::Logger::new(rec, true).context("starting the recording")?;
-    for event in replay_events(TraceReader::new(bytes.as_slice(), &name), options) {
+    for event in replay_events(
+        TraceReader::new_indexed(std::io::Cursor::new(bytes.as_slice()), &name),
+        options,
+    ) {
         match event {
             Ok(ReplayEvent::Scene(scene)) => {
                 logger.log_scene(&scene).context("logging the scene")?
@@ -251,7 +255,7 @@ fn write_failure_rrd(trace: &Path, dir: &Path, report: &TraceReport) -> anyhow::
                 .with_context(|| format!("logging frame {}", r.frame))?,
             // The check already reported read errors; record what was read.
             Err(ReplayError::Trace(_)) => break,
-            Err(err) => return Err(err).context(format!("replaying {name}")),
+            Err(err) => return Err(err).name_file_once("replaying", &name),
         }
     }
     let rec = logger.finish();

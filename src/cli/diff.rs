@@ -1,6 +1,7 @@
 //! `sweeptrace diff`: compare the outcomes of two replays, sweep by sweep
 //! (the library's [`sweeptrace::regress`]).
 
+use super::NameFileOnce;
 use std::fs::File;
 use std::io::BufReader;
 use std::path::{Path, PathBuf};
@@ -60,8 +61,8 @@ pub struct Args {
 fn side(path: &Path, options: ReplayOptions) -> anyhow::Result<Side> {
     let name = path.display().to_string();
     let file = File::open(path).with_context(|| format!("cannot open trace {name}"))?;
-    let reader = TraceReader::new(BufReader::with_capacity(1 << 16, file), &name);
-    Side::replay(reader, &name, options).with_context(|| format!("replaying {name}"))
+    let reader = TraceReader::new_indexed(BufReader::with_capacity(1 << 16, file), &name);
+    Side::replay(reader, &name, options).name_file_once("replaying", &name)
 }
 
 /// Compares the two replays.

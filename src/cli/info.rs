@@ -1,5 +1,6 @@
 //! `sweeptrace info`: what a trace holds.
 
+use super::NameFileOnce;
 use std::fs::File;
 use std::io::BufReader;
 use std::path::PathBuf;
@@ -26,7 +27,7 @@ pub struct Args {
 pub fn run(args: Args) -> anyhow::Result<RunOutcome> {
     let name = args.trace.display().to_string();
     let file = File::open(&args.trace).with_context(|| format!("cannot open trace {name}"))?;
-    let (info, error) = collect(TraceReader::new(BufReader::new(file), &name));
+    let (info, error) = collect(TraceReader::new_indexed(BufReader::new(file), &name));
     let report = if args.json {
         render_json(&info)
     } else {
@@ -42,6 +43,6 @@ pub fn run(args: Args) -> anyhow::Result<RunOutcome> {
             eprintln!("error: {err}");
             Ok(RunOutcome::IncompleteInput)
         }
-        Some(err) => Err(err).with_context(|| format!("cannot read trace {name} to its end")),
+        Some(err) => Err(err).name_file_once("reading the trace", &name),
     }
 }

@@ -128,6 +128,30 @@ pub fn recording_id(
     Ok(hasher.finish())
 }
 
+/// Context for an error that may already name its file: the library's
+/// errors name the file they are about, so `doing FILE` is put in front of
+/// an error only when its message does not name `file` yet (a message names
+/// each file once).
+pub trait NameFileOnce<T> {
+    /// `self`, with `doing FILE: ` in front of its error unless the error
+    /// names `file`.
+    fn name_file_once(self, doing: &str, file: impl std::fmt::Display) -> anyhow::Result<T>;
+}
+
+impl<T, E: Into<anyhow::Error>> NameFileOnce<T> for Result<T, E> {
+    fn name_file_once(self, doing: &str, file: impl std::fmt::Display) -> anyhow::Result<T> {
+        self.map_err(|err| {
+            let err = err.into();
+            let shown = file.to_string();
+            if format!("{err:#}").contains(&shown) {
+                err
+            } else {
+                err.context(format!("{doing} {shown}"))
+            }
+        })
+    }
+}
+
 /// Warns about temporary files an interrupted earlier run left next to
 /// `target`, and says how to remove them.
 pub fn warn_unfinished(target: &std::path::Path) {

@@ -1,5 +1,6 @@
 //! `sweeptrace record`: simulate balls through a scene and write a trace.
 
+use super::NameFileOnce;
 use std::io::IsTerminal;
 use std::path::PathBuf;
 
@@ -173,7 +174,7 @@ pub fn run(args: Args) -> anyhow::Result<RunOutcome> {
         })?;
         Ok(summary)
     })
-    .with_context(|| format!("recording {}", output.display()))?;
+    .name_file_once("recording", output.display())?;
     bar.finish_and_clear();
     println!(
         "{}",

@@ -2,6 +2,7 @@
 //! write the outcomes, a Rerun recording and/or a Foxglove file that
 //! explain them.
 
+use super::NameFileOnce;
 use std::fs::File;
 use std::io::{BufReader, BufWriter, IsTerminal, Read, Write};
 use std::path::{Path, PathBuf};
@@ -101,6 +102,14 @@ pub struct Args {
 struct CountingReader<R> {
     inner: R,
     count: Arc<AtomicU64>,
+}
+
+/// Seeking (to the summary, and to chunks when a trace is read through
+/// its chunk indexes) counts nothing: only bytes read.
+impl<R: std::io::Seek> std::io::Seek for CountingReader<R> {
+    fn seek(&mut self, to: std::io::SeekFrom) -> std::io::Result<u64> {
+        self.inner.seek(to)
+    }
 }
 
 impl<R: Read> Read for CountingReader<R> {
@@ -283,7 +292,7 @@ pub fn run(args: Args) -> anyhow::Result<RunOutcome> {
     let progress = progress_bar(total_bytes);
     // Decode on a thread of its own, so reading overlaps the core's work.
     let read_ahead = prefetch(
-        TraceReader::new(reader, &source_name),
+        TraceReader::new_indexed(reader, &source_name),
         prefetch::DEFAULT_CHUNK,
         prefetch::DEFAULT_DEPTH,
     )
@@ -333,7 +342,7 @@ pub fn run(args: Args) -> anyhow::Result<RunOutcome> {
                     trace_error = Some(err);
                 }
                 Err(err) => {
-                    return Err(anyhow::Error::new(err).context(format!("replaying {source_name}")));
+                    return Err(err).name_file_once("replaying", &source_name);
                 }
             }
             Ok(())

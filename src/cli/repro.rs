@@ -1,6 +1,7 @@
 //! `sweeptrace repro`: one sweep of a trace as a minimal trace and a
 //! ready-to-paste Rust test (the library's [`sweeptrace::regress::repro`]).
 
+use super::NameFileOnce;
 use std::path::PathBuf;
 
 use anyhow::Context;
@@ -44,11 +45,11 @@ pub fn run(args: Args) -> anyhow::Result<RunOutcome> {
     let tolerances = args.tolerances.to_tolerances()?;
     let shown = args.trace.display().to_string();
     let file = std::fs::File::open(&args.trace).with_context(|| format!("cannot open {shown}"))?;
-    let reader = TraceReader::new(std::io::BufReader::new(file), &shown);
+    let reader = TraceReader::new_indexed(std::io::BufReader::new(file), &shown);
     let found = find_sweep(reader, &shown, args.frame, args.ball)?;
     let case = ReproCase::build(&shown, &found, &tolerances)?;
     write_trace_file(&args.output, |w| case.write(w))
-        .with_context(|| format!("writing {}", args.output.display()))?;
+        .name_file_once("writing", args.output.display())?;
     eprint!("{}", case.summary());
     eprintln!("wrote {}", args.output.display());
     print!("{}", case.rust_test(&tolerances));

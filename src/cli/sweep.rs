@@ -77,7 +77,7 @@ pub fn run(args: Args) -> anyhow::Result<RunOutcome> {
         let frame = args.frame.context("--trace needs --frame")?;
         let shown = path.display().to_string();
         let file = std::fs::File::open(path).with_context(|| format!("cannot open {shown}"))?;
-        let reader = TraceReader::new(std::io::BufReader::new(file), &shown);
+        let reader = TraceReader::new_indexed(std::io::BufReader::new(file), &shown);
         let found = find_sweep(reader, &shown, frame, args.ball)?;
         let mesh = sweeptrace::Mesh::new(found.scene.vertices.clone(), &found.scene.triangles)
             .with_context(|| format!("{shown}: building the scene of frame {frame}"))?;

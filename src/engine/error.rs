@@ -113,14 +113,14 @@ pub enum EngineError {
         seconds: f64,
     },
     /// Reading from or writing to the engine failed.
-    #[error("the engine `{command}`: {what}: {source}")]
+    #[error("the engine `{command}`: {what}: {}", crate::error_text::full_text(.cause))]
     Io {
         /// The command.
         command: String,
         /// What was being done.
         what: &'static str,
         /// The error.
-        source: std::io::Error,
+        cause: std::io::Error,
     },
 }
 

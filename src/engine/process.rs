@@ -104,10 +104,10 @@ impl EngineSession {
                 reason: format!("{}: {e}", command.program),
                 stderr_tail: Vec::new(),
             })?;
-        let io_error = |what, source| EngineError::Io {
+        let io_error = |what, cause| EngineError::Io {
             command: command.text.clone(),
             what,
-            source,
+            cause,
         };
         let missing = || std::io::Error::other("the pipe was not created");
         let stdin = child
@@ -187,11 +187,11 @@ impl EngineSession {
         }
     }
 
-    fn io(&self, what: &'static str, source: std::io::Error) -> EngineError {
+    fn io(&self, what: &'static str, cause: std::io::Error) -> EngineError {
         EngineError::Io {
             command: self.command.text.clone(),
             what,
-            source,
+            cause,
         }
     }
 

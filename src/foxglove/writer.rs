@@ -37,27 +37,25 @@ use crate::trace::write::library_string;
 #[non_exhaustive]
 pub enum FoxgloveError {
     /// The MCAP writer failed (an I/O error underneath, usually).
-    #[error("{file}: writing the Foxglove file: {source}")]
+    #[error("{file}: writing the Foxglove file: {}", crate::error_text::full_text(.cause))]
     Write {
         /// The output file.
         file: String,
         /// The writer's error.
-        #[source]
-        source: mcap::McapError,
+        cause: mcap::McapError,
     },
     /// Creating, flushing, syncing or renaming the file failed.
-    #[error("{file}: {doing}: {source}")]
+    #[error("{file}: {doing}: {}", crate::error_text::full_text(.cause))]
     Io {
         /// The output file.
         file: String,
         /// What was being done.
         doing: &'static str,
         /// The I/O error.
-        #[source]
-        source: std::io::Error,
+        cause: std::io::Error,
     },
     /// A message could not be serialized.
-    #[error("{file}: serializing the {topic} message of frame {frame}: {source}")]
+    #[error("{file}: serializing the {topic} message of frame {frame}: {}", crate::error_text::full_text(.cause))]
     Json {
         /// The output file.
         file: String,
@@ -66,8 +64,7 @@ pub enum FoxgloveError {
         /// The sweep's frame (0 for a scene).
         frame: u64,
         /// The serializer's error.
-        #[source]
-        source: serde_json::Error,
+        cause: serde_json::Error,
     },
 }
 
@@ -128,9 +125,9 @@ impl<W: Write + Seek> FoxgloveWriter<W> {
     /// A writer on `w`; `file` names the output in errors. Writes the
     /// header, the metadata record, the schemas and the channels.
     pub fn new(w: W, file: &str, options: FoxgloveOptions) -> Result<Self, FoxgloveError> {
-        let error = |source| FoxgloveError::Write {
+        let error = |cause| FoxgloveError::Write {
             file: file.to_string(),
-            source,
+            cause,
         };
         let mut writer = write_options().create(w).map_err(error)?;
         writer
@@ -197,11 +194,11 @@ impl<W: Write + Seek> FoxgloveWriter<W> {
         message: &T,
     ) -> Result<(), FoxgloveError> {
         self.data.clear();
-        serde_json::to_writer(&mut self.data, message).map_err(|source| FoxgloveError::Json {
+        serde_json::to_writer(&mut self.data, message).map_err(|cause| FoxgloveError::Json {
             file: self.file.clone(),
             topic,
             frame,
-            source,
+            cause,
         })?;
         let header = MessageHeader {
             channel_id,
@@ -211,9 +208,9 @@ impl<W: Write + Seek> FoxgloveWriter<W> {
         };
         self.writer
             .write_to_known_channel(&header, &self.data)
-            .map_err(|source| FoxgloveError::Write {
+            .map_err(|cause| FoxgloveError::Write {
                 file: self.file.clone(),
-                source,
+                cause,
             })?;
         self.counts.messages += 1;
         Ok(())
@@ -279,12 +276,10 @@ impl<W: Write + Seek> FoxgloveWriter<W> {
     /// Writes the last chunk, the summary and the footer; returns the
     /// underlying writer.
     pub fn finish(mut self) -> Result<W, FoxgloveError> {
-        self.writer
-            .finish()
-            .map_err(|source| FoxgloveError::Write {
-                file: self.file.clone(),
-                source,
-            })?;
+        self.writer.finish().map_err(|cause| FoxgloveError::Write {
+            file: self.file.clone(),
+            cause,
+        })?;
         Ok(self.writer.into_inner())
     }
 }
@@ -304,10 +299,10 @@ impl FoxgloveFile {
     pub fn create(target: &Path, options: FoxgloveOptions) -> Result<FoxgloveFile, FoxgloveError> {
         let name = target.display().to_string();
         let (pending, file) =
-            PendingFile::create_seekable(target).map_err(|source| FoxgloveError::Io {
+            PendingFile::create_seekable(target).map_err(|cause| FoxgloveError::Io {
                 file: name.clone(),
                 doing: "creating a temporary file next to it",
-                source,
+                cause,
             })?;
         let writer = FoxgloveWriter::new(BufWriter::new(file), &name, options)?;
         Ok(FoxgloveFile { writer, pending })
@@ -323,10 +318,10 @@ impl FoxgloveFile {
         let name = self.pending.target().display().to_string();
         let io = |doing| {
             let name = name.clone();
-            move |source| FoxgloveError::Io {
+            move |cause| FoxgloveError::Io {
                 file: name,
                 doing,
-                source,
+                cause,
             }
         };
         let counts = self.writer.counts();

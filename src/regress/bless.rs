@@ -30,6 +30,7 @@ use mcap::{Attachment, McapError};
 use thiserror::Error;
 
 use crate::atomic::PendingFile;
+use crate::error_text::full_text;
 use crate::replay::{ReplayError, ReplayEvent, ReplayOptions, replay_events};
 use crate::trace::TraceReader;
 use crate::trace::messages::{EXPECTED_TOPIC, OUTCOME_SCHEMA, OutcomeMsg, SWEEP_TOPIC};
@@ -42,35 +43,32 @@ use crate::trace::write::default_write_options;
 #[non_exhaustive]
 pub enum BlessError {
     /// The trace could not be replayed (read error, invalid scene or sweep).
-    #[error("{file}: cannot replay the trace: {source}")]
+    #[error("{}", replay_error_text(file, cause))]
     Replay {
         /// The input's name.
         file: String,
         /// What went wrong.
-        #[source]
-        source: ReplayError,
+        cause: ReplayError,
     },
     /// The MCAP container could not be read or written.
-    #[error("{file}: {what}: {source}")]
+    #[error("{file}: {what}: {}", full_text(.cause))]
     Mcap {
         /// The file's name.
         file: String,
         /// What was being done.
         what: String,
         /// The error.
-        #[source]
-        source: McapError,
+        cause: McapError,
     },
     /// A file could not be read or written.
-    #[error("{file}: {what}: {source}")]
+    #[error("{file}: {what}: {}", full_text(.cause))]
     Io {
         /// The file's name.
         file: String,
         /// What was being done.
         what: String,
         /// The error.
-        #[source]
-        source: std::io::Error,
+        cause: std::io::Error,
     },
     /// A `/sweep` message found in the copy pass has no outcome from the
     /// replay pass (the replay and the copy disagree on the file).
@@ -81,6 +79,15 @@ pub enum BlessError {
         /// Index of the message in the file.
         index: u64,
     },
+}
+
+/// A replay error in words, naming the file once: a read error names it
+/// already; the other errors (an invalid scene or sweep) do not.
+fn replay_error_text(file: &str, cause: &ReplayError) -> String {
+    match cause {
+        ReplayError::Trace(_) => cause.to_string(),
+        _ => format!("{file}: cannot replay the trace: {cause}"),
+    }
 }
 
 /// Counts of a bless.
@@ -115,17 +122,20 @@ fn outcomes_of(
         ..options
     };
     let mut out: HashMap<(u64, u32), VecDeque<OutcomeMsg>> = HashMap::new();
-    for event in replay_events(TraceReader::new(input, name), options) {
+    for event in replay_events(
+        TraceReader::new_indexed(std::io::Cursor::new(input), name),
+        options,
+    ) {
         match event {
             Ok(ReplayEvent::Sweep(r)) => out
                 .entry((r.frame, r.ball))
                 .or_default()
                 .push_back(r.outcome_msg()),
             Ok(ReplayEvent::Scene(_)) => {}
-            Err(source) => {
+            Err(cause) => {
                 return Err(BlessError::Replay {
                     file: name.to_string(),
-                    source,
+                    cause,
                 });
             }
         }
@@ -143,16 +153,27 @@ pub fn bless_bytes<W: Write + Seek>(
     output: W,
     options: ReplayOptions,
 ) -> Result<(BlessSummary, W), BlessError> {
+    bless_into(input, name, output, name, options)
+}
+
+/// [`bless_bytes`], with write errors naming `output_name`.
+fn bless_into<W: Write + Seek>(
+    input: &[u8],
+    name: &str,
+    output: W,
+    output_name: &str,
+    options: ReplayOptions,
+) -> Result<(BlessSummary, W), BlessError> {
     let mut outcomes = outcomes_of(input, name, options)?;
-    let read_err = |source| BlessError::Mcap {
+    let read_err = |cause| BlessError::Mcap {
         file: name.to_string(),
         what: "reading the container".to_string(),
-        source,
+        cause,
     };
-    let write_err = |source| BlessError::Mcap {
-        file: name.to_string(),
+    let write_err = |cause| BlessError::Mcap {
+        file: output_name.to_string(),
         what: "writing the blessed trace".to_string(),
-        source,
+        cause,
     };
 
     // Pass 2 (cheap; pass 1 was the replay): the header, and which schemas
@@ -216,7 +237,7 @@ pub fn bless_bytes<W: Write + Seek>(
                         .ok_or_else(|| BlessError::Mcap {
                             file: name.to_string(),
                             what: format!("channel `{}`", c.topic),
-                            source: McapError::UnknownSchema(c.topic.clone(), c.schema_id),
+                            cause: McapError::UnknownSchema(c.topic.clone(), c.schema_id),
                         })?
                 };
                 let id = writer
@@ -237,7 +258,7 @@ pub fn bless_bytes<W: Write + Seek>(
                     return Err(BlessError::Mcap {
                         file: name.to_string(),
                         what: format!("message {this}"),
-                        source: McapError::UnknownChannel(header.sequence, header.channel_id),
+                        cause: McapError::UnknownChannel(header.sequence, header.channel_id),
                     });
                 };
                 writer
@@ -287,7 +308,7 @@ pub fn bless_bytes<W: Write + Seek>(
                 let json = serde_json::to_vec(&outcome).map_err(|e| BlessError::Io {
                     file: name.to_string(),
                     what: format!("serializing the outcome of frame {}", outcome.frame),
-                    source: std::io::Error::other(e),
+                    cause: std::io::Error::other(e),
                 })?;
                 writer
                     .write_to_known_channel(
@@ -347,16 +368,17 @@ pub fn bless_file(
     let io = |file: &str, what: &str| {
         let file = file.to_string();
         let what = what.to_string();
-        move |source| BlessError::Io { file, what, source }
+        move |cause| BlessError::Io { file, what, cause }
     };
     let bytes = std::fs::read(input).map_err(io(&in_name, "reading"))?;
     let (pending, file) = PendingFile::create_seekable(output)
         .map_err(io(&out_name, "creating a temporary file next to it"))?;
-    let (summary, buffered) = bless_bytes(&bytes, &in_name, BufWriter::new(file), options)?;
+    let (summary, buffered) =
+        bless_into(&bytes, &in_name, BufWriter::new(file), &out_name, options)?;
     let file = buffered.into_inner().map_err(|e| BlessError::Io {
         file: out_name.clone(),
         what: "writing".to_string(),
-        source: e.into_error(),
+        cause: e.into_error(),
     })?;
     crate::atomic::sync(&file).map_err(io(&out_name, "writing"))?;
     drop(file);

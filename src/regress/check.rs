@@ -303,7 +303,15 @@ pub fn check_reader<R: std::io::Read>(
     name: &str,
     options: &CheckOptions,
 ) -> TraceReport {
-    let mut reader = TraceReader::new(reader, name);
+    check_trace(TraceReader::new(reader, name), name, options)
+}
+
+/// Checks the trace `reader` reads (see [`check_reader`]).
+fn check_trace<R: std::io::Read>(
+    mut reader: TraceReader<R>,
+    name: &str,
+    options: &CheckOptions,
+) -> TraceReport {
     let mut report = check_events(reader.by_ref(), name, options);
     report.has_expected_channel = reader.stats().channels.contains_key(EXPECTED_TOPIC);
     report.status = status_of(&report);
@@ -598,8 +606,8 @@ pub fn frames_around(
 pub fn check_file(path: &std::path::Path, options: &CheckOptions) -> TraceReport {
     let name = path.display().to_string();
     match std::fs::File::open(path) {
-        Ok(file) => check_reader(
-            std::io::BufReader::with_capacity(1 << 16, file),
+        Ok(file) => check_trace(
+            TraceReader::new_indexed(std::io::BufReader::with_capacity(1 << 16, file), &name),
             &name,
             options,
         ),

@@ -285,10 +285,13 @@ pub fn render_text(r: &TraceReport) -> String {
             tunnel_lines(&mut s);
         }
         Status::Error => {
-            // A message of several lines (an engine's last stderr lines)
-            // keeps its first line with the counts, the rest below.
-            let first = r.errors.first().map(String::as_str).unwrap_or("error");
-            let (head, below) = first.split_once('\n').unwrap_or((first, ""));
+            // The errors name the trace; the line names it once. A message
+            // of several lines (an engine's last stderr lines) keeps its
+            // first line with the counts, the rest below.
+            let prefix = format!("{}: ", r.trace);
+            let unnamed = |e: &str| e.strip_prefix(&prefix).unwrap_or(e).to_string();
+            let first = r.errors.first().map_or("error".to_string(), |e| unnamed(e));
+            let (head, below) = first.split_once('\n').unwrap_or((first.as_str(), ""));
             let _ = writeln!(
                 s,
                 "ERROR {}: {head}; {counts}, {} diverge",
@@ -298,7 +301,7 @@ pub fn render_text(r: &TraceReport) -> String {
                 let _ = writeln!(s, "{line}");
             }
             for e in r.errors.iter().skip(1) {
-                let _ = writeln!(s, "  also: {e}");
+                let _ = writeln!(s, "  also: {}", unnamed(e));
             }
             tunnel_lines(&mut s);
             for d in &r.divergences {

@@ -182,8 +182,8 @@ impl Replay {
             margin,
             facing,
         } = scene;
-        let mesh = Mesh::new(vertices, &triangles)
-            .map_err(|source| ReplayError::Mesh { index, source })?;
+        let mesh =
+            Mesh::new(vertices, &triangles).map_err(|cause| ReplayError::Mesh { index, cause })?;
         let options = Options {
             margin: self.options.margin.unwrap_or(margin),
             facing: self.options.facing.unwrap_or(facing),
@@ -437,11 +437,11 @@ pub fn compute_sweep(
 ) -> Result<ComputedSweep, ReplayError> {
     let start = Instant::now();
     let sweep = Sweep::new(msg.p0, msg.p1, msg.radius);
-    let err = |source| ReplayError::Sweep {
+    let err = |cause| ReplayError::Sweep {
         frame: msg.frame,
         ball: msg.ball,
         index,
-        source,
+        cause,
     };
     let mut verdicts: Vec<(Verdict, u64)> = Vec::new();
     let (outcome, records) = if options.explain {

@@ -10,12 +10,12 @@ use crate::trace::TraceError;
 #[non_exhaustive]
 pub enum ReplayError {
     /// A scene's mesh is invalid.
-    #[error("scene message {index}: {source}")]
+    #[error("scene message {index}: {cause}")]
     Mesh {
         /// Index of the scene message.
         index: u64,
         /// What is wrong.
-        source: MeshError,
+        cause: MeshError,
     },
     /// A sweep came before any scene.
     #[error("sweep of frame {frame} (message {index}) has no scene before it")]
@@ -26,7 +26,7 @@ pub enum ReplayError {
         index: u64,
     },
     /// A sweep's values are invalid.
-    #[error("frame {frame}, ball {ball} (message {index}): {source}")]
+    #[error("frame {frame}, ball {ball} (message {index}): {cause}")]
     Sweep {
         /// Frame.
         frame: u64,
@@ -35,7 +35,7 @@ pub enum ReplayError {
         /// Index of the sweep message.
         index: u64,
         /// What is wrong.
-        source: SweepError,
+        cause: SweepError,
     },
     /// The trace could not be read further.
     /// (Boxed: a trace error is large, and results pass through here.)

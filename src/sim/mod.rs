@@ -225,14 +225,14 @@ pub enum SimError {
     },
     /// The core refused a sweep (cannot happen with validated options; kept
     /// as an error rather than a panic).
-    #[error("frame {frame}, ball {ball}: {source}")]
+    #[error("frame {frame}, ball {ball}: {cause}")]
     Sweep {
         /// Trace frame.
         frame: u64,
         /// Ball.
         ball: u32,
         /// The core's error.
-        source: SweepError,
+        cause: SweepError,
     },
 }
 
@@ -428,10 +428,10 @@ pub fn simulate<E: From<SimError>>(
                     radius: options.radius,
                 };
                 let outcome =
-                    sweep_mesh(mesh, &sweep, &core_options).map_err(|source| SimError::Sweep {
+                    sweep_mesh(mesh, &sweep, &core_options).map_err(|cause| SimError::Sweep {
                         frame,
                         ball: index,
-                        source,
+                        cause,
                     })?;
                 let event = Event {
                     sim_frame,

@@ -7,12 +7,12 @@ use super::scenes::SceneMesh;
 #[non_exhaustive]
 pub enum ObjError {
     /// The file could not be opened or read.
-    #[error("cannot read {path}: {source}")]
+    #[error("cannot read {path}: {}", crate::error_text::full_text(.cause))]
     Io {
         /// The file.
         path: String,
         /// The cause.
-        source: std::io::Error,
+        cause: std::io::Error,
     },
     /// The OBJ parser refused the file.
     #[error("{path} is not a valid Wavefront OBJ file: {reason}")]
@@ -37,9 +37,9 @@ pub enum ObjError {
 /// front, as in the OBJ convention. Coordinates are read as `f32`.
 pub fn load_obj(path: &std::path::Path) -> Result<SceneMesh, ObjError> {
     let shown = path.display().to_string();
-    let file = std::fs::File::open(path).map_err(|source| ObjError::Io {
+    let file = std::fs::File::open(path).map_err(|cause| ObjError::Io {
         path: shown.clone(),
-        source,
+        cause,
     })?;
     let mut reader = std::io::BufReader::new(file);
     let mut scene = obj_from_reader(&mut reader).map_err(|e| match e {

@@ -1,11 +1,14 @@
 //! Errors of reading and writing traces.
 //!
-//! Every message names the file, and when a message is at fault its channel,
+//! Each message is whole (its cause's text included, no `source()`: see
+//! [`crate::error_text`]) and names the file, and when a message is at fault its channel,
 //! its index in the file, its frame when known, and the field.
 
 use std::fmt;
 
 use thiserror::Error;
+
+use crate::error_text::full_text;
 
 /// Where in a trace a message sits: its channel, its index in the file
 /// (counting every message, foreign topics included) and its frame when the
@@ -37,15 +40,14 @@ impl fmt::Display for MessageAt {
 #[non_exhaustive]
 pub enum TraceError {
     /// The underlying reader or writer failed.
-    #[error("{file}: I/O error after {messages} complete messages: {source}")]
+    #[error("{file}: I/O error after {messages} complete messages: {}", full_text(.cause))]
     Io {
         /// File name.
         file: String,
         /// Messages read (or written) before the error.
         messages: u64,
         /// The I/O error.
-        #[source]
-        source: std::io::Error,
+        cause: std::io::Error,
     },
     /// The file ends in the middle of a record (or before its footer).
     #[error(
@@ -59,7 +61,10 @@ pub enum TraceError {
         messages: u64,
     },
     /// The MCAP container is malformed (bad magic, bad chunk, CRC mismatch, ...).
-    #[error("{file}: corrupt MCAP data after {messages} complete messages ({context}): {source}")]
+    #[error(
+        "{file}: corrupt MCAP data after {messages} complete messages ({context}): {}",
+        full_text(.cause)
+    )]
     Corrupt {
         /// File name.
         file: String,
@@ -68,8 +73,25 @@ pub enum TraceError {
         /// What was being read (`chunk 3`, `record`, ...).
         context: String,
         /// The container error.
-        #[source]
-        source: mcap::McapError,
+        cause: mcap::McapError,
+    },
+    /// A record declares a field (a string, a map, a byte array) longer
+    /// than what is left of the record.
+    #[error(
+        "{file}: corrupt MCAP data after {messages} complete messages ({context}): a field \
+         declares {declared} bytes, but only {available} are left in the record"
+    )]
+    FieldTooLong {
+        /// File name.
+        file: String,
+        /// Complete messages read before the error.
+        messages: u64,
+        /// What was being read (`record with opcode 0x03`, `chunk 2`).
+        context: String,
+        /// The field's declared length.
+        declared: u64,
+        /// Bytes left in the record after the length.
+        available: u64,
     },
     /// A chunk or record declares a size above the reader's limit.
     #[error(
@@ -128,7 +150,8 @@ pub enum TraceError {
     /// A message's `log_time` is smaller than that of an earlier message.
     #[error(
         "{at}: `log_time` {log_time_nanos} ns is earlier than the previous message's {previous_nanos} ns; \
-         trace messages must be written in `log_time` order"
+         trace messages must be written in `log_time` order (a file whose chunks overlap in time \
+         is read in log-time order only through the chunk indexes of its summary)"
     )]
     OutOfOrder {
         /// The message.
@@ -161,13 +184,12 @@ pub enum TraceError {
         channel_id: u16,
     },
     /// The MCAP writer failed.
-    #[error("{file}: cannot write the trace: {source}")]
+    #[error("{file}: cannot write the trace: {}", full_text(.cause))]
     Write {
         /// File name.
         file: String,
         /// The container error.
-        #[source]
-        source: mcap::McapError,
+        cause: mcap::McapError,
     },
 }
 

@@ -186,6 +186,13 @@ pub fn render_text(info: &TraceInfo) -> String {
         s.bytes,
         if s.has_summary { "present" } else { "absent" }
     );
+    if s.read_through_chunk_indexes {
+        let _ = writeln!(
+            out,
+            "messages:    out of log-time order across chunks (they overlap in time); \
+             read in log-time order through the chunk indexes"
+        );
+    }
     let library = if s.library.is_empty() {
         "(none)"
     } else {

@@ -7,6 +7,7 @@
 
 pub mod error;
 pub mod info;
+mod lengths;
 pub mod messages;
 pub mod prefetch;
 pub mod read;

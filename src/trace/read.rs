@@ -15,6 +15,13 @@
 //! `log_time` keep their file order, so a scene must be written before the
 //! sweeps that share its `log_time`.
 //!
+//! A file whose chunks overlap in log time (written by a multi-threaded
+//! recorder) cannot be read this way without reordering. When it has a
+//! summary with chunk indexes, [`TraceReader::new_indexed`] reads its
+//! messages in log-time order through the indexes instead, holding only the
+//! chunks that overlap at once (`info` says so); without a summary it gives
+//! the error above.
+//!
 //! # Limits
 //! Sizes declared by the file are checked before anything is allocated for
 //! them (see [`ReadLimits`]): any record, and any chunk compressed or
@@ -41,6 +48,9 @@ use mcap::sans_io::{LinearReadEvent, LinearReader, LinearReaderOptions};
 use super::error::{MessageAt, TraceError};
 use super::messages::{EXPECTED_TOPIC, OutcomeMsg, SCENE_TOPIC, SWEEP_TOPIC, SceneMsg, SweepMsg};
 use super::validate::{parse_message, validate_outcome, validate_scene, validate_sweep};
+use log_time_order::LogTimeOrder;
+
+mod log_time_order;
 
 /// Largest record, or chunk (compressed or uncompressed), accepted: 256 MiB.
 pub const MAX_RECORD_BYTES: u64 = 256 * 1024 * 1024;
@@ -153,6 +163,10 @@ pub struct ReadStats {
     pub bytes: u64,
     /// Whether the file has a summary section.
     pub has_summary: bool,
+    /// Whether the messages were read in log-time order through the
+    /// summary's chunk indexes, because chunks of the file overlap in log
+    /// time ([`TraceReader::new_indexed`]).
+    pub read_through_chunk_indexes: bool,
     /// Metadata records, by name, in file order (the summary's copies are not repeated).
     pub metadata: Vec<(String, BTreeMap<String, String>)>,
     /// The header's library string.
@@ -178,6 +192,9 @@ struct State {
     last_log_time: Option<u64>,
     /// The margin of the current scene; `None` before the first scene.
     scene_margin: Option<f64>,
+    /// Messages are left for a second pass (the pass in file order before
+    /// a read in log-time order).
+    skip_messages: bool,
 }
 
 /// Reads a trace from any [`Read`], yielding the messages of the three trace
@@ -186,6 +203,8 @@ pub struct TraceReader<R: Read> {
     input: R,
     file: LinearReader,
     chunk: Option<LinearReader>,
+    /// Set when the messages are read through the chunk indexes.
+    log_time_order: Option<LogTimeOrder<R>>,
     state: State,
     done: bool,
 }
@@ -215,7 +234,9 @@ impl<R: Read> TraceReader<R> {
                 after_data_end: false,
                 last_log_time: None,
                 scene_margin: None,
+                skip_messages: false,
             },
+            log_time_order: None,
             done: false,
         }
     }
@@ -231,6 +252,13 @@ impl<R: Read> TraceReader<R> {
     }
 
     fn step(&mut self) -> Result<Option<TraceEvent>, TraceError> {
+        if self.log_time_order.is_some() {
+            return self.step_in_log_time_order();
+        }
+        self.step_in_file_order()
+    }
+
+    fn step_in_file_order(&mut self) -> Result<Option<TraceEvent>, TraceError> {
         loop {
             if let Some(chunk) = self.chunk.as_mut() {
                 match chunk.next_event() {
@@ -264,11 +292,11 @@ impl<R: Read> TraceReader<R> {
                         match self.input.read(buf) {
                             Ok(n) => break n,
                             Err(e) if e.kind() == ErrorKind::Interrupted => continue,
-                            Err(source) => {
+                            Err(cause) => {
                                 return Err(TraceError::Io {
                                     file: self.state.source_name.clone(),
                                     messages: self.state.stats.messages,
-                                    source,
+                                    cause,
                                 });
                             }
                         }
@@ -341,11 +369,11 @@ impl State {
                 declared: len,
                 limit,
             },
-            source => TraceError::Corrupt {
+            cause => TraceError::Corrupt {
                 file,
                 messages,
                 context: context.to_string(),
-                source,
+                cause,
             },
         }
     }
@@ -354,6 +382,10 @@ impl State {
     fn open_chunk(&mut self, data: &[u8]) -> Result<LinearReader, TraceError> {
         let index = self.stats.chunks;
         let context = format!("chunk {index}");
+        let messages = self.stats.messages;
+        super::lengths::refuse(op::CHUNK, data, &self.source_name, messages, || {
+            context.clone()
+        })?;
         let header = match mcap::parse_record(op::CHUNK, data) {
             Ok(Record::Chunk { header, .. }) => header,
             // `parse_record(op::CHUNK, ..)` always returns a chunk.
@@ -402,15 +434,17 @@ impl State {
             // Indexes, statistics, attachments and unknown records are not needed.
             _ => return Ok(None),
         }
+        let context = || format!("record with opcode {opcode:#04x}");
+        super::lengths::refuse(
+            opcode,
+            data,
+            &self.source_name,
+            self.stats.messages,
+            context,
+        )?;
         let record = match mcap::parse_record(opcode, data) {
             Ok(record) => record,
-            Err(err) => {
-                return Err(self.mcap_error(
-                    err,
-                    &format!("record with opcode {opcode:#04x}"),
-                    false,
-                ));
-            }
+            Err(err) => return Err(self.mcap_error(err, &context(), false)),
         };
         match record {
             Record::Header(header) => {
@@ -458,7 +492,7 @@ impl State {
                 self.after_data_end = true;
             }
             Record::Message { header, data } => {
-                if self.after_data_end {
+                if self.after_data_end || self.skip_messages {
                     return Ok(None);
                 }
                 return self.message(header.channel_id, header.log_time, &data);

@@ -81,7 +81,12 @@ pub fn parse_message<T: DeserializeOwned>(data: &[u8], mut at: MessageAt) -> Res
                 Some(name) => format!("{path}.{name}"),
                 None => path,
             };
-            let detail = if inner.is_syntax() || inner.is_eof() {
+            let detail = if let Some(rest) = message.strip_prefix("unknown field `")
+                && let Some((_, expected)) = rest.rsplit_once("`, expected ")
+            {
+                // The field's name is already given as the field.
+                format!("not a field of this message; expected {expected}")
+            } else if inner.is_syntax() || inner.is_eof() {
                 format!("the message is not valid JSON: {message}")
             } else if message.contains("invalid type: null") {
                 format!("{message} (`null` is not a number; JSON has no NaN or infinity)")
@@ -129,7 +134,7 @@ pub fn validate_scene(scene: &SceneMsg) -> Result<(), FieldProblem> {
 }
 
 /// Checks a sweep: a finite radius `> 0` above the scene's margin (when a
-/// scene is given), finite `p0` and `p1`.
+/// scene is given), finite `p0` and `p1` at a finite distance.
 pub fn validate_sweep(sweep: &SweepMsg, scene_margin: Option<f64>) -> Result<(), FieldProblem> {
     numbers::check(sweep.radius, Rule::Positive).map_err(|e| FieldProblem::new("radius", e))?;
     if let Some(margin) = scene_margin
@@ -145,6 +150,15 @@ pub fn validate_sweep(sweep: &SweepMsg, scene_margin: Option<f64>) -> Result<(),
     }
     finite3("p0", &sweep.p0)?;
     finite3("p1", &sweep.p1)?;
+    // The core measures the path (as `SweptPath::new` does): finite ends
+    // far apart can still overflow its length (found by fuzzing).
+    let length = (nalgebra::Vector3::from(sweep.p1) - nalgebra::Vector3::from(sweep.p0)).norm();
+    if !length.is_finite() {
+        return Err(FieldProblem::new(
+            "p1",
+            format!("is too far from p0: the path's length overflows to {length}"),
+        ));
+    }
     Ok(())
 }
 

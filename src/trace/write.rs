@@ -75,9 +75,9 @@ impl<W: Write + Seek> TraceWriter<W> {
     }
 
     fn build(w: W, options: WriteOptions, name: String) -> Result<Self, TraceError> {
-        let error = |source| TraceError::Write {
+        let error = |cause| TraceError::Write {
             file: name.clone(),
-            source,
+            cause,
         };
         let mut writer = options.create(w).map_err(error)?;
         let metadata = BTreeMap::from([
@@ -179,9 +179,9 @@ impl<W: Write + Seek> TraceWriter<W> {
         };
         self.writer
             .write_to_known_channel(&header, &data)
-            .map_err(|source| TraceError::Write {
+            .map_err(|cause| TraceError::Write {
                 file: self.name.clone(),
-                source,
+                cause,
             })?;
         self.messages += 1;
         self.last_log_time = Some(log_time_nanos);
@@ -200,9 +200,9 @@ impl<W: Write + Seek> TraceWriter<W> {
                 name: name.to_string(),
                 metadata: entries,
             })
-            .map_err(|source| TraceError::Write {
+            .map_err(|cause| TraceError::Write {
                 file: self.name.clone(),
-                source,
+                cause,
             })
     }
 
@@ -254,9 +254,9 @@ impl<W: Write + Seek> TraceWriter<W> {
 
     /// Writes the summary and footer and returns the underlying writer.
     pub fn finish(mut self) -> Result<W, TraceError> {
-        self.writer.finish().map_err(|source| TraceError::Write {
+        self.writer.finish().map_err(|cause| TraceError::Write {
             file: self.name.clone(),
-            source,
+            cause,
         })?;
         Ok(self.writer.into_inner())
     }
@@ -283,10 +283,10 @@ impl PendingTrace {
         let path = path.as_ref();
         let name = path.display().to_string();
         let (pending, file) =
-            PendingFile::create_seekable(path).map_err(|source| TraceError::Io {
+            PendingFile::create_seekable(path).map_err(|cause| TraceError::Io {
                 file: name.clone(),
                 messages: 0,
-                source,
+                cause,
             })?;
         let writer =
             TraceWriter::build(BufWriter::new(file), default_write_options(), name.clone())?;
@@ -316,10 +316,10 @@ impl PendingTrace {
             name,
         } = self;
         let messages = writer.messages();
-        let io = |source: std::io::Error| TraceError::Io {
+        let io = |cause: std::io::Error| TraceError::Io {
             file: name.clone(),
             messages,
-            source,
+            cause,
         };
         let buffered = writer.finish()?;
         let file = buffered.into_inner().map_err(|e| io(e.into_error()))?;

@@ -25,22 +25,20 @@ use super::{
 #[non_exhaustive]
 pub enum LogError {
     /// Logging a scene's mesh.
-    #[error("logging scene {scene}")]
+    #[error("logging scene {scene}: {}", crate::error_text::full_text(.cause))]
     Scene {
         /// [`crate::replay::SceneState::number`] of the scene.
         scene: usize,
         /// The SDK's error.
-        #[source]
-        source: RecordingStreamError,
+        cause: RecordingStreamError,
     },
     /// Logging the rows of a run of sweeps.
-    #[error("logging the frames from {frame}")]
+    #[error("logging the frames from {frame}: {}", crate::error_text::full_text(.cause))]
     Sweeps {
         /// Frame of the run's first sweep.
         frame: u64,
         /// The SDK's error.
-        #[source]
-        source: RecordingStreamError,
+        cause: RecordingStreamError,
     },
 }
 
@@ -138,16 +136,16 @@ where
             if let Some(l) = logger.as_mut() {
                 match &event {
                     Ok(ReplayEvent::Scene(scene)) => {
-                        l.log_scene(scene).map_err(|source| LogError::Scene {
+                        l.log_scene(scene).map_err(|cause| LogError::Scene {
                             scene: scene.number,
-                            source,
+                            cause,
                         })?;
                     }
                     Ok(ReplayEvent::Sweep(result)) => {
                         if let Some((_, rows)) = prepared.next_if(|(start, _)| *start == i) {
-                            l.log_prepared(rows).map_err(|source| LogError::Sweeps {
+                            l.log_prepared(rows).map_err(|cause| LogError::Sweeps {
                                 frame: result.frame,
-                                source,
+                                cause,
                             })?;
                         }
                     }

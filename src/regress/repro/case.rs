@@ -160,20 +160,20 @@ impl ReproCase {
         let frame = found.sweep.frame;
         let ball = found.sweep.ball;
         let scene = &found.scene;
-        let mesh = Mesh::new(scene.vertices.clone(), &scene.triangles).map_err(|source| {
+        let mesh = Mesh::new(scene.vertices.clone(), &scene.triangles).map_err(|cause| {
             ReproError::Mesh {
                 trace: trace.to_string(),
                 frame,
-                source,
+                cause,
             }
         })?;
         let sweep = found.core_sweep();
         let options = found.options();
-        let sweep_error = |source| ReproError::Sweep {
+        let sweep_error = |cause| ReproError::Sweep {
             trace: trace.to_string(),
             frame,
             ball,
-            source,
+            cause,
         };
         let (outcome, _) = sweep_ties(&mesh, &sweep, &options).map_err(sweep_error)?;
 
@@ -272,18 +272,18 @@ impl ReproCase {
         });
 
         let reduced =
-            Mesh::new(vertices.clone(), &triangles).map_err(|source| ReproError::Mesh {
+            Mesh::new(vertices.clone(), &triangles).map_err(|cause| ReproError::Mesh {
                 trace: format!("the reduced case of {trace}"),
                 frame,
-                source,
+                cause,
             })?;
         let reduced_outcome_local =
-            crate::core::sweep_mesh(&reduced, &sweep, &options).map_err(|source| {
+            crate::core::sweep_mesh(&reduced, &sweep, &options).map_err(|cause| {
                 ReproError::Sweep {
                     trace: format!("the reduced case of {trace}"),
                     frame,
                     ball,
-                    source,
+                    cause,
                 }
             })?;
         let agreement_on = |mesh: &Mesh, outcome: Outcome, expected: Option<OutcomeMsg>| {

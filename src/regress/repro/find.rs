@@ -35,17 +35,17 @@ pub enum ReproError {
         ball: u32,
     },
     /// The scene is not a valid mesh.
-    #[error("{trace}: the scene of frame {frame}: {source}")]
+    #[error("{trace}: the scene of frame {frame}: {cause}")]
     Mesh {
         /// The trace.
         trace: String,
         /// Frame.
         frame: u64,
         /// The cause.
-        source: MeshError,
+        cause: MeshError,
     },
     /// The sweep is invalid.
-    #[error("{trace}: the sweep of frame {frame}, ball {ball}: {source}")]
+    #[error("{trace}: the sweep of frame {frame}, ball {ball}: {cause}")]
     Sweep {
         /// The trace.
         trace: String,
@@ -54,7 +54,7 @@ pub enum ReproError {
         /// Ball.
         ball: u32,
         /// The cause.
-        source: SweepError,
+        cause: SweepError,
     },
 }
 

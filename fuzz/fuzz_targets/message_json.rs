@@ -1,0 +1,11 @@
+//! Fuzz target: `sweeptrace::fuzzing::check_message_validation` (its documentation says what
+//! is checked). The committed corpus runs on stable in `cargo test`.
+#![no_main]
+
+use libfuzzer_sys::fuzz_target;
+
+fuzz_target!(|data: &[u8]| {
+    if let Err(broken) = sweeptrace::fuzzing::check_message_validation(data) {
+        panic!("{broken}");
+    }
+});

@@ -1,0 +1,205 @@
+//! Error messages in one style: a representative set of failing commands,
+//! each of whose messages names the file (and the channel, frame and field
+//! where there is one) and says no part of itself twice
+//! (`sweeptrace::error_text::repeated_segment`).
+
+use std::path::Path;
+
+use libtest_mimic::Trial;
+
+use crate::{ensure, trial};
+
+pub fn tests() -> Vec<Trial> {
+    vec![trial!(failing_commands_say_each_thing_once)]
+}
+
+/// One failing command: its arguments, the exit code, and what its message
+/// must contain besides the file.
+struct Case {
+    what: &'static str,
+    args: Vec<std::ffi::OsString>,
+    exit: i32,
+    file: String,
+    must_say: Vec<&'static str>,
+}
+
+fn failing_commands_say_each_thing_once() -> Result<(), String> {
+    let dir = tempfile::tempdir().map_err(|e| e.to_string())?;
+    let at = |name: &str| dir.path().join(name);
+    let sample = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/tunnel_floor.mcap");
+    let bytes = std::fs::read(&sample).map_err(|e| e.to_string())?;
+
+    // A corrupt chunk, a truncated file, a bad field of a sweep.
+    let mut corrupt = bytes.clone();
+    let (start, len) = crate::trace_io::first_chunk(&corrupt).ok_or("no chunk")?;
+    corrupt[start + 9 + len - len / 3] ^= 0x5a;
+    std::fs::write(at("corrupt.mcap"), &corrupt).map_err(|e| e.to_string())?;
+    std::fs::write(at("truncated.mcap"), &bytes[..bytes.len() * 2 / 3])
+        .map_err(|e| e.to_string())?;
+    let scene = br#"{"vertices":[[0,0,0],[4,0,0],[0,4,0]],"triangles":[[0,1,2]]}"#;
+    let bad_sweep = br#"{"frame":7,"radius":-1,"p0":[1,1,1],"p1":[1,1,-1]}"#;
+    let bad_type = br#"{"frame":8,"radius":0.5,"p0":[1,"x",1],"p1":[1,1,-1]}"#;
+    std::fs::write(
+        at("bad_field.mcap"),
+        crate::trace_io::raw_trace(&[("/scene", 0, scene), ("/sweep", 1, bad_sweep)]),
+    )
+    .map_err(|e| e.to_string())?;
+    std::fs::write(
+        at("bad_type.mcap"),
+        crate::trace_io::raw_trace(&[("/scene", 0, scene), ("/sweep", 1, bad_type)]),
+    )
+    .map_err(|e| e.to_string())?;
+    std::fs::write(at("level.obj"), "v 0 0 0\nv 1 0 0\nf 1 2 9\n").map_err(|e| e.to_string())?;
+
+    let path = |name: &str| at(name).display().to_string();
+    let sample_name = sample.display().to_string();
+    let os = |parts: &[&str]| {
+        parts
+            .iter()
+            .map(std::ffi::OsString::from)
+            .collect::<Vec<_>>()
+    };
+    let cases = vec![
+        Case {
+            what: "info on a missing file",
+            args: os(&["info", &path("missing.mcap")]),
+            exit: 2,
+            file: path("missing.mcap"),
+            must_say: vec!["No such file or directory"],
+        },
+        Case {
+            what: "replay of a corrupt chunk",
+            args: os(&[
+                "replay",
+                &path("corrupt.mcap"),
+                "--outcomes",
+                &path("out.jsonl"),
+            ]),
+            exit: 2,
+            file: path("corrupt.mcap"),
+            must_say: vec!["corrupt MCAP data", "chunk 0"],
+        },
+        Case {
+            what: "info of a truncated file",
+            args: os(&["info", &path("truncated.mcap")]),
+            exit: 3,
+            file: path("truncated.mcap"),
+            must_say: vec!["truncated"],
+        },
+        Case {
+            what: "replay of a sweep with a bad radius",
+            args: os(&[
+                "replay",
+                &path("bad_field.mcap"),
+                "--outcomes",
+                &path("out.jsonl"),
+            ]),
+            exit: 2,
+            file: path("bad_field.mcap"),
+            must_say: vec!["channel `/sweep`", "frame 7", "field `radius`"],
+        },
+        Case {
+            what: "bless of a sweep with a mistyped coordinate",
+            args: os(&["bless", &path("bad_type.mcap"), "-o", &path("blessed.mcap")]),
+            exit: 2,
+            file: path("bad_type.mcap"),
+            must_say: vec!["channel `/sweep`", "frame 8", "field `p0[1]`"],
+        },
+        Case {
+            what: "replay --outcomes to a full device",
+            args: os(&["replay", &sample_name, "--outcomes", "/dev/full"]),
+            exit: 2,
+            file: "/dev/full".to_string(),
+            must_say: vec!["No space left on device"],
+        },
+        Case {
+            what: "replay --rrd into a missing directory",
+            args: os(&[
+                "replay",
+                &sample_name,
+                "--rrd",
+                &path("no/such/dir/out.rrd"),
+            ]),
+            exit: 2,
+            file: path("no/such/dir/out.rrd"),
+            must_say: vec!["No such file or directory"],
+        },
+        Case {
+            what: "record into a missing directory",
+            args: os(&[
+                "record",
+                "--scene",
+                "cube",
+                "--frames",
+                "3",
+                "-o",
+                &path("no/t.mcap"),
+            ]),
+            exit: 2,
+            file: path("no/t.mcap"),
+            must_say: vec!["No such file or directory"],
+        },
+        Case {
+            what: "record with an OBJ whose face names a missing vertex",
+            args: os(&[
+                "record",
+                "--mesh",
+                &path("level.obj"),
+                "-o",
+                &path("t.mcap"),
+            ]),
+            exit: 2,
+            file: path("level.obj"),
+            must_say: vec![],
+        },
+        Case {
+            what: "diff with a missing file",
+            args: os(&["diff", &sample_name, &path("missing.mcap")]),
+            exit: 2,
+            file: path("missing.mcap"),
+            must_say: vec!["No such file or directory"],
+        },
+        Case {
+            what: "check of a corrupt trace",
+            args: os(&["check", &path("corrupt.mcap")]),
+            exit: 2,
+            file: path("corrupt.mcap"),
+            must_say: vec!["corrupt MCAP data", "chunk 0"],
+        },
+    ];
+    for case in cases {
+        let args: Vec<&std::ffi::OsStr> = case.args.iter().map(|a| a.as_os_str()).collect();
+        let (code, stdout, stderr) = crate::support::run_bin(&args)?;
+        let what = case.what;
+        ensure!(
+            code == case.exit,
+            "{what}: exit {code}, want {}: {stdout}{stderr}",
+            case.exit
+        );
+        // The message: the `error:` line, or check's `ERROR` line.
+        let message = stderr
+            .lines()
+            .chain(stdout.lines())
+            .find(|l| {
+                l.starts_with("error: ") || l.starts_with("ERROR ") || l.starts_with("incomplete: ")
+            })
+            .ok_or_else(|| format!("{what}: no error line: {stdout}{stderr}"))?;
+        ensure!(
+            message.matches(case.file.as_str()).count() == 1,
+            "{what}: the message does not name {} exactly once: {message}",
+            case.file
+        );
+        for needle in case.must_say {
+            ensure!(
+                message.contains(needle),
+                "{what}: the message does not say `{needle}`: {message}"
+            );
+        }
+        if let Some(repeated) = sweeptrace::error_text::repeated_segment(message) {
+            return Err(format!(
+                "{what}: the message repeats `{repeated}`: {message}"
+            ));
+        }
+    }
+    Ok(())
+}

@@ -48,6 +48,7 @@ pub fn tests() -> Vec<Trial> {
         trial!(rrd_marks_fragile_decisions),
         trial!(viewer_and_check_agree_on_divergences),
         trial!(flush_by_bytes_keeps_the_content),
+        trial!(rrd_footer_only_when_asked),
     ]
 }
 
@@ -1796,6 +1797,48 @@ fn flush_by_bytes_keeps_the_content() -> Result<(), String> {
         return Err(
             "the recordings with the default and a one-byte bound differ in content".into(),
         );
+    }
+    Ok(())
+}
+
+/// The `.rrd` writer adds the footer (the index of every chunk, built in
+/// memory until the end) only when asked: the file with it is larger by
+/// that index, and both hold the same recording.
+fn rrd_footer_only_when_asked() -> Result<(), String> {
+    let dir = tempfile::tempdir().map_err(|e| e.to_string())?;
+    let sweeps = random_sweeps(13, 30, 2);
+    let write = |path: &std::path::Path, footer: bool| -> Result<u64, String> {
+        let (sink, writer) = viz::rrd_file::create(path, viz::rrd_file::RrdFileOptions { footer })
+            .map_err(|e| e.to_string())?;
+        let id = viz::recording_id(&[b"footer"]);
+        let rec = viz::builder(&id, "test")
+            .set_sinks(vec![Box::new(sink) as Box<dyn rerun::sink::LogSink>])
+            .map_err(|e| e.to_string())?;
+        let mut logger = viz::Logger::new(rec, true).map_err(|e| e.to_string())?;
+        for e in replay_events(
+            events_for(cube_scene(), &sweeps).into_iter(),
+            explained(Detail::Primary),
+        ) {
+            logger
+                .log(&e.map_err(|e| e.to_string())?)
+                .map_err(|e| e.to_string())?;
+        }
+        logger.flush().map_err(|e| e.to_string())?;
+        drop(logger.finish());
+        writer.finish().map_err(|e| e.to_string())?;
+        Ok(std::fs::metadata(path).map_err(|e| e.to_string())?.len())
+    };
+    let without = dir.path().join("without.rrd");
+    let with = dir.path().join("with.rrd");
+    let (size_without, size_with) = (write(&without, false)?, write(&with, true)?);
+    if size_with <= size_without {
+        return Err(format!(
+            "the file with the footer has {size_with} bytes, without it {size_without}: no footer written"
+        ));
+    }
+    let (a, b) = (decode_rrd(&without)?, decode_rrd(&with)?);
+    if a.components.is_empty() || a != b {
+        return Err("the files with and without the footer hold different recordings".into());
     }
     Ok(())
 }

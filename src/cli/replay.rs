@@ -61,7 +61,7 @@ pub struct Args {
     /// Leave out the `.rrd` file's footer, the index of every chunk that
     /// lets a reader find chunks without reading the whole file
     /// (`--rrd run.rrd --no-rrd-footer`). The index is built in memory
-    /// until the end, about 3.7 KB per chunk, so with it the memory of a
+    /// until the end, 6 to 8 KB per chunk, so with it the memory of a
     /// replay grows with the trace's length (1.5 GB for 1.2 million sweeps
     /// of 64 balls); without it the memory stays bounded, but `rerun rrd
     /// verify` rejects the file.

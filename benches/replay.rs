@@ -80,7 +80,11 @@ fn rrd(bytes: &[u8], detail: Detail, path: &std::path::Path) -> u64 {
         ..ReplayOptions::default()
     };
     let id = viz::recording_id(&[bytes, detail.as_str().as_bytes()]);
-    let rec = viz::builder(&id, "bench").save(path).expect("rrd file");
+    // The command's own file writer (with the footer, as `replay --rrd`).
+    let (sink, writer) = viz::rrd_file::create(path, Default::default()).expect("rrd file");
+    let rec = viz::builder(&id, "bench")
+        .set_sinks(vec![Box::new(sink) as Box<dyn rerun::sink::LogSink>])
+        .expect("recording");
     let mut logger = viz::Logger::new(rec, true).expect("recording");
     let read_ahead = prefetch(
         TraceReader::new(std::io::Cursor::new(bytes.to_vec()), "bench.mcap"),
@@ -111,6 +115,7 @@ fn rrd(bytes: &[u8], detail: Detail, path: &std::path::Path) -> u64 {
     let rec = logger.finish();
     rec.flush_blocking().expect("flush");
     drop(rec);
+    writer.finish().expect("rrd file");
     n
 }
 

@@ -47,6 +47,8 @@ pub fn tests() -> Vec<Trial> {
         trial!(rrd_shows_edges_features_and_explanations),
         trial!(rrd_marks_fragile_decisions),
         trial!(viewer_and_check_agree_on_divergences),
+        trial!(flush_by_bytes_keeps_the_content),
+        trial!(rrd_footer_only_when_asked),
     ]
 }
 
@@ -623,7 +625,7 @@ fn worked_sweeps() -> Vec<SweepMsg> {
 
 /// Values decoded from an `.rrd`: per entity and component, the values at
 /// each frame (static data at frame `i64::MIN`).
-#[derive(Default)]
+#[derive(Debug, Default, PartialEq)]
 pub(crate) struct Decoded {
     scalars: BTreeMap<(String, String), BTreeMap<i64, Vec<f64>>>,
     pub(crate) texts: BTreeMap<(String, String), BTreeMap<i64, Vec<String>>>,
@@ -1736,5 +1738,107 @@ fn viewer_and_check_agree_on_divergences() -> Result<(), String> {
         "the divergences layout: {} stores",
         d.blueprint_stores
     );
+    Ok(())
+}
+
+/// The logger's buffer is bounded in bytes: with a bound of one byte it
+/// sends its rows after every run of sweeps, as more and smaller chunks,
+/// and the recording holds the same values at the same frames as with the
+/// default bound.
+fn flush_by_bytes_keeps_the_content() -> Result<(), String> {
+    let dir = tempfile::tempdir().map_err(|e| e.to_string())?;
+    let sweeps = random_sweeps(12, 40, 3);
+    let write = |path: &std::path::Path, flush_bytes: Option<usize>| -> Result<(), String> {
+        let id = viz::recording_id(&[b"flush by bytes"]);
+        let rec = viz::builder(&id, "test")
+            .save(path)
+            .map_err(|e| e.to_string())?;
+        let mut logger = viz::Logger::new(rec, true).map_err(|e| e.to_string())?;
+        if let Some(bytes) = flush_bytes {
+            logger = logger.with_flush_bytes(bytes);
+        }
+        for e in replay_events(
+            events_for(cube_scene(), &sweeps).into_iter(),
+            explained(Detail::Primary),
+        ) {
+            logger
+                .log(&e.map_err(|e| e.to_string())?)
+                .map_err(|e| e.to_string())?;
+        }
+        logger.flush().map_err(|e| e.to_string())?;
+        drop(logger.finish());
+        Ok(())
+    };
+    let default_path = dir.path().join("default.rrd");
+    let small_path = dir.path().join("small.rrd");
+    write(&default_path, None)?;
+    write(&small_path, Some(1))?;
+    let chunks = |path: &std::path::Path| -> Result<usize, String> {
+        Ok(rrd_messages(path)?
+            .iter()
+            .filter(|m| {
+                matches!(m, Message::Chunk(store, _, chunk)
+                if store.kind() == rerun::StoreKind::Recording && !chunk.is_static())
+            })
+            .count())
+    };
+    let (default_chunks, small_chunks) = (chunks(&default_path)?, chunks(&small_path)?);
+    if small_chunks <= default_chunks {
+        return Err(format!(
+            "a one-byte bound gave {small_chunks} temporal chunks, the default {default_chunks}: \
+             the bound in bytes did not send the buffer"
+        ));
+    }
+    let (default_decoded, small_decoded) = (decode_rrd(&default_path)?, decode_rrd(&small_path)?);
+    if default_decoded.components.is_empty() {
+        return Err("the recording holds no rows".into());
+    }
+    if default_decoded != small_decoded {
+        return Err(
+            "the recordings with the default and a one-byte bound differ in content".into(),
+        );
+    }
+    Ok(())
+}
+
+/// The `.rrd` writer adds the footer (the index of every chunk, built in
+/// memory until the end) only when asked: the file with it is larger by
+/// that index, and both hold the same recording.
+fn rrd_footer_only_when_asked() -> Result<(), String> {
+    let dir = tempfile::tempdir().map_err(|e| e.to_string())?;
+    let sweeps = random_sweeps(13, 30, 2);
+    let write = |path: &std::path::Path, footer: bool| -> Result<u64, String> {
+        let (sink, writer) = viz::rrd_file::create(path, viz::rrd_file::RrdFileOptions { footer })
+            .map_err(|e| e.to_string())?;
+        let id = viz::recording_id(&[b"footer"]);
+        let rec = viz::builder(&id, "test")
+            .set_sinks(vec![Box::new(sink) as Box<dyn rerun::sink::LogSink>])
+            .map_err(|e| e.to_string())?;
+        let mut logger = viz::Logger::new(rec, true).map_err(|e| e.to_string())?;
+        for e in replay_events(
+            events_for(cube_scene(), &sweeps).into_iter(),
+            explained(Detail::Primary),
+        ) {
+            logger
+                .log(&e.map_err(|e| e.to_string())?)
+                .map_err(|e| e.to_string())?;
+        }
+        logger.flush().map_err(|e| e.to_string())?;
+        drop(logger.finish());
+        writer.finish().map_err(|e| e.to_string())?;
+        Ok(std::fs::metadata(path).map_err(|e| e.to_string())?.len())
+    };
+    let without = dir.path().join("without.rrd");
+    let with = dir.path().join("with.rrd");
+    let (size_without, size_with) = (write(&without, false)?, write(&with, true)?);
+    if size_with <= size_without {
+        return Err(format!(
+            "the file with the footer has {size_with} bytes, without it {size_without}: no footer written"
+        ));
+    }
+    let (a, b) = (decode_rrd(&without)?, decode_rrd(&with)?);
+    if a.components.is_empty() || a != b {
+        return Err("the files with and without the footer hold different recordings".into());
+    }
     Ok(())
 }

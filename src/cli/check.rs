@@ -237,7 +237,8 @@ fn write_failure_rrd(trace: &Path, dir: &Path, report: &TraceReport) -> anyhow::
     let rrd_error = |e: viz::rrd_file::RrdFileError| {
         anyhow::anyhow!("writing {}: {}", target.display(), e.reason)
     };
-    let (sink, writer) = viz::rrd_file::create(temp.path()).map_err(rrd_error)?;
+    let (sink, writer) =
+        viz::rrd_file::create(temp.path(), Default::default()).map_err(rrd_error)?;
     let rec = viz::builder(&id, &format!("{name} (check, frames {frames})"))
         .set_sinks(vec![Box::new(sink) as Box<dyn rerun::sink::LogSink>])
         .context("creating the recording")?;

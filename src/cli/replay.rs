@@ -59,6 +59,15 @@ pub struct Args {
     /// Write the Rerun recording to this `.rrd` file.
     #[arg(long, value_name = "FILE")]
     pub rrd: Option<PathBuf>,
+    /// Leave out the `.rrd` file's footer, the index of every chunk that
+    /// lets a reader find chunks without reading the whole file
+    /// (`--rrd run.rrd --no-rrd-footer`). The index is built in memory
+    /// until the end, 6 to 8 KB per chunk, so with it the memory of a
+    /// replay grows with the trace's length (1.5 GB for 1.2 million sweeps
+    /// of 64 balls); without it the memory stays bounded, but `rerun rrd
+    /// verify` rejects the file.
+    #[arg(long)]
+    pub no_rrd_footer: bool,
     /// Write the replay as an MCAP file for Foxglove (`--foxglove run.fg.mcap`):
     /// the mesh, balls, sweeps, contacts and normals as 3D scene entities
     /// (`foxglove.SceneUpdate`, frame `world`), the decision per sweep as
@@ -201,9 +210,13 @@ pub fn run(args: Args) -> anyhow::Result<RunOutcome> {
         let mut sinks: Vec<Box<dyn rerun::sink::LogSink>> = Vec::new();
         if let Some(path) = &rrd_path {
             let pending = pending_file(path)?;
-            let (sink, writer) = viz::rrd_file::create(pending.path()).map_err(|e| {
-                anyhow::anyhow!("writing the recording {}: {}", path.display(), e.reason)
-            })?;
+            let file_options = viz::rrd_file::RrdFileOptions {
+                footer: !args.no_rrd_footer,
+            };
+            let (sink, writer) =
+                viz::rrd_file::create(pending.path(), file_options).map_err(|e| {
+                    anyhow::anyhow!("writing the recording {}: {}", path.display(), e.reason)
+                })?;
             sinks.push(Box::new(sink));
             rrd_file = Some((pending, writer));
         }

@@ -86,6 +86,9 @@ trait Column: Send + fmt::Debug {
     /// column.
     fn take_list(&mut self) -> Result<ListArray, RecordingStreamError>;
     fn as_any_mut(&mut self) -> &mut dyn Any;
+    /// Bytes the buffered rows take (values and lengths, not the spare
+    /// capacity).
+    fn bytes(&self) -> usize;
 }
 
 /// A column of component `C`: all values in one `Vec`, and how many each
@@ -128,6 +131,10 @@ impl<C: Component> Column for Typed<C> {
 
     fn as_any_mut(&mut self) -> &mut dyn Any {
         self
+    }
+
+    fn bytes(&self) -> usize {
+        self.values.len() * std::mem::size_of::<C>() + self.lengths.len() * USIZE
     }
 }
 
@@ -172,6 +179,10 @@ impl Column for Strings {
 
     fn as_any_mut(&mut self) -> &mut dyn Any {
         self
+    }
+
+    fn bytes(&self) -> usize {
+        self.bytes.len() + (self.string_lengths.len() + self.lengths.len()) * USIZE
     }
 }
 
@@ -226,7 +237,13 @@ impl Column for Strips {
     fn as_any_mut(&mut self) -> &mut dyn Any {
         self
     }
+
+    fn bytes(&self) -> usize {
+        self.coords.len() * 4 + (self.strip_lengths.len() + self.lengths.len()) * USIZE
+    }
 }
+
+const USIZE: usize = std::mem::size_of::<usize>();
 
 /// One list per row over `values`, `lengths` values each; empties
 /// `lengths`.
@@ -338,6 +355,18 @@ impl Columns {
     /// Rows buffered.
     pub fn rows(&self) -> usize {
         self.rows
+    }
+
+    /// Bytes the buffered rows take: their times, row numbers and values
+    /// (not the buffers' spare capacity). Visits every entity's columns.
+    pub fn bytes(&self) -> usize {
+        self.entities
+            .iter()
+            .map(|e| {
+                (e.frames.len() + e.times.len() + e.rows.len()) * 8
+                    + e.columns.iter().map(|c| c.bytes()).sum::<usize>()
+            })
+            .sum()
     }
 
     fn chunk_id(&mut self) -> ChunkId {

@@ -26,8 +26,18 @@ use crate::regress::Tolerances;
 use crate::regress::decision::divergence;
 use crate::replay::{ReplayEvent, SceneState, SweepResult};
 
-/// Rows buffered before the logger sends them (see [`Logger`]).
-pub const DEFAULT_FLUSH_ROWS: usize = 1 << 17;
+/// Rows buffered before the logger sends them (see [`Logger`]); with
+/// [`DEFAULT_FLUSH_BYTES`] the bytes usually come first (about 75 bytes a
+/// row at `primary`).
+pub const DEFAULT_FLUSH_ROWS: usize = 1 << 20;
+
+/// Bytes of buffered rows (times, row numbers, values) at which the logger
+/// sends them, whatever their number (see [`Logger`]). The chunks are one
+/// per entity and set of components, so the larger the buffer, the more
+/// rows each chunk holds: with 64 balls (about 2,000 entities), 32 MiB give
+/// chunks of about 130 rows on average, and each chunk costs about 1.4 KB
+/// in the file besides its rows (schema, footer entry).
+pub const DEFAULT_FLUSH_BYTES: usize = 32 << 20;
 
 /// Sweeps per [`PreparedSweeps`] that the command and the bench prepare on
 /// one worker (runs of consecutive sweeps of a batch, cut at this length).
@@ -111,8 +121,9 @@ struct Mark {
 ///
 /// Rows are not sent one by one: they are buffered per entity as typed
 /// columns (plain values, see `columns`), and sent as one chunk per entity
-/// every [`DEFAULT_FLUSH_ROWS`] rows (and by [`Logger::flush`] and
-/// [`Logger::finish`]). What the recording holds is what logging each row
+/// when [`DEFAULT_FLUSH_ROWS`] rows or [`DEFAULT_FLUSH_BYTES`] bytes are
+/// buffered (and by [`Logger::flush`] and [`Logger::finish`]), so memory
+/// is bounded whatever the number of balls and the trace's length. What the recording holds is what logging each row
 /// on its own would give, with ids that depend only on the order of the
 /// rows, so the same events give the same chunks.
 ///
@@ -126,6 +137,7 @@ pub struct Logger {
     options: LoggerOptions,
     columns: columns::Columns,
     flush_rows: usize,
+    flush_bytes: usize,
     /// Divergent sweeps logged.
     divergent: u64,
     /// Tunnels logged.
@@ -291,6 +303,7 @@ impl Logger {
             options,
             columns: columns::Columns::default(),
             flush_rows: DEFAULT_FLUSH_ROWS,
+            flush_bytes: DEFAULT_FLUSH_BYTES,
             divergent: 0,
             tunnels: 0,
             spare: Vec::new(),
@@ -308,6 +321,13 @@ impl Logger {
     /// Sets how many rows are buffered before they are sent (at least 1).
     pub fn with_flush_rows(mut self, rows: usize) -> Logger {
         self.flush_rows = rows.max(1);
+        self
+    }
+
+    /// Sets how many bytes of rows are buffered before they are sent (at
+    /// least 1).
+    pub fn with_flush_bytes(mut self, bytes: usize) -> Logger {
+        self.flush_bytes = bytes.max(1);
         self
     }
 
@@ -483,7 +503,7 @@ impl Logger {
         if self.spare.len() < MAX_SPARE_PREPARED {
             self.spare.push(p);
         }
-        if self.columns.rows() >= self.flush_rows {
+        if self.columns.rows() >= self.flush_rows || self.columns.bytes() >= self.flush_bytes {
             self.flush()?;
         }
         Ok(())

@@ -39,8 +39,8 @@ use rerun::RecordingStreamBuilder;
 pub use crate::regress::decision::{decision_line, divergence};
 pub use ids::{IdHasher, recording_id};
 pub use logger::{
-    DEFAULT_FLUSH_ROWS, Logger, LoggerOptions, PREPARE_GROUP_SWEEPS, PrepareOptions,
-    PreparedSweeps, prepare_sweeps, prepare_sweeps_into,
+    DEFAULT_FLUSH_BYTES, DEFAULT_FLUSH_ROWS, Logger, LoggerOptions, PREPARE_GROUP_SWEEPS,
+    PrepareOptions, PreparedSweeps, prepare_sweeps, prepare_sweeps_into,
 };
 pub use rerun::RecordingStreamError;
 
@@ -59,12 +59,24 @@ pub const MAX_EDGE_FRAMES: usize = 16;
 /// recording's start.
 pub const TIMESTAMP_THRESHOLD_NANOS: u64 = 1_000_000_000_000_000_000;
 
+/// Bytes of chunks the recording stream holds in its queues before the
+/// logger waits for its sink (the SDK's `max_bytes_in_flight`, split over
+/// its three channels; its default is 100 MiB, which a sink slower than the
+/// logger fills, whatever the trace's length).
+pub const MAX_BYTES_IN_FLIGHT: u64 = 16 << 20;
+
 /// A recording stream builder with the project's settings: application id
 /// [`APPLICATION_ID`], the given recording id, no recording properties (they
-/// would hold the wall-clock start time).
+/// would hold the wall-clock start time), at most [`MAX_BYTES_IN_FLIGHT`]
+/// in the stream's queues. The logger sends whole chunks, so the batcher's
+/// other thresholds do not apply.
 pub fn builder(recording_id: &str, name: &str) -> RecordingStreamBuilder {
     RecordingStreamBuilder::new(APPLICATION_ID)
         .recording_id(recording_id.to_string())
         .recording_name(name.to_string())
         .send_properties(false)
+        .batcher_config(rerun::log::ChunkBatcherConfig {
+            max_bytes_in_flight: MAX_BYTES_IN_FLIGHT,
+            ..rerun::log::ChunkBatcherConfig::LOW_LATENCY
+        })
 }

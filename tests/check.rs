@@ -49,6 +49,7 @@ pub fn tests() -> Vec<Trial> {
         trial!(compare_only_selected_fields),
         trial!(check_fields_option_binary),
         trial!(rapier_sample_needs_its_check_flags),
+        trial!(differences_below_the_shown_digits_are_shown_in_full),
         trial!(blessed_trace_passes),
         trial!(wrong_engine_config_fixture_fails_with_frame_and_reason),
         trial!(wrong_engine_config_fixture_binary_exit_1),
@@ -1025,4 +1026,37 @@ fn diff_binary_exit_codes() -> Result<(), String> {
 fn generate_wrong_engine_config() -> Result<(), String> {
     let bytes = fixture_bytes()?;
     std::fs::write(fixture_path(), bytes).map_err(|e| e.to_string())
+}
+
+/// The Rapier sample differs from the core by about 1e-6 (more than the
+/// default tolerances): the two sides of each differing field never read
+/// the same in the report (they are printed in full when their short forms
+/// agree), and a test that decides the sweep is said to be the same test
+/// with other numbers, not a question about the margin.
+fn differences_below_the_shown_digits_are_shown_in_full() -> Result<(), String> {
+    let trace = rapier_sample();
+    let (code, out, err) = run_bin(os!["check", trace.as_os_str(), "--max-details", "8"])?;
+    ensure!(code == 1, "exit {code}: {out}{err}");
+    let mut fields = 0;
+    for line in out.lines().map(str::trim) {
+        let Some((field, rest)) = line.split_once(": expected ") else {
+            continue;
+        };
+        if !["alpha", "normal", "contact"].contains(&field) {
+            continue;
+        }
+        let (expected, got) = rest
+            .split_once(", got ")
+            .ok_or_else(|| format!("no `got` in `{line}`"))?;
+        let got = got.split(" (").next().unwrap_or(got);
+        ensure!(expected != got, "the two sides read the same: `{line}`");
+        fields += 1;
+    }
+    ensure!(fields >= 8, "{fields} differing fields found in:\n{out}");
+    ensure!(
+        out.contains("the same test with other numbers")
+            || out.contains("only the fields above differ"),
+        "{out}"
+    );
+    Ok(())
 }

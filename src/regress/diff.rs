@@ -274,13 +274,8 @@ pub fn render_text(r: &DiffReport) -> String {
     if let Some(f) = &r.first {
         let _ = writeln!(s, "first divergence: frame {}, ball {}", f.frame, f.ball);
         for d in &f.fields {
-            let _ = write!(
-                s,
-                "  {}: A {}, B {}",
-                d.field,
-                crate::regress::value_text(&d.expected),
-                crate::regress::value_text(&d.got)
-            );
+            let (a, b) = crate::regress::values_text(&d.expected, &d.got);
+            let _ = write!(s, "  {}: A {a}, B {b}", d.field);
             if let Some(detail) = &d.detail {
                 let _ = write!(s, " ({detail})");
             }

@@ -133,12 +133,24 @@ fn expected_test(r: &TestRecord, expected: &OutcomeMsg, got: &Outcome) -> Expect
     let decides = got.is_reported_by(r);
     let why_not = match r.alpha() {
         None => format!("it reports no collision ({verdict})"),
-        Some(a) if decides => format!(
-            "it decides the sweep, at α = {} where the expectation has α = {} \
-             (was the expectation recorded with another margin or facing rule?)",
-            num(a),
-            num(expected.alpha)
+        Some(a) if decides && a == expected.alpha => format!(
+            "it is the test that decides the sweep, at the expected α = {}: \
+             only the fields above differ",
+            num(a)
         ),
+        Some(a) if decides => {
+            // In full when the short forms would read the same.
+            let (here, there) = match (num(a), num(expected.alpha)) {
+                (x, y) if x == y => (a.to_string(), expected.alpha.to_string()),
+                short => short,
+            };
+            format!(
+                "it is the test that decides the sweep, at α = {here} where the \
+                 expectation has α = {there}: the same test with other numbers (an \
+                 engine less precise than the tolerances, or one with another margin \
+                 or facing rule)"
+            )
+        }
         Some(a) if got.is_hit() && !got.ties_with(a) => format!(
             "it hits at α = {}, later than the primary collision at α = {}",
             num(a),

@@ -40,5 +40,6 @@ pub use explain::{ExpectedTest, expected_tests, explain_outcome, explained_recor
 pub use infer::{Inferred, Spread, infer};
 pub use render::{
     Sides, render_divergence, render_divergence_as, render_json, render_text, value_text,
+    value_text_exact, values_text,
 };
 pub use repro::{HexInputs, ReproCase, ReproError, SweepInputs, TraceSweep, find_sweep};

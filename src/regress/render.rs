@@ -12,15 +12,40 @@ use super::check::{Divergence, Status, TraceReport};
 
 /// A JSON value in words: numbers as [`num`], null as `null`.
 pub fn value_text(v: &Value) -> String {
+    text_with(v, num)
+}
+
+/// [`value_text`] with every number in full (the shortest decimal that
+/// reads back to the same `f64`).
+pub fn value_text_exact(v: &Value) -> String {
+    text_with(v, |x| x.to_string())
+}
+
+fn text_with(v: &Value, number: fn(f64) -> String) -> String {
     match v {
         Value::Null => "null".to_string(),
         Value::String(s) => s.clone(),
-        Value::Number(n) => n.as_f64().map(num).unwrap_or_else(|| n.to_string()),
+        Value::Number(n) => n.as_f64().map(number).unwrap_or_else(|| n.to_string()),
         Value::Array(a) => format!(
             "[{}]",
-            a.iter().map(value_text).collect::<Vec<_>>().join(", ")
+            a.iter()
+                .map(|x| text_with(x, number))
+                .collect::<Vec<_>>()
+                .join(", ")
         ),
         other => other.to_string(),
+    }
+}
+
+/// The two sides of a differing field in words: short numbers, unless
+/// they would read the same (a difference below the fifth significant
+/// digit), then in full, so that the reader sees where they differ.
+pub fn values_text(expected: &Value, got: &Value) -> (String, String) {
+    let (e, g) = (value_text(expected), value_text(got));
+    if e == g && expected != got {
+        (value_text_exact(expected), value_text_exact(got))
+    } else {
+        (e, g)
     }
 }
 
@@ -85,14 +110,13 @@ pub fn render_divergence_as(d: &Divergence, indent: &str, sides: Sides) -> Strin
         let _ = writeln!(s, "{indent}  inputs (hex): {}", hex.text());
     }
     for f in &d.fields {
+        let (expected, got) = values_text(&f.expected, &f.got);
         let _ = write!(
             s,
-            "{indent}  {}: {} {}, {} {}",
+            "{indent}  {}: {} {expected}, {} {got}",
             f.field,
             sides.expected(),
-            value_text(&f.expected),
             sides.got(),
-            value_text(&f.got)
         );
         if let Some(detail) = &f.detail {
             let _ = write!(s, " ({detail})");

@@ -18,8 +18,7 @@ use sweeptrace::foxglove::{FoxgloveFile, FoxgloveOptions};
 use sweeptrace::numbers::{self, Rule};
 use sweeptrace::regress::Tolerances;
 use sweeptrace::replay::{
-    DEFAULT_BATCH_EVENTS, Detail, FrameRange, ReplayError, ReplayEvent, ReplayOptions,
-    replay_events_parallel,
+    Detail, FrameRange, ReplayError, ReplayEvent, ReplayOptions, replay_events_parallel,
 };
 use sweeptrace::run::RunOutcome;
 use sweeptrace::trace::TraceReader;
@@ -313,14 +312,14 @@ pub fn run(args: Args) -> anyhow::Result<RunOutcome> {
     let mut events = replay_events_parallel(
         read_ahead,
         options,
-        DEFAULT_BATCH_EVENTS,
+        options.detail.batch_events(),
         Some(pool.clone()),
     );
     let mut trace_error = None;
     let mut last_frame = None;
     let pipeline = PipelineOptions {
         outcome_lines: outcomes.is_some(),
-        batch_events: DEFAULT_BATCH_EVENTS,
+        batch_events: options.detail.batch_events(),
     };
     let result = run_pipeline(
         &mut events,

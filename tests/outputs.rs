@@ -189,34 +189,8 @@ fn killed_mid_write_leaves_the_target_intact() -> Result<(), String> {
                 format!("after a kill at {delay_ms} ms the target does not decode: {e}")
             })?;
         }
-        let leftovers: Vec<String> = std::fs::read_dir(dir.path())
-            .map_err(|e| e.to_string())?
-            .filter_map(Result::ok)
-            .map(|e| e.file_name().to_string_lossy().into_owned())
-            .filter(|n| n != "golf.rrd")
-            .collect();
-        if let Some(odd) = leftovers
-            .iter()
-            .find(|n| !n.starts_with(".golf.rrd.partial-"))
-        {
-            return Err(format!("an unexpected file is left: {odd}"));
-        }
-        if !leftovers.is_empty() {
-            // The next run names them and says how to remove them.
-            let next = replay(&[]).output().map_err(|e| e.to_string())?;
-            let stderr = String::from_utf8_lossy(&next.stderr);
-            if !(next.status.success()
-                && stderr.contains("unfinished temporary file")
-                && stderr.contains("rm "))
-            {
-                return Err(format!(
-                    "the next run does not report the leftovers: {stderr}"
-                ));
-            }
-            for name in leftovers {
-                std::fs::remove_file(dir.path().join(name)).map_err(|e| e.to_string())?;
-            }
-        }
+        leftovers_are_reported(dir.path(), "golf.rrd", || replay(&[]).output())
+            .map_err(|e| format!("after a kill at {delay_ms} ms: {e}"))?;
     }
     Ok(())
 }
@@ -274,38 +248,52 @@ fn killed_bless_and_record_leave_the_target_intact() -> Result<(), String> {
                     ));
                 }
             }
-            let leftovers: Vec<String> = std::fs::read_dir(dir.path())
-                .map_err(|e| e.to_string())?
-                .filter_map(Result::ok)
-                .map(|e| e.file_name().to_string_lossy().into_owned())
-                .filter(|n| n != "golf.mcap")
-                .collect();
-            if let Some(odd) = leftovers
-                .iter()
-                .find(|n| !n.starts_with(".golf.mcap.partial-"))
-            {
-                return Err(format!("{what}: an unexpected file is left: {odd}"));
-            }
-            if !leftovers.is_empty() {
-                let next = std::process::Command::new(env!("CARGO_BIN_EXE_sweeptrace"))
+            leftovers_are_reported(dir.path(), "golf.mcap", || {
+                std::process::Command::new(env!("CARGO_BIN_EXE_sweeptrace"))
                     .args(["record", "--scene", "cube", "--frames", "3", "-o"])
                     .arg(&target)
                     .output()
-                    .map_err(|e| e.to_string())?;
-                let stderr = String::from_utf8_lossy(&next.stderr);
-                if !(next.status.success()
-                    && stderr.contains("unfinished temporary file")
-                    && stderr.contains("rm "))
-                {
-                    return Err(format!(
-                        "{what}: the next run does not report the leftovers: {stderr}"
-                    ));
-                }
-                for name in leftovers {
-                    std::fs::remove_file(dir.path().join(name)).map_err(|e| e.to_string())?;
-                }
-            }
+            })
+            .map_err(|e| format!("{what} killed at {delay_ms} ms: {e}"))?;
         }
+    }
+    Ok(())
+}
+
+/// After a killed run writing `target_name` in `dir`: every file left
+/// besides the target is a `.TARGET.partial-*` temporary, and when there is
+/// one, the next run (`next`) succeeds and reports it with the `rm` command
+/// to remove it. The leftovers are removed for the next attempt.
+fn leftovers_are_reported(
+    dir: &std::path::Path,
+    target_name: &str,
+    next: impl FnOnce() -> std::io::Result<std::process::Output>,
+) -> Result<(), String> {
+    let leftovers: Vec<String> = std::fs::read_dir(dir)
+        .map_err(|e| e.to_string())?
+        .filter_map(Result::ok)
+        .map(|e| e.file_name().to_string_lossy().into_owned())
+        .filter(|n| n != target_name)
+        .collect();
+    let temporary = format!(".{target_name}.partial-");
+    if let Some(odd) = leftovers.iter().find(|n| !n.starts_with(&temporary)) {
+        return Err(format!("an unexpected file is left: {odd}"));
+    }
+    if leftovers.is_empty() {
+        return Ok(());
+    }
+    let next = next().map_err(|e| e.to_string())?;
+    let stderr = String::from_utf8_lossy(&next.stderr);
+    if !(next.status.success()
+        && stderr.contains("unfinished temporary file")
+        && stderr.contains("rm "))
+    {
+        return Err(format!(
+            "the next run does not report the leftovers: {stderr}"
+        ));
+    }
+    for name in leftovers {
+        std::fs::remove_file(dir.join(name)).map_err(|e| e.to_string())?;
     }
     Ok(())
 }

@@ -7,9 +7,10 @@ use nalgebra::{Point3, Rotation3, Vector3};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use sweeptrace::core::{
-    Broadphase, Facing, Kind, Mesh, NoObserver, Options, Outcome, Sweep, sweep_mesh,
-    sweep_mesh_with,
+    Broadphase, CollectRecords, Facing, Kind, Mesh, NoObserver, Options, Outcome, Sweep,
+    sweep_mesh, sweep_mesh_with,
 };
+use sweeptrace::replay::{CollectPrimary, primary_records};
 
 use crate::oracle::{OTri, OracleResult, oracle};
 use crate::trial;
@@ -19,6 +20,7 @@ pub fn tests() -> Vec<Trial> {
         trial!(oracle_agreement_100k_sweeps),
         trial!(parry_agreement_front_facing),
         trial!(bvh_equals_exhaustive),
+        trial!(primary_collector_equals_collecting_every_record),
     ]
 }
 
@@ -348,54 +350,126 @@ fn parry_agreement_front_facing() -> Result<(), String> {
     Ok(())
 }
 
+/// The mesh of `vertices` and `triangles`, and its usable (non-degenerate)
+/// triangles by vertex indices.
+fn mesh_and_usable(
+    vertices: &[[f64; 3]],
+    triangles: &[[u64; 3]],
+) -> Result<(Mesh, Vec<[u64; 3]>), String> {
+    let mesh = Mesh::new(vertices.to_vec(), triangles).map_err(|e| e.to_string())?;
+    let usable = mesh
+        .triangles()
+        .iter()
+        .map(|t| t.vertex_indices.map(u64::from))
+        .collect();
+    Ok((mesh, usable))
+}
+
+/// Mesh `m` of the random comparisons: a bumpy height field for even `m`,
+/// a random triangle soup for odd.
+fn random_mesh(rng: &mut ChaCha8Rng, m: usize) -> (Vec<[f64; 3]>, Vec<[u64; 3]>) {
+    if m.is_multiple_of(2) {
+        let n = 24 + m * 2;
+        let mut v = Vec::new();
+        for j in 0..=n {
+            for i in 0..=n {
+                let (x, y) = (i as f64 * 0.25, j as f64 * 0.25);
+                v.push([
+                    x,
+                    y,
+                    0.3 * (x * 1.3).sin() * (y * 0.7).cos() + uniform(rng, -0.05, 0.05),
+                ]);
+            }
+        }
+        let mut t = Vec::new();
+        let w = (n + 1) as u64;
+        for j in 0..n as u64 {
+            for i in 0..n as u64 {
+                let a = j * w + i;
+                t.push([a, a + 1, a + w + 1]);
+                t.push([a, a + w + 1, a + w]);
+            }
+        }
+        (v, t)
+    } else {
+        let mut v = Vec::new();
+        let mut t = Vec::new();
+        for k in 0..600u64 {
+            let c = random_point(rng, 5.0);
+            for _ in 0..3 {
+                let o = random_point(rng, 0.6);
+                v.push([c[0] + o[0], c[1] + o[1], c[2] + o[2]]);
+            }
+            t.push([3 * k, 3 * k + 1, 3 * k + 2]);
+        }
+        (v, t)
+    }
+}
+
+/// At `--detail primary` the replay keeps only the hits and the nearest
+/// miss while the tests run (`CollectPrimary`); it must give exactly what
+/// collecting every record and then choosing (`primary_records`) gives,
+/// and the same verdict counts.
+fn primary_collector_equals_collecting_every_record() -> Result<(), String> {
+    let mut rng = ChaCha8Rng::seed_from_u64(0x5EED_0004);
+    let (mut checked, mut hits, mut ties) = (0, 0, 0);
+    for m in 0..6 {
+        let (vertices, triangles) = random_mesh(&mut rng, m);
+        let (mesh, usable) = mesh_and_usable(&vertices, &triangles)?;
+        for _ in 0..800 {
+            let (p0, p1, radius, margin, facing) = random_sweep(&mut rng, &vertices, &usable);
+            let sweep = Sweep::new(p0, p1, radius);
+            let options = Options { margin, facing };
+            for broadphase in [Broadphase::Bvh, Broadphase::Exhaustive] {
+                let mut every = CollectRecords::default();
+                let outcome = sweep_mesh_with(&mesh, &sweep, &options, broadphase, &mut every)
+                    .map_err(|e| e.to_string())?;
+                let mut primary = CollectPrimary::default();
+                let again = sweep_mesh_with(&mesh, &sweep, &options, broadphase, &mut primary)
+                    .map_err(|e| e.to_string())?;
+                if format!("{outcome:?}") != format!("{again:?}") {
+                    return Err(format!("{p0:?} -> {p1:?}: outcomes differ"));
+                }
+                let mut counts = std::collections::BTreeMap::new();
+                for r in &every.records {
+                    *counts.entry(r.verdict()).or_insert(0u64) += 1;
+                }
+                let got: std::collections::BTreeMap<_, _> =
+                    primary.verdict_counts().into_iter().collect();
+                if got != counts {
+                    return Err(format!(
+                        "{p0:?} -> {p1:?}: verdict counts {got:?}, expected {counts:?}"
+                    ));
+                }
+                let want = primary_records(&outcome, every.records);
+                let got = primary.into_primary_records(&outcome);
+                if got != want {
+                    return Err(format!(
+                        "{p0:?} -> {p1:?} ({broadphase:?}): records {got:?}, expected {want:?}"
+                    ));
+                }
+                checked += 1;
+                hits += usize::from(outcome.is_hit());
+                ties += usize::from(want.len() > 1);
+            }
+        }
+    }
+    // The comparison covers hits, misses and ties.
+    if hits < checked / 10 || hits > checked * 9 / 10 || ties == 0 {
+        return Err(format!(
+            "{checked} sweeps: {hits} hits, {ties} with ties: not a useful mix"
+        ));
+    }
+    Ok(())
+}
+
 fn bvh_equals_exhaustive() -> Result<(), String> {
     let mut rng = ChaCha8Rng::seed_from_u64(0x5EED_0003);
     let mut checked = 0;
     let mut hits = 0;
     for m in 0..12 {
-        // Alternate a bumpy height field and a random triangle soup.
-        let (vertices, triangles) = if m % 2 == 0 {
-            let n = 24 + m * 2;
-            let mut v = Vec::new();
-            for j in 0..=n {
-                for i in 0..=n {
-                    let (x, y) = (i as f64 * 0.25, j as f64 * 0.25);
-                    v.push([
-                        x,
-                        y,
-                        0.3 * (x * 1.3).sin() * (y * 0.7).cos() + uniform(&mut rng, -0.05, 0.05),
-                    ]);
-                }
-            }
-            let mut t = Vec::new();
-            let w = (n + 1) as u64;
-            for j in 0..n as u64 {
-                for i in 0..n as u64 {
-                    let a = j * w + i;
-                    t.push([a, a + 1, a + w + 1]);
-                    t.push([a, a + w + 1, a + w]);
-                }
-            }
-            (v, t)
-        } else {
-            let mut v = Vec::new();
-            let mut t = Vec::new();
-            for k in 0..600u64 {
-                let c = random_point(&mut rng, 5.0);
-                for _ in 0..3 {
-                    let o = random_point(&mut rng, 0.6);
-                    v.push([c[0] + o[0], c[1] + o[1], c[2] + o[2]]);
-                }
-                t.push([3 * k, 3 * k + 1, 3 * k + 2]);
-            }
-            (v, t)
-        };
-        let mesh = Mesh::new(vertices.clone(), &triangles).map_err(|e| e.to_string())?;
-        let usable: Vec<[u64; 3]> = mesh
-            .triangles()
-            .iter()
-            .map(|t| t.vertex_indices.map(u64::from))
-            .collect();
+        let (vertices, triangles) = random_mesh(&mut rng, m);
+        let (mesh, usable) = mesh_and_usable(&vertices, &triangles)?;
         for _ in 0..2_000 {
             let (p0, p1, radius, margin, facing) = random_sweep(&mut rng, &vertices, &usable);
             let sweep = Sweep::new(p0, p1, radius);

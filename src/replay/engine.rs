@@ -5,10 +5,10 @@ use std::collections::{HashMap, VecDeque};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
-use crate::core::explain::nearest_miss;
+use crate::core::explain::{miss_distance, nearest_miss};
 use crate::core::{
-    Broadphase, CollectRecords, Mesh, Options, Outcome, Sweep, TestRecord, Verdict, sweep_mesh,
-    sweep_mesh_with,
+    Broadphase, CollectRecords, EdgeRecord, FaceRecord, Mesh, Observer, Options, Outcome, Sweep,
+    TestRecord, Verdict, VertexRecord, sweep_mesh, sweep_mesh_with,
 };
 use crate::trace::TraceEvent;
 use crate::trace::messages::{OutcomeMsg, SceneMsg, SweepMsg};
@@ -449,27 +449,29 @@ pub fn compute_sweep(
             Detail::All => Broadphase::Exhaustive,
             Detail::Primary | Detail::Candidates => Broadphase::Bvh,
         };
-        let mut collect = CollectRecords::default();
-        let outcome = sweep_mesh_with(
-            &scene.mesh,
-            &sweep,
-            &scene.options,
-            broadphase,
-            &mut collect,
-        )
-        .map_err(err)?;
-        for r in &collect.records {
-            let v = r.verdict();
-            match verdicts.iter_mut().find(|(w, _)| *w == v) {
-                Some((_, n)) => *n += 1,
-                None => verdicts.push((v, 1)),
+        match options.detail {
+            Detail::Primary => {
+                // Only what `primary_records` keeps is kept: the hits and
+                // the nearest miss so far, not every record.
+                let mut collect = CollectPrimary::default();
+                let outcome = explained(scene, &sweep, broadphase, &mut collect).map_err(err)?;
+                verdicts = collect.verdict_counts();
+                let records = collect.into_primary_records(&outcome);
+                (outcome, records)
+            }
+            Detail::Candidates | Detail::All => {
+                let mut collect = CollectRecords::default();
+                let outcome = explained(scene, &sweep, broadphase, &mut collect).map_err(err)?;
+                for r in &collect.records {
+                    let v = r.verdict();
+                    match verdicts.iter_mut().find(|(w, _)| *w == v) {
+                        Some((_, n)) => *n += 1,
+                        None => verdicts.push((v, 1)),
+                    }
+                }
+                (outcome, collect.records)
             }
         }
-        let records = match options.detail {
-            Detail::Primary => primary_records(&outcome, collect.records),
-            Detail::Candidates | Detail::All => collect.records,
-        };
-        (outcome, records)
     } else {
         (
             sweep_mesh(&scene.mesh, &sweep, &scene.options).map_err(err)?,
@@ -485,6 +487,92 @@ pub fn compute_sweep(
         during,
         elapsed: start.elapsed(),
     })
+}
+
+/// The explained query of `sweep` against `scene` with `observer`.
+fn explained<O: Observer>(
+    scene: &SceneState,
+    sweep: &Sweep,
+    broadphase: Broadphase,
+    observer: &mut O,
+) -> Result<Outcome, crate::core::SweepError> {
+    sweep_mesh_with(&scene.mesh, sweep, &scene.options, broadphase, observer)
+}
+
+/// An observer that keeps, of a sweep's records, only what
+/// [`primary_records`] can return (every hit, and the nearest miss so far,
+/// [`nearest_miss`]'s first of equals) and counts the verdicts of all: the
+/// same answer as collecting every record, without storing them.
+#[derive(Debug, Default)]
+pub struct CollectPrimary {
+    /// Every hit, in the order the tests ran.
+    hits: Vec<TestRecord>,
+    /// The rejected test nearest to a hit so far, with its distance.
+    nearest: Option<(f64, TestRecord)>,
+    /// Tests run, by verdict (index in [`Verdict::ALL`]).
+    verdicts: [u64; Verdict::ALL.len()],
+}
+
+// `CollectPrimary` counts verdicts at `verdict as usize`: that must be the
+// verdict's index in `Verdict::ALL`.
+const _: () = {
+    let mut i = 0;
+    while i < Verdict::ALL.len() {
+        assert!(Verdict::ALL[i] as usize == i);
+        i += 1;
+    }
+};
+
+impl CollectPrimary {
+    fn keep(&mut self, record: TestRecord) {
+        self.verdicts[record.verdict() as usize] += 1;
+        if record.alpha().is_some() {
+            self.hits.push(record);
+        }
+        if let Some(d) = miss_distance(&record)
+            && self
+                .nearest
+                .as_ref()
+                .is_none_or(|(best, _)| d.total_cmp(best).is_lt())
+        {
+            self.nearest = Some((d, record));
+        }
+    }
+
+    /// The tests run by verdict, the verdicts that occurred only.
+    pub fn verdict_counts(&self) -> Vec<(Verdict, u64)> {
+        Verdict::ALL
+            .iter()
+            .zip(self.verdicts)
+            .filter(|(_, n)| *n > 0)
+            .map(|(v, n)| (*v, n))
+            .collect()
+    }
+
+    /// [`primary_records`] of every record this observer saw.
+    pub fn into_primary_records(self, outcome: &Outcome) -> Vec<TestRecord> {
+        if outcome.is_hit() {
+            // The records `primary_records` keeps of a hit are all hits.
+            primary_records(outcome, self.hits)
+        } else {
+            self.nearest.map(|(_, r)| r).into_iter().collect()
+        }
+    }
+}
+
+impl Observer for CollectPrimary {
+    #[inline]
+    fn face(&mut self, r: &FaceRecord) {
+        self.keep(TestRecord::Face(*r));
+    }
+    #[inline]
+    fn edge(&mut self, r: &EdgeRecord) {
+        self.keep(TestRecord::Edge(*r));
+    }
+    #[inline]
+    fn vertex(&mut self, r: &VertexRecord) {
+        self.keep(TestRecord::Vertex(*r));
+    }
 }
 
 /// The records of [`Detail::Primary`]: the primary test, then every other

@@ -26,7 +26,8 @@ mod summary;
 mod tunnel;
 
 pub use engine::{
-    ComputedSweep, Replay, ReplayEvent, SceneState, SweepResult, compute_sweep, primary_records,
+    CollectPrimary, ComputedSweep, Replay, ReplayEvent, SceneState, SweepResult, compute_sweep,
+    primary_records,
 };
 pub use error::ReplayError;
 pub use iter::{

@@ -264,40 +264,57 @@ pub fn nearest_miss(records: &[TestRecord]) -> Option<&TestRecord> {
 /// How close a rejected test came to a hit, for choosing the "nearest miss"
 /// to explain when nothing is hit: smaller is closer. `None` for hits.
 pub fn miss_distance(record: &TestRecord) -> Option<f64> {
-    let r = record;
-    if r.verdict() == Verdict::Hit {
-        return None;
+    match record {
+        TestRecord::Face(f) => face_miss_distance(f),
+        TestRecord::Edge(e) => edge_miss_distance(e),
+        TestRecord::Vertex(v) => vertex_miss_distance(v),
     }
-    Some(match r {
-        TestRecord::Face(f) => match f.verdict {
-            Verdict::OutsideTriangle => {
-                let b = f.barycentric.unwrap_or([0.0; 3]);
-                -b.iter().copied().fold(0.0, f64::min)
-            }
-            Verdict::BeyondEnd => f.beta.unwrap_or(f64::INFINITY) - 1.0,
-            Verdict::BackFacing => 2.0,
-            _ => 10.0,
-        },
-        TestRecord::Edge(e) => match e.verdict {
-            Verdict::OffEdge => {
-                let xc = e.xc.unwrap_or(0.0);
-                (if xc < 0.0 { -xc } else { xc - e.length }) / e.length.max(f64::MIN_POSITIVE)
-            }
-            Verdict::BeyondEnd => e.roots.map_or(f64::INFINITY, |r| r.0 - 1.0),
-            Verdict::BackFacing => 2.0,
-            Verdict::NoRealRoots => {
-                3.0 + (-e.discriminant).max(0.0).sqrt() / e.a.max(f64::MIN_POSITIVE)
-            }
-            _ => 10.0,
-        },
-        TestRecord::Vertex(v) => match v.verdict {
-            Verdict::BeyondEnd => v.roots.map_or(f64::INFINITY, |r| r.0 - 1.0),
-            Verdict::BackFacing => 2.0,
-            Verdict::NoRealRoots => {
-                3.0 + (-v.discriminant).max(0.0).sqrt() / v.a.max(f64::MIN_POSITIVE)
-            }
-            _ => 10.0,
-        },
+}
+
+/// [`miss_distance`] of a face test.
+#[inline]
+pub fn face_miss_distance(f: &FaceRecord) -> Option<f64> {
+    Some(match f.verdict {
+        Verdict::Hit => return None,
+        Verdict::OutsideTriangle => {
+            let b = f.barycentric.unwrap_or([0.0; 3]);
+            -b.iter().copied().fold(0.0, f64::min)
+        }
+        Verdict::BeyondEnd => f.beta.unwrap_or(f64::INFINITY) - 1.0,
+        Verdict::BackFacing => 2.0,
+        _ => 10.0,
+    })
+}
+
+/// [`miss_distance`] of an edge test.
+#[inline]
+pub fn edge_miss_distance(e: &EdgeRecord) -> Option<f64> {
+    Some(match e.verdict {
+        Verdict::Hit => return None,
+        Verdict::OffEdge => {
+            let xc = e.xc.unwrap_or(0.0);
+            (if xc < 0.0 { -xc } else { xc - e.length }) / e.length.max(f64::MIN_POSITIVE)
+        }
+        Verdict::BeyondEnd => e.roots.map_or(f64::INFINITY, |r| r.0 - 1.0),
+        Verdict::BackFacing => 2.0,
+        Verdict::NoRealRoots => {
+            3.0 + (-e.discriminant).max(0.0).sqrt() / e.a.max(f64::MIN_POSITIVE)
+        }
+        _ => 10.0,
+    })
+}
+
+/// [`miss_distance`] of a vertex test.
+#[inline]
+pub fn vertex_miss_distance(v: &VertexRecord) -> Option<f64> {
+    Some(match v.verdict {
+        Verdict::Hit => return None,
+        Verdict::BeyondEnd => v.roots.map_or(f64::INFINITY, |r| r.0 - 1.0),
+        Verdict::BackFacing => 2.0,
+        Verdict::NoRealRoots => {
+            3.0 + (-v.discriminant).max(0.0).sqrt() / v.a.max(f64::MIN_POSITIVE)
+        }
+        _ => 10.0,
     })
 }
 

@@ -5,7 +5,9 @@ use std::collections::{HashMap, VecDeque};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
-use crate::core::explain::{miss_distance, nearest_miss};
+use crate::core::explain::{
+    edge_miss_distance, face_miss_distance, nearest_miss, vertex_miss_distance,
+};
 use crate::core::{
     Broadphase, CollectRecords, EdgeRecord, FaceRecord, Mesh, Observer, Options, Outcome, Sweep,
     TestRecord, Verdict, VertexRecord, sweep_mesh, sweep_mesh_with,
@@ -500,14 +502,20 @@ fn explained<O: Observer>(
 }
 
 /// An observer that keeps, of a sweep's records, only what
-/// [`primary_records`] can return (every hit, and the nearest miss so far,
-/// [`nearest_miss`]'s first of equals) and counts the verdicts of all: the
-/// same answer as collecting every record, without storing them.
+/// [`primary_records`] can return (every hit; while nothing is hit, the
+/// nearest miss so far, [`nearest_miss`]'s first of equals) and counts the
+/// verdicts of all: the same answer as collecting every record, without
+/// storing them.
 #[derive(Debug, Default)]
 pub struct CollectPrimary {
     /// Every hit, in the order the tests ran.
     hits: Vec<TestRecord>,
-    /// The rejected test nearest to a hit so far, with its distance.
+    /// Whether one of `hits` makes the outcome a hit (one at an `α` below
+    /// infinity, as the core's decision counts them).
+    found_hit: bool,
+    /// The rejected test nearest to a hit so far, with its distance; not
+    /// looked for once something is hit (the outcome is then a hit, whose
+    /// records are hits).
     nearest: Option<(f64, TestRecord)>,
     /// Tests run, by verdict (index in [`Verdict::ALL`]).
     verdicts: [u64; Verdict::ALL.len()],
@@ -524,18 +532,29 @@ const _: () = {
 };
 
 impl CollectPrimary {
-    fn keep(&mut self, record: TestRecord) {
-        self.verdicts[record.verdict() as usize] += 1;
-        if record.alpha().is_some() {
-            self.hits.push(record);
-        }
-        if let Some(d) = miss_distance(&record)
+    /// One test's record: its verdict, whether it hit (`alpha`), its
+    /// [`miss_distance`](crate::core::explain::miss_distance) and the
+    /// record itself, made only when kept.
+    #[inline]
+    fn keep(
+        &mut self,
+        verdict: Verdict,
+        alpha: Option<f64>,
+        distance: impl FnOnce() -> Option<f64>,
+        record: impl Fn() -> TestRecord,
+    ) {
+        self.verdicts[verdict as usize] += 1;
+        if let Some(a) = alpha {
+            self.hits.push(record());
+            self.found_hit |= a < f64::INFINITY;
+        } else if !self.found_hit
+            && let Some(d) = distance()
             && self
                 .nearest
                 .as_ref()
                 .is_none_or(|(best, _)| d.total_cmp(best).is_lt())
         {
-            self.nearest = Some((d, record));
+            self.nearest = Some((d, record()));
         }
     }
 
@@ -563,15 +582,30 @@ impl CollectPrimary {
 impl Observer for CollectPrimary {
     #[inline]
     fn face(&mut self, r: &FaceRecord) {
-        self.keep(TestRecord::Face(*r));
+        self.keep(
+            r.verdict,
+            r.alpha(),
+            || face_miss_distance(r),
+            || TestRecord::Face(*r),
+        );
     }
     #[inline]
     fn edge(&mut self, r: &EdgeRecord) {
-        self.keep(TestRecord::Edge(*r));
+        self.keep(
+            r.verdict,
+            r.alpha(),
+            || edge_miss_distance(r),
+            || TestRecord::Edge(*r),
+        );
     }
     #[inline]
     fn vertex(&mut self, r: &VertexRecord) {
-        self.keep(TestRecord::Vertex(*r));
+        self.keep(
+            r.verdict,
+            r.alpha(),
+            || vertex_miss_distance(r),
+            || TestRecord::Vertex(*r),
+        );
     }
 }
 

@@ -17,8 +17,8 @@ use super::convert::{MESH_COLOR, WIREFRAME_COLOR, WIREFRAME_POINTS, albedo, f32x
 use super::edge_frame::{choose_edges, edge_frame_rows};
 use super::paths::{self, Entity};
 use super::rows::{
-    Out, PLOT_BITS, expected_rows, focus_rows, plot_entity, plot_rows, primary_rows, sweep_rows,
-    text_rows, tunnel_rows,
+    Out, PLOT_BITS, Shown, expected_rows, focus_rows, plot_entity, plot_rows, primary_rows,
+    sweep_rows, text_rows, tunnel_rows,
 };
 use super::{MAX_EDGE_FRAMES, TIMESTAMP_THRESHOLD_NANOS};
 use crate::core::{EdgeRecord, Triangle};
@@ -134,6 +134,8 @@ struct Mark {
 pub struct Logger {
     rec: RecordingStream,
     balls: BTreeMap<u32, BallState>,
+    /// What each ball's last sweep handed to [`Logger::shown_before`] shows.
+    shown: BTreeMap<u32, Shown>,
     options: LoggerOptions,
     columns: columns::Columns,
     flush_rows: usize,
@@ -176,28 +178,36 @@ impl PreparedSweeps {
 /// order); `options` are the logger's ([`Logger::prepare_options`]).
 pub fn prepare_sweeps<'r>(
     results: impl IntoIterator<Item = &'r SweepResult>,
+    before: &[Shown],
     options: &PrepareOptions,
 ) -> PreparedSweeps {
     let mut p = PreparedSweeps::default();
-    prepare_sweeps_into(&mut p, results, options);
+    prepare_sweeps_into(&mut p, results, before, options);
     p
 }
 
 /// [`prepare_sweeps`] into `p` (an empty one, for example from
-/// [`Logger::spare_prepared`], whose buffers are reused).
+/// [`Logger::spare_prepared`], whose buffers are reused). `before` holds,
+/// for each of `results`, what the previous sweep of its ball left shown
+/// ([`Logger::shown_before`]).
 pub fn prepare_sweeps_into<'r>(
     p: &mut PreparedSweeps,
     results: impl IntoIterator<Item = &'r SweepResult>,
+    before: &[Shown],
     options: &PrepareOptions,
 ) {
     debug_assert!(p.is_empty() && p.columns.rows() == 0);
+    let mut before = before.iter();
     for r in results {
         let frame = i64::try_from(r.frame).unwrap_or(i64::MAX);
         let time = time_of(r.log_time_nanos);
+        let before = before.next().copied();
+        debug_assert!(before.is_some(), "fewer `before` than results");
         let mut out = Out {
             columns: &mut p.columns,
             frame,
             time,
+            before: before.unwrap_or_default(),
         };
         let decisive = r.decisive_record().copied();
         let diffs = divergence(r, &options.tolerances);
@@ -300,6 +310,7 @@ impl Logger {
         let mut logger = Logger {
             rec,
             balls: BTreeMap::new(),
+            shown: BTreeMap::new(),
             options,
             columns: columns::Columns::default(),
             flush_rows: DEFAULT_FLUSH_ROWS,
@@ -456,8 +467,22 @@ impl Logger {
 
     /// Logs one sweep's result at its frame.
     pub fn log_sweep(&mut self, r: &SweepResult) -> Result<(), RecordingStreamError> {
-        let prepared = prepare_sweeps([r], &self.options.prepare);
+        let before = self.shown_before([r]);
+        let prepared = prepare_sweeps([r], &before, &self.options.prepare);
         self.log_prepared(prepared)
+    }
+
+    /// What the previous sweep of each of `results`' balls left shown, in
+    /// order (for [`prepare_sweeps`]); remembers what each shows, so the
+    /// results must then be prepared and logged, in this order.
+    pub fn shown_before<'r>(
+        &mut self,
+        results: impl IntoIterator<Item = &'r SweepResult>,
+    ) -> Vec<Shown> {
+        results
+            .into_iter()
+            .map(|r| std::mem::replace(self.shown.entry(r.ball).or_default(), Shown::of(r)))
+            .collect()
     }
 
     /// Logs sweeps prepared by [`prepare_sweeps`] (sweeps must be logged in
@@ -483,6 +508,7 @@ impl Logger {
                 columns: &mut self.columns,
                 frame: m.frame,
                 time: m.time,
+                before: Shown::default(),
             };
             for slot in m.edge_slots..edge_slots {
                 out.clear(Entity::EdgeFrame(b, slot), true);

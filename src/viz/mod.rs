@@ -43,6 +43,7 @@ pub use logger::{
     PrepareOptions, PreparedSweeps, prepare_sweeps, prepare_sweeps_into,
 };
 pub use rerun::RecordingStreamError;
+pub use rows::Shown;
 
 /// Application id of every recording.
 pub const APPLICATION_ID: &str = "sweeptrace";

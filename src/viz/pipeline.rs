@@ -17,7 +17,7 @@ use thiserror::Error;
 use crate::replay::{DEFAULT_BATCH_EVENTS, ReplayError, ReplayEvent, SweepResult};
 
 use super::{
-    Logger, PREPARE_GROUP_SWEEPS, PreparedSweeps, RecordingStreamError, prepare_sweeps_into,
+    Logger, PREPARE_GROUP_SWEEPS, PreparedSweeps, RecordingStreamError, Shown, prepare_sweeps_into,
 };
 
 /// Logging to the recording failed.
@@ -93,6 +93,23 @@ where
             Some(_) => sweep_runs(&batch),
             None => Vec::new(),
         };
+        // What each sweep's ball showed before it (sequential: it depends
+        // on the ball's previous sweep, perhaps in another run).
+        let before: Vec<Shown> = match logger.as_mut() {
+            Some(l) if prepare_options.is_some() => {
+                let mut shown = l
+                    .shown_before(batch.iter().filter_map(sweep_of))
+                    .into_iter();
+                batch
+                    .iter()
+                    .map(|e| match sweep_of(e) {
+                        Some(_) => shown.next().unwrap_or_default(),
+                        None => Shown::default(),
+                    })
+                    .collect()
+            }
+            _ => Vec::new(),
+        };
         // Emptied buffers of earlier runs, reused.
         let spares: Vec<PreparedSweeps> = match logger.as_mut() {
             Some(l) => groups.iter().map(|_| l.spare_prepared()).collect(),
@@ -121,6 +138,7 @@ where
                             prepare_sweeps_into(
                                 &mut p,
                                 batch[g.clone()].iter().filter_map(sweep_of),
+                                &before[g.clone()],
                                 prepare_options,
                             );
                             p

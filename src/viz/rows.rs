@@ -54,11 +54,52 @@ pub(crate) mod set {
     pub const TUNNEL: u8 = 22;
 }
 
+/// What a sweep's rows leave shown for its ball, of the entities that are
+/// cleared when a sweep no longer shows them: the contact and its normal,
+/// the primary triangle and outline, the primary edge, the primary vertex.
+/// A ball's rows clear one of them only when the ball's previous sweep
+/// showed it, not at every sweep that does not ([`Out::before`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Shown(u8);
+
+impl Shown {
+    const CONTACT: u8 = 1;
+    const PRIMARY: u8 = 2;
+    const EDGE: u8 = 4;
+    const VERTEX: u8 = 8;
+
+    /// What the rows of `r` show (as [`sweep_rows`] and [`primary_rows`]
+    /// decide).
+    pub fn of(r: &SweepResult) -> Shown {
+        let mut bits = 0;
+        if r.outcome.contact.is_some() && r.outcome.normal.is_some() {
+            bits |= Shown::CONTACT;
+        }
+        if let Some(t) = r.decisive_record()
+            && r.scene.mesh.triangle_by_index(t.triangle()).is_some()
+        {
+            bits |= Shown::PRIMARY
+                | match t {
+                    TestRecord::Edge(_) => Shown::EDGE,
+                    TestRecord::Vertex(_) => Shown::VERTEX,
+                    TestRecord::Face(_) => 0,
+                };
+        }
+        Shown(bits)
+    }
+
+    fn has(self, bit: u8) -> bool {
+        self.0 & bit != 0
+    }
+}
+
 /// Where the rows of one sweep go.
 pub(crate) struct Out<'a> {
     pub(crate) columns: &'a mut columns::Columns,
     pub(crate) frame: i64,
     pub(crate) time: columns::Time,
+    /// What the ball's previous sweep left shown ([`Shown`]).
+    pub(crate) before: Shown,
 }
 
 impl Out<'_> {
@@ -69,6 +110,14 @@ impl Out<'_> {
     pub(crate) fn clear(&mut self, entity: Entity, recursive: bool) {
         self.row(entity, set::CLEAR)
             .put::<ClearIsRecursive>(Clear::descriptor_is_recursive, [recursive.into()]);
+    }
+
+    /// Clears `entity` (not recursively) if the ball's previous sweep
+    /// showed it (`bit` of [`Shown`]).
+    fn clear_shown(&mut self, entity: Entity, bit: u8) {
+        if self.before.has(bit) {
+            self.clear(entity, false);
+        }
     }
 }
 
@@ -148,8 +197,8 @@ pub(crate) fn sweep_rows(out: &mut Out<'_>, r: &SweepResult) {
             );
         }
         _ => {
-            out.clear(Entity::Contact(b), false);
-            out.clear(Entity::Normal(b), false);
+            out.clear_shown(Entity::Contact(b), Shown::CONTACT);
+            out.clear_shown(Entity::Normal(b), Shown::CONTACT);
         }
     }
 }
@@ -229,10 +278,10 @@ pub(crate) fn primary_rows(
     let b = r.ball;
     let triangle = decisive.and_then(|t| r.scene.mesh.triangle_by_index(t.triangle()));
     let (Some(t), Some(test)) = (triangle, decisive) else {
-        out.clear(Entity::PrimaryTriangle(b), false);
-        out.clear(Entity::PrimaryOutline(b), false);
-        out.clear(Entity::PrimaryEdge(b), false);
-        out.clear(Entity::PrimaryVertex(b), false);
+        out.clear_shown(Entity::PrimaryTriangle(b), Shown::PRIMARY);
+        out.clear_shown(Entity::PrimaryOutline(b), Shown::PRIMARY);
+        out.clear_shown(Entity::PrimaryEdge(b), Shown::EDGE);
+        out.clear_shown(Entity::PrimaryVertex(b), Shown::VERTEX);
         return;
     };
     let hit = test.alpha().is_some();
@@ -284,7 +333,7 @@ pub(crate) fn primary_rows(
                         s.push_fmt(format_args!("{prefix}{label}"));
                     }
                 });
-            out.clear(Entity::PrimaryVertex(b), false);
+            out.clear_shown(Entity::PrimaryVertex(b), Shown::VERTEX);
         }
         TestRecord::Vertex(_) => {
             out.row(Entity::PrimaryVertex(b), set::LABELED_POINT)
@@ -296,11 +345,11 @@ pub(crate) fn primary_rows(
                         s.push_fmt(format_args!("{prefix}{label}"));
                     }
                 });
-            out.clear(Entity::PrimaryEdge(b), false);
+            out.clear_shown(Entity::PrimaryEdge(b), Shown::EDGE);
         }
         TestRecord::Face(_) => {
-            out.clear(Entity::PrimaryEdge(b), false);
-            out.clear(Entity::PrimaryVertex(b), false);
+            out.clear_shown(Entity::PrimaryEdge(b), Shown::EDGE);
+            out.clear_shown(Entity::PrimaryVertex(b), Shown::VERTEX);
         }
     }
 }

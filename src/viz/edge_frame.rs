@@ -148,17 +148,7 @@ pub(crate) fn edge_frame_rows(
     let b = r.ball;
     let rho = r.rho();
     for (slot, e) in edges.iter().enumerate() {
-        let world_from_edge = e.frame.world_from_edge();
-        out.row(Entity::EdgeFrame(b, slot), set::TRANSFORM)
-            .put::<Translation3D>(
-                Transform3D::descriptor_translation,
-                [f32x3(world_from_edge.translation.vector).into()],
-            )
-            .put::<RotationQuat>(
-                Transform3D::descriptor_quaternion,
-                [quaternion(&world_from_edge.rotation).into()],
-            );
-        edge_values(out, Entity::EdgeFrame(b, slot), e);
+        edge_frame_row(out, Entity::EdgeFrame(b, slot), e);
         let hit = e.alpha().is_some();
         let length = e.length as f32;
         // The edge, on +x. Slot 0 is labelled when it is not the decisive
@@ -248,29 +238,36 @@ pub(crate) fn edge_frame_rows(
     }
 }
 
-/// The numbers of an edge test (as `AnyValues`: test, verdict, length, a,
-/// b, c, discriminant, and s0, s1, xc when known).
-fn edge_values(out: &mut Out<'_>, entity: Entity, e: &EdgeRecord) {
-    let set = set::EDGE_VALUES + u8::from(e.roots.is_some()) + 2 * u8::from(e.xc.is_some());
-    let mut row = out.row(entity, set);
-    row.put_fmt(
-        || any_value::<Text>("test"),
-        format_args!("edge {}.{}", e.triangle, e.edge),
-    )
-    .put_strs(|| any_value::<Text>("verdict"), [e.verdict.as_str()])
-    .put::<Scalar>(|| any_value::<Scalar>("length"), [e.length.into()])
-    .put::<Scalar>(|| any_value::<Scalar>("a"), [e.a.into()])
-    .put::<Scalar>(|| any_value::<Scalar>("b"), [e.b.into()])
-    .put::<Scalar>(|| any_value::<Scalar>("c"), [e.c.into()])
-    .put::<Scalar>(
-        || any_value::<Scalar>("discriminant"),
-        [e.discriminant.into()],
-    );
-    if let Some((s0, s1)) = e.roots {
-        row.put::<Scalar>(|| any_value::<Scalar>("s0"), [s0.into()])
-            .put::<Scalar>(|| any_value::<Scalar>("s1"), [s1.into()]);
-    }
-    if let Some(xc) = e.xc {
-        row.put::<Scalar>(|| any_value::<Scalar>("xc"), [xc.into()]);
-    }
+/// The edge frame's transform (world from edge) and the numbers of its edge
+/// test (as `AnyValues`: test, verdict, length, a, b, c, discriminant, s0,
+/// s1 and xc; s0, s1 and xc empty when the test did not get that far, so
+/// that no earlier sweep's value shows).
+fn edge_frame_row(out: &mut Out<'_>, entity: Entity, e: &EdgeRecord) {
+    let world_from_edge = e.frame.world_from_edge();
+    let (s0, s1) = e.roots.unzip();
+    out.row(entity, set::EDGE_FRAME)
+        .put::<Translation3D>(
+            Transform3D::descriptor_translation,
+            [f32x3(world_from_edge.translation.vector).into()],
+        )
+        .put::<RotationQuat>(
+            Transform3D::descriptor_quaternion,
+            [quaternion(&world_from_edge.rotation).into()],
+        )
+        .put_fmt(
+            || any_value::<Text>("test"),
+            format_args!("edge {}.{}", e.triangle, e.edge),
+        )
+        .put_strs(|| any_value::<Text>("verdict"), [e.verdict.as_str()])
+        .put::<Scalar>(|| any_value::<Scalar>("length"), [e.length.into()])
+        .put::<Scalar>(|| any_value::<Scalar>("a"), [e.a.into()])
+        .put::<Scalar>(|| any_value::<Scalar>("b"), [e.b.into()])
+        .put::<Scalar>(|| any_value::<Scalar>("c"), [e.c.into()])
+        .put::<Scalar>(
+            || any_value::<Scalar>("discriminant"),
+            [e.discriminant.into()],
+        )
+        .put::<Scalar>(|| any_value::<Scalar>("s0"), s0.map(Scalar::from))
+        .put::<Scalar>(|| any_value::<Scalar>("s1"), s1.map(Scalar::from))
+        .put::<Scalar>(|| any_value::<Scalar>("xc"), e.xc.map(Scalar::from));
 }

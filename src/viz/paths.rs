@@ -23,8 +23,9 @@
 //!                                     triangle front to back (during this sweep or since
 //!                                     its previous one), labelled with the triangle
 //! world/ball/{ball}/edge/{slot}       Transform3D world_from_edge of one logged edge test,
-//!                                     plus its numbers (AnyValues: triangle, edge, A, B, C,
-//!                                     discriminant, s0, s1, xc, verdict)
+//!                                     plus its numbers (AnyValues: test, verdict, length,
+//!                                     a, b, c, discriminant, s0, s1, xc; s0, s1 and xc
+//!                                     empty when the test did not compute them)
 //! world/ball/{ball}/edge/{slot}/edge      LineStrips3D (0,0,0)→(L,0,0) in the edge frame
 //! world/ball/{ball}/edge/{slot}/cylinder  Capsules3D of radius ρ around the edge
 //! world/ball/{ball}/edge/{slot}/path      LineStrips3D p0_in_edge→p1_in_edge

@@ -39,7 +39,6 @@ pub(crate) mod set {
     pub const TRIANGLE: u8 = 5;
     pub const LABELED_STRIP: u8 = 6;
     pub const LABELED_POINT: u8 = 7;
-    pub const TRANSFORM: u8 = 8;
     pub const STRIP: u8 = 9;
     pub const CYLINDER: u8 = 10;
     pub const EDGE_POINTS: u8 = 11;
@@ -47,8 +46,8 @@ pub(crate) mod set {
     pub const KIND: u8 = 13;
     pub const TEXT_LOG: u8 = 14;
     pub const FOCUS: u8 = 15;
-    /// Plus 1 with roots, plus 2 with xc.
-    pub const EDGE_VALUES: u8 = 16;
+    /// An edge frame's transform and its test's numbers.
+    pub const EDGE_FRAME: u8 = 16;
     pub const AXES: u8 = 20;
     pub const EXPECTED_BALL: u8 = 21;
     pub const TUNNEL: u8 = 22;
@@ -425,8 +424,9 @@ fn scalar(out: &mut Out<'_>, entity: Entity, v: f64) {
 /// got a value (bit `i` for `plot_entity(ball, i)`).
 pub(crate) fn plot_rows(out: &mut Out<'_>, r: &SweepResult, decisive: Option<&TestRecord>) -> u16 {
     let b = r.ball;
-    scalar(out, Entity::Alpha(b), r.outcome.alpha);
+    // One row: α and the kind beside it.
     out.row(Entity::Alpha(b), set::KIND)
+        .put::<Scalar>(Scalars::descriptor_scalars, [r.outcome.alpha.into()])
         .put_strs(|| any_value::<Text>("kind"), [r.outcome.kind.as_str()]);
     let mut plotted = 0u16;
     let mut quadratic = |a: f64, bb: f64, c: f64, disc: f64, roots: Option<(f64, f64)>| {

@@ -96,7 +96,7 @@ trait Column: Send + fmt::Debug {
 struct Typed<C> {
     descriptor: ComponentDescriptor,
     values: Vec<C>,
-    lengths: Vec<usize>,
+    lengths: Lengths,
 }
 
 impl<C> fmt::Debug for Typed<C> {
@@ -134,7 +134,7 @@ impl<C: Component> Column for Typed<C> {
     }
 
     fn bytes(&self) -> usize {
-        self.values.len() * std::mem::size_of::<C>() + self.lengths.len() * USIZE
+        self.values.len() * std::mem::size_of::<C>() + self.lengths.bytes()
     }
 }
 
@@ -145,9 +145,9 @@ struct Strings {
     descriptor: ComponentDescriptor,
     bytes: String,
     /// Length in bytes of each string.
-    string_lengths: Vec<usize>,
+    string_lengths: Vec<u32>,
     /// Strings of each row.
-    lengths: Vec<usize>,
+    lengths: Lengths,
 }
 
 impl Column for Strings {
@@ -167,7 +167,7 @@ impl Column for Strings {
     }
 
     fn take_list(&mut self) -> Result<ListArray, RecordingStreamError> {
-        let offsets = OffsetBuffer::<i32>::from_lengths(self.string_lengths.drain(..));
+        let offsets = OffsetBuffer::<i32>::from_lengths(self.string_lengths.drain(..).map(widen));
         // The next flush holds about as many bytes: allocate them at once.
         let n = self.bytes.len();
         let bytes = std::mem::replace(&mut self.bytes, String::with_capacity(n));
@@ -182,7 +182,7 @@ impl Column for Strings {
     }
 
     fn bytes(&self) -> usize {
-        self.bytes.len() + (self.string_lengths.len() + self.lengths.len()) * USIZE
+        self.bytes.len() + self.string_lengths.len() * 4 + self.lengths.bytes()
     }
 }
 
@@ -194,9 +194,9 @@ struct Strips {
     /// x, y, z of every point.
     coords: Vec<f32>,
     /// Points of each strip.
-    strip_lengths: Vec<usize>,
+    strip_lengths: Vec<u32>,
     /// Strips of each row.
-    lengths: Vec<usize>,
+    lengths: Lengths,
 }
 
 impl Column for Strips {
@@ -228,7 +228,7 @@ impl Column for Strips {
         let coords = Float32Array::new(ScalarBuffer::from(coords), None);
         let points = FixedSizeListArray::try_new(point_field.clone(), 3, Arc::new(coords), None)
             .map_err(|e| RecordingStreamError::Chunk(e.into()))?;
-        let offsets = OffsetBuffer::<i32>::from_lengths(self.strip_lengths.drain(..));
+        let offsets = OffsetBuffer::<i32>::from_lengths(self.strip_lengths.drain(..).map(widen));
         let strips = ListArray::try_new(strip_field.clone(), offsets, Arc::new(points), None)
             .map_err(|e| RecordingStreamError::Chunk(e.into()))?;
         list_array(Arc::new(strips), &mut self.lengths)
@@ -239,19 +239,86 @@ impl Column for Strips {
     }
 
     fn bytes(&self) -> usize {
-        self.coords.len() * 4 + (self.strip_lengths.len() + self.lengths.len()) * USIZE
+        self.coords.len() * 4 + self.strip_lengths.len() * 4 + self.lengths.bytes()
     }
 }
 
-const USIZE: usize = std::mem::size_of::<usize>();
+/// How many values each buffered row of a column has: only a count while
+/// every row has exactly one (most components), which then costs nothing
+/// per row; the lengths themselves from the first row that does not.
+#[derive(Debug, Default)]
+struct Lengths {
+    /// Rows, while every row has one value (`list` is empty then).
+    ones: usize,
+    /// Every row's length, once a row has not had exactly one.
+    list: Vec<u32>,
+}
+
+impl Lengths {
+    fn push(&mut self, n: usize) {
+        if self.list.is_empty() {
+            if n == 1 {
+                self.ones += 1;
+                return;
+            }
+            self.spell_out();
+        }
+        self.list.push(narrow(n));
+    }
+
+    /// From the count to the list.
+    fn spell_out(&mut self) {
+        self.list.extend(std::iter::repeat_n(1, self.ones));
+        self.ones = 0;
+    }
+
+    fn len(&self) -> usize {
+        if self.list.is_empty() {
+            self.ones
+        } else {
+            self.list.len()
+        }
+    }
+
+    /// Moves the rows of `other` to the end.
+    fn append(&mut self, other: &mut Lengths) {
+        if self.list.is_empty() && other.list.is_empty() {
+            self.ones += std::mem::take(&mut other.ones);
+            return;
+        }
+        self.spell_out();
+        other.spell_out();
+        self.list.append(&mut other.list);
+    }
+
+    fn bytes(&self) -> usize {
+        self.list.len() * 4
+    }
+
+    /// The offsets of the rows; empties the lengths.
+    fn take_offsets(&mut self) -> OffsetBuffer<i32> {
+        if self.list.is_empty() {
+            OffsetBuffer::from_lengths(std::iter::repeat_n(1, std::mem::take(&mut self.ones)))
+        } else {
+            OffsetBuffer::from_lengths(self.list.drain(..).map(widen))
+        }
+    }
+}
+
+/// A length as stored (Arrow's offsets here are `i32`, so no list is near
+/// `u32::MAX` long).
+fn narrow(n: usize) -> u32 {
+    u32::try_from(n).expect("a list of fewer than 2^31 values")
+}
+
+fn widen(n: u32) -> usize {
+    n as usize
+}
 
 /// One list per row over `values`, `lengths` values each; empties
 /// `lengths`.
-fn list_array(
-    values: ArrayRef,
-    lengths: &mut Vec<usize>,
-) -> Result<ListArray, RecordingStreamError> {
-    let offsets = OffsetBuffer::<i32>::from_lengths(lengths.drain(..));
+fn list_array(values: ArrayRef, lengths: &mut Lengths) -> Result<ListArray, RecordingStreamError> {
+    let offsets = lengths.take_offsets();
     let field = Arc::new(Field::new_list_field(values.data_type().clone(), true));
     ListArray::try_new(field, offsets, values, None)
         .map_err(|e| RecordingStreamError::Chunk(e.into()))
@@ -447,7 +514,9 @@ impl Columns {
         let mut components = Vec::with_capacity(batches.len());
         for batch in batches {
             let len = batch_len(&batch);
-            let list = list_array(batch.array, &mut vec![len])?;
+            let mut lengths = Lengths::default();
+            lengths.push(len);
+            let list = list_array(batch.array, &mut lengths)?;
             components.push((batch.descriptor, list));
         }
         let chunk = Chunk::from_native_row_ids(
@@ -513,7 +582,7 @@ impl Row<'_> {
                 Box::new(Typed::<C> {
                     descriptor: descriptor(),
                     values: Vec::new(),
-                    lengths: Vec::new(),
+                    lengths: Lengths::default(),
                 })
             })
             .downcast_mut::<Typed<C>>()
@@ -537,13 +606,13 @@ impl Row<'_> {
                     descriptor: descriptor(),
                     coords: Vec::new(),
                     strip_lengths: Vec::new(),
-                    lengths: Vec::new(),
+                    lengths: Lengths::default(),
                 })
             })
             .downcast_mut::<Strips>()
             .expect("every row of a set puts the same components");
         column.coords.extend_from_slice(points.as_flattened());
-        column.strip_lengths.push(points.len());
+        column.strip_lengths.push(narrow(points.len()));
         column.lengths.push(1);
         self
     }
@@ -559,7 +628,7 @@ impl Row<'_> {
         let mut n = 0;
         for s in strings {
             column.bytes.push_str(s);
-            column.string_lengths.push(s.len());
+            column.string_lengths.push(narrow(s.len()));
             n += 1;
         }
         column.lengths.push(n);
@@ -575,7 +644,9 @@ impl Row<'_> {
         let column = self.strings(descriptor);
         let before = column.bytes.len();
         fmt::Write::write_fmt(&mut column.bytes, args).expect("writing to a String");
-        column.string_lengths.push(column.bytes.len() - before);
+        column
+            .string_lengths
+            .push(narrow(column.bytes.len() - before));
         column.lengths.push(1);
         self
     }
@@ -601,7 +672,7 @@ impl Row<'_> {
                 descriptor: descriptor(),
                 bytes: String::new(),
                 string_lengths: Vec::new(),
-                lengths: Vec::new(),
+                lengths: Lengths::default(),
             })
         })
         .downcast_mut::<Strings>()
@@ -629,7 +700,7 @@ impl Texts<'_> {
         debug_assert!(self.column.bytes.len() >= before);
         self.column
             .string_lengths
-            .push(self.column.bytes.len() - before);
+            .push(narrow(self.column.bytes.len() - before));
         self.n += 1;
         self
     }
@@ -645,5 +716,51 @@ impl Drop for Row<'_> {
             self.next,
             self.entity.columns.len()
         );
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::Lengths;
+
+    fn offsets(lengths: &[usize]) -> Vec<i32> {
+        let mut o = vec![0];
+        for n in lengths {
+            o.push(o.last().unwrap() + *n as i32);
+        }
+        o
+    }
+
+    /// Every way of splitting short sequences of lengths 0, 1 and 2 into
+    /// two appended halves gives the offsets of the plain list.
+    #[test]
+    fn lengths_give_the_offsets_of_the_plain_list() {
+        for code in 0..3usize.pow(6) {
+            let seq: Vec<usize> = (0..6).map(|i| code / 3usize.pow(i) % 3).collect();
+            for cut in 0..=seq.len() {
+                let (a, b) = seq.split_at(cut);
+                let mut x = Lengths::default();
+                a.iter().for_each(|&n| x.push(n));
+                let mut y = Lengths::default();
+                b.iter().for_each(|&n| y.push(n));
+                x.append(&mut y);
+                assert_eq!(y.len(), 0);
+                assert_eq!(x.len(), seq.len());
+                assert_eq!(x.take_offsets().to_vec(), offsets(&seq), "{a:?} + {b:?}");
+                assert_eq!(x.len(), 0);
+                // Reused after taking.
+                x.push(2);
+                assert_eq!(x.take_offsets().to_vec(), vec![0, 2]);
+            }
+        }
+    }
+
+    #[test]
+    fn rows_of_one_value_cost_nothing() {
+        let mut x = Lengths::default();
+        (0..1000).for_each(|_| x.push(1));
+        assert_eq!(x.bytes(), 0);
+        x.push(3);
+        assert_eq!(x.bytes(), 1001 * 4);
     }
 }

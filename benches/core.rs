@@ -2,6 +2,13 @@
 //!
 //! Run: `cargo bench --no-default-features --bench core`
 //!
+//! Besides parry, two explained queries on the same sweeps: what
+//! `replay --detail primary` runs (`CollectPrimary`: the records it keeps,
+//! the verdicts counted) and the same with every test's record collected
+//! (`CollectRecords`, what `--detail candidates` keeps, and what primary did
+//! before `CollectPrimary`); their ratio to `sweeptrace` is the cost of
+//! explaining.
+//!
 //! Meshes are height fields of about 10^3, 10^5 and 10^6 triangles built
 //! from a seed; 4,096 sweeps per mesh (a ball of radius 0.25 falling from
 //! above the terrain, with sideways motion) are cycled so that no single
@@ -14,7 +21,10 @@ use std::hint::black_box;
 use criterion::{BenchmarkId, Criterion, Throughput, criterion_group};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
-use sweeptrace::core::{Mesh, Options, Sweep, sweep_mesh};
+use sweeptrace::core::{
+    Broadphase, CollectRecords, Mesh, Options, Sweep, sweep_mesh, sweep_mesh_with,
+};
+use sweeptrace::replay::{CollectPrimary, primary_records};
 
 use parry3d_f64::math::{Pose, Vector};
 use parry3d_f64::query::{ShapeCastOptions, cast_shapes};
@@ -150,6 +160,49 @@ fn bench(c: &mut Criterion) {
                 black_box(sweep_mesh(&s.ours, &s.sweeps[i], &options).ok())
             })
         });
+        let mut i = 0usize;
+        group.bench_with_input(
+            BenchmarkId::new("explained-primary", s.triangles),
+            &s,
+            |b, s| {
+                b.iter(|| {
+                    i = (i + 1) % SWEEPS;
+                    let mut collect = CollectPrimary::default();
+                    let outcome = sweep_mesh_with(
+                        &s.ours,
+                        &s.sweeps[i],
+                        &options,
+                        Broadphase::Bvh,
+                        &mut collect,
+                    )
+                    .ok()?;
+                    let verdicts = collect.verdict_counts();
+                    black_box((collect.into_primary_records(&outcome), verdicts));
+                    Some(())
+                })
+            },
+        );
+        let mut i = 0usize;
+        group.bench_with_input(
+            BenchmarkId::new("explained-every-record", s.triangles),
+            &s,
+            |b, s| {
+                b.iter(|| {
+                    i = (i + 1) % SWEEPS;
+                    let mut collect = CollectRecords::default();
+                    let outcome = sweep_mesh_with(
+                        &s.ours,
+                        &s.sweeps[i],
+                        &options,
+                        Broadphase::Bvh,
+                        &mut collect,
+                    )
+                    .ok()?;
+                    black_box(primary_records(&outcome, collect.records));
+                    Some(())
+                })
+            },
+        );
         let mut i = 0usize;
         group.bench_with_input(BenchmarkId::new("parry", s.triangles), &s, |b, s| {
             b.iter(|| {

@@ -31,6 +31,7 @@ use crate::trial;
 pub fn tests() -> Vec<Trial> {
     vec![
         trial!(outcomes_equal_sweep_mesh),
+        trial!(spilled_recording_holds_the_same_rows),
         trial!(outcomes_equal_without_explanation),
         trial!(frame_and_ball_filters),
         trial!(frame_range_parsing),
@@ -1757,14 +1758,7 @@ fn flush_by_bytes_keeps_the_content() -> Result<(), String> {
         if let Some(bytes) = flush_bytes {
             logger = logger.with_flush_bytes(bytes);
         }
-        for e in replay_events(
-            events_for(cube_scene(), &sweeps).into_iter(),
-            explained(Detail::Primary),
-        ) {
-            logger
-                .log(&e.map_err(|e| e.to_string())?)
-                .map_err(|e| e.to_string())?;
-        }
+        log_cube_sweeps(&mut logger, &sweeps)?;
         logger.flush().map_err(|e| e.to_string())?;
         drop(logger.finish());
         Ok(())
@@ -1801,6 +1795,145 @@ fn flush_by_bytes_keeps_the_content() -> Result<(), String> {
     Ok(())
 }
 
+/// Replays `sweeps` against the cube scene (explained, `primary`) into
+/// `logger`.
+fn log_cube_sweeps(logger: &mut viz::Logger, sweeps: &[SweepMsg]) -> Result<(), String> {
+    for e in replay_events(
+        events_for(cube_scene(), sweeps).into_iter(),
+        explained(Detail::Primary),
+    ) {
+        logger
+            .log(&e.map_err(|e| e.to_string())?)
+            .map_err(|e| e.to_string())?;
+    }
+    Ok(())
+}
+
+/// A recording's rows: entity, row id, `frame`, `time`, component and its
+/// values (as text).
+type Rows = std::collections::BTreeSet<(String, String, i64, i64, String, String)>;
+
+/// Every row of a recording, whatever the chunks they came in.
+fn rows_of_rrd(path: &std::path::Path) -> Result<Rows, String> {
+    use rerun::external::arrow::array::Array as _;
+    let mut rows = std::collections::BTreeSet::new();
+    for m in rrd_messages(path)? {
+        let Message::Chunk(store, _, chunk) = m else {
+            continue;
+        };
+        if store.kind() != rerun::StoreKind::Recording {
+            continue;
+        }
+        let entity = chunk.entity_path().to_string();
+        let ids: Vec<String> = chunk.row_ids().map(|r| r.to_string()).collect();
+        let index = |name: &'static str| -> Vec<i64> {
+            if chunk.is_static() {
+                vec![i64::MIN; chunk.num_rows()]
+            } else {
+                chunk
+                    .iter_indices(&name.into())
+                    .map(|(t, _)| t.as_i64())
+                    .collect()
+            }
+        };
+        let (frames, times) = (index("frame"), index("time"));
+        for (descriptor, list) in chunk
+            .components()
+            .component_descriptors()
+            .zip(chunk.components().list_arrays())
+        {
+            for row in 0..list.len() {
+                rows.insert((
+                    entity.clone(),
+                    ids[row].clone(),
+                    frames[row],
+                    times[row],
+                    descriptor.to_string(),
+                    format!("{:?}", list.value(row)),
+                ));
+            }
+        }
+    }
+    Ok(rows)
+}
+
+/// A recording whose rows waited in the temporary file (`with_spill`, what
+/// `replay --rrd FILE` does) holds the same rows as one sent at each flush,
+/// in fewer, longer chunks (at most `MAX_CHUNK_ROWS` rows each).
+fn spilled_recording_holds_the_same_rows() -> Result<(), String> {
+    let dir = tempfile::tempdir().map_err(|e| e.to_string())?;
+    let sweeps = random_sweeps(14, 60, 5);
+    let write = |path: &std::path::Path, spill: bool| -> Result<(), String> {
+        let (sink, writer) =
+            viz::rrd_file::create(path, viz::rrd_file::RrdFileOptions { footer: true })
+                .map_err(|e| e.to_string())?;
+        let id = viz::recording_id(&[b"spill"]);
+        let rec = viz::builder(&id, "test")
+            .set_sinks(vec![Box::new(sink) as Box<dyn rerun::sink::LogSink>])
+            .map_err(|e| e.to_string())?;
+        // A flush every few sweeps: many parts per entity.
+        let mut logger = viz::Logger::new(rec, true)
+            .map_err(|e| e.to_string())?
+            .with_flush_rows(100);
+        if spill {
+            logger = logger
+                .with_spill(dir.path(), path)
+                .map_err(|e| e.to_string())?;
+        }
+        log_cube_sweeps(&mut logger, &sweeps)?;
+        logger.send_all().map_err(|e| e.to_string())?;
+        drop(logger.finish());
+        writer.finish().map_err(|e| e.to_string())?;
+        Ok(())
+    };
+    let direct = dir.path().join("direct.rrd");
+    let spilled = dir.path().join("spilled.rrd");
+    write(&direct, false)?;
+    write(&spilled, true)?;
+    let leftovers: Vec<_> = std::fs::read_dir(dir.path())
+        .map_err(|e| e.to_string())?
+        .filter_map(|e| e.ok())
+        .map(|e| e.file_name())
+        .filter(|n| n != "direct.rrd" && n != "spilled.rrd")
+        .collect();
+    ensure!(leftovers.is_empty(), "left behind: {leftovers:?}");
+    let (a, b) = (rows_of_rrd(&direct)?, rows_of_rrd(&spilled)?);
+    ensure!(a.len() > 1000, "only {} rows", a.len());
+    if a != b {
+        let only_a = a.difference(&b).next();
+        let only_b = b.difference(&a).next();
+        return Err(format!(
+            "the rows differ: only sent directly {only_a:?}, only spilled {only_b:?}"
+        ));
+    }
+    let chunks = |path: &std::path::Path| -> Result<Vec<usize>, String> {
+        Ok(rrd_messages(path)?
+            .iter()
+            .filter_map(|m| match m {
+                Message::Chunk(store, _, chunk)
+                    if store.kind() == rerun::StoreKind::Recording && !chunk.is_static() =>
+                {
+                    Some(chunk.num_rows())
+                }
+                _ => None,
+            })
+            .collect())
+    };
+    let (direct_chunks, spilled_chunks) = (chunks(&direct)?, chunks(&spilled)?);
+    ensure!(
+        spilled_chunks.len() * 3 < direct_chunks.len(),
+        "{} chunks spilled, {} sent directly: the parts were not joined",
+        spilled_chunks.len(),
+        direct_chunks.len()
+    );
+    ensure!(
+        spilled_chunks.iter().all(|n| *n <= viz::MAX_CHUNK_ROWS),
+        "a spilled chunk has more than {} rows",
+        viz::MAX_CHUNK_ROWS
+    );
+    Ok(())
+}
+
 /// The `.rrd` writer adds the footer (the index of every chunk, built in
 /// memory until the end) only when asked: the file with it is larger by
 /// that index, and both hold the same recording.
@@ -1815,14 +1948,7 @@ fn rrd_footer_only_when_asked() -> Result<(), String> {
             .set_sinks(vec![Box::new(sink) as Box<dyn rerun::sink::LogSink>])
             .map_err(|e| e.to_string())?;
         let mut logger = viz::Logger::new(rec, true).map_err(|e| e.to_string())?;
-        for e in replay_events(
-            events_for(cube_scene(), &sweeps).into_iter(),
-            explained(Detail::Primary),
-        ) {
-            logger
-                .log(&e.map_err(|e| e.to_string())?)
-                .map_err(|e| e.to_string())?;
-        }
+        log_cube_sweeps(&mut logger, &sweeps)?;
         logger.flush().map_err(|e| e.to_string())?;
         drop(logger.finish());
         writer.finish().map_err(|e| e.to_string())?;

@@ -248,8 +248,24 @@ pub fn run(args: Args) -> anyhow::Result<RunOutcome> {
             },
             flush_timeout: (args.spawn || args.connect.is_some()).then_some(VIEWER_FLUSH_TIMEOUT),
         };
-        logger =
-            Some(viz::Logger::with_options(rec, logger_options).context("starting the recording")?);
+        let mut l =
+            viz::Logger::with_options(rec, logger_options).context("starting the recording")?;
+        // To a file only: the rows wait in a temporary file beside it and
+        // go out at the end in long chunks (a live viewer would see nothing
+        // until then).
+        if let Some((pending, _)) = &rrd_file
+            && !args.spawn
+            && args.connect.is_none()
+        {
+            let dir = match pending.path().parent() {
+                Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
+                _ => std::path::PathBuf::from("."),
+            };
+            l = l
+                .with_spill(&dir, pending.target())
+                .context("starting the recording")?;
+        }
+        logger = Some(l);
     }
 
     // The outcomes.
@@ -370,7 +386,7 @@ pub fn run(args: Args) -> anyhow::Result<RunOutcome> {
     // Finish the files: the recording's footer is written when the last
     // clone of the stream is dropped.
     if let Some(mut l) = logger {
-        l.flush().context("logging the last frames")?;
+        l.send_all().context("logging the last frames")?;
         let rec = l.finish();
         if args.spawn || args.connect.is_some() {
             // A viewer that cannot be reached would make a blocking flush

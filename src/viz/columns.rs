@@ -38,7 +38,9 @@ use rerun::{
 };
 use rustc_hash::FxHashMap;
 
+use super::RecordError;
 use super::paths::Entity;
+use super::spill::Spill;
 use super::{FRAME_TIMELINE, TIME_TIMELINE};
 
 /// Time part of the ids: 2020-01-01T00:00:00Z in nanoseconds. Fixed, so
@@ -358,14 +360,36 @@ impl EntityColumns {
         }
     }
 
-    /// The chunk of the buffered rows, and the buffer emptied.
-    fn take_chunk(&mut self, id: ChunkId) -> Result<Option<Chunk>, RecordingStreamError> {
+    /// The buffered rows, taken out of the buffer (`None` when there are
+    /// none).
+    fn take_part(&mut self) -> Result<Option<Part>, RecordingStreamError> {
         if self.rows.is_empty() {
             return Ok(None);
         }
         let rows = self.rows.len();
         let frames = std::mem::replace(&mut self.frames, Vec::with_capacity(rows));
         let times = std::mem::replace(&mut self.times, Vec::with_capacity(rows));
+        let mut lists = Vec::with_capacity(self.columns.len());
+        for column in &mut self.columns {
+            lists.push(column.take_list()?);
+        }
+        let row_numbers = std::mem::replace(&mut self.rows, Vec::with_capacity(rows));
+        Ok(Some(Part {
+            frames,
+            times,
+            rows: row_numbers,
+            lists,
+        }))
+    }
+
+    /// The chunk of `part` (rows of this entity and set).
+    fn chunk(&mut self, id: ChunkId, part: Part) -> Result<Chunk, RecordingStreamError> {
+        let Part {
+            frames,
+            times,
+            rows,
+            lists,
+        } = part;
         let time_column = if self.key.timestamps {
             TimeColumn::new_timestamp_nanos_since_epoch(TIME_TIMELINE, times)
         } else {
@@ -378,14 +402,14 @@ impl EntityColumns {
         .into_iter()
         .map(|c| (*c.timeline().name(), c))
         .collect();
-        let mut components = Vec::with_capacity(self.columns.len());
-        for column in &mut self.columns {
-            let list = column.take_list()?;
-            components.push((column.descriptor().clone(), list));
-        }
-        let components: ChunkComponents = components.into_iter().collect();
-        let row_ids: Vec<RowId> = self.rows.drain(..).map(row_id).collect();
-        let chunk = Chunk::from_native_row_ids(
+        let components: ChunkComponents = self
+            .columns
+            .iter()
+            .map(|c| c.descriptor().clone())
+            .zip(lists)
+            .collect();
+        let row_ids: Vec<RowId> = rows.into_iter().map(row_id).collect();
+        Chunk::from_native_row_ids(
             id,
             self.path
                 .get_or_insert_with(|| EntityPath::from(self.key.entity.path()))
@@ -395,9 +419,22 @@ impl EntityColumns {
             timelines,
             components,
         )
-        .map_err(RecordingStreamError::Chunk)?;
-        Ok(Some(chunk))
+        .map_err(RecordingStreamError::Chunk)
     }
+}
+
+/// Rows of one entity and set taken out of the buffer, in the order they
+/// were logged: what a chunk is made of.
+#[derive(Debug)]
+pub(crate) struct Part {
+    /// `frame` of each row.
+    pub(crate) frames: Vec<i64>,
+    /// `time` of each row (nanoseconds).
+    pub(crate) times: Vec<i64>,
+    /// Number of each row (see [`row_id`]).
+    pub(crate) rows: Vec<u64>,
+    /// Each component's values, one list per row, in the set's order.
+    pub(crate) lists: Vec<ListArray>,
 }
 
 /// The row id of the `n`-th row (0-based).
@@ -536,16 +573,42 @@ impl Columns {
     /// they were first logged.
     pub fn send(&mut self, rec: &RecordingStream) -> Result<(), RecordingStreamError> {
         for i in 0..self.entities.len() {
-            if self.entities[i].rows.is_empty() {
-                continue;
-            }
-            let id = self.chunk_id();
-            if let Some(chunk) = self.entities[i].take_chunk(id)? {
-                rec.send_chunk(chunk);
+            if let Some(part) = self.entities[i].take_part()? {
+                let id = self.chunk_id();
+                rec.send_chunk(self.entities[i].chunk(id, part)?);
             }
         }
         self.rows = 0;
         Ok(())
+    }
+
+    /// Writes every buffered row to `spill`, one part per entity and set,
+    /// in the order they were first logged.
+    pub(crate) fn spill(&mut self, spill: &mut Spill) -> Result<(), RecordError> {
+        for e in &mut self.entities {
+            if let Some(part) = e.take_part()? {
+                spill.put(e.key, part)?;
+            }
+        }
+        self.rows = 0;
+        Ok(())
+    }
+
+    /// Sends what `spill` holds (see [`Spill::drain`]), as chunks built like
+    /// those of [`Columns::send`].
+    pub(crate) fn send_spilled(
+        &mut self,
+        spill: &mut Spill,
+        rec: &RecordingStream,
+    ) -> Result<(), RecordError> {
+        spill.drain(|key, part| {
+            let Some(&i) = self.index.get(&key) else {
+                unreachable!("a spilled part comes from a buffered entity");
+            };
+            let id = self.chunk_id();
+            rec.send_chunk(self.entities[i].chunk(id, part)?);
+            Ok(())
+        })
     }
 }
 

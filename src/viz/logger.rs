@@ -3,6 +3,7 @@
 //! the logger, so that runs can be prepared in parallel.
 
 use std::collections::BTreeMap;
+use std::path::Path;
 use std::sync::Arc;
 
 use rerun::components::Radius;
@@ -20,7 +21,8 @@ use super::rows::{
     Out, PLOT_BITS, Shown, expected_rows, focus_rows, plot_entity, plot_rows, primary_rows,
     sweep_rows, text_rows, tunnel_rows,
 };
-use super::{MAX_EDGE_FRAMES, TIMESTAMP_THRESHOLD_NANOS};
+use super::spill::Spill;
+use super::{MAX_EDGE_FRAMES, RecordError, TIMESTAMP_THRESHOLD_NANOS};
 use crate::core::{EdgeRecord, Triangle};
 use crate::regress::Tolerances;
 use crate::regress::decision::divergence;
@@ -144,6 +146,9 @@ pub struct Logger {
     divergent: u64,
     /// Tunnels logged.
     tunnels: u64,
+    /// Where buffered rows go until the recording is finished, when it is
+    /// a file ([`Logger::with_spill`]).
+    spill: Option<Spill>,
     /// Emptied [`PreparedSweeps`], handed out again by
     /// [`Logger::spare_prepared`] so that their buffers are reused.
     spare: Vec<PreparedSweeps>,
@@ -317,6 +322,7 @@ impl Logger {
             flush_bytes: DEFAULT_FLUSH_BYTES,
             divergent: 0,
             tunnels: 0,
+            spill: None,
             spare: Vec::new(),
         };
         logger.log_static(paths::WORLD, &ViewCoordinates::RIGHT_HAND_Z_UP())?;
@@ -368,9 +374,33 @@ impl Logger {
         self.tunnels
     }
 
-    /// Sends every buffered row.
-    pub fn flush(&mut self) -> Result<(), RecordingStreamError> {
-        self.columns.send(&self.rec)
+    /// Keeps the buffered rows in an anonymous temporary file in `dir`
+    /// until the end ([`Logger::send_all`]), and then sends them joined into
+    /// long chunks (see `spill`): for a recording that goes to the file
+    /// `recording` only (a viewer would see nothing until the end; errors
+    /// name `recording`). The temporary file disappears with the process.
+    pub fn with_spill(mut self, dir: &Path, recording: &Path) -> Result<Logger, RecordError> {
+        self.spill = Some(Spill::new(dir, recording)?);
+        Ok(self)
+    }
+
+    /// Sends every buffered row (to the temporary file with
+    /// [`Logger::with_spill`]).
+    pub fn flush(&mut self) -> Result<(), RecordError> {
+        match &mut self.spill {
+            Some(spill) => self.columns.spill(spill),
+            None => Ok(self.columns.send(&self.rec)?),
+        }
+    }
+
+    /// Sends every row logged so far to the stream, those held in the
+    /// temporary file included.
+    pub fn send_all(&mut self) -> Result<(), RecordError> {
+        self.flush()?;
+        if let Some(spill) = &mut self.spill {
+            self.columns.send_spilled(spill, &self.rec)?;
+        }
+        Ok(())
     }
 
     fn log_static(
@@ -388,9 +418,9 @@ impl Logger {
     }
 
     /// Logs one event.
-    pub fn log(&mut self, event: &ReplayEvent) -> Result<(), RecordingStreamError> {
+    pub fn log(&mut self, event: &ReplayEvent) -> Result<(), RecordError> {
         match event {
-            ReplayEvent::Scene(scene) => self.log_scene(scene),
+            ReplayEvent::Scene(scene) => Ok(self.log_scene(scene)?),
             ReplayEvent::Sweep(result) => self.log_sweep(result),
         }
     }
@@ -398,10 +428,10 @@ impl Logger {
     /// Sends what is buffered, flushes and hands the stream back (drop it,
     /// and every clone, to finish a file). When some sweep diverged from
     /// its expectation, first sends the layout that leads with the
-    /// divergences (and tunnels), as the active one. Use [`Logger::flush`] first to see
-    /// an error of the last rows.
+    /// divergences (and tunnels), as the active one. Use
+    /// [`Logger::send_all`] first to see an error of the last rows.
     pub fn finish(mut self) -> RecordingStream {
-        let _ = self.flush();
+        let _ = self.send_all();
         if self.options.blueprint && self.divergent + self.tunnels > 0 {
             // Every chunk before the second layout, so that the order of
             // the file's messages does not vary.
@@ -466,7 +496,7 @@ impl Logger {
     }
 
     /// Logs one sweep's result at its frame.
-    pub fn log_sweep(&mut self, r: &SweepResult) -> Result<(), RecordingStreamError> {
+    pub fn log_sweep(&mut self, r: &SweepResult) -> Result<(), RecordError> {
         let before = self.shown_before([r]);
         let prepared = prepare_sweeps([r], &before, &self.options.prepare);
         self.log_prepared(prepared)
@@ -487,7 +517,7 @@ impl Logger {
 
     /// Logs sweeps prepared by [`prepare_sweeps`] (sweeps must be logged in
     /// trace order).
-    pub fn log_prepared(&mut self, mut p: PreparedSweeps) -> Result<(), RecordingStreamError> {
+    pub fn log_prepared(&mut self, mut p: PreparedSweeps) -> Result<(), RecordError> {
         self.columns.append(&mut p.columns);
         self.divergent += std::mem::take(&mut p.divergent);
         self.tunnels += std::mem::take(&mut p.tunnels);

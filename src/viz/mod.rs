@@ -33,6 +33,7 @@ pub mod paths;
 pub mod pipeline;
 mod rows;
 pub mod rrd_file;
+mod spill;
 
 use rerun::RecordingStreamBuilder;
 
@@ -44,6 +45,7 @@ pub use logger::{
 };
 pub use rerun::RecordingStreamError;
 pub use rows::Shown;
+pub use spill::{MAX_CHUNK_BYTES, MAX_CHUNK_ROWS};
 
 /// Application id of every recording.
 pub const APPLICATION_ID: &str = "sweeptrace";
@@ -80,4 +82,51 @@ pub fn builder(recording_id: &str, name: &str) -> RecordingStreamBuilder {
             max_bytes_in_flight: MAX_BYTES_IN_FLIGHT,
             ..rerun::log::ChunkBatcherConfig::LOW_LATENCY
         })
+}
+
+/// Writing the recording failed.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum RecordError {
+    /// The Rerun SDK refused the data.
+    #[error("{}", crate::error_text::full_text(.cause))]
+    Stream {
+        /// The SDK's error.
+        cause: RecordingStreamError,
+    },
+    /// The temporary file that holds the rows until a recording file is
+    /// finished (see [`Logger::with_spill`]).
+    #[error(
+        "{doing} the temporary file of the recording {}: {}",
+        recording.display(),
+        crate::error_text::full_text(.cause)
+    )]
+    Spill {
+        /// The recording file it is for (it lies in the same directory).
+        recording: std::path::PathBuf,
+        /// What failed: "creating", "writing", "reading", "emptying".
+        doing: &'static str,
+        /// The error.
+        cause: std::io::Error,
+    },
+}
+
+impl From<RecordingStreamError> for RecordError {
+    fn from(cause: RecordingStreamError) -> RecordError {
+        RecordError::Stream { cause }
+    }
+}
+
+impl From<rerun::log::ChunkError> for RecordError {
+    fn from(cause: rerun::log::ChunkError) -> RecordError {
+        RecordError::Stream {
+            cause: RecordingStreamError::Chunk(cause),
+        }
+    }
+}
+
+impl From<rerun::external::arrow::error::ArrowError> for RecordError {
+    fn from(cause: rerun::external::arrow::error::ArrowError) -> RecordError {
+        rerun::log::ChunkError::Arrow(cause).into()
+    }
 }

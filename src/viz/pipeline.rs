@@ -17,7 +17,8 @@ use thiserror::Error;
 use crate::replay::{DEFAULT_BATCH_EVENTS, ReplayError, ReplayEvent, SweepResult};
 
 use super::{
-    Logger, PREPARE_GROUP_SWEEPS, PreparedSweeps, RecordingStreamError, Shown, prepare_sweeps_into,
+    Logger, PREPARE_GROUP_SWEEPS, PreparedSweeps, RecordError, RecordingStreamError, Shown,
+    prepare_sweeps_into,
 };
 
 /// Logging to the recording failed.
@@ -37,8 +38,8 @@ pub enum LogError {
     Sweeps {
         /// Frame of the run's first sweep.
         frame: u64,
-        /// The SDK's error.
-        cause: RecordingStreamError,
+        /// What failed.
+        cause: RecordError,
     },
 }
 

@@ -1,0 +1,244 @@
+//! Rows kept on disk until a recording file is finished, so that its chunks
+//! are long whatever the number of balls.
+//!
+//! The logger's buffer is bounded in bytes, and at each flush every entity
+//! and set of components that has rows gets a chunk; with many balls, the
+//! entities share the buffer and each chunk holds few rows. Every chunk
+//! costs the file its Arrow schema and the footer one row of its index
+//! (several KB of memory until the file is finished), so short chunks make
+//! the file larger and the footer's memory grow with the trace.
+//!
+//! When the recording goes to a file only, each flush's chunks are written
+//! here instead (Arrow IPC, to an anonymous temporary file next to the
+//! output, which disappears with the process however it ends), and
+//! [`Spill::drain`] sends them at the end, entity after entity, joined into
+//! chunks of up to [`MAX_CHUNK_ROWS`] rows and [`MAX_CHUNK_BYTES`] bytes
+//! (the viewer's own compaction thresholds). Memory: one entity's pending
+//! chunk and the index of the parts (16 bytes each). The rows, their ids and
+//! their times are unchanged; only the chunking and the order of the
+//! chunks in the file differ (the viewer orders rows by time, and rows of
+//! equal time by row id).
+
+use std::collections::hash_map::Entry;
+use std::fs::File;
+use std::io::{self, BufWriter, Read, Seek, SeekFrom, Write};
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+use rerun::external::arrow::array::{
+    Array, ArrayRef, AsArray, Int64Array, ListArray, RecordBatch, UInt64Array,
+};
+use rerun::external::arrow::compute::concat_batches;
+use rerun::external::arrow::datatypes::{DataType, Field, Int64Type, Schema, UInt64Type};
+use rerun::external::arrow::ipc::reader::StreamReader;
+use rerun::external::arrow::ipc::writer::StreamWriter;
+use rustc_hash::FxHashMap;
+
+use super::RecordError;
+use super::columns::{Key, Part};
+
+/// At most this many rows per chunk sent by [`Spill::drain`] (the viewer
+/// store's default `chunk_max_rows`).
+pub const MAX_CHUNK_ROWS: usize = 4096;
+
+/// About this many bytes per chunk at most (the viewer store's default
+/// `chunk_max_bytes`, 384 KiB; a chunk is closed at the first part that
+/// reaches it).
+pub const MAX_CHUNK_BYTES: usize = 384 << 10;
+
+/// Parts of chunks written to a temporary file, by entity and set of
+/// components.
+#[derive(Debug)]
+pub(crate) struct Spill {
+    /// The recording file it is for (for messages).
+    recording: PathBuf,
+    file: BufWriter<File>,
+    /// Bytes written so far.
+    written: u64,
+    /// The keys in the order they first came.
+    order: Vec<Key>,
+    /// Offset and length of each part, by key.
+    parts: FxHashMap<Key, Vec<(u64, u64)>>,
+    /// Scratch: one part's bytes.
+    buf: Vec<u8>,
+}
+
+impl Spill {
+    /// A spill in an anonymous temporary file in `dir`, for the recording
+    /// file `recording`.
+    pub(crate) fn new(dir: &Path, recording: &Path) -> Result<Spill, RecordError> {
+        let file = tempfile::tempfile_in(dir).map_err(|cause| RecordError::Spill {
+            recording: recording.to_path_buf(),
+            doing: "creating",
+            cause,
+        })?;
+        Ok(Spill {
+            recording: recording.to_path_buf(),
+            file: BufWriter::with_capacity(1 << 20, file),
+            written: 0,
+            order: Vec::new(),
+            parts: FxHashMap::default(),
+            buf: Vec::new(),
+        })
+    }
+
+    fn error(&self, doing: &'static str, cause: io::Error) -> RecordError {
+        RecordError::Spill {
+            recording: self.recording.clone(),
+            doing,
+            cause,
+        }
+    }
+
+    /// Writes `part`, rows of `key` (later than every part of `key` written
+    /// before).
+    pub(crate) fn put(&mut self, key: Key, part: Part) -> Result<(), RecordError> {
+        let batch = to_batch(part)?;
+        self.buf.clear();
+        {
+            let mut w = StreamWriter::try_new(&mut self.buf, &batch.schema())?;
+            w.write(&batch)?;
+            w.finish()?;
+        }
+        let len = self.buf.len() as u64;
+        let offset = self.written;
+        if let Err(cause) = self.file.write_all(&self.buf) {
+            return Err(self.error("writing", cause));
+        }
+        self.written += len;
+        match self.parts.entry(key) {
+            Entry::Occupied(mut e) => e.get_mut().push((offset, len)),
+            Entry::Vacant(e) => {
+                self.order.push(key);
+                e.insert(vec![(offset, len)]);
+            }
+        }
+        Ok(())
+    }
+
+    /// Hands every part written to `send`, key after key in the order they
+    /// first came, joined into parts of at most [`MAX_CHUNK_ROWS`] rows and
+    /// about [`MAX_CHUNK_BYTES`] bytes; empties the spill (its file is
+    /// reused).
+    pub(crate) fn drain(
+        &mut self,
+        mut send: impl FnMut(Key, Part) -> Result<(), RecordError>,
+    ) -> Result<(), RecordError> {
+        if let Err(cause) = self.file.flush() {
+            return Err(self.error("writing", cause));
+        }
+        let order = std::mem::take(&mut self.order);
+        let mut parts = std::mem::take(&mut self.parts);
+        let mut pending: Vec<RecordBatch> = Vec::new();
+        let (mut rows, mut bytes) = (0usize, 0usize);
+        for key in order {
+            for (offset, len) in parts.remove(&key).unwrap_or_default() {
+                let batch = self.read(offset, len)?;
+                if rows > 0
+                    && (rows + batch.num_rows() > MAX_CHUNK_ROWS || bytes >= MAX_CHUNK_BYTES)
+                {
+                    send(key, joined(&mut pending)?)?;
+                    (rows, bytes) = (0, 0);
+                }
+                rows += batch.num_rows();
+                bytes += batch.get_array_memory_size();
+                pending.push(batch);
+            }
+            if rows > 0 {
+                send(key, joined(&mut pending)?)?;
+                (rows, bytes) = (0, 0);
+            }
+        }
+        let file = self.file.get_mut();
+        let emptied = file.set_len(0).and_then(|()| file.seek(SeekFrom::Start(0)));
+        if let Err(cause) = emptied {
+            return Err(self.error("emptying", cause));
+        }
+        self.written = 0;
+        Ok(())
+    }
+
+    /// The part written at `offset`, as a record batch.
+    fn read(&mut self, offset: u64, len: u64) -> Result<RecordBatch, RecordError> {
+        let file = self.file.get_mut();
+        let buf = &mut self.buf;
+        let read = (|| {
+            file.seek(SeekFrom::Start(offset))?;
+            buf.clear();
+            Read::by_ref(file).take(len).read_to_end(buf)?;
+            if buf.len() as u64 != len {
+                return Err(io::Error::new(
+                    io::ErrorKind::UnexpectedEof,
+                    "the file is shorter than what was written to it",
+                ));
+            }
+            // Later writes go to the end.
+            file.seek(SeekFrom::End(0))?;
+            Ok(())
+        })();
+        if let Err(cause) = read {
+            return Err(self.error("reading", cause));
+        }
+        let mut reader = StreamReader::try_new(&self.buf[..], None)?;
+        match reader.next() {
+            Some(batch) => Ok(batch?),
+            None => Err(self.error(
+                "reading",
+                io::Error::new(io::ErrorKind::InvalidData, "a part is missing"),
+            )),
+        }
+    }
+}
+
+/// A part as a record batch: columns `frame`, `time`, `row`, then one per
+/// component (its lists).
+fn to_batch(part: Part) -> Result<RecordBatch, RecordError> {
+    let Part {
+        frames,
+        times,
+        rows,
+        lists,
+    } = part;
+    let mut fields = vec![
+        Field::new("frame", DataType::Int64, false),
+        Field::new("time", DataType::Int64, false),
+        Field::new("row", DataType::UInt64, false),
+    ];
+    let mut columns: Vec<ArrayRef> = vec![
+        Arc::new(Int64Array::from(frames)),
+        Arc::new(Int64Array::from(times)),
+        Arc::new(UInt64Array::from(rows)),
+    ];
+    for (i, list) in lists.into_iter().enumerate() {
+        fields.push(Field::new(format!("c{i}"), list.data_type().clone(), true));
+        columns.push(Arc::new(list));
+    }
+    Ok(RecordBatch::try_new(
+        Arc::new(Schema::new(fields)),
+        columns,
+    )?)
+}
+
+/// The parts in `pending` (rows of one key, in order) as one; empties
+/// `pending`.
+fn joined(pending: &mut Vec<RecordBatch>) -> Result<Part, RecordError> {
+    let batch = match pending.len() {
+        1 => pending[0].clone(),
+        _ => concat_batches(&pending[0].schema(), pending.iter())?,
+    };
+    pending.clear();
+    let columns = batch.columns();
+    let frames = columns[0].as_primitive::<Int64Type>().values().to_vec();
+    let times = columns[1].as_primitive::<Int64Type>().values().to_vec();
+    let rows = columns[2].as_primitive::<UInt64Type>().values().to_vec();
+    let lists = columns[3..]
+        .iter()
+        .map(|c| c.as_list::<i32>().clone())
+        .collect::<Vec<ListArray>>();
+    Ok(Part {
+        frames,
+        times,
+        rows,
+        lists,
+    })
+}

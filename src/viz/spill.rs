@@ -12,8 +12,8 @@
 //! here instead (Arrow IPC, to an anonymous temporary file next to the
 //! output, which disappears with the process however it ends), and
 //! [`Spill::drain`] sends them at the end, entity after entity, joined into
-//! chunks of up to [`MAX_CHUNK_ROWS`] rows and [`MAX_CHUNK_BYTES`] bytes
-//! (the viewer's own compaction thresholds). Memory: one entity's pending
+//! chunks of up to [`MAX_CHUNK_ROWS`] rows and [`MAX_CHUNK_BYTES`] bytes.
+//! Memory: one entity's pending
 //! chunk and the index of the parts (16 bytes each). The rows, their ids and
 //! their times are unchanged; only the chunking and the order of the
 //! chunks in the file differ (the viewer orders rows by time, and rows of
@@ -37,14 +37,18 @@ use rustc_hash::FxHashMap;
 use super::RecordError;
 use super::columns::{Key, Part};
 
-/// At most this many rows per chunk sent by [`Spill::drain`] (the viewer
-/// store's default `chunk_max_rows`).
-pub const MAX_CHUNK_ROWS: usize = 4096;
+/// At most this many rows per chunk sent by [`Spill::drain`].
+pub const MAX_CHUNK_ROWS: usize = 16384;
 
-/// About this many bytes per chunk at most (the viewer store's default
-/// `chunk_max_bytes`, 384 KiB; a chunk is closed at the first part that
-/// reaches it).
-pub const MAX_CHUNK_BYTES: usize = 384 << 10;
+/// About this many bytes per chunk at most (a chunk is closed at the first
+/// part that reaches it).
+///
+/// Both are above the viewer store's compaction thresholds (4,096 rows,
+/// 384 KiB), which only say how far the viewer merges small chunks: the
+/// footer's index costs several KB per chunk until the file is finished
+/// (one row of a column per entity and component), so fewer, longer chunks
+/// keep that memory small.
+pub const MAX_CHUNK_BYTES: usize = 2 << 20;
 
 /// Parts of chunks written to a temporary file, by entity and set of
 /// components.

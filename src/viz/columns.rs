@@ -79,6 +79,18 @@ pub(crate) struct Key {
     timestamps: bool,
 }
 
+#[cfg(test)]
+impl Key {
+    /// The key of `entity`'s set `set` with durations on `time`.
+    pub(crate) fn for_test(entity: Entity, set: u8) -> Key {
+        Key {
+            entity,
+            set,
+            timestamps: false,
+        }
+    }
+}
+
 /// One component's values over the buffered rows.
 trait Column: Send + fmt::Debug {
     fn descriptor(&self) -> &ComponentDescriptor;

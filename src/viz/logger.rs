@@ -41,6 +41,14 @@ pub const DEFAULT_FLUSH_ROWS: usize = 1 << 20;
 /// in the file besides its rows (schema, footer entry).
 pub const DEFAULT_FLUSH_BYTES: usize = 32 << 20;
 
+/// [`DEFAULT_FLUSH_BYTES`] of a logger that spills ([`Logger::with_spill`]):
+/// its parts are joined into long chunks at the end, so the buffer's size no
+/// longer sets the chunks' length, only how often the buffer is written
+/// out. On the 64-ball session of BENCHMARKS.md, 8 MiB gave 151 MB of max
+/// RSS and 8.8-9.1 s, 16 MiB 176 MB and 8.4-8.7 s, 32 MiB 224 MB and
+/// 7.5-7.7 s (each flush writes one part per entity and set).
+pub const SPILL_FLUSH_BYTES: usize = 16 << 20;
+
 /// Sweeps per [`PreparedSweeps`] that the command and the bench prepare on
 /// one worker (runs of consecutive sweeps of a batch, cut at this length).
 pub const PREPARE_GROUP_SWEEPS: usize = 1024;
@@ -379,8 +387,12 @@ impl Logger {
     /// long chunks (see `spill`): for a recording that goes to the file
     /// `recording` only (a viewer would see nothing until the end; errors
     /// name `recording`). The temporary file disappears with the process.
+    ///
+    /// The buffer is then sent at [`SPILL_FLUSH_BYTES`] (call
+    /// [`Logger::with_flush_bytes`] after this to choose another bound).
     pub fn with_spill(mut self, dir: &Path, recording: &Path) -> Result<Logger, RecordError> {
         self.spill = Some(Spill::new(dir, recording)?);
+        self.flush_bytes = SPILL_FLUSH_BYTES;
         Ok(self)
     }
 

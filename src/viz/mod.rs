@@ -41,7 +41,7 @@ pub use crate::regress::decision::{decision_line, divergence};
 pub use ids::{IdHasher, recording_id};
 pub use logger::{
     DEFAULT_FLUSH_BYTES, DEFAULT_FLUSH_ROWS, Logger, LoggerOptions, PREPARE_GROUP_SWEEPS,
-    PrepareOptions, PreparedSweeps, prepare_sweeps, prepare_sweeps_into,
+    PrepareOptions, PreparedSweeps, SPILL_FLUSH_BYTES, prepare_sweeps, prepare_sweeps_into,
 };
 pub use rerun::RecordingStreamError;
 pub use rows::Shown;

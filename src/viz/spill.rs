@@ -65,6 +65,8 @@ pub(crate) struct Spill {
     parts: FxHashMap<Key, Vec<(u64, u64)>>,
     /// Scratch: one part's bytes.
     buf: Vec<u8>,
+    /// [`MAX_CHUNK_ROWS`] (smaller in tests).
+    max_rows: usize,
 }
 
 impl Spill {
@@ -83,6 +85,7 @@ impl Spill {
             order: Vec::new(),
             parts: FxHashMap::default(),
             buf: Vec::new(),
+            max_rows: MAX_CHUNK_ROWS,
         })
     }
 
@@ -137,16 +140,22 @@ impl Spill {
         let (mut rows, mut bytes) = (0usize, 0usize);
         for key in order {
             for (offset, len) in parts.remove(&key).unwrap_or_default() {
-                let batch = self.read(offset, len)?;
-                if rows > 0
-                    && (rows + batch.num_rows() > MAX_CHUNK_ROWS || bytes >= MAX_CHUNK_BYTES)
-                {
-                    send(key, joined(&mut pending)?)?;
-                    (rows, bytes) = (0, 0);
+                let whole = self.read(offset, len)?;
+                // A part longer than a chunk is cut (slices share its
+                // buffers).
+                let mut start = 0;
+                while start < whole.num_rows() {
+                    let n = (whole.num_rows() - start).min(self.max_rows);
+                    let batch = whole.slice(start, n);
+                    start += n;
+                    if rows > 0 && (rows + n > self.max_rows || bytes >= MAX_CHUNK_BYTES) {
+                        send(key, joined(&mut pending)?)?;
+                        (rows, bytes) = (0, 0);
+                    }
+                    rows += n;
+                    bytes += batch.get_array_memory_size() * n / whole.num_rows();
+                    pending.push(batch);
                 }
-                rows += batch.num_rows();
-                bytes += batch.get_array_memory_size();
-                pending.push(batch);
             }
             if rows > 0 {
                 send(key, joined(&mut pending)?)?;
@@ -226,10 +235,8 @@ fn to_batch(part: Part) -> Result<RecordBatch, RecordError> {
 /// The parts in `pending` (rows of one key, in order) as one; empties
 /// `pending`.
 fn joined(pending: &mut Vec<RecordBatch>) -> Result<Part, RecordError> {
-    let batch = match pending.len() {
-        1 => pending[0].clone(),
-        _ => concat_batches(&pending[0].schema(), pending.iter())?,
-    };
+    // Always a copy: the rows of a part that was cut are a slice of it.
+    let batch = concat_batches(&pending[0].schema(), pending.iter())?;
     pending.clear();
     let columns = batch.columns();
     let frames = columns[0].as_primitive::<Int64Type>().values().to_vec();
@@ -245,4 +252,117 @@ fn joined(pending: &mut Vec<RecordBatch>) -> Result<Part, RecordError> {
         rows,
         lists,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use std::sync::Arc;
+
+    use rerun::external::arrow::array::{AsArray, Int64Array, ListArray};
+    use rerun::external::arrow::buffer::OffsetBuffer;
+    use rerun::external::arrow::datatypes::{Field, Int64Type};
+
+    use super::{Part, Spill};
+    use crate::viz::columns::Key;
+    use crate::viz::paths::Entity;
+
+    /// Rows `from..to`, each with `row % 3` values (0, 1 or 2).
+    fn part(from: u64, to: u64) -> Part {
+        let lengths: Vec<usize> = (from..to).map(|r| (r % 3) as usize).collect();
+        let values: Vec<i64> = (from..to)
+            .flat_map(|r| (0..r % 3).map(move |k| (r * 10 + k) as i64))
+            .collect();
+        let list = ListArray::new(
+            Arc::new(Field::new_list_field(
+                rerun::external::arrow::datatypes::DataType::Int64,
+                true,
+            )),
+            OffsetBuffer::from_lengths(lengths),
+            Arc::new(Int64Array::from(values)),
+            None,
+        );
+        Part {
+            frames: (from..to).map(|r| r as i64 / 4).collect(),
+            times: (from..to).map(|r| r as i64 * 1000).collect(),
+            rows: (from..to).collect(),
+            lists: vec![list],
+        }
+    }
+
+    /// The rows of `parts` as (row, frame, time, values).
+    fn flat(parts: &[Part]) -> Vec<(u64, i64, i64, Vec<i64>)> {
+        let mut out = Vec::new();
+        for p in parts {
+            for i in 0..p.rows.len() {
+                let v = p.lists[0].value(i);
+                let v = v.as_primitive::<Int64Type>().values().to_vec();
+                out.push((p.rows[i], p.frames[i], p.times[i], v));
+            }
+        }
+        out
+    }
+
+    /// Parts of two keys, interleaved and of uneven lengths, some longer
+    /// than a chunk, come back per key in order, whole, joined or cut into
+    /// chunks of at most the limit, and the file is reusable.
+    #[test]
+    fn parts_come_back_per_key_joined_and_cut() {
+        let dir = tempfile::tempdir().unwrap();
+        let mut spill = Spill::new(dir.path(), &dir.path().join("x.rrd")).unwrap();
+        spill.max_rows = 10;
+        let (a, b) = (
+            Key::for_test(Entity::Log, 0),
+            Key::for_test(Entity::Divergences, 0),
+        );
+        let cuts_a = [0u64, 3, 7, 30, 31, 40];
+        let cuts_b = [100u64, 104, 125];
+        for round in 0..2 {
+            let (mut ia, mut ib) = (cuts_a.windows(2), cuts_b.windows(2));
+            loop {
+                let (wa, wb) = (ia.next(), ib.next());
+                if wa.is_none() && wb.is_none() {
+                    break;
+                }
+                if let Some(w) = wa {
+                    spill.put(a, part(w[0], w[1])).unwrap();
+                }
+                if let Some(w) = wb {
+                    spill.put(b, part(w[0], w[1])).unwrap();
+                }
+            }
+            let mut got: Vec<(Key, Part)> = Vec::new();
+            spill
+                .drain(|k, p| {
+                    got.push((k, p));
+                    Ok(())
+                })
+                .unwrap();
+            let of = |k: Key| -> Vec<Part> {
+                got.iter()
+                    .filter(|(g, _)| *g == k)
+                    .map(|(_, p)| Part {
+                        frames: p.frames.clone(),
+                        times: p.times.clone(),
+                        rows: p.rows.clone(),
+                        lists: p.lists.clone(),
+                    })
+                    .collect()
+            };
+            assert!(got.iter().all(|(_, p)| p.rows.len() <= 10), "round {round}");
+            assert_eq!(flat(&of(a)), flat(&[part(0, 40)]), "round {round}");
+            assert_eq!(flat(&of(b)), flat(&[part(100, 125)]), "round {round}");
+            // Key a's chunks before key b's, each key's in order.
+            let first_b = got.iter().position(|(k, _)| *k == b).unwrap();
+            assert!(got[..first_b].iter().all(|(k, _)| *k == a));
+            // Joined as far as the limit allows: no two neighbours would fit
+            // in one chunk.
+            for k in [a, b] {
+                let lengths: Vec<usize> = of(k).iter().map(|p| p.rows.len()).collect();
+                assert!(
+                    lengths.windows(2).all(|w| w[0] + w[1] > 10),
+                    "round {round}: {lengths:?}"
+                );
+            }
+        }
+    }
 }

@@ -317,7 +317,7 @@ pub fn run(args: Args) -> anyhow::Result<RunOutcome> {
         inner: BufReader::with_capacity(1 << 16, file),
         count: count.clone(),
     };
-    let progress = progress_bar(total_bytes);
+    let progress = progress_bar(total_bytes, "replaying");
     // Decode on a thread of its own, so reading overlaps the core's work.
     let read_ahead = prefetch(
         TraceReader::new_indexed(reader, &source_name),
@@ -386,7 +386,13 @@ pub fn run(args: Args) -> anyhow::Result<RunOutcome> {
     // Finish the files: the recording's footer is written when the last
     // clone of the stream is dropped.
     if let Some(mut l) = logger {
-        l.send_all().context("logging the last frames")?;
+        let writing = progress_bar(0, "writing the recording");
+        l.send_all_with(|done, total| {
+            writing.set_length(total);
+            writing.set_position(done);
+        })
+        .context("logging the last frames")?;
+        writing.finish_and_clear();
         let rec = l.finish();
         if args.spawn || args.connect.is_some() {
             // A viewer that cannot be reached would make a blocking flush
@@ -455,14 +461,16 @@ pub fn run(args: Args) -> anyhow::Result<RunOutcome> {
     Ok(RunOutcome::Success)
 }
 
-fn progress_bar(total_bytes: u64) -> ProgressBar {
+/// A progress bar on stderr (hidden when stderr is not a terminal): `what`,
+/// then the bar, bytes and time left.
+fn progress_bar(total_bytes: u64, what: &str) -> ProgressBar {
     if !std::io::stderr().is_terminal() {
         return ProgressBar::hidden();
     }
     let bar = ProgressBar::with_draw_target(Some(total_bytes), ProgressDrawTarget::stderr());
-    if let Ok(style) =
-        ProgressStyle::with_template("{spinner} replaying [{bar:40}] {bytes}/{total_bytes} ({eta})")
-    {
+    if let Ok(style) = ProgressStyle::with_template(&format!(
+        "{{spinner}} {what} [{{bar:40}}] {{bytes}}/{{total_bytes}} ({{eta}})"
+    )) {
         bar.set_style(style.progress_chars("=> "));
     }
     bar

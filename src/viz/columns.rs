@@ -612,15 +612,19 @@ impl Columns {
         &mut self,
         spill: &mut Spill,
         rec: &RecordingStream,
+        progress: impl FnMut(u64, u64),
     ) -> Result<(), RecordError> {
-        spill.drain(|key, part| {
-            let Some(&i) = self.index.get(&key) else {
-                unreachable!("a spilled part comes from a buffered entity");
-            };
-            let id = self.chunk_id();
-            rec.send_chunk(self.entities[i].chunk(id, part)?);
-            Ok(())
-        })
+        spill.drain(
+            |key, part| {
+                let Some(&i) = self.index.get(&key) else {
+                    unreachable!("a spilled part comes from a buffered entity");
+                };
+                let id = self.chunk_id();
+                rec.send_chunk(self.entities[i].chunk(id, part)?);
+                Ok(())
+            },
+            progress,
+        )
     }
 }
 

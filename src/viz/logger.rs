@@ -408,9 +408,16 @@ impl Logger {
     /// Sends every row logged so far to the stream, those held in the
     /// temporary file included.
     pub fn send_all(&mut self) -> Result<(), RecordError> {
+        self.send_all_with(|_, _| {})
+    }
+
+    /// [`Logger::send_all`], telling `progress` the bytes of the temporary
+    /// file read back so far and their total (not called without
+    /// [`Logger::with_spill`]).
+    pub fn send_all_with(&mut self, progress: impl FnMut(u64, u64)) -> Result<(), RecordError> {
         self.flush()?;
         if let Some(spill) = &mut self.spill {
-            self.columns.send_spilled(spill, &self.rec)?;
+            self.columns.send_spilled(spill, &self.rec, progress)?;
         }
         Ok(())
     }

@@ -127,10 +127,16 @@ impl Spill {
     /// first came, joined into parts of at most [`MAX_CHUNK_ROWS`] rows and
     /// about [`MAX_CHUNK_BYTES`] bytes; empties the spill (its file is
     /// reused).
+    ///
+    /// `progress` is told the bytes read back so far and the total, after
+    /// each part.
     pub(crate) fn drain(
         &mut self,
         mut send: impl FnMut(Key, Part) -> Result<(), RecordError>,
+        mut progress: impl FnMut(u64, u64),
     ) -> Result<(), RecordError> {
+        let total = self.written;
+        let mut done = 0;
         if let Err(cause) = self.file.flush() {
             return Err(self.error("writing", cause));
         }
@@ -141,6 +147,8 @@ impl Spill {
         for key in order {
             for (offset, len) in parts.remove(&key).unwrap_or_default() {
                 let whole = self.read(offset, len)?;
+                done += len;
+                progress(done, total);
                 // A part longer than a chunk is cut (slices share its
                 // buffers).
                 let mut start = 0;
@@ -331,12 +339,17 @@ mod tests {
                 }
             }
             let mut got: Vec<(Key, Part)> = Vec::new();
+            let mut last = (0, 0);
             spill
-                .drain(|k, p| {
-                    got.push((k, p));
-                    Ok(())
-                })
+                .drain(
+                    |k, p| {
+                        got.push((k, p));
+                        Ok(())
+                    },
+                    |done, total| last = (done, total),
+                )
                 .unwrap();
+            assert!(last.0 > 0 && last.0 == last.1, "progress {last:?}");
             let of = |k: Key| -> Vec<Part> {
                 got.iter()
                     .filter(|(g, _)| *g == k)

@@ -1859,7 +1859,7 @@ fn rows_of_rrd(path: &std::path::Path) -> Result<Rows, String> {
 
 /// A recording whose rows waited in the temporary file (`with_spill`, what
 /// `replay --rrd FILE` does) holds the same rows as one sent at each flush,
-/// in fewer, longer chunks (at most `MAX_CHUNK_ROWS` rows each).
+/// in fewer, longer chunks (at most the limit, here 16 rows, each).
 fn spilled_recording_holds_the_same_rows() -> Result<(), String> {
     let dir = tempfile::tempdir().map_err(|e| e.to_string())?;
     let sweeps = random_sweeps(14, 60, 5);
@@ -1876,9 +1876,12 @@ fn spilled_recording_holds_the_same_rows() -> Result<(), String> {
             .map_err(|e| e.to_string())?
             .with_flush_rows(100);
         if spill {
+            // Chunks of at most 16 rows: some parts are cut, some chunks
+            // go out during the replay.
             logger = logger
                 .with_spill(dir.path(), path)
-                .map_err(|e| e.to_string())?;
+                .map_err(|e| e.to_string())?
+                .with_spill_chunk_rows(16);
         }
         log_cube_sweeps(&mut logger, &sweeps)?;
         logger.send_all().map_err(|e| e.to_string())?;
@@ -1921,15 +1924,18 @@ fn spilled_recording_holds_the_same_rows() -> Result<(), String> {
     };
     let (direct_chunks, spilled_chunks) = (chunks(&direct)?, chunks(&spilled)?);
     ensure!(
-        spilled_chunks.len() * 3 < direct_chunks.len(),
+        spilled_chunks.len() * 2 < direct_chunks.len(),
         "{} chunks spilled, {} sent directly: the parts were not joined",
         spilled_chunks.len(),
         direct_chunks.len()
     );
     ensure!(
-        spilled_chunks.iter().all(|n| *n <= viz::MAX_CHUNK_ROWS),
-        "a spilled chunk has more than {} rows",
-        viz::MAX_CHUNK_ROWS
+        spilled_chunks.iter().all(|n| *n <= 16),
+        "a spilled chunk has more than 16 rows"
+    );
+    ensure!(
+        spilled_chunks.iter().filter(|n| **n == 16).count() > 10,
+        "few chunks reach the limit: {spilled_chunks:?}"
     );
     Ok(())
 }

@@ -606,6 +606,31 @@ impl Columns {
         Ok(())
     }
 
+    /// Sends what `spill` holds in chunks' worth (see
+    /// [`Spill::drain_ready`]), as chunks built like those of
+    /// [`Columns::send`].
+    pub(crate) fn send_ready(
+        &mut self,
+        spill: &mut Spill,
+        rec: &RecordingStream,
+    ) -> Result<(), RecordError> {
+        spill.drain_ready(|key, part| self.send_part(rec, key, part))
+    }
+
+    fn send_part(
+        &mut self,
+        rec: &RecordingStream,
+        key: Key,
+        part: Part,
+    ) -> Result<(), RecordError> {
+        let Some(&i) = self.index.get(&key) else {
+            unreachable!("a spilled part comes from a buffered entity");
+        };
+        let id = self.chunk_id();
+        rec.send_chunk(self.entities[i].chunk(id, part)?);
+        Ok(())
+    }
+
     /// Sends what `spill` holds (see [`Spill::drain`]), as chunks built like
     /// those of [`Columns::send`].
     pub(crate) fn send_spilled(
@@ -614,17 +639,7 @@ impl Columns {
         rec: &RecordingStream,
         progress: impl FnMut(u64, u64),
     ) -> Result<(), RecordError> {
-        spill.drain(
-            |key, part| {
-                let Some(&i) = self.index.get(&key) else {
-                    unreachable!("a spilled part comes from a buffered entity");
-                };
-                let id = self.chunk_id();
-                rec.send_chunk(self.entities[i].chunk(id, part)?);
-                Ok(())
-            },
-            progress,
-        )
+        spill.drain(|key, part| self.send_part(rec, key, part), progress)
     }
 }
 

@@ -396,11 +396,26 @@ impl Logger {
         Ok(self)
     }
 
+    /// With [`Logger::with_spill`]: at most `rows` rows per chunk instead
+    /// of [`super::MAX_CHUNK_ROWS`] (for tests of the joining; no effect
+    /// without a spill).
+    pub fn with_spill_chunk_rows(mut self, rows: usize) -> Logger {
+        if let Some(spill) = &mut self.spill {
+            spill.set_max_rows(rows);
+        }
+        self
+    }
+
     /// Sends every buffered row (to the temporary file with
     /// [`Logger::with_spill`]).
     pub fn flush(&mut self) -> Result<(), RecordError> {
         match &mut self.spill {
-            Some(spill) => self.columns.spill(spill),
+            Some(spill) => {
+                self.columns.spill(spill)?;
+                // What has a chunk's worth goes out now, while the replay
+                // goes on.
+                self.columns.send_ready(spill, &self.rec)
+            }
             None => Ok(self.columns.send(&self.rec)?),
         }
     }

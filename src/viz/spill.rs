@@ -10,14 +10,17 @@
 //!
 //! When the recording goes to a file only, each flush's chunks are written
 //! here instead (Arrow IPC, to an anonymous temporary file next to the
-//! output, which disappears with the process however it ends), and
-//! [`Spill::drain`] sends them at the end, entity after entity, joined into
-//! chunks of up to [`MAX_CHUNK_ROWS`] rows and [`MAX_CHUNK_BYTES`] bytes.
-//! Memory: one entity's pending
-//! chunk and the index of the parts (16 bytes each). The rows, their ids and
-//! their times are unchanged; only the chunking and the order of the
-//! chunks in the file differ (the viewer orders rows by time, and rows of
-//! equal time by row id).
+//! output, which disappears with the process however it ends). After each
+//! flush, [`Spill::drain_ready`] sends the entities that have a chunk's
+//! worth waiting ([`MAX_CHUNK_ROWS`] rows or [`MAX_CHUNK_BYTES`] bytes), so
+//! the file is written while the replay goes on; at the end
+//! [`Spill::drain`] sends the rest, entity after entity. Either way the
+//! parts are joined into chunks of up to [`MAX_CHUNK_ROWS`] rows and about
+//! [`MAX_CHUNK_BYTES`] bytes. Memory: one entity's pending chunk and the
+//! index of the parts (24 bytes each). The rows, their ids and their times
+//! are unchanged; only the chunking and the order of the chunks in the file
+//! differ (the viewer orders rows by time, and rows of equal time by row
+//! id).
 
 use std::collections::hash_map::Entry;
 use std::fs::File;
@@ -50,6 +53,14 @@ pub const MAX_CHUNK_ROWS: usize = 16384;
 /// keep that memory small.
 pub const MAX_CHUNK_BYTES: usize = 2 << 20;
 
+/// Where a part lies in the file, and its rows.
+#[derive(Clone, Copy, Debug)]
+struct PartRef {
+    offset: u64,
+    len: u64,
+    rows: usize,
+}
+
 /// Parts of chunks written to a temporary file, by entity and set of
 /// components.
 #[derive(Debug)]
@@ -61,11 +72,12 @@ pub(crate) struct Spill {
     written: u64,
     /// The keys in the order they first came.
     order: Vec<Key>,
-    /// Offset and length of each part, by key.
-    parts: FxHashMap<Key, Vec<(u64, u64)>>,
+    /// The parts not sent yet, by key.
+    parts: FxHashMap<Key, Vec<PartRef>>,
     /// Scratch: one part's bytes.
     buf: Vec<u8>,
-    /// [`MAX_CHUNK_ROWS`] (smaller in tests).
+    /// At most this many rows per chunk: [`MAX_CHUNK_ROWS`] unless set
+    /// ([`Spill::set_max_rows`]).
     max_rows: usize,
 }
 
@@ -89,6 +101,11 @@ impl Spill {
         })
     }
 
+    /// At most `rows` rows per chunk (at least 1).
+    pub(crate) fn set_max_rows(&mut self, rows: usize) {
+        self.max_rows = rows.max(1);
+    }
+
     fn error(&self, doing: &'static str, cause: io::Error) -> RecordError {
         RecordError::Spill {
             recording: self.recording.clone(),
@@ -100,6 +117,7 @@ impl Spill {
     /// Writes `part`, rows of `key` (later than every part of `key` written
     /// before).
     pub(crate) fn put(&mut self, key: Key, part: Part) -> Result<(), RecordError> {
+        let rows = part.rows.len();
         let batch = to_batch(part)?;
         self.buf.clear();
         {
@@ -113,12 +131,66 @@ impl Spill {
             return Err(self.error("writing", cause));
         }
         self.written += len;
+        let r = PartRef { offset, len, rows };
         match self.parts.entry(key) {
-            Entry::Occupied(mut e) => e.get_mut().push((offset, len)),
+            Entry::Occupied(mut e) => e.get_mut().push(r),
             Entry::Vacant(e) => {
                 self.order.push(key);
-                e.insert(vec![(offset, len)]);
+                e.insert(vec![r]);
             }
+        }
+        Ok(())
+    }
+
+    /// Hands to `send` the parts of the keys that have a chunk's worth
+    /// ([`MAX_CHUNK_ROWS`] rows or [`MAX_CHUNK_BYTES`] bytes) waiting, joined
+    /// as [`Spill::drain`] joins them, keeping back each key's last parts
+    /// that are less than a chunk; so the recording is written while the
+    /// replay goes on, and the chunks stay long.
+    pub(crate) fn drain_ready(
+        &mut self,
+        mut send: impl FnMut(Key, Part) -> Result<(), RecordError>,
+    ) -> Result<(), RecordError> {
+        let max_rows = self.max_rows;
+        let ready = |refs: &[PartRef]| {
+            refs.iter().map(|r| r.rows).sum::<usize>() >= max_rows
+                || refs.iter().map(|r| r.len as usize).sum::<usize>() >= MAX_CHUNK_BYTES
+        };
+        let mut flushed = false;
+        for i in 0..self.order.len() {
+            let key = self.order[i];
+            let Some(refs) = self.parts.get_mut(&key) else {
+                continue;
+            };
+            if !ready(refs) {
+                continue;
+            }
+            // The start of the last group of parts that is not a chunk's
+            // worth: those wait for more.
+            let (mut start, mut rows, mut bytes) = (0, 0, 0);
+            for (j, r) in refs.iter().enumerate() {
+                if rows > 0
+                    && (rows + r.rows > max_rows || bytes + r.len as usize > MAX_CHUNK_BYTES)
+                {
+                    (start, rows, bytes) = (j, 0, 0);
+                }
+                rows += r.rows;
+                bytes += r.len as usize;
+            }
+            if rows >= max_rows || bytes >= MAX_CHUNK_BYTES {
+                start = refs.len();
+            }
+            let now: Vec<PartRef> = refs.drain(..start).collect();
+            if now.is_empty() {
+                continue;
+            }
+            if !flushed {
+                if let Err(cause) = self.file.flush() {
+                    return Err(self.error("writing", cause));
+                }
+                flushed = true;
+            }
+            self.emit(key, &now, &mut send, &mut |_| {})?;
         }
         Ok(())
     }
@@ -135,40 +207,19 @@ impl Spill {
         mut send: impl FnMut(Key, Part) -> Result<(), RecordError>,
         mut progress: impl FnMut(u64, u64),
     ) -> Result<(), RecordError> {
-        let total = self.written;
-        let mut done = 0;
         if let Err(cause) = self.file.flush() {
             return Err(self.error("writing", cause));
         }
         let order = std::mem::take(&mut self.order);
         let mut parts = std::mem::take(&mut self.parts);
-        let mut pending: Vec<RecordBatch> = Vec::new();
-        let (mut rows, mut bytes) = (0usize, 0usize);
+        let total: u64 = parts.values().flatten().map(|r| r.len).sum();
+        let mut done = 0;
         for key in order {
-            for (offset, len) in parts.remove(&key).unwrap_or_default() {
-                let whole = self.read(offset, len)?;
+            let refs = parts.remove(&key).unwrap_or_default();
+            self.emit(key, &refs, &mut send, &mut |len| {
                 done += len;
                 progress(done, total);
-                // A part longer than a chunk is cut (slices share its
-                // buffers).
-                let mut start = 0;
-                while start < whole.num_rows() {
-                    let n = (whole.num_rows() - start).min(self.max_rows);
-                    let batch = whole.slice(start, n);
-                    start += n;
-                    if rows > 0 && (rows + n > self.max_rows || bytes >= MAX_CHUNK_BYTES) {
-                        send(key, joined(&mut pending)?)?;
-                        (rows, bytes) = (0, 0);
-                    }
-                    rows += n;
-                    bytes += batch.get_array_memory_size() * n / whole.num_rows();
-                    pending.push(batch);
-                }
-            }
-            if rows > 0 {
-                send(key, joined(&mut pending)?)?;
-                (rows, bytes) = (0, 0);
-            }
+            })?;
         }
         let file = self.file.get_mut();
         let emptied = file.set_len(0).and_then(|()| file.seek(SeekFrom::Start(0)));
@@ -176,6 +227,44 @@ impl Spill {
             return Err(self.error("emptying", cause));
         }
         self.written = 0;
+        Ok(())
+    }
+
+    /// Reads the parts `refs` of `key` back and hands them to `send`,
+    /// joined into chunks of at most `max_rows` rows and about
+    /// [`MAX_CHUNK_BYTES`] bytes (a part longer than that is cut); tells
+    /// `read` the bytes of each part read.
+    fn emit(
+        &mut self,
+        key: Key,
+        refs: &[PartRef],
+        send: &mut impl FnMut(Key, Part) -> Result<(), RecordError>,
+        read: &mut impl FnMut(u64),
+    ) -> Result<(), RecordError> {
+        let mut pending: Vec<RecordBatch> = Vec::new();
+        let (mut rows, mut bytes) = (0usize, 0usize);
+        for r in refs {
+            let whole = self.read(r.offset, r.len)?;
+            read(r.len);
+            // A part longer than a chunk is cut (slices share its
+            // buffers).
+            let mut start = 0;
+            while start < whole.num_rows() {
+                let n = (whole.num_rows() - start).min(self.max_rows);
+                let batch = whole.slice(start, n);
+                start += n;
+                if rows > 0 && (rows + n > self.max_rows || bytes >= MAX_CHUNK_BYTES) {
+                    send(key, joined(&mut pending)?)?;
+                    (rows, bytes) = (0, 0);
+                }
+                rows += n;
+                bytes += batch.get_array_memory_size() * n / whole.num_rows();
+                pending.push(batch);
+            }
+        }
+        if rows > 0 {
+            send(key, joined(&mut pending)?)?;
+        }
         Ok(())
     }
 
@@ -312,19 +401,21 @@ mod tests {
 
     /// Parts of two keys, interleaved and of uneven lengths, some longer
     /// than a chunk, come back per key in order, whole, joined or cut into
-    /// chunks of at most the limit, and the file is reusable.
+    /// chunks of at most the limit; the file is reusable; sending what is
+    /// ready along the way (round 1) changes nothing of that.
     #[test]
     fn parts_come_back_per_key_joined_and_cut() {
         let dir = tempfile::tempdir().unwrap();
         let mut spill = Spill::new(dir.path(), &dir.path().join("x.rrd")).unwrap();
-        spill.max_rows = 10;
+        spill.set_max_rows(10);
         let (a, b) = (
             Key::for_test(Entity::Log, 0),
             Key::for_test(Entity::Divergences, 0),
         );
-        let cuts_a = [0u64, 3, 7, 30, 31, 40];
+        let cuts_a = [0u64, 3, 7, 30, 31, 40, 42, 44, 47, 49, 52];
         let cuts_b = [100u64, 104, 125];
         for round in 0..2 {
+            let mut got: Vec<(Key, Part)> = Vec::new();
             let (mut ia, mut ib) = (cuts_a.windows(2), cuts_b.windows(2));
             loop {
                 let (wa, wb) = (ia.next(), ib.next());
@@ -337,8 +428,16 @@ mod tests {
                 if let Some(w) = wb {
                     spill.put(b, part(w[0], w[1])).unwrap();
                 }
+                if round == 1 {
+                    spill
+                        .drain_ready(|k, p| {
+                            got.push((k, p));
+                            Ok(())
+                        })
+                        .unwrap();
+                }
             }
-            let mut got: Vec<(Key, Part)> = Vec::new();
+            let early = got.len();
             let mut last = (0, 0);
             spill
                 .drain(
@@ -350,6 +449,7 @@ mod tests {
                 )
                 .unwrap();
             assert!(last.0 > 0 && last.0 == last.1, "progress {last:?}");
+            assert_eq!(early > 0, round == 1, "round {round}: {early} sent early");
             let of = |k: Key| -> Vec<Part> {
                 got.iter()
                     .filter(|(g, _)| *g == k)
@@ -362,19 +462,28 @@ mod tests {
                     .collect()
             };
             assert!(got.iter().all(|(_, p)| p.rows.len() <= 10), "round {round}");
-            assert_eq!(flat(&of(a)), flat(&[part(0, 40)]), "round {round}");
+            assert_eq!(flat(&of(a)), flat(&[part(0, 52)]), "round {round}");
             assert_eq!(flat(&of(b)), flat(&[part(100, 125)]), "round {round}");
-            // Key a's chunks before key b's, each key's in order.
-            let first_b = got.iter().position(|(k, _)| *k == b).unwrap();
-            assert!(got[..first_b].iter().all(|(k, _)| *k == a));
-            // Joined as far as the limit allows: no two neighbours would fit
-            // in one chunk.
             for k in [a, b] {
                 let lengths: Vec<usize> = of(k).iter().map(|p| p.rows.len()).collect();
-                assert!(
-                    lengths.windows(2).all(|w| w[0] + w[1] > 10),
-                    "round {round}: {lengths:?}"
-                );
+                if round == 0 {
+                    // Joined as far as the limit allows: no two neighbours
+                    // would fit in one chunk.
+                    assert!(
+                        lengths.windows(2).all(|w| w[0] + w[1] > 10),
+                        "round {round}: {lengths:?}"
+                    );
+                } else {
+                    // Sent early only a chunk's worth at a time: at most one
+                    // short chunk more per early sending.
+                    let rows: usize = lengths.iter().sum();
+                    assert!(lengths.len() <= 2 * rows.div_ceil(10), "{lengths:?}");
+                }
+            }
+            if round == 0 {
+                // Key a's chunks before key b's.
+                let first_b = got.iter().position(|(k, _)| *k == b).unwrap();
+                assert!(got[..first_b].iter().all(|(k, _)| *k == a));
             }
         }
     }

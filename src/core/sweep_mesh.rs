@@ -499,12 +499,26 @@ pub fn sweep_mesh_with<O: Observer>(
 /// test would end back-facing, and its facing value is far enough from 0
 /// that rounding cannot turn the rule (near 0 it is tested for the
 /// `grazing` flag).
+///
+/// Or: the whole path stays on one side of the triangle's plane, farther
+/// from it than `ρ` plus a margin far above the fragility band (the one the
+/// broadphase grows its boxes by). Every feature of the triangle lies in
+/// that plane, so no test can hit, and none can come within the band of a
+/// hit (the line of an edge, its vertices, its face are no nearer than the
+/// plane): the tests would give no hit and no near miss.
 #[inline]
 fn skip<O: Observer>(triangle: &Triangle, path: &SweptPath, facing: Facing) -> bool {
+    if O::WANTS_RECORDS {
+        return false;
+    }
     let facing_value = triangle.normal.dot(&path.d);
-    !O::WANTS_RECORDS
-        && !facing.allows(facing_value)
-        && facing_value.abs() >= GRAZING_COSINE * path.length
+    if !facing.allows(facing_value) && facing_value.abs() >= GRAZING_COSINE * path.length {
+        return true;
+    }
+    let h0 = triangle.normal.dot(&(path.p0 - triangle.vertices[0]));
+    let h1 = h0 + facing_value;
+    let clear = path.rho + 1e-9 * path.scale;
+    (h0 > clear && h1 > clear) || (h0 < -clear && h1 < -clear)
 }
 
 fn visit_triangles<O: Observer>(

@@ -133,9 +133,11 @@ struct Mark {
 /// columns (plain values, see `columns`), and sent as one chunk per entity
 /// when [`DEFAULT_FLUSH_ROWS`] rows or [`DEFAULT_FLUSH_BYTES`] bytes are
 /// buffered (and by [`Logger::flush`] and [`Logger::finish`]), so memory
-/// is bounded whatever the number of balls and the trace's length. What the recording holds is what logging each row
-/// on its own would give, with ids that depend only on the order of the
-/// rows, so the same events give the same chunks.
+/// is bounded whatever the number of balls and the trace's length. With
+/// [`Logger::with_spill`] (a recording file) they go to a temporary file
+/// instead and into the recording in long chunks. What the recording holds
+/// is what logging each row on its own would give, with ids that depend
+/// only on the order of the rows, so the same events give the same chunks.
 ///
 /// The layout sent at the start leads with the followed ball; when some
 /// sweep diverged from its expectation, [`Logger::finish`] sends a second

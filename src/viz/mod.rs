@@ -20,7 +20,8 @@
 //! - `convert`: conversions to Rerun types, colors and sizes;
 //! - [`blueprint`]: the default layouts, with fixed ids; `columns`: rows
 //!   buffered as typed columns and sent as chunks (both use SDK internals
-//!   pinned to Rerun 0.36.3);
+//!   pinned to Rerun 0.36.3); `spill`: for a recording file, the buffered
+//!   rows kept in a temporary file and sent in long chunks;
 //! - [`paths`]: every entity path.
 
 pub mod blueprint;

@@ -57,7 +57,7 @@ pub(crate) mod set {
 /// cleared when a sweep no longer shows them: the contact and its normal,
 /// the primary triangle and outline, the primary edge, the primary vertex.
 /// A ball's rows clear one of them only when the ball's previous sweep
-/// showed it, not at every sweep that does not ([`Out::before`]).
+/// showed it, not at every sweep that does not.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct Shown(u8);
 
@@ -67,7 +67,7 @@ impl Shown {
     const EDGE: u8 = 4;
     const VERTEX: u8 = 8;
 
-    /// What the rows of `r` show (as [`sweep_rows`] and [`primary_rows`]
+    /// What the rows of `r` show (as the rows of its ball, sweep and primary
     /// decide).
     pub fn of(r: &SweepResult) -> Shown {
         let mut bits = 0;

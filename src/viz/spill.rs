@@ -40,7 +40,8 @@ use rustc_hash::FxHashMap;
 use super::RecordError;
 use super::columns::{Key, Part};
 
-/// At most this many rows per chunk sent by [`Spill::drain`].
+/// At most this many rows per chunk of a recording written through a
+/// temporary file ([`crate::viz::Logger::with_spill`]).
 pub const MAX_CHUNK_ROWS: usize = 16384;
 
 /// About this many bytes per chunk at most (a chunk is closed at the first

@@ -17,7 +17,7 @@
 //! [`Spill::drain`] sends the rest, entity after entity. Either way the
 //! parts are joined into chunks of up to [`MAX_CHUNK_ROWS`] rows and about
 //! [`MAX_CHUNK_BYTES`] bytes. Memory: one entity's pending chunk and the
-//! index of the parts (24 bytes each). The rows, their ids and their times
+//! index of the parts (32 bytes each). The rows, their ids and their times
 //! are unchanged; only the chunking and the order of the chunks in the file
 //! differ (the viewer orders rows by time, and rows of equal time by row
 //! id).
@@ -44,22 +44,26 @@ use super::columns::{Key, Part};
 /// temporary file ([`crate::viz::Logger::with_spill`]).
 pub const MAX_CHUNK_ROWS: usize = 16384;
 
-/// About this many bytes per chunk at most (a chunk is closed at the first
-/// part that reaches it).
+/// About this many bytes of arrays per chunk at most (a chunk is closed at
+/// the first part that reaches it; the schema each part carries in the
+/// temporary file is not counted).
 ///
 /// Both are above the viewer store's compaction thresholds (4,096 rows,
 /// 384 KiB), which only say how far the viewer merges small chunks: the
 /// footer's index costs several KB per chunk until the file is finished
 /// (one row of a column per entity and component), so fewer, longer chunks
-/// keep that memory small.
-pub const MAX_CHUNK_BYTES: usize = 2 << 20;
+/// keep that memory small. 2 MiB gave fewer chunks but a larger file (see
+/// BENCHMARKS.md).
+pub const MAX_CHUNK_BYTES: usize = 512 << 10;
 
-/// Where a part lies in the file, and its rows.
+/// Where a part lies in the file, its rows and the bytes of its arrays
+/// (without the schema each part carries in the file).
 #[derive(Clone, Copy, Debug)]
 struct PartRef {
     offset: u64,
     len: u64,
     rows: usize,
+    bytes: usize,
 }
 
 /// Parts of chunks written to a temporary file, by entity and set of
@@ -120,6 +124,7 @@ impl Spill {
     pub(crate) fn put(&mut self, key: Key, part: Part) -> Result<(), RecordError> {
         let rows = part.rows.len();
         let batch = to_batch(part)?;
+        let bytes = batch.get_array_memory_size();
         self.buf.clear();
         {
             let mut w = StreamWriter::try_new(&mut self.buf, &batch.schema())?;
@@ -132,7 +137,12 @@ impl Spill {
             return Err(self.error("writing", cause));
         }
         self.written += len;
-        let r = PartRef { offset, len, rows };
+        let r = PartRef {
+            offset,
+            len,
+            rows,
+            bytes,
+        };
         match self.parts.entry(key) {
             Entry::Occupied(mut e) => e.get_mut().push(r),
             Entry::Vacant(e) => {
@@ -155,7 +165,7 @@ impl Spill {
         let max_rows = self.max_rows;
         let ready = |refs: &[PartRef]| {
             refs.iter().map(|r| r.rows).sum::<usize>() >= max_rows
-                || refs.iter().map(|r| r.len as usize).sum::<usize>() >= MAX_CHUNK_BYTES
+                || refs.iter().map(|r| r.bytes).sum::<usize>() >= MAX_CHUNK_BYTES
         };
         let mut flushed = false;
         for i in 0..self.order.len() {
@@ -170,13 +180,11 @@ impl Spill {
             // worth: those wait for more.
             let (mut start, mut rows, mut bytes) = (0, 0, 0);
             for (j, r) in refs.iter().enumerate() {
-                if rows > 0
-                    && (rows + r.rows > max_rows || bytes + r.len as usize > MAX_CHUNK_BYTES)
-                {
+                if rows > 0 && (rows + r.rows > max_rows || bytes + r.bytes > MAX_CHUNK_BYTES) {
                     (start, rows, bytes) = (j, 0, 0);
                 }
                 rows += r.rows;
-                bytes += r.len as usize;
+                bytes += r.bytes;
             }
             if rows >= max_rows || bytes >= MAX_CHUNK_BYTES {
                 start = refs.len();
@@ -259,7 +267,7 @@ impl Spill {
                     (rows, bytes) = (0, 0);
                 }
                 rows += n;
-                bytes += batch.get_array_memory_size() * n / whole.num_rows();
+                bytes += r.bytes * n / whole.num_rows();
                 pending.push(batch);
             }
         }

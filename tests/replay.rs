@@ -32,6 +32,7 @@ pub fn tests() -> Vec<Trial> {
     vec![
         trial!(outcomes_equal_sweep_mesh),
         trial!(spilled_recording_holds_the_same_rows),
+        trial!(clears_keep_their_place_among_the_sweeps_of_a_frame),
         trial!(outcomes_equal_without_explanation),
         trial!(frame_and_ball_filters),
         trial!(frame_range_parsing),
@@ -1855,6 +1856,61 @@ fn rows_of_rrd(path: &std::path::Path) -> Result<Rows, String> {
         }
     }
     Ok(rows)
+}
+
+/// Two sweeps of one ball in one frame (a sub-step): the first clears the
+/// face plots the ball's previous sweep drew, the second draws them again.
+/// At that frame the face plots must show the second sweep's values: its
+/// rows come after the first sweep's clears (the clears used to be written
+/// after the whole run's rows, and won).
+fn clears_keep_their_place_among_the_sweeps_of_a_frame() -> Result<(), String> {
+    let dir = tempfile::tempdir().map_err(|e| e.to_string())?;
+    let path = dir.path().join("substeps.rrd");
+    let w = worked_sweeps();
+    let at = |frame, s: &SweepMsg| SweepMsg { frame, ..*s };
+    // Frame 0 a face, frame 1 an edge then a face again.
+    let sweeps = [at(0, &w[0]), at(1, &w[1]), at(1, &w[0])];
+    // The three sweeps prepared as one run, as `replay` prepares them.
+    let id = viz::recording_id(&[b"sub-steps"]);
+    let rec = viz::builder(&id, "test")
+        .save(&path)
+        .map_err(|e| e.to_string())?;
+    let mut logger = viz::Logger::new(rec, true).map_err(|e| e.to_string())?;
+    let mut results = Vec::new();
+    for e in replay_events(
+        events_for(triangle_scene(), &sweeps).into_iter(),
+        explained(Detail::Primary),
+    ) {
+        match e.map_err(|e| e.to_string())? {
+            ReplayEvent::Scene(scene) => logger.log_scene(&scene).map_err(|e| e.to_string())?,
+            ReplayEvent::Sweep(r) => results.push(*r),
+        }
+    }
+    let before = logger.shown_before(&results);
+    let run = viz::prepare_sweeps(&results, &before, &logger.prepare_options());
+    logger.log_prepared(run).map_err(|e| e.to_string())?;
+    drop(logger.finish());
+    let kinds: Vec<_> = results.iter().map(|r| r.outcome.kind).collect();
+    ensure!(
+        kinds == [Kind::Face, Kind::Edge, Kind::Face],
+        "the sweeps decide {kinds:?}, the test needs face, edge, face"
+    );
+    let rows = rows_of_rrd(&path)?;
+    for (entity, want) in [
+        ("/plots/ball/0/face/h0", "Scalars:scalars"),
+        ("/plots/ball/0/quadratic/a", "Clear:is_recursive"),
+    ] {
+        let last = rows
+            .iter()
+            .filter(|(e, _, frame, ..)| e == entity && *frame == 1)
+            .max_by(|a, b| a.1.cmp(&b.1))
+            .map(|(.., component, _)| component.clone());
+        ensure!(
+            last.as_deref() == Some(want),
+            "{entity} at frame 1: the last row is {last:?}, expected {want}"
+        );
+    }
+    Ok(())
 }
 
 /// A recording whose rows waited in the temporary file (`with_spill`, what

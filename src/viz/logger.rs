@@ -2,7 +2,7 @@
 //! columns; [`prepare_sweeps`] builds the rows of a run of sweeps without
 //! the logger, so that runs can be prepared in parallel.
 
-use std::collections::BTreeMap;
+use std::collections::{BTreeMap, BTreeSet};
 use std::path::Path;
 use std::sync::Arc;
 
@@ -19,7 +19,7 @@ use super::edge_frame::{choose_edges, edge_frame_rows};
 use super::paths::{self, Entity};
 use super::rows::{
     Out, PLOT_BITS, Shown, expected_rows, focus_rows, plot_entity, plot_rows, primary_rows,
-    sweep_rows, text_rows, tunnel_rows,
+    sweep_rows, text_rows, transition_rows, tunnel_rows,
 };
 use super::spill::Spill;
 use super::{MAX_EDGE_FRAMES, RecordError, TIMESTAMP_THRESHOLD_NANOS};
@@ -101,30 +101,10 @@ impl Default for LoggerOptions {
     }
 }
 
-/// What the logger remembers of a ball's previous sweep, to clear what the
-/// next one no longer shows.
-#[derive(Debug, Default)]
-struct BallState {
-    /// Edge slots logged.
-    edge_slots: usize,
-    /// Plot entities that got a value (bits of `rows::plot_entity`).
-    plotted: u16,
-    /// Whether the expected outcome was drawn.
-    expected: bool,
-    /// Whether a tunnel marker was drawn.
-    tunnel: bool,
-}
-
 /// What [`Logger::log_prepared`] needs of each prepared sweep.
 #[derive(Clone, Copy, Debug)]
 struct Mark {
     ball: u32,
-    edge_slots: usize,
-    plotted: u16,
-    expected: bool,
-    tunnel: bool,
-    frame: i64,
-    time: columns::Time,
 }
 
 /// Logs replay events to a recording stream.
@@ -145,9 +125,12 @@ struct Mark {
 #[derive(Debug)]
 pub struct Logger {
     rec: RecordingStream,
-    balls: BTreeMap<u32, BallState>,
+    /// The balls seen (their plots' styles sent).
+    balls: BTreeSet<u32>,
     /// What each ball's last sweep handed to [`Logger::shown_before`] shows.
     shown: BTreeMap<u32, Shown>,
+    /// Scratch for [`Shown::of`].
+    scratch: Vec<EdgeRecord>,
     options: LoggerOptions,
     columns: columns::Columns,
     flush_rows: usize,
@@ -175,6 +158,8 @@ pub struct PreparedSweeps {
     tunnels: u64,
     /// Scratch: the edge tests of one sweep.
     edges: Vec<EdgeRecord>,
+    /// Scratch for [`Shown::of`].
+    scratch: Vec<EdgeRecord>,
 }
 
 impl PreparedSweeps {
@@ -244,17 +229,23 @@ pub fn prepare_sweeps_into<'r>(
         };
         text_rows(&mut out, r, decisive.as_ref(), &diffs);
         let tunnel = tunnel_rows(&mut out, r);
+        // What this sweep shows, as `Logger::shown_before` worked it out
+        // for the ball's next sweep.
+        let now = Shown::of(r, options, &mut p.scratch);
+        debug_assert_eq!(
+            (
+                now.edge_slots(),
+                now.plotted(),
+                now.expected(),
+                now.tunnel()
+            ),
+            (p.edges.len(), plotted, expected, tunnel),
+            "Shown::of disagrees with the rows drawn"
+        );
+        transition_rows(&mut out, r.ball, now);
         p.divergent += u64::from(!diffs.is_empty());
         p.tunnels += r.tunnels.len() as u64;
-        p.marks.push(Mark {
-            ball: r.ball,
-            edge_slots: p.edges.len(),
-            plotted,
-            expected,
-            tunnel,
-            frame,
-            time,
-        });
+        p.marks.push(Mark { ball: r.ball });
     }
 }
 
@@ -324,8 +315,9 @@ impl Logger {
         }
         let mut logger = Logger {
             rec,
-            balls: BTreeMap::new(),
+            balls: BTreeSet::new(),
             shown: BTreeMap::new(),
+            scratch: Vec::new(),
             options,
             columns: columns::Columns::default(),
             flush_rows: DEFAULT_FLUSH_ROWS,
@@ -547,7 +539,23 @@ impl Logger {
     ) -> Vec<Shown> {
         results
             .into_iter()
-            .map(|r| std::mem::replace(self.shown.entry(r.ball).or_default(), Shown::of(r)))
+            .map(|r| {
+                let now = Shown::of(r, &self.options.prepare, &mut self.scratch);
+                std::mem::replace(self.shown.entry(r.ball).or_default(), now)
+            })
+            .collect()
+    }
+
+    /// [`Logger::shown_before`] of sweeps of the balls `balls` whose rows
+    /// show `now` (worked out elsewhere, for example in parallel, with
+    /// `Shown::of`).
+    pub(crate) fn shown_before_given(
+        &mut self,
+        balls_now: impl IntoIterator<Item = (u32, Shown)>,
+    ) -> Vec<Shown> {
+        balls_now
+            .into_iter()
+            .map(|(ball, now)| std::mem::replace(self.shown.entry(ball).or_default(), now))
             .collect()
     }
 
@@ -557,39 +565,11 @@ impl Logger {
         self.columns.append(&mut p.columns);
         self.divergent += std::mem::take(&mut p.divergent);
         self.tunnels += std::mem::take(&mut p.tunnels);
-        // Clear what a ball showed at its previous sweep and no longer
-        // shows: edge frames, plot values (so that a plot has a gap rather
-        // than a line to a distant frame), the expected outcome.
+        // (What a ball showed at its previous sweep and no longer shows is
+        // cleared among the sweep's rows: `rows::transition_rows`.)
         for m in p.marks.drain(..) {
-            let b = m.ball;
-            if !self.balls.contains_key(&b) {
-                series_styles(&mut self.columns, &self.rec, b)?;
-            }
-            let state = self.balls.entry(b).or_default();
-            let edge_slots = std::mem::replace(&mut state.edge_slots, m.edge_slots);
-            let plotted = std::mem::replace(&mut state.plotted, m.plotted);
-            let expected = std::mem::replace(&mut state.expected, m.expected);
-            let tunnel = std::mem::replace(&mut state.tunnel, m.tunnel);
-            let mut out = Out {
-                columns: &mut self.columns,
-                frame: m.frame,
-                time: m.time,
-                before: Shown::default(),
-            };
-            for slot in m.edge_slots..edge_slots {
-                out.clear(Entity::EdgeFrame(b, slot), true);
-            }
-            let gone = plotted & !m.plotted;
-            if gone != 0 {
-                for bit in (0..PLOT_BITS).filter(|bit| gone & (1 << bit) != 0) {
-                    out.clear(plot_entity(b, bit), false);
-                }
-            }
-            if expected && !m.expected {
-                out.clear(Entity::Expected(b), true);
-            }
-            if tunnel && !m.tunnel {
-                out.clear(Entity::Tunnel(b), false);
+            if self.balls.insert(m.ball) {
+                series_styles(&mut self.columns, &self.rec, m.ball)?;
             }
         }
         if self.spare.len() < MAX_SPARE_PREPARED {

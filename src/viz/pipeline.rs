@@ -96,11 +96,20 @@ where
         };
         // What each sweep's ball showed before it (sequential: it depends
         // on the ball's previous sweep, perhaps in another run).
-        let before: Vec<Shown> = match logger.as_mut() {
-            Some(l) if prepare_options.is_some() => {
-                let mut shown = l
-                    .shown_before(batch.iter().filter_map(sweep_of))
-                    .into_iter();
+        let before: Vec<Shown> = match (logger.as_mut(), &prepare_options) {
+            (Some(l), Some(prepare_options)) => {
+                // What each sweep shows, in parallel; then, in order, what
+                // its ball's previous sweep showed.
+                let nows: Vec<(u32, Shown)> = pool.install(|| {
+                    batch
+                        .par_iter()
+                        .filter_map(sweep_of)
+                        .map_init(Vec::new, |scratch, r| {
+                            (r.ball, Shown::of(r, prepare_options, scratch))
+                        })
+                        .collect()
+                });
+                let mut shown = l.shown_before_given(nows).into_iter();
                 batch
                     .iter()
                     .map(|e| match sweep_of(e) {

@@ -20,11 +20,13 @@ use super::convert::{
     OUTLINE_POINTS, P0_COLOR, P1_COLOR, SWEEP_COLOR, TUNNEL_COLOR, VERTEX_POINTS, albedo,
     any_value, capsule_pose, f32x3, rgba, ui_points,
 };
+use super::edge_frame::choose_edges;
+use super::logger::PrepareOptions;
 use super::paths::{Entity, FACE_NAMES, QUADRATIC_NAMES};
 use crate::core::explain::Label;
-use crate::core::{Kind, TestRecord};
+use crate::core::{EdgeRecord, Kind, TestRecord};
 use crate::regress::FieldDiff;
-use crate::regress::decision::{write_decision_line, write_divergence_line};
+use crate::regress::decision::{divergence, write_decision_line, write_divergence_line};
 use crate::replay::SweepResult;
 use crate::trace::messages::OutcomeMsg;
 
@@ -55,26 +57,41 @@ pub(crate) mod set {
 
 /// What a sweep's rows leave shown for its ball, of the entities that are
 /// cleared when a sweep no longer shows them: the contact and its normal,
-/// the primary triangle and outline, the primary edge, the primary vertex.
-/// A ball's rows clear one of them only when the ball's previous sweep
-/// showed it, not at every sweep that does not.
+/// the primary triangle and outline, the primary edge, the primary vertex,
+/// the edge frames, the plot series, the expected outcome, the tunnel
+/// marker. A ball's rows clear one of them only when the ball's previous
+/// sweep showed it, right after the sweep's own rows (so that a clear
+/// keeps its place among the sweeps of one frame).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub struct Shown(u8);
+pub struct Shown {
+    bits: u8,
+    /// Edge slots logged.
+    edge_slots: u8,
+    /// Plot entities that got a value (bits of [`plot_entity`]).
+    plotted: u16,
+}
 
 impl Shown {
     const CONTACT: u8 = 1;
     const PRIMARY: u8 = 2;
     const EDGE: u8 = 4;
     const VERTEX: u8 = 8;
+    const EXPECTED: u8 = 16;
+    const TUNNEL: u8 = 32;
 
-    /// What the rows of `r` show (as the rows of its ball, sweep and primary
-    /// decide).
-    pub fn of(r: &SweepResult) -> Shown {
+    /// What the rows of `r` show, as the logger with `options` draws them
+    /// (`edges`: scratch for the edge tests chosen).
+    pub(crate) fn of(
+        r: &SweepResult,
+        options: &PrepareOptions,
+        edges: &mut Vec<EdgeRecord>,
+    ) -> Shown {
         let mut bits = 0;
         if r.outcome.contact.is_some() && r.outcome.normal.is_some() {
             bits |= Shown::CONTACT;
         }
-        if let Some(t) = r.decisive_record()
+        let decisive = r.decisive_record();
+        if let Some(t) = decisive
             && r.scene.mesh.triangle_by_index(t.triangle()).is_some()
         {
             bits |= Shown::PRIMARY
@@ -84,11 +101,59 @@ impl Shown {
                     TestRecord::Face(_) => 0,
                 };
         }
-        Shown(bits)
+        if r.expected.is_some() && !divergence(r, &options.tolerances).is_empty() {
+            bits |= Shown::EXPECTED;
+        }
+        if !r.tunnels.is_empty() {
+            bits |= Shown::TUNNEL;
+        }
+        choose_edges(edges, r, decisive, options.max_edge_frames);
+        Shown {
+            bits,
+            edge_slots: u8::try_from(edges.len()).unwrap_or(u8::MAX),
+            plotted: plot_bits(decisive),
+        }
     }
 
     fn has(self, bit: u8) -> bool {
-        self.0 & bit != 0
+        self.bits & bit != 0
+    }
+
+    pub(crate) fn edge_slots(self) -> usize {
+        usize::from(self.edge_slots)
+    }
+
+    pub(crate) fn plotted(self) -> u16 {
+        self.plotted
+    }
+
+    pub(crate) fn expected(self) -> bool {
+        self.has(Shown::EXPECTED)
+    }
+
+    pub(crate) fn tunnel(self) -> bool {
+        self.has(Shown::TUNNEL)
+    }
+}
+
+/// Clears, at ball `b`'s sweep that shows `now`, what its previous sweep
+/// showed (`out.before`) and this one does not, of the edge frames, plot
+/// series, expected outcome and tunnel marker (the rest is cleared where it
+/// is drawn).
+pub(crate) fn transition_rows(out: &mut Out<'_>, b: u32, now: Shown) {
+    let before = out.before;
+    for slot in now.edge_slots..before.edge_slots {
+        out.clear(Entity::EdgeFrame(b, usize::from(slot)), true);
+    }
+    let gone = before.plotted & !now.plotted;
+    for bit in (0..PLOT_BITS).filter(|bit| gone & (1 << bit) != 0) {
+        out.clear(plot_entity(b, bit), false);
+    }
+    if before.has(Shown::EXPECTED) && !now.has(Shown::EXPECTED) {
+        out.clear(Entity::Expected(b), true);
+    }
+    if before.has(Shown::TUNNEL) && !now.has(Shown::TUNNEL) {
+        out.clear(Entity::Tunnel(b), false);
     }
 }
 
@@ -106,7 +171,7 @@ impl Out<'_> {
         self.columns.row(entity, set, self.frame, self.time)
     }
 
-    pub(crate) fn clear(&mut self, entity: Entity, recursive: bool) {
+    fn clear(&mut self, entity: Entity, recursive: bool) {
         self.row(entity, set::CLEAR)
             .put::<ClearIsRecursive>(Clear::descriptor_is_recursive, [recursive.into()]);
     }
@@ -420,8 +485,33 @@ fn scalar(out: &mut Out<'_>, entity: Entity, v: f64) {
         .put::<Scalar>(Scalars::descriptor_scalars, [v.into()]);
 }
 
+/// Which plot entities the decisive test's numbers go to (bit `i` for
+/// `plot_entity(ball, i)`): those of its values that are finite.
+pub(crate) fn plot_bits(decisive: Option<&TestRecord>) -> u16 {
+    let bits = |values: &[Option<f64>], first: u16| {
+        values
+            .iter()
+            .enumerate()
+            .filter(|(_, v)| v.is_some_and(f64::is_finite))
+            .fold(0u16, |acc, (i, _)| acc | 1 << (first + i as u16))
+    };
+    let quadratic = |a, b, c, d, roots: Option<(f64, f64)>| {
+        let (s0, s1) = roots.unzip();
+        bits(
+            &[Some(a), Some(b), Some(c), Some(d), s0, s1],
+            QUADRATIC_BITS,
+        )
+    };
+    match decisive {
+        Some(TestRecord::Edge(e)) => quadratic(e.a, e.b, e.c, e.discriminant, e.roots),
+        Some(TestRecord::Vertex(v)) => quadratic(v.a, v.b, v.c, v.discriminant, v.roots),
+        Some(TestRecord::Face(f)) => bits(&[Some(f.h0), Some(f.h1), f.beta], FACE_BITS),
+        None => 0,
+    }
+}
+
 /// The α plot and the decisive test's numbers; returns which plot entities
-/// got a value (bit `i` for `plot_entity(ball, i)`).
+/// got a value (bit `i` for `plot_entity(ball, i)`, as [`plot_bits`]).
 pub(crate) fn plot_rows(out: &mut Out<'_>, r: &SweepResult, decisive: Option<&TestRecord>) -> u16 {
     let b = r.ball;
     // One row: α and the kind beside it.

@@ -18,11 +18,13 @@
 
 use std::hint::black_box;
 
-use criterion::{BenchmarkId, Criterion, Throughput, criterion_group};
+use criterion::measurement::WallTime;
+use criterion::{BenchmarkGroup, BenchmarkId, Criterion, Throughput, criterion_group};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use sweeptrace::core::{
-    Broadphase, CollectRecords, Mesh, Options, Sweep, sweep_mesh, sweep_mesh_with,
+    Broadphase, CollectRecords, Mesh, Observer, Options, Outcome, Sweep, sweep_mesh,
+    sweep_mesh_with,
 };
 use sweeptrace::replay::{CollectPrimary, primary_records};
 
@@ -160,49 +162,20 @@ fn bench(c: &mut Criterion) {
                 black_box(sweep_mesh(&s.ours, &s.sweeps[i], &options).ok())
             })
         });
-        let mut i = 0usize;
-        group.bench_with_input(
-            BenchmarkId::new("explained-primary", s.triangles),
-            &s,
-            |b, s| {
-                b.iter(|| {
-                    i = (i + 1) % SWEEPS;
-                    let mut collect = CollectPrimary::default();
-                    let outcome = sweep_mesh_with(
-                        &s.ours,
-                        &s.sweeps[i],
-                        &options,
-                        Broadphase::Bvh,
-                        &mut collect,
-                    )
-                    .ok()?;
-                    let verdicts = collect.verdict_counts();
-                    black_box((collect.into_primary_records(&outcome), verdicts));
-                    Some(())
-                })
-            },
-        );
-        let mut i = 0usize;
-        group.bench_with_input(
-            BenchmarkId::new("explained-every-record", s.triangles),
-            &s,
-            |b, s| {
-                b.iter(|| {
-                    i = (i + 1) % SWEEPS;
-                    let mut collect = CollectRecords::default();
-                    let outcome = sweep_mesh_with(
-                        &s.ours,
-                        &s.sweeps[i],
-                        &options,
-                        Broadphase::Bvh,
-                        &mut collect,
-                    )
-                    .ok()?;
-                    black_box(primary_records(&outcome, collect.records));
-                    Some(())
-                })
-            },
-        );
+        // The explained queries: each observer, then what the replay keeps.
+        explained_bench(&mut group, &s, "explained-primary", |s, sweep| {
+            let mut collect = CollectPrimary::default();
+            let outcome = explained(s, sweep, &options, &mut collect)?;
+            let verdicts = collect.verdict_counts();
+            black_box((collect.into_primary_records(&outcome), verdicts));
+            Some(())
+        });
+        explained_bench(&mut group, &s, "explained-every-record", |s, sweep| {
+            let mut collect = CollectRecords::default();
+            let outcome = explained(s, sweep, &options, &mut collect)?;
+            black_box(primary_records(&outcome, collect.records));
+            Some(())
+        });
         let mut i = 0usize;
         group.bench_with_input(BenchmarkId::new("parry", s.triangles), &s, |b, s| {
             b.iter(|| {
@@ -213,6 +186,32 @@ fn bench(c: &mut Criterion) {
         let _ = s.n;
     }
     group.finish();
+}
+
+/// The explained query of `sweep` with `observer` (BVH broadphase).
+fn explained<O: Observer>(
+    s: &Setup,
+    sweep: &Sweep,
+    options: &Options,
+    observer: &mut O,
+) -> Option<Outcome> {
+    sweep_mesh_with(&s.ours, sweep, options, Broadphase::Bvh, observer).ok()
+}
+
+/// A bench named `name` of `run` over the setup's sweeps, cycled.
+fn explained_bench(
+    group: &mut BenchmarkGroup<'_, WallTime>,
+    s: &Setup,
+    name: &str,
+    mut run: impl FnMut(&Setup, &Sweep) -> Option<()>,
+) {
+    let mut i = 0usize;
+    group.bench_with_input(BenchmarkId::new(name, s.triangles), s, |b, s| {
+        b.iter(|| {
+            i = (i + 1) % SWEEPS;
+            run(s, &s.sweeps[i])
+        })
+    });
 }
 
 criterion_group!(benches, bench);

@@ -263,7 +263,8 @@ impl Spill {
                 let batch = whole.slice(start, n);
                 start += n;
                 if rows > 0 && (rows + n > self.max_rows || bytes >= MAX_CHUNK_BYTES) {
-                    send(key, joined(&mut pending)?)?;
+                    let part = self.joined(&mut pending)?;
+                    send(key, part)?;
                     (rows, bytes) = (0, 0);
                 }
                 rows += n;
@@ -272,9 +273,20 @@ impl Spill {
             }
         }
         if rows > 0 {
-            send(key, joined(&mut pending)?)?;
+            let part = self.joined(&mut pending)?;
+            send(key, part)?;
         }
         Ok(())
+    }
+
+    /// [`joined`], with a part that does not read back as an error.
+    fn joined(&self, pending: &mut Vec<RecordBatch>) -> Result<Part, RecordError> {
+        joined(pending)?.ok_or_else(|| {
+            self.error(
+                "reading",
+                io::Error::new(io::ErrorKind::InvalidData, "a part does not read back"),
+            )
+        })
     }
 
     /// The part written at `offset`, as a record batch.
@@ -339,25 +351,39 @@ fn to_batch(part: Part) -> Result<RecordBatch, RecordError> {
 }
 
 /// The parts in `pending` (rows of one key, in order) as one; empties
-/// `pending`.
-fn joined(pending: &mut Vec<RecordBatch>) -> Result<Part, RecordError> {
+/// `pending`. `None` when they are not in the layout [`to_batch`] writes
+/// (a temporary file damaged under us).
+fn joined(pending: &mut Vec<RecordBatch>) -> Result<Option<Part>, RecordError> {
     // Always a copy: the rows of a part that was cut are a slice of it.
     let batch = concat_batches(&pending[0].schema(), pending.iter())?;
     pending.clear();
     let columns = batch.columns();
-    let frames = columns[0].as_primitive::<Int64Type>().values().to_vec();
-    let times = columns[1].as_primitive::<Int64Type>().values().to_vec();
-    let rows = columns[2].as_primitive::<UInt64Type>().values().to_vec();
-    let lists = columns[3..]
+    if columns.len() < 3 {
+        return Ok(None);
+    }
+    let int64 = |c: &ArrayRef| Some(c.as_primitive_opt::<Int64Type>()?.values().to_vec());
+    let (Some(frames), Some(times), Some(rows)) = (
+        int64(&columns[0]),
+        int64(&columns[1]),
+        columns[2]
+            .as_primitive_opt::<UInt64Type>()
+            .map(|a| a.values().to_vec()),
+    ) else {
+        return Ok(None);
+    };
+    let Some(lists) = columns[3..]
         .iter()
-        .map(|c| c.as_list::<i32>().clone())
-        .collect::<Vec<ListArray>>();
-    Ok(Part {
+        .map(|c| c.as_list_opt::<i32>().cloned())
+        .collect::<Option<Vec<ListArray>>>()
+    else {
+        return Ok(None);
+    };
+    Ok(Some(Part {
         frames,
         times,
         rows,
         lists,
-    })
+    }))
 }
 
 #[cfg(test)]

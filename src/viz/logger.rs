@@ -101,12 +101,6 @@ impl Default for LoggerOptions {
     }
 }
 
-/// What [`Logger::log_prepared`] needs of each prepared sweep.
-#[derive(Clone, Copy, Debug)]
-struct Mark {
-    ball: u32,
-}
-
 /// Logs replay events to a recording stream.
 ///
 /// Rows are not sent one by one: they are buffered per entity as typed
@@ -153,24 +147,23 @@ pub struct Logger {
 #[derive(Debug, Default)]
 pub struct PreparedSweeps {
     columns: columns::Columns,
-    marks: Vec<Mark>,
+    /// The ball of each sweep prepared.
+    balls: Vec<u32>,
     divergent: u64,
     tunnels: u64,
     /// Scratch: the edge tests of one sweep.
     edges: Vec<EdgeRecord>,
-    /// Scratch for [`Shown::of`].
-    scratch: Vec<EdgeRecord>,
 }
 
 impl PreparedSweeps {
     /// Sweeps prepared.
     pub fn len(&self) -> usize {
-        self.marks.len()
+        self.balls.len()
     }
 
     /// Whether no sweep was prepared.
     pub fn is_empty(&self) -> bool {
-        self.marks.is_empty()
+        self.balls.is_empty()
     }
 }
 
@@ -229,23 +222,17 @@ pub fn prepare_sweeps_into<'r>(
         };
         text_rows(&mut out, r, decisive.as_ref(), &diffs);
         let tunnel = tunnel_rows(&mut out, r);
-        // What this sweep shows, as `Logger::shown_before` worked it out
-        // for the ball's next sweep.
-        let now = Shown::of(r, options, &mut p.scratch);
-        debug_assert_eq!(
-            (
-                now.edge_slots(),
-                now.plotted(),
-                now.expected(),
-                now.tunnel()
-            ),
-            (p.edges.len(), plotted, expected, tunnel),
+        // What this sweep drew (`Logger::shown_before` worked out the same
+        // for the ball's next sweep).
+        let now = Shown::drawn(p.edges.len(), plotted, expected, tunnel);
+        debug_assert!(
+            Shown::of(r, options, &mut Vec::new()).same_drawn(now),
             "Shown::of disagrees with the rows drawn"
         );
         transition_rows(&mut out, r.ball, now);
         p.divergent += u64::from(!diffs.is_empty());
         p.tunnels += r.tunnels.len() as u64;
-        p.marks.push(Mark { ball: r.ball });
+        p.balls.push(r.ball);
     }
 }
 
@@ -567,9 +554,9 @@ impl Logger {
         self.tunnels += std::mem::take(&mut p.tunnels);
         // (What a ball showed at its previous sweep and no longer shows is
         // cleared among the sweep's rows: `rows::transition_rows`.)
-        for m in p.marks.drain(..) {
-            if self.balls.insert(m.ball) {
-                series_styles(&mut self.columns, &self.rec, m.ball)?;
+        for b in p.balls.drain(..) {
+            if self.balls.insert(b) {
+                series_styles(&mut self.columns, &self.rec, b)?;
             }
         }
         if self.spare.len() < MAX_SPARE_PREPARED {

@@ -119,20 +119,24 @@ impl Shown {
         self.bits & bit != 0
     }
 
-    pub(crate) fn edge_slots(self) -> usize {
-        usize::from(self.edge_slots)
+    /// What the rows drawn for a sweep show of what [`transition_rows`]
+    /// clears: `edge_slots` edge frames, the `plotted` plot entities,
+    /// whether the expected outcome and a tunnel marker were drawn (the rest
+    /// is cleared where it is drawn, from the previous sweep's `Shown::of`).
+    pub(crate) fn drawn(edge_slots: usize, plotted: u16, expected: bool, tunnel: bool) -> Shown {
+        let bit = |on: bool, b: u8| if on { b } else { 0 };
+        Shown {
+            bits: bit(expected, Shown::EXPECTED) | bit(tunnel, Shown::TUNNEL),
+            edge_slots: u8::try_from(edge_slots).unwrap_or(u8::MAX),
+            plotted,
+        }
     }
 
-    pub(crate) fn plotted(self) -> u16 {
-        self.plotted
-    }
-
-    pub(crate) fn expected(self) -> bool {
-        self.has(Shown::EXPECTED)
-    }
-
-    pub(crate) fn tunnel(self) -> bool {
-        self.has(Shown::TUNNEL)
+    /// Whether `self` and `drawn` agree on what [`transition_rows`] clears.
+    pub(crate) fn same_drawn(self, drawn: Shown) -> bool {
+        let mask = Shown::EXPECTED | Shown::TUNNEL;
+        (self.bits & mask, self.edge_slots, self.plotted)
+            == (drawn.bits & mask, drawn.edge_slots, drawn.plotted)
     }
 }
 

@@ -626,12 +626,15 @@ fn worked_sweeps() -> Vec<SweepMsg> {
 }
 
 /// Values decoded from an `.rrd`: per entity and component, the values at
-/// each frame (static data at frame `i64::MIN`).
-#[derive(Debug, Default, PartialEq)]
+/// each frame (static data at frame `i64::MIN`). Equal when everything is
+/// equal, the scalars bit for bit (a NaN is a series' missing value).
+#[derive(Debug, Default)]
 pub(crate) struct Decoded {
     scalars: BTreeMap<(String, String), BTreeMap<i64, Vec<f64>>>,
     pub(crate) texts: BTreeMap<(String, String), BTreeMap<i64, Vec<String>>>,
     translations: BTreeMap<String, BTreeMap<i64, [f32; 3]>>,
+    /// Per entity and frame, how many line strips its row has.
+    strips: BTreeMap<String, BTreeMap<i64, usize>>,
     quaternions: BTreeMap<String, BTreeMap<i64, [f32; 4]>>,
     timelines: std::collections::BTreeSet<String>,
     recording_ids: std::collections::BTreeSet<String>,
@@ -644,7 +647,41 @@ pub(crate) struct Decoded {
     blueprint_paths: Vec<Vec<String>>,
 }
 
+impl PartialEq for Decoded {
+    fn eq(&self, other: &Decoded) -> bool {
+        self.same_scalars(other)
+            && self.texts == other.texts
+            && self.translations == other.translations
+            && self.quaternions == other.quaternions
+            && self.strips == other.strips
+            && self.timelines == other.timelines
+            && self.recording_ids == other.recording_ids
+            && self.blueprint_stores == other.blueprint_stores
+            && self.static_entities == other.static_entities
+            && self.components == other.components
+            && self.blueprint_paths == other.blueprint_paths
+    }
+}
+
 impl Decoded {
+    /// Whether the scalars of `self` and `other` are the same, bit for bit
+    /// (NaN, a missing value of a series, equals NaN).
+    pub(crate) fn same_scalars(&self, other: &Decoded) -> bool {
+        let bits = |d: &Decoded| {
+            d.scalars
+                .iter()
+                .map(|(k, m)| {
+                    let m: Vec<(i64, Vec<u64>)> = m
+                        .iter()
+                        .map(|(f, v)| (*f, v.iter().map(|x| x.to_bits()).collect()))
+                        .collect();
+                    (k.clone(), m)
+                })
+                .collect::<Vec<_>>()
+        };
+        bits(self) == bits(other)
+    }
+
     /// The frames at which `entity` has a row with `component` (with
     /// values).
     pub(crate) fn frames_with(
@@ -769,6 +806,14 @@ pub(crate) fn decode_rrd(path: &std::path::Path) -> Result<Decoded, String> {
                                 .entry(key.clone())
                                 .or_default()
                                 .insert(frames[*row], v.clone());
+                        }
+                    }
+                    if name == "LineStrips3D:strips" {
+                        for (row, span) in chunk.iter_component_offsets(*id).enumerate() {
+                            d.strips
+                                .entry(entity.clone())
+                                .or_default()
+                                .insert(frames[row], span.len);
                         }
                     }
                     if name == "Transform3D:translation" {
@@ -913,46 +958,33 @@ fn rrd_reads_back_through_rerun() -> Result<(), String> {
             results[1].records[0]
         ));
     };
-    let scalar_at = |entity: &str, frame: i64| -> Result<f64, String> {
+    // The `series`-th value of `entity`'s row at `frame`.
+    let scalar_at = |entity: &str, series: usize, frame: i64| -> Result<f64, String> {
         d.scalars
             .get(&(entity.to_string(), "Scalars:scalars".to_string()))
             .and_then(|m| m.get(&frame))
-            .and_then(|v| v.first().copied())
-            .ok_or(format!("no scalar {entity} at frame {frame}"))
+            .and_then(|v| v.get(series).copied())
+            .ok_or(format!("no scalar {entity}[{series}] at frame {frame}"))
     };
+    let q = "/plots/ball/0/quadratic";
+    let face = "/plots/ball/0/face";
     let (s0, s1) = edge.roots.ok_or("edge without roots")?;
-    ensure!(
-        scalar_at("/plots/ball/0/quadratic/s0", 1)? == s0,
-        "s0 differs"
-    );
-    ensure!(
-        scalar_at("/plots/ball/0/quadratic/s1", 1)? == s1,
-        "s1 differs"
-    );
+    ensure!(scalar_at(q, 4, 1)? == s0, "s0 differs");
+    ensure!(scalar_at(q, 5, 1)? == s1, "s1 differs");
     ensure!(
         (s0 - 13.0 / 30.0).abs() < 1e-12 && (s1 - 17.0 / 30.0).abs() < 1e-12,
         "roots {s0}, {s1}"
     );
-    ensure!(scalar_at("/plots/ball/0/quadratic/a", 1)? == 36.0, "A");
-    ensure!(
-        scalar_at("/plots/ball/0/quadratic/discriminant", 1)? == edge.discriminant,
-        "discriminant"
-    );
+    ensure!(scalar_at(q, 0, 1)? == 36.0, "A");
+    ensure!(scalar_at(q, 3, 1)? == edge.discriminant, "discriminant");
     // Vertex example: the vertex quadratic's s0.
-    ensure!(
-        (scalar_at("/plots/ball/0/quadratic/s0", 2)? - 0.44226).abs() < 1e-5,
-        "vertex s0"
-    );
+    ensure!((scalar_at(q, 4, 2)? - 0.44226).abs() < 1e-5, "vertex s0");
     // Face example: h0, h1, β.
     ensure!(
-        scalar_at("/plots/ball/0/face/h0", 0)? == 3.0
-            && scalar_at("/plots/ball/0/face/h1", 0)? == -3.0,
+        scalar_at(face, 0, 0)? == 3.0 && scalar_at(face, 1, 0)? == -3.0,
         "h0, h1"
     );
-    ensure!(
-        (scalar_at("/plots/ball/0/face/beta", 0)? - 5.0 / 12.0).abs() < 1e-12,
-        "β"
-    );
+    ensure!((scalar_at(face, 2, 0)? - 5.0 / 12.0).abs() < 1e-12, "β");
     // The edge's numbers alongside its transform.
     ensure!(
         d.scalars
@@ -1006,7 +1038,7 @@ fn rrd_reads_back_through_rerun() -> Result<(), String> {
     )?;
     let d2 = decode_rrd(&again)?;
     ensure!(
-        d2.scalars == d.scalars && d2.texts == d.texts && d2.recording_ids == d.recording_ids,
+        d2.same_scalars(&d) && d2.texts == d.texts && d2.recording_ids == d.recording_ids,
         "content differs between runs"
     );
     ensure!(
@@ -1216,7 +1248,7 @@ fn threads_do_not_change_the_outputs() -> Result<(), String> {
         let d1 = decode_rrd(&dir.path().join(format!("1-{detail}-false.rrd")))?;
         let d4 = decode_rrd(&dir.path().join(format!("4-{detail}-false.rrd")))?;
         ensure!(
-            d1.scalars == d4.scalars
+            d1.same_scalars(&d4)
                 && d1.texts == d4.texts
                 && d1.translations == d4.translations
                 && d1.quaternions == d4.quaternions,
@@ -1229,7 +1261,7 @@ fn threads_do_not_change_the_outputs() -> Result<(), String> {
     let d1 = decode_rrd(&dir.path().join("1-primary-true.rrd"))?;
     let d4 = decode_rrd(&dir.path().join("4-primary-true.rrd"))?;
     ensure!(
-        d1.scalars == d4.scalars
+        d1.same_scalars(&d4)
             && d1.texts == d4.texts
             && d1.translations == d4.translations
             && d1.quaternions == d4.quaternions
@@ -1516,21 +1548,61 @@ fn rrd_shows_edges_features_and_explanations() -> Result<(), String> {
     };
 
     // The primary triangle and its feature.
-    let outline = "/world/ball/0/primary/outline";
+    let primary = "/world/ball/0/primary";
     ensure!(
-        d.frames_with(outline, "LineStrips3D:strips") == frames(&[0, 1, 2]),
-        "outline at {:?}",
-        d.frames_with(outline, "LineStrips3D:strips")
+        d.frames_with(primary, "LineStrips3D:strips") == frames(&[0, 1, 2])
+            && d.frames_with(primary, "Mesh3D:vertex_positions") == frames(&[0, 1, 2]),
+        "primary triangle at {:?}",
+        d.frames_with(primary, "LineStrips3D:strips")
     );
     ensure!(
-        d.frames_with(outline, "Clear:is_recursive") == frames(&[3]),
-        "outline not cleared at the miss"
+        d.frames_with(primary, "Clear:is_recursive") == frames(&[3]),
+        "primary triangle not cleared at the miss"
     );
+    // Its vertex only at the vertex test (frame 2), its bold edge (a
+    // second strip) only at the edge test (frame 1).
+    ensure!(
+        d.frames_with(primary, "Points3D:positions") == frames(&[2]),
+        "primary vertex at {:?}",
+        d.frames_with(primary, "Points3D:positions")
+    );
+    let radii = d
+        .components
+        .get(primary)
+        .and_then(|m| m.get(&1))
+        .is_some_and(|c| c.contains("LineStrips3D:radii"));
+    ensure!(radii, "no strip radii at frame 1");
+    ensure!(
+        d.strips
+            .get(primary)
+            .map(|m| m.iter().map(|(f, n)| (*f, *n)).collect())
+            == Some(BTreeMap::from([(0, 1), (1, 2), (2, 1)])),
+        "strips of the primary triangle per frame: {:?}",
+        d.strips.get(primary)
+    );
+    // The contact and the normal on the ball's entity at the hits only.
+    let ball = "/world/ball/0";
+    let hits: Vec<i64> = results
+        .iter()
+        .filter(|r| r.outcome.is_hit())
+        .map(|r| r.frame as i64)
+        .collect();
+    ensure!(
+        d.frames_with(ball, "Points3D:positions") == frames(&hits)
+            && d.frames_with(ball, "Arrows3D:vectors") == frames(&hits)
+            && d.frames_with(ball, "Capsules3D:lengths") == frames(&[0, 1, 2, 3]),
+        "contact at {:?}, hits at {hits:?}",
+        d.frames_with(ball, "Points3D:positions")
+    );
+    // The labels drawn (an empty label is not drawn).
     let mut labels: BTreeMap<i64, Vec<String>> = BTreeMap::new();
     for ((entity, component), by_frame) in &d.texts {
         if entity.starts_with("/world") && component.ends_with("labels") {
             for (f, v) in by_frame {
-                labels.entry(*f).or_default().extend(v.iter().cloned());
+                labels
+                    .entry(*f)
+                    .or_default()
+                    .extend(v.iter().filter(|l| !l.is_empty()).cloned());
             }
         }
     }
@@ -1579,7 +1651,9 @@ fn rrd_shows_edges_features_and_explanations() -> Result<(), String> {
             .map(|m| m.keys().collect::<Vec<_>>())
     );
     ensure!(
-        d.frames_with(&format!("{slot0}/axes"), "Arrows3D:vectors") == frames(&[0, 1, 2]),
+        d.frames_with(slot0, "Arrows3D:vectors") == frames(&[0, 1, 2])
+            && d.frames_with(slot0, "Capsules3D:lengths") == frames(&[0, 1, 2])
+            && d.frames_with(slot0, "Points3D:positions") == frames(&[0, 1, 2]),
         "edge frame axes"
     );
     ensure!(
@@ -1587,14 +1661,13 @@ fn rrd_shows_edges_features_and_explanations() -> Result<(), String> {
         "edge frame not cleared at the miss"
     );
     ensure!(
-        d.texts_at(&format!("{slot0}/edge"), "LineStrips3D:labels", 1)
-            .is_empty(),
+        d.texts_at(slot0, "LineStrips3D:labels", 1).is_empty(),
         "the decisive edge is labelled twice"
     );
 
     // Plot values exist where they exist, and are cleared after.
-    let q = "/plots/ball/0/quadratic/a";
-    let h = "/plots/ball/0/face/h0";
+    let q = "/plots/ball/0/quadratic";
+    let h = "/plots/ball/0/face";
     ensure!(
         d.frames_with(q, "Scalars:scalars") == frames(&[1, 2]),
         "quadratic at {:?}",
@@ -1708,9 +1781,9 @@ fn viewer_and_check_agree_on_divergences() -> Result<(), String> {
         );
     }
     ensure!(
-        d.frames_with("/world/ball/0/expected/ball", "Ellipsoids3D:centers") == check_frames,
+        d.frames_with("/world/ball/0/expected", "Ellipsoids3D:centers") == check_frames,
         "expected ball at {:?}",
-        d.frames_with("/world/ball/0/expected/ball", "Ellipsoids3D:centers")
+        d.frames_with("/world/ball/0/expected", "Ellipsoids3D:centers")
     );
     for f in &check_frames {
         if all.contains(&(f + 1)) && !check_frames.contains(&(f + 1)) {
@@ -1897,8 +1970,8 @@ fn clears_keep_their_place_among_the_sweeps_of_a_frame() -> Result<(), String> {
     );
     let rows = rows_of_rrd(&path)?;
     for (entity, want) in [
-        ("/plots/ball/0/face/h0", "Scalars:scalars"),
-        ("/plots/ball/0/quadratic/a", "Clear:is_recursive"),
+        ("/plots/ball/0/face", "Scalars:scalars"),
+        ("/plots/ball/0/quadratic", "Clear:is_recursive"),
     ] {
         let last = rows
             .iter()

@@ -164,12 +164,9 @@ pub fn blueprint_messages(
     let alpha = b.plot(&format!("α (ball {ball})"), &paths::alpha(ball))?;
     let quadratic = b.plot(
         &format!("Quadratic A, B, C, disc, s0, s1 (ball {ball})"),
-        &format!("{}/ball/{ball}/quadratic", paths::PLOTS),
+        &paths::quadratic(ball),
     )?;
-    let face = b.plot(
-        &format!("Face h0, h1, β (ball {ball})"),
-        &format!("{}/ball/{ball}/face", paths::PLOTS),
-    )?;
+    let face = b.plot(&format!("Face h0, h1, β (ball {ball})"), &paths::face(ball))?;
     let status = b.plot(
         "Divergent (1) and fragile decisions (…/fragile) per ball",
         paths::STATUS,

@@ -687,12 +687,12 @@ impl Row<'_> {
         self
     }
 
-    /// Puts one `LineStrip3D` through `points` (`descriptor` names the
-    /// component).
-    pub(crate) fn put_strip(
+    /// Puts one `LineStrip3D` through each of `strips` (none, one or
+    /// several; `descriptor` names the component).
+    pub(crate) fn put_strips(
         &mut self,
         descriptor: fn() -> ComponentDescriptor,
-        points: &[[f32; 3]],
+        strips: &[&[[f32; 3]]],
     ) -> &mut Self {
         let column = self
             .column(|| {
@@ -705,9 +705,11 @@ impl Row<'_> {
             })
             .downcast_mut::<Strips>()
             .expect("every row of a set puts the same components");
-        column.coords.extend_from_slice(points.as_flattened());
-        column.strip_lengths.push(narrow(points.len()));
-        column.lengths.push(1);
+        for points in strips {
+            column.coords.extend_from_slice(points.as_flattened());
+            column.strip_lengths.push(narrow(points.len()));
+        }
+        column.lengths.push(strips.len());
         self
     }
 

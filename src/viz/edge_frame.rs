@@ -17,6 +17,7 @@ use rerun::components::{
 };
 use rerun::{Arrows3D, Capsules3D, LineStrips3D, Points3D, Transform3D};
 
+use super::columns::Row;
 use super::convert::{
     AXIS_COLORS, CYLINDER_COLOR, EDGE_COLOR, HIT_COLOR, MISS_COLOR, PATH_COLOR, any_value, f32x3,
     quaternion, rgba, ui_points,
@@ -136,8 +137,9 @@ fn nearest_edge_of(r: &SweepResult, triangle: u32) -> Option<EdgeRecord> {
         .reduce(|a, b| if better(&b, &a) { b } else { a })
 }
 
-/// The rows of the chosen edge tests; `slot0` as [`choose_edges`]
-/// returned. Slot 0 is labelled only for the followed ball (`followed`).
+/// The rows of the chosen edge tests, one per test; `slot0` as
+/// [`choose_edges`] returned. Slot 0 is labelled only for the followed ball
+/// (`followed`).
 pub(crate) fn edge_frame_rows(
     out: &mut Out<'_>,
     r: &SweepResult,
@@ -148,38 +150,54 @@ pub(crate) fn edge_frame_rows(
     let b = r.ball;
     let rho = r.rho();
     for (slot, e) in edges.iter().enumerate() {
-        edge_frame_row(out, Entity::EdgeFrame(b, slot), e);
+        let set = if slot == 0 {
+            set::EDGE_FRAME_AXES
+        } else {
+            set::EDGE_FRAME
+        };
+        let mut row = out.row(Entity::EdgeFrame(b, slot), set);
+        edge_frame_values(&mut row, e);
         let hit = e.alpha().is_some();
         let length = e.length as f32;
-        // The edge, on +x. Slot 0 is labelled when it is not the decisive
-        // test (whose label is on the primary edge already): it then says
-        // which edge test it is and how it ended.
+        // The edge on +x, then the path. Slot 0's edge is labelled when it
+        // is not the decisive test (whose label is on the primary edge
+        // already): it then says which edge test it is and how it ended.
         let label = match slot0 {
             _ if slot > 0 || !followed => None,
             Slot0::Decisive => None,
             Slot0::Nearest => Some("nearest edge test"),
             Slot0::Expected => Some("expected edge test"),
         };
-        out.row(Entity::EdgeSegment(b, slot), set::LABELED_STRIP)
-            .put_strip(
-                LineStrips3D::descriptor_strips,
-                &[[0.0, 0.0, 0.0], [length, 0.0, 0.0]],
-            )
-            .put::<Radius>(LineStrips3D::descriptor_radii, [ui_points(3.0)])
-            .put::<Color>(LineStrips3D::descriptor_colors, [rgba(EDGE_COLOR)])
-            .put_texts(LineStrips3D::descriptor_labels, |t| {
-                if let Some(what) = label {
-                    t.push_fmt(format_args!(
-                        "{what}: {} ({})",
-                        Label(&TestRecord::Edge(*e)),
-                        e.verdict
-                    ));
-                }
-            });
-        // A capsule lies along +z; turn it onto +x (90° about +y).
+        let p0e = f32x3(e.p0_in_edge.coords);
+        let p1e = f32x3(e.p1_in_edge.coords);
+        row.put_strips(
+            LineStrips3D::descriptor_strips,
+            &[&[[0.0, 0.0, 0.0], [length, 0.0, 0.0]], &[p0e, p1e]],
+        )
+        .put::<Radius>(
+            LineStrips3D::descriptor_radii,
+            [ui_points(3.0), ui_points(1.5)],
+        )
+        .put::<Color>(
+            LineStrips3D::descriptor_colors,
+            [rgba(EDGE_COLOR), rgba(PATH_COLOR)],
+        )
+        .put_texts(LineStrips3D::descriptor_labels, |t| {
+            // Two labels, the path's empty (not drawn): a single label
+            // would be drawn between the two strips.
+            if let Some(what) = label {
+                t.push_fmt(format_args!(
+                    "{what}: {} ({})",
+                    Label(&TestRecord::Edge(*e)),
+                    e.verdict
+                ));
+                t.push_fmt(format_args!(""));
+            }
+        });
+        // The cylinder of radius ρ around the edge: a capsule lies along +z;
+        // turn it onto +x (90° about +y).
         let half = std::f32::consts::FRAC_1_SQRT_2;
-        out.row(Entity::EdgeCylinder(b, slot), set::CYLINDER)
-            .put::<Length>(Capsules3D::descriptor_lengths, [length.into()])
+        row.put::<Length>(Capsules3D::descriptor_lengths, [length.into()])
             .put::<Radius>(Capsules3D::descriptor_radii, [(rho as f32).into()])
             .put::<RotationQuat>(
                 Capsules3D::descriptor_quaternions,
@@ -187,12 +205,6 @@ pub(crate) fn edge_frame_rows(
             )
             .put::<Color>(Capsules3D::descriptor_colors, [rgba(CYLINDER_COLOR)])
             .put::<FillMode>(Capsules3D::descriptor_fill_mode, [FillMode::MajorWireframe]);
-        let p0e = f32x3(e.p0_in_edge.coords);
-        let p1e = f32x3(e.p1_in_edge.coords);
-        out.row(Entity::EdgePath(b, slot), set::STRIP)
-            .put_strip(LineStrips3D::descriptor_strips, &[p0e, p1e])
-            .put::<Radius>(LineStrips3D::descriptor_radii, [ui_points(1.5)])
-            .put::<Color>(LineStrips3D::descriptor_colors, [rgba(PATH_COLOR)]);
         // p0, p1, the centers at s0 and s1, xc on the edge.
         let at = |s: f64| f32x3((e.p0_in_edge + (e.p1_in_edge - e.p0_in_edge) * s).coords);
         let roots = e
@@ -200,40 +212,38 @@ pub(crate) fn edge_frame_rows(
             .filter(|(s0, s1)| s0.is_finite() && s1.is_finite() && *s0 > -2.0 && *s1 < 3.0);
         let root_color = rgba(if hit { HIT_COLOR } else { MISS_COLOR });
         let xc = e.xc.filter(|x| x.is_finite());
-        out.row(Entity::EdgePoints(b, slot), set::EDGE_POINTS)
-            .put::<Position3D>(
-                Points3D::descriptor_positions,
-                [p0e, p1e]
-                    .into_iter()
-                    .chain(roots.map(|(s0, _)| at(s0)))
-                    .chain(roots.map(|(_, s1)| at(s1)))
-                    .chain(xc.map(|x| [x as f32, 0.0, 0.0]))
-                    .map(Position3D::from),
-            )
-            .put::<Radius>(
-                Points3D::descriptor_radii,
-                [ui_points(4.0), ui_points(4.0)]
-                    .into_iter()
-                    .chain(roots.map(|_| ui_points(5.0)))
-                    .chain(roots.map(|_| ui_points(3.0)))
-                    .chain(xc.map(|_| ui_points(6.0))),
-            )
-            .put::<Color>(
-                Points3D::descriptor_colors,
-                [rgba(PATH_COLOR), rgba(PATH_COLOR)]
-                    .into_iter()
-                    .chain(roots.map(|_| root_color))
-                    .chain(roots.map(|_| rgba([150, 150, 150, 255])))
-                    .chain(xc.map(|_| root_color)),
-            );
+        row.put::<Position3D>(
+            Points3D::descriptor_positions,
+            [p0e, p1e]
+                .into_iter()
+                .chain(roots.map(|(s0, _)| at(s0)))
+                .chain(roots.map(|(_, s1)| at(s1)))
+                .chain(xc.map(|x| [x as f32, 0.0, 0.0]))
+                .map(Position3D::from),
+        )
+        .put::<Radius>(
+            Points3D::descriptor_radii,
+            [ui_points(4.0), ui_points(4.0)]
+                .into_iter()
+                .chain(roots.map(|_| ui_points(5.0)))
+                .chain(roots.map(|_| ui_points(3.0)))
+                .chain(xc.map(|_| ui_points(6.0))),
+        )
+        .put::<Color>(
+            Points3D::descriptor_colors,
+            [rgba(PATH_COLOR), rgba(PATH_COLOR)]
+                .into_iter()
+                .chain(roots.map(|_| root_color))
+                .chain(roots.map(|_| rgba([150, 150, 150, 255])))
+                .chain(xc.map(|_| root_color)),
+        );
         if slot == 0 {
             let a = (rho.max(e.length * 0.25)) as f32;
-            out.row(Entity::EdgeAxes(b, slot), set::AXES)
-                .put::<Vector3D>(
-                    Arrows3D::descriptor_vectors,
-                    [[a, 0.0, 0.0], [0.0, a, 0.0], [0.0, 0.0, a]].map(Vector3D::from),
-                )
-                .put::<Color>(Arrows3D::descriptor_colors, AXIS_COLORS.map(rgba));
+            row.put::<Vector3D>(
+                Arrows3D::descriptor_vectors,
+                [[a, 0.0, 0.0], [0.0, a, 0.0], [0.0, 0.0, a]].map(Vector3D::from),
+            )
+            .put::<Color>(Arrows3D::descriptor_colors, AXIS_COLORS.map(rgba));
         }
     }
 }
@@ -242,32 +252,31 @@ pub(crate) fn edge_frame_rows(
 /// test (as `AnyValues`: test, verdict, length, a, b, c, discriminant, s0,
 /// s1 and xc; s0, s1 and xc empty when the test did not get that far, so
 /// that no earlier sweep's value shows).
-fn edge_frame_row(out: &mut Out<'_>, entity: Entity, e: &EdgeRecord) {
+fn edge_frame_values(row: &mut Row<'_>, e: &EdgeRecord) {
     let world_from_edge = e.frame.world_from_edge();
     let (s0, s1) = e.roots.unzip();
-    out.row(entity, set::EDGE_FRAME)
-        .put::<Translation3D>(
-            Transform3D::descriptor_translation,
-            [f32x3(world_from_edge.translation.vector).into()],
-        )
-        .put::<RotationQuat>(
-            Transform3D::descriptor_quaternion,
-            [quaternion(&world_from_edge.rotation).into()],
-        )
-        .put_fmt(
-            || any_value::<Text>("test"),
-            format_args!("edge {}.{}", e.triangle, e.edge),
-        )
-        .put_strs(|| any_value::<Text>("verdict"), [e.verdict.as_str()])
-        .put::<Scalar>(|| any_value::<Scalar>("length"), [e.length.into()])
-        .put::<Scalar>(|| any_value::<Scalar>("a"), [e.a.into()])
-        .put::<Scalar>(|| any_value::<Scalar>("b"), [e.b.into()])
-        .put::<Scalar>(|| any_value::<Scalar>("c"), [e.c.into()])
-        .put::<Scalar>(
-            || any_value::<Scalar>("discriminant"),
-            [e.discriminant.into()],
-        )
-        .put::<Scalar>(|| any_value::<Scalar>("s0"), s0.map(Scalar::from))
-        .put::<Scalar>(|| any_value::<Scalar>("s1"), s1.map(Scalar::from))
-        .put::<Scalar>(|| any_value::<Scalar>("xc"), e.xc.map(Scalar::from));
+    row.put::<Translation3D>(
+        Transform3D::descriptor_translation,
+        [f32x3(world_from_edge.translation.vector).into()],
+    )
+    .put::<RotationQuat>(
+        Transform3D::descriptor_quaternion,
+        [quaternion(&world_from_edge.rotation).into()],
+    )
+    .put_fmt(
+        || any_value::<Text>("test"),
+        format_args!("edge {}.{}", e.triangle, e.edge),
+    )
+    .put_strs(|| any_value::<Text>("verdict"), [e.verdict.as_str()])
+    .put::<Scalar>(|| any_value::<Scalar>("length"), [e.length.into()])
+    .put::<Scalar>(|| any_value::<Scalar>("a"), [e.a.into()])
+    .put::<Scalar>(|| any_value::<Scalar>("b"), [e.b.into()])
+    .put::<Scalar>(|| any_value::<Scalar>("c"), [e.c.into()])
+    .put::<Scalar>(
+        || any_value::<Scalar>("discriminant"),
+        [e.discriminant.into()],
+    )
+    .put::<Scalar>(|| any_value::<Scalar>("s0"), s0.map(Scalar::from))
+    .put::<Scalar>(|| any_value::<Scalar>("s1"), s1.map(Scalar::from))
+    .put::<Scalar>(|| any_value::<Scalar>("xc"), e.xc.map(Scalar::from));
 }

@@ -18,8 +18,8 @@ use super::convert::{MESH_COLOR, WIREFRAME_COLOR, WIREFRAME_POINTS, albedo, f32x
 use super::edge_frame::{choose_edges, edge_frame_rows};
 use super::paths::{self, Entity};
 use super::rows::{
-    Out, PLOT_BITS, Shown, expected_rows, focus_rows, plot_entity, plot_rows, primary_rows,
-    sweep_rows, text_rows, transition_rows, tunnel_rows,
+    Out, PLOT_BITS, Shown, ball_row, expected_rows, focus_rows, plot_entity, plot_rows,
+    primary_rows, text_rows, transition_rows, tunnel_rows,
 };
 use super::spill::Spill;
 use super::{MAX_EDGE_FRAMES, RecordError, TIMESTAMP_THRESHOLD_NANOS};
@@ -204,12 +204,12 @@ pub fn prepare_sweeps_into<'r>(
         };
         let decisive = r.decisive_record().copied();
         let diffs = divergence(r, &options.tolerances);
-        sweep_rows(&mut out, r);
+        ball_row(&mut out, r);
         let followed = r.ball == options.follow_ball;
         if followed {
             focus_rows(&mut out, r, decisive.as_ref(), !diffs.is_empty());
         }
-        primary_rows(&mut out, r, decisive.as_ref(), followed);
+        let primary = primary_rows(&mut out, r, decisive.as_ref(), followed);
         let slot0 = choose_edges(&mut p.edges, r, decisive.as_ref(), options.max_edge_frames);
         edge_frame_rows(&mut out, r, &p.edges, slot0, followed);
         let plotted = plot_rows(&mut out, r, decisive.as_ref());
@@ -224,9 +224,9 @@ pub fn prepare_sweeps_into<'r>(
         let tunnel = tunnel_rows(&mut out, r);
         // What this sweep drew (`Logger::shown_before` worked out the same
         // for the ball's next sweep).
-        let now = Shown::drawn(p.edges.len(), plotted, expected, tunnel);
+        let now = Shown::drawn(p.edges.len(), plotted, primary, expected, tunnel);
         debug_assert!(
-            Shown::of(r, options, &mut Vec::new()).same_drawn(now),
+            Shown::of(r, options, &mut Vec::new()) == now,
             "Shown::of disagrees with the rows drawn"
         );
         transition_rows(&mut out, r.ball, now);
@@ -247,17 +247,16 @@ fn series_styles(
 ) -> Result<(), RecordingStreamError> {
     for bit in 0..PLOT_BITS {
         let entity = plot_entity(b, bit);
-        let name = match entity {
-            Entity::Quadratic(_, i) => ["A", "B", "C", "discriminant", "s0", "s1"][i],
-            Entity::Face(_, i) => ["h0", "h1", "β"][i],
-            _ => continue,
+        let names: &[&str] = match entity {
+            Entity::Quadratic(_) => &paths::QUADRATIC_NAMES,
+            _ => &paths::FACE_NAMES,
         };
         let mut batches = SeriesLines::new()
-            .with_names([name])
+            .with_names(names.iter().copied())
             .as_serialized_batches();
         batches.extend(
             SeriesPoints::new()
-                .with_names([name])
+                .with_names(names.iter().copied())
                 .with_marker_sizes([2.5])
                 .as_serialized_batches(),
         );

@@ -33,35 +33,32 @@ use crate::trace::messages::OutcomeMsg;
 /// Component sets: the rows of one entity with the same set number have the
 /// same components (see `columns::Columns::row`).
 pub(crate) mod set {
-    pub const SPHERES: u8 = 0;
-    pub const SWEEP: u8 = 1;
-    pub const CONTACT: u8 = 2;
-    pub const NORMAL: u8 = 3;
+    /// A ball's sweep: balls, swept volume, contact, normal.
+    pub const BALL: u8 = 0;
     pub const CLEAR: u8 = 4;
-    pub const TRIANGLE: u8 = 5;
-    pub const LABELED_STRIP: u8 = 6;
-    pub const LABELED_POINT: u8 = 7;
-    pub const STRIP: u8 = 9;
-    pub const CYLINDER: u8 = 10;
-    pub const EDGE_POINTS: u8 = 11;
+    /// The primary triangle, its outline and decisive edge, its vertex.
+    pub const PRIMARY: u8 = 5;
     pub const SCALAR: u8 = 12;
     pub const KIND: u8 = 13;
     pub const TEXT_LOG: u8 = 14;
     pub const FOCUS: u8 = 15;
-    /// An edge frame's transform and its test's numbers.
+    /// An edge frame: its transform, its test's numbers and what is drawn
+    /// in it.
     pub const EDGE_FRAME: u8 = 16;
-    pub const AXES: u8 = 20;
-    pub const EXPECTED_BALL: u8 = 21;
+    /// [`EDGE_FRAME`] with the frame's axes (slot 0).
+    pub const EDGE_FRAME_AXES: u8 = 17;
+    pub const EXPECTED: u8 = 21;
     pub const TUNNEL: u8 = 22;
 }
 
 /// What a sweep's rows leave shown for its ball, of the entities that are
-/// cleared when a sweep no longer shows them: the contact and its normal,
-/// the primary triangle and outline, the primary edge, the primary vertex,
-/// the edge frames, the plot series, the expected outcome, the tunnel
-/// marker. A ball's rows clear one of them only when the ball's previous
-/// sweep showed it, right after the sweep's own rows (so that a clear
-/// keeps its place among the sweeps of one frame).
+/// cleared when a sweep no longer logs them: the primary triangle, the edge
+/// frames, the plot series, the expected outcome, the tunnel marker. A
+/// ball's rows clear one of them only when the ball's previous sweep showed
+/// it, right after the sweep's own rows (so that a clear keeps its place
+/// among the sweeps of one frame). (The contact, the normal, the decisive
+/// edge and vertex are parts of rows logged at every sweep that can show
+/// them, logged empty when not shown.)
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct Shown {
     bits: u8,
@@ -72,10 +69,7 @@ pub struct Shown {
 }
 
 impl Shown {
-    const CONTACT: u8 = 1;
     const PRIMARY: u8 = 2;
-    const EDGE: u8 = 4;
-    const VERTEX: u8 = 8;
     const EXPECTED: u8 = 16;
     const TUNNEL: u8 = 32;
 
@@ -87,19 +81,11 @@ impl Shown {
         edges: &mut Vec<EdgeRecord>,
     ) -> Shown {
         let mut bits = 0;
-        if r.outcome.contact.is_some() && r.outcome.normal.is_some() {
-            bits |= Shown::CONTACT;
-        }
         let decisive = r.decisive_record();
         if let Some(t) = decisive
             && r.scene.mesh.triangle_by_index(t.triangle()).is_some()
         {
-            bits |= Shown::PRIMARY
-                | match t {
-                    TestRecord::Edge(_) => Shown::EDGE,
-                    TestRecord::Vertex(_) => Shown::VERTEX,
-                    TestRecord::Face(_) => 0,
-                };
+            bits |= Shown::PRIMARY;
         }
         if r.expected.is_some() && !divergence(r, &options.tolerances).is_empty() {
             bits |= Shown::EXPECTED;
@@ -119,42 +105,44 @@ impl Shown {
         self.bits & bit != 0
     }
 
-    /// What the rows drawn for a sweep show of what [`transition_rows`]
-    /// clears: `edge_slots` edge frames, the `plotted` plot entities,
-    /// whether the expected outcome and a tunnel marker were drawn (the rest
-    /// is cleared where it is drawn, from the previous sweep's `Shown::of`).
-    pub(crate) fn drawn(edge_slots: usize, plotted: u16, expected: bool, tunnel: bool) -> Shown {
+    /// What the rows drawn for a sweep show: `edge_slots` edge frames, the
+    /// `plotted` plot entities, whether the primary triangle, the expected
+    /// outcome and a tunnel marker were drawn.
+    pub(crate) fn drawn(
+        edge_slots: usize,
+        plotted: u16,
+        primary: bool,
+        expected: bool,
+        tunnel: bool,
+    ) -> Shown {
         let bit = |on: bool, b: u8| if on { b } else { 0 };
         Shown {
-            bits: bit(expected, Shown::EXPECTED) | bit(tunnel, Shown::TUNNEL),
+            bits: bit(primary, Shown::PRIMARY)
+                | bit(expected, Shown::EXPECTED)
+                | bit(tunnel, Shown::TUNNEL),
             edge_slots: u8::try_from(edge_slots).unwrap_or(u8::MAX),
             plotted,
         }
     }
-
-    /// Whether `self` and `drawn` agree on what [`transition_rows`] clears.
-    pub(crate) fn same_drawn(self, drawn: Shown) -> bool {
-        let mask = Shown::EXPECTED | Shown::TUNNEL;
-        (self.bits & mask, self.edge_slots, self.plotted)
-            == (drawn.bits & mask, drawn.edge_slots, drawn.plotted)
-    }
 }
 
 /// Clears, at ball `b`'s sweep that shows `now`, what its previous sweep
-/// showed (`out.before`) and this one does not, of the edge frames, plot
-/// series, expected outcome and tunnel marker (the rest is cleared where it
-/// is drawn).
+/// showed (`out.before`) and this one does not log: the primary triangle,
+/// edge frames, plot series, expected outcome and tunnel marker.
 pub(crate) fn transition_rows(out: &mut Out<'_>, b: u32, now: Shown) {
     let before = out.before;
+    if before.has(Shown::PRIMARY) && !now.has(Shown::PRIMARY) {
+        out.clear(Entity::Primary(b), false);
+    }
     for slot in now.edge_slots..before.edge_slots {
-        out.clear(Entity::EdgeFrame(b, usize::from(slot)), true);
+        out.clear(Entity::EdgeFrame(b, usize::from(slot)), false);
     }
     let gone = before.plotted & !now.plotted;
     for bit in (0..PLOT_BITS).filter(|bit| gone & (1 << bit) != 0) {
         out.clear(plot_entity(b, bit), false);
     }
     if before.has(Shown::EXPECTED) && !now.has(Shown::EXPECTED) {
-        out.clear(Entity::Expected(b), true);
+        out.clear(Entity::Expected(b), false);
     }
     if before.has(Shown::TUNNEL) && !now.has(Shown::TUNNEL) {
         out.clear(Entity::Tunnel(b), false);
@@ -179,35 +167,24 @@ impl Out<'_> {
         self.row(entity, set::CLEAR)
             .put::<ClearIsRecursive>(Clear::descriptor_is_recursive, [recursive.into()]);
     }
-
-    /// Clears `entity` (not recursively) if the ball's previous sweep
-    /// showed it (`bit` of [`Shown`]).
-    fn clear_shown(&mut self, entity: Entity, bit: u8) {
-        if self.before.has(bit) {
-            self.clear(entity, false);
-        }
-    }
 }
 
-/// Bits of [`plot_rows`]'s answer: which plot entities got a value.
-pub(crate) const QUADRATIC_BITS: u16 = 0;
-pub(crate) const FACE_BITS: u16 = QUADRATIC_NAMES.len() as u16;
-
-/// The plot entity of bit `bit` (see [`plot_rows`]).
+/// The plot entities of the decisive test's numbers, by their bit in
+/// [`plot_bits`]'s answer.
 pub(crate) fn plot_entity(ball: u32, bit: u16) -> Entity {
-    if bit < FACE_BITS {
-        Entity::Quadratic(ball, (bit - QUADRATIC_BITS) as usize)
-    } else {
-        Entity::Face(ball, (bit - FACE_BITS) as usize)
+    match bit {
+        0 => Entity::Quadratic(ball),
+        _ => Entity::Face(ball),
     }
 }
 
 /// How many plot bits there are.
-pub(crate) const PLOT_BITS: u16 = FACE_BITS + FACE_NAMES.len() as u16;
+pub(crate) const PLOT_BITS: u16 = 2;
 
 /// The ball at p0, at the contact and at p1, the swept volume, the contact
-/// and the normal. No labels: the numbers are in the decision line.
-pub(crate) fn sweep_rows(out: &mut Out<'_>, r: &SweepResult) {
+/// and the normal, in one row (the contact and the normal empty when
+/// nothing is hit). No labels: the numbers are in the decision line.
+pub(crate) fn ball_row(out: &mut Out<'_>, r: &SweepResult) {
     let b = r.ball;
     let o = &r.outcome;
     let p0 = r.sweep.p0;
@@ -217,72 +194,70 @@ pub(crate) fn sweep_rows(out: &mut Out<'_>, r: &SweepResult) {
     let at_contact = p0 + d * o.alpha;
 
     let hit = o.is_hit();
-    let n = if hit { 3 } else { 2 };
     let contact_center = hit.then(|| f32x3(at_contact.coords));
     let contact_color = hit.then(|| rgba(CONTACT_BALL_COLOR));
-    out.row(Entity::Spheres(b), set::SPHERES)
-        .put::<HalfSize3D>(
-            Ellipsoids3D::descriptor_half_sizes,
-            std::iter::repeat_n(HalfSize3D::splat(radius), n),
-        )
-        .put::<Translation3D>(
-            Ellipsoids3D::descriptor_centers,
-            once(f32x3(p0.coords))
-                .chain(contact_center)
-                .chain(once(f32x3(r.sweep.p1.coords)))
-                .map(Translation3D::from),
-        )
-        .put::<Color>(
-            Ellipsoids3D::descriptor_colors,
-            once(rgba(P0_COLOR))
-                .chain(contact_color)
-                .chain(once(rgba(P1_COLOR))),
-        )
-        .put::<FillMode>(Ellipsoids3D::descriptor_fill_mode, [FillMode::Solid]);
-
-    // The swept volume at the detection radius.
     let (length, rotation) = capsule_pose(&d);
-    out.row(Entity::Sweep(b), set::SWEEP)
-        .put::<Length>(Capsules3D::descriptor_lengths, [length.into()])
-        .put::<Radius>(Capsules3D::descriptor_radii, [(rho as f32).into()])
-        .put::<Translation3D>(
-            Capsules3D::descriptor_translations,
-            [f32x3(p0.coords).into()],
-        )
-        .put::<RotationQuat>(Capsules3D::descriptor_quaternions, [rotation.into()])
-        .put::<Color>(Capsules3D::descriptor_colors, [rgba(SWEEP_COLOR)])
-        .put::<FillMode>(Capsules3D::descriptor_fill_mode, [FillMode::MajorWireframe]);
-
-    match (o.contact, o.normal) {
-        (Some(c), Some(nrm)) => {
-            contact_row(out, Entity::Contact(b), f32x3(c.coords), HIT_COLOR);
-            normal_row(
-                out,
-                Entity::Normal(b),
-                f32x3(c.coords),
-                f32x3(nrm * (r.sweep.radius.max(1e-3) * 1.5)),
-                NORMAL_COLOR,
-            );
-        }
-        _ => {
-            out.clear_shown(Entity::Contact(b), Shown::CONTACT);
-            out.clear_shown(Entity::Normal(b), Shown::CONTACT);
-        }
-    }
+    let contact = o.contact.zip(o.normal);
+    let mut row = out.row(Entity::Ball(b), set::BALL);
+    // One half size for the two or three balls (the viewer repeats it).
+    row.put::<HalfSize3D>(
+        Ellipsoids3D::descriptor_half_sizes,
+        [HalfSize3D::splat(radius)],
+    )
+    .put::<Translation3D>(
+        Ellipsoids3D::descriptor_centers,
+        once(f32x3(p0.coords))
+            .chain(contact_center)
+            .chain(once(f32x3(r.sweep.p1.coords)))
+            .map(Translation3D::from),
+    )
+    .put::<Color>(
+        Ellipsoids3D::descriptor_colors,
+        once(rgba(P0_COLOR))
+            .chain(contact_color)
+            .chain(once(rgba(P1_COLOR))),
+    )
+    .put::<FillMode>(Ellipsoids3D::descriptor_fill_mode, [FillMode::Solid])
+    // The swept volume at the detection radius.
+    .put::<Length>(Capsules3D::descriptor_lengths, [length.into()])
+    .put::<Radius>(Capsules3D::descriptor_radii, [(rho as f32).into()])
+    .put::<Translation3D>(
+        Capsules3D::descriptor_translations,
+        [f32x3(p0.coords).into()],
+    )
+    .put::<RotationQuat>(Capsules3D::descriptor_quaternions, [rotation.into()])
+    .put::<Color>(Capsules3D::descriptor_colors, [rgba(SWEEP_COLOR)])
+    .put::<FillMode>(Capsules3D::descriptor_fill_mode, [FillMode::MajorWireframe]);
+    contact_parts(
+        &mut row,
+        contact.map(|(c, _)| f32x3(c.coords)),
+        contact.map(|(_, nrm)| f32x3(nrm * (r.sweep.radius.max(1e-3) * 1.5))),
+        [HIT_COLOR, NORMAL_COLOR],
+    );
 }
 
-fn contact_row(out: &mut Out<'_>, entity: Entity, at: [f32; 3], color: [u8; 4]) {
-    out.row(entity, set::CONTACT)
-        .put::<Position3D>(Points3D::descriptor_positions, [at.into()])
+/// The `Points3D` and `Arrows3D` parts of a row: a contact point (or none)
+/// and its normal drawn from it (when both are given; else none), in
+/// `colors` (point, arrow).
+fn contact_parts(
+    row: &mut Row<'_>,
+    at: Option<[f32; 3]>,
+    normal: Option<[f32; 3]>,
+    colors: [[u8; 4]; 2],
+) {
+    let arrow = at.zip(normal);
+    row.put::<Position3D>(Points3D::descriptor_positions, at.map(Position3D::from))
         .put::<Radius>(Points3D::descriptor_radii, [ui_points(5.0)])
-        .put::<Color>(Points3D::descriptor_colors, [rgba(color)]);
-}
-
-fn normal_row(out: &mut Out<'_>, entity: Entity, from: [f32; 3], v: [f32; 3], color: [u8; 4]) {
-    out.row(entity, set::NORMAL)
-        .put::<Vector3D>(Arrows3D::descriptor_vectors, [v.into()])
-        .put::<Position3D>(Arrows3D::descriptor_origins, [from.into()])
-        .put::<Color>(Arrows3D::descriptor_colors, [rgba(color)]);
+        .put::<Color>(Points3D::descriptor_colors, [rgba(colors[0])])
+        .put::<Vector3D>(
+            Arrows3D::descriptor_vectors,
+            arrow.map(|(_, v)| Vector3D::from(v)),
+        )
+        .put::<Position3D>(
+            Arrows3D::descriptor_origins,
+            arrow.map(|(p, _)| Position3D::from(p)),
+        )
+        .put::<Color>(Arrows3D::descriptor_colors, [rgba(colors[1])]);
 }
 
 /// The transform the view that follows ball `r.ball` looks from: at the
@@ -331,9 +306,10 @@ pub(crate) fn focus_rows(
         );
 }
 
-/// The primary (or nearest-miss) triangle: filled, its three edges
-/// outlined, its decisive edge bold or its vertex as a point; one label, on
-/// the decisive feature.
+/// The primary (or nearest-miss) triangle, in one row: filled, its three
+/// edges outlined, its decisive edge bold (a second strip) or its vertex as
+/// a point; one label, on the decisive feature. Returns whether it was
+/// drawn (when not, [`transition_rows`] clears it).
 ///
 /// A nearest miss is labelled only for the followed ball (`followed`), so
 /// that the balls that hit nothing do not cover the picture with labels.
@@ -342,89 +318,72 @@ pub(crate) fn primary_rows(
     r: &SweepResult,
     decisive: Option<&TestRecord>,
     followed: bool,
-) {
+) -> bool {
     let b = r.ball;
     let triangle = decisive.and_then(|t| r.scene.mesh.triangle_by_index(t.triangle()));
     let (Some(t), Some(test)) = (triangle, decisive) else {
-        out.clear_shown(Entity::PrimaryTriangle(b), Shown::PRIMARY);
-        out.clear_shown(Entity::PrimaryOutline(b), Shown::PRIMARY);
-        out.clear_shown(Entity::PrimaryEdge(b), Shown::EDGE);
-        out.clear_shown(Entity::PrimaryVertex(b), Shown::VERTEX);
-        return;
+        return false;
     };
     let hit = test.alpha().is_some();
     let color = if hit { HIT_COLOR } else { MISS_COLOR };
     // Lift the highlight a little off the mesh so it is not hidden by it.
     let lift = t.normal * (r.rho() * 0.02);
     let verts: [[f32; 3]; 3] = std::array::from_fn(|i| f32x3(t.vertices[i].coords + lift));
-    out.row(Entity::PrimaryTriangle(b), set::TRIANGLE)
-        .put::<Position3D>(
-            Mesh3D::descriptor_vertex_positions,
-            verts.map(Position3D::from),
-        )
-        .put::<TriangleIndices>(Mesh3D::descriptor_triangle_indices, [[0u32, 1, 2].into()])
-        .put::<AlbedoFactor>(
-            Mesh3D::descriptor_albedo_factor,
-            [albedo([color[0], color[1], color[2], 90]).into()],
-        );
     let label = Label(test);
     let prefix = if hit { "" } else { "nearest miss: " };
     let labelled = hit || followed;
-    let is_face = labelled && matches!(test, TestRecord::Face(_));
-    out.row(Entity::PrimaryOutline(b), set::LABELED_STRIP)
-        .put_strip(
-            LineStrips3D::descriptor_strips,
-            &[verts[0], verts[1], verts[2], verts[0]],
-        )
-        .put::<Radius>(LineStrips3D::descriptor_radii, [ui_points(OUTLINE_POINTS)])
-        .put::<Color>(LineStrips3D::descriptor_colors, [rgba(color)])
-        .put_texts(LineStrips3D::descriptor_labels, |s| {
-            if is_face {
+    let f = test.feature() as usize % 3;
+    let outline = [verts[0], verts[1], verts[2], verts[0]];
+    let bold = [verts[f], verts[(f + 1) % 3]];
+    let (strips, radii): (&[&[[f32; 3]]], &[f32]) = match test {
+        TestRecord::Edge(_) => (&[&outline, &bold], &[OUTLINE_POINTS, BOLD_EDGE_POINTS]),
+        _ => (&[&outline], &[OUTLINE_POINTS]),
+    };
+    let vertex = matches!(test, TestRecord::Vertex(_)).then(|| Position3D::from(verts[f]));
+    let mut row = out.row(Entity::Primary(b), set::PRIMARY);
+    row.put::<Position3D>(
+        Mesh3D::descriptor_vertex_positions,
+        verts.map(Position3D::from),
+    )
+    .put::<TriangleIndices>(Mesh3D::descriptor_triangle_indices, [[0u32, 1, 2].into()])
+    .put::<AlbedoFactor>(
+        Mesh3D::descriptor_albedo_factor,
+        [albedo([color[0], color[1], color[2], 90]).into()],
+    )
+    .put_strips(LineStrips3D::descriptor_strips, strips)
+    .put::<Radius>(
+        LineStrips3D::descriptor_radii,
+        radii.iter().map(|&p| ui_points(p)),
+    )
+    .put::<Color>(LineStrips3D::descriptor_colors, [rgba(color)])
+    .put_texts(LineStrips3D::descriptor_labels, |s| {
+        // On the outline for a face test, on the bold edge for an edge
+        // test (the outline's label then empty, which is not drawn).
+        match test {
+            TestRecord::Face(_) if labelled => {
                 s.push_fmt(format_args!("{prefix}{label}"));
             }
-        });
-    let f = test.feature() as usize % 3;
-    match test {
-        TestRecord::Edge(_) => {
-            out.row(Entity::PrimaryEdge(b), set::LABELED_STRIP)
-                .put_strip(
-                    LineStrips3D::descriptor_strips,
-                    &[verts[f], verts[(f + 1) % 3]],
-                )
-                .put::<Radius>(
-                    LineStrips3D::descriptor_radii,
-                    [ui_points(BOLD_EDGE_POINTS)],
-                )
-                .put::<Color>(LineStrips3D::descriptor_colors, [rgba(color)])
-                .put_texts(LineStrips3D::descriptor_labels, |s| {
-                    if labelled {
-                        s.push_fmt(format_args!("{prefix}{label}"));
-                    }
-                });
-            out.clear_shown(Entity::PrimaryVertex(b), Shown::VERTEX);
+            TestRecord::Edge(_) if labelled => {
+                s.push_fmt(format_args!(""));
+                s.push_fmt(format_args!("{prefix}{label}"));
+            }
+            _ => {}
         }
-        TestRecord::Vertex(_) => {
-            out.row(Entity::PrimaryVertex(b), set::LABELED_POINT)
-                .put::<Position3D>(Points3D::descriptor_positions, [verts[f].into()])
-                .put::<Radius>(Points3D::descriptor_radii, [ui_points(VERTEX_POINTS)])
-                .put::<Color>(Points3D::descriptor_colors, [rgba(color)])
-                .put_texts(Points3D::descriptor_labels, |s| {
-                    if labelled {
-                        s.push_fmt(format_args!("{prefix}{label}"));
-                    }
-                });
-            out.clear_shown(Entity::PrimaryEdge(b), Shown::EDGE);
+    })
+    .put::<Position3D>(Points3D::descriptor_positions, vertex)
+    .put::<Radius>(Points3D::descriptor_radii, [ui_points(VERTEX_POINTS)])
+    .put::<Color>(Points3D::descriptor_colors, [rgba(color)])
+    .put_texts(Points3D::descriptor_labels, |s| {
+        if labelled && vertex.is_some() {
+            s.push_fmt(format_args!("{prefix}{label}"));
         }
-        TestRecord::Face(_) => {
-            out.clear_shown(Entity::PrimaryEdge(b), Shown::EDGE);
-            out.clear_shown(Entity::PrimaryVertex(b), Shown::VERTEX);
-        }
-    }
+    });
+    true
 }
 
-/// The expected outcome beside the replayed one, for a divergent sweep:
-/// the ball at the expected α, the expected contact and normal (when the
-/// expectation names them).
+/// The expected outcome beside the replayed one, for a divergent sweep, in
+/// one row: the ball at the expected α, the expected contact and normal
+/// (when the expectation names them; else none).
 pub(crate) fn expected_rows(out: &mut Out<'_>, r: &SweepResult, e: &OutcomeMsg) {
     let b = r.ball;
     let p0 = r.sweep.p0;
@@ -435,52 +394,37 @@ pub(crate) fn expected_rows(out: &mut Out<'_>, r: &SweepResult, e: &OutcomeMsg) 
         1.0
     };
     let center = p0 + d * alpha;
-    out.row(Entity::ExpectedBall(b), set::EXPECTED_BALL)
-        .put::<HalfSize3D>(
-            Ellipsoids3D::descriptor_half_sizes,
-            [HalfSize3D::splat(r.sweep.radius as f32)],
-        )
-        .put::<Translation3D>(
-            Ellipsoids3D::descriptor_centers,
-            [f32x3(center.coords).into()],
-        )
-        .put::<Color>(Ellipsoids3D::descriptor_colors, [rgba(EXPECTED_COLOR)])
-        .put::<FillMode>(
-            Ellipsoids3D::descriptor_fill_mode,
-            [FillMode::MajorWireframe],
-        )
-        .put_fmt(
-            Ellipsoids3D::descriptor_labels,
-            format_args!("expected: {}", e.kind),
-        );
-    let contact = e.contact.flatten();
-    match contact {
-        Some(c) => contact_row(
-            out,
-            Entity::ExpectedContact(b),
-            c.map(|x| x as f32),
-            EXPECTED_COLOR,
-        ),
-        None => out.clear(Entity::ExpectedContact(b), false),
-    }
-    match (e.normal.flatten(), contact) {
-        (Some(n), Some(c)) => {
+    let contact = e.contact.flatten().map(|c| c.map(|x| x as f32));
+    let normal = match (e.normal.flatten(), contact) {
+        (Some(n), Some(_)) => {
             let len = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
-            if len > 0.0 && len.is_finite() {
+            (len > 0.0 && len.is_finite()).then(|| {
                 let k = r.sweep.radius.max(1e-3) * 1.5 / len;
-                normal_row(
-                    out,
-                    Entity::ExpectedNormal(b),
-                    c.map(|x| x as f32),
-                    n.map(|x| (x * k) as f32),
-                    EXPECTED_COLOR,
-                );
-            } else {
-                out.clear(Entity::ExpectedNormal(b), false);
-            }
+                n.map(|x| (x * k) as f32)
+            })
         }
-        _ => out.clear(Entity::ExpectedNormal(b), false),
-    }
+        _ => None,
+    };
+    let mut row = out.row(Entity::Expected(b), set::EXPECTED);
+    row.put::<HalfSize3D>(
+        Ellipsoids3D::descriptor_half_sizes,
+        [HalfSize3D::splat(r.sweep.radius as f32)],
+    )
+    .put::<Translation3D>(
+        Ellipsoids3D::descriptor_centers,
+        [f32x3(center.coords).into()],
+    )
+    .put::<Color>(Ellipsoids3D::descriptor_colors, [rgba(EXPECTED_COLOR)])
+    .put::<FillMode>(
+        Ellipsoids3D::descriptor_fill_mode,
+        [FillMode::MajorWireframe],
+    )
+    .put_fmt(
+        Ellipsoids3D::descriptor_labels,
+        format_args!("expected: {}", e.kind),
+    );
+    // The contact point alone when the normal is missing or unusable.
+    contact_parts(&mut row, contact, normal, [EXPECTED_COLOR; 2]);
 }
 
 /// A `Scalars` row.
@@ -489,66 +433,55 @@ fn scalar(out: &mut Out<'_>, entity: Entity, v: f64) {
         .put::<Scalar>(Scalars::descriptor_scalars, [v.into()]);
 }
 
-/// Which plot entities the decisive test's numbers go to (bit `i` for
-/// `plot_entity(ball, i)`): those of its values that are finite.
-pub(crate) fn plot_bits(decisive: Option<&TestRecord>) -> u16 {
-    let bits = |values: &[Option<f64>], first: u16| {
-        values
-            .iter()
-            .enumerate()
-            .filter(|(_, v)| v.is_some_and(f64::is_finite))
-            .fold(0u16, |acc, (i, _)| acc | 1 << (first + i as u16))
-    };
+/// The decisive test's numbers for the plots: its plot bit (see
+/// [`plot_entity`]) and its values, a series each (`None` where the test
+/// has no such value).
+fn plot_values(decisive: Option<&TestRecord>) -> Option<(u16, [Option<f64>; 6])> {
     let quadratic = |a, b, c, d, roots: Option<(f64, f64)>| {
         let (s0, s1) = roots.unzip();
-        bits(
-            &[Some(a), Some(b), Some(c), Some(d), s0, s1],
-            QUADRATIC_BITS,
-        )
+        (0, [Some(a), Some(b), Some(c), Some(d), s0, s1])
     };
-    match decisive {
-        Some(TestRecord::Edge(e)) => quadratic(e.a, e.b, e.c, e.discriminant, e.roots),
-        Some(TestRecord::Vertex(v)) => quadratic(v.a, v.b, v.c, v.discriminant, v.roots),
-        Some(TestRecord::Face(f)) => bits(&[Some(f.h0), Some(f.h1), f.beta], FACE_BITS),
-        None => 0,
+    Some(match decisive? {
+        TestRecord::Edge(e) => quadratic(e.a, e.b, e.c, e.discriminant, e.roots),
+        TestRecord::Vertex(v) => quadratic(v.a, v.b, v.c, v.discriminant, v.roots),
+        TestRecord::Face(f) => (1, [Some(f.h0), Some(f.h1), f.beta, None, None, None]),
+    })
+}
+
+/// Which plot entities the decisive test's numbers go to (bit `i` for
+/// `plot_entity(ball, i)`): the test's entity when one of its values is
+/// finite.
+pub(crate) fn plot_bits(decisive: Option<&TestRecord>) -> u16 {
+    match plot_values(decisive) {
+        Some((bit, values)) if values.iter().flatten().any(|v| v.is_finite()) => 1 << bit,
+        _ => 0,
     }
 }
 
-/// The α plot and the decisive test's numbers; returns which plot entities
-/// got a value (bit `i` for `plot_entity(ball, i)`, as [`plot_bits`]).
+/// The α plot and the decisive test's numbers (one row of a series each,
+/// NaN, which breaks a series' line, where a value is missing or not
+/// finite); returns which plot entities got a row (as [`plot_bits`]).
 pub(crate) fn plot_rows(out: &mut Out<'_>, r: &SweepResult, decisive: Option<&TestRecord>) -> u16 {
     let b = r.ball;
     // One row: α and the kind beside it.
     out.row(Entity::Alpha(b), set::KIND)
         .put::<Scalar>(Scalars::descriptor_scalars, [r.outcome.alpha.into()])
         .put_strs(|| any_value::<Text>("kind"), [r.outcome.kind.as_str()]);
-    let mut plotted = 0u16;
-    let mut quadratic = |a: f64, bb: f64, c: f64, disc: f64, roots: Option<(f64, f64)>| {
-        let (s0, s1) = roots.unzip();
-        for (i, v) in [Some(a), Some(bb), Some(c), Some(disc), s0, s1]
-            .into_iter()
-            .enumerate()
-        {
-            if let Some(v) = v.filter(|v| v.is_finite()) {
-                scalar(out, Entity::Quadratic(b, i), v);
-                plotted |= 1 << (QUADRATIC_BITS + i as u16);
-            }
-        }
-    };
-    match decisive {
-        Some(TestRecord::Edge(e)) => quadratic(e.a, e.b, e.c, e.discriminant, e.roots),
-        Some(TestRecord::Vertex(v)) => quadratic(v.a, v.b, v.c, v.discriminant, v.roots),
-        Some(TestRecord::Face(f)) => {
-            for (i, v) in [Some(f.h0), Some(f.h1), f.beta].into_iter().enumerate() {
-                if let Some(v) = v.filter(|v| v.is_finite()) {
-                    scalar(out, Entity::Face(b, i), v);
-                    plotted |= 1 << (FACE_BITS + i as u16);
-                }
-            }
-        }
-        None => {}
+    let bits = plot_bits(decisive);
+    if let Some((bit, values)) = plot_values(decisive).filter(|_| bits != 0) {
+        let n = if bit == 0 {
+            QUADRATIC_NAMES.len()
+        } else {
+            FACE_NAMES.len()
+        };
+        out.row(plot_entity(b, bit), set::SCALAR).put::<Scalar>(
+            Scalars::descriptor_scalars,
+            values[..n]
+                .iter()
+                .map(|v| v.filter(|v| v.is_finite()).unwrap_or(f64::NAN).into()),
+        );
     }
-    plotted
+    bits
 }
 
 /// The decision in words; for a divergent sweep (`diffs` not empty) also

@@ -13,6 +13,17 @@ pub(crate) const CYLINDER_COLOR: [u8; 4] = [255, 120, 120, 255];
 pub(crate) const PATH_COLOR: [u8; 4] = [80, 140, 255, 255];
 pub(crate) const AXIS_COLORS: [[u8; 4]; 3] =
     [[220, 60, 60, 255], [60, 200, 60, 255], [70, 110, 240, 255]];
+/// The colors of the series of a plot with several (A, B, C, discriminant,
+/// s0, s1; h0, h1, β take the first three): distinct on the viewer's dark
+/// background.
+pub(crate) const SERIES_COLORS: [[u8; 4]; 6] = [
+    [240, 200, 60, 255],
+    [90, 180, 250, 255],
+    [240, 110, 190, 255],
+    [160, 160, 160, 255],
+    [90, 210, 120, 255],
+    [250, 140, 60, 255],
+];
 
 /// Line radii in UI points (the same on screen at every zoom).
 pub(crate) const WIREFRAME_POINTS: f32 = 0.75;

@@ -54,6 +54,88 @@ pub(crate) enum Slot0 {
     Expected,
 }
 
+/// Where slot 0's edge test comes from.
+#[derive(Clone, Copy, Debug)]
+enum First<'r> {
+    /// A test the core recorded.
+    Recorded(&'r EdgeRecord),
+    /// The nearest of the three edge tests of this triangle, to run here.
+    Nearest(u32),
+    /// This edge test (triangle, edge), to run here.
+    Edge(u32, u8),
+}
+
+/// Slot 0's edge test and what it is, without running any test (see
+/// [`choose_edges`]). A test to run here is named only when it can run
+/// (its triangle exists and the sweep is valid); it is then of a triangle
+/// none of whose edge tests was recorded.
+fn choose_first<'r>(
+    r: &'r SweepResult,
+    decisive: Option<&'r TestRecord>,
+) -> Option<(First<'r>, Slot0)> {
+    let recorded = r.records.iter().filter_map(|t| match t {
+        TestRecord::Edge(e) => Some(e),
+        _ => None,
+    });
+    let best = |of: &mut dyn Iterator<Item = &'r EdgeRecord>| {
+        of.fold(None::<&EdgeRecord>, |first, e| match first {
+            Some(f) if !better(e, f) => Some(f),
+            _ => Some(e),
+        })
+    };
+    let can_run = |triangle: u32| {
+        r.scene.mesh.triangle_by_index(triangle).is_some()
+            && SweptPath::new(&r.sweep, &r.options).is_ok()
+    };
+    match decisive {
+        Some(TestRecord::Edge(e)) => Some((First::Recorded(e), Slot0::Decisive)),
+        Some(t) => {
+            let triangle = t.triangle();
+            match best(&mut recorded.filter(|e| e.triangle == triangle)) {
+                Some(e) => Some((First::Recorded(e), Slot0::Nearest)),
+                None => can_run(triangle).then_some((First::Nearest(triangle), Slot0::Nearest)),
+            }
+        }
+        None => {
+            if let Some(e) = best(&mut recorded.clone()) {
+                return Some((First::Recorded(e), Slot0::Nearest));
+            }
+            let e = r.expected?;
+            let triangle = e.triangle.flatten()?;
+            let first = match (e.kind, e.feature) {
+                (Kind::Edge, Some(Some(edge))) if edge < 3 => First::Edge(triangle, edge),
+                _ => First::Nearest(triangle),
+            };
+            can_run(triangle).then_some((first, Slot0::Expected))
+        }
+    }
+}
+
+/// The edge tests recorded for `r` other than `first` (by triangle and
+/// edge).
+fn others<'r>(r: &'r SweepResult, first: &First<'_>) -> impl Iterator<Item = &'r EdgeRecord> {
+    let key = match first {
+        First::Recorded(e) => Some((e.triangle, e.edge)),
+        // No edge test of that triangle was recorded.
+        First::Nearest(_) | First::Edge(..) => None,
+    };
+    r.records.iter().filter_map(move |t| match t {
+        TestRecord::Edge(e) if key != Some((e.triangle, e.edge)) => Some(e),
+        _ => None,
+    })
+}
+
+/// How many edge tests [`choose_edges`] chooses, without running any.
+pub(crate) fn count_edges(r: &SweepResult, decisive: Option<&TestRecord>, max: usize) -> usize {
+    if max == 0 {
+        return 0;
+    }
+    match choose_first(r, decisive) {
+        Some((first, _)) => (1 + others(r, &first).count()).min(max),
+        None => 0,
+    }
+}
+
 /// Chooses the edge tests to show into `edges` (slot order, at most `max`).
 /// Returns what slot 0 is.
 pub(crate) fn choose_edges(
@@ -66,53 +148,20 @@ pub(crate) fn choose_edges(
     if max == 0 {
         return Slot0::Nearest;
     }
-    let recorded = r.records.iter().filter_map(|t| match t {
-        TestRecord::Edge(e) => Some(e),
-        _ => None,
-    });
-    // Slot 0.
-    let mut first: Option<EdgeRecord> = None;
-    let mut what = Slot0::Nearest;
-    match decisive {
-        Some(TestRecord::Edge(e)) => {
-            first = Some(*e);
-            what = Slot0::Decisive;
-        }
-        Some(t) => {
-            let triangle = t.triangle();
-            for e in recorded.clone().filter(|e| e.triangle == triangle) {
-                if first.as_ref().is_none_or(|f| better(e, f)) {
-                    first = Some(*e);
-                }
-            }
-            if first.is_none() {
-                first = nearest_edge_of(r, triangle);
-            }
-        }
-        None => {
-            for e in recorded.clone() {
-                if first.as_ref().is_none_or(|f| better(e, f)) {
-                    first = Some(*e);
-                }
-            }
-            if first.is_none()
-                && let Some(e) = r.expected
-                && let Some(Some(triangle)) = e.triangle
-            {
-                first = match (e.kind, e.feature) {
-                    (Kind::Edge, Some(Some(edge))) if edge < 3 => edge_of(r, triangle, edge),
-                    _ => nearest_edge_of(r, triangle),
-                };
-                what = Slot0::Expected;
-            }
-        }
-    }
-    let Some(first) = first else {
+    let Some((first, what)) = choose_first(r, decisive) else {
         return Slot0::Nearest;
     };
-    edges.push(first);
+    let test = match first {
+        First::Recorded(e) => Some(*e),
+        First::Nearest(triangle) => nearest_edge_of(r, triangle),
+        First::Edge(triangle, edge) => edge_of(r, triangle, edge),
+    };
+    let Some(test) = test else {
+        return Slot0::Nearest;
+    };
+    edges.push(test);
     let start = edges.len();
-    edges.extend(recorded.filter(|e| !(e.triangle == first.triangle && e.edge == first.edge)));
+    edges.extend(others(r, &first));
     edges[start..].sort_by(|x, y| {
         let (a, b) = (rank(x), rank(y));
         a.0.cmp(&b.0).then(a.1.total_cmp(&b.1))

@@ -14,7 +14,9 @@ use rerun::{
 
 use super::blueprint::{self, Layout};
 use super::columns;
-use super::convert::{MESH_COLOR, WIREFRAME_COLOR, WIREFRAME_POINTS, albedo, f32x3, rgba};
+use super::convert::{
+    MESH_COLOR, SERIES_COLORS, WIREFRAME_COLOR, WIREFRAME_POINTS, albedo, f32x3, rgba,
+};
 use super::edge_frame::{choose_edges, edge_frame_rows};
 use super::paths::{self, Entity};
 use super::rows::{
@@ -44,10 +46,12 @@ pub const DEFAULT_FLUSH_BYTES: usize = 32 << 20;
 /// [`DEFAULT_FLUSH_BYTES`] of a logger that spills ([`Logger::with_spill`]):
 /// its parts are joined into long chunks at the end, so the buffer's size no
 /// longer sets the chunks' length, only how often the buffer is written
-/// out. On the 64-ball session of BENCHMARKS.md, 8 MiB gave 151 MB of max
-/// RSS and 8.8-9.1 s, 16 MiB 176 MB and 8.4-8.7 s, 32 MiB 224 MB and
-/// 7.5-7.7 s (each flush writes one part per entity and set).
-pub const SPILL_FLUSH_BYTES: usize = 16 << 20;
+/// out (each flush writes one part per entity and set). On the 64-ball
+/// sessions of BENCHMARKS.md (one entity per part of a ball's picture),
+/// 8 MiB gave 149-154 MB of max RSS and 5.6-6.3 s, 12 MiB 168-170 MB and
+/// 5.6-6.1 s, 16 MiB 181-184 MB and 5.4-6.0 s; on the 1.2 M-sweep session,
+/// with the file's footer, 166, 188 and 205 MB.
+pub const SPILL_FLUSH_BYTES: usize = 12 << 20;
 
 /// Sweeps per [`PreparedSweeps`] that the command and the bench prepare on
 /// one worker (runs of consecutive sweeps of a batch, cut at this length).
@@ -123,8 +127,6 @@ pub struct Logger {
     balls: BTreeSet<u32>,
     /// What each ball's last sweep handed to [`Logger::shown_before`] shows.
     shown: BTreeMap<u32, Shown>,
-    /// Scratch for [`Shown::of`].
-    scratch: Vec<EdgeRecord>,
     options: LoggerOptions,
     columns: columns::Columns,
     flush_rows: usize,
@@ -226,7 +228,7 @@ pub fn prepare_sweeps_into<'r>(
         // for the ball's next sweep).
         let now = Shown::drawn(p.edges.len(), plotted, primary, expected, tunnel);
         debug_assert!(
-            Shown::of(r, options, &mut Vec::new()) == now,
+            Shown::of(r, options) == now,
             "Shown::of disagrees with the rows drawn"
         );
         transition_rows(&mut out, r.ball, now);
@@ -251,12 +253,15 @@ fn series_styles(
             Entity::Quadratic(_) => &paths::QUADRATIC_NAMES,
             _ => &paths::FACE_NAMES,
         };
+        let colors = || SERIES_COLORS[..names.len()].iter().map(|&c| rgba(c));
         let mut batches = SeriesLines::new()
             .with_names(names.iter().copied())
+            .with_colors(colors())
             .as_serialized_batches();
         batches.extend(
             SeriesPoints::new()
                 .with_names(names.iter().copied())
+                .with_colors(colors())
                 .with_marker_sizes([2.5])
                 .as_serialized_batches(),
         );
@@ -303,7 +308,6 @@ impl Logger {
             rec,
             balls: BTreeSet::new(),
             shown: BTreeMap::new(),
-            scratch: Vec::new(),
             options,
             columns: columns::Columns::default(),
             flush_rows: DEFAULT_FLUSH_ROWS,
@@ -526,7 +530,7 @@ impl Logger {
         results
             .into_iter()
             .map(|r| {
-                let now = Shown::of(r, &self.options.prepare, &mut self.scratch);
+                let now = Shown::of(r, &self.options.prepare);
                 std::mem::replace(self.shown.entry(r.ball).or_default(), now)
             })
             .collect()

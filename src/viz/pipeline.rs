@@ -104,9 +104,7 @@ where
                     batch
                         .par_iter()
                         .filter_map(sweep_of)
-                        .map_init(Vec::new, |scratch, r| {
-                            (r.ball, Shown::of(r, prepare_options, scratch))
-                        })
+                        .map(|r| (r.ball, Shown::of(r, prepare_options)))
                         .collect()
                 });
                 let mut shown = l.shown_before_given(nows).into_iter();

@@ -20,11 +20,11 @@ use super::convert::{
     OUTLINE_POINTS, P0_COLOR, P1_COLOR, SWEEP_COLOR, TUNNEL_COLOR, VERTEX_POINTS, albedo,
     any_value, capsule_pose, f32x3, rgba, ui_points,
 };
-use super::edge_frame::choose_edges;
+use super::edge_frame::count_edges;
 use super::logger::PrepareOptions;
 use super::paths::{Entity, FACE_NAMES, QUADRATIC_NAMES};
 use crate::core::explain::Label;
-use crate::core::{EdgeRecord, Kind, TestRecord};
+use crate::core::{Kind, TestRecord};
 use crate::regress::FieldDiff;
 use crate::regress::decision::{divergence, write_decision_line, write_divergence_line};
 use crate::replay::SweepResult;
@@ -74,12 +74,8 @@ impl Shown {
     const TUNNEL: u8 = 32;
 
     /// What the rows of `r` show, as the logger with `options` draws them
-    /// (`edges`: scratch for the edge tests chosen).
-    pub(crate) fn of(
-        r: &SweepResult,
-        options: &PrepareOptions,
-        edges: &mut Vec<EdgeRecord>,
-    ) -> Shown {
+    /// (worked out without drawing them or running any test).
+    pub(crate) fn of(r: &SweepResult, options: &PrepareOptions) -> Shown {
         let mut bits = 0;
         let decisive = r.decisive_record();
         if let Some(t) = decisive
@@ -93,10 +89,10 @@ impl Shown {
         if !r.tunnels.is_empty() {
             bits |= Shown::TUNNEL;
         }
-        choose_edges(edges, r, decisive, options.max_edge_frames);
+        let edges = count_edges(r, decisive, options.max_edge_frames);
         Shown {
             bits,
-            edge_slots: u8::try_from(edges.len()).unwrap_or(u8::MAX),
+            edge_slots: u8::try_from(edges).unwrap_or(u8::MAX),
             plotted: plot_bits(decisive),
         }
     }

@@ -51,6 +51,8 @@ pub fn tests() -> Vec<Trial> {
         trial!(viewer_and_check_agree_on_divergences),
         trial!(flush_by_bytes_keeps_the_content),
         trial!(rrd_footer_only_when_asked),
+        trial!(plots_hold_the_decisive_numbers_nan_where_missing),
+        trial!(expected_edge_test_only_of_an_existing_triangle),
     ]
 }
 
@@ -635,6 +637,8 @@ pub(crate) struct Decoded {
     translations: BTreeMap<String, BTreeMap<i64, [f32; 3]>>,
     /// Per entity and frame, how many line strips its row has.
     strips: BTreeMap<String, BTreeMap<i64, usize>>,
+    /// Per entity and frame, the line strips' radii (UI points negative).
+    radii: BTreeMap<String, BTreeMap<i64, Vec<f32>>>,
     quaternions: BTreeMap<String, BTreeMap<i64, [f32; 4]>>,
     timelines: std::collections::BTreeSet<String>,
     recording_ids: std::collections::BTreeSet<String>,
@@ -654,6 +658,7 @@ impl PartialEq for Decoded {
             && self.translations == other.translations
             && self.quaternions == other.quaternions
             && self.strips == other.strips
+            && self.radii == other.radii
             && self.timelines == other.timelines
             && self.recording_ids == other.recording_ids
             && self.blueprint_stores == other.blueprint_stores
@@ -814,6 +819,18 @@ pub(crate) fn decode_rrd(path: &std::path::Path) -> Result<Decoded, String> {
                                 .entry(entity.clone())
                                 .or_default()
                                 .insert(frames[row], span.len);
+                        }
+                    }
+                    if name == "LineStrips3D:radii" {
+                        let v: Vec<Vec<f32>> = chunk
+                            .iter_component::<rerun::components::Radius>(*id)
+                            .map(|b| b.iter().map(|r| r.0.0).collect())
+                            .collect();
+                        for (row, v) in rows.iter().zip(v.iter().filter(|v| !v.is_empty())) {
+                            d.radii
+                                .entry(entity.clone())
+                                .or_default()
+                                .insert(frames[*row], v.clone());
                         }
                     }
                     if name == "Transform3D:translation" {
@@ -1566,12 +1583,26 @@ fn rrd_shows_edges_features_and_explanations() -> Result<(), String> {
         "primary vertex at {:?}",
         d.frames_with(primary, "Points3D:positions")
     );
-    let radii = d
-        .components
-        .get(primary)
-        .and_then(|m| m.get(&1))
-        .is_some_and(|c| c.contains("LineStrips3D:radii"));
-    ensure!(radii, "no strip radii at frame 1");
+    // The bold edge is the second strip, thicker, and carries the label
+    // (the outline's is empty, which the viewer does not draw); a face
+    // test's label is on the outline.
+    let radii_at_1 = d.radii.get(primary).and_then(|m| m.get(&1));
+    ensure!(
+        radii_at_1.is_some_and(|r| r.len() == 2 && r[1].abs() > r[0].abs()),
+        "strip radii at frame 1: {radii_at_1:?}"
+    );
+    ensure!(
+        d.texts_at(primary, "LineStrips3D:labels", 1) == ["", "edge 0.0"],
+        "primary strip labels at frame 1: {:?}",
+        d.texts_at(primary, "LineStrips3D:labels", 1)
+    );
+    ensure!(
+        d.texts_at(primary, "LineStrips3D:labels", 0) == ["face 0"]
+            && d.texts_at(primary, "Points3D:labels", 2) == ["vertex 0.0"],
+        "primary labels at frames 0 and 2: {:?}, {:?}",
+        d.texts_at(primary, "LineStrips3D:labels", 0),
+        d.texts_at(primary, "Points3D:labels", 2)
+    );
     ensure!(
         d.strips
             .get(primary)
@@ -1661,7 +1692,11 @@ fn rrd_shows_edges_features_and_explanations() -> Result<(), String> {
         "edge frame not cleared at the miss"
     );
     ensure!(
-        d.texts_at(slot0, "LineStrips3D:labels", 1).is_empty(),
+        d.texts_at(slot0, "LineStrips3D:labels", 1).is_empty()
+            && d.texts_at(slot0, "LineStrips3D:labels", 0).len() == 2
+            && d.texts_at(slot0, "LineStrips3D:labels", 0)[0]
+                .starts_with("nearest edge test: edge 0.")
+            && d.texts_at(slot0, "LineStrips3D:labels", 0)[1].is_empty(),
         "the decisive edge is labelled twice"
     );
 
@@ -1784,6 +1819,13 @@ fn viewer_and_check_agree_on_divergences() -> Result<(), String> {
         d.frames_with("/world/ball/0/expected", "Ellipsoids3D:centers") == check_frames,
         "expected ball at {:?}",
         d.frames_with("/world/ball/0/expected", "Ellipsoids3D:centers")
+    );
+    // With the expected contact and normal, in the same row.
+    let contact = d.frames_with("/world/ball/0/expected", "Points3D:positions");
+    let normal = d.frames_with("/world/ball/0/expected", "Arrows3D:vectors");
+    ensure!(
+        !contact.is_empty() && contact.is_subset(&check_frames) && normal == contact,
+        "expected contact at {contact:?}, normal at {normal:?}, divergent frames {check_frames:?}"
     );
     for f in &check_frames {
         if all.contains(&(f + 1)) && !check_frames.contains(&(f + 1)) {
@@ -2101,5 +2143,150 @@ fn rrd_footer_only_when_asked() -> Result<(), String> {
     if a.components.is_empty() || a != b {
         return Err("the files with and without the footer hold different recordings".into());
     }
+    Ok(())
+}
+
+/// The plots hold the decisive test's numbers, one series each (A, B, C,
+/// discriminant, s0, s1 of an edge or vertex test; h0, h1, β of a face
+/// test), with NaN, which the viewer draws as a break in the line, where
+/// the test has no such value (no real roots, no β) or it is not finite.
+fn plots_hold_the_decisive_numbers_nan_where_missing() -> Result<(), String> {
+    let dir = tempfile::tempdir().map_err(|e| e.to_string())?;
+    let path = dir.path().join("plots.rrd");
+    // One ball, so that each frame has one sweep.
+    let results = write_rrd(
+        events_for(cube_scene(), &random_sweeps(31, 400, 1)),
+        Detail::Primary,
+        &path,
+    )?;
+    let d = decode_rrd(&path)?;
+    let row = |entity: &str, frame: u64| -> Option<Vec<u64>> {
+        d.scalars
+            .get(&(entity.to_string(), "Scalars:scalars".to_string()))
+            .and_then(|m| m.get(&(frame as i64)))
+            .map(|v| v.iter().map(|x| x.to_bits()).collect())
+    };
+    let bits = |values: &[Option<f64>]| -> Vec<u64> {
+        values
+            .iter()
+            .map(|v| v.filter(|v| v.is_finite()).unwrap_or(f64::NAN).to_bits())
+            .collect()
+    };
+    let (mut missing_roots, mut quadratics, mut faces) = (0, 0, 0);
+    for r in &results {
+        let quadratic = |a, b, c, disc, roots: Option<(f64, f64)>| {
+            let (s0, s1) = roots.unzip();
+            bits(&[Some(a), Some(b), Some(c), Some(disc), s0, s1])
+        };
+        let (entity, want) = match r.decisive_record() {
+            Some(TestRecord::Edge(e)) => (
+                "/plots/ball/0/quadratic",
+                quadratic(e.a, e.b, e.c, e.discriminant, e.roots),
+            ),
+            Some(TestRecord::Vertex(v)) => (
+                "/plots/ball/0/quadratic",
+                quadratic(v.a, v.b, v.c, v.discriminant, v.roots),
+            ),
+            Some(TestRecord::Face(f)) => (
+                "/plots/ball/0/face",
+                bits(&[Some(f.h0), Some(f.h1), f.beta]),
+            ),
+            None => continue,
+        };
+        if entity.ends_with("quadratic") {
+            quadratics += 1;
+            missing_roots += usize::from(f64::from_bits(want[4]).is_nan());
+        } else {
+            faces += 1;
+        }
+        let got = row(entity, r.frame);
+        ensure!(
+            got.as_ref() == Some(&want),
+            "frame {}: {entity} holds {:?}, the decisive test {:?}",
+            r.frame,
+            got.map(|g| g.into_iter().map(f64::from_bits).collect::<Vec<_>>()),
+            want.into_iter().map(f64::from_bits).collect::<Vec<_>>()
+        );
+    }
+    ensure!(
+        quadratics > 10 && faces > 10 && missing_roots > 0,
+        "the sweeps need edge or vertex decisions ({quadratics}), some without real \
+         roots ({missing_roots}), and face decisions ({faces})"
+    );
+    Ok(())
+}
+
+/// Where no test ran, slot 0's edge frame shows the edge test the
+/// expectation names, run for the recording; an expectation naming a
+/// triangle the mesh does not have gets no edge frame (and the replay and
+/// the recording go on).
+fn expected_edge_test_only_of_an_existing_triangle() -> Result<(), String> {
+    let dir = tempfile::tempdir().map_err(|e| e.to_string())?;
+    let path = dir.path().join("expected_edge.rrd");
+    // Frames 0 to 2: far from the triangle, so no test runs.
+    let sweep = |frame| SweepMsg {
+        frame,
+        ball: 0,
+        radius: 0.5,
+        p0: [6.0, 6.0, 3.0],
+        p1: [6.0, 6.0, 2.0],
+    };
+    let expected = |frame, triangle| OutcomeMsg {
+        frame,
+        ball: 0,
+        alpha: 0.5,
+        kind: Kind::Edge,
+        triangle: Some(Some(triangle)),
+        feature: Some(Some(1)),
+        normal: None,
+        contact: None,
+    };
+    let mut ev: Events = vec![Ok(TraceEvent::Scene {
+        log_time_nanos: 0,
+        index: 0,
+        scene: triangle_scene(),
+    })];
+    for (frame, triangle) in [(0, 0), (1, 7), (2, 0)] {
+        ev.push(Ok(TraceEvent::Expected {
+            log_time_nanos: 1 + frame,
+            index: ev.len() as u64,
+            outcome: expected(frame, triangle),
+        }));
+        ev.push(Ok(TraceEvent::Sweep {
+            log_time_nanos: 1 + frame,
+            index: ev.len() as u64,
+            sweep: sweep(frame),
+        }));
+    }
+    let results = write_rrd(ev, Detail::Primary, &path)?;
+    ensure!(
+        results.len() == 3 && results.iter().all(|r| r.records.is_empty()),
+        "the sweeps should run no test: {:?}",
+        results.iter().map(|r| r.records.len()).collect::<Vec<_>>()
+    );
+    let d = decode_rrd(&path)?;
+    let slot0 = "/world/ball/0/edge/0";
+    let frames = |v: &[i64]| {
+        v.iter()
+            .copied()
+            .collect::<std::collections::BTreeSet<i64>>()
+    };
+    ensure!(
+        d.frames_with(slot0, "Capsules3D:lengths") == frames(&[0, 2])
+            && d.frames_with(slot0, "Clear:is_recursive") == frames(&[1]),
+        "edge frame at {:?}, cleared at {:?}",
+        d.frames_with(slot0, "Capsules3D:lengths"),
+        d.frames_with(slot0, "Clear:is_recursive")
+    );
+    ensure!(
+        d.texts_at(slot0, "test", 0) == ["edge 0.1"],
+        "slot 0 at frame 0: {:?}",
+        d.texts_at(slot0, "test", 0)
+    );
+    ensure!(
+        d.frames_with("/world/ball/0/expected", "Ellipsoids3D:centers") == frames(&[0, 1, 2]),
+        "expected outcome at {:?}",
+        d.frames_with("/world/ball/0/expected", "Ellipsoids3D:centers")
+    );
     Ok(())
 }

@@ -16,12 +16,16 @@
 //!                                       Mesh3D: the triangle, filled
 //!                                       LineStrips3D: its three edges (labelled for a face
 //!                                       test), then its edge, bold, for an edge test
-//!                                       Points3D: its vertex, for a vertex test (else none)
+//!                                       (labelled; the outline's label is then empty)
+//!                                       Points3D: its vertex, labelled, for a vertex test
+//!                                       (else none)
 //! world/ball/{ball}/expected          the expected outcome, when the sweep diverges from
 //!                                     the trace's expectation:
 //!                                       Ellipsoids3D: the ball at the expected α
-//!                                       Points3D, Arrows3D: the expected contact and
-//!                                       normal (none when the expectation names none)
+//!                                       Points3D: the expected contact (none when the
+//!                                       expectation names none)
+//!                                       Arrows3D: the expected normal, from that contact
+//!                                       (none without a contact or a usable normal)
 //! world/ball/{ball}/tunnel            Points3D: where the ball's centre went through a
 //!                                     triangle front to back (during this sweep or since
 //!                                     its previous one), labelled with the triangle
@@ -62,8 +66,11 @@
 //! Slot 0 of `edge` is the decisive test when it is an edge test (the
 //! primary test, or the nearest miss); when the decision was a face or
 //! vertex test (or the nearest miss was one), it is the nearest edge test of
-//! the same triangle. The edge-frame view of the default blueprint looks at
-//! `world/ball/{followed}/edge/0`.
+//! the same triangle; when there is no decisive test, the nearest recorded
+//! edge test, or, when none was recorded and the expectation names a
+//! triangle, the expected edge test (run for the recording). The other
+//! slots hold the other recorded edge tests, hits first. The edge-frame
+//! view of the default blueprint looks at `world/ball/{followed}/edge/0`.
 
 /// Root of the 3D world.
 pub const WORLD: &str = "world";

@@ -378,8 +378,9 @@ pub(crate) fn primary_rows(
 }
 
 /// The expected outcome beside the replayed one, for a divergent sweep, in
-/// one row: the ball at the expected α, the expected contact and normal
-/// (when the expectation names them; else none).
+/// one row: the ball at the expected α, the expected contact (when the
+/// expectation names one) and normal (when it names a contact and a normal
+/// of finite, non-zero length; else none).
 pub(crate) fn expected_rows(out: &mut Out<'_>, r: &SweepResult, e: &OutcomeMsg) {
     let b = r.ball;
     let p0 = r.sweep.p0;

@@ -15,6 +15,12 @@
 //! branch-predicted case is what gets measured. Before timing, the bench
 //! prints how often the two libraries agree on hit or miss and the largest
 //! difference in α where both hit.
+//!
+//! The group `session` measures the fast and the explained query on the
+//! sweeps of a real session's shape instead: 4,096 sweeps taken evenly from
+//! the simulation `record --scene terrain --terrain-cells 224 --balls 64
+//! --seed 1 --frames 1954` writes (100,352 triangles; balls falling,
+//! bouncing and rolling on the terrain), in trace order.
 
 use std::hint::black_box;
 
@@ -27,6 +33,7 @@ use sweeptrace::core::{
     sweep_mesh_with,
 };
 use sweeptrace::replay::{CollectPrimary, primary_records};
+use sweeptrace::sim::{self, BuiltinScene};
 
 use parry3d_f64::math::{Pose, Vector};
 use parry3d_f64::query::{ShapeCastOptions, cast_shapes};
@@ -214,7 +221,59 @@ fn explained_bench(
     });
 }
 
-criterion_group!(benches, bench);
+/// The session's mesh, options and 4,096 of its sweeps (see the module
+/// documentation).
+fn session() -> (Mesh, Options, Vec<Sweep>) {
+    let scene = BuiltinScene::Terrain.mesh_with_terrain_cells(224);
+    let mesh = scene.to_mesh().expect("valid terrain");
+    let options = sim::SimOptions {
+        balls: 64,
+        seed: 1,
+        frames: 1954,
+        ..BuiltinScene::Terrain.sim_options()
+    };
+    let mut all = Vec::new();
+    sim::simulate(&mesh, &options, |event| -> Result<(), sim::SimError> {
+        let s = event.sweep;
+        all.push(Sweep::new(s.p0, s.p1, s.radius));
+        Ok(())
+    })
+    .expect("the session simulates");
+    let step = (all.len() / SWEEPS).max(1);
+    let sweeps: Vec<Sweep> = all.into_iter().step_by(step).take(SWEEPS).collect();
+    (mesh, options.core_options(), sweeps)
+}
+
+fn bench_session(c: &mut Criterion) {
+    let (mesh, options, sweeps) = session();
+    let n = sweeps.len();
+    let mut group = c.benchmark_group("session");
+    group.sample_size(20);
+    group.warm_up_time(std::time::Duration::from_secs(1));
+    group.measurement_time(std::time::Duration::from_secs(4));
+    group.throughput(Throughput::Elements(1));
+    let mut i = 0usize;
+    group.bench_function("sweeptrace", |b| {
+        b.iter(|| {
+            i = (i + 1) % n;
+            black_box(sweep_mesh(&mesh, &sweeps[i], &options).ok())
+        })
+    });
+    let mut i = 0usize;
+    group.bench_function("explained-primary", |b| {
+        b.iter(|| {
+            i = (i + 1) % n;
+            let mut collect = CollectPrimary::default();
+            let outcome =
+                sweep_mesh_with(&mesh, &sweeps[i], &options, Broadphase::Bvh, &mut collect).ok();
+            let verdicts = collect.verdict_counts();
+            black_box((outcome.map(|o| collect.into_primary_records(&o)), verdicts))
+        })
+    });
+    group.finish();
+}
+
+criterion_group!(benches, bench, bench_session);
 
 fn main() {
     benches();

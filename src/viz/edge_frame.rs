@@ -160,14 +160,41 @@ pub(crate) fn choose_edges(
         return Slot0::Nearest;
     };
     edges.push(test);
-    let start = edges.len();
-    edges.extend(others(r, &first));
-    edges[start..].sort_by(|x, y| {
-        let (a, b) = (rank(x), rank(y));
-        a.0.cmp(&b.0).then(a.1.total_cmp(&b.1))
-    });
-    edges.truncate(max);
+    // The others by rank, hits first (at `candidates` a sweep can record
+    // hundreds: each rank is worked out once, and only the first `max - 1`
+    // put in order).
+    let others: Vec<&EdgeRecord> = others(r, &first).collect();
+    let order = first_by_key(&others, max - 1, |e| rank(e));
+    edges.extend(order.into_iter().map(|i| *others[i]));
     what
+}
+
+/// The indices of the first `keep` of `items` in the order of `key`
+/// (class, then value by `f64::total_cmp`), equal keys in their order in
+/// `items`: what a stable sort by `key` then keeping `keep` gives.
+fn first_by_key<T>(items: &[T], keep: usize, key: impl Fn(&T) -> (u8, f64)) -> Vec<usize> {
+    let mut keys: Vec<(u8, i64, usize)> = items
+        .iter()
+        .enumerate()
+        .map(|(i, item)| {
+            let (class, value) = key(item);
+            (class, total_order_key(value), i)
+        })
+        .collect();
+    if keys.len() > keep {
+        if keep > 0 {
+            keys.select_nth_unstable(keep - 1);
+        }
+        keys.truncate(keep);
+    }
+    keys.sort_unstable();
+    keys.into_iter().map(|(.., i)| i).collect()
+}
+
+/// An integer whose order is `f64::total_cmp`'s.
+fn total_order_key(x: f64) -> i64 {
+    let bits = x.to_bits() as i64;
+    bits ^ (((bits >> 63) as u64) >> 1) as i64
 }
 
 /// Edge test `edge` of `triangle`, run here.
@@ -328,4 +355,50 @@ fn edge_frame_values(row: &mut Row<'_>, e: &EdgeRecord) {
     .put::<Scalar>(|| any_value::<Scalar>("s0"), s0.map(Scalar::from))
     .put::<Scalar>(|| any_value::<Scalar>("s1"), s1.map(Scalar::from))
     .put::<Scalar>(|| any_value::<Scalar>("xc"), e.xc.map(Scalar::from));
+}
+
+#[cfg(test)]
+mod tests {
+    use super::first_by_key;
+
+    /// `first_by_key` gives what a stable sort by the key and a truncation
+    /// give, with ties, both zeros, infinities and NaNs among the values.
+    #[test]
+    fn first_by_key_equals_a_stable_sort() {
+        let values = [
+            0.0,
+            -0.0,
+            1.0,
+            -1.0,
+            0.5,
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+            f64::NAN,
+            -f64::NAN,
+            1e-300,
+            -1e300,
+        ];
+        let mut state = 12345u64;
+        let mut next = |n: usize| {
+            state = state
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (state >> 33) as usize % n
+        };
+        for round in 0..500 {
+            let len = next(40);
+            let items: Vec<(u8, f64)> = (0..len)
+                .map(|_| (next(2) as u8, values[next(values.len())]))
+                .collect();
+            let keep = next(20);
+            let mut want: Vec<usize> = (0..len).collect();
+            want.sort_by(|&x, &y| {
+                let (a, b) = (items[x], items[y]);
+                a.0.cmp(&b.0).then(a.1.total_cmp(&b.1))
+            });
+            want.truncate(keep);
+            let got = first_by_key(&items, keep, |&k| k);
+            assert_eq!(got, want, "round {round}: {items:?}, keep {keep}");
+        }
+    }
 }

@@ -22,17 +22,16 @@ mod engine;
 mod error;
 mod iter;
 mod options;
+mod primary;
 mod summary;
 mod tunnel;
 
-pub use engine::{
-    CollectPrimary, ComputedSweep, Replay, ReplayEvent, SceneState, SweepResult, compute_sweep,
-    primary_records,
-};
+pub use engine::{ComputedSweep, Replay, ReplayEvent, SceneState, SweepResult, compute_sweep};
 pub use error::ReplayError;
 pub use iter::{
     DEFAULT_BATCH_EVENTS, ParallelReplayIter, ReplayIter, replay_events, replay_events_parallel,
 };
 pub use options::{Detail, FrameRange, ReplayOptions};
+pub use primary::{CollectPrimary, primary_records};
 pub use summary::{LISTED_TUNNELS, ReplaySummary, TunnelAt};
 pub use tunnel::{Tunnel, TunnelKind, sweep_end, tunnel_during_sweep};

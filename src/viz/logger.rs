@@ -18,10 +18,10 @@ use super::convert::{
     MESH_COLOR, SERIES_COLORS, WIREFRAME_COLOR, WIREFRAME_POINTS, albedo, f32x3, rgba,
 };
 use super::edge_frame::{choose_edges, edge_frame_rows};
-use super::paths::{self, Entity};
+use super::paths;
 use super::rows::{
     Out, PLOT_BITS, Shown, ball_row, expected_rows, focus_rows, plot_entity, plot_rows,
-    primary_rows, text_rows, transition_rows, tunnel_rows,
+    plot_series, primary_rows, text_rows, transition_rows, tunnel_rows,
 };
 use super::spill::Spill;
 use super::{MAX_EDGE_FRAMES, RecordError, TIMESTAMP_THRESHOLD_NANOS};
@@ -249,10 +249,7 @@ fn series_styles(
 ) -> Result<(), RecordingStreamError> {
     for bit in 0..PLOT_BITS {
         let entity = plot_entity(b, bit);
-        let names: &[&str] = match entity {
-            Entity::Quadratic(_) => &paths::QUADRATIC_NAMES,
-            _ => &paths::FACE_NAMES,
-        };
+        let names = plot_series(bit);
         let colors = || SERIES_COLORS[..names.len()].iter().map(|&c| rgba(c));
         let mut batches = SeriesLines::new()
             .with_names(names.iter().copied())
@@ -527,13 +524,11 @@ impl Logger {
         &mut self,
         results: impl IntoIterator<Item = &'r SweepResult>,
     ) -> Vec<Shown> {
-        results
+        let nows: Vec<(u32, Shown)> = results
             .into_iter()
-            .map(|r| {
-                let now = Shown::of(r, &self.options.prepare);
-                std::mem::replace(self.shown.entry(r.ball).or_default(), now)
-            })
-            .collect()
+            .map(|r| (r.ball, Shown::of(r, &self.options.prepare)))
+            .collect();
+        self.shown_before_given(nows)
     }
 
     /// [`Logger::shown_before`] of sweeps of the balls `balls` whose rows

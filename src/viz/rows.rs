@@ -69,9 +69,9 @@ pub struct Shown {
 }
 
 impl Shown {
-    const PRIMARY: u8 = 2;
-    const EXPECTED: u8 = 16;
-    const TUNNEL: u8 = 32;
+    const PRIMARY: u8 = 1;
+    const EXPECTED: u8 = 2;
+    const TUNNEL: u8 = 4;
 
     /// What the rows of `r` show, as the logger with `options` draws them
     /// (worked out without drawing them or running any test).
@@ -430,29 +430,41 @@ fn scalar(out: &mut Out<'_>, entity: Entity, v: f64) {
         .put::<Scalar>(Scalars::descriptor_scalars, [v.into()]);
 }
 
-/// The decisive test's numbers for the plots: its plot bit (see
-/// [`plot_entity`]) and its values, a series each (`None` where the test
-/// has no such value).
+/// The series of the plot entity of bit `bit` (see [`plot_entity`]), in
+/// the order of its values.
+pub(crate) fn plot_series(bit: u16) -> &'static [&'static str] {
+    match bit {
+        0 => &QUADRATIC_NAMES,
+        _ => &FACE_NAMES,
+    }
+}
+
+/// The decisive test's numbers for the plots, when one of them is finite:
+/// its plot bit (see [`plot_entity`]) and its values, a series each
+/// (`None` where the test has no such value; the first
+/// `plot_series(bit).len()` are used).
 fn plot_values(decisive: Option<&TestRecord>) -> Option<(u16, [Option<f64>; 6])> {
     let quadratic = |a, b, c, d, roots: Option<(f64, f64)>| {
         let (s0, s1) = roots.unzip();
         (0, [Some(a), Some(b), Some(c), Some(d), s0, s1])
     };
-    Some(match decisive? {
+    let (bit, values) = match decisive? {
         TestRecord::Edge(e) => quadratic(e.a, e.b, e.c, e.discriminant, e.roots),
         TestRecord::Vertex(v) => quadratic(v.a, v.b, v.c, v.discriminant, v.roots),
         TestRecord::Face(f) => (1, [Some(f.h0), Some(f.h1), f.beta, None, None, None]),
-    })
+    };
+    values
+        .iter()
+        .flatten()
+        .any(|v| v.is_finite())
+        .then_some((bit, values))
 }
 
 /// Which plot entities the decisive test's numbers go to (bit `i` for
 /// `plot_entity(ball, i)`): the test's entity when one of its values is
 /// finite.
 pub(crate) fn plot_bits(decisive: Option<&TestRecord>) -> u16 {
-    match plot_values(decisive) {
-        Some((bit, values)) if values.iter().flatten().any(|v| v.is_finite()) => 1 << bit,
-        _ => 0,
-    }
+    plot_values(decisive).map_or(0, |(bit, _)| 1 << bit)
 }
 
 /// The α plot and the decisive test's numbers (one row of a series each,
@@ -464,21 +476,16 @@ pub(crate) fn plot_rows(out: &mut Out<'_>, r: &SweepResult, decisive: Option<&Te
     out.row(Entity::Alpha(b), set::KIND)
         .put::<Scalar>(Scalars::descriptor_scalars, [r.outcome.alpha.into()])
         .put_strs(|| any_value::<Text>("kind"), [r.outcome.kind.as_str()]);
-    let bits = plot_bits(decisive);
-    if let Some((bit, values)) = plot_values(decisive).filter(|_| bits != 0) {
-        let n = if bit == 0 {
-            QUADRATIC_NAMES.len()
-        } else {
-            FACE_NAMES.len()
-        };
-        out.row(plot_entity(b, bit), set::SCALAR).put::<Scalar>(
-            Scalars::descriptor_scalars,
-            values[..n]
-                .iter()
-                .map(|v| v.filter(|v| v.is_finite()).unwrap_or(f64::NAN).into()),
-        );
-    }
-    bits
+    let Some((bit, values)) = plot_values(decisive) else {
+        return 0;
+    };
+    out.row(plot_entity(b, bit), set::SCALAR).put::<Scalar>(
+        Scalars::descriptor_scalars,
+        values[..plot_series(bit).len()]
+            .iter()
+            .map(|v| v.filter(|v| v.is_finite()).unwrap_or(f64::NAN).into()),
+    );
+    1 << bit
 }
 
 /// The decision in words; for a divergent sweep (`diffs` not empty) also

@@ -30,6 +30,15 @@ pub fn tests() -> Vec<Trial> {
             strict_facing_bug_fails_exactly_the_in_plane_rules,
             timeout = LIMIT
         ),
+        trial!(
+            tie_highest_triangle_bug_fails_exactly_the_triangle_order_rules,
+            timeout = LIMIT
+        ),
+        trial!(
+            tie_vertex_first_bug_fails_exactly_the_kind_order_rules,
+            timeout = LIMIT
+        ),
+        trial!(lenient_lets_tie_choices_pass, timeout = LIMIT),
         trial!(repro_command_runs_one_case, timeout = LIMIT),
         trial!(conform_engine_not_found_exits_125, timeout = LIMIT),
         trial!(cases_written_as_a_trace_check_the_same, timeout = LIMIT),
@@ -144,7 +153,7 @@ fn skip_vertex_bug_fails_exactly_the_vertex_rules() -> Result<(), String> {
             "edge.miss.before-v0",
             "vertex.hit",
             "tie.shared-vertex",
-            "cube.corner",
+            "tie.cube-corner",
             "margin.vertex-hit",
         ],
     )?;
@@ -163,14 +172,100 @@ fn strict_facing_bug_fails_exactly_the_in_plane_rules() -> Result<(), String> {
     // Both are paths with n·d = 0 for a triangle that must report the hit:
     // the in-plane approach, and the cube edge whose +x triangle the path
     // runs parallel to (its normal then misses from the average).
+    // The third is the in-plane approach of the feature-order case.
     let doc = expect_failing(
         "strict-facing",
-        &["tie.shared-edge.cube", "facing.non-strict"],
+        &[
+            "tie.shared-edge.cube",
+            "tie.feature-order",
+            "facing.non-strict",
+        ],
     )?;
     ensure!(
-        doc["fragile"] == 2,
-        "both on grazing (fragile) decisions: {doc}"
+        doc["fragile"] == 3,
+        "all three on grazing (fragile) decisions that a perturbation reproduces: {doc}"
     );
+    Ok(())
+}
+
+/// The rule's first failing case says which member the tie order chooses.
+fn tie_order_of(doc: &serde_json::Value, rule: &str) -> String {
+    doc["rules"]
+        .as_array()
+        .into_iter()
+        .flatten()
+        .find(|r| r["rule"] == rule)
+        .and_then(|r| r["first_failure"]["tie_order"].as_str())
+        .unwrap_or_default()
+        .to_string()
+}
+
+fn tie_highest_triangle_bug_fails_exactly_the_triangle_order_rules() -> Result<(), String> {
+    let doc = expect_failing(
+        "tie-highest-triangle",
+        &[
+            "tie.shared-edge.planar",
+            "tie.shared-edge.cube",
+            "tie.shared-vertex",
+            "tie.cube-corner",
+        ],
+    )?;
+    ensure!(doc["fragile"] == 0, "no failure excused: {doc}");
+    let why = tie_order_of(&doc, "tie.shared-edge.cube");
+    for want in [
+        "the engine names edge 1 of triangle 8",
+        "chooses edge 1 of triangle 1",
+        "the lower triangle index comes first (1 < 8)",
+    ] {
+        ensure!(
+            why.contains(want),
+            "missing `{want}` in the tie order: {why}"
+        );
+    }
+    Ok(())
+}
+
+fn tie_vertex_first_bug_fails_exactly_the_kind_order_rules() -> Result<(), String> {
+    let doc = expect_failing(
+        "tie-vertex-first",
+        &[
+            "tie.edge-end",
+            "tie.shared-edge.planar",
+            "tie.kind-order",
+            "tie.across-kinds",
+        ],
+    )?;
+    let why = tie_order_of(&doc, "tie.kind-order");
+    for want in [
+        "the engine names vertex 0 of triangle 0",
+        "chooses the face of triangle 0",
+        "the kind order face < edge < vertex puts face before vertex",
+    ] {
+        ensure!(
+            why.contains(want),
+            "missing `{want}` in the tie order: {why}"
+        );
+    }
+    let why = tie_order_of(&doc, "tie.across-kinds");
+    ensure!(
+        why.contains("chooses the face of triangle 1") && why.contains("edge 2 of triangle 0"),
+        "the face of the higher triangle beats the edge of the lower: {why}"
+    );
+    Ok(())
+}
+
+fn lenient_lets_tie_choices_pass() -> Result<(), String> {
+    for bug in ["tie-highest-triangle", "tie-vertex-first"] {
+        let engine = example_engine_command(&format!("--bug {bug}"));
+        let (code, stdout, stderr) =
+            run_bin(os!("conform", "--engine", &engine, "--lenient", "--json"))?;
+        let doc: serde_json::Value = serde_json::from_str(&stdout)
+            .map_err(|e| format!("not JSON ({e}): {stdout}\n{stderr}"))?;
+        ensure!(
+            code == 0 && doc["failed"] == 0,
+            "--bug {bug} --lenient: exit {code}: {doc}"
+        );
+    }
     Ok(())
 }
 

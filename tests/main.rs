@@ -33,6 +33,7 @@ mod scanned;
 mod support;
 mod trace_io;
 mod tunnel;
+mod verdicts;
 
 /// What a test function returns on success: `()`, or a [`Completion`] for a
 /// test that finds at run time that it cannot run here and says why
@@ -111,6 +112,7 @@ fn main() {
     trials.extend(foxglove::tests());
     trials.extend(engine::tests());
     trials.extend(conform::tests());
+    trials.extend(verdicts::tests());
     trials.extend(bisect::tests());
     trials.extend(rapier::tests());
     trials.extend(faults::tests());

@@ -16,6 +16,12 @@ reports about an engine that has it:
     skip-vertex     never runs the vertex test (corners are missed)
     ignore-margin   detects at the radius r instead of rho = r - margin
     strict-facing   always uses the strict facing rule n.d < 0
+    tie-highest-triangle
+                    among simultaneous hits of one kind, takes the highest
+                    triangle index (the rule: the lowest)
+    tie-vertex-first
+                    among simultaneous hits, prefers a vertex over an edge
+                    and an edge over a face (the rule: face < edge < vertex)
 """
 
 import argparse
@@ -29,7 +35,7 @@ DEGENERATE_TOLERANCE = 1e-12
 TIE_WINDOW_ULPS = 1024.0
 EPSILON = sys.float_info.epsilon
 
-BUGS = ("skip-vertex", "ignore-margin", "strict-facing")
+BUGS = ("skip-vertex", "ignore-margin", "strict-facing", "tie-highest-triangle", "tie-vertex-first")
 
 
 def sub(a, b):
@@ -203,7 +209,10 @@ def sweep(scene, radius, p0, p1, bugs):
         return {"alpha": 1.0, "kind": "none", "triangle": None, "feature": None, "normal": None, "contact": None}
     alpha = min(h[0] for h in hits)
     tied = [h for h in hits if h[0] <= alpha + window]
-    primary = min(tied, key=lambda h: (h[1], h[2], -1 if h[3] is None else h[3]))
+    # The tie order: kind (face < edge < vertex), then triangle, then feature.
+    kind_key = (lambda h: -h[1]) if "tie-vertex-first" in bugs else (lambda h: h[1])
+    triangle_key = (lambda h: -h[2]) if "tie-highest-triangle" in bugs else (lambda h: h[2])
+    primary = min(tied, key=lambda h: (kind_key(h), triangle_key(h), -1 if h[3] is None else h[3]))
     total, seen = (0.0, 0.0, 0.0), set()
     for h in sorted(tied, key=lambda h: h[2]):
         if h[2] not in seen:

@@ -7,7 +7,8 @@ use std::path::{Path, PathBuf};
 use anyhow::{Context, bail};
 
 use sweeptrace::atomic::PendingFile;
-use sweeptrace::engine::{Against, EngineCommand, EngineOptions, check_file_with_engine};
+use sweeptrace::engine::{EngineCommand, EngineOptions};
+use sweeptrace::regress::{Against, check_file_with_engine};
 use sweeptrace::regress::{
     CheckOptions, DEFAULT_MAX_DETAILS, Status, TraceReport, check_file, find_traces, frames_around,
     render_json, render_text,
@@ -48,8 +49,12 @@ back, named by frame, ball, triangle and point), `NO EXPECTATIONS` (no
 divergence gives the sweep's inputs exactly (--hex: also as hex floats).
 When expectations fail, the recording engine's margin and facing rule are
 inferred from them, with how many expectations match when replayed with
-them. Exit status: 0 every trace matches (ties and fragile divergences
-included, unless --strict), 1 a divergence or a tunnel was found, 2
+them. A divergence on a fragile decision is excused only when rounding
+explains it: a perturbation of the sweep's inputs within the rounding
+budget (a few units of p0, p1 or the radius) makes the core give the
+expected answer; the report names that perturbation. Exit status: 0 every
+trace matches (ties and divergences rounding explains included, unless
+--strict), 1 a divergence or a tunnel was found, 2
 something could not be checked (bad input, I/O error, no expectations, a
 fault of the engine), 3 a trace ends early, 125 the engine cannot be
 started (git bisect run skips that commit).")]
@@ -62,10 +67,12 @@ pub struct Args {
     /// Print one JSON document instead of text.
     #[arg(long)]
     pub json: bool,
-    /// Fail on divergences of fragile decisions too (ties across kinds or
-    /// triangles, near-tangent paths, contacts at a feature's boundary, ...:
-    /// see docs/SEMANTICS.md). Without it they are counted and shown apart
-    /// and do not fail the check.
+    /// Fail on divergences that rounding explains too. On a fragile
+    /// decision (ties across kinds or triangles, near-tangent paths,
+    /// contacts at a feature's boundary, ...: see docs/SEMANTICS.md) a
+    /// divergence whose expected answer the core gives under a small
+    /// perturbation of the inputs is counted and shown apart and, without
+    /// --strict, does not fail the check; any other divergence fails.
     #[arg(long)]
     pub strict: bool,
     /// Count and list tunnels (a ball's centre through a triangle, front to

@@ -24,10 +24,12 @@ docs/SEMANTICS.md it exercises: face, edge and vertex hits and each way
 each can miss, shared edges and vertices with ties, cube corners, grazing
 and parallel paths, starts touching or inside ρ, zero-length paths,
 margins, strict and non-strict facing, degenerate triangles. The core's
-outcome is the expected answer; an answer naming another member of a tie
-counts as a pass. The cases are exact in binary, so a divergence fails even
-on a fragile decision (counted as `fragile` too; --lenient lets those
-pass). One line per rule with passed / failed / fragile counts,
+outcome is the expected answer. The cases are exact in binary, so the
+rules, not rounding, decide them: an answer naming another member of the
+tie set fails its rule (the report says which member the tie order face <
+edge < vertex, then triangle, then feature chooses, and why), and a
+divergence fails even when a perturbation of the inputs reproduces it
+(counted as `fragile` too). --lenient lets both pass. One line per rule with passed / failed / fragile counts,
 then each failing rule's first failing case explained, with a command that
 runs it alone. Exit status: 0 every case passes, 1 a case fails, 2 a fault
 of the engine or a bad argument, 125 the engine cannot be started.")]
@@ -50,11 +52,13 @@ pub struct Args {
     /// replay cases.mcap --spawn`. No engine needed.
     #[arg(long, value_name = "FILE")]
     pub write_trace: Option<std::path::PathBuf>,
-    /// Do not fail on divergences of fragile decisions (count them apart,
-    /// as `check` does without --strict). By default they fail: every case
-    /// is exact in binary, so the rules decide it; the `fragile` count says
-    /// how many failures sit at a rounding boundary, where an engine that
-    /// computes in another order could differ.
+    /// Judge as `check` does without --strict: an answer naming another
+    /// member of the tie set passes, and so does a divergence that a
+    /// perturbation of the inputs within the rounding budget reproduces
+    /// (counted apart). By default both fail: every case is exact in
+    /// binary, so the rules decide it; the `fragile` count says how many
+    /// failures sit at a rounding boundary, where an engine that computes
+    /// in another order could differ.
     #[arg(long)]
     pub lenient: bool,
     #[command(flatten)]

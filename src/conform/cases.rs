@@ -144,7 +144,19 @@ pub const RULES: &[Rule] = &[
         description: "the apex of a pyramid hit head-on: the vertex of four triangles ties, the normal averages their four normals",
     },
     Rule {
-        name: "cube.corner",
+        name: "tie.kind-order",
+        description: "straight down onto a triangle's vertex: the face, both edges that end there and the vertex all touch at one α: the kind order face < edge < vertex makes it a face collision",
+    },
+    Rule {
+        name: "tie.across-kinds",
+        description: "the face of triangle 1 and an edge of triangle 0 touch at one α: the kind order comes before the triangle index, so the face of the higher triangle is primary",
+    },
+    Rule {
+        name: "tie.feature-order",
+        description: "a ball inside the plane's band (no face test) moving to a vertex along its bisector touches the triangle's two edges there at one α: the lower feature (edge 0) is primary",
+    },
+    Rule {
+        name: "tie.cube-corner",
         description: "a ball coming diagonally at a cube's corner: a vertex collision shared by the corner's triangles, averaged normal",
     },
     Rule {
@@ -248,6 +260,26 @@ fn pyramid() -> SceneMsg {
             [-1.0, 1.0, 0.0],
         ],
         vec![[0, 1, 2], [0, 2, 3], [0, 3, 4], [0, 4, 1]],
+        0.0,
+        Facing::NonStrict,
+    )
+}
+
+/// A floor at z = 0 (triangle 1, facing up) over a fin (triangle 0) whose
+/// edge 2, from (2, 1, 0) to (0, 1, 0), lies in the floor's plane; the fin
+/// hangs below it, slanted, facing up and toward -y.
+fn fin_under_floor() -> SceneMsg {
+    scene(
+        "fin_under_floor",
+        vec![
+            [0.0, 1.0, 0.0],
+            [1.0, 0.0, -1.0],
+            [2.0, 1.0, 0.0],
+            [-1.0, -1.0, 0.0],
+            [4.0, -1.0, 0.0],
+            [-1.0, 4.0, 0.0],
+        ],
+        vec![[0, 1, 2], [3, 4, 5]],
         0.0,
         Facing::NonStrict,
     )
@@ -565,7 +597,34 @@ pub fn cases() -> Vec<Case> {
             Kind::Vertex,
         ),
         (
-            "cube.corner",
+            "tie.kind-order",
+            "straight down onto vertex 0 of T: face, edges 0 and 2 and vertex 0 at one α",
+            t(),
+            0.5,
+            [0.0, 0.0, 3.0],
+            [0.0, 0.0, -3.0],
+            Kind::Face,
+        ),
+        (
+            "tie.across-kinds",
+            "down onto a floor (triangle 1) where the top edge of a fin below it (triangle 0) lies",
+            fin_under_floor(),
+            0.5,
+            [1.0, 1.0, 3.0],
+            [1.0, 1.0, -3.0],
+            Kind::Face,
+        ),
+        (
+            "tie.feature-order",
+            "at height 0.375 < ρ toward vertex 0 along the bisector: edges 0 and 2 at β = 0.8",
+            t(),
+            0.625,
+            [1.5, 1.5, 0.375],
+            [0.25, 0.25, 0.375],
+            Kind::Edge,
+        ),
+        (
+            "tie.cube-corner",
             "diagonally at the cube's corner (1, 1, 1)",
             cube(),
             0.5,
@@ -574,7 +633,7 @@ pub fn cases() -> Vec<Case> {
             Kind::Vertex,
         ),
         (
-            "cube.corner",
+            "tie.cube-corner",
             "diagonally at the cube's corner (-1, 1, -1)",
             cube(),
             0.25,

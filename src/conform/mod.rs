@@ -16,13 +16,17 @@ use std::fmt::Write as _;
 
 use serde::Serialize;
 
+use crate::core::explain::num;
+use crate::core::{Kind, Outcome};
 use crate::engine::{EngineAnswers, EngineCommand, EngineError, EngineOptions, EngineSession};
 use crate::regress::{
-    Agreement, Divergence, Sides, Tolerances, agreement, divergence_details, render_divergence_as,
+    Agreement, Divergence, Sides, Tolerances, agreement, compare, divergence_details,
+    render_divergence_as,
 };
 use crate::replay::{ReplayEvent, ReplayOptions, replay_events};
 use crate::run::RunOutcome;
 use crate::trace::TraceEvent;
+use crate::trace::messages::OutcomeMsg;
 
 /// The first failing case of a rule, explained.
 #[derive(Clone, Debug, PartialEq, Serialize)]
@@ -34,8 +38,79 @@ pub struct CaseFailure {
     /// The engine's answer against the core's outcome, explained
     /// (`expected` is the engine's answer, `got` the core's).
     pub divergence: Divergence,
+    /// When the engine named another member of the core's tie set (a
+    /// failure unless `--lenient`): which member the rule chooses and why.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub tie_order: Option<String>,
     /// A command that runs this case alone and explains it.
     pub repro: String,
+}
+
+impl CaseFailure {
+    /// Whether rounding explains the divergence (a fragile divergence
+    /// reproduced by a perturbation of the inputs), not a failure under
+    /// `--lenient`.
+    fn is_excused(&self) -> bool {
+        self.divergence.reproduced.is_some() && self.tie_order.is_none()
+    }
+}
+
+/// What a hit names, in words: `face of triangle 3`, `edge 2 of triangle 3`.
+fn hit_name(kind: Kind, triangle: Option<u32>, feature: Option<u8>) -> String {
+    let on = triangle.map_or_else(String::new, |t| format!(" of triangle {t}"));
+    match (kind, feature) {
+        (Kind::Face, _) => format!("the face{on}"),
+        (_, None) => format!("{kind}{on}"),
+        (_, Some(f)) => format!("{kind} {f}{on}"),
+    }
+}
+
+/// Why the rule's tie order chooses the core's primary over the member of
+/// the tie set the engine named.
+fn tie_order_text(answer: &OutcomeMsg, outcome: &Outcome) -> String {
+    let named = (
+        answer.kind,
+        answer.triangle.flatten(),
+        answer.feature.flatten(),
+    );
+    let chosen = (outcome.kind, outcome.triangle, outcome.feature);
+    let why = if named.0 != chosen.0 {
+        format!(
+            "the kind order face < edge < vertex puts {} before {}",
+            chosen.0, named.0
+        )
+    } else if named.1 != chosen.1 {
+        format!(
+            "at the same kind, the lower triangle index comes first ({} < {})",
+            OrNull(chosen.1),
+            OrNull(named.1)
+        )
+    } else {
+        format!(
+            "in the same triangle, the lower feature index comes first ({} < {})",
+            OrNull(chosen.2),
+            OrNull(named.2)
+        )
+    };
+    format!(
+        "the engine names {}, a member of the tie set at α = {}; the rule's tie order \
+         (kind face < edge < vertex, then triangle index, then feature index) chooses {}: {why}",
+        hit_name(named.0, named.1, named.2),
+        num(outcome.alpha),
+        hit_name(chosen.0, chosen.1, chosen.2),
+    )
+}
+
+/// A value, or `null`.
+struct OrNull<T>(Option<T>);
+
+impl<T: std::fmt::Display> std::fmt::Display for OrNull<T> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match &self.0 {
+            Some(v) => v.fmt(f),
+            None => f.write_str("null"),
+        }
+    }
 }
 
 /// One rule's result.
@@ -115,7 +190,9 @@ impl ConformReport {
 pub struct ConformOptions {
     /// The comparison's tolerances.
     pub tolerances: Tolerances,
-    /// Whether a divergence on a fragile decision fails.
+    /// Whether a divergence rounding explains fails, and whether an answer
+    /// naming another member of the tie set than the rule's choice fails
+    /// (the default of `conform`; `--lenient` turns both off).
     pub strict: bool,
     /// Run only the cases whose id (`rule/index`) or rule is this.
     pub only: Option<String>,
@@ -243,35 +320,54 @@ pub fn run(
         };
         rule.cases += 1;
         report.cases += 1;
-        let (fields, fragile) = match agreement(&answer, &result, &options.tolerances) {
-            Agreement::Match | Agreement::Tie => {
+        let (fields, reproduced, tie_order) = match agreement(&answer, &result, &options.tolerances)
+        {
+            Agreement::Match => {
                 rule.passed += 1;
                 report.passed += 1;
                 continue;
             }
-            Agreement::Diverges { fields, fragile } => (fields, fragile),
+            // The cases are exact in binary: the rule's choice among the
+            // tie set is the only right answer, unless --lenient.
+            Agreement::Tie if options.strict => (
+                compare(&answer, &result.outcome_msg(), &options.tolerances),
+                None,
+                Some(tie_order_text(&answer, &result.outcome)),
+            ),
+            Agreement::Tie => {
+                rule.passed += 1;
+                report.passed += 1;
+                continue;
+            }
+            Agreement::Diverges {
+                fields, reproduced, ..
+            } => (fields, reproduced, None),
         };
-        let is_fragile = !fragile.is_robust();
-        if is_fragile {
+        let excused = reproduced.is_some();
+        if excused {
             rule.fragile += 1;
             report.fragile += 1;
         }
-        let fails = !is_fragile || options.strict;
+        let fails = !excused || options.strict;
         if fails {
             rule.failed += 1;
             report.failed += 1;
         }
         let replace = match &rule.first_failure {
             None => true,
-            // A failure is shown before a fragile divergence.
-            Some(first) => fails && !first.divergence.fragile.is_robust() && !options.strict,
+            // A failure is shown before a divergence rounding explains.
+            Some(first) => fails && first.is_excused() && !options.strict,
         };
         if replace {
             let got = result.outcome_msg();
+            let mut divergence = divergence_details(&result, answer, got, fields, false);
+            divergence.reproduced = reproduced;
+            divergence.names_tie_member = tie_order.is_some();
             rule.first_failure = Some(CaseFailure {
                 case: case.id(),
                 what: case.what.to_string(),
-                divergence: divergence_details(&result, answer, got, fields, false),
+                divergence,
+                tie_order,
                 repro: format!(
                     "sweeptrace conform --engine {} --case {}",
                     shell_quote(&command.text),
@@ -340,6 +436,9 @@ pub fn render_text(r: &ConformReport) -> String {
             f.case,
             f.what
         );
+        if let Some(t) = &f.tie_order {
+            let _ = writeln!(s, "  tie order: {t}");
+        }
         s.push_str(&render_divergence_as(
             &f.divergence,
             "  ",

@@ -263,6 +263,14 @@ impl EdgeRecord {
     pub fn alpha(&self) -> Option<f64> {
         self.hit().map(|h| h.alpha)
     }
+
+    /// The point `xc` of the edge the ball touches, in world coordinates,
+    /// if the verdict is a hit.
+    #[inline]
+    pub fn contact(&self) -> Option<Point3<f64>> {
+        self.hit()
+            .map(|h| self.frame.to_world(&Point3::new(h.xc, 0.0, 0.0)))
+    }
 }
 
 impl VertexRecord {
@@ -370,6 +378,18 @@ impl TestRecord {
             TestRecord::Face(r) => r.alpha(),
             TestRecord::Edge(r) => r.alpha(),
             TestRecord::Vertex(r) => r.alpha(),
+        }
+    }
+
+    /// The point of the mesh the test touches, if it is a hit: the face's
+    /// touch point, the point `xc` on the edge, or the vertex. The one
+    /// definition of a hit's contact (the outcome's `contact` is its
+    /// primary test's).
+    pub fn contact(&self) -> Option<Point3<f64>> {
+        match self {
+            TestRecord::Face(r) => r.hit().map(|h| h.touch),
+            TestRecord::Edge(r) => r.contact(),
+            TestRecord::Vertex(r) => r.alpha().map(|_| r.position),
         }
     }
 }

@@ -290,12 +290,12 @@ fn test_triangle<O: Observer, S: Sink>(
         };
         match r.verdict {
             Verdict::Hit => {
-                if let Some(h) = r.hit() {
+                if let (Some(h), Some(contact)) = (r.hit(), r.contact()) {
                     sink.hit(hit(
                         h.alpha,
                         Kind::Edge,
                         e,
-                        r.frame.to_world(&Point3::new(h.xc, 0.0, 0.0)),
+                        contact,
                         approach(r.discriminant),
                         h.xc.min(r.length - h.xc),
                     ));

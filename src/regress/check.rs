@@ -15,7 +15,6 @@
 //! passing traces.
 
 use std::collections::BTreeMap;
-use std::fmt::Write as _;
 
 use serde::Serialize;
 
@@ -24,9 +23,10 @@ use crate::run::RunOutcome;
 use crate::trace::messages::{EXPECTED_TOPIC, OutcomeMsg};
 use crate::trace::{TraceError, TraceEvent, TraceReader};
 
-use super::compare::{Agreement, FieldDiff, Tolerances, agreement};
+use super::compare::{FieldDiff, Tolerances};
 use super::explain::{ExpectedTest, expected_tests, explain_outcome, explained_records};
 use super::infer::{ComparedSweep, Inferred, infer};
+use super::judge::{Agreement, agreement};
 use super::repro::{HexInputs, SweepInputs};
 
 /// Default number of divergences described in detail per trace.
@@ -80,6 +80,17 @@ pub struct Divergence {
     pub got: OutcomeMsg,
     /// Why the core's decision is fragile (empty when robust).
     pub fragile: crate::core::Fragility,
+    /// When the decision is fragile and rounding explains the divergence:
+    /// the perturbation of the inputs under which the core gives each
+    /// side's answer (absent otherwise: a fragile decision does not excuse
+    /// an answer no rounding gives).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub reproduced: Option<super::judge::Reproduced>,
+    /// Whether the expectation names another member of the core's tie set
+    /// (a failure only where the tie order must be followed exactly:
+    /// `conform`). Only in the JSON when true.
+    #[serde(skip_serializing_if = "std::ops::Not::not")]
+    pub names_tie_member: bool,
     /// The sweep's inputs, exactly (shortest round-trip decimals in the
     /// JSON): with them the core makes the same decision.
     pub inputs: SweepInputs,
@@ -96,19 +107,6 @@ pub struct Divergence {
     /// The tests that would have produced the expected result (none when the
     /// expectation is `none`, or names no triangle).
     pub expected_tests: Vec<ExpectedTest>,
-}
-
-/// A running engine's part in a check.
-#[derive(Clone, Debug, PartialEq, Eq, Serialize)]
-pub struct EngineCheck {
-    /// The engine's command.
-    pub command: String,
-    /// `core`: the engine's answers are the expectations and the core's
-    /// outcomes are compared with them ("expected" is the engine's answer,
-    /// "got" the core's); `expected`: the trace's `/expected` is the
-    /// expectation and the engine's answers are compared with it ("got" is
-    /// the engine's answer).
-    pub against: &'static str,
 }
 
 /// The status of one trace.
@@ -233,9 +231,13 @@ pub struct TraceReport {
     /// decision's tie set: an equally valid answer to the rules, counted
     /// as a match.
     pub ties: u64,
-    /// Sweeps that diverge on a fragile decision (rounding at the level of
-    /// the inputs could change it); they fail the check only with `strict`,
-    /// where they are also counted in `divergent`.
+    /// Sweeps that diverge on a fragile decision in a way rounding
+    /// explains: a perturbation of the inputs within the rounding budget
+    /// makes the core give the expected answer
+    /// ([`Divergence::reproduced`]). They fail the check only with
+    /// `strict`, where they are also counted in `divergent`. A divergence
+    /// on a fragile decision that no perturbation reproduces is counted in
+    /// `divergent`.
     pub fragile_divergent: u64,
     /// Fragile divergences by reason (one sweep can have several).
     pub fragile_by_reason: BTreeMap<String, u64>,
@@ -284,7 +286,7 @@ pub struct TraceReport {
     /// When a running engine was checked (`check --engine`): its command
     /// and what its answers were compared with.
     #[serde(skip_serializing_if = "Option::is_none")]
-    pub engine: Option<EngineCheck>,
+    pub engine: Option<super::engine_check::EngineCheck>,
 }
 
 /// How many compared sweeps (the first ones) the inference of the
@@ -450,16 +452,25 @@ where
                             .flatten(),
                     });
                 }
-                let (fields, fragile) = match judged.agreement {
+                let (fields, fragile, reproduced) = match judged.agreement {
                     Agreement::Match => continue,
                     Agreement::Tie => {
                         report.ties += 1;
                         continue;
                     }
-                    Agreement::Diverges { fields, fragile } => (fields, fragile),
+                    Agreement::Diverges {
+                        fields,
+                        fragile,
+                        reproduced,
+                    } => (fields, fragile, reproduced),
                 };
                 let got = judged.got;
-                if !fragile.is_robust() {
+                let details = |fields| {
+                    let mut d = divergence_details(&result, *expected, got, fields, options.hex);
+                    d.reproduced = reproduced;
+                    d
+                };
+                if reproduced.is_some() {
                     report.fragile_divergent += 1;
                     for reason in fragile.iter() {
                         *report
@@ -469,13 +480,7 @@ where
                     }
                     if !options.strict {
                         if report.fragile_divergences.len() < options.max_details {
-                            report.fragile_divergences.push(divergence_details(
-                                &result,
-                                *expected,
-                                got,
-                                fields,
-                                options.hex,
-                            ));
+                            report.fragile_divergences.push(details(fields));
                         }
                         continue;
                     }
@@ -489,13 +494,7 @@ where
                     report.divergent_frames.push(result.frame);
                 }
                 if report.divergences.len() < options.max_details {
-                    report.divergences.push(divergence_details(
-                        &result,
-                        *expected,
-                        got,
-                        fields,
-                        options.hex,
-                    ));
+                    report.divergences.push(details(fields));
                 }
             }
             Err(err) => {
@@ -503,7 +502,7 @@ where
                     report.incomplete = true;
                 }
                 if report.errors.len() < MAX_ERRORS {
-                    report.errors.push(error_text(&err));
+                    report.errors.push(crate::error_text::full_text(&err));
                 }
             }
         }
@@ -518,19 +517,6 @@ where
     }
     report.status = status_of(&report);
     report
-}
-
-fn error_text(err: &ReplayError) -> String {
-    let mut s = err.to_string();
-    let mut source = std::error::Error::source(err);
-    while let Some(e) = source {
-        let text = e.to_string();
-        if !s.contains(&text) {
-            let _ = write!(s, ": {text}");
-        }
-        source = e.source();
-    }
-    s
 }
 
 fn status_of(r: &TraceReport) -> Status {
@@ -568,6 +554,8 @@ pub fn divergence_details(
         expected,
         got,
         fragile: result.outcome.fragile,
+        reproduced: None,
+        names_tie_member: false,
         margin: result.options.margin,
         facing: result.options.facing.to_string(),
         got_explanation: explain_outcome(&result.outcome, &records),

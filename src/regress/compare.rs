@@ -1,5 +1,5 @@
-//! The one comparison of an outcome with its expectation, used by `check`,
-//! `diff` and the viewer's decision line.
+//! The field-by-field comparison of an outcome with its expectation, on
+//! which the one judgement ([`super::judge`]) rests.
 //!
 //! [`compare`] compares one outcome with one expectation, field by field,
 //! **only over the fields the expectation holds** (an absent field is `None`
@@ -12,10 +12,9 @@ use nalgebra::Vector3;
 use serde::Serialize;
 use serde_json::{Value, json};
 
+use crate::core::Kind;
 use crate::core::explain::num;
-use crate::core::{Broadphase, CollectRecords, Fragility, Kind, TestRecord, Tie, sweep_mesh_with};
 use crate::numbers::{self, Rule};
-use crate::replay::SweepResult;
 use crate::trace::messages::OutcomeMsg;
 
 /// Default absolute tolerance on `α` (a fraction of the path, unitless).
@@ -260,176 +259,52 @@ fn compare_all(expected: &OutcomeMsg, got: &OutcomeMsg, tol: &Tolerances) -> Vec
     }
     if let Some(want) = expected.normal {
         let have = got.normal.flatten();
-        let detail = match (want, have) {
+        // Null on one side only: the values say it (`engine null, core
+        // [0, 0, 1]`), in the words of whoever renders the two sides.
+        let differs = match (want, have) {
             (None, None) => None,
-            (Some(_), None) => Some("expected a normal, got none".to_string()),
-            (None, Some(_)) => Some("expected no normal (null), got one".to_string()),
+            (Some(_), None) | (None, Some(_)) => Some(None),
             (Some(w), Some(h)) => match angle_degrees(w, h) {
-                None => Some("one of the normals has zero or non-finite length".to_string()),
+                None => Some(Some(
+                    "one of the normals has zero or non-finite length".to_string(),
+                )),
                 Some(a) if a <= tol.normal_degrees => None,
-                Some(a) => Some(format!("angle {}° > {}°", num(a), num(tol.normal_degrees))),
+                Some(a) => Some(Some(format!(
+                    "angle {}° > {}°",
+                    num(a),
+                    num(tol.normal_degrees)
+                ))),
             },
         };
-        if let Some(detail) = detail {
+        if let Some(detail) = differs {
             out.push(FieldDiff {
                 field: Field::Normal,
                 expected: vec3(&want),
                 got: vec3(&have),
-                detail: Some(detail),
+                detail,
             });
         }
     }
     if let Some(want) = expected.contact {
         let have = got.contact.flatten();
-        let detail = match (want, have) {
+        let differs = match (want, have) {
             (None, None) => None,
-            (Some(_), None) => Some("expected a contact point, got none".to_string()),
-            (None, Some(_)) => Some("expected no contact point (null), got one".to_string()),
+            (Some(_), None) | (None, Some(_)) => Some(None),
             (Some(w), Some(h)) => {
                 let d = distance(w, h);
-                if d <= tol.contact {
-                    None
-                } else {
-                    Some(format!("distance {} > {}", num(d), num(tol.contact)))
-                }
+                // NaN (a non-finite point) is a difference too.
+                (d.is_nan() || d > tol.contact)
+                    .then(|| Some(format!("distance {} > {}", num(d), num(tol.contact))))
             }
         };
-        if let Some(detail) = detail {
+        if let Some(detail) = differs {
             out.push(FieldDiff {
                 field: Field::Contact,
                 expected: vec3(&want),
                 got: vec3(&have),
-                detail: Some(detail),
+                detail,
             });
         }
     }
     out
-}
-
-/// How a replayed sweep stands against its expectation: the one judgement
-/// used by `check`, `diff` and the viewer's decision line.
-#[derive(Clone, Debug, PartialEq)]
-pub enum Agreement {
-    /// Every field the expectation holds matches within the tolerances.
-    Match,
-    /// The expectation names another member of the replayed decision's tie
-    /// set (its kind, triangle or feature differ) and every other field it
-    /// holds matches that member (the contact is the member's own: a ball
-    /// touching two faces at once touches them at two points; α and the
-    /// averaged normal are the decision's): an equally valid answer to the
-    /// rules' tie order, reached by different rounding. Not a divergence.
-    Tie,
-    /// Fields differ. When the replayed decision is fragile (rounding at the
-    /// level of the inputs could change it), `fragile` names why; `check`
-    /// counts such divergences apart and fails on them only with
-    /// `--strict`.
-    Diverges {
-        /// The fields that differ (when the expectation names a member of
-        /// the tie set: those that differ from that member).
-        fields: Vec<FieldDiff>,
-        /// Why the replayed decision is fragile; empty when robust.
-        fragile: Fragility,
-    },
-}
-
-impl Agreement {
-    /// Whether the sweep diverges (robust or fragile).
-    pub fn is_divergent(&self) -> bool {
-        matches!(self, Agreement::Diverges { .. })
-    }
-
-    /// Whether the sweep fails a check: a divergence on a robust decision,
-    /// or any divergence when `strict`.
-    pub fn fails(&self, strict: bool) -> bool {
-        match self {
-            Agreement::Diverges { fragile, .. } => strict || fragile.is_robust(),
-            Agreement::Match | Agreement::Tie => false,
-        }
-    }
-}
-
-/// Judges `result` against `expected` ([`compare`] over the fields the
-/// expectation holds; see [`Agreement`]). An expectation naming another
-/// member of the tie set in the scene the sweep was replayed against is a
-/// [`Agreement::Tie`].
-pub fn agreement(expected: &OutcomeMsg, result: &SweepResult, tol: &Tolerances) -> Agreement {
-    let got = result.outcome_msg();
-    let mut fields = compare(expected, &got, tol);
-    if fields.is_empty() {
-        return Agreement::Match;
-    }
-    let identity =
-        |f: &FieldDiff| matches!(f.field, Field::Kind | Field::Triangle | Field::Feature);
-    if fields.iter().any(identity) {
-        match tie_member(expected, result, &result.scene.mesh, tol) {
-            Some(TieMember::Agrees) => return Agreement::Tie,
-            // Judged against the member it names: its fields that differ.
-            Some(TieMember::Named(differ)) => fields = differ,
-            None => {}
-        }
-    }
-    Agreement::Diverges {
-        fields,
-        fragile: result.outcome.fragile,
-    }
-}
-
-/// How an expectation relates to the replayed decision's tie set.
-enum TieMember {
-    /// It names a member of the tie set, and every field it holds matches
-    /// that member (the contact is the member's own: two faces touched at
-    /// once touch at two points).
-    Agrees,
-    /// It names a member, but some other field differs from every member
-    /// it names: the fields that differ from the first of them.
-    Named(Vec<FieldDiff>),
-}
-
-/// The point of the mesh a hit's test touches.
-fn contact_of(record: &TestRecord) -> Option<[f64; 3]> {
-    let p = match record {
-        TestRecord::Face(r) => r.touch?,
-        TestRecord::Edge(r) => r.frame.to_world(&nalgebra::Point3::new(r.xc?, 0.0, 0.0)),
-        TestRecord::Vertex(r) => r.position,
-    };
-    Some([p.x, p.y, p.z])
-}
-
-/// Whether `expected` names a member of the tie set of `result`'s decision
-/// (re-run with every hit recorded), and whether it matches that member.
-fn tie_member(
-    expected: &OutcomeMsg,
-    result: &SweepResult,
-    mesh: &crate::core::Mesh,
-    tol: &Tolerances,
-) -> Option<TieMember> {
-    let mut records = CollectRecords::default();
-    let outcome = sweep_mesh_with(
-        mesh,
-        &result.sweep,
-        &result.options,
-        Broadphase::Bvh,
-        &mut records,
-    )
-    .ok()?;
-    let mut named: Option<Vec<FieldDiff>> = None;
-    for r in &records.records {
-        let Some(tie) = Tie::of(r) else { continue };
-        if !outcome.ties_with(tie.alpha)
-            || !tie.matches(expected.kind, expected.triangle, expected.feature)
-        {
-            continue;
-        }
-        let mut member = OutcomeMsg::from_outcome(result.frame, result.ball, &outcome);
-        member.kind = tie.kind;
-        member.triangle = Some(Some(tie.triangle));
-        member.feature = Some(tie.feature);
-        member.contact = Some(contact_of(r));
-        let differ = compare(expected, &member, tol);
-        if differ.is_empty() {
-            return Some(TieMember::Agrees);
-        }
-        named.get_or_insert(differ);
-    }
-    named.map(TieMember::Named)
 }

@@ -12,14 +12,18 @@ use crate::replay::SweepResult;
 
 /// The fields in which the sweep's outcome differs from the trace's expected
 /// outcome when `check` counts the sweep as a failure (empty when it
-/// matches, ties, diverges only on a fragile decision, or has no
-/// expectation).
+/// matches, ties, diverges on a fragile decision in a way a perturbation of
+/// the inputs reproduces, or has no expectation).
 pub fn divergence(r: &SweepResult, tolerances: &Tolerances) -> Vec<FieldDiff> {
     let Some(expected) = &r.expected else {
         return Vec::new();
     };
     match agreement(expected, r, tolerances) {
-        Agreement::Diverges { fields, fragile } if fragile.is_robust() => fields,
+        Agreement::Diverges {
+            fields,
+            reproduced: None,
+            ..
+        } => fields,
         Agreement::Diverges { .. } | Agreement::Match | Agreement::Tie => Vec::new(),
     }
 }

@@ -163,8 +163,8 @@ fn expected_test(r: &TestRecord, expected: &OutcomeMsg, got: &Outcome) -> Expect
             num(got.alpha)
         ),
         Some(a) if got.is_hit() => format!(
-            "it hits at α = {}, as expected, but loses the tie to the primary test \
-             (ties go face < edge < vertex, then lower triangle, then lower feature)",
+            "it hits at α = {}, as expected, tied with the primary test, which the tie \
+             order puts first (face < edge < vertex, then lower triangle, then lower feature)",
             num(a)
         ),
         Some(a) => format!("it hits at α = {} but the sweep reports none", num(a)),

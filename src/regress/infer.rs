@@ -29,7 +29,8 @@ use crate::core::{Facing, Kind, Options, Sweep, sweep_mesh};
 use crate::replay::{SceneState, SweepResult};
 use crate::trace::messages::OutcomeMsg;
 
-use super::compare::{Agreement, Tolerances, agreement};
+use super::compare::Tolerances;
+use super::judge::{Agreement, agreement};
 
 /// One compared sweep, kept by `check` for the inference.
 #[derive(Clone, Debug)]

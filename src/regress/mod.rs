@@ -1,9 +1,13 @@
 //! Regression testing on top of replay: a trace's `/expected` outcomes are
 //! the test case.
 //!
-//! - [`compare`](mod@compare): the one rule deciding whether an outcome diverges from its
-//!   expectation ([`compare()`], [`Tolerances`]), shared by `check`, `diff`
-//!   and the viewer;
+//! - [`compare`](mod@compare): an outcome against its expectation, field
+//!   by field ([`compare()`], [`Tolerances`]);
+//! - [`judge`](mod@judge): the one judgement of a sweep's answer against its
+//!   expectation ([`agreement`], [`agreement_of`]): match, tie, or
+//!   divergence, excused only when a named perturbation within the
+//!   rounding budget reproduces it; shared by `check`, `check --engine`,
+//!   `diff`, `conform` and the viewer;
 //! - [`decision`](mod@decision): the decision line of a sweep in words, and
 //!   whether it diverges (used by the viewer and the Foxglove output);
 //! - [`explain`](mod@explain): why a divergent sweep came out as it did;
@@ -19,25 +23,30 @@ pub mod check;
 pub mod compare;
 pub mod decision;
 pub mod diff;
+pub mod engine_check;
 pub mod explain;
 pub mod infer;
+pub mod judge;
 mod render;
 pub mod repro;
 
 pub use bless::{BlessError, BlessSummary, bless_bytes, bless_file};
 pub use check::{
-    CheckOptions, DEFAULT_MAX_DETAILS, Divergence, EngineCheck, Judged, MAX_LISTED_TUNNELS, Status,
-    TraceReport, TunnelReport, check_events, check_events_judged, check_file, check_reader,
-    divergence_details, find_traces, frames_around, judge_against_core,
+    CheckOptions, DEFAULT_MAX_DETAILS, Divergence, Judged, MAX_LISTED_TUNNELS, Status, TraceReport,
+    TunnelReport, check_events, check_events_judged, check_file, check_reader, divergence_details,
+    find_traces, frames_around, judge_against_core,
 };
 pub use compare::{
-    Agreement, DEFAULT_ALPHA_TOLERANCE, DEFAULT_CONTACT_TOLERANCE,
-    DEFAULT_NORMAL_TOLERANCE_DEGREES, Field, FieldDiff, FieldSet, Tolerances, agreement,
-    angle_degrees, compare,
+    DEFAULT_ALPHA_TOLERANCE, DEFAULT_CONTACT_TOLERANCE, DEFAULT_NORMAL_TOLERANCE_DEGREES, Field,
+    FieldDiff, FieldSet, Tolerances, angle_degrees, compare,
 };
 pub use diff::{DiffReport, FirstDifference, Side, diff};
+pub use engine_check::{
+    Against, EngineCheck, check_file_with_engine, judge_answer_against_expected,
+};
 pub use explain::{ExpectedTest, expected_tests, explain_outcome, explained_records};
 pub use infer::{Inferred, Spread, infer};
+pub use judge::{Agreement, Perturbation, Reproduced, agreement, agreement_of, perturbations};
 pub use render::{
     Sides, render_divergence, render_divergence_as, render_json, render_text, value_text,
     value_text_exact, values_text,

@@ -70,6 +70,23 @@ impl Sides {
         }
     }
 
+    /// The expectation's answer, as a phrase.
+    fn answer(self) -> &'static str {
+        match self {
+            Sides::ExpectedAndCore | Sides::ExpectedAndEngine => "the expected answer",
+            Sides::EngineAndCore => "the engine's answer",
+        }
+    }
+
+    /// The other side's answer, as a phrase.
+    fn other_answer(self) -> &'static str {
+        match self {
+            Sides::ExpectedAndCore => "the core's",
+            Sides::EngineAndCore => "the core's",
+            Sides::ExpectedAndEngine => "the engine's answer",
+        }
+    }
+
     fn got(self) -> &'static str {
         match self {
             Sides::ExpectedAndCore => "got",
@@ -105,6 +122,24 @@ pub fn render_divergence_as(d: &Divergence, indent: &str, sides: Sides) -> Strin
             format!("; the core's decision is fragile: {}", d.fragile)
         }
     );
+    match &d.reproduced {
+        Some(r) => {
+            let _ = writeln!(
+                s,
+                "{indent}  rounding explains it: {}",
+                r.text(sides.answer(), sides.other_answer())
+            );
+        }
+        None if !d.fragile.is_robust() && !d.names_tie_member => {
+            let _ = writeln!(
+                s,
+                "{indent}  no perturbation of the inputs within the rounding budget gives {}: \
+                 a divergence, not rounding",
+                sides.answer()
+            );
+        }
+        None => {}
+    }
     let _ = writeln!(s, "{indent}  inputs: {}", d.inputs.text());
     if let Some(hex) = &d.inputs_hex {
         let _ = writeln!(s, "{indent}  inputs (hex): {}", hex.text());
@@ -154,7 +189,7 @@ pub fn render_text(r: &TraceReport) -> String {
     let mut s = String::new();
     let sides = match &r.engine {
         None => Sides::ExpectedAndCore,
-        Some(e) if e.against == "expected" => Sides::ExpectedAndEngine,
+        Some(e) if e.against == super::Against::Expected => Sides::ExpectedAndEngine,
         Some(_) => Sides::EngineAndCore,
     };
     let mut counts = format!(

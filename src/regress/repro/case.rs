@@ -9,7 +9,8 @@ use crate::core::{Mesh, Options, Outcome, Sweep, sweep_ties};
 use crate::trace::messages::{OutcomeMsg, SceneMsg, SweepMsg};
 use crate::trace::{TraceError, TraceWriter};
 
-use crate::regress::compare::{Agreement, Field, FieldSet, Tolerances, agreement};
+use crate::regress::compare::{Field, FieldSet, Tolerances};
+use crate::regress::judge::{Agreement, agreement};
 
 use super::find::{ReproError, TraceSweep};
 use super::inputs::SweepInputs;
@@ -62,16 +63,23 @@ pub fn agreement_text(a: &Agreement) -> String {
     match a {
         Agreement::Match => "match".to_string(),
         Agreement::Tie => "tie (the expectation names another member of the tie set)".to_string(),
-        Agreement::Diverges { fields, fragile } => {
+        Agreement::Diverges {
+            fields,
+            fragile,
+            reproduced,
+        } => {
             let names = fields
                 .iter()
                 .map(|f| f.field.as_str())
                 .collect::<Vec<_>>()
                 .join(", ");
-            if fragile.is_robust() {
-                format!("diverges ({names})")
-            } else {
-                format!("fragile divergence ({names}; {fragile})")
+            match (fragile.is_robust(), reproduced) {
+                (true, _) => format!("diverges ({names})"),
+                (false, Some(_)) => format!("fragile divergence ({names}; {fragile})"),
+                (false, None) => format!(
+                    "diverges ({names}; the decision is fragile: {fragile}, but no perturbation \
+                     gives the expected answer)"
+                ),
             }
         }
     }
@@ -84,14 +92,17 @@ fn same_verdict(a: &Agreement, b: &Agreement) -> bool {
             Agreement::Diverges {
                 fields: fa,
                 fragile: xa,
+                reproduced: ra,
             },
             Agreement::Diverges {
                 fields: fb,
                 fragile: xb,
+                reproduced: rb,
             },
         ) => {
             fa.iter().map(|f| f.field).eq(fb.iter().map(|f| f.field))
                 && xa.is_robust() == xb.is_robust()
+                && ra.is_some() == rb.is_some()
         }
         _ => false,
     }

@@ -2,7 +2,8 @@
 
 use std::fmt::Write as _;
 
-use crate::regress::compare::{Agreement, Tolerances};
+use crate::regress::compare::Tolerances;
+use crate::regress::judge::Agreement;
 
 use crate::core::{Facing, Kind};
 

@@ -1,0 +1,140 @@
+//! `check --engine`: a trace's sweeps answered by a running engine (the
+//! protocol client of [`crate::engine`]) and judged by the one judgement
+//! ([`super::judge`]), in an ordinary check's report.
+
+// An engine's error carries its command, the line and its last stderr
+// lines; it happens once per run, so its size does not matter.
+#![allow(clippy::result_large_err)]
+
+use serde::Serialize;
+
+use crate::engine::{
+    AnswerSink, EngineAnswers, EngineCommand, EngineError, EngineOptions, EngineSession,
+};
+use crate::replay::SweepResult;
+use crate::trace::TraceReader;
+use crate::trace::messages::{EXPECTED_TOPIC, OutcomeMsg};
+
+use super::check::{
+    CheckOptions, Judged, TraceReport, check_events, check_events_judged, check_file,
+};
+use super::compare::Tolerances;
+use super::judge::agreement_of;
+
+/// What an engine's answers are compared with.
+#[derive(
+    Clone, Copy, Debug, PartialEq, Eq, Default, Serialize, strum::IntoStaticStr, strum::Display,
+)]
+#[serde(rename_all = "snake_case")]
+#[strum(serialize_all = "snake_case")]
+pub enum Against {
+    /// The core's outcomes: the answers are the sweeps' expectations.
+    #[default]
+    Core,
+    /// The trace's `/expected` channel: the answers are compared with it
+    /// (ties and fragility are the core's decision's).
+    Expected,
+}
+
+/// A running engine's part in a check.
+#[derive(Clone, Debug, PartialEq, Eq, Serialize)]
+pub struct EngineCheck {
+    /// The engine's command.
+    pub command: String,
+    /// [`Against::Core`]: the engine's answers are the expectations and the
+    /// core's outcomes are compared with them ("expected" is the engine's
+    /// answer, "got" the core's); [`Against::Expected`]: the trace's
+    /// `/expected` is the expectation and the engine's answers are compared
+    /// with it ("got" is the engine's answer).
+    pub against: Against,
+}
+
+/// Checks the trace at `path` against a running engine: the engine answers
+/// every sweep ([`EngineAnswers`]) and the answers are judged by an
+/// ordinary check ([`check_events_judged`]): with [`Against::Core`] they
+/// are the expectations and the core's outcomes are compared with them
+/// (the trace's `/expected` is not used); with [`Against::Expected`] they
+/// are compared with the trace's `/expected` ([`judge_answer_against_expected`]).
+/// Either way the report counts and explains the differences, with ties
+/// and fragile decisions judged as `check` judges them.
+///
+/// `Err` only when the engine cannot be started; any later fault of the
+/// engine is an error of the report (what was answered before it is
+/// reported too).
+pub fn check_file_with_engine(
+    path: &std::path::Path,
+    command: &EngineCommand,
+    engine: EngineOptions,
+    against: Against,
+    options: &CheckOptions,
+) -> Result<TraceReport, EngineError> {
+    let name = path.display().to_string();
+    let engine_check = EngineCheck {
+        command: command.text.clone(),
+        against,
+    };
+    let file = match std::fs::File::open(path) {
+        Ok(file) => file,
+        Err(_) => {
+            // The same report as `check` gives for a file it cannot open.
+            let mut report = check_file(path, options);
+            report.engine = Some(engine_check);
+            return Ok(report);
+        }
+    };
+    let session = EngineSession::start(command, engine)?;
+    let mut reader = TraceReader::new(std::io::BufReader::with_capacity(1 << 16, file), &name);
+    let (mut report, run) = match against {
+        Against::Core => {
+            let mut answers = EngineAnswers::new(reader.by_ref(), session, engine.window);
+            let report = check_events(answers.by_ref(), &name, options);
+            (report, answers.finish())
+        }
+        Against::Expected => {
+            let sink = AnswerSink::default();
+            let mut answers = EngineAnswers::keeping_expectations(
+                reader.by_ref(),
+                session,
+                engine.window,
+                sink.clone(),
+            );
+            let report = check_events_judged(answers.by_ref(), &name, options, |result| {
+                let answer = sink.borrow_mut().remove(&(result.frame, result.ball))?;
+                judge_answer_against_expected(result, answer, &options.tolerances)
+            });
+            (report, answers.finish())
+        }
+    };
+    report.engine = Some(engine_check);
+    report.has_expected_channel = match against {
+        Against::Core => true,
+        Against::Expected => reader.stats().channels.contains_key(EXPECTED_TOPIC),
+    };
+    if let Some(error) = run.error {
+        if error.cannot_start() {
+            return Err(error);
+        }
+        report.add_error(error.to_string());
+    }
+    Ok(report)
+}
+
+/// The trace's expectation of a sweep against an engine's answer to it,
+/// judged by the one judgement ([`agreement_of`]): a match; a tie when both
+/// are answers the core's decision accepts (its primary, or another member
+/// of its tie set with that member's own contact); otherwise a divergence,
+/// excused as fragile only when a perturbation of the inputs gives each
+/// side's answer. `None` when the sweep has no expectation.
+pub fn judge_answer_against_expected(
+    result: &SweepResult,
+    answer: OutcomeMsg,
+    tolerances: &Tolerances,
+) -> Option<Judged> {
+    let expected = result.expected?;
+    Some(Judged {
+        agreement: agreement_of(&expected, &answer, result, tolerances),
+        expected,
+        got: answer,
+        got_is_core: false,
+    })
+}

@@ -1,0 +1,448 @@
+//! The one judgement of an answer against an expectation for one sweep,
+//! used by `check`, `check --engine` (both `--against` modes), `diff`,
+//! `conform` and the viewer's divergence marks.
+//!
+//! Three outcomes ([`Agreement`]):
+//! - **match**: [`compare`] finds no field that differs;
+//! - **tie**: each side is an answer the core's decision accepts: its
+//!   primary, or another member of its tie set with that member's own
+//!   kind, triangle, feature and contact (α and the averaged normal are the
+//!   decision's);
+//! - **divergence**, which is *excused as fragile* only when the core's
+//!   decision is fragile **and** a named perturbation of the sweep's inputs
+//!   within the rounding budget the fragility reasons are defined by makes
+//!   the core give each side's answer ([`Reproduced`]). Any other
+//!   divergence fails, whatever the decision's fragility: a fragile
+//!   decision does not excuse an answer no rounding gives.
+//!
+//! The perturbations ([`perturbations`]) move one input at a time by
+//! `k · u`, where `u = ε · S` is the sweep's rounding unit (`S` the scale of
+//! [`SweptPath`], ε the machine epsilon) and `k` runs over 1, 2⁴, 2⁸, 2¹²
+//! and 2¹⁶ = [`FRAGILE_ULPS`] (the fragility band), both signs: each
+//! coordinate of `p0`, of `p1`, of both together (the path moved, which is
+//! the mesh moved the other way), and the radius. The first one that
+//! reproduces an answer, smallest first, is the one reported.
+
+use std::fmt;
+
+use serde::Serialize;
+
+use crate::core::explain::num;
+use crate::core::{
+    Broadphase, EdgeRecord, FRAGILE_ULPS, FaceRecord, Fragility, Mesh, Observer, Options, Outcome,
+    Sweep, SweptPath, TestRecord, Tie, VertexRecord, sweep_mesh_with,
+};
+use crate::replay::SweepResult;
+use crate::trace::messages::OutcomeMsg;
+
+use super::compare::{FieldDiff, Tolerances, compare};
+
+/// How an answer stands against an expectation: the one judgement.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Agreement {
+    /// Every field the expectation holds matches within the tolerances.
+    Match,
+    /// Both sides are answers the core's decision accepts: its primary or
+    /// another member of its tie set, each with that member's own contact
+    /// (a ball touching two faces at once touches them at two points; α
+    /// and the averaged normal are the decision's). An equally valid
+    /// answer to the rules' tie order, reached by different rounding: not
+    /// a divergence (except in `conform`, where the cases are exact and the
+    /// rule's choice is the only right answer).
+    Tie,
+    /// Fields differ.
+    Diverges {
+        /// The fields that differ (when the expectation names a member of
+        /// the tie set and the other side is the core's outcome: those that
+        /// differ from that member).
+        fields: Vec<FieldDiff>,
+        /// Why the core's decision is fragile; empty when robust.
+        fragile: Fragility,
+        /// When the decision is fragile and rounding explains the
+        /// divergence: the perturbation of the inputs under which the core
+        /// gives each side's answer. `None`: no perturbation does (or the
+        /// decision is robust), and the divergence fails.
+        reproduced: Option<Reproduced>,
+    },
+}
+
+impl Agreement {
+    /// Whether the sweep diverges (excused or not).
+    pub fn is_divergent(&self) -> bool {
+        matches!(self, Agreement::Diverges { .. })
+    }
+
+    /// Whether the sweep diverges only as rounding could have made it: a
+    /// fragile decision and a [`Reproduced`] answer.
+    pub fn is_excused(&self) -> bool {
+        matches!(
+            self,
+            Agreement::Diverges {
+                reproduced: Some(_),
+                ..
+            }
+        )
+    }
+
+    /// Whether the sweep fails a check: a divergence that no perturbation
+    /// reproduces, or any divergence when `strict`.
+    pub fn fails(&self, strict: bool) -> bool {
+        match self {
+            Agreement::Diverges { reproduced, .. } => strict || reproduced.is_none(),
+            Agreement::Match | Agreement::Tie => false,
+        }
+    }
+}
+
+/// One change of one input of a sweep, within its rounding budget.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct Perturbation {
+    /// What moved: `p0.x` … `p1.z`, `path.x` … `path.z` (both ends of the
+    /// path by the same amount), or `radius`.
+    pub input: &'static str,
+    /// By how many rounding units `u` (signed).
+    pub units: f64,
+    /// By how much, in the scene's length unit (`units · u`, signed).
+    pub offset: f64,
+}
+
+impl Perturbation {
+    /// Applies the perturbation to `sweep`.
+    fn apply(&self, sweep: &Sweep) -> Sweep {
+        let mut s = *sweep;
+        let axis = |name: &str| match name.as_bytes().last() {
+            Some(b'x') => 0,
+            Some(b'y') => 1,
+            _ => 2,
+        };
+        match self.input.split_once('.') {
+            Some(("p0", a)) => s.p0[axis(a)] += self.offset,
+            Some(("p1", a)) => s.p1[axis(a)] += self.offset,
+            Some((_, a)) => {
+                s.p0[axis(a)] += self.offset;
+                s.p1[axis(a)] += self.offset;
+            }
+            None => s.radius += self.offset,
+        }
+        s
+    }
+}
+
+/// `p1.z lower by 2^12 u`, `the radius larger by 1 u`, `the whole path
+/// (p0 and p1) moved by -2^4 u in y` (`u`: [`Reproduced::rounding_unit`]).
+impl fmt::Display for Perturbation {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let exponent = self.units.abs().log2().round();
+        let size = if exponent == 0.0 {
+            "1 u".to_string()
+        } else {
+            format!("2^{exponent} u")
+        };
+        let up = self.units > 0.0;
+        match self.input.strip_prefix("path.") {
+            Some(axis) => write!(
+                f,
+                "the whole path (p0 and p1) moved by {}{size} in {axis}",
+                if up { "+" } else { "-" }
+            ),
+            None if self.input == "radius" => write!(
+                f,
+                "the radius {} by {size}",
+                if up { "larger" } else { "smaller" }
+            ),
+            None => write!(
+                f,
+                "{} {} by {size}",
+                self.input,
+                if up { "higher" } else { "lower" }
+            ),
+        }
+    }
+}
+
+/// How the two sides of a fragile divergence are each an answer of the
+/// core: `None` for the core's own decision (its primary or a member of
+/// its tie set), or the perturbation under which the core gives it.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct Reproduced {
+    /// The expectation's side.
+    pub expected: Option<Perturbation>,
+    /// The side compared with it (the core's outcome, or an engine's answer).
+    pub got: Option<Perturbation>,
+    /// The sweep's rounding unit `u = ε · S`.
+    pub rounding_unit: f64,
+}
+
+impl Reproduced {
+    /// In words, naming the two sides `expected` and `got` (`the engine's
+    /// answer is what the core gives with p1.z lower by 2^12 u (u = …)`).
+    pub fn text(&self, expected: &str, got: &str) -> String {
+        let one = |side: &str, p: &Option<Perturbation>| match p {
+            Some(p) => format!("{side} is what the core gives with {p}"),
+            None => format!("{side} is the core's own decision"),
+        };
+        let mut s = match (&self.expected, &self.got) {
+            (Some(_), None) => one(expected, &self.expected),
+            (None, Some(_)) => one(got, &self.got),
+            _ => format!(
+                "{}, and {}",
+                one(expected, &self.expected),
+                one(got, &self.got)
+            ),
+        };
+        s.push_str(&format!(
+            " (u = {}, the sweep's rounding unit)",
+            num(self.rounding_unit)
+        ));
+        s
+    }
+}
+
+/// The magnitudes of the perturbations, in rounding units: 1, 2⁴, 2⁸, 2¹²,
+/// 2¹⁶ (the fragility band, [`FRAGILE_ULPS`]).
+const PERTURBATION_UNITS: [f64; 5] = [1.0, 16.0, 256.0, 4096.0, FRAGILE_ULPS];
+
+/// The inputs that are perturbed, one at a time.
+const PERTURBED_INPUTS: [&str; 10] = [
+    "p0.x", "p0.y", "p0.z", "p1.x", "p1.y", "p1.z", "path.x", "path.y", "path.z", "radius",
+];
+
+/// The perturbations of a sweep whose rounding unit is `u`, smallest first
+/// (each magnitude over every input, lower before higher).
+pub fn perturbations(u: f64) -> impl Iterator<Item = Perturbation> {
+    PERTURBATION_UNITS.into_iter().flat_map(move |k| {
+        PERTURBED_INPUTS.into_iter().flat_map(move |input| {
+            [-k, k].into_iter().map(move |units| Perturbation {
+                input,
+                units,
+                offset: units * u,
+            })
+        })
+    })
+}
+
+/// The sweep's rounding unit `u = ε · S` against `mesh` (the scale the
+/// core's tests use); `None` when the sweep is invalid.
+fn rounding_unit(mesh: &Mesh, sweep: &Sweep, options: &Options) -> Option<f64> {
+    let (lo, hi) = mesh.bounds();
+    Some(
+        SweptPath::new(sweep, options)
+            .ok()?
+            .with_mesh_scale(&lo, &hi)
+            .rounding(),
+    )
+}
+
+/// Keeps the records of the tests that hit.
+#[derive(Default)]
+struct Hits(Vec<TestRecord>);
+
+impl Observer for Hits {
+    // Triangles whose every test ends back-facing hit nothing.
+    const WANTS_RECORDS: bool = false;
+    fn face(&mut self, r: &FaceRecord) {
+        if r.alpha().is_some() {
+            self.0.push(TestRecord::Face(*r));
+        }
+    }
+    fn edge(&mut self, r: &EdgeRecord) {
+        if r.alpha().is_some() {
+            self.0.push(TestRecord::Edge(*r));
+        }
+    }
+    fn vertex(&mut self, r: &VertexRecord) {
+        if r.alpha().is_some() {
+            self.0.push(TestRecord::Vertex(*r));
+        }
+    }
+}
+
+/// The core's decision on one sweep: its outcome and the hits that can be
+/// members of its tie set.
+struct Decision {
+    outcome: Outcome,
+    hits: Vec<TestRecord>,
+}
+
+impl Decision {
+    fn of(mesh: &Mesh, sweep: &Sweep, options: &Options) -> Option<Decision> {
+        let mut hits = Hits::default();
+        let outcome = sweep_mesh_with(mesh, sweep, options, Broadphase::Bvh, &mut hits).ok()?;
+        Some(Decision {
+            outcome,
+            hits: hits.0,
+        })
+    }
+
+    /// `None` when the decision accepts `answer`: it matches the primary,
+    /// or another member of the tie set with that member's own contact.
+    /// Otherwise the fields that differ: from the first member the answer
+    /// names, or from the primary.
+    fn disagreement(&self, answer: &OutcomeMsg, tol: &Tolerances) -> Option<Vec<FieldDiff>> {
+        let primary = OutcomeMsg::from_outcome(answer.frame, answer.ball, &self.outcome);
+        let differ = compare(answer, &primary, tol);
+        if differ.is_empty() {
+            return None;
+        }
+        let mut named: Option<Vec<FieldDiff>> = None;
+        for r in &self.hits {
+            let Some(tie) = Tie::of(r) else { continue };
+            if !self.outcome.ties_with(tie.alpha) {
+                continue;
+            }
+            let mut member = primary;
+            member.kind = tie.kind;
+            member.triangle = Some(Some(tie.triangle));
+            member.feature = Some(tie.feature);
+            member.contact = Some(r.contact().map(|c| [c.x, c.y, c.z]));
+            let d = compare(answer, &member, tol);
+            if d.is_empty() {
+                return None;
+            }
+            if tie.matches(answer.kind, answer.triangle, answer.feature) {
+                named.get_or_insert(d);
+            }
+        }
+        Some(named.unwrap_or(differ))
+    }
+}
+
+/// Judges the expectation against the core's outcome of `result` (`check`,
+/// `diff`, `conform`, the viewer): see the [module documentation](self).
+pub fn agreement(expected: &OutcomeMsg, result: &SweepResult, tol: &Tolerances) -> Agreement {
+    judge(expected, &result.outcome_msg(), true, result, tol)
+}
+
+/// Judges `expected` against another answer `got` to the same sweep (an
+/// engine's), with the core's decision on `result` as the referee: a tie
+/// when both are answers the decision accepts; a divergence excused only
+/// when a perturbation gives each side's answer.
+pub fn agreement_of(
+    expected: &OutcomeMsg,
+    got: &OutcomeMsg,
+    result: &SweepResult,
+    tol: &Tolerances,
+) -> Agreement {
+    judge(expected, got, false, result, tol)
+}
+
+fn judge(
+    expected: &OutcomeMsg,
+    got: &OutcomeMsg,
+    got_is_core: bool,
+    result: &SweepResult,
+    tol: &Tolerances,
+) -> Agreement {
+    let fields = compare(expected, got, tol);
+    if fields.is_empty() {
+        return Agreement::Match;
+    }
+    let fragile = result.outcome.fragile;
+    let mesh = &result.scene.mesh;
+    let Some(decision) = Decision::of(mesh, &result.sweep, &result.options) else {
+        return Agreement::Diverges {
+            fields,
+            fragile,
+            reproduced: None,
+        };
+    };
+    let on_expected = decision.disagreement(expected, tol);
+    let on_got = if got_is_core {
+        None
+    } else {
+        decision.disagreement(got, tol)
+    };
+    if on_expected.is_none() && on_got.is_none() {
+        return Agreement::Tie;
+    }
+    // Against the core's own outcome, the fields that differ are those
+    // from the member of the tie set the expectation names.
+    let fields = match (got_is_core, on_expected.as_ref()) {
+        (true, Some(named)) => named.clone(),
+        _ => fields,
+    };
+    let reproduced = if fragile.is_robust() {
+        None
+    } else {
+        reproduce(
+            expected,
+            on_expected.is_some(),
+            got,
+            on_got.is_some(),
+            result,
+            tol,
+        )
+    };
+    Agreement::Diverges {
+        fields,
+        fragile,
+        reproduced,
+    }
+}
+
+/// The smallest perturbations under which the core gives `expected` (when
+/// `expected_open`, i.e. its own decision does not) and `got` (when
+/// `got_open`); `None` unless both are found.
+fn reproduce(
+    expected: &OutcomeMsg,
+    expected_open: bool,
+    got: &OutcomeMsg,
+    got_open: bool,
+    result: &SweepResult,
+    tol: &Tolerances,
+) -> Option<Reproduced> {
+    let mesh = &result.scene.mesh;
+    let u = rounding_unit(mesh, &result.sweep, &result.options)?;
+    let mut on_expected: Option<Option<Perturbation>> = (!expected_open).then_some(None);
+    let mut on_got: Option<Option<Perturbation>> = (!got_open).then_some(None);
+    for p in perturbations(u) {
+        if on_expected.is_some() && on_got.is_some() {
+            break;
+        }
+        let Some(decision) = Decision::of(mesh, &p.apply(&result.sweep), &result.options) else {
+            continue;
+        };
+        if on_expected.is_none() && decision.disagreement(expected, tol).is_none() {
+            on_expected = Some(Some(p));
+        }
+        if on_got.is_none() && decision.disagreement(got, tol).is_none() {
+            on_got = Some(Some(p));
+        }
+    }
+    Some(Reproduced {
+        expected: on_expected?,
+        got: on_got?,
+        rounding_unit: u,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn perturbations_are_ordered_smallest_first_and_cover_every_input() {
+        let all: Vec<Perturbation> = perturbations(1.0).collect();
+        assert_eq!(all.len(), 5 * 10 * 2);
+        assert!(all.windows(2).all(|w| w[0].units.abs() <= w[1].units.abs()));
+        assert_eq!(all[0].input, "p0.x");
+        assert_eq!(all[0].units, -1.0);
+        assert_eq!(all.last().map(|p| p.units), Some(FRAGILE_ULPS));
+    }
+
+    #[test]
+    fn a_perturbation_moves_only_its_input() {
+        let s = Sweep::new([1.0, 2.0, 3.0], [4.0, 5.0, 6.0], 0.5);
+        let p = |input, offset| Perturbation {
+            input,
+            units: 1.0,
+            offset,
+        };
+        assert_eq!(p("p1.z", 0.25).apply(&s).p1.z, 6.25);
+        assert_eq!(p("p1.z", 0.25).apply(&s).p0, s.p0);
+        let moved = p("path.y", -1.0).apply(&s);
+        assert_eq!((moved.p0.y, moved.p1.y), (1.0, 4.0));
+        assert_eq!(p("radius", 0.125).apply(&s).radius, 0.625);
+        assert_eq!(p("p0.x", 0.5).to_string(), "p0.x higher by 1 u".to_string());
+    }
+}

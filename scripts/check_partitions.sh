@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Checks that cargo-nextest's hash partitions split the trace test cases
 # (one test per file in traces/) so that N partitions together run every
-# trace exactly once: the sharding recipe of the README.
+# trace exactly once: the sharding recipe of docs/REGRESSION.md.
 #
 #   scripts/check_partitions.sh        # 2 partitions
 #   scripts/check_partitions.sh 3      # 3 partitions

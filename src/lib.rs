@@ -54,3 +54,8 @@ pub use crate::trace::{TraceEvent, TraceReader, TraceWriter, write_trace_file};
 #[cfg(doctest)]
 #[doc = include_str!("../README.md")]
 pub struct ReadmeDoctests;
+
+/// docs/LIBRARY.md's Rust examples, compiled and run as doctests.
+#[cfg(doctest)]
+#[doc = include_str!("../docs/LIBRARY.md")]
+pub struct LibraryDoctests;

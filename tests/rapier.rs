@@ -1,6 +1,6 @@
 //! The Rapier recorder (`examples/rapier_record.rs`) runs and writes a
-//! trace that passes `check` with the options the README gives a Rapier
-//! user, and fails without them.
+//! trace that passes `check` with the options examples/rapier/README.md
+//! gives a Rapier user, and fails without them.
 
 use libtest_mimic::Trial;
 use sweeptrace::regress::{

@@ -78,7 +78,7 @@ fn c_example_compiled_with_the_system_compiler_writes_a_trace_that_check_passes(
     let program = dir.path().join("write_trace");
     let compiler = std::env::var_os("CC").unwrap_or_else(|| "cc".into());
     let library_dir = library_dir();
-    // Fails on warnings too: the README shows this file.
+    // Fails on warnings too: capi/README.md shows this file.
     run(
         "compiling examples/c/write_trace.c",
         Command::new(&compiler)
@@ -155,9 +155,10 @@ fn process_ending_before_close_leaves_no_file_under_the_target_name() {
 fn readme_shows_the_tested_c_example_unchanged() {
     let example = std::fs::read_to_string(root().join("examples/c/write_trace.c"))
         .expect("reading examples/c/write_trace.c");
-    let readme = std::fs::read_to_string(root().join("README.md")).expect("reading README.md");
+    let readme =
+        std::fs::read_to_string(root().join("capi/README.md")).expect("reading capi/README.md");
     assert!(
         readme.contains(&format!("```c\n{example}```\n")),
-        "README.md does not show examples/c/write_trace.c as it is: copy the file into its ```c block"
+        "capi/README.md does not show examples/c/write_trace.c as it is: copy the file into its ```c block"
     );
 }

@@ -61,10 +61,10 @@ pub struct Args {
     /// Leave out the `.rrd` file's footer, the index of every chunk that
     /// lets a reader find chunks without reading the whole file
     /// (`--rrd run.rrd --no-rrd-footer`). The index is built in memory
-    /// until the end, 6 to 8 KB per chunk, so with it the memory of a
-    /// replay grows slowly with the trace's length (188 MB for 1.2 million
-    /// sweeps of 64 balls, against 168 MB for 200,000); without it the
-    /// memory stays bounded, but `rerun rrd verify` rejects the file.
+    /// until the end, a few kilobytes per chunk, so with it the memory of a
+    /// replay grows slowly with the trace's length (BENCHMARKS.md has the
+    /// figures); without it the memory stays bounded, but `rerun rrd
+    /// verify` rejects the file.
     #[arg(long)]
     pub no_rrd_footer: bool,
     /// Write the replay as an MCAP file for Foxglove (`--foxglove run.fg.mcap`):

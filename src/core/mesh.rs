@@ -228,7 +228,7 @@ impl Mesh {
         let bvh = Bvh::build(&usable);
         // Store triangles in BVH leaf order so leaves are contiguous ranges,
         // permuted in place: a copy would hold the largest array of the mesh
-        // twice (42 MB each on 10^5 triangles) while building.
+        // twice while building.
         permute_into_order(&mut usable, bvh.order());
         Ok(Mesh {
             vertices,

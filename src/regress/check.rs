@@ -291,7 +291,7 @@ pub struct TraceReport {
 
 /// How many compared sweeps (the first ones) the inference of the
 /// recording engine's configuration looks at and replays, so that a
-/// check's memory stays bounded whatever the trace's length (about 20 MB).
+/// check's memory stays bounded whatever the trace's length.
 pub const MAX_INFERENCE_SWEEPS: usize = 100_000;
 
 /// How many divergent frames a report lists.

@@ -40,10 +40,10 @@ impl Detail {
 
     /// Trace events per batch of a parallel replay at this detail: a batch's
     /// results are in memory together, and at `candidates` and `all` each
-    /// sweep keeps the record of every test it ran (tens of kilobytes for a
-    /// ball rolling on a fine mesh, megabytes at `all` on 10^5 triangles),
-    /// so those batches are shorter. (4,096 events of `candidates` records
-    /// on the 100,352-triangle terrain held 600 MB.)
+    /// sweep keeps the record of every test it ran (many for a ball rolling
+    /// on a fine mesh, far more at `all` on a large one), so those batches
+    /// are shorter: a full batch of `candidates` records on a large terrain
+    /// held far more memory than the rest of the replay (BENCHMARKS.md).
     pub fn batch_events(self) -> usize {
         match self {
             Detail::Primary => super::DEFAULT_BATCH_EVENTS,

@@ -31,26 +31,26 @@ use crate::regress::decision::divergence;
 use crate::replay::{ReplayEvent, SceneState, SweepResult};
 
 /// Rows buffered before the logger sends them (see [`Logger`]); with
-/// [`DEFAULT_FLUSH_BYTES`] the bytes usually come first (about 75 bytes a
-/// row at `primary`).
+/// [`DEFAULT_FLUSH_BYTES`] the bytes usually come first.
 pub const DEFAULT_FLUSH_ROWS: usize = 1 << 20;
 
 /// Bytes of buffered rows (times, row numbers, values) at which the logger
 /// sends them, whatever their number (see [`Logger`]). The chunks are one
 /// per entity and set of components, so the larger the buffer, the more
-/// rows each chunk holds: with 64 balls (about 2,000 entities), 32 MiB give
-/// chunks of about 130 rows on average, and each chunk costs about 1.4 KB
-/// in the file besides its rows (schema, footer entry).
+/// rows each chunk holds, and each chunk costs a fixed overhead in the
+/// file besides its rows (schema, footer entry); many balls mean many
+/// entities sharing the buffer, hence short chunks. BENCHMARKS.md has the
+/// measurements.
 pub const DEFAULT_FLUSH_BYTES: usize = 32 << 20;
 
 /// [`DEFAULT_FLUSH_BYTES`] of a logger that spills ([`Logger::with_spill`]):
 /// its parts are joined into long chunks at the end, so the buffer's size no
 /// longer sets the chunks' length, only how often the buffer is written
-/// out (each flush writes one part per entity and set). On the 64-ball
-/// sessions of BENCHMARKS.md (one entity per part of a ball's picture),
-/// 8 MiB gave 149-154 MB of max RSS and 5.6-6.3 s, 12 MiB 168-170 MB and
-/// 5.6-6.1 s, 16 MiB 181-184 MB and 5.4-6.0 s; on the 1.2 M-sweep session,
-/// with the file's footer, 166, 188 and 205 MB.
+/// out (each flush writes one part per entity and set). A smaller buffer
+/// means more flushes, a larger one more memory for little speed: this is
+/// the largest of the sizes tried that keeps the long 64-ball session of
+/// BENCHMARKS.md, footer included, within the memory goal (the
+/// measurements are there).
 pub const SPILL_FLUSH_BYTES: usize = 12 << 20;
 
 /// Sweeps per [`PreparedSweeps`] that the command and the bench prepare on

@@ -13,8 +13,8 @@
 //! The file ends with a footer unless told otherwise
 //! ([`RrdFileOptions::footer`]). The SDK's encoder builds the footer's index
 //! in memory, one row per chunk with a column per timeline and component
-//! type (6 to 8 KB of memory per chunk measured on a replay's recording), until the file is
-//! finished, so that memory grows with the trace's length; without the
+//! type (the memory per chunk is measured in BENCHMARKS.md), until the file
+//! is finished, so that memory grows with the trace's length; without the
 //! footer the writer's memory is bounded, but `rerun rrd verify` (0.36.3)
 //! rejects the file ("Missing RRD footer").
 
@@ -51,7 +51,7 @@ pub struct RrdFileOptions {
     /// Write the footer (the default): an index of every chunk (entity,
     /// time ranges, byte offsets) at the end of the file, which lets a
     /// reader locate chunks without reading the whole file. Built in memory
-    /// while the file is written: 6 to 8 KB per chunk measured.
+    /// while the file is written, a row per chunk (see the module's doc).
     pub footer: bool,
 }
 

@@ -52,8 +52,8 @@ pub const MAX_CHUNK_ROWS: usize = 16384;
 /// 384 KiB), which only say how far the viewer merges small chunks: the
 /// footer's index costs several KB per chunk until the file is finished
 /// (one row of a column per entity and component), so fewer, longer chunks
-/// keep that memory small. 2 MiB gave fewer chunks but a larger file (see
-/// BENCHMARKS.md).
+/// keep that memory small. A larger limit gave fewer chunks but a larger
+/// file (see BENCHMARKS.md).
 pub const MAX_CHUNK_BYTES: usize = 512 << 10;
 
 /// Where a part lies in the file, its rows and the bytes of its arrays

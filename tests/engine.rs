@@ -29,6 +29,10 @@ pub fn tests() -> Vec<Trial> {
         trial!(engine_wrong_frame_is_an_error, timeout = LIMIT),
         trial!(engine_timeout_stops_it, timeout = LIMIT),
         trial!(
+            engine_started_through_a_shell_is_stopped_with_its_children,
+            timeout = LIMIT
+        ),
+        trial!(
             engine_extra_output_after_the_end_is_an_error,
             timeout = LIMIT
         ),
@@ -237,6 +241,52 @@ fn engine_timeout_stops_it() -> Result<(), String> {
         start.elapsed()
     );
     Ok(())
+}
+
+/// An engine run through `sh -c` that never answers: stopping it at the
+/// timeout stops the shell's child too (the whole process group).
+fn engine_started_through_a_shell_is_stopped_with_its_children() -> Result<(), String> {
+    let (dir, trace, _) = setup("")?;
+    let pid_file = dir.path().join("child.pid");
+    // The shell starts a long sleep in the background, writes its pid,
+    // then waits for it (never answering).
+    let command = format!(
+        "sh -c 'sleep 300 & echo $! > \"{}\"; wait'",
+        pid_file.display()
+    );
+    let (code, stdout, stderr) = run_bin(os!(
+        "check",
+        trace.as_os_str(),
+        "--engine",
+        &command,
+        "--engine-timeout",
+        "1"
+    ))?;
+    ensure!(code == 2, "exit {code}, want 2:\n{stdout}\n{stderr}");
+    let pid: i32 = std::fs::read_to_string(&pid_file)
+        .map_err(|e| format!("the shell wrote no pid: {e}"))?
+        .trim()
+        .parse()
+        .map_err(|e| format!("pid: {e}"))?;
+    // Killed by the time check returned; it may take a moment to be reaped
+    // by init, so look at its state rather than at its existence.
+    let alive = |pid: i32| {
+        std::fs::read_to_string(format!("/proc/{pid}/stat"))
+            .map(|s| !s.contains(") Z "))
+            .unwrap_or(false)
+    };
+    for _ in 0..100 {
+        if !alive(pid) {
+            return Ok(());
+        }
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    // Do not leave it behind even when the test fails.
+    // SAFETY: sends a signal to a pid this test's engine started.
+    unsafe {
+        libc::kill(pid, libc::SIGKILL);
+    }
+    Err(format!("the engine's child {pid} still runs after check returned"))
 }
 
 fn engine_extra_output_after_the_end_is_an_error() -> Result<(), String> {

@@ -93,11 +93,18 @@ impl EngineSession {
         command: &EngineCommand,
         options: EngineOptions,
     ) -> Result<EngineSession, EngineError> {
-        let mut child = Command::new(&command.program)
+        let mut engine = Command::new(&command.program);
+        engine
             .args(&command.arguments)
             .stdin(Stdio::piped())
             .stdout(Stdio::piped())
-            .stderr(Stdio::piped())
+            .stderr(Stdio::piped());
+        // A process group of its own, so that stopping the engine stops
+        // what it started too (an engine run through `sh -c` is the shell's
+        // child: killing the shell alone would leave it running).
+        #[cfg(unix)]
+        std::os::unix::process::CommandExt::process_group(&mut engine, 0);
+        let mut child = engine
             .spawn()
             .map_err(|e| EngineError::CannotStart {
                 command: command.text.clone(),
@@ -345,10 +352,20 @@ impl EngineSession {
         }
     }
 
-    /// Stops the engine (if it still runs) and reaps it.
+    /// Stops the engine (if it still runs) with every process of its group,
+    /// and reaps it.
     fn stop(&mut self) {
         self.to_engine = None;
         if let Ok(None) = self.child.try_wait() {
+            // The group is the engine's own pid (`process_group(0)`), alive
+            // until reaped below, so the id cannot be another's.
+            #[cfg(unix)]
+            if let Ok(group) = libc::pid_t::try_from(self.child.id()) {
+                // SAFETY: killpg only sends a signal; no memory is involved.
+                unsafe {
+                    libc::killpg(group, libc::SIGKILL);
+                }
+            }
             let _ = self.child.kill();
         }
         let _ = self.child.wait();

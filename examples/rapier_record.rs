@@ -284,16 +284,7 @@ pub fn run(args: Args) -> Result<(u64, u64, u64), String> {
                 let answer =
                     pipeline.cast_shape(&Pose::from_translation(p0), p1 - p0, &shape, cast);
                 let outcome = match answer {
-                    None => OutcomeMsg {
-                        frame,
-                        ball,
-                        alpha: 1.0,
-                        kind: Kind::None,
-                        triangle: Some(None),
-                        feature: Some(None),
-                        normal: Some(None),
-                        contact: Some(None),
-                    },
+                    None => OutcomeMsg::miss(frame, ball),
                     // Rapier's answer for a ball that starts inside the mesh
                     // (its solver lets resting balls sink by its allowed
                     // error): already touching, time of impact 0. The core

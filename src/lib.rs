@@ -2,16 +2,65 @@
 //! triangle-mesh collision core and explain, frame by frame, why each
 //! collision was or was not found.
 //!
+//! # Write a trace, check it, read it back
+//!
+//! An engine records its scene, its sweeps and the outcomes it computed
+//! (its *expectations*); `check` (here [`check_reader`]) replays the sweeps
+//! through the core and judges each expectation:
+//!
+//! ```
+//! use sweeptrace::{
+//!     CheckOptions, Facing, Kind, OutcomeMsg, SceneMsg, Status, SweepMsg, TraceEvent,
+//!     TraceReader, TraceWriter, check_reader,
+//! };
+//!
+//! let scene = SceneMsg {
+//!     name: Some("triangle".into()),
+//!     vertices: vec![[0.0, 0.0, 0.0], [4.0, 0.0, 0.0], [0.0, 4.0, 0.0]],
+//!     triangles: vec![[0, 1, 2]],
+//!     margin: 0.0,
+//!     facing: Facing::NonStrict,
+//! };
+//! let sweep = SweepMsg { frame: 0, ball: 0, radius: 0.5, p0: [1.0, 1.0, 3.0], p1: [1.0, 1.0, -3.0] };
+//! // The engine's answer: a face hit at α = 5/12 on triangle 0 (fields left
+//! // unset, such as the contact, are not compared).
+//! let answer = OutcomeMsg::hit(0, 0, 5.0 / 12.0, Kind::Face).triangle(0).normal([0.0, 0.0, 1.0]);
+//!
+//! let mut writer = TraceWriter::new(std::io::Cursor::new(Vec::new()))?;
+//! writer.scene(0, &scene)?;
+//! writer.sweep(1, &sweep)?;
+//! writer.expected(2, &answer)?;
+//! let bytes = writer.finish()?.into_inner();
+//!
+//! let report = check_reader(bytes.as_slice(), "example.mcap", &CheckOptions::default());
+//! assert_eq!(report.status, Status::Ok);
+//!
+//! let mut sweeps = 0;
+//! for event in TraceReader::new(bytes.as_slice(), "example.mcap") {
+//!     if let TraceEvent::Sweep { sweep, .. } = event? {
+//!         assert_eq!(sweep.radius, 0.5);
+//!         sweeps += 1;
+//!     }
+//! }
+//! assert_eq!(sweeps, 1);
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
+//!
 //! # The public surface
 //!
 //! - The collision core: [`sweep_mesh`] (fast) and [`sweep_mesh_with`] (every
 //!   test's record handed to an [`Observer`]) over a [`Mesh`], with the
-//!   [`Sweep`] and [`Options`]; the result is an [`Outcome`].
-//! - Traces: [`TraceWriter`] / [`write_trace_file`] to record, [`TraceReader`]
-//!   to read (any `Read`), their events [`TraceEvent`].
+//!   [`Sweep`] and [`Options`]; the result is an [`Outcome`]; [`sweep_ties`]
+//!   adds its tie set.
+//! - Traces: the messages [`SceneMsg`], [`SweepMsg`], [`OutcomeMsg`];
+//!   [`TraceWriter`] / [`write_trace_file`] to record, [`TraceReader`] to
+//!   read (any `Read`), their events [`TraceEvent`] and errors
+//!   [`TraceError`].
 //! - Replay: [`replay_events`] turns trace events into explained results.
-//! - Regression: [`check_file`] / [`check_reader`] compare a trace's
-//!   expectations with the core; [`compare()`] is the one comparison rule.
+//! - Regression: [`check_file`] / [`check_reader`] judge a trace's
+//!   expectations with the core ([`CheckOptions`] in, a [`TraceReport`]
+//!   out); [`agreement`] is the one judgement of an answer, [`compare()`]
+//!   the field-by-field comparison under it.
 //!
 //! Embedding the core and the trace writer needs no command-line crates:
 //! build with `default-features = false` (the `viewer` feature adds the
@@ -23,18 +72,25 @@
 
 #![warn(missing_docs)]
 
+// Plumbing the command line shares with the library (atomic output files,
+// error texts, number checks, exit codes): public for the binary, not part
+// of the library's API.
+#[doc(hidden)]
 pub mod atomic;
 pub mod conform;
 pub mod core;
 pub mod engine;
+#[doc(hidden)]
 pub mod error_text;
 pub mod foxglove;
 #[doc(hidden)]
 pub mod fuzzing;
+#[doc(hidden)]
 pub mod numbers;
-pub mod palette;
+pub(crate) mod palette;
 pub mod regress;
 pub mod replay;
+#[doc(hidden)]
 pub mod run;
 pub mod sim;
 pub mod trace;
@@ -42,13 +98,16 @@ pub mod trace;
 pub mod viz;
 
 pub use crate::core::{
-    CollectRecords, Facing, Kind, Mesh, NoObserver, Observer, Options, Outcome, Sweep, sweep_mesh,
-    sweep_mesh_with,
+    CollectRecords, Facing, Kind, Mesh, MeshError, NoObserver, Observer, Options, Outcome, Sweep,
+    SweepError, Tie, sweep_mesh, sweep_mesh_with, sweep_ties,
 };
-pub use crate::regress::{Tolerances, check_file, check_reader, compare};
+pub use crate::regress::{
+    Agreement, CheckOptions, Status, Tolerances, TraceReport, agreement, check_file, check_reader,
+    compare,
+};
 pub use crate::replay::{ReplayOptions, replay_events};
-pub use crate::run::RunOutcome;
-pub use crate::trace::{TraceEvent, TraceReader, TraceWriter, write_trace_file};
+pub use crate::trace::messages::{OutcomeMsg, SceneMsg, SweepMsg};
+pub use crate::trace::{TraceError, TraceEvent, TraceReader, TraceWriter, write_trace_file};
 
 /// The README's Rust examples, compiled and run as doctests.
 #[cfg(doctest)]

@@ -16,11 +16,14 @@ pub const CONTACT_BALL_COLOR: [u8; 4] = [255, 140, 0, 140];
 pub const SWEEP_COLOR: [u8; 4] = [120, 170, 255, 255];
 /// The contact point.
 pub const HIT_COLOR: [u8; 4] = [230, 40, 40, 255];
-/// The nearest miss.
+/// The nearest miss (the viewer only).
+#[cfg_attr(not(feature = "viewer"), allow(dead_code))]
 pub const MISS_COLOR: [u8; 4] = [240, 200, 40, 255];
 /// The reported normal.
 pub const NORMAL_COLOR: [u8; 4] = [40, 200, 80, 255];
 /// The expected outcome, where it diverges.
 pub const EXPECTED_COLOR: [u8; 4] = [230, 60, 230, 255];
-/// The marker where a ball's centre went through a triangle.
+/// The marker where a ball's centre went through a triangle (the viewer
+/// only).
+#[cfg_attr(not(feature = "viewer"), allow(dead_code))]
 pub const TUNNEL_COLOR: [u8; 4] = [255, 0, 90, 255];

@@ -224,16 +224,7 @@ fn alt_sweep(mesh: &[AltTriangle], s: &SweepMsg, margin: f64, facing: Facing) ->
         .min_by_key(|h| (h.kind, h.triangle, h.feature))
         .copied()
     else {
-        return OutcomeMsg {
-            frame: s.frame,
-            ball: s.ball,
-            alpha: 1.0,
-            kind: Kind::None,
-            triangle: Some(None),
-            feature: Some(None),
-            normal: Some(None),
-            contact: Some(None),
-        };
+        return OutcomeMsg::miss(s.frame, s.ball);
     };
     let mut triangles: Vec<u32> = tied.iter().map(|h| h.triangle).collect();
     triangles.sort_unstable();

@@ -286,7 +286,9 @@ fn engine_started_through_a_shell_is_stopped_with_its_children() -> Result<(), S
     unsafe {
         libc::kill(pid, libc::SIGKILL);
     }
-    Err(format!("the engine's child {pid} still runs after check returned"))
+    Err(format!(
+        "the engine's child {pid} still runs after check returned"
+    ))
 }
 
 fn engine_extra_output_after_the_end_is_an_error() -> Result<(), String> {

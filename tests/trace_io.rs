@@ -539,16 +539,7 @@ fn python_fixture_exact_values() -> Result<(), String> {
         normal: None,
         ..face
     };
-    let none = OutcomeMsg {
-        frame: 3,
-        alpha: 1.0,
-        kind: Kind::None,
-        triangle: Some(None),
-        feature: Some(None),
-        normal: Some(None),
-        contact: Some(None),
-        ..face
-    };
+    let none = OutcomeMsg::miss(3, face.ball);
     ensure!(
         outcomes == [face, edge, vertex, none],
         "outcomes {outcomes:?}"

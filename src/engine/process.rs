@@ -104,13 +104,11 @@ impl EngineSession {
         // child: killing the shell alone would leave it running).
         #[cfg(unix)]
         std::os::unix::process::CommandExt::process_group(&mut engine, 0);
-        let mut child = engine
-            .spawn()
-            .map_err(|e| EngineError::CannotStart {
-                command: command.text.clone(),
-                reason: format!("{}: {e}", command.program),
-                stderr_tail: Vec::new(),
-            })?;
+        let mut child = engine.spawn().map_err(|e| EngineError::CannotStart {
+            command: command.text.clone(),
+            reason: format!("{}: {e}", command.program),
+            stderr_tail: Vec::new(),
+        })?;
         let io_error = |what, cause| EngineError::Io {
             command: command.text.clone(),
             what,

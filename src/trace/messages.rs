@@ -108,6 +108,80 @@ fn present<'de, T: Deserialize<'de>, D: Deserializer<'de>>(
 }
 
 impl OutcomeMsg {
+    /// No collision: `α = 1`, kind `none`, and `triangle`, `feature`,
+    /// `normal`, `contact` null (every field present, so every field is
+    /// compared).
+    ///
+    /// ```
+    /// use sweeptrace::{Kind, OutcomeMsg};
+    /// let miss = OutcomeMsg::miss(7, 0);
+    /// assert_eq!((miss.alpha, miss.kind, miss.triangle), (1.0, Kind::None, Some(None)));
+    /// ```
+    pub fn miss(frame: u64, ball: u32) -> OutcomeMsg {
+        OutcomeMsg {
+            frame,
+            ball,
+            alpha: 1.0,
+            kind: Kind::None,
+            triangle: Some(None),
+            feature: Some(None),
+            normal: Some(None),
+            contact: Some(None),
+        }
+    }
+
+    /// A collision of `kind` at `alpha`. Give the fields the engine knows
+    /// with [`triangle`](Self::triangle), [`feature`](Self::feature),
+    /// [`normal`](Self::normal) and [`contact`](Self::contact); a field
+    /// left unset is absent and so not compared (a face's `feature` is
+    /// null: a face has none).
+    ///
+    /// ```
+    /// use sweeptrace::{Kind, OutcomeMsg};
+    /// let hit = OutcomeMsg::hit(3, 1, 0.25, Kind::Edge)
+    ///     .triangle(12)
+    ///     .feature(2)
+    ///     .normal([0.0, 0.0, 1.0]);
+    /// assert_eq!(hit.triangle, Some(Some(12)));
+    /// assert_eq!(hit.contact, None); // not compared
+    /// ```
+    pub fn hit(frame: u64, ball: u32, alpha: f64, kind: Kind) -> OutcomeMsg {
+        OutcomeMsg {
+            frame,
+            ball,
+            alpha,
+            kind,
+            triangle: None,
+            feature: (kind == Kind::Face).then_some(None),
+            normal: None,
+            contact: None,
+        }
+    }
+
+    /// The primary triangle's input index.
+    pub fn triangle(mut self, triangle: u32) -> OutcomeMsg {
+        self.triangle = Some(Some(triangle));
+        self
+    }
+
+    /// The edge or vertex index (0..2) within the triangle.
+    pub fn feature(mut self, feature: u8) -> OutcomeMsg {
+        self.feature = Some(Some(feature));
+        self
+    }
+
+    /// The reported normal.
+    pub fn normal(mut self, normal: [f64; 3]) -> OutcomeMsg {
+        self.normal = Some(Some(normal));
+        self
+    }
+
+    /// The contact point.
+    pub fn contact(mut self, contact: [f64; 3]) -> OutcomeMsg {
+        self.contact = Some(Some(contact));
+        self
+    }
+
     /// The full outcome record of a core result (every field present).
     pub fn from_outcome(frame: u64, ball: u32, o: &crate::core::Outcome) -> OutcomeMsg {
         OutcomeMsg {

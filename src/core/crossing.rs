@@ -25,7 +25,7 @@ use nalgebra::Point3;
 use serde::Serialize;
 
 use super::mesh::{Mesh, Triangle};
-use super::options::TIE_WINDOW_ULPS;
+use super::options::{BROADPHASE_MARGIN, TIE_WINDOW_ULPS};
 use super::sweep_face::barycentric_and_distance;
 
 /// A front-to-back crossing of a triangle by a segment.
@@ -106,7 +106,7 @@ pub fn first_crossing(mesh: &Mesh, p: &Point3<f64>, q: &Point3<f64>) -> Option<C
     let tau = TIE_WINDOW_ULPS * f64::EPSILON * s;
     let window = (tau / length).min(1.0);
     // Boxes grown by τ plus a margin far above it, as the sweep grows them.
-    let grow = tau + 1e-9 * s;
+    let grow = tau + BROADPHASE_MARGIN * s;
     let triangles = mesh.triangles();
     // First pass: the smallest fraction.
     let mut first = f64::INFINITY;

@@ -153,6 +153,58 @@ fn describe_face(w: &mut impl Write, r: &FaceRecord) -> fmt::Result {
     }
 }
 
+/// The quadratic's numbers of an edge or vertex test.
+trait Quadratic {
+    fn numbers(&self) -> (f64, f64, f64, f64, Option<(f64, f64)>);
+}
+
+impl Quadratic for EdgeRecord {
+    fn numbers(&self) -> (f64, f64, f64, f64, Option<(f64, f64)>) {
+        (self.a, self.b, self.c, self.discriminant, self.roots)
+    }
+}
+
+impl Quadratic for VertexRecord {
+    fn numbers(&self) -> (f64, f64, f64, f64, Option<(f64, f64)>) {
+        (self.a, self.b, self.c, self.discriminant, self.roots)
+    }
+}
+
+/// The words of the ladder both quadratic tests share
+/// (`quadratic::first_contact`): no real roots (never within ρ of `what`),
+/// before the start, beyond the end.
+fn write_no_contact(
+    w: &mut impl Write,
+    verdict: Verdict,
+    r: &impl Quadratic,
+    what: &str,
+) -> fmt::Result {
+    let (a, b, c, discriminant, roots) = r.numbers();
+    let (s0, s1) = roots.unwrap_or((f64::NAN, f64::NAN));
+    match verdict {
+        Verdict::NoRealRoots => write!(
+            w,
+            "A = {}, B = {}, C = {}, disc = {} < 0 (never within ρ of {what}): none",
+            Num(a),
+            Num(b),
+            Num(c),
+            Num(discriminant)
+        ),
+        Verdict::BeforeStart => write!(
+            w,
+            "s0 = {}, s1 = {}: s0 < 0 (before the start of the path): none",
+            Num(s0),
+            Num(s1)
+        ),
+        _ => write!(
+            w,
+            "s0 = {}, s1 = {}: s0 > 1 (beyond the end of the path): none",
+            Num(s0),
+            Num(s1)
+        ),
+    }
+}
+
 fn describe_edge(w: &mut impl Write, r: &EdgeRecord) -> fmt::Result {
     match r.verdict {
         Verdict::Parallel => write!(
@@ -160,53 +212,32 @@ fn describe_edge(w: &mut impl Write, r: &EdgeRecord) -> fmt::Result {
             "A = {} ≤ (PARALLEL_TOLERANCE·|d|)² (path parallel to the edge, or not moving): none",
             Num(r.a)
         ),
-        Verdict::NoRealRoots => write!(
-            w,
-            "A = {}, B = {}, C = {}, disc = {} < 0 (never within ρ of the edge's line): none",
-            Num(r.a),
-            Num(r.b),
-            Num(r.c),
-            Num(r.discriminant)
-        ),
+        verdict @ (Verdict::NoRealRoots | Verdict::BeforeStart | Verdict::BeyondEnd) => {
+            write_no_contact(w, verdict, r, "the edge's line")
+        }
         _ => {
-            let (s0, s1) = r.roots.unwrap_or((f64::NAN, f64::NAN));
+            let (s0, _) = r.roots.unwrap_or((f64::NAN, f64::NAN));
+            let xc = r.xc.unwrap_or(f64::NAN);
+            write!(w, "s0 = {} in [0, 1], xc = {}", Num(s0), Num(xc))?;
             match r.verdict {
-                Verdict::BeforeStart => write!(
+                Verdict::OffEdge => write!(
                     w,
-                    "s0 = {}, s1 = {}: s0 < 0 (before the start of the path): none",
-                    Num(s0),
-                    Num(s1)
+                    " outside [0, {}] (touches the line off the edge: a vertex case): none",
+                    Num(r.length)
                 ),
-                Verdict::BeyondEnd => write!(
+                Verdict::BackFacing => write!(
                     w,
-                    "s0 = {}, s1 = {}: s0 > 1 (beyond the end of the path): none",
-                    Num(s0),
-                    Num(s1)
+                    " in [0, {}], {}: back-facing",
+                    Num(r.length),
+                    FacingText(r.normal_dot_d, r.verdict)
                 ),
-                _ => {
-                    let xc = r.xc.unwrap_or(f64::NAN);
-                    write!(w, "s0 = {} in [0, 1], xc = {}", Num(s0), Num(xc))?;
-                    match r.verdict {
-                        Verdict::OffEdge => write!(
-                            w,
-                            " outside [0, {}] (touches the line off the edge: a vertex case): none",
-                            Num(r.length)
-                        ),
-                        Verdict::BackFacing => write!(
-                            w,
-                            " in [0, {}], {}: back-facing",
-                            Num(r.length),
-                            FacingText(r.normal_dot_d, r.verdict)
-                        ),
-                        _ if xc < 0.0 || xc > r.length => write!(
-                            w,
-                            " outside [0, {}] by less than the tie distance (at an end up to \
-                             rounding), facing ok: hit",
-                            Num(r.length)
-                        ),
-                        _ => write!(w, " in [0, {}], facing ok: hit", Num(r.length)),
-                    }
-                }
+                _ if xc < 0.0 || xc > r.length => write!(
+                    w,
+                    " outside [0, {}] by less than the tie distance (at an end up to \
+                     rounding), facing ok: hit",
+                    Num(r.length)
+                ),
+                _ => write!(w, " in [0, {}], facing ok: hit", Num(r.length)),
             }
         }
     }
@@ -215,30 +246,12 @@ fn describe_edge(w: &mut impl Write, r: &EdgeRecord) -> fmt::Result {
 fn describe_vertex(w: &mut impl Write, r: &VertexRecord) -> fmt::Result {
     match r.verdict {
         Verdict::NotMoving => w.write_str("A = 0 (zero-length path): none"),
-        Verdict::NoRealRoots => write!(
-            w,
-            "A = {}, B = {}, C = {}, disc = {} < 0 (never within ρ of the vertex): none",
-            Num(r.a),
-            Num(r.b),
-            Num(r.c),
-            Num(r.discriminant)
-        ),
+        verdict @ (Verdict::NoRealRoots | Verdict::BeforeStart | Verdict::BeyondEnd) => {
+            write_no_contact(w, verdict, r, "the vertex")
+        }
         _ => {
-            let (s0, s1) = r.roots.unwrap_or((f64::NAN, f64::NAN));
+            let (s0, _) = r.roots.unwrap_or((f64::NAN, f64::NAN));
             match r.verdict {
-                Verdict::BeforeStart => write!(
-                    w,
-                    "s0 = {}, s1 = {}: s0 < 0 (before the start): none",
-                    Num(s0),
-                    Num(s1)
-                ),
-                Verdict::BeyondEnd => {
-                    write!(
-                        w,
-                        "s0 = {}: s0 > 1 (beyond the end of the path): none",
-                        Num(s0)
-                    )
-                }
                 Verdict::BackFacing => write!(
                     w,
                     "s0 = {} in [0, 1], {}: back-facing",

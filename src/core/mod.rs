@@ -37,8 +37,8 @@ pub use error::{MeshError, SweepError};
 pub use fragility::{FragileReason, Fragility};
 pub use mesh::{DegenerateReason, DegenerateTriangle, Mesh, StandardFrame, Triangle};
 pub use options::{
-    ALPHA_SENSITIVITY, DEGENERATE_TOLERANCE, FRAGILE_ULPS, Facing, GRAZING_COSINE, Options,
-    PARALLEL_TOLERANCE, TIE_WINDOW_ULPS,
+    ALPHA_SENSITIVITY, BROADPHASE_MARGIN, DEGENERATE_TOLERANCE, FRAGILE_ULPS, Facing,
+    GRAZING_COSINE, Options, PARALLEL_TOLERANCE, TIE_WINDOW_ULPS,
 };
 pub use path::{Sweep, SweptPath};
 pub use record::{

@@ -115,6 +115,16 @@ pub const TIE_WINDOW_ULPS: f64 = 1024.0;
 /// `xc` outside by less than it, a root just before 0 or beyond 1).
 pub const FRAGILE_ULPS: f64 = 65536.0;
 
+/// The broadphase's margin, relative to the scale `S`: a triangle's box is
+/// grown by `ρ + BROADPHASE_MARGIN · S` before the path is tested against it
+/// (and a triangle whose plane stays farther than that from the path is
+/// skipped), far above the fragility band (`FRAGILE_ULPS · ε · S ≈
+/// 1.5e-11 · S`), so that every hit and near miss that matters is visited.
+/// The one definition: the mesh sweep, the crossing query and `repro`'s
+/// choice of the triangles a minimal trace keeps use it
+/// ([`SweptPath::broadphase_margin`](super::SweptPath::broadphase_margin)).
+pub const BROADPHASE_MARGIN: f64 = 1e-9;
+
 /// A contact whose approach cosine is below this is *grazing* (face:
 /// `|n · d| / |d|`; edge or vertex: `√disc / (2ρ|d|)`, the cosine between
 /// the path and the contact normal, which is the discriminant relative to

@@ -3,7 +3,7 @@
 use nalgebra::{Point3, Vector3};
 
 use super::error::SweepError;
-use super::options::{FRAGILE_ULPS, Options, TIE_WINDOW_ULPS};
+use super::options::{BROADPHASE_MARGIN, FRAGILE_ULPS, Options, TIE_WINDOW_ULPS};
 
 /// One sweep as given: the ball of radius `radius` moves from `p0` to `p1`.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -105,6 +105,13 @@ impl SweptPath {
         let coordinates = self.p0.coords.amax().max(self.p1.coords.amax());
         self.scale = coordinates.max(lo.coords.amax()).max(hi.coords.amax()) + self.rho;
         self
+    }
+
+    /// The broadphase's margin `BROADPHASE_MARGIN · S`, in length
+    /// ([`BROADPHASE_MARGIN`]).
+    #[inline]
+    pub fn broadphase_margin(&self) -> f64 {
+        BROADPHASE_MARGIN * self.scale
     }
 
     /// The rounding unit `u = f64::EPSILON · S`: the size of one rounding

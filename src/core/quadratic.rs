@@ -42,6 +42,22 @@ pub fn solve(a: f64, b: f64, c: f64, discriminant: f64) -> Option<(f64, f64)> {
     Some(if r0 <= r1 { (r0, r1) } else { (r1, r0) })
 }
 
+/// Where a ball-versus-line or ball-versus-point quadratic first touches the
+/// path, from its roots (`solve`'s answer): the smaller root `s0` when it
+/// lies in `[0, 1]`; otherwise why not (no real roots, before the start,
+/// beyond the end). The one ladder of the edge and the vertex tests (steps
+/// 2 to 4 of the edge test in docs/SEMANTICS.md).
+#[inline]
+pub(crate) fn first_contact(roots: Option<(f64, f64)>) -> Result<f64, super::record::Verdict> {
+    use super::record::Verdict;
+    match roots {
+        None => Err(Verdict::NoRealRoots),
+        Some((s0, _)) if s0 < 0.0 => Err(Verdict::BeforeStart),
+        Some((s0, _)) if s0 > 1.0 => Err(Verdict::BeyondEnd),
+        Some((s0, _)) => Ok(s0),
+    }
+}
+
 /// `B² - 4AC` of a ball-versus-line or ball-versus-point quadratic, computed
 /// without cancellation: with `A = |d|²`, `B = 2 d·m`, `C = |m|² - ρ²`
 /// (Lagrange's identity `|d|²|m|² - (d·m)² = |d × m|²`),

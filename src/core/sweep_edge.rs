@@ -46,27 +46,21 @@ pub fn sweep_edge(triangle: &Triangle, edge: u8, path: &SweptPath, facing: Facin
         Verdict::Parallel
     } else {
         // `solve` answers `None` for a negative (or NaN) discriminant.
-        match quadratic::solve(a, b, c, discriminant) {
-            None => Verdict::NoRealRoots,
-            Some((s0, s1)) => {
-                record.roots = Some((s0, s1));
-                if s0 < 0.0 {
-                    Verdict::BeforeStart
-                } else if s0 > 1.0 {
-                    Verdict::BeyondEnd
+        record.roots = quadratic::solve(a, b, c, discriminant);
+        match quadratic::first_contact(record.roots) {
+            Err(verdict) => verdict,
+            Ok(s0) => {
+                let xc = x0 + s0 * (x1 - x0);
+                record.xc = Some(xc);
+                // On the edge, ends included, up to the tie distance
+                // (see TIE_WINDOW_ULPS).
+                let tolerance = path.tie_distance();
+                if xc < -tolerance || xc > frame.length + tolerance {
+                    Verdict::OffEdge
+                } else if !facing.allows(normal_dot_d) {
+                    Verdict::BackFacing
                 } else {
-                    let xc = x0 + s0 * (x1 - x0);
-                    record.xc = Some(xc);
-                    // On the edge, ends included, up to the tie distance
-                    // (see TIE_WINDOW_ULPS).
-                    let tolerance = path.tie_distance();
-                    if xc < -tolerance || xc > frame.length + tolerance {
-                        Verdict::OffEdge
-                    } else if !facing.allows(normal_dot_d) {
-                        Verdict::BackFacing
-                    } else {
-                        Verdict::Hit
-                    }
+                    Verdict::Hit
                 }
             }
         }

@@ -517,7 +517,7 @@ fn skip<O: Observer>(triangle: &Triangle, path: &SweptPath, facing: Facing) -> b
     }
     let h0 = triangle.normal.dot(&(path.p0 - triangle.vertices[0]));
     let h1 = h0 + facing_value;
-    let clear = path.rho + 1e-9 * path.scale;
+    let clear = path.rho + path.broadphase_margin();
     (h0 > clear && h1 > clear) || (h0 < -clear && h1 < -clear)
 }
 
@@ -545,7 +545,7 @@ fn visit_triangles<O: Observer>(
         Broadphase::Bvh => {
             // Boxes grown by ρ plus a margin far above the fragility band,
             // so every hit and near miss that matters is visited.
-            let grow = path.rho + 1e-9 * path.scale;
+            let grow = path.rho + path.broadphase_margin();
             mesh.bvh()
                 .traverse(&path.p0, &path.d, grow, combiner.cutoff(), |range| {
                     for position in range {

@@ -38,20 +38,11 @@ pub fn sweep_vertex(
     record.verdict = if a == 0.0 {
         Verdict::NotMoving
     } else {
-        match quadratic::solve(a, b, c, discriminant) {
-            None => Verdict::NoRealRoots,
-            Some((s0, s1)) => {
-                record.roots = Some((s0, s1));
-                if s0 < 0.0 {
-                    Verdict::BeforeStart
-                } else if s0 > 1.0 {
-                    Verdict::BeyondEnd
-                } else if !facing.allows(normal_dot_d) {
-                    Verdict::BackFacing
-                } else {
-                    Verdict::Hit
-                }
-            }
+        record.roots = quadratic::solve(a, b, c, discriminant);
+        match quadratic::first_contact(record.roots) {
+            Err(verdict) => verdict,
+            Ok(_) if !facing.allows(normal_dot_d) => Verdict::BackFacing,
+            Ok(_) => Verdict::Hit,
         }
     };
     record

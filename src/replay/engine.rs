@@ -344,22 +344,16 @@ impl Replay {
                 index,
                 sweep,
             } => self.sweep(log_time_nanos, index, sweep),
-            TraceEvent::Expected {
-                log_time_nanos,
-                index,
-                outcome,
-            } => {
-                self.expected(log_time_nanos, index, outcome);
+            TraceEvent::Expected { outcome, .. } => {
+                self.expected(outcome);
                 Ok(())
             }
         }
     }
 
     /// An `/expected` message.
-    pub fn expected(&mut self, _log_time_nanos: u64, _index: u64, outcome: OutcomeMsg) {
-        if !self.options.frames.contains(outcome.frame)
-            || self.options.ball.is_some_and(|b| b != outcome.ball)
-        {
+    pub fn expected(&mut self, outcome: OutcomeMsg) {
+        if !self.options.wants(outcome.frame, outcome.ball) {
             return;
         }
         if let Some(p) = self

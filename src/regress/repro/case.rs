@@ -5,7 +5,7 @@ use std::collections::BTreeMap;
 use std::fmt::Write as _;
 
 use crate::core::explain::num;
-use crate::core::{Mesh, Options, Outcome, Sweep, sweep_ties};
+use crate::core::{Mesh, Options, Outcome, Sweep, SweptPath, sweep_ties};
 use crate::trace::messages::{OutcomeMsg, SceneMsg, SweepMsg};
 use crate::trace::{TraceError, TraceWriter};
 
@@ -157,8 +157,8 @@ impl ReproCase {
     /// Builds the minimal case of `found` (a sweep of the trace `source`).
     ///
     /// A triangle is *within reach* when its bounding sphere (centred on
-    /// its centroid) and its bounding box both come within `r` (plus
-    /// `1e-9` of the scene's extent, far above the rounding of the tests)
+    /// its centroid) and its bounding box both come within `r` (plus the
+    /// core's broadphase margin, far above the rounding of the tests)
     /// of the segment `p0 → p1`: every triangle the ball can touch, or
     /// miss by rounding, is kept. The expected triangle is always kept.
     /// Triangles keep their order, vertices their order within each
@@ -188,14 +188,15 @@ impl ReproCase {
         };
         let (outcome, _) = sweep_ties(&mesh, &sweep, &options).map_err(sweep_error)?;
 
+        // The core's own scale and broadphase margin; the reach is the
+        // radius r, not ρ = r - ε, so a margin only keeps more triangles.
         let (lo, hi) = mesh.bounds();
         let extent = lo.coords.amax().max(hi.coords.amax());
+        let path = SweptPath::new(&sweep, &options)
+            .map_err(sweep_error)?
+            .with_mesh_scale(&lo, &hi);
         let (p0, p1) = (found.sweep.p0, found.sweep.p1);
-        let scale = extent
-            .max(p0.map(f64::abs).into_iter().fold(0.0, f64::max))
-            .max(p1.map(f64::abs).into_iter().fold(0.0, f64::max))
-            + sweep.radius;
-        let reach = sweep.radius + 1e-9 * scale;
+        let reach = sweep.radius + path.broadphase_margin();
         let box_lo: [f64; 3] = std::array::from_fn(|k| p0[k].min(p1[k]) - reach);
         let box_hi: [f64; 3] = std::array::from_fn(|k| p0[k].max(p1[k]) + reach);
         let expected_triangle = found.expected.and_then(|e| e.triangle.flatten());

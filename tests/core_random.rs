@@ -347,6 +347,12 @@ fn parry_agreement_front_facing() -> Result<(), String> {
             failures[..failures.len().min(5)].join("\n")
         ));
     }
+    // An agreement over misses only would say nothing about the hits:
+    // most sweeps are compared, and a good share of them hit.
+    crate::ensure!(
+        compared * 2 > compared + skipped && hits * 5 > compared,
+        "too little compared to mean anything: {compared} compared ({hits} hits), {skipped} skipped"
+    );
     Ok(())
 }
 

@@ -119,5 +119,48 @@ fn main() {
     trials.extend(error_messages::tests());
     trials.extend(out_of_order::tests());
     trials.extend(fuzz_corpus::tests());
+    let trials = mark_slow(trials);
     libtest_mimic::run(&args, trials).exit();
+}
+
+/// The trials that take seconds each on their own (a 100,000-sweep oracle,
+/// a connect timeout, recordings replayed several ways): kind `slow`, and
+/// ignored when `SWEEPTRACE_QUICK=1`, for a fast inner loop. CI runs them.
+const SLOW: &[&str] = &[
+    "outputs::unreachable_viewer_is_a_clear_error",
+    "outputs::killed_mid_write_leaves_the_target_intact",
+    "core_random::oracle_agreement_100k_sweeps",
+    "core_random::primary_collector_equals_collecting_every_record",
+    "core_random::bvh_equals_exhaustive",
+    "replay::threads_do_not_change_the_outputs",
+    "replay::spilled_recording_holds_the_same_rows",
+    "replay::flush_by_bytes_keeps_the_content",
+];
+
+fn mark_slow(trials: Vec<Trial>) -> Vec<Trial> {
+    let quick = std::env::var_os("SWEEPTRACE_QUICK").is_some_and(|v| v == "1");
+    let missing: Vec<&str> = SLOW
+        .iter()
+        .copied()
+        .filter(|name| !trials.iter().any(|t| t.name() == *name))
+        .collect();
+    let mut out: Vec<Trial> = trials
+        .into_iter()
+        .map(|t| {
+            if SLOW.contains(&t.name()) {
+                t.with_kind("slow").with_ignored_flag(quick)
+            } else {
+                t
+            }
+        })
+        .collect();
+    // A renamed test would silently leave the list.
+    out.push(trial("main::slow_list_names_registered_tests", move || {
+        if missing.is_empty() {
+            Ok(())
+        } else {
+            Err(format!("SLOW names no registered test: {missing:?}"))
+        }
+    }));
+    out
 }

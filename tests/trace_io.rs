@@ -21,6 +21,7 @@ use crate::trial;
 
 pub fn tests() -> Vec<Trial> {
     vec![
+        trial!(enum_names_in_words_are_their_serde_names),
         trial!(round_trip_default_writer),
         trial!(writer_output_is_deterministic),
         trial!(reads_unchunked),
@@ -1301,4 +1302,48 @@ fn python_reads_our_trace() -> Result<Completion, String> {
     let bad = run(&["--sweeps", "61"]).map_err(|e| e.to_string())?;
     ensure!(!bad.status.success(), "script accepted a wrong count");
     Ok(Completion::Completed)
+}
+
+/// The names the reports write (`as_str`, `Display`) are the names the JSON
+/// and the trace format write (serde), for every variant, and read back.
+fn enum_names_in_words_are_their_serde_names() -> Result<(), String> {
+    use sweeptrace::core::{FragileReason, Verdict};
+    fn same<T>(v: T, words: &str) -> Result<(), String>
+    where
+        T: serde::Serialize + serde::de::DeserializeOwned + PartialEq + std::fmt::Debug,
+    {
+        let json = serde_json::to_value(&v).map_err(|e| e.to_string())?;
+        ensure!(
+            json == serde_json::Value::from(words),
+            "{v:?}: serde writes {json}, the words say `{words}`"
+        );
+        let back: T = serde_json::from_value(json).map_err(|e| format!("{v:?}: {e}"))?;
+        ensure!(back == v, "{v:?} reads back as {back:?}");
+        Ok(())
+    }
+    for k in [Kind::None, Kind::Face, Kind::Edge, Kind::Vertex] {
+        same(k, k.as_str())?;
+        ensure!(k.to_string() == k.as_str(), "{k:?}: Display");
+    }
+    for f in [Facing::Strict, Facing::NonStrict] {
+        same(f, f.as_str())?;
+        ensure!(f.to_string() == f.as_str(), "{f:?}: Display");
+    }
+    for v in Verdict::ALL {
+        let json = serde_json::to_value(v).map_err(|e| e.to_string())?;
+        ensure!(
+            json == serde_json::Value::from(v.as_str()),
+            "{v:?}: serde writes {json}, the words say `{}`",
+            v.as_str()
+        );
+    }
+    for r in FragileReason::ALL {
+        let json = serde_json::to_value(r).map_err(|e| e.to_string())?;
+        ensure!(
+            json == serde_json::Value::from(r.as_str()),
+            "{r:?}: serde writes {json}, the words say `{}`",
+            r.as_str()
+        );
+    }
+    Ok(())
 }

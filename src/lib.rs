@@ -48,7 +48,7 @@ pub use crate::core::{
 pub use crate::regress::{Tolerances, check_file, check_reader, compare};
 pub use crate::replay::{ReplayOptions, replay_events};
 pub use crate::run::RunOutcome;
-pub use crate::trace::{TraceEvent, TraceReader, TraceWriter, write_trace_file};
+pub use crate::trace::{ExpectedSource, TraceEvent, TraceReader, TraceWriter, write_trace_file};
 
 /// The README's Rust examples, compiled and run as doctests.
 #[cfg(doctest)]

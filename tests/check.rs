@@ -872,8 +872,10 @@ fn bless_keeps_foreign_channel_metadata_attachment() -> Result<(), String> {
     // Every metadata record is kept; the expectations' source (sweeptrace
     // now) is written first.
     ensure!(
-        md_out.first().is_some_and(|(name, entries)| name == "sweeptrace.expected_source"
-            && entries.get("engine").map(String::as_str) == Some("sweeptrace"))
+        md_out
+            .first()
+            .is_some_and(|(name, entries)| name == "sweeptrace.expected_source"
+                && entries.get("engine").map(String::as_str) == Some("sweeptrace"))
             && md_out[1..] == md_in[..],
         "metadata:\n{md_in:?}\n{md_out:?}"
     );

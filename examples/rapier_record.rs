@@ -26,6 +26,12 @@
 //! (collision groups), like the balls of `sweeptrace record`. A ball is no
 //! longer recorded once it leaves the scene's play volume.
 //!
+//! The trace names its expectations' source (the `sweeptrace.expected_source`
+//! record): engine `rapier3d-f64`, the version linked, and the settings that
+//! bear on its answers ([`rapier_source`]: the mesh's `fix_internal_edges`
+//! flag, the contact skin, the time step and allowed linear error, the shape
+//! cast's options and the kind's tolerance).
+//!
 //! The scene's starting positions, velocities, radius, time step, gravity
 //! and restitution are those of `sweeptrace record --scene NAME` (the
 //! built-in scene's defaults); `--mesh` uses `record`'s defaults with
@@ -38,14 +44,14 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use rapier3d_f64::parry::query::{ShapeCastOptions, ShapeCastStatus};
-use rapier3d_f64::parry::shape::Ball;
+use rapier3d_f64::parry::shape::{Ball, TriMeshFlags};
 use rapier3d_f64::prelude::*;
 use sweeptrace::core::Kind;
 use sweeptrace::sim::obj::load_obj;
 use sweeptrace::sim::scenes::SceneMesh;
 use sweeptrace::sim::{BuiltinScene, SimOptions, initial_states, play_volume, scene_message};
 use sweeptrace::trace::messages::{OutcomeMsg, SweepMsg};
-use sweeptrace::trace::write_trace_file;
+use sweeptrace::trace::{ExpectedSource, write_trace_file};
 
 /// Relative tolerance of the kind read from Rapier's answer (see the module
 /// documentation).
@@ -185,6 +191,30 @@ fn classify(corners: [Vector; 3], witness: Vector, normal: Vector) -> (Kind, Opt
     (Kind::Edge, Some(edge as u8))
 }
 
+/// The expectations' source: Rapier, its version, and the settings of this
+/// recording that bear on its answers.
+pub fn rapier_source(
+    world: &PhysicsWorld,
+    mesh: ColliderHandle,
+    cast: &ShapeCastOptions,
+) -> ExpectedSource {
+    let collider = &world.colliders[mesh];
+    let fix_internal_edges = collider
+        .shape()
+        .as_trimesh()
+        .is_some_and(|t| t.flags().contains(TriMeshFlags::FIX_INTERNAL_EDGES));
+    let parameters = &world.integration_parameters;
+    ExpectedSource::new("rapier3d-f64", rapier3d_f64::VERSION)
+        .setting("fix_internal_edges", fix_internal_edges)
+        .setting("contact_skin", collider.contact_skin())
+        .setting("dt", parameters.dt)
+        .setting("allowed_linear_error", parameters.allowed_linear_error())
+        .setting("ccd", true)
+        .setting("cast_target_distance", cast.target_distance)
+        .setting("cast_stop_at_penetration", cast.stop_at_penetration)
+        .setting("kind_tolerance", CLASSIFY_TOLERANCE)
+}
+
 /// Writes the trace; returns the sweeps, Rapier's hits, and the sweeps
 /// that start in contact (written without an expectation).
 pub fn run(args: Args) -> Result<(u64, u64, u64), String> {
@@ -221,7 +251,7 @@ pub fn run(args: Args) -> Result<(u64, u64, u64), String> {
         .map_err(|e| format!("Rapier refuses the mesh {}: {e}", scene.name))?
         .collision_groups(mesh_groups)
         .restitution(options.restitution);
-    world.insert(RigidBodyBuilder::fixed(), mesh_collider);
+    let (_, mesh_handle) = world.insert(RigidBodyBuilder::fixed(), mesh_collider);
     let mut balls = Vec::new();
     for (position, velocity) in initial_states(options) {
         let body = RigidBodyBuilder::dynamic()
@@ -246,7 +276,9 @@ pub fn run(args: Args) -> Result<(u64, u64, u64), String> {
     };
     let step_nanos = options.time_step_nanos();
     let trimesh_triangles = &scene.triangles;
+    let source = rapier_source(&world, mesh_handle, &cast);
     let counts = write_trace_file(&args.output, |trace| {
+        trace.expected_source(&source)?;
         trace.scene(0, &scene_message(&scene, options))?;
         let (mut sweeps, mut hits, mut starting_in_contact) = (0u64, 0u64, 0u64);
         let gravity = vector(options.gravity);

@@ -2,11 +2,16 @@
 """Read a trace recorded by sweeptrace with Python's `mcap` package and check it.
 
 Checks the header's library string, the `sweeptrace` metadata record, the
-schema names and encodings of the three channels, that every message is
-JSON, and the message counts (against the summary's statistics and, when
-given, against --scenes/--sweeps/--expected). Exits 1 on any mismatch.
+`sweeptrace.expected_source` record when there is one (at most one; keys
+`engine`, not empty, `version` and `setting.<name>`; with --engine, that it
+names that engine, --engine-version and exactly the --setting NAME=VALUE
+given; with --no-expected-source, that there is none), the schema names and
+encodings of the three channels, that every message is JSON, and the
+message counts (against the summary's statistics and, when given, against
+--scenes/--sweeps/--expected). Exits 1 on any mismatch.
 
     venv/bin/python scripts/read_with_python.py TRACE.mcap [--scenes N] [--sweeps N] [--expected N]
+        [--engine NAME [--engine-version V] [--setting NAME=VALUE ...] | --no-expected-source]
 """
 
 import argparse
@@ -22,12 +27,51 @@ CHANNELS = {
 }
 
 
+SOURCE = "sweeptrace.expected_source"
+
+
+def setting_arg(text):
+    """NAME=VALUE as a pair."""
+    name, equals, value = text.partition("=")
+    if not equals or not name:
+        raise argparse.ArgumentTypeError(f"expected NAME=VALUE, got {text!r}")
+    return name, value
+
+
+def check_source(sources, args):
+    """The problems of the expected-source records, against the options."""
+    if len(sources) > 1:
+        return [f"{len(sources)} metadata records {SOURCE!r}, at most one allowed"]
+    if args.no_expected_source:
+        return [f"a metadata record {SOURCE!r} is present: {sources[0]}"] if sources else []
+    if not sources:
+        return [f"no metadata record {SOURCE!r}"] if args.engine is not None else []
+    entries = sources[0]
+    problems = [f"{SOURCE}: unknown key {key!r}" for key in entries
+                if key not in ("engine", "version") and not key.startswith("setting.")]
+    if not entries.get("engine"):
+        problems.append(f"{SOURCE}: no engine, or an empty one: {entries}")
+    if args.engine is not None:
+        settings = {k[len("setting."):]: v for k, v in entries.items() if k.startswith("setting.")}
+        want = dict(args.setting)
+        got = (entries.get("engine"), entries.get("version", ""), settings)
+        if got != (args.engine, args.engine_version, want):
+            problems.append(f"{SOURCE}: {got}, expected {(args.engine, args.engine_version, want)}")
+    return problems
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("trace")
     parser.add_argument("--scenes", type=int)
     parser.add_argument("--sweeps", type=int)
     parser.add_argument("--expected", type=int)
+    parser.add_argument("--engine", help="the expected source's engine")
+    parser.add_argument("--engine-version", default="", help="its version ('' when absent)")
+    parser.add_argument("--setting", action="append", default=[], metavar="NAME=VALUE",
+                        type=setting_arg,
+                        help="one of its settings (all of them must be given)")
+    parser.add_argument("--no-expected-source", action="store_true")
     args = parser.parse_args()
     problems = []
 
@@ -36,9 +80,12 @@ def main():
         header = reader.get_header()
         if not header.library.startswith("sweeptrace "):
             problems.append(f"library is {header.library!r}, expected 'sweeptrace <version>'")
-        metadata = {m.name: m.metadata for m in reader.iter_metadata()}
+        records = list(reader.iter_metadata())
+        metadata = {m.name: m.metadata for m in records}
         if metadata.get("sweeptrace", {}).get("format_version") != "1":
             problems.append(f"metadata record 'sweeptrace' lacks format_version = '1': {metadata}")
+        sources = [m.metadata for m in records if m.name == SOURCE]
+        problems += check_source(sources, args)
         summary = reader.get_summary()
         if summary is None:
             problems.append("the trace has no summary")

@@ -107,7 +107,9 @@ pub use crate::regress::{
 };
 pub use crate::replay::{ReplayOptions, replay_events};
 pub use crate::trace::messages::{OutcomeMsg, SceneMsg, SweepMsg};
-pub use crate::trace::{TraceError, TraceEvent, TraceReader, TraceWriter, write_trace_file};
+pub use crate::trace::{
+    ExpectedSource, TraceError, TraceEvent, TraceReader, TraceWriter, write_trace_file,
+};
 
 /// The README's Rust examples, compiled and run as doctests.
 #[cfg(doctest)]

@@ -14,6 +14,7 @@ mod core_decisions;
 mod core_random;
 mod engine;
 mod error_messages;
+mod expected_source;
 mod faults;
 mod foxglove;
 mod fuzz_corpus;
@@ -117,6 +118,7 @@ fn main() {
     trials.extend(rapier::tests());
     trials.extend(faults::tests());
     trials.extend(error_messages::tests());
+    trials.extend(expected_source::tests());
     trials.extend(out_of_order::tests());
     trials.extend(fuzz_corpus::tests());
     let trials = mark_slow(trials);

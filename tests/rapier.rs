@@ -1,6 +1,7 @@
 //! The Rapier recorder (`examples/rapier_record.rs`) runs and writes a
 //! trace that passes `check` with the options examples/rapier/README.md
-//! gives a Rapier user, and fails without them.
+//! gives a Rapier user, and fails without them; the trace names Rapier as
+//! its expectations' source.
 
 use libtest_mimic::Trial;
 use sweeptrace::regress::{
@@ -50,6 +51,34 @@ fn rapier_recording_passes_check_with_the_readme_options() -> Result<(), String>
             && report.sweeps_without_expectation == starting_in_contact,
         "{}",
         render_text(&report)
+    );
+    // The trace says who computed its expectations: Rapier, the version
+    // linked, and its settings.
+    let source = report
+        .expected_source
+        .as_ref()
+        .ok_or("no expected source")?;
+    ensure!(
+        source.engine == "rapier3d-f64"
+            && source.version == rapier3d_f64::VERSION
+            && source
+                .settings
+                .get("fix_internal_edges")
+                .map(String::as_str)
+                == Some("false")
+            && source.settings.get("dt")
+                == Some(&BuiltinScene::MiniGolf.sim_options().time_step.to_string()),
+        "{source:?}"
+    );
+    let text = render_text(&report);
+    ensure!(
+        text.lines().nth(1).is_some_and(|l| {
+            l.starts_with(&format!(
+                "  expectations from rapier3d-f64 {} (",
+                rapier3d_f64::VERSION
+            )) && l.contains("fix_internal_edges = false")
+        }),
+        "{text}"
     );
     // With the defaults Rapier's α (to about 1e-5) does not pass.
     let report = check_file(&output, &CheckOptions::default());

@@ -1314,7 +1314,7 @@ fn enum_names_in_words_are_their_serde_names() -> Result<(), String> {
     {
         let json = serde_json::to_value(&v).map_err(|e| e.to_string())?;
         ensure!(
-            json == serde_json::Value::from(words),
+            json == words,
             "{v:?}: serde writes {json}, the words say `{words}`"
         );
         let back: T = serde_json::from_value(json).map_err(|e| format!("{v:?}: {e}"))?;
@@ -1332,7 +1332,7 @@ fn enum_names_in_words_are_their_serde_names() -> Result<(), String> {
     for v in Verdict::ALL {
         let json = serde_json::to_value(v).map_err(|e| e.to_string())?;
         ensure!(
-            json == serde_json::Value::from(v.as_str()),
+            json == v.as_str(),
             "{v:?}: serde writes {json}, the words say `{}`",
             v.as_str()
         );
@@ -1340,7 +1340,7 @@ fn enum_names_in_words_are_their_serde_names() -> Result<(), String> {
     for r in FragileReason::ALL {
         let json = serde_json::to_value(r).map_err(|e| e.to_string())?;
         ensure!(
-            json == serde_json::Value::from(r.as_str()),
+            json == r.as_str(),
             "{r:?}: serde writes {json}, the words say `{}`",
             r.as_str()
         );

@@ -118,6 +118,34 @@ extern "C" {
 enum SweeptraceStatus sweeptrace_writer_open(const char *path,
                                              struct SweeptraceWriter **out_writer);
 
+// Says who computed the trace's expected outcomes: the engine's name
+// (`engine`, not empty), its version (`version`; null or empty when not
+// known) and `setting_count` settings that bear on its answers, the
+// `i`-th named `setting_names[i]` with the value `setting_values[i]`
+// (`"fix_internal_edges"`, `"false"`). Written into the trace as its
+// `sweeptrace.expected_source` metadata record (docs/TRACE_FORMAT.md);
+// `sweeptrace info` and `sweeptrace check` show it.
+//
+// Call it at most once per trace, best right after
+// [`sweeptrace_writer_open`]. Every string is UTF-8 without control
+// characters; the engine's name and version are at most 128 bytes, a
+// setting's name 128 and its value 1024, at most 64 settings, names not
+// empty (a repeated name keeps its last value). An invalid argument, or a
+// second call, returns [`SweeptraceStatus::InvalidArgument`] and writes
+// nothing.
+//
+// # Safety
+// `writer` is a live writer or null; `engine` and `version` are null or
+// NUL-terminated; `setting_names` and `setting_values` are null (only
+// with a count of 0) or point to `setting_count` pointers, each null or
+// NUL-terminated.
+enum SweeptraceStatus sweeptrace_writer_set_expected_source(struct SweeptraceWriter *writer,
+                                                            const char *engine,
+                                                            const char *version,
+                                                            const char *const *setting_names,
+                                                            const char *const *setting_values,
+                                                            size_t setting_count);
+
 // Adds a scene: the triangle mesh the sweeps after it are tested against.
 //
 // `vertices` holds `vertex_count` points as `x, y, z` triples;

@@ -1,6 +1,6 @@
 //! The C API of the sweeptrace trace writer, for engines written in C, C++,
-//! C# or Python (`ctypes`): open a trace file, add scenes, sweeps and
-//! expected outcomes, close.
+//! C# or Python (`ctypes`): open a trace file, say which engine computed
+//! the expected outcomes, add scenes, sweeps and expected outcomes, close.
 //!
 //! Every function returns a [`SweeptraceStatus`]; on an error,
 //! [`sweeptrace_writer_last_error`] gives the message (naming the file, the
@@ -27,7 +27,8 @@ use std::path::PathBuf;
 
 use sweeptrace::core::{Facing, Kind};
 use sweeptrace::trace::messages::{OutcomeMsg, SceneMsg, SweepMsg};
-use sweeptrace::trace::{PendingTrace, TraceError};
+use sweeptrace::trace::source::MAX_SETTINGS;
+use sweeptrace::trace::{ExpectedSource, PendingTrace, TraceError};
 
 /// What a call came to.
 #[repr(C)]
@@ -176,7 +177,8 @@ impl From<TraceError> for Failure {
         let status = match &error {
             TraceError::Invalid { .. }
             | TraceError::Json { .. }
-            | TraceError::MessageTooLarge { .. } => SweeptraceStatus::InvalidArgument,
+            | TraceError::MessageTooLarge { .. }
+            | TraceError::ExpectedSource { .. } => SweeptraceStatus::InvalidArgument,
             TraceError::SweepBeforeScene { .. } | TraceError::OutOfOrder { .. } => {
                 SweeptraceStatus::WrongOrder
             }
@@ -394,6 +396,87 @@ pub unsafe extern "C" fn sweeptrace_writer_open(
     };
     set_thread_error(&failure.message);
     failure.status
+}
+
+/// A C string argument as UTF-8 text.
+///
+/// # Safety
+/// A non-null `pointer` is NUL-terminated.
+unsafe fn text<'a>(pointer: *const c_char, argument: &str) -> Result<&'a str, Failure> {
+    if pointer.is_null() {
+        return Err(Failure::null(argument));
+    }
+    // SAFETY: non-null, NUL-terminated by the contract.
+    unsafe { CStr::from_ptr(pointer) }
+        .to_str()
+        .map_err(|e| Failure::invalid(format!("`{argument}` is not valid UTF-8: {e}")))
+}
+
+/// Says who computed the trace's expected outcomes: the engine's name
+/// (`engine`, not empty), its version (`version`; null or empty when not
+/// known) and `setting_count` settings that bear on its answers, the
+/// `i`-th named `setting_names[i]` with the value `setting_values[i]`
+/// (`"fix_internal_edges"`, `"false"`). Written into the trace as its
+/// `sweeptrace.expected_source` metadata record (docs/TRACE_FORMAT.md);
+/// `sweeptrace info` and `sweeptrace check` show it.
+///
+/// Call it at most once per trace, best right after
+/// [`sweeptrace_writer_open`]. Every string is UTF-8 without control
+/// characters; the engine's name and version are at most 128 bytes, a
+/// setting's name 128 and its value 1024, at most 64 settings, names not
+/// empty (a repeated name keeps its last value). An invalid argument, or a
+/// second call, returns [`SweeptraceStatus::InvalidArgument`] and writes
+/// nothing.
+///
+/// # Safety
+/// `writer` is a live writer or null; `engine` and `version` are null or
+/// NUL-terminated; `setting_names` and `setting_values` are null (only
+/// with a count of 0) or point to `setting_count` pointers, each null or
+/// NUL-terminated.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn sweeptrace_writer_set_expected_source(
+    writer: *mut SweeptraceWriter,
+    engine: *const c_char,
+    version: *const c_char,
+    setting_names: *const *const c_char,
+    setting_values: *const *const c_char,
+    setting_count: usize,
+) -> SweeptraceStatus {
+    // SAFETY: the contract is the caller's.
+    unsafe {
+        with_writer(writer, |w| {
+            let engine = text(engine, "engine")?;
+            let version = if version.is_null() {
+                ""
+            } else {
+                text(version, "version")?
+            };
+            if setting_count > MAX_SETTINGS {
+                return Err(Failure::invalid(format!(
+                    "`setting_count` is {setting_count}, above the limit of {MAX_SETTINGS}"
+                )));
+            }
+            let mut source = ExpectedSource::new(engine, version);
+            if setting_count > 0 {
+                if setting_names.is_null() {
+                    return Err(Failure::null("setting_names"));
+                }
+                if setting_values.is_null() {
+                    return Err(Failure::null("setting_values"));
+                }
+                // SAFETY: non-null, `setting_count` pointers by the contract.
+                let names = std::slice::from_raw_parts(setting_names, setting_count);
+                // SAFETY: as above.
+                let values = std::slice::from_raw_parts(setting_values, setting_count);
+                for (i, (&name, &value)) in names.iter().zip(values).enumerate() {
+                    let name = text(name, &format!("setting_names[{i}]"))?;
+                    let value = text(value, &format!("setting_values[{i}]"))?;
+                    source = source.setting(name, value);
+                }
+            }
+            w.write(|trace| trace.writer().expected_source(&source))
+        })
+    }
 }
 
 /// Adds a scene: the triangle mesh the sweeps after it are tested against.

@@ -438,3 +438,124 @@ fn outcome_fields_for_a_kind_without_them_are_written_as_null() {
         sweeptrace::regress::render_text(&report)
     );
 }
+
+#[test]
+fn bad_expected_sources_are_refused_and_the_good_one_is_read_back() {
+    let dir = tempfile::tempdir().expect("a temporary directory");
+    let (writer, target) = open(dir.path(), "source.mcap");
+    let names = [c"fix_internal_edges".as_ptr(), c"dt".as_ptr()];
+    let values = [c"true".as_ptr(), c"0.01".as_ptr()];
+    let bad_names = [c"".as_ptr(), c"dt".as_ptr()];
+    let nul_value = [c"true".as_ptr(), null()];
+    let newline = [c"a\nb".as_ptr(), c"0.01".as_ptr()];
+    let set = |engine: *const c_char,
+               version: *const c_char,
+               names: *const *const c_char,
+               values: *const *const c_char,
+               count: usize| {
+        // SAFETY: null or NUL-terminated strings, arrays of `count` pointers.
+        unsafe {
+            sweeptrace_writer_set_expected_source(writer, engine, version, names, values, count)
+        }
+    };
+    let (engine, version) = (c"my-engine".as_ptr(), c"2.1".as_ptr());
+    // SAFETY: a null writer is accepted.
+    let status = unsafe {
+        sweeptrace_writer_set_expected_source(null_mut(), engine, version, null(), null(), 0)
+    };
+    assert_eq!(status, SweeptraceStatus::NullPointer);
+    let status = set(null(), version, null(), null(), 0);
+    assert_error(writer, status, SweeptraceStatus::NullPointer, &["`engine`"]);
+    let status = set(c"".as_ptr(), version, null(), null(), 0);
+    assert_error(
+        writer,
+        status,
+        SweeptraceStatus::InvalidArgument,
+        &[
+            "source.mcap",
+            "sweeptrace.expected_source",
+            "`engine` is empty",
+        ],
+    );
+    let status = set(engine, version, null(), values.as_ptr(), 2);
+    assert_error(
+        writer,
+        status,
+        SweeptraceStatus::NullPointer,
+        &["`setting_names`"],
+    );
+    let status = set(engine, version, names.as_ptr(), nul_value.as_ptr(), 2);
+    assert_error(
+        writer,
+        status,
+        SweeptraceStatus::NullPointer,
+        &["`setting_values[1]`"],
+    );
+    let status = set(engine, version, bad_names.as_ptr(), values.as_ptr(), 2);
+    assert_error(
+        writer,
+        status,
+        SweeptraceStatus::InvalidArgument,
+        &["empty name"],
+    );
+    let status = set(engine, version, names.as_ptr(), newline.as_ptr(), 2);
+    assert_error(
+        writer,
+        status,
+        SweeptraceStatus::InvalidArgument,
+        &["setting.fix_internal_edges", "control character"],
+    );
+    let status = set(engine, version, names.as_ptr(), values.as_ptr(), 65);
+    assert_error(
+        writer,
+        status,
+        SweeptraceStatus::InvalidArgument,
+        &["`setting_count` is 65"],
+    );
+    let long = CString::new("e".repeat(129)).expect("no NUL");
+    let status = set(long.as_ptr(), version, null(), null(), 0);
+    assert_error(
+        writer,
+        status,
+        SweeptraceStatus::InvalidArgument,
+        &["129 bytes", "limit of 128"],
+    );
+    // Refused calls wrote nothing: the good one is the trace's only source.
+    assert_eq!(
+        set(engine, version, names.as_ptr(), values.as_ptr(), 2),
+        SweeptraceStatus::Ok
+    );
+    let status = set(engine, version, null(), null(), 0);
+    assert_error(
+        writer,
+        status,
+        SweeptraceStatus::InvalidArgument,
+        &["already written"],
+    );
+    assert_eq!(
+        add_scene(writer, &VERTICES, &TRIANGLES),
+        SweeptraceStatus::Ok
+    );
+    assert_eq!(add_sweep(writer, 0, P0), SweeptraceStatus::Ok);
+    assert_eq!(add_expected(writer, &face_outcome(0)), SweeptraceStatus::Ok);
+    // SAFETY: a live writer, closed then freed.
+    unsafe {
+        assert_eq!(sweeptrace_writer_close(writer), SweeptraceStatus::Ok);
+        sweeptrace_writer_free(writer);
+    }
+    let bytes = std::fs::read(&target).expect("the trace");
+    let mut reader = sweeptrace::TraceReader::new(bytes.as_slice(), "source.mcap");
+    let events = reader.by_ref().collect::<Result<Vec<_>, _>>();
+    assert_eq!(events.map(|e| e.len()).ok(), Some(3));
+    let want = sweeptrace::trace::ExpectedSource::new("my-engine", "2.1")
+        .setting("fix_internal_edges", "true")
+        .setting("dt", "0.01");
+    assert_eq!(reader.expected_source(), Some(&want));
+    let sources = reader
+        .stats()
+        .metadata
+        .iter()
+        .filter(|(name, _)| name == "sweeptrace.expected_source")
+        .count();
+    assert_eq!(sources, 1, "{:?}", reader.stats().metadata);
+}

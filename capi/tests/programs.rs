@@ -6,6 +6,7 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 
 use sweeptrace::regress::{CheckOptions, Status, check_file, render_text};
+use sweeptrace::trace::ExpectedSource;
 
 /// The repository's root.
 fn root() -> PathBuf {
@@ -56,9 +57,26 @@ fn run(what: &str, command: &mut Command) {
 }
 
 /// `sweeptrace check`'s verdict on the trace: ok, with all three sweeps
-/// compared with an expectation.
+/// compared with an expectation, which the report says came from the
+/// examples' engine with its settings.
 fn assert_check_passes(trace: &Path) {
     let report = check_file(trace, &CheckOptions::default());
+    let source = ExpectedSource::new("example-engine", "1.0")
+        .setting("margin", "0")
+        .setting("two_sided_triangles", "false");
+    assert_eq!(
+        report.expected_source.as_ref(),
+        Some(&source),
+        "{}",
+        render_text(&report)
+    );
+    assert!(
+        render_text(&report).contains(
+            "\n  expectations from example-engine 1.0 (margin = 0, two_sided_triangles = false)\n"
+        ),
+        "{}",
+        render_text(&report)
+    );
     assert!(
         report.status == Status::Ok,
         "check does not pass:\n{}",

@@ -26,12 +26,19 @@ int main(int argc, char **argv) {
         fprintf(stderr, "open: %s\n", sweeptrace_last_error());
         return 1;
     }
+    /* Who computes the expected outcomes below: the engine, its version and
+     * the settings that bear on its answers (shown by info and check). */
+    const char *setting_names[] = {"margin", "two_sided_triangles"};
+    const char *setting_values[] = {"0", "false"};
+    int error = failed(sweeptrace_writer_set_expected_source(writer, "example-engine", "1.0",
+                                                             setting_names, setting_values, 2),
+                       writer, "expected source");
     /* One triangle in the plane z = 0, its front facing +z. */
     const double vertices[] = {0, 0, 0, 4, 0, 0, 0, 4, 0};
     const uint32_t triangles[] = {0, 1, 2};
-    int error = failed(sweeptrace_writer_add_scene(writer, 0, "level", vertices, 3, triangles, 1,
-                                                   0.0, SWEEPTRACE_FACING_NON_STRICT),
-                       writer, "scene");
+    error = error || failed(sweeptrace_writer_add_scene(writer, 0, "level", vertices, 3, triangles,
+                                                        1, 0.0, SWEEPTRACE_FACING_NON_STRICT),
+                            writer, "scene");
 
     /* A ball of radius 0.5 falling onto the face, onto the edge y = 0, and
      * moving beside the triangle; the engine's answer for each (the normal

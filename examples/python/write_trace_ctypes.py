@@ -38,6 +38,10 @@ def load(path):
     writer_p = ctypes.c_void_p
     double_p = ctypes.POINTER(ctypes.c_double)
     lib.sweeptrace_writer_open.argtypes = [ctypes.c_char_p, ctypes.POINTER(writer_p)]
+    char_pp = ctypes.POINTER(ctypes.c_char_p)
+    lib.sweeptrace_writer_set_expected_source.argtypes = [
+        writer_p, ctypes.c_char_p, ctypes.c_char_p, char_pp, char_pp, ctypes.c_size_t,
+    ]
     lib.sweeptrace_writer_add_scene.argtypes = [
         writer_p, ctypes.c_uint64, ctypes.c_char_p, double_p, ctypes.c_size_t,
         ctypes.POINTER(ctypes.c_uint32), ctypes.c_size_t, ctypes.c_double, ctypes.c_uint32,
@@ -56,7 +60,7 @@ def load(path):
     lib.sweeptrace_writer_last_error.restype = ctypes.c_char_p
     lib.sweeptrace_last_error.argtypes = []
     lib.sweeptrace_last_error.restype = ctypes.c_char_p
-    for name in ("open", "add_scene", "add_sweep", "add_expected", "close"):
+    for name in ("open", "set_expected_source", "add_scene", "add_sweep", "add_expected", "close"):
         getattr(lib, "sweeptrace_writer_" + name).restype = ctypes.c_int
     return lib
 
@@ -77,6 +81,12 @@ def main(library, out):
     if lib.sweeptrace_writer_open(out.encode(), ctypes.byref(writer)) != STATUS_OK:
         raise TraceError("open: " + lib.sweeptrace_last_error().decode())
     try:
+        # Who computes the expected outcomes below, and its settings.
+        settings = {"margin": "0", "two_sided_triangles": "false"}
+        names = (ctypes.c_char_p * len(settings))(*(k.encode() for k in settings))
+        values = (ctypes.c_char_p * len(settings))(*(v.encode() for v in settings.values()))
+        checked(lib, writer, lib.sweeptrace_writer_set_expected_source(
+            writer, b"example-engine", b"1.0", names, values, len(settings)), "expected source")
         vertices = (ctypes.c_double * 9)(0, 0, 0, 4, 0, 0, 0, 4, 0)
         triangles = (ctypes.c_uint32 * 3)(0, 1, 2)
         checked(lib, writer, lib.sweeptrace_writer_add_scene(

@@ -48,11 +48,16 @@ pub fn run(args: Args) -> anyhow::Result<RunOutcome> {
     super::warn_unfinished(&output);
     let summary = bless_file(&args.trace, &output, ReplayOptions::default())
         .name_file_once("blessing", args.trace.display())?;
+    let replaced = match &summary.replaced_expected_source {
+        Some(old) => format!(" (expectations were from {old})"),
+        None => String::new(),
+    };
     eprintln!(
-        "wrote {}: {} expectations (replacing {}), {} other messages, {} channels, {} schemas, \
-         {} metadata records and {} attachments kept",
+        "wrote {}: {} expectations from {}{replaced} (replacing {}), {} other messages, \
+         {} channels, {} schemas, {} metadata records and {} attachments kept",
         output.display(),
         summary.expected_written,
+        summary.expected_source,
         summary.expected_dropped,
         summary.messages_copied,
         summary.channels_copied,

@@ -11,6 +11,7 @@ use sweeptrace::core::Facing;
 use sweeptrace::run::RunOutcome;
 use sweeptrace::sim::scenes::{self, BuiltinScene, SceneMesh};
 use sweeptrace::sim::{self, SimOptions, SimSummary, StopReason};
+use sweeptrace::trace::source::sweeptrace_source;
 use sweeptrace::trace::write_trace_file;
 
 /// Arguments of `record`. Every simulation option defaults to the scene's
@@ -161,6 +162,11 @@ pub fn run(args: Args) -> anyhow::Result<RunOutcome> {
     let bar = progress_bar(options.frames);
     super::warn_unfinished(&output);
     let summary = write_trace_file(&output, |writer| -> anyhow::Result<SimSummary> {
+        // The expectations are the core's, with the recording's margin and facing.
+        writer.expected_source(&sweeptrace_source(
+            &options.margin.to_string(),
+            options.facing.as_str(),
+        ))?;
         writer.scene(0, &scene_msg)?;
         let mut shown = 0;
         let summary = sim::simulate(&mesh, &options, |event| -> anyhow::Result<()> {

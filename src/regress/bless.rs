@@ -12,6 +12,10 @@
 //!    messages of `/expected` channels, which are dropped; after each `/sweep`
 //!    message its new expectation is written on a `/expected` channel with
 //!    the project's `sweeptrace.Outcome` schema, at the sweep's `log_time`.
+//!    The expectations now come from sweeptrace: the input's
+//!    `sweeptrace.expected_source` record, if any, is dropped and a new one
+//!    (engine `sweeptrace`, its version, the margin and facing rule the
+//!    replay used) is written first.
 //!
 //! The header's profile and library string are kept. The output is written
 //! with the project's container options (chunked, zstd, summary and
@@ -32,11 +36,12 @@ use thiserror::Error;
 use crate::atomic::PendingFile;
 use crate::error_text::full_text;
 use crate::replay::{ReplayError, ReplayEvent, ReplayOptions, replay_events};
-use crate::trace::TraceReader;
 use crate::trace::messages::{EXPECTED_TOPIC, OUTCOME_SCHEMA, OutcomeMsg, SWEEP_TOPIC};
 use crate::trace::schemas::{MESSAGE_ENCODING, OUTCOME_SCHEMA_JSON, SCHEMA_ENCODING};
+use crate::trace::source::{EXPECTED_SOURCE_METADATA, ExpectedSource, sweeptrace_source};
 use crate::trace::validate::frame_of;
 use crate::trace::write::default_write_options;
+use crate::trace::{TraceError, TraceReader};
 
 /// What went wrong while blessing.
 #[derive(Debug, Error)]
@@ -69,6 +74,12 @@ pub enum BlessError {
         what: String,
         /// The error.
         cause: std::io::Error,
+    },
+    /// The blessed trace could not be given its expectations' source.
+    #[error("{cause}")]
+    Trace {
+        /// The error, naming the output.
+        cause: TraceError,
     },
     /// A `/sweep` message found in the copy pass has no outcome from the
     /// replay pass (the replay and the copy disagree on the file).
@@ -107,14 +118,39 @@ pub struct BlessSummary {
     pub metadata_copied: u64,
     /// Attachments copied.
     pub attachments_copied: u64,
+    /// The expectations' source written (sweeptrace, with the margins and
+    /// facing rules of the replay).
+    pub expected_source: ExpectedSource,
+    /// The input's expectations' source, replaced, if it had one.
+    pub replaced_expected_source: Option<ExpectedSource>,
 }
 
-/// The outcomes of every sweep of a trace, by `(frame, ball)` in trace order.
-fn outcomes_of(
-    input: &[u8],
-    name: &str,
-    options: ReplayOptions,
-) -> Result<HashMap<(u64, u32), VecDeque<OutcomeMsg>>, BlessError> {
+/// What the replay pass found: the outcomes of every sweep of a trace, by
+/// `(frame, ball)` in trace order, and the source of the new expectations.
+struct Replayed {
+    outcomes: HashMap<(u64, u32), VecDeque<OutcomeMsg>>,
+    source: ExpectedSource,
+    replaced: Option<ExpectedSource>,
+}
+
+/// Values in words, the first few of many only (a setting's value is
+/// bounded: [`crate::trace::source::MAX_SETTING_VALUE_BYTES`]).
+fn listed(values: &[String]) -> String {
+    const SHOWN: usize = 8;
+    let text = values
+        .iter()
+        .take(SHOWN)
+        .cloned()
+        .collect::<Vec<_>>()
+        .join(", ");
+    if values.len() > SHOWN {
+        format!("{text} and {} more", values.len() - SHOWN)
+    } else {
+        text
+    }
+}
+
+fn outcomes_of(input: &[u8], name: &str, options: ReplayOptions) -> Result<Replayed, BlessError> {
     let options = ReplayOptions {
         explain: false,
         frames: Default::default(),
@@ -122,16 +158,25 @@ fn outcomes_of(
         ..options
     };
     let mut out: HashMap<(u64, u32), VecDeque<OutcomeMsg>> = HashMap::new();
-    for event in replay_events(
-        TraceReader::new_indexed(std::io::Cursor::new(input), name),
-        options,
-    ) {
+    // The margins and facing rules the scenes were replayed with, in order.
+    let (mut margins, mut facings): (Vec<String>, Vec<String>) = (Vec::new(), Vec::new());
+    let mut reader = TraceReader::new_indexed(std::io::Cursor::new(input), name);
+    for event in replay_events(reader.by_ref(), options) {
         match event {
             Ok(ReplayEvent::Sweep(r)) => out
                 .entry((r.frame, r.ball))
                 .or_default()
                 .push_back(r.outcome_msg()),
-            Ok(ReplayEvent::Scene(_)) => {}
+            Ok(ReplayEvent::Scene(scene)) => {
+                for (list, value) in [
+                    (&mut margins, scene.options.margin.to_string()),
+                    (&mut facings, scene.options.facing.to_string()),
+                ] {
+                    if !list.contains(&value) {
+                        list.push(value);
+                    }
+                }
+            }
             Err(cause) => {
                 return Err(BlessError::Replay {
                     file: name.to_string(),
@@ -140,7 +185,11 @@ fn outcomes_of(
             }
         }
     }
-    Ok(out)
+    Ok(Replayed {
+        outcomes: out,
+        source: sweeptrace_source(&listed(&margins), &listed(&facings)),
+        replaced: reader.expected_source().cloned(),
+    })
 }
 
 /// Blesses the trace `input` (its bytes; `name` is used in messages) into
@@ -164,7 +213,11 @@ fn bless_into<W: Write + Seek>(
     output_name: &str,
     options: ReplayOptions,
 ) -> Result<(BlessSummary, W), BlessError> {
-    let mut outcomes = outcomes_of(input, name, options)?;
+    let Replayed {
+        mut outcomes,
+        source,
+        replaced,
+    } = outcomes_of(input, name, options)?;
     let read_err = |cause| BlessError::Mcap {
         file: name.to_string(),
         what: "reading the container".to_string(),
@@ -199,7 +252,23 @@ fn bless_into<W: Write + Seek>(
 
     // Pass 3: the copy.
     let mut writer = write_options.create(output).map_err(write_err)?;
-    let mut summary = BlessSummary::default();
+    source.validate().map_err(|problem| BlessError::Trace {
+        cause: TraceError::ExpectedSource {
+            file: output_name.to_string(),
+            problem,
+        },
+    })?;
+    writer
+        .write_metadata(&mcap::records::Metadata {
+            name: EXPECTED_SOURCE_METADATA.to_string(),
+            metadata: source.to_metadata(),
+        })
+        .map_err(write_err)?;
+    let mut summary = BlessSummary {
+        expected_source: source,
+        replaced_expected_source: replaced,
+        ..BlessSummary::default()
+    };
     let mut schema_ids: HashMap<u16, u16> = HashMap::new();
     let mut channel_ids: HashMap<u16, u16> = HashMap::new();
     let mut channel_topics: HashMap<u16, String> = HashMap::new();
@@ -324,6 +393,8 @@ fn bless_into<W: Write + Seek>(
                 sequence = sequence.wrapping_add(1);
                 summary.expected_written += 1;
             }
+            // Replaced by the record written first.
+            Record::Metadata(m) if m.name == EXPECTED_SOURCE_METADATA => {}
             Record::Metadata(m) => {
                 writer.write_metadata(&m).map_err(write_err)?;
                 summary.metadata_copied += 1;

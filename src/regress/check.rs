@@ -287,6 +287,11 @@ pub struct TraceReport {
     /// and what its answers were compared with.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub engine: Option<super::engine_check::EngineCheck>,
+    /// Who computed the trace's `/expected` outcomes, as its
+    /// `sweeptrace.expected_source` record says (`null` when it does not).
+    /// With `check --engine` and `against` `core` the report's
+    /// expectations are the engine's answers instead (`engine`).
+    pub expected_source: Option<crate::trace::ExpectedSource>,
 }
 
 /// How many compared sweeps (the first ones) the inference of the
@@ -316,6 +321,7 @@ fn check_trace<R: std::io::Read>(
 ) -> TraceReport {
     let mut report = check_events(reader.by_ref(), name, options);
     report.has_expected_channel = reader.stats().channels.contains_key(EXPECTED_TOPIC);
+    report.expected_source = reader.expected_source().cloned();
     report.status = status_of(&report);
     report
 }
@@ -409,6 +415,7 @@ where
         tolerances: options.tolerances,
         inferred: None,
         engine: None,
+        expected_source: None,
     };
     let mut compared: Vec<ComparedSweep> = Vec::new();
     let mut replay = crate::replay::replay_events(events, replay_options);

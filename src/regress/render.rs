@@ -373,7 +373,27 @@ pub fn render_text(r: &TraceReport) -> String {
             let _ = writeln!(s, "  {line}");
         }
     }
+    if let Some(line) = source_line(r) {
+        // Right below the status line: part of the trace's header.
+        let at = s.find('\n').map_or(s.len(), |i| i + 1);
+        s.insert_str(at, &line);
+    }
     s
+}
+
+/// Who computed the expectations the report compared with, one line: the
+/// engine command (`check --engine`, against the core), or the trace's
+/// `sweeptrace.expected_source` record; `None` when the trace does not say.
+fn source_line(r: &TraceReport) -> Option<String> {
+    match (&r.engine, &r.expected_source) {
+        (Some(e), _) if e.against == super::Against::Core => Some(format!(
+            "  expectations from the engine command `{}` (answers to every sweep; the \
+             trace's /expected is not used)\n",
+            e.command
+        )),
+        (_, Some(source)) => Some(format!("  expectations from {source}\n")),
+        (_, None) => None,
+    }
 }
 
 fn tunnel_words(n: u64) -> &'static str {

@@ -183,6 +183,15 @@ pub enum TraceError {
         /// The channel id.
         channel_id: u16,
     },
+    /// The metadata record `sweeptrace.expected_source` is malformed (or
+    /// there are two), or the writer was given an invalid source.
+    #[error("{file}: metadata record `sweeptrace.expected_source`: {problem}")]
+    ExpectedSource {
+        /// File name.
+        file: String,
+        /// What is wrong.
+        problem: String,
+    },
     /// The MCAP writer failed.
     #[error("{file}: cannot write the trace: {}", full_text(.cause))]
     Write {

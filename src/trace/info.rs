@@ -67,6 +67,8 @@ pub struct TraceInfo {
     pub expected: u64,
     /// Expected outcomes by kind.
     pub expected_by_kind: BTreeMap<String, u64>,
+    /// Who computed them (the `sweeptrace.expected_source` record), if known.
+    pub expected_source: Option<super::ExpectedSource>,
     /// What the reader saw: channels, chunks, compression, bytes, metadata.
     pub stats: ReadStats,
     /// The error that ended reading early, if any (the rest of the report
@@ -96,6 +98,7 @@ pub fn collect<R: Read>(mut reader: TraceReader<R>) -> (TraceInfo, Option<TraceE
         expected_present: false,
         expected: 0,
         expected_by_kind: BTreeMap::new(),
+        expected_source: None,
         stats: ReadStats::default(),
         error: None,
     };
@@ -161,6 +164,7 @@ pub fn collect<R: Read>(mut reader: TraceReader<R>) -> (TraceInfo, Option<TraceE
         }
     }
     info.stats = reader.stats().clone();
+    info.expected_source = info.stats.expected_source.clone();
     info.expected_present = info.stats.channels.contains_key(EXPECTED_TOPIC);
     (info, error)
 }
@@ -278,6 +282,9 @@ pub fn render_text(info: &TraceInfo) -> String {
         );
     } else {
         let _ = writeln!(out, "expected:    absent");
+    }
+    if let Some(source) = &info.expected_source {
+        let _ = writeln!(out, "expected by: {source}");
     }
     let _ = writeln!(out, "channels:");
     for (topic, c) in &s.channels {

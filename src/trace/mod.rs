@@ -1,7 +1,8 @@
 //! Traces: MCAP files holding a scene, ball sweeps and expected outcomes.
 //!
 //! [`read`] streams a trace from any `Read`, [`write`](mod@write) records one,
-//! [`validate`] holds the message checks both share, and [`info`] summarises
+//! [`validate`] holds the message checks both share, [`source`] the record
+//! of who computed the expectations, and [`info`] summarises
 //! a trace for `sweeptrace info`. The format is described in
 //! `docs/TRACE_FORMAT.md`.
 
@@ -12,9 +13,11 @@ pub mod messages;
 pub mod prefetch;
 pub mod read;
 pub mod schemas;
+pub mod source;
 pub mod validate;
 pub mod write;
 
 pub use error::{MessageAt, TraceError};
 pub use read::{ReadLimits, ReadStats, TraceEvent, TraceReader};
+pub use source::{EXPECTED_SOURCE_METADATA, ExpectedSource};
 pub use write::{PendingTrace, TraceWriter, write_trace_file};

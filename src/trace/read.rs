@@ -47,6 +47,7 @@ use mcap::sans_io::{LinearReadEvent, LinearReader, LinearReaderOptions};
 
 use super::error::{MessageAt, TraceError};
 use super::messages::{EXPECTED_TOPIC, OutcomeMsg, SCENE_TOPIC, SWEEP_TOPIC, SceneMsg, SweepMsg};
+use super::source::{EXPECTED_SOURCE_METADATA, ExpectedSource};
 use super::validate::{parse_message, validate_outcome, validate_scene, validate_sweep};
 use log_time_order::LogTimeOrder;
 
@@ -169,6 +170,12 @@ pub struct ReadStats {
     pub read_through_chunk_indexes: bool,
     /// Metadata records, by name, in file order (the summary's copies are not repeated).
     pub metadata: Vec<(String, BTreeMap<String, String>)>,
+    /// Who computed the expectations: the `sweeptrace.expected_source`
+    /// record, validated; `None` when the trace does not say. (Left out of
+    /// the JSON: the record is also in `metadata`, and reports give it
+    /// field of their own.)
+    #[serde(skip)]
+    pub expected_source: Option<ExpectedSource>,
     /// The header's library string.
     pub library: String,
     /// The header's profile.
@@ -244,6 +251,16 @@ impl<R: Read> TraceReader<R> {
     /// What has been read so far (complete after the iterator returned `None`).
     pub fn stats(&self) -> &ReadStats {
         &self.state.stats
+    }
+
+    /// Who computed the expectations, when the trace says so (its
+    /// `sweeptrace.expected_source` record). Known once the reader has
+    /// passed the record: the project's writer puts it before the first
+    /// message, other writers may put it anywhere in the data section, so
+    /// read to the end to be sure. A malformed record (or a second one)
+    /// is an error of the iteration, [`TraceError::ExpectedSource`].
+    pub fn expected_source(&self) -> Option<&ExpectedSource> {
+        self.state.stats.expected_source.as_ref()
     }
 
     /// The name given to [`TraceReader::new`].
@@ -486,6 +503,9 @@ impl State {
                 );
             }
             Record::Metadata(metadata) if !self.after_data_end => {
+                if metadata.name == EXPECTED_SOURCE_METADATA {
+                    self.expected_source(&metadata.metadata)?;
+                }
                 self.stats.metadata.push((metadata.name, metadata.metadata));
             }
             Record::DataEnd(_) => {
@@ -500,6 +520,22 @@ impl State {
             _ => {}
         }
         Ok(None)
+    }
+
+    /// Reads the `sweeptrace.expected_source` record into the stats.
+    fn expected_source(&mut self, entries: &BTreeMap<String, String>) -> Result<(), TraceError> {
+        let refuse = |problem: String| TraceError::ExpectedSource {
+            file: self.source_name.clone(),
+            problem,
+        };
+        if self.stats.expected_source.is_some() {
+            return Err(refuse(
+                "the file holds two; a trace has at most one expected source".to_string(),
+            ));
+        }
+        let source = ExpectedSource::from_metadata(entries).map_err(refuse)?;
+        self.stats.expected_source = Some(source);
+        Ok(())
     }
 
     fn message(

@@ -3,7 +3,9 @@
 //! [`TraceWriter`] writes the project's own flavour of the format: chunked,
 //! zstd, summary and indexes, library string `sweeptrace <version>`, a
 //! `sweeptrace` metadata record with `format_version = "1"`, the three JSON
-//! Schemas. Output is deterministic: no clock is read and zstd runs on the
+//! Schemas, and when given ([`TraceWriter::expected_source`]) the
+//! `sweeptrace.expected_source` record naming who computed the
+//! expectations. Output is deterministic: no clock is read and zstd runs on the
 //! calling thread. Every message is checked with the reader's validation
 //! and size limits before it is written, so whatever this writer accepts,
 //! the reader reads.
@@ -31,6 +33,7 @@ use super::schemas::{
     FORMAT_VERSION, MESSAGE_ENCODING, METADATA_NAME, OUTCOME_SCHEMA_JSON, SCENE_SCHEMA_JSON,
     SCHEMA_ENCODING, SWEEP_SCHEMA_JSON,
 };
+use super::source::{EXPECTED_SOURCE_METADATA, ExpectedSource};
 use super::validate::{validate_outcome, validate_scene, validate_sweep};
 use crate::atomic::PendingFile;
 
@@ -59,6 +62,8 @@ pub struct TraceWriter<W: Write + Seek> {
     messages: u64,
     last_log_time: Option<u64>,
     scene_margin: Option<f64>,
+    /// Whether the `sweeptrace.expected_source` record was written.
+    wrote_expected_source: bool,
 }
 
 impl<W: Write + Seek> TraceWriter<W> {
@@ -110,6 +115,7 @@ impl<W: Write + Seek> TraceWriter<W> {
             messages: 0,
             last_log_time: None,
             scene_margin: None,
+            wrote_expected_source: false,
         })
     }
 
@@ -188,9 +194,54 @@ impl<W: Write + Seek> TraceWriter<W> {
         Ok(())
     }
 
+    /// Writes the `sweeptrace.expected_source` record: who computed the
+    /// `/expected` outcomes of this trace (an engine, its version, its
+    /// settings). Call it once, before the first message, so that a reader
+    /// streaming the file sees it first (it is valid anywhere in the data
+    /// section). The source is validated first
+    /// ([`ExpectedSource::validate`]: a non-empty engine name, bounded
+    /// lengths, no control characters); an invalid source, or a second
+    /// call, is an error and writes nothing. Like every record it goes into
+    /// the trace being written: [`write_trace_file`] and [`PendingTrace`]
+    /// rename the file only when the whole trace is written.
+    pub fn expected_source(&mut self, source: &ExpectedSource) -> Result<(), TraceError> {
+        let refuse = |problem: String| TraceError::ExpectedSource {
+            file: self.name.clone(),
+            problem,
+        };
+        if self.wrote_expected_source {
+            return Err(refuse(
+                "already written; a trace has at most one expected source".to_string(),
+            ));
+        }
+        source.validate().map_err(refuse)?;
+        self.write_metadata(EXPECTED_SOURCE_METADATA, source.to_metadata())?;
+        self.wrote_expected_source = true;
+        Ok(())
+    }
+
     /// Writes a metadata record `name` (besides the `sweeptrace` record
-    /// every trace has), e.g. where a trace was cut from.
+    /// every trace has), e.g. where a trace was cut from. The name
+    /// `sweeptrace.expected_source` is written only through
+    /// [`TraceWriter::expected_source`], which validates it.
     pub fn metadata(
+        &mut self,
+        name: &str,
+        entries: BTreeMap<String, String>,
+    ) -> Result<(), TraceError> {
+        if name == EXPECTED_SOURCE_METADATA {
+            let source = ExpectedSource::from_metadata(&entries).map_err(|problem| {
+                TraceError::ExpectedSource {
+                    file: self.name.clone(),
+                    problem,
+                }
+            })?;
+            return self.expected_source(&source);
+        }
+        self.write_metadata(name, entries)
+    }
+
+    fn write_metadata(
         &mut self,
         name: &str,
         entries: BTreeMap<String, String>,
@@ -332,6 +383,8 @@ impl PendingTrace {
 /// Writes a trace to `path` through `f`, atomically: the trace goes to a
 /// temporary file in the same directory, which is renamed to `path` only
 /// when `f` and the writer both succeeded (and the data reached the disk).
+/// `f` gives the expectations' source, when it writes expectations, with
+/// [`TraceWriter::expected_source`] before its first message.
 /// On any error the temporary file is removed and `path` is untouched.
 /// ([`PendingTrace`] is the same without a closure.)
 pub fn write_trace_file<T, E: From<TraceError>>(

@@ -31,6 +31,7 @@ pub mod error_text;
 pub mod foxglove;
 #[doc(hidden)]
 pub mod fuzzing;
+pub mod junit;
 pub mod numbers;
 pub mod palette;
 pub mod regress;

@@ -27,6 +27,7 @@ pub mod engine_check;
 pub mod explain;
 pub mod infer;
 pub mod judge;
+pub mod junit;
 mod render;
 pub mod repro;
 
@@ -48,7 +49,7 @@ pub use explain::{ExpectedTest, expected_tests, explain_outcome, explained_recor
 pub use infer::{Inferred, Spread, infer};
 pub use judge::{Agreement, Perturbation, Reproduced, agreement, agreement_of, perturbations};
 pub use render::{
-    Sides, render_divergence, render_divergence_as, render_json, render_text, value_text,
-    value_text_exact, values_text,
+    Sides, divergence_line, render_divergence, render_divergence_as, render_json, render_text,
+    sides_of, value_text, value_text_exact, values_text,
 };
 pub use repro::{HexInputs, ReproCase, ReproError, SweepInputs, TraceSweep, find_sweep};

@@ -17,6 +17,7 @@ mod error_messages;
 mod faults;
 mod foxglove;
 mod fuzz_corpus;
+mod junit;
 mod oracle;
 mod out_of_order;
 mod outputs;
@@ -112,6 +113,7 @@ fn main() {
     trials.extend(foxglove::tests());
     trials.extend(engine::tests());
     trials.extend(conform::tests());
+    trials.extend(junit::tests());
     trials.extend(verdicts::tests());
     trials.extend(bisect::tests());
     trials.extend(rapier::tests());

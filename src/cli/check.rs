@@ -58,7 +58,10 @@ trace matches (ties and divergences rounding explains included, unless
 --strict), 1 a divergence or a tunnel was found, 2
 something could not be checked (bad input, I/O error, no expectations, a
 fault of the engine), 3 a trace ends early, 125 the engine cannot be
-started (git bisect run skips that commit).")]
+started (git bisect run skips that commit). In GitHub Actions
+(GITHUB_ACTIONS=true) the first divergences and tunnels of each failing
+trace, and why a trace could not be checked, are also printed as ::error
+annotations (not with --json).")]
 pub struct Args {
     /// Trace files, or directories searched recursively for `*.mcap`.
     #[arg(value_name = "TRACE|DIR", required = true)]

@@ -27,9 +27,9 @@ pub struct JunitArgs {
     /// edge, tie, ...) with a test case per rule. A failure's message is
     /// the first divergence; its text is what is printed for that trace or
     /// rule. A trace that could not be checked is an error; a divergence
-    /// that rounding explains a skipped test case (a failure with
-    /// --strict). The file is written under a temporary name and renamed
-    /// when complete.
+    /// that rounding explains is a skipped test case (check without
+    /// --strict, conform with --lenient), otherwise a failure. The file is
+    /// written under a temporary name and renamed when complete.
     #[arg(long, value_name = "FILE")]
     pub junit: Option<PathBuf>,
     /// With --junit: `traces` (the default), one test case per trace

@@ -13,6 +13,8 @@
 //! - [`explain`](mod@explain): why a divergent sweep came out as it did;
 //! - [`check`](mod@check): a whole trace checked ([`check_file`]), and
 //!   [`render_text`] / [`render_json`] for its report;
+//! - [`junit`](mod@junit): check's reports as JUnit XML and GitHub Actions
+//!   annotations, for CI systems;
 //! - [`diff`](mod@diff): two traces, or one under two configurations;
 //! - [`bless`](mod@bless): a trace's expectations rewritten from the core;
 //! - [`repro`]: one sweep taken out of its trace, bit-exactly: a minimal

@@ -25,6 +25,7 @@ pub fn tests() -> Vec<Trial> {
         trial!(check_junit_detail_sweeps_adds_divergences_and_tunnels),
         trial!(check_junit_fragile_divergences_are_skipped_unless_strict),
         trial!(conform_junit_fails_exactly_the_failing_rules),
+        trial!(check_engine_junit_names_the_engine),
         trial!(github_annotations_only_in_github_actions),
         trial!(junit_not_writable_fails_before_checking_and_leaves_nothing),
         trial!(junit_reports_validate_against_the_schema_and_read_back),
@@ -504,6 +505,43 @@ fn conform_junit_fails_exactly_the_failing_rules() -> Result<(), String> {
         json["failed"].as_u64() == Some(failed_cases),
         "{failed_cases} failing case test cases, {} failed",
         json["failed"]
+    );
+    Ok(())
+}
+
+fn check_engine_junit_names_the_engine() -> Result<(), String> {
+    let dir = tempdir()?;
+    let report = dir.path().join("e.xml");
+    // An engine that ignores the margin diverges on a trace with one.
+    let trace = at("traces/record_cube_corner_margin.mcap");
+    let engine = example_engine_command("--bug ignore-margin");
+    let (code, stdout, stderr) = run_bin(os![
+        "check",
+        s(&trace),
+        "--engine",
+        &engine,
+        "--against",
+        "expected",
+        "--junit",
+        s(&report)
+    ])?;
+    ensure!(code == 1, "exit {code}\n{stdout}{stderr}");
+    let xml = read(&report)?;
+    let doc = parse(&xml)?;
+    counts_add_up(&doc)?;
+    let suite = suite_named(&doc, s(&trace))?;
+    ensure!(
+        property(suite, "engine") == Some(engine.as_str())
+            && property(suite, "against") == Some("expected"),
+        "properties: {xml}"
+    );
+    let case = children(suite, "testcase")[0];
+    let failure = outcome(case).ok_or("no failure")?;
+    ensure!(
+        failure.has_tag_name("failure")
+            && attr(failure, "message")?
+                .contains("first divergence: frame 29, ball 0: kind expected "),
+        "{xml}"
     );
     Ok(())
 }

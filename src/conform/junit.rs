@@ -189,6 +189,40 @@ mod tests {
     use super::*;
 
     #[test]
+    fn a_fault_of_the_engine_is_an_error_in_a_suite_of_its_own() {
+        let report = ConformReport {
+            engine: "./engine --flag".to_string(),
+            rules: Vec::new(),
+            cases: 0,
+            passed: 0,
+            failed: 0,
+            fragile: 0,
+            strict: true,
+            error: Some("the engine exited\nits last stderr line".to_string()),
+        };
+        let xml = conform_junit(
+            &report,
+            &Tolerances::default(),
+            None,
+            &JunitOptions::default(),
+        );
+        assert!(
+            xml.contains(r#"<testsuites name="sweeptrace conform" tests="1" failures="0" errors="1" skipped="0">"#),
+            "{xml}"
+        );
+        assert!(
+            xml.contains(r#"<error message="the engine exited its last stderr line" type="engine_fault">the engine exited
+its last stderr line
+</error>"#),
+            "{xml}"
+        );
+        assert!(
+            xml.contains(r#"<property name="engine" value="./engine --flag"/>"#),
+            "{xml}"
+        );
+    }
+
+    #[test]
     fn a_rule_s_group_is_its_first_component() {
         assert_eq!(rule_group("edge.miss.parallel"), "edge");
         assert_eq!(rule_group("tie"), "tie");

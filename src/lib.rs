@@ -85,6 +85,7 @@ pub mod error_text;
 pub mod foxglove;
 #[doc(hidden)]
 pub mod fuzzing;
+pub mod junit;
 #[doc(hidden)]
 pub mod numbers;
 pub(crate) mod palette;

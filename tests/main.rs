@@ -18,6 +18,7 @@ mod expected_source;
 mod faults;
 mod foxglove;
 mod fuzz_corpus;
+mod junit;
 mod oracle;
 mod out_of_order;
 mod outputs;
@@ -113,6 +114,7 @@ fn main() {
     trials.extend(foxglove::tests());
     trials.extend(engine::tests());
     trials.extend(conform::tests());
+    trials.extend(junit::tests());
     trials.extend(verdicts::tests());
     trials.extend(bisect::tests());
     trials.extend(rapier::tests());

@@ -608,7 +608,7 @@ fn infer_wrong_engine_config() -> Result<(), String> {
 
 /// A trace of `scene` and `sweeps` whose expectations are the core's with
 /// `margin` and `facing` (an engine configured otherwise than the scene).
-fn recorded_by(
+pub(crate) fn recorded_by(
     scene: &SceneMsg,
     sweeps: &[SweepMsg],
     margin: f64,
@@ -632,7 +632,7 @@ fn recorded_by(
 
 /// A floor of two triangles (z = 0, front +z) and drops onto it, plus one
 /// path parallel to it that crosses the edge y = 0 at height 0.3.
-fn floor_and_sweeps(margin: f64, facing: Facing) -> (SceneMsg, Vec<SweepMsg>) {
+pub(crate) fn floor_and_sweeps(margin: f64, facing: Facing) -> (SceneMsg, Vec<SweepMsg>) {
     let scene = SceneMsg {
         name: Some("floor".into()),
         vertices: vec![

@@ -103,6 +103,40 @@ pub fn python_with_mcap() -> Result<Result<(), libtest_mimic::Completion>, Strin
     ))))
 }
 
+/// Whether `python3` on `PATH` can import every module of `modules`
+/// (`pip install` hint: `install`), as [`python_with_mcap`] does for
+/// `mcap`: `Ok(Err(completion))` to skip, an error when
+/// [`REQUIRE_PYTHON`] requires them.
+pub fn python_with_modules(
+    modules: &[&str],
+    install: &str,
+) -> Result<Result<(), libtest_mimic::Completion>, String> {
+    let missing = match std::process::Command::new("python3")
+        .args(["-c", &format!("import {}", modules.join(", "))])
+        .output()
+    {
+        Ok(o) if o.status.success() => return Ok(Ok(())),
+        Ok(o) => format!(
+            "python3 cannot import {} ({})",
+            modules.join(", "),
+            String::from_utf8_lossy(&o.stderr)
+                .lines()
+                .last()
+                .unwrap_or("no message")
+        ),
+        Err(e) => format!("python3 cannot be run ({e})"),
+    };
+    if std::env::var_os(REQUIRE_PYTHON).is_some_and(|v| v == "1") {
+        return Err(format!(
+            "{missing}, and {REQUIRE_PYTHON}=1 requires this check \
+             (`{install}` and put that Python first on PATH)"
+        ));
+    }
+    Ok(Err(libtest_mimic::Completion::ignored_with(format!(
+        "skipped: {missing}; {REQUIRE_PYTHON}=1 makes this a failure"
+    ))))
+}
+
 /// `|a - b| ≤ tol`, or an error naming `what`.
 pub fn close(what: &str, got: f64, want: f64, tol: f64) -> Result<(), String> {
     if (got - want).abs() <= tol {

@@ -31,6 +31,7 @@ Examples:
   sweeptrace check traces/ --engine 'python3 examples/engines/sweep_engine.py'
   git bisect run sweeptrace check traces/ --engine ./build/engine
   sweeptrace check rapier.mcap --fields kind,alpha --tolerance 1e-5
+  sweeptrace check traces/ --junit report.xml   # a test report for CI
 
 With --engine, the engine runs as a child process and answers every sweep
 over stdin/stdout (docs/ENGINE_PROTOCOL.md); its answers are compared with
@@ -57,7 +58,10 @@ trace matches (ties and divergences rounding explains included, unless
 --strict), 1 a divergence or a tunnel was found, 2
 something could not be checked (bad input, I/O error, no expectations, a
 fault of the engine), 3 a trace ends early, 125 the engine cannot be
-started (git bisect run skips that commit).")]
+started (git bisect run skips that commit). In GitHub Actions
+(GITHUB_ACTIONS=true) the first divergences and tunnels of each failing
+trace, and why a trace could not be checked, are also printed as ::error
+annotations (not with --json).")]
 pub struct Args {
     /// Trace files, or directories searched recursively for `*.mcap`.
     #[arg(value_name = "TRACE|DIR", required = true)]
@@ -108,6 +112,8 @@ pub struct Args {
     /// `--engine ./build/engine --against expected`.
     #[arg(long, value_enum, default_value_t = AgainstArg::Core, requires = "engine")]
     pub against: AgainstArg,
+    #[command(flatten)]
+    pub junit: super::junit::JunitArgs,
 }
 
 /// `--against`.
@@ -152,9 +158,11 @@ pub fn run(args: Args) -> anyhow::Result<RunOutcome> {
             engine_options(args.engine_timeout)?,
         )),
     };
-    let mut reports: Vec<TraceReport> = Vec::new();
+    let junit = args.junit.start()?;
+    let (mut reports, mut times): (Vec<TraceReport>, Vec<_>) = (Vec::new(), Vec::new());
     let mut rrd_error = false;
     for path in &traces {
+        let started = std::time::Instant::now();
         let report = match &engine {
             None => check_file(path, &options),
             Some((command, engine_options)) => {
@@ -171,8 +179,10 @@ pub fn run(args: Args) -> anyhow::Result<RunOutcome> {
                 }
             }
         };
+        times.push(started.elapsed());
         if !args.json {
             print!("{}", render_text(&report));
+            super::junit::print_github_annotations(&report);
         }
         if report.status == Status::Fail
             && let Some(dir) = &args.rrd_on_failure
@@ -200,6 +210,7 @@ pub fn run(args: Args) -> anyhow::Result<RunOutcome> {
             count(Status::Error)
         );
     }
+    super::junit::finish_check(junit, &reports, &times)?;
     let outcome = RunOutcome::worst(reports.iter().map(TraceReport::outcome));
     Ok(if rrd_error {
         RunOutcome::Error

@@ -17,6 +17,7 @@ Examples:
   sweeptrace conform --engine ./build/engine --case vertex.hit/1
   sweeptrace conform --list
   sweeptrace conform --case vertex.hit --write-trace cases.mcap
+  sweeptrace conform --engine ./build/engine --junit conform.xml
 
 Every case is a small scene and one sweep (sent to the engine as in `check
 --engine`, docs/ENGINE_PROTOCOL.md), grouped by the rule of
@@ -70,6 +71,8 @@ pub struct Args {
     /// Print one JSON document instead of text.
     #[arg(long)]
     pub json: bool,
+    #[command(flatten)]
+    pub junit: super::junit::JunitArgs,
 }
 
 /// Runs the suite, prints the report, returns the exit code.
@@ -124,6 +127,7 @@ pub fn run(args: Args) -> anyhow::Result<RunOutcome> {
         strict: !args.lenient,
         only: args.case.clone(),
     };
+    let junit = args.junit.start()?;
     let report = match conform::run(&command, engine, &cases, &options) {
         Ok(report) => report,
         Err(err) => {
@@ -135,6 +139,15 @@ pub fn run(args: Args) -> anyhow::Result<RunOutcome> {
         print!("{}", conform::render_json(&report));
     } else {
         print!("{}", conform::render_text(&report));
+    }
+    if let Some(junit) = junit {
+        let xml = conform::junit::conform_junit(
+            &report,
+            &options.tolerances,
+            Some(junit.elapsed()),
+            junit.options(),
+        );
+        junit.finish(&xml)?;
     }
     Ok(report.outcome())
 }

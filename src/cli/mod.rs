@@ -9,6 +9,7 @@ pub mod check;
 pub mod conform;
 pub mod diff;
 pub mod info;
+pub mod junit;
 pub mod record;
 pub mod replay;
 pub mod report;

@@ -9,6 +9,7 @@
 //! [`render_text`] and [`render_json`] are pure functions of it.
 
 mod cases;
+pub mod junit;
 
 pub use cases::{Case, RULES, Rule, cases};
 
@@ -44,6 +45,10 @@ pub struct CaseFailure {
     pub tie_order: Option<String>,
     /// A command that runs this case alone and explains it.
     pub repro: String,
+    /// Whether the case fails (a divergence rounding explains does not,
+    /// under `--lenient`). Not in the JSON, where the rule's counts say it.
+    #[serde(skip)]
+    pub fails: bool,
 }
 
 impl CaseFailure {
@@ -134,6 +139,11 @@ pub struct RuleReport {
     /// The first failing case (or, when none fails, the first fragile one).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub first_failure: Option<CaseFailure>,
+    /// Every case whose answer diverges, failing or fragile, in the order
+    /// they ran (`conform --junit-detail sweeps`). Not in the JSON, which
+    /// keeps the first failure.
+    #[serde(skip)]
+    pub divergent_cases: Vec<CaseFailure>,
 }
 
 impl RuleReport {
@@ -314,6 +324,7 @@ pub fn run(
                     failed: 0,
                     fragile: 0,
                     first_failure: None,
+                    divergent_cases: Vec::new(),
                 });
                 rules.last_mut().expect("just pushed")
             }
@@ -358,23 +369,26 @@ pub fn run(
             // A failure is shown before a divergence rounding explains.
             Some(first) => fails && first.is_excused() && !options.strict,
         };
+        let got = result.outcome_msg();
+        let mut divergence = divergence_details(&result, answer, got, fields, false);
+        divergence.reproduced = reproduced;
+        divergence.names_tie_member = tie_order.is_some();
+        let failure = CaseFailure {
+            case: case.id(),
+            what: case.what.to_string(),
+            divergence,
+            tie_order,
+            repro: format!(
+                "sweeptrace conform --engine {} --case {}",
+                shell_quote(&command.text),
+                case.id()
+            ),
+            fails,
+        };
         if replace {
-            let got = result.outcome_msg();
-            let mut divergence = divergence_details(&result, answer, got, fields, false);
-            divergence.reproduced = reproduced;
-            divergence.names_tie_member = tie_order.is_some();
-            rule.first_failure = Some(CaseFailure {
-                case: case.id(),
-                what: case.what.to_string(),
-                divergence,
-                tie_order,
-                repro: format!(
-                    "sweeptrace conform --engine {} --case {}",
-                    shell_quote(&command.text),
-                    case.id()
-                ),
-            });
+            rule.first_failure = Some(failure.clone());
         }
+        rule.divergent_cases.push(failure);
     }
     let run = answers.finish();
     if let Some(e) = run.error {
@@ -413,38 +427,11 @@ pub fn render_text(r: &ConformReport) -> String {
             if rule.cases == 1 { "case" } else { "cases" },
         );
     }
-    for rule in r.rules.iter().filter(|x| x.first_failure.is_some()) {
-        let Some(f) = &rule.first_failure else {
-            continue;
-        };
-        let _ = writeln!(s);
-        let _ = writeln!(
-            s,
-            "{} {}: {}",
-            if rule.failed > 0 { "FAIL" } else { "fragile" },
-            rule.rule,
-            rule.description
-        );
-        let _ = writeln!(
-            s,
-            "  first {}: {} ({})",
-            if rule.failed > 0 {
-                "failing case"
-            } else {
-                "fragile divergence"
-            },
-            f.case,
-            f.what
-        );
-        if let Some(t) = &f.tie_order {
-            let _ = writeln!(s, "  tie order: {t}");
+    for rule in &r.rules {
+        if let Some(section) = render_rule_failure(rule) {
+            let _ = writeln!(s);
+            s.push_str(&section);
         }
-        s.push_str(&render_divergence_as(
-            &f.divergence,
-            "  ",
-            Sides::EngineAndCore,
-        ));
-        let _ = writeln!(s, "  reproduce: {}", f.repro);
     }
     let _ = writeln!(s);
     let failing = r.rules.iter().filter(|x| x.failed > 0).count();
@@ -475,6 +462,50 @@ pub fn render_text(r: &ConformReport) -> String {
     if let Some(e) = &r.error {
         let _ = writeln!(s, "ERROR: {e}");
     }
+    s
+}
+
+/// A rule's first failing case (or first fragile divergence) explained,
+/// as [`render_text`] shows it; `None` when no case of the rule diverged.
+pub fn render_rule_failure(rule: &RuleReport) -> Option<String> {
+    let f = rule.first_failure.as_ref()?;
+    let mut s = String::new();
+    let _ = writeln!(
+        s,
+        "{} {}: {}",
+        if rule.failed > 0 { "FAIL" } else { "fragile" },
+        rule.rule,
+        rule.description
+    );
+    let _ = writeln!(
+        s,
+        "  first {}: {} ({})",
+        if rule.failed > 0 {
+            "failing case"
+        } else {
+            "fragile divergence"
+        },
+        f.case,
+        f.what
+    );
+    s.push_str(&render_case_failure(f, "  "));
+    Some(s)
+}
+
+/// One divergent case explained: the tie order when the engine named
+/// another member of the tie set, the divergence, the command that
+/// reproduces it; each line starts with `indent`.
+pub fn render_case_failure(f: &CaseFailure, indent: &str) -> String {
+    let mut s = String::new();
+    if let Some(t) = &f.tie_order {
+        let _ = writeln!(s, "{indent}tie order: {t}");
+    }
+    s.push_str(&render_divergence_as(
+        &f.divergence,
+        indent,
+        Sides::EngineAndCore,
+    ));
+    let _ = writeln!(s, "{indent}reproduce: {}", f.repro);
     s
 }
 

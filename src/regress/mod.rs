@@ -13,6 +13,8 @@
 //! - [`explain`](mod@explain): why a divergent sweep came out as it did;
 //! - [`check`](mod@check): a whole trace checked ([`check_file`]), and
 //!   [`render_text`] / [`render_json`] for its report;
+//! - [`junit`](mod@junit): check's reports as JUnit XML and GitHub Actions
+//!   annotations, for CI systems;
 //! - [`diff`](mod@diff): two traces, or one under two configurations;
 //! - [`bless`](mod@bless): a trace's expectations rewritten from the core;
 //! - [`repro`]: one sweep taken out of its trace, bit-exactly: a minimal
@@ -27,6 +29,7 @@ pub mod engine_check;
 pub mod explain;
 pub mod infer;
 pub mod judge;
+pub mod junit;
 mod render;
 pub mod repro;
 
@@ -48,7 +51,7 @@ pub use explain::{ExpectedTest, expected_tests, explain_outcome, explained_recor
 pub use infer::{Inferred, Spread, infer};
 pub use judge::{Agreement, Perturbation, Reproduced, agreement, agreement_of, perturbations};
 pub use render::{
-    Sides, render_divergence, render_divergence_as, render_json, render_text, value_text,
-    value_text_exact, values_text,
+    Sides, divergence_line, render_divergence, render_divergence_as, render_json, render_text,
+    sides_of, value_text, value_text_exact, values_text,
 };
 pub use repro::{HexInputs, ReproCase, ReproError, SweepInputs, TraceSweep, find_sweep};

@@ -183,15 +183,54 @@ pub fn render_divergence_as(d: &Divergence, indent: &str, sides: Sides) -> Strin
     s
 }
 
+/// One divergence on one line: the sweep, each differing field's two
+/// sides, and what rounding explains when it does (`frame 2, ball 0: kind
+/// expected edge, got none; alpha expected 0.4, got 1`). The summary CI
+/// reports show ([`super::junit`]).
+pub fn divergence_line(d: &Divergence, sides: Sides) -> String {
+    let fields = d
+        .fields
+        .iter()
+        .map(|f| {
+            let (expected, got) = values_text(&f.expected, &f.got);
+            let detail = f
+                .detail
+                .as_ref()
+                .map_or_else(String::new, |x| format!(" ({x})"));
+            format!(
+                "{} {} {expected}, {} {got}{detail}",
+                f.field,
+                sides.expected(),
+                sides.got()
+            )
+        })
+        .collect::<Vec<_>>()
+        .join("; ");
+    let mut s = format!("frame {}, ball {}: {fields}", d.frame, d.ball);
+    if let Some(r) = &d.reproduced {
+        let _ = write!(
+            s,
+            "; rounding explains it: {}",
+            r.text(sides.answer(), sides.other_answer())
+        );
+    }
+    s
+}
+
+/// Who the two sides of a report's divergences are.
+pub fn sides_of(r: &TraceReport) -> Sides {
+    match &r.engine {
+        None => Sides::ExpectedAndCore,
+        Some(e) if e.against == super::Against::Expected => Sides::ExpectedAndEngine,
+        Some(_) => Sides::EngineAndCore,
+    }
+}
+
 /// One line of a trace's status, then (when it failed) the first
 /// divergences in detail.
 pub fn render_text(r: &TraceReport) -> String {
     let mut s = String::new();
-    let sides = match &r.engine {
-        None => Sides::ExpectedAndCore,
-        Some(e) if e.against == super::Against::Expected => Sides::ExpectedAndEngine,
-        Some(_) => Sides::EngineAndCore,
-    };
+    let sides = sides_of(r);
     let mut counts = format!(
         "{} sweeps, {} compared, {} without expectation, {} expectations without a sweep",
         r.sweeps, r.compared, r.sweeps_without_expectation, r.expectations_without_sweep

@@ -13,6 +13,9 @@
 //! - [`explain`](mod@explain): why a divergent sweep came out as it did;
 //! - [`check`](mod@check): a whole trace checked ([`check_file`]), and
 //!   [`render_text`] / [`render_json`] for its report;
+//! - [`config`]: `check`'s suite configuration, the `sweeptrace.toml`
+//!   files beside the traces, resolved key by key with where each setting
+//!   came from ([`config::resolve`]);
 //! - [`diff`](mod@diff): two traces, or one under two configurations;
 //! - [`bless`](mod@bless): a trace's expectations rewritten from the core;
 //! - [`repro`]: one sweep taken out of its trace, bit-exactly: a minimal
@@ -21,6 +24,7 @@
 pub mod bless;
 pub mod check;
 pub mod compare;
+pub mod config;
 pub mod decision;
 pub mod diff;
 pub mod engine_check;

@@ -12,6 +12,8 @@ use crate::ensure;
 use crate::os;
 use crate::support::run_bin_in;
 use crate::trial;
+use sweeptrace::regress::config::{ConfigFile, Overrides, Source, resolve};
+use sweeptrace::regress::{Field, FieldSet, Tolerances};
 
 pub fn tests() -> Vec<Trial> {
     vec![
@@ -22,6 +24,7 @@ pub fn tests() -> Vec<Trial> {
         trial!(bad_key_is_an_error_with_file_and_line),
         trial!(bad_values_are_errors_with_file_and_line),
         trial!(repository_traces_and_examples_pass_with_no_options),
+        trial!(regression_md_example_is_a_valid_file),
     ]
 }
 
@@ -187,6 +190,9 @@ fn command_line_overrides_the_file() -> Result<(), String> {
             && setting_line(&out, "allow_tunnels")?.ends_with("# command line"),
         "--strict=false: exit {code}: {out}{err}"
     );
+    // A bare flag takes no value: the path after it is a path.
+    let (code, out, err) = run_bin_in(&repo, os!["check", "--strict", "suite"])?;
+    ensure!(code == 0, "--strict: exit {code}: {out}{err}");
     Ok(())
 }
 
@@ -310,6 +316,43 @@ fn repository_traces_and_examples_pass_with_no_options() -> Result<(), String> {
         code == 0
             && setting_line(&out, "tolerances.alpha")?.ends_with("# examples/sweeptrace.toml:14"),
         "exit {code}: {out}{err}"
+    );
+    Ok(())
+}
+
+/// The full example of docs/REGRESSION.md parses, and means what the text
+/// around it says.
+fn regression_md_example_is_a_valid_file() -> Result<(), String> {
+    let doc =
+        std::fs::read_to_string(root().join("docs/REGRESSION.md")).map_err(|e| e.to_string())?;
+    let start = doc
+        .find("```toml\n# traces/sweeptrace.toml")
+        .ok_or("no example in docs/REGRESSION.md")?
+        + "```toml\n".len();
+    let end = start + doc[start..].find("```").ok_or("unterminated example")?;
+    let file = ConfigFile::parse(&doc[start..end], Path::new("traces/sweeptrace.toml"))
+        .map_err(|e| e.to_string())?;
+    let files = std::slice::from_ref(&file);
+    let none = Overrides::default();
+    // Its top level spells out the defaults.
+    let plain = resolve(files, Path::new("traces/a.mcap"), &none);
+    ensure!(plain.tolerances() == Tolerances::default(), "{plain:?}");
+    ensure!(
+        !plain.strict.value && !plain.allow_tunnels.value,
+        "{plain:?}"
+    );
+    let rapier = resolve(files, Path::new("traces/rapier/a.mcap"), &none);
+    ensure!(
+        rapier.alpha.value == 1e-5
+            && rapier.contact.value == 1e-5
+            && !rapier.fields.value.contains(Field::Normal)
+            && rapier.fields.value != FieldSet::ALL,
+        "{rapier:?}"
+    );
+    let legacy = resolve(files, Path::new("traces/old/deeper/legacy_1.mcap"), &none);
+    ensure!(
+        legacy.strict.value && matches!(legacy.strict.source, Source::File { .. }),
+        "{legacy:?}"
     );
     Ok(())
 }

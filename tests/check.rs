@@ -2,10 +2,9 @@
 //!
 //! Every `*.mcap` under `traces/` and `examples/rapier/` (found at run
 //! time, so adding a trace needs no code) is a test case of its own, checked
-//! with the same library code as `sweeptrace check`; a trace with a
-//! `NAME.check-flags` file beside it (one line of `check` options, for a
-//! trace recorded by another engine, such as the Rapier sample) is checked
-//! by the binary with those options.
+//! with the same library code as `sweeptrace check`, with the settings its
+//! `sweeptrace.toml` files give it (for a trace recorded by another engine,
+//! such as the Rapier sample: `examples/sweeptrace.toml`).
 //!
 //! The fixture `tests/fixtures/wrong_engine_config.mcap` is made by the
 //! ignored generator below, from the project's own writer:
@@ -17,13 +16,13 @@
 
 use std::borrow::Cow;
 use std::collections::BTreeMap;
-use std::ffi::{OsStr, OsString};
 use std::io::Cursor;
 use std::path::{Path, PathBuf};
 
 use libtest_mimic::Trial;
 use sweeptrace::core::{Facing, Kind};
 use sweeptrace::regress::bless_bytes;
+use sweeptrace::regress::config;
 use sweeptrace::regress::{
     CheckOptions, Field, FieldSet, Status, Tolerances, check_file, check_reader, compare,
     find_traces, render_json, render_text,
@@ -48,7 +47,7 @@ pub fn tests() -> Vec<Trial> {
         trial!(compare_nan_never_matches),
         trial!(compare_only_selected_fields),
         trial!(check_fields_option_binary),
-        trial!(rapier_sample_needs_its_check_flags),
+        trial!(rapier_sample_needs_its_settings_file),
         trial!(differences_below_the_shown_digits_are_shown_in_full),
         trial!(blessed_trace_passes),
         trial!(wrong_engine_config_fixture_fails_with_frame_and_reason),
@@ -90,32 +89,16 @@ fn trace_trials() -> Vec<Trial> {
                     .display()
                     .to_string();
                 trial(&format!("check::trace::{name}"), move || {
-                    if let Some(flags) = check_flags(&path)? {
-                        let mut args = vec![OsString::from("check"), path.clone().into()];
-                        args.extend(flags.into_iter().map(OsString::from));
-                        let args: Vec<&OsStr> = args.iter().map(OsString::as_os_str).collect();
-                        let (code, out, err) = run_bin(&args)?;
-                        ensure!(code == 0, "exit {code}: {out}{err}");
-                        return Ok(());
-                    }
-                    let report = check_file(&path, &CheckOptions::default());
+                    let settings = config::settings_for(&path, &config::Overrides::default())
+                        .map_err(|e| e.to_string())?;
+                    let report =
+                        check_file(&path, &settings.check_options(CheckOptions::default()));
                     ensure!(report.status == Status::Ok, "{}", render_text(&report));
                     Ok(())
                 })
             })
             .collect(),
         Err(e) => vec![trial("check::trace::discovery", move || Err::<(), _>(e))],
-    }
-}
-
-/// The `check` options a sample trace is checked with: the words of
-/// `NAME.check-flags` beside `NAME.mcap`, or `None` when there is none.
-fn check_flags(trace: &Path) -> Result<Option<Vec<String>>, String> {
-    let sidecar = trace.with_extension("check-flags");
-    match std::fs::read_to_string(&sidecar) {
-        Ok(text) => Ok(Some(text.split_whitespace().map(str::to_string).collect())),
-        Err(e) if e.kind() == std::io::ErrorKind::NotFound => Ok(None),
-        Err(e) => Err(format!("{}: {e}", sidecar.display())),
     }
 }
 
@@ -361,35 +344,40 @@ fn check_fields_option_binary() -> Result<(), String> {
     Ok(())
 }
 
-/// The Rapier-recorded sample fails with the default options, and without
-/// either part of its `.check-flags` (Rapier reports the contact normal at
-/// an edge hit; its α and witness points are accurate to about 1e-5), so
-/// every flag is needed and the test of the sample can fail.
-fn rapier_sample_needs_its_check_flags() -> Result<(), String> {
+/// The Rapier-recorded sample passes with no options, by the settings of
+/// `examples/sweeptrace.toml`, and fails without that file or either part
+/// of its settings (Rapier reports the contact normal at an edge hit; its
+/// α and witness points are accurate to about 1e-5), so every setting is
+/// needed and the test of the sample can fail.
+fn rapier_sample_needs_its_settings_file() -> Result<(), String> {
     let trace = rapier_sample();
-    let flags =
-        check_flags(&trace)?.ok_or("examples/rapier/rapier_mini_golf.check-flags is missing")?;
+    let settings =
+        config::settings_for(&trace, &config::Overrides::default()).map_err(|e| e.to_string())?;
+    let tolerances = settings.tolerances();
     ensure!(
-        flags
-            == [
-                "--fields",
-                "kind,triangle,feature,alpha,contact",
-                "--tolerance",
-                "1e-5",
-                "--contact-tolerance",
-                "1e-5"
-            ],
-        "the flags changed ({flags:?}): update this test"
+        tolerances.fields.names() == "kind,triangle,feature,alpha,contact"
+            && tolerances.alpha == 1e-5
+            && tolerances.contact == 1e-5
+            && tolerances.normal_degrees == Tolerances::default().normal_degrees
+            && !settings.strict.value
+            && !settings.allow_tunnels.value,
+        "the settings changed ({settings:?}): update this test"
     );
+    for source in [&settings.fields.source, &settings.alpha.source] {
+        ensure!(
+            matches!(source, config::Source::File { file, .. } if file == "examples/sweeptrace.toml"),
+            "{source:?}"
+        );
+    }
     let (code, out, err) = run_bin(os!["check", trace.as_os_str()])?;
+    ensure!(code == 0, "with its settings file: exit {code}: {out}{err}");
+    let (code, out, err) = run_bin(os!["check", "--no-config", trace.as_os_str()])?;
     ensure!(code == 1, "default options: exit {code}: {out}{err}");
     let (code, out, err) = run_bin(os![
         "check",
         trace.as_os_str(),
-        "--tolerance",
-        "1e-5",
-        "--contact-tolerance",
-        "1e-5"
+        "--fields",
+        "kind,triangle,feature,alpha,normal,contact",
     ])?;
     ensure!(
         code == 1
@@ -397,11 +385,14 @@ fn rapier_sample_needs_its_check_flags() -> Result<(), String> {
             && out.contains("normal: expected"),
         "every field: exit {code}: {out}{err}"
     );
+    // The command line overrides the file, key by key.
     let (code, out, err) = run_bin(os![
         "check",
         trace.as_os_str(),
-        "--fields",
-        "kind,triangle,feature,alpha,contact"
+        "--tolerance",
+        "1e-6",
+        "--contact-tolerance",
+        "1e-6"
     ])?;
     ensure!(
         code == 1 && out.contains("alpha: expected"),
@@ -1044,7 +1035,15 @@ fn generate_wrong_engine_config() -> Result<(), String> {
 /// with other numbers, not a question about the margin.
 fn differences_below_the_shown_digits_are_shown_in_full() -> Result<(), String> {
     let trace = rapier_sample();
-    let (code, out, err) = run_bin(os!["check", trace.as_os_str(), "--max-details", "8"])?;
+    // Without its settings file (examples/sweeptrace.toml), which excuses
+    // those differences.
+    let (code, out, err) = run_bin(os![
+        "check",
+        "--no-config",
+        trace.as_os_str(),
+        "--max-details",
+        "8"
+    ])?;
     ensure!(code == 1, "exit {code}: {out}{err}");
     let mut fields = 0;
     for line in out.lines().map(str::trim) {

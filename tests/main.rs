@@ -32,6 +32,7 @@ mod record;
 mod replay;
 mod repro;
 mod scanned;
+mod suite_config;
 mod support;
 mod trace_io;
 mod tunnel;
@@ -102,6 +103,7 @@ fn main() {
     trials.extend(core_decisions::tests());
     trials.extend(core_random::tests());
     trials.extend(check::tests());
+    trials.extend(suite_config::tests());
     trials.extend(trace_io::tests());
     trials.extend(replay::tests());
     trials.extend(record::tests());

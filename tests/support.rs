@@ -38,6 +38,23 @@ pub fn run_bin(args: &[&std::ffi::OsStr]) -> Result<(i32, String, String), Strin
     ))
 }
 
+/// [`run_bin`] with `dir` as the working directory.
+pub fn run_bin_in(
+    dir: &std::path::Path,
+    args: &[&std::ffi::OsStr],
+) -> Result<(i32, String, String), String> {
+    let out = bin()
+        .args(args)
+        .current_dir(dir)
+        .output()
+        .map_err(|e| format!("running sweeptrace in {}: {e}", dir.display()))?;
+    Ok((
+        out.status.code().unwrap_or(-1),
+        String::from_utf8_lossy(&out.stdout).into_owned(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    ))
+}
+
 /// `&[&OsStr]` of the arguments, for [`run_bin`].
 #[macro_export]
 macro_rules! os {

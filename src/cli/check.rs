@@ -61,7 +61,25 @@ fault of the engine), 3 a trace ends early, 125 the engine cannot be
 started (git bisect run skips that commit). In GitHub Actions
 (GITHUB_ACTIONS=true) the first divergences and tunnels of each failing
 trace, and why a trace could not be checked, are also printed as ::error
-annotations (not with --json).")]
+annotations (not with --json).
+
+Settings file: a sweeptrace.toml in a trace's folder or in any parent, up to
+the repository root (the first folder holding .git), sets the tolerances,
+fields, strict and allow_tunnels of the traces below it; a nearer file
+overrides a farther one key by key, and its [[traces]] blocks apply to the
+traces their match glob selects (relative to the file's folder), the last
+matching block winning. For example:
+
+  fields = [\"kind\", \"alpha\"]
+  [tolerances]
+  alpha = 1e-5
+  [[traces]]
+  match = \"rapier/*.mcap\"
+  tolerances = { contact = 1e-5 }
+
+The command line overrides the files (--strict=false undoes strict = true);
+--print-config shows each trace's settings and where each came from;
+--no-config ignores the files (docs/REGRESSION.md).")]
 pub struct Args {
     /// Trace files, or directories searched recursively for `*.mcap`.
     #[arg(value_name = "TRACE|DIR", required = true)]
@@ -77,14 +95,24 @@ pub struct Args {
     /// divergence whose expected answer the core gives under a small
     /// perturbation of the inputs is counted and shown apart and, without
     /// --strict, does not fail the check; any other divergence fails.
-    #[arg(long)]
-    pub strict: bool,
+    /// `--strict=false` overrides a settings file's `strict = true`.
+    #[arg(long, value_name = "BOOL", num_args = 0..=1, require_equals = true, default_missing_value = "true")]
+    pub strict: Option<bool>,
     /// Count and list tunnels (a ball's centre through a triangle, front to
     /// back, during a sweep or between two sweeps of a ball) without failing
     /// the check. Without it a tunnel fails the check: it is a bug of the
     /// engine that recorded the trace, whatever its expectations say.
+    /// `--allow-tunnels=false` overrides a settings file's `allow_tunnels = true`.
+    #[arg(long, value_name = "BOOL", num_args = 0..=1, require_equals = true, default_missing_value = "true")]
+    pub allow_tunnels: Option<bool>,
+    /// Ignore the sweeptrace.toml files: the defaults and the command line only.
     #[arg(long)]
-    pub allow_tunnels: bool,
+    pub no_config: bool,
+    /// Print each trace's settings and where each came from (`default`,
+    /// `FILE:LINE`, `command line`), and exit without checking (with
+    /// --json, as JSON).
+    #[arg(long)]
+    pub print_config: bool,
     /// Also give each divergence's inputs as hexadecimal floating point
     /// (`0x1.5555555555555p-2`), besides the shortest round-trip decimals.
     #[arg(long)]
@@ -127,7 +155,11 @@ pub enum AgainstArg {
 
 /// Checks every trace, prints the reports, returns the exit code.
 pub fn run(args: Args) -> anyhow::Result<RunOutcome> {
-    let tolerances = args.tolerances.to_tolerances()?;
+    let overrides = sweeptrace::regress::config::Overrides {
+        strict: args.strict,
+        allow_tunnels: args.allow_tunnels,
+        ..args.tolerances.to_overrides()?
+    };
     let traces = find_traces(&args.paths).map_err(anyhow::Error::msg)?;
     if traces.is_empty() {
         bail!(
@@ -139,17 +171,22 @@ pub fn run(args: Args) -> anyhow::Result<RunOutcome> {
                 .join(", ")
         );
     }
+    let settings = super::check_config::settings(&traces, &overrides, args.no_config)?;
+    if args.print_config {
+        print!(
+            "{}",
+            super::check_config::render(&traces, &settings, args.json)
+        );
+        return Ok(RunOutcome::Success);
+    }
     if let Some(dir) = &args.rrd_on_failure {
         std::fs::create_dir_all(dir)
             .with_context(|| format!("creating the directory {}", dir.display()))?;
     }
     let options = CheckOptions {
-        tolerances,
         max_details: args.max_details,
-        strict: args.strict,
-        fail_on_tunnel: !args.allow_tunnels,
         hex: args.hex,
-        replay: ReplayOptions::default(),
+        ..CheckOptions::default()
     };
     let engine = match &args.engine {
         None => None,
@@ -161,8 +198,9 @@ pub fn run(args: Args) -> anyhow::Result<RunOutcome> {
     let junit = args.junit.start()?;
     let (mut reports, mut times): (Vec<TraceReport>, Vec<_>) = (Vec::new(), Vec::new());
     let mut rrd_error = false;
-    for path in &traces {
+    for (path, settings) in traces.iter().zip(&settings) {
         let started = std::time::Instant::now();
+        let options = settings.check_options(options);
         let report = match &engine {
             None => check_file(path, &options),
             Some((command, engine_options)) => {

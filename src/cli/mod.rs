@@ -6,6 +6,7 @@ use sweeptrace::run::RunOutcome;
 
 pub mod bless;
 pub mod check;
+pub mod check_config;
 pub mod conform;
 pub mod diff;
 pub mod info;
@@ -65,18 +66,19 @@ pub fn run(cli: Cli) -> anyhow::Result<RunOutcome> {
     }
 }
 
-/// The comparison tolerances of `check` and `diff`.
+/// The comparison tolerances of `check` and `diff`. A value not given is
+/// `None`: the default, or for `check` a `sweeptrace.toml`'s value.
 #[derive(Debug, clap::Args)]
 pub struct ToleranceArgs {
-    /// Absolute tolerance on α.
-    #[arg(long, value_name = "A", default_value_t = sweeptrace::regress::DEFAULT_ALPHA_TOLERANCE)]
-    pub tolerance: f64,
-    /// Angular tolerance on the normal, in degrees.
-    #[arg(long, value_name = "DEG", default_value_t = sweeptrace::regress::DEFAULT_NORMAL_TOLERANCE_DEGREES)]
-    pub normal_tolerance: f64,
-    /// Distance tolerance on the contact point, in scene units.
-    #[arg(long, value_name = "D", default_value_t = sweeptrace::regress::DEFAULT_CONTACT_TOLERANCE)]
-    pub contact_tolerance: f64,
+    /// Absolute tolerance on α [default: 1e-6].
+    #[arg(long, value_name = "A")]
+    pub tolerance: Option<f64>,
+    /// Angular tolerance on the normal, in degrees [default: 0.01].
+    #[arg(long, value_name = "DEG")]
+    pub normal_tolerance: Option<f64>,
+    /// Distance tolerance on the contact point, in scene units [default: 1e-6].
+    #[arg(long, value_name = "D")]
+    pub contact_tolerance: Option<f64>,
     /// Compare only these fields of each expectation (comma-separated:
     /// kind, triangle, feature, alpha, normal, contact; default: every
     /// field the expectation holds). For engines whose answers differ from
@@ -87,20 +89,40 @@ pub struct ToleranceArgs {
 }
 
 impl ToleranceArgs {
-    /// The library's tolerances, validated.
+    /// The library's tolerances (the defaults where not given), validated.
     pub fn to_tolerances(&self) -> anyhow::Result<sweeptrace::regress::Tolerances> {
+        use sweeptrace::regress::{
+            DEFAULT_ALPHA_TOLERANCE, DEFAULT_CONTACT_TOLERANCE, DEFAULT_NORMAL_TOLERANCE_DEGREES,
+        };
         let tolerances = sweeptrace::regress::Tolerances {
-            alpha: self.tolerance,
-            normal_degrees: self.normal_tolerance,
-            contact: self.contact_tolerance,
-            fields: if self.fields.is_empty() {
-                sweeptrace::regress::FieldSet::ALL
-            } else {
-                sweeptrace::regress::FieldSet::of(&self.fields)
-            },
+            alpha: self.tolerance.unwrap_or(DEFAULT_ALPHA_TOLERANCE),
+            normal_degrees: self
+                .normal_tolerance
+                .unwrap_or(DEFAULT_NORMAL_TOLERANCE_DEGREES),
+            contact: self.contact_tolerance.unwrap_or(DEFAULT_CONTACT_TOLERANCE),
+            fields: self
+                .field_set()
+                .unwrap_or(sweeptrace::regress::FieldSet::ALL),
         };
         tolerances.validate().map_err(anyhow::Error::msg)?;
         Ok(tolerances)
+    }
+
+    /// The values given, as the command line's layer of `check`'s settings
+    /// (validated).
+    pub fn to_overrides(&self) -> anyhow::Result<sweeptrace::regress::config::Overrides> {
+        self.to_tolerances()?;
+        Ok(sweeptrace::regress::config::Overrides {
+            alpha: self.tolerance,
+            normal_degrees: self.normal_tolerance,
+            contact: self.contact_tolerance,
+            fields: self.field_set(),
+            ..Default::default()
+        })
+    }
+
+    fn field_set(&self) -> Option<sweeptrace::regress::FieldSet> {
+        (!self.fields.is_empty()).then(|| sweeptrace::regress::FieldSet::of(&self.fields))
     }
 }
 

@@ -15,6 +15,9 @@
 //!   [`render_text`] / [`render_json`] for its report;
 //! - [`junit`](mod@junit): check's reports as JUnit XML and GitHub Actions
 //!   annotations, for CI systems;
+//! - [`config`]: `check`'s suite configuration, the `sweeptrace.toml`
+//!   files beside the traces, resolved key by key with where each setting
+//!   came from ([`config::resolve`]);
 //! - [`diff`](mod@diff): two traces, or one under two configurations;
 //! - [`bless`](mod@bless): a trace's expectations rewritten from the core;
 //! - [`repro`]: one sweep taken out of its trace, bit-exactly: a minimal
@@ -23,6 +26,7 @@
 pub mod bless;
 pub mod check;
 pub mod compare;
+pub mod config;
 pub mod decision;
 pub mod diff;
 pub mod engine_check;

@@ -160,6 +160,19 @@ impl ReplayOptions {
         )
     }
 
+    /// The frame and ball filters in words (`frames 100..200, ball 0`), or
+    /// `None` when there is none.
+    pub fn filter_text(&self) -> Option<String> {
+        let mut parts = Vec::new();
+        if self.frames != FrameRange::default() {
+            parts.push(format!("frames {}", self.frames));
+        }
+        if let Some(b) = self.ball {
+            parts.push(format!("ball {b}"));
+        }
+        (!parts.is_empty()).then(|| parts.join(", "))
+    }
+
     /// Whether the frame and ball filters keep the sweep of `ball` at `frame`.
     pub fn wants(&self, frame: u64, ball: u32) -> bool {
         self.frames.contains(frame) && self.ball.is_none_or(|b| b == ball)

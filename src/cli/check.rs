@@ -126,10 +126,6 @@ pub fn run(args: Args) -> anyhow::Result<RunOutcome> {
                 .join(", ")
         );
     }
-    if let Some(dir) = &args.rrd_on_failure {
-        std::fs::create_dir_all(dir)
-            .with_context(|| format!("creating the directory {}", dir.display()))?;
-    }
     let options = CheckOptions {
         tolerances,
         max_details: args.max_details,
@@ -222,6 +218,11 @@ fn write_failure_rrd(trace: &Path, dir: &Path, report: &TraceReport) -> anyhow::
         .map(|s| s.to_string_lossy().into_owned())
         .unwrap_or_else(|| "trace".to_string());
     let target = dir.join(format!("{stem}.rrd"));
+    // Created with the first recording: a check that writes none leaves
+    // no directory behind.
+    std::fs::create_dir_all(dir)
+        .with_context(|| format!("creating the directory {}", dir.display()))?;
+    super::warn_unfinished(&target);
     let temp = PendingFile::new(&target)
         .with_context(|| format!("creating a temporary file in {}", dir.display()))?;
     let options = ReplayOptions {

@@ -69,6 +69,9 @@ pub struct TraceInfo {
     pub expected_by_kind: BTreeMap<String, u64>,
     /// What the reader saw: channels, chunks, compression, bytes, metadata.
     pub stats: ReadStats,
+    /// The size of the file, when known (the reader's `stats.bytes` counts
+    /// the bytes read, fewer when reading stopped early).
+    pub file_bytes: Option<u64>,
     /// The error that ended reading early, if any (the rest of the report
     /// covers the messages before it).
     pub error: Option<String>,
@@ -97,6 +100,7 @@ pub fn collect<R: Read>(mut reader: TraceReader<R>) -> (TraceInfo, Option<TraceE
         expected: 0,
         expected_by_kind: BTreeMap::new(),
         stats: ReadStats::default(),
+        file_bytes: None,
         error: None,
     };
     let mut error = None;
@@ -173,7 +177,11 @@ fn seconds(nanos: u64) -> String {
 pub fn render_text(info: &TraceInfo) -> String {
     let mut out = String::new();
     let s = &info.stats;
-    let compression = if s.compression.is_empty() {
+    let compression = if s.compression.is_empty() && info.error.is_some() {
+        // Reading stopped before a complete chunk: whether the rest of the
+        // file holds chunks is not known.
+        "no complete chunk read".to_string()
+    } else if s.compression.is_empty() {
         "not chunked".to_string()
     } else {
         let list: Vec<&str> = s.compression.iter().map(String::as_str).collect();
@@ -182,8 +190,12 @@ pub fn render_text(info: &TraceInfo) -> String {
     let _ = writeln!(out, "trace:       {}", info.file);
     let _ = writeln!(
         out,
-        "file:        {} bytes, {compression}, summary {}",
-        s.bytes,
+        "file:        {}, {compression}, summary {}",
+        match info.file_bytes {
+            Some(size) if size != s.bytes => format!("{size} bytes ({} read)", s.bytes),
+            Some(size) => format!("{size} bytes"),
+            None => format!("{} bytes read", s.bytes),
+        },
         if s.has_summary { "present" } else { "absent" }
     );
     if s.read_through_chunk_indexes {

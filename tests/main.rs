@@ -17,6 +17,7 @@ mod error_messages;
 mod faults;
 mod foxglove;
 mod fuzz_corpus;
+mod interrupts;
 mod oracle;
 mod out_of_order;
 mod outputs;
@@ -117,5 +118,6 @@ fn main() {
     trials.extend(error_messages::tests());
     trials.extend(out_of_order::tests());
     trials.extend(fuzz_corpus::tests());
+    trials.extend(interrupts::tests());
     libtest_mimic::run(&args, trials).exit();
 }

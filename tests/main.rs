@@ -17,6 +17,7 @@ mod error_messages;
 mod faults;
 mod foxglove;
 mod fuzz_corpus;
+mod help;
 mod interrupts;
 mod oracle;
 mod out_of_order;
@@ -119,5 +120,6 @@ fn main() {
     trials.extend(out_of_order::tests());
     trials.extend(fuzz_corpus::tests());
     trials.extend(interrupts::tests());
+    trials.extend(help::tests());
     libtest_mimic::run(&args, trials).exit();
 }

@@ -15,8 +15,8 @@ use sweeptrace::run::RunOutcome;
 #[derive(Debug, clap::Args)]
 #[command(after_help = "\
 Examples:
-  sweeptrace bless run.mcap -o run.blessed.mcap
-  sweeptrace bless traces/bowl.mcap --in-place
+  sweeptrace bless traces/record_mini_golf.mcap -o golf.mcap
+  sweeptrace bless golf.mcap --in-place         # the file the first example wrote
 
 Each sweep gets the outcome the core computes with the scene's own margin
 and facing rule. The output is written under a temporary name next to it

@@ -25,11 +25,13 @@ const RRD_CONTEXT_FRAMES: u64 = 10;
 #[command(after_help = "\
 Examples:
   sweeptrace check traces/                     # every *.mcap under traces/
-  sweeptrace check run.mcap --tolerance 1e-4 --normal-tolerance 0.5
-  sweeptrace check traces/ --json --rrd-on-failure /tmp/failures
-  sweeptrace check traces/ --engine 'python3 examples/engines/sweep_engine.py'
-  git bisect run sweeptrace check traces/ --engine ./build/engine
-  sweeptrace check rapier.mcap --fields kind,alpha --tolerance 1e-5
+  sweeptrace check traces/record_mini_golf.mcap --tolerance 1e-4 --normal-tolerance 0.5
+  sweeptrace check tests/fixtures/wrong_engine_config.mcap --json --rrd-on-failure failures
+  sweeptrace check traces/record_cube_corner_margin.mcap --engine 'python3 examples/engines/sweep_engine.py'
+  sweeptrace check examples/rapier/rapier_mini_golf.mcap --fields kind,alpha --tolerance 1e-5
+
+Under `git bisect run sweeptrace check traces/ --engine ./build/engine`,
+an engine that cannot be started skips the commit (exit 125).
 
 With --engine, the engine runs as a child process and answers every sweep
 over stdin/stdout (docs/ENGINE_PROTOCOL.md); its answers are compared with

@@ -13,8 +13,8 @@ use sweeptrace::trace::TraceEvent;
 #[command(after_help = "\
 Examples:
   sweeptrace conform --engine 'python3 examples/engines/sweep_engine.py'
-  sweeptrace conform --engine ./build/engine --json
-  sweeptrace conform --engine ./build/engine --case vertex.hit/1
+  sweeptrace conform --engine 'python3 examples/engines/trivial_engine.py' --json
+  sweeptrace conform --engine 'python3 examples/engines/sweep_engine.py' --case vertex.hit/1
   sweeptrace conform --list
   sweeptrace conform --case vertex.hit --write-trace cases.mcap
 

@@ -20,9 +20,13 @@ use sweeptrace::trace::TraceReader;
 #[derive(Debug, clap::Args)]
 #[command(after_help = "\
 Examples:
-  sweeptrace diff old.mcap new.mcap
-  sweeptrace diff run.mcap run.mcap --facing-b strict     # what the strict rule changes
-  sweeptrace diff run.mcap run.mcap --margin-b 0.01 --json
+  sweeptrace diff traces/record_box_strict.mcap traces/record_box_strict.mcap --facing-b non_strict
+  sweeptrace diff traces/record_mini_golf.mcap traces/record_mini_golf.mcap --margin-b 0.01 --json
+  sweeptrace diff traces/record_mini_golf.mcap tests/fixtures/wrong_engine_config.mcap --allow-different-scenes
+
+The first shows what the non-strict rule changes in a trace recorded with the
+strict one; before and after a change of the engine, `sweeptrace diff
+before.mcap after.mcap`.
 
 Sweeps are matched by (frame, ball), so the two traces must have the same
 scenes (vertex and triangle counts, geometry, margin and facing rule, scene

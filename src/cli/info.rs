@@ -13,7 +13,7 @@ use sweeptrace::trace::info::{collect, render_json, render_text};
 
 /// Arguments of `info`.
 #[derive(Debug, clap::Args)]
-#[command(after_help = "Example:\n  sweeptrace info run.mcap --json")]
+#[command(after_help = "Example:\n  sweeptrace info traces/record_mini_golf.mcap --json")]
 pub struct Args {
     /// The trace (an MCAP file).
     pub trace: PathBuf,

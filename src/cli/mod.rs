@@ -81,7 +81,7 @@ pub struct ToleranceArgs {
     /// field the expectation holds). For engines whose answers differ from
     /// the core's by design in the others: `--fields kind,alpha` for an
     /// engine that reports the contact normal, not the face normal.
-    #[arg(long, value_name = "FIELD,...", value_delimiter = ',')]
+    #[arg(long, value_name = "FIELD,...", value_delimiter = ',', value_parser = field_parser())]
     pub fields: Vec<sweeptrace::regress::Field>,
 }
 
@@ -101,6 +101,20 @@ impl ToleranceArgs {
         tolerances.validate().map_err(anyhow::Error::msg)?;
         Ok(tolerances)
     }
+}
+
+/// The parser of `--fields`: a name that is not a field is an error listing
+/// the valid ones (and the nearest, on a typo).
+fn field_parser() -> impl clap::builder::TypedValueParser<Value = sweeptrace::regress::Field> {
+    use clap::builder::TypedValueParser;
+    use strum::IntoEnumIterator;
+    let names: Vec<&'static str> = sweeptrace::regress::Field::iter()
+        .map(<&'static str>::from)
+        .collect();
+    clap::builder::PossibleValuesParser::new(names).try_map(|name: String| {
+        name.parse::<sweeptrace::regress::Field>()
+            .map_err(|_| format!("`{name}` is not a field"))
+    })
 }
 
 /// The recording id of a replay of `trace` for `purpose` (`replay`,

@@ -19,7 +19,7 @@ use sweeptrace::trace::write_trace_file;
 #[command(after_help = "Examples:\n  \
     sweeptrace record --scene mini_golf -o mini_golf.mcap\n  \
     sweeptrace record --scene terrain --terrain-cells 64 --balls 4 --seed 7 --frames 600 -o hills.mcap\n  \
-    sweeptrace record --mesh level.obj --radius 0.2 --position 0,0,5 --margin 0.01 -o level.mcap")]
+    sweeptrace record --mesh tests/fixtures/scanned/bunny_res4.obj --radius 0.005 --position 0,0.1,0.3 --margin 0.001 --frames 200 -o bunny.mcap")]
 pub struct Args {
     /// Built-in scene: `mini_golf` (green, walls, ramp, cup), `bowl`, `box`
     /// (closed, ball inside), `terrain` (height field, 100,352 triangles by
@@ -35,7 +35,7 @@ pub struct Args {
     /// 1 to 4096).
     #[arg(long, default_value_t = scenes::TERRAIN_DEFAULT_CELLS, value_name = "N")]
     pub terrain_cells: usize,
-    /// Output trace file [default: `<scene>.mcap`]. Written atomically: a
+    /// Output trace file [default: <scene>.mcap]. Written atomically: a
     /// failed run leaves no file behind.
     #[arg(short, long, value_name = "OUT")]
     pub output: Option<PathBuf>,

@@ -39,16 +39,22 @@ pub const DEFAULT_CONNECT_URL: &str = "rerun+http://127.0.0.1:9876/proxy";
 #[derive(Debug, clap::Args)]
 #[command(after_help = "\
 Examples:
-  sweeptrace replay traces/bowl.mcap                      # writes ./bowl.rrd
-  sweeptrace replay traces/bowl.mcap --spawn --frames 100..200 --detail candidates
-  sweeptrace replay traces/bowl.mcap --outcomes - --rrd /tmp/bowl.rrd --ball 0
-  sweeptrace replay traces/bowl.mcap --foxglove bowl.foxglove.mcap   # open in Foxglove
+  sweeptrace replay traces/record_mini_golf.mcap          # writes ./record_mini_golf.rrd
+  sweeptrace replay traces/record_mini_golf.mcap --frames 100..200 --detail candidates --rrd golf.rrd
+  sweeptrace replay traces/record_mini_golf.mcap --outcomes - --rrd golf.rrd --ball 0
+  sweeptrace replay traces/record_mini_golf.mcap --foxglove golf.foxglove.mcap   # open in Foxglove
 
-Without --outcomes, --rrd, --foxglove, --spawn or --connect the recording is
+To watch in a Rerun viewer, add --spawn (starts `rerun`, which must be on
+PATH) or --connect (streams to a viewer already running).
+
+A --frames or --ball filter that selects no sweep is an error naming the
+trace's balls and frames, and writes nothing; one that selects part says how
+many sweeps it kept. Without --outcomes, --rrd, --foxglove, --spawn or --connect the recording is
 written to <trace stem>.rrd in the current directory. The outputs combine:
 one replay can write outcomes, a Rerun recording and a Foxglove file. Files
 are written under a temporary name next to the target and renamed once
-complete.")]
+complete: an error (or Ctrl-C, SIGTERM) leaves none of them, only a trace
+that ends early (exit 3) keeps what was read before its end.")]
 pub struct Args {
     /// The trace (an MCAP file).
     #[arg(value_name = "TRACE")]

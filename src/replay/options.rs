@@ -25,10 +25,20 @@ pub enum Detail {
     /// normal); when nothing hits, the one test that came nearest
     /// ([`crate::core::explain::miss_distance`]) among the BVH candidates.
     #[default]
+    #[cfg_attr(
+        feature = "cli",
+        value(help = "The tests that report the primary collision (the primary test first, \
+                      then every other hit tied with it, which share the averaged normal); \
+                      when nothing hits, the one test that came nearest among the BVH candidates")
+    )]
     Primary,
     /// Every test of every triangle the BVH visited.
     Candidates,
     /// Every test of every triangle ([`crate::core::Broadphase::Exhaustive`]).
+    #[cfg_attr(
+        feature = "cli",
+        value(help = "Every test of every triangle (no broadphase)")
+    )]
     All,
 }
 

@@ -171,3 +171,17 @@ mod tests {
         assert_eq!(parse_f64("0x1p+1024"), None);
     }
 }
+
+/// `noun` or `noun`s for `n` of them (regular plurals; see [`counted`]).
+pub fn plural(n: u64, noun: &str) -> String {
+    if n == 1 {
+        noun.to_string()
+    } else {
+        format!("{noun}s")
+    }
+}
+
+/// `n` and the word for that many: `1 vertex`, `3 vertices`.
+pub fn counted(n: u64, one: &str, many: &str) -> String {
+    format!("{n} {}", if n == 1 { one } else { many })
+}

@@ -175,9 +175,13 @@ pub fn warn_unfinished(target: &std::path::Path) {
     }
     let names: Vec<String> = found.iter().map(|p| p.display().to_string()).collect();
     eprintln!(
-        "warning: {} unfinished temporary file(s) of {} from an interrupted earlier run \
+        "warning: {} of {} from an interrupted earlier run \
          (the target itself was not touched); remove them with: rm {}",
-        found.len(),
+        sweeptrace::numbers::counted(
+            found.len() as u64,
+            "unfinished temporary file",
+            "unfinished temporary files"
+        ),
         target.display(),
         names.join(" ")
     );

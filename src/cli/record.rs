@@ -130,9 +130,13 @@ pub fn run(args: Args) -> anyhow::Result<RunOutcome> {
             .map(|d| d.index.to_string())
             .collect();
         eprintln!(
-            "warning: scene `{}`: {} degenerate triangle(s) left out (first: {})",
+            "warning: scene `{}`: {} left out (first: {})",
             scene.name,
-            mesh.degenerate().len(),
+            sweeptrace::numbers::counted(
+                mesh.degenerate().len() as u64,
+                "degenerate triangle",
+                "degenerate triangles"
+            ),
             first.join(", ")
         );
     }
@@ -197,28 +201,29 @@ pub fn summary_paragraph(
     s: &SimSummary,
     file: &str,
 ) -> String {
+    use sweeptrace::numbers::counted;
     let mut text = format!(
-        "Recorded {} sweeps of {} ball(s) of radius {} over {} frames ({} trace frames with sub-steps) \
-         in scene `{scene}` ({triangles} triangles, margin {}, facing {}, seed {}): {} collisions \
-         ({} face, {} edge, {} vertex) and {} misses.",
-        s.sweeps,
-        options.balls,
+        "Recorded {} of {} of radius {} over {} ({} with sub-steps) in scene `{scene}` \
+         ({}, margin {}, facing {}, seed {}): {} ({} face, {} edge, {} vertex) and {}.",
+        counted(s.sweeps, "sweep", "sweeps"),
+        counted(u64::from(options.balls), "ball", "balls"),
         options.radius,
-        s.sim_frames,
-        s.trace_frames,
+        counted(s.sim_frames, "frame", "frames"),
+        counted(s.trace_frames, "trace frame", "trace frames"),
+        counted(triangles as u64, "triangle", "triangles"),
         options.margin,
         options.facing,
         options.seed,
-        s.collisions(),
+        counted(s.collisions(), "collision", "collisions"),
         s.face,
         s.edge,
         s.vertex,
-        s.none,
+        counted(s.none, "miss", "misses"),
     );
     if s.truncated > 0 {
         text.push_str(&format!(
-            " {} ball-frames ran out of sub-steps.",
-            s.truncated
+            " {} ran out of sub-steps.",
+            counted(s.truncated, "ball-frame", "ball-frames")
         ));
     }
     if !s.stopped.is_empty() {
@@ -229,7 +234,8 @@ pub fn summary_paragraph(
             .count();
         let bad = s.stopped.len() - left;
         text.push_str(&format!(
-            " {left} ball(s) left the play volume and stopped recording"
+            " {} left the play volume and stopped recording",
+            counted(left as u64, "ball", "balls")
         ));
         if bad > 0 {
             text.push_str(&format!(", {bad} stopped on a non-finite value"));

@@ -16,10 +16,10 @@ use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use sweeptrace::atomic::PendingFile;
 use sweeptrace::core::Facing;
 use sweeptrace::foxglove::{FoxgloveFile, FoxgloveOptions};
-use sweeptrace::numbers::{self, Rule};
+use sweeptrace::numbers::{self, Rule, plural};
 use sweeptrace::regress::Tolerances;
 use sweeptrace::replay::{
-    Detail, FrameRange, ReplayError, ReplayEvent, ReplayOptions, Selection, plural,
+    Detail, FrameRange, ReplayError, ReplayEvent, ReplayOptions, Selection,
     replay_events_parallel,
 };
 use sweeptrace::run::RunOutcome;

@@ -143,9 +143,9 @@ pub fn sweep_text(r: &SweepReport) -> String {
     }
     writeln!(
         s,
-        "scene {} ({} triangles), radius {}, margin {} (ρ = {}), facing {}",
+        "scene {} ({}), radius {}, margin {} (ρ = {}), facing {}",
         r.scene,
-        r.triangles,
+        sweeptrace::numbers::counted(r.triangles as u64, "triangle", "triangles"),
         num(r.sweep.radius),
         num(r.options.margin),
         num(rho),

@@ -20,9 +20,10 @@ use crate::regress::{
     explain_outcome, explained_records,
 };
 use crate::replay::{
-    ReplayError, ReplayEvent, ReplayOptions, ReplaySummary, SceneState, SweepResult, plural,
+    ReplayError, ReplayEvent, ReplayOptions, ReplaySummary, SceneState, SweepResult,
     replay_events,
 };
+use crate::numbers::plural;
 use std::sync::Arc;
 use crate::trace::messages::OutcomeMsg;
 use crate::trace::{TraceError, TraceEvent};

@@ -6,6 +6,7 @@ use std::collections::BTreeSet;
 use std::fmt;
 
 use super::ReplayOptions;
+use crate::numbers::plural;
 
 /// Distinct balls remembered; beyond this only their range is kept.
 const MAX_DISTINCT_BALLS: usize = 1024;
@@ -150,14 +151,5 @@ impl fmt::Display for Selection {
                 plural(seen.sweeps, "sweep")
             ),
         }
-    }
-}
-
-/// `noun` or `noun`s for `n` of them (regular plurals only).
-pub fn plural(n: u64, noun: &str) -> String {
-    if n == 1 {
-        noun.to_string()
-    } else {
-        format!("{noun}s")
     }
 }

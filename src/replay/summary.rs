@@ -6,7 +6,8 @@ use std::time::Duration;
 use crate::core::explain::num;
 use crate::core::{FragileReason, Kind, Verdict};
 
-use super::selection::{Selection, SweepExtent, plural};
+use super::selection::{Selection, SweepExtent};
+use crate::numbers::plural;
 use super::tunnel::{Tunnel, TunnelKind};
 use super::ReplayOptions;
 

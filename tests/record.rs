@@ -603,12 +603,12 @@ fn bad_obj_is_a_clear_error() -> Result<(), String> {
         (
             "parse.obj",
             "v 0 0 0\nv 1 zero 0\nv 0 1 0\nf 1 2 3\n",
-            "not a valid Wavefront OBJ",
+            "not a valid Wavefront OBJ file: line 2 (`v 1 zero 0`)",
         ),
         (
             "range.obj",
             "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 9\n",
-            "not a valid Wavefront OBJ",
+            "not a valid Wavefront OBJ file: line 4 (`f 1 2 9`)",
         ),
         (
             "empty.obj",

@@ -15,6 +15,7 @@ mod core_random;
 mod engine;
 mod error_messages;
 mod faults;
+mod first_hour;
 mod foxglove;
 mod fuzz_corpus;
 mod help;
@@ -121,5 +122,6 @@ fn main() {
     trials.extend(fuzz_corpus::tests());
     trials.extend(interrupts::tests());
     trials.extend(help::tests());
+    trials.extend(first_hour::tests());
     libtest_mimic::run(&args, trials).exit();
 }

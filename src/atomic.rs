@@ -29,7 +29,9 @@ static NEXT_REGISTRATION: AtomicU64 = AtomicU64::new(0);
 
 fn registry() -> MutexGuard<'static, BTreeMap<u64, PathBuf>> {
     // The map stays consistent even if a holder panicked.
-    PENDING.lock().unwrap_or_else(|poisoned| poisoned.into_inner())
+    PENDING
+        .lock()
+        .unwrap_or_else(|poisoned| poisoned.into_inner())
 }
 
 /// Removes every temporary file of this process that is not finished yet,

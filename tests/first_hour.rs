@@ -70,11 +70,12 @@ fn golf_contents() -> Result<(u32, u32, u64, u64), String> {
             .ok_or_else(|| format!("no `{key}` in {out}"))
     };
     let balls = line("sweeps:")?;
-    let list = balls.split_once(": ").map(|(_, l)| l.trim_end_matches(')')).unwrap_or("");
+    let list = balls
+        .split_once(": ")
+        .map(|(_, l)| l.trim_end_matches(')'))
+        .unwrap_or("");
     let balls: Vec<u32> = list.split(", ").filter_map(|b| b.parse().ok()).collect();
-    let (lo, hi) = line("frames:")?
-        .split_once(" to ")
-        .ok_or("frames line")?;
+    let (lo, hi) = line("frames:")?.split_once(" to ").ok_or("frames line")?;
     Ok((
         *balls.iter().min().ok_or("no ball")?,
         *balls.iter().max().ok_or("no ball")?,
@@ -98,7 +99,17 @@ fn filter_selecting_nothing_is_an_error_naming_the_trace_contents() -> Result<()
     let cases: Vec<Vec<&OsStr>> = vec![
         os!["replay", t, "--ball", b].to_vec(),
         os!["replay", t, "--frames", &beyond_frames].to_vec(),
-        os!["replay", t, "--ball", b, "--outcomes", "out.jsonl", "--foxglove", "f.foxglove.mcap"].to_vec(),
+        os![
+            "replay",
+            t,
+            "--ball",
+            b,
+            "--outcomes",
+            "out.jsonl",
+            "--foxglove",
+            "f.foxglove.mcap"
+        ]
+        .to_vec(),
         os!["diff", t, t, "--ball", b].to_vec(),
         os!["diff", t, t, "--frames", &beyond_frames, "--json"].to_vec(),
         os!["repro", t, "--frame", &beyond_frame, "-o", "case.mcap"].to_vec(),
@@ -123,14 +134,24 @@ fn filter_selecting_part_says_how_much() -> Result<(), String> {
     let trace = golf();
     let (code, _, err) = run_in(
         dir.path(),
-        os!["replay", trace.as_os_str(), "--frames", "100..120", "--outcomes", "out.jsonl"],
+        os![
+            "replay",
+            trace.as_os_str(),
+            "--frames",
+            "100..120",
+            "--outcomes",
+            "out.jsonl"
+        ],
     )?;
     ensure!(code == 0, "exit {code}: {err}");
     let kept = std::fs::read_to_string(dir.path().join("out.jsonl"))
         .map_err(|e| e.to_string())?
         .lines()
         .count();
-    let (code, all, _) = run_in(dir.path(), os!["replay", trace.as_os_str(), "--outcomes", "-"])?;
+    let (code, all, _) = run_in(
+        dir.path(),
+        os!["replay", trace.as_os_str(), "--outcomes", "-"],
+    )?;
     ensure!(code == 0, "exit {code}");
     let total = all.lines().count();
     let want = format!("the filter (frames 100..120) kept {kept} of {total} sweeps");
@@ -138,7 +159,13 @@ fn filter_selecting_part_says_how_much() -> Result<(), String> {
     ensure!(err.contains(&want), "no `{want}` in: {err}");
     let (code, _, err) = run_in(
         dir.path(),
-        os!["diff", trace.as_os_str(), trace.as_os_str(), "--frames", "100..120"],
+        os![
+            "diff",
+            trace.as_os_str(),
+            trace.as_os_str(),
+            "--frames",
+            "100..120"
+        ],
     )?;
     ensure!(code == 0 && err.contains(&want), "diff: exit {code}: {err}");
     Ok(())
@@ -152,7 +179,17 @@ fn non_trace_input_leaves_no_output() -> Result<(), String> {
     let r = readme.as_os_str();
     let cases: Vec<Vec<&OsStr>> = vec![
         os!["replay", r].to_vec(),
-        os!["replay", r, "--rrd", "x.rrd", "--foxglove", "x.foxglove.mcap", "--outcomes", "x.jsonl"].to_vec(),
+        os![
+            "replay",
+            r,
+            "--rrd",
+            "x.rrd",
+            "--foxglove",
+            "x.foxglove.mcap",
+            "--outcomes",
+            "x.jsonl"
+        ]
+        .to_vec(),
         os!["bless", r, "-o", "blessed.mcap"].to_vec(),
         os!["repro", r, "--frame", "0", "-o", "case.mcap"].to_vec(),
         os!["check", r, "--rrd-on-failure", "failures"].to_vec(),
@@ -197,13 +234,19 @@ fn truncated_trace_still_writes_what_was_read() -> Result<(), String> {
     let bytes = std::fs::read(golf()).map_err(|e| e.to_string())?;
     std::fs::write(dir.path().join("cut.mcap"), &bytes[..bytes.len() * 2 / 3])
         .map_err(|e| e.to_string())?;
-    let (code, _, err) = run_in(dir.path(), os!["replay", "cut.mcap", "--outcomes", "cut.jsonl"])?;
+    let (code, _, err) = run_in(
+        dir.path(),
+        os!["replay", "cut.mcap", "--outcomes", "cut.jsonl"],
+    )?;
     ensure!(code == 3, "exit {code}: {err}");
     let lines = std::fs::read_to_string(dir.path().join("cut.jsonl"))
         .map_err(|e| e.to_string())?
         .lines()
         .count();
-    ensure!(lines > 0 && err.contains("wrote the outcomes"), "{lines} lines: {err}");
+    ensure!(
+        lines > 0 && err.contains("wrote the outcomes"),
+        "{lines} lines: {err}"
+    );
     Ok(())
 }
 
@@ -214,7 +257,11 @@ fn info_of_a_non_trace_prints_nothing_on_stdout() -> Result<(), String> {
     std::fs::write(dir.path().join("empty.mcap"), b"").map_err(|e| e.to_string())?;
     let traces = root().join("traces");
     let readme = root().join("README.md");
-    for input in [traces.as_os_str(), readme.as_os_str(), OsStr::new("empty.mcap")] {
+    for input in [
+        traces.as_os_str(),
+        readme.as_os_str(),
+        OsStr::new("empty.mcap"),
+    ] {
         for json in [false, true] {
             let mut args = vec![OsStr::new("info"), input];
             if json {
@@ -264,12 +311,21 @@ fn diff_of_different_scenes_is_refused() -> Result<(), String> {
         crate::support::run_bin(os!["diff", golf.as_os_str(), bowl.as_os_str()])?;
     ensure!(code == 2, "exit {code}: {out}{err}");
     ensure!(out.is_empty(), "a report was printed: {out}");
-    for want in ["scene 0", "vertices and", "triangles in A", "margin 0 in A, 0.02 in B", "--allow-different-scenes"] {
+    for want in [
+        "scene 0",
+        "vertices and",
+        "triangles in A",
+        "margin 0 in A, 0.02 in B",
+        "--allow-different-scenes",
+    ] {
         ensure!(err.contains(want), "no `{want}` in: {err}");
     }
     let (code, out, err) =
         crate::support::run_bin(os!["diff", golf.as_os_str(), box_strict.as_os_str()])?;
-    ensure!(code == 2 && err.contains("facing non_strict in A, strict in B"), "{code}: {out}{err}");
+    ensure!(
+        code == 2 && err.contains("facing non_strict in A, strict in B"),
+        "{code}: {out}{err}"
+    );
     let (code, out, err) = crate::support::run_bin(os![
         "diff",
         golf.as_os_str(),
@@ -277,7 +333,10 @@ fn diff_of_different_scenes_is_refused() -> Result<(), String> {
         "--allow-different-scenes"
     ])?;
     ensure!(code == 1, "exit {code}: {err}");
-    ensure!(out.contains("the scenes differ:") && err.contains("warning"), "{out}{err}");
+    ensure!(
+        out.contains("the scenes differ:") && err.contains("warning"),
+        "{out}{err}"
+    );
     let (code, _, err) = crate::support::run_bin(os![
         "diff",
         box_strict.as_os_str(),
@@ -287,7 +346,10 @@ fn diff_of_different_scenes_is_refused() -> Result<(), String> {
         "--margin-a",
         "0.01"
     ])?;
-    ensure!(code == 0 || code == 1, "an override refused: exit {code}: {err}");
+    ensure!(
+        code == 0 || code == 1,
+        "an override refused: exit {code}: {err}"
+    );
     Ok(())
 }
 
@@ -306,10 +368,19 @@ fn replay_summary_reads_right() -> Result<(), String> {
         "-"
     ])?;
     ensure!(code == 0, "exit {code}: {err}");
-    ensure!(err.contains("1 sweep replayed") && err.contains("over 1 scene:"), "{err}");
-    ensure!(err.contains("1 collision (") || err.contains("0 collisions ("), "{err}");
+    ensure!(
+        err.contains("1 sweep replayed") && err.contains("over 1 scene:"),
+        "{err}"
+    );
+    ensure!(
+        err.contains("1 collision (") || err.contains("0 collisions ("),
+        "{err}"
+    );
     ensure!(!err.contains("(s)"), "{err}");
-    ensure!(err.contains(" s in all, ") && err.contains(" s of it in the core"), "{err}");
+    ensure!(
+        err.contains(" s in all, ") && err.contains(" s of it in the core"),
+        "{err}"
+    );
     Ok(())
 }
 
@@ -317,17 +388,41 @@ fn replay_summary_reads_right() -> Result<(), String> {
 /// of the rest; a back-facing face the ball never comes near is not among
 /// them; --all shows every test.
 fn sweep_lists_the_closest_tests_only() -> Result<(), String> {
-    let inside_box = os!["sweep", "--scene", "box", "--radius", "0.1", "--from", "0,0,0.5", "--to", "0.3,0.2,-0.9"];
+    let inside_box = os![
+        "sweep",
+        "--scene",
+        "box",
+        "--radius",
+        "0.1",
+        "--from",
+        "0,0,0.5",
+        "--to",
+        "0.3,0.2,-0.9"
+    ];
     let (code, out, err) = crate::support::run_bin(inside_box)?;
     ensure!(code == 0, "exit {code}: {err}");
-    ensure!(!out.contains("back-facing"), "far back-facing faces listed:\n{out}");
+    ensure!(
+        !out.contains("back-facing"),
+        "far back-facing faces listed:\n{out}"
+    );
     let mut all = inside_box.to_vec();
     all.push(OsStr::new("--all"));
     let (_, every, _) = crate::support::run_bin(&all)?;
-    ensure!(every.matches("back-facing").count() >= 20, "--all:\n{every}");
+    ensure!(
+        every.matches("back-facing").count() >= 20,
+        "--all:\n{every}"
+    );
 
     let (code, out, err) = crate::support::run_bin(os![
-        "sweep", "--scene", "cube", "--radius", "0.5", "--from", "0,3,0.2", "--to", "0.9,-3,0.2"
+        "sweep",
+        "--scene",
+        "cube",
+        "--radius",
+        "0.5",
+        "--from",
+        "0,3,0.2",
+        "--to",
+        "0.9,-3,0.2"
     ])?;
     ensure!(code == 0, "exit {code}: {err}");
     let listed: Vec<&str> = out
@@ -337,12 +432,18 @@ fn sweep_lists_the_closest_tests_only() -> Result<(), String> {
         .take_while(|l| l.starts_with("  "))
         .collect();
     ensure!(!listed.is_empty() && listed.len() <= 5, "listed:\n{out}");
-    ensure!(listed[0].ends_with("<- primary"), "the primary test is not first:\n{out}");
+    ensure!(
+        listed[0].ends_with("<- primary"),
+        "the primary test is not first:\n{out}"
+    );
     let hits = listed.iter().take_while(|l| l.contains(": hit")).count();
     ensure!(
         listed[hits..].iter().all(|l| !l.contains(": hit")),
         "hits after misses:\n{out}"
     );
-    ensure!(out.contains("came close too, less so"), "no count of the rest:\n{out}");
+    ensure!(
+        out.contains("came close too, less so"),
+        "no count of the rest:\n{out}"
+    );
     Ok(())
 }

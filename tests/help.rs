@@ -56,14 +56,20 @@ fn help_has_no_rustdoc_syntax() -> Result<(), String> {
     let mut found = Vec::new();
     for (sub, text) in &helps {
         for line in text.lines() {
-            if line.contains("[`") || line.contains("`]") || line.contains("crate::")
+            if line.contains("[`")
+                || line.contains("`]")
+                || line.contains("crate::")
                 || line.contains("](")
             {
                 found.push(format!("{sub}: {}", line.trim()));
             }
         }
     }
-    ensure!(found.is_empty(), "rustdoc syntax in the help:\n{}", found.join("\n"));
+    ensure!(
+        found.is_empty(),
+        "rustdoc syntax in the help:\n{}",
+        found.join("\n")
+    );
     Ok(())
 }
 
@@ -93,7 +99,9 @@ fn copy_tree(from: &Path, to: &Path) -> Result<(), String> {
         }
         Ok(())
     } else {
-        std::fs::copy(from, to).map(|_| ()).map_err(|e| format!("{}: {e}", from.display()))
+        std::fs::copy(from, to)
+            .map(|_| ())
+            .map_err(|e| format!("{}: {e}", from.display()))
     }
 }
 
@@ -130,11 +138,9 @@ fn help_examples_run_as_written() -> Result<(), String> {
         .parent()
         .ok_or("the binary has no directory")?
         .to_path_buf();
-    let path = std::env::join_paths(
-        std::iter::once(bin_dir).chain(std::env::split_paths(
-            &std::env::var_os("PATH").unwrap_or_default(),
-        )),
-    )
+    let path = std::env::join_paths(std::iter::once(bin_dir).chain(std::env::split_paths(
+        &std::env::var_os("PATH").unwrap_or_default(),
+    )))
     .map_err(|e| e.to_string())?;
     let mut failures = Vec::new();
     for line in &lines {
@@ -161,7 +167,13 @@ fn help_examples_run_as_written() -> Result<(), String> {
         "the examples changed the repository's top level: {:?}",
         after.symmetric_difference(&before).collect::<Vec<_>>()
     );
-    ensure!(failures.is_empty(), "{} of {} examples fail:\n{}", failures.len(), lines.len(), failures.join("\n"));
+    ensure!(
+        failures.is_empty(),
+        "{} of {} examples fail:\n{}",
+        failures.len(),
+        lines.len(),
+        failures.join("\n")
+    );
     Ok(())
 }
 
@@ -178,13 +190,36 @@ fn enum_options_list_their_values_on_a_typo() -> Result<(), String> {
     let trace = root().join("traces/record_mini_golf.mcap");
     let trace = trace.as_os_str();
     let cases: [(&[&std::ffi::OsStr], &[&str]); 7] = [
-        (os!["check", trace, "--fields", "kind,alhpa"], &["kind", "triangle", "feature", "alpha", "normal", "contact"]),
-        (os!["diff", trace, trace, "--fields", "normals"], &["alpha", "normal", "contact"]),
-        (os!["replay", trace, "--detail", "primry"], &["primary", "candidates", "all"]),
-        (os!["replay", trace, "--facing", "strikt"], &["non_strict", "strict"]),
-        (os!["record", "--scene", "minigolf"], &["mini_golf", "bowl", "box", "terrain", "cube", "triangle"]),
-        (os!["sweep", "--scene", "cubes", "--from", "0,0,1", "--to", "0,0,-1"], &["cube", "triangle"]),
-        (os!["check", trace, "--engine", "x", "--against", "cor"], &["core", "expected"]),
+        (
+            os!["check", trace, "--fields", "kind,alhpa"],
+            &["kind", "triangle", "feature", "alpha", "normal", "contact"],
+        ),
+        (
+            os!["diff", trace, trace, "--fields", "normals"],
+            &["alpha", "normal", "contact"],
+        ),
+        (
+            os!["replay", trace, "--detail", "primry"],
+            &["primary", "candidates", "all"],
+        ),
+        (
+            os!["replay", trace, "--facing", "strikt"],
+            &["non_strict", "strict"],
+        ),
+        (
+            os!["record", "--scene", "minigolf"],
+            &["mini_golf", "bowl", "box", "terrain", "cube", "triangle"],
+        ),
+        (
+            os![
+                "sweep", "--scene", "cubes", "--from", "0,0,1", "--to", "0,0,-1"
+            ],
+            &["cube", "triangle"],
+        ),
+        (
+            os!["check", trace, "--engine", "x", "--against", "cor"],
+            &["core", "expected"],
+        ),
     ];
     for (args, values) in cases {
         let (code, out, err) = run_bin(args)?;

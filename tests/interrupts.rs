@@ -45,11 +45,16 @@ fn wait_for_partials(child: &mut Child, dir: &Path, count: usize) -> Result<(), 
             return Ok(());
         }
         if let Some(status) = child.try_wait().map_err(|e| e.to_string())? {
-            return Err(format!("the run ended ({status}) before its outputs appeared"));
+            return Err(format!(
+                "the run ended ({status}) before its outputs appeared"
+            ));
         }
         if Instant::now() > deadline {
             let _ = child.kill();
-            return Err(format!("no {count} partial files in {} in time", dir.display()));
+            return Err(format!(
+                "no {count} partial files in {} in time",
+                dir.display()
+            ));
         }
         std::thread::sleep(Duration::from_millis(20));
     }
@@ -69,7 +74,10 @@ fn signal_and_wait(mut child: Child, signal: i32) -> Result<(Option<i32>, String
         }
         if Instant::now() > deadline {
             let _ = child.kill();
-            return Err(format!("still running {} s after signal {signal}", LONG_WAIT.as_secs()));
+            return Err(format!(
+                "still running {} s after signal {signal}",
+                LONG_WAIT.as_secs()
+            ));
         }
         std::thread::sleep(Duration::from_millis(20));
     };
@@ -103,7 +111,9 @@ fn check_exit(
         return Err(format!("{what}: left behind {left:?}; stderr: {stderr}"));
     }
     if !stderr.contains("interrupted") {
-        return Err(format!("{what}: stderr does not say it was interrupted: {stderr}"));
+        return Err(format!(
+            "{what}: stderr does not say it was interrupted: {stderr}"
+        ));
     }
     Ok(())
 }

@@ -711,7 +711,10 @@ fn regenerate_script_reproduces_every_sample_trace() -> Result<(), String> {
             (name, words.collect())
         })
         .collect();
-    ensure!(commands.len() >= 5, "record lines found in the script: {commands:?}");
+    ensure!(
+        commands.len() >= 5,
+        "record lines found in the script: {commands:?}"
+    );
     let dir = tempfile::tempdir().map_err(|e| e.to_string())?;
     let mut problems = Vec::new();
     let mut made = BTreeSet::new();

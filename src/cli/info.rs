@@ -29,7 +29,11 @@ pub struct Args {
 pub fn run(args: Args) -> anyhow::Result<RunOutcome> {
     let name = args.trace.display().to_string();
     let file = File::open(&args.trace).with_context(|| format!("cannot open trace {name}"))?;
-    let file_bytes = file.metadata().ok().filter(|m| m.is_file()).map(|m| m.len());
+    let file_bytes = file
+        .metadata()
+        .ok()
+        .filter(|m| m.is_file())
+        .map(|m| m.len());
     let (mut info, error) = collect(TraceReader::new_indexed(BufReader::new(file), &name));
     info.file_bytes = file_bytes;
     let (error, not_mcap) = match error {

@@ -19,8 +19,7 @@ use sweeptrace::foxglove::{FoxgloveFile, FoxgloveOptions};
 use sweeptrace::numbers::{self, Rule, plural};
 use sweeptrace::regress::Tolerances;
 use sweeptrace::replay::{
-    Detail, FrameRange, ReplayError, ReplayEvent, ReplayOptions, Selection,
-    replay_events_parallel,
+    Detail, FrameRange, ReplayError, ReplayEvent, ReplayOptions, Selection, replay_events_parallel,
 };
 use sweeptrace::run::RunOutcome;
 use sweeptrace::trace::TraceReader;
@@ -430,10 +429,9 @@ pub fn run(args: Args) -> anyhow::Result<RunOutcome> {
                 // One figure: how long the stream tried, from its start.
                 let tried = viewer_since.map_or(0.0, |t| t.elapsed().as_secs_f64());
                 let what = match err {
-                    rerun::sink::SinkFlushError::Timeout => format!(
-                        "the viewer did not take the last messages within {} s",
-                        VIEWER_FLUSH_TIMEOUT.as_secs()
-                    ),
+                    rerun::sink::SinkFlushError::Timeout => {
+                        format!("no viewer took the recording (waited {tried:.0} s in all)")
+                    }
                     rerun::sink::SinkFlushError::Failed { .. } => {
                         format!("could not connect (tried for {tried:.0} s)")
                     }

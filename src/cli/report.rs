@@ -126,11 +126,7 @@ fn shown_records<'a>(r: &SweepReport<'a>) -> (Vec<&'a TestRecord>, usize) {
         return (shown, 0);
     }
     let rho = r.sweep.radius - r.options.margin;
-    let mut close: Vec<&TestRecord> = r
-        .records
-        .iter()
-        .filter(|t| came_close(t, rho))
-        .collect();
+    let mut close: Vec<&TestRecord> = r.records.iter().filter(|t| came_close(t, rho)).collect();
     let rank = |t: &TestRecord| match (t.verdict(), t.alpha()) {
         (Verdict::Hit, Some(alpha)) => (0u8, alpha),
         _ => (1u8, miss_distance(t).unwrap_or(f64::INFINITY)),

@@ -15,18 +15,17 @@ use serde::Serialize;
 use serde_json::json;
 
 use crate::core::explain::num;
+use crate::numbers::plural;
 use crate::regress::{
     Agreement, ExpectedTest, FieldDiff, Tolerances, agreement, compare, expected_tests,
     explain_outcome, explained_records,
 };
 use crate::replay::{
-    ReplayError, ReplayEvent, ReplayOptions, ReplaySummary, SceneState, SweepResult,
-    replay_events,
+    ReplayError, ReplayEvent, ReplayOptions, ReplaySummary, SceneState, SweepResult, replay_events,
 };
-use crate::numbers::plural;
-use std::sync::Arc;
 use crate::trace::messages::OutcomeMsg;
 use crate::trace::{TraceError, TraceEvent};
+use std::sync::Arc;
 
 /// One side's replayed sweeps, by `(frame, ball)`.
 pub struct Side {

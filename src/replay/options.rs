@@ -27,9 +27,11 @@ pub enum Detail {
     #[default]
     #[cfg_attr(
         feature = "cli",
-        value(help = "The tests that report the primary collision (the primary test first, \
+        value(
+            help = "The tests that report the primary collision (the primary test first, \
                       then every other hit tied with it, which share the averaged normal); \
-                      when nothing hits, the one test that came nearest among the BVH candidates")
+                      when nothing hits, the one test that came nearest among the BVH candidates"
+        )
     )]
     Primary,
     /// Every test of every triangle the BVH visited.

@@ -142,7 +142,10 @@ impl fmt::Display for Selection {
                 )
             }
             Selection::Nothing { filter, seen } if seen.sweeps == 0 => {
-                write!(f, "the filter ({filter}) selects nothing: the trace has no sweep")
+                write!(
+                    f,
+                    "the filter ({filter}) selects nothing: the trace has no sweep"
+                )
             }
             Selection::Nothing { filter, seen } => write!(
                 f,
@@ -151,5 +154,70 @@ impl fmt::Display for Selection {
                 plural(seen.sweeps, "sweep")
             ),
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::replay::FrameRange;
+
+    fn extent(sweeps: &[(u64, u32)]) -> SweepExtent {
+        let mut e = SweepExtent::default();
+        for &(frame, ball) in sweeps {
+            e.add(frame, ball);
+        }
+        e
+    }
+
+    #[test]
+    fn extent_names_balls_and_frames() {
+        assert_eq!(extent(&[]).to_string(), "no sweep");
+        assert_eq!(extent(&[(4, 0)]).to_string(), "ball 0, frame 4");
+        assert_eq!(
+            extent(&[(0, 3), (591, 0), (7, 1), (9, 2)]).to_string(),
+            "balls 0..=3, frames 0..=591"
+        );
+        assert_eq!(
+            extent(&[(1, 0), (2, 2), (3, 7)]).to_string(),
+            "balls 0, 2, 7, frames 1..=3"
+        );
+        let many: Vec<(u64, u32)> = (0..20).map(|b| (0, b * 3)).collect();
+        assert_eq!(
+            extent(&many).to_string(),
+            "balls 0..=57 (20 distinct), frame 0"
+        );
+    }
+
+    #[test]
+    fn selection_of_filters() {
+        let seen = extent(&[(0, 0), (10, 1)]);
+        let none = ReplayOptions::default();
+        assert_eq!(Selection::of(&none, &seen, 0), Selection::Everything);
+        let ball = ReplayOptions {
+            ball: Some(9),
+            ..ReplayOptions::default()
+        };
+        let nothing = Selection::of(&ball, &seen, 0);
+        assert!(nothing.is_nothing());
+        assert_eq!(
+            nothing.to_string(),
+            "the filter (ball 9) selects none of the trace's 2 sweeps: it has balls 0..=1, frames 0..=10"
+        );
+        let frames = ReplayOptions {
+            frames: FrameRange {
+                start: Some(5),
+                end: None,
+            },
+            ..ReplayOptions::default()
+        };
+        assert_eq!(
+            Selection::of(&frames, &seen, 1).to_string(),
+            "the filter (frames 5..) kept 1 of 2 sweeps"
+        );
+        assert_eq!(
+            Selection::of(&frames, &SweepExtent::default(), 0).to_string(),
+            "the filter (frames 5..) selects nothing: the trace has no sweep"
+        );
     }
 }

@@ -6,10 +6,10 @@ use std::time::Duration;
 use crate::core::explain::num;
 use crate::core::{FragileReason, Kind, Verdict};
 
-use super::selection::{Selection, SweepExtent};
-use crate::numbers::plural;
-use super::tunnel::{Tunnel, TunnelKind};
 use super::ReplayOptions;
+use super::selection::{Selection, SweepExtent};
+use super::tunnel::{Tunnel, TunnelKind};
+use crate::numbers::plural;
 
 /// How many tunnels the summary lists.
 pub const LISTED_TUNNELS: usize = 5;

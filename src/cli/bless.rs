@@ -7,6 +7,7 @@ use std::path::PathBuf;
 
 use anyhow::bail;
 
+use sweeptrace::numbers::counted;
 use sweeptrace::regress::bless_file;
 use sweeptrace::replay::ReplayOptions;
 use sweeptrace::run::RunOutcome;
@@ -49,16 +50,19 @@ pub fn run(args: Args) -> anyhow::Result<RunOutcome> {
     let summary = bless_file(&args.trace, &output, ReplayOptions::default())
         .name_file_once("blessing", args.trace.display())?;
     eprintln!(
-        "wrote {}: {} expectations (replacing {}), {} other messages, {} channels, {} schemas, \
-         {} metadata records and {} attachments kept",
+        "wrote {}: {} (replacing {}), {}, {}, {}, {} and {} kept",
         output.display(),
-        summary.expected_written,
+        counted(summary.expected_written, "expectation", "expectations"),
         summary.expected_dropped,
-        summary.messages_copied,
-        summary.channels_copied,
-        summary.schemas_copied,
-        summary.metadata_copied,
-        summary.attachments_copied
+        counted(summary.messages_copied, "other message", "other messages"),
+        counted(summary.channels_copied, "channel", "channels"),
+        counted(summary.schemas_copied, "schema", "schemas"),
+        counted(
+            summary.metadata_copied,
+            "metadata record",
+            "metadata records"
+        ),
+        counted(summary.attachments_copied, "attachment", "attachments"),
     );
     Ok(RunOutcome::Success)
 }

@@ -97,9 +97,9 @@ pub fn run(args: Args) -> anyhow::Result<RunOutcome> {
         })
         .with_context(|| format!("writing {}", path.display()))?;
         eprintln!(
-            "wrote {} ({} cases; frame N is case N: {})",
+            "wrote {} ({}; frame N is case N: {})",
             path.display(),
-            cases.len(),
+            sweeptrace::numbers::counted(cases.len() as u64, "case", "cases"),
             cases
                 .iter()
                 .map(|c| format!("{} {}", c.sweep.frame, c.id()))

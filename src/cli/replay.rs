@@ -510,8 +510,8 @@ pub fn run(args: Args) -> anyhow::Result<RunOutcome> {
     }
     if let Some(err) = trace_error {
         eprintln!(
-            "error: {err:#}\nthe outputs hold the {} sweeps read before it{}",
-            summary.sweeps,
+            "error: {err:#}\nthe outputs hold the {} read before it{}",
+            numbers::counted(summary.sweeps, "sweep", "sweeps"),
             last_frame.map_or(String::new(), |f| format!(" (up to frame {f})"))
         );
         return Ok(RunOutcome::IncompleteInput);

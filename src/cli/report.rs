@@ -213,8 +213,8 @@ pub fn sweep_text(r: &SweepReport) -> String {
     if shown.is_empty() {
         writeln!(
             s,
-            "no test came close ({} tests run; --all explains each)",
-            r.records.len()
+            "no test came close ({} run; --all explains each)",
+            sweeptrace::numbers::counted(r.records.len() as u64, "test", "tests")
         )
         .unwrap();
     } else {

@@ -358,14 +358,21 @@ pub fn render_text(r: &DiffReport) -> String {
                 r.compared, r.ties
             );
         } else {
-            let _ = writeln!(s, "same: {} sweeps, identical outcomes", r.compared);
+            let _ = writeln!(
+                s,
+                "same: {}, identical outcomes",
+                crate::numbers::counted(r.compared, "sweep", "sweeps")
+            );
         }
         return s;
     }
     let _ = writeln!(
         s,
-        "different: {} of {} sweeps differ; {} only in A, {} only in B",
-        r.different, r.compared, r.only_in_a, r.only_in_b
+        "different: {} of {} differ; {} only in A, {} only in B",
+        r.different,
+        crate::numbers::counted(r.compared, "sweep", "sweeps"),
+        r.only_in_a,
+        r.only_in_b
     );
     if !r.by_kind.is_empty() {
         let _ = writeln!(s, "by kind (A -> B):");

@@ -127,10 +127,18 @@ pub fn run(args: Args) -> anyhow::Result<RunOutcome> {
             "warning: the scenes differ (compared anyway, --allow-different-scenes):\n  {list}"
         );
     }
+    let mut kept: Vec<String> = Vec::new();
     for side in [&a, &b] {
         if let part @ Selection::Part { .. } = side.summary.selection(&side.options) {
-            eprintln!("{}: {part}", side.name);
+            let line = format!("{}: {part}", side.name);
+            // `diff T T ...` replays one trace twice: say it once.
+            if !kept.contains(&line) {
+                kept.push(line);
+            }
         }
+    }
+    for line in kept {
+        eprintln!("{line}");
     }
     if args.json {
         print!("{}", render_json(&report));

@@ -3,14 +3,59 @@
 //! one file system) and renamed into place only when finished. A pending
 //! file that is dropped without [`PendingFile::commit`] is removed.
 //!
+//! Every temporary file of the process is also in a registry, so that a
+//! process ended by a signal can remove them first
+//! ([`remove_pending_files`]; the binary does it on SIGINT and SIGTERM):
+//! only a process killed outright (SIGKILL, a crash) leaves `.NAME.partial-*`
+//! files behind, and the next run writing the same target reports them
+//! ([`unfinished_temporaries`]).
+//!
 //! A target that exists and is not a regular file (`/dev/null`, a named
 //! pipe, a terminal) is written directly: renaming a file over it would
 //! replace the device. A target that is a symbolic link is resolved, so the
 //! link keeps pointing at the finished file.
 
+use std::collections::BTreeMap;
 use std::fs::File;
 use std::io;
 use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::{Mutex, MutexGuard};
+
+/// The temporary files of this process not yet renamed or removed, by
+/// registration number.
+static PENDING: Mutex<BTreeMap<u64, PathBuf>> = Mutex::new(BTreeMap::new());
+static NEXT_REGISTRATION: AtomicU64 = AtomicU64::new(0);
+
+fn registry() -> MutexGuard<'static, BTreeMap<u64, PathBuf>> {
+    // The map stays consistent even if a holder panicked.
+    PENDING
+        .lock()
+        .unwrap_or_else(|poisoned| poisoned.into_inner())
+}
+
+/// Removes every temporary file of this process that is not finished yet,
+/// and keeps them from being renamed into place afterwards (a pending file
+/// committed from now on waits forever): for a process about to exit on a
+/// signal. Returns the files removed.
+pub fn remove_pending_files() -> Vec<PathBuf> {
+    let guard = registry();
+    let mut removed = Vec::new();
+    for path in guard.values() {
+        if std::fs::remove_file(path).is_ok() {
+            removed.push(path.clone());
+        }
+    }
+    // Held until the process exits: no rename can follow the removal.
+    std::mem::forget(guard);
+    removed
+}
+
+/// The temporary files of this process not yet finished (for tests and
+/// diagnostics).
+pub fn pending_files() -> Vec<PathBuf> {
+    registry().values().cloned().collect()
+}
 
 /// A file being written next to its target.
 #[derive(Debug)]
@@ -18,6 +63,21 @@ pub struct PendingFile {
     /// `None` when the target is written directly (not a regular file).
     temp: Option<tempfile::TempPath>,
     target: PathBuf,
+    /// Its number in the registry of pending files, when it has a temporary file.
+    registration: Option<u64>,
+}
+
+impl Drop for PendingFile {
+    /// Removes the temporary file (an unfinished output) and its registration.
+    fn drop(&mut self) {
+        let mut pending = registry();
+        if let Some(temp) = self.temp.take() {
+            let _ = temp.close();
+        }
+        if let Some(n) = self.registration.take() {
+            pending.remove(&n);
+        }
+    }
 }
 
 impl PendingFile {
@@ -31,6 +91,7 @@ impl PendingFile {
             let pending = PendingFile {
                 temp: None,
                 target: target.to_path_buf(),
+                registration: None,
             };
             return Ok((pending, file));
         }
@@ -52,13 +113,20 @@ impl PendingFile {
         // An ordinary file once renamed (temporary files are private by default).
         #[cfg(unix)]
         builder.permissions(std::os::unix::fs::PermissionsExt::from_mode(0o644));
+        // Created and registered with the registry held: a signal handled
+        // meanwhile waits for it, then finds the file.
+        let mut pending_files = registry();
         let (file, temp) = builder
             .tempfile_in(dir_of(target))
             .map_err(one_message)?
             .into_parts();
+        let registration = NEXT_REGISTRATION.fetch_add(1, Ordering::Relaxed);
+        pending_files.insert(registration, temp.to_path_buf());
+        drop(pending_files);
         let pending = PendingFile {
             temp: Some(temp),
             target: target.to_path_buf(),
+            registration: Some(registration),
         };
         Ok((pending, file))
     }
@@ -97,10 +165,17 @@ impl PendingFile {
         &self.target
     }
 
-    /// Renames the finished file to its target.
-    pub fn commit(self) -> io::Result<()> {
-        match self.temp {
-            Some(temp) => temp.persist(&self.target).map_err(|e| e.error),
+    /// Renames the finished file to its target. The registry is held
+    /// during the rename, so a signal either removes the temporary file
+    /// before it or finds it renamed.
+    pub fn commit(mut self) -> io::Result<()> {
+        let mut pending = registry();
+        if let Some(n) = self.registration.take() {
+            pending.remove(&n);
+        }
+        match self.temp.take() {
+            // On an error the temporary file is removed (dropped).
+            Some(temp) => temp.persist(&self.target).map(|_| ()).map_err(|e| e.error),
             None => Ok(()),
         }
     }

@@ -17,10 +17,73 @@ fn main() -> ExitCode {
     unsafe {
         libc::signal(libc::SIGPIPE, libc::SIG_DFL);
     }
+    #[cfg(unix)]
+    interrupts::handle();
     let args = cli::Cli::parse();
     let outcome = cli::run(args).unwrap_or_else(|err| {
         eprintln!("error: {err:#}");
         RunOutcome::Error
     });
     ExitCode::from(outcome.exit_code())
+}
+
+/// SIGINT (Ctrl-C) and SIGTERM: the unfinished outputs are removed
+/// ([`sweeptrace::atomic::remove_pending_files`]) and the process exits
+/// with 128 + the signal's number (130, 143), as a shell reports a process
+/// ended by it.
+#[cfg(unix)]
+mod interrupts {
+    /// Blocks the two signals in every thread (called before any other
+    /// thread starts, so all inherit the mask; child processes get the
+    /// default mask back from `std::process::Command`) and waits for them
+    /// on a thread of its own. If that thread cannot be started, the
+    /// signals keep their default action.
+    pub fn handle() {
+        // SAFETY: `set` is initialised by sigemptyset before use; the calls
+        // only read and write the local set and this thread's mask.
+        let set = unsafe {
+            let mut set: libc::sigset_t = std::mem::zeroed();
+            libc::sigemptyset(&mut set);
+            libc::sigaddset(&mut set, libc::SIGINT);
+            libc::sigaddset(&mut set, libc::SIGTERM);
+            set
+        };
+        // SAFETY: a valid set; the old mask is not needed.
+        unsafe { libc::pthread_sigmask(libc::SIG_BLOCK, &set, std::ptr::null_mut()) };
+        let waiter = std::thread::Builder::new()
+            .name("signals".to_string())
+            .spawn(move || wait(set));
+        if waiter.is_err() {
+            // SAFETY: as above.
+            unsafe { libc::pthread_sigmask(libc::SIG_UNBLOCK, &set, std::ptr::null_mut()) };
+        }
+    }
+
+    fn wait(set: libc::sigset_t) {
+        loop {
+            let mut signal: libc::c_int = 0;
+            // SAFETY: `set` is a valid signal set and `signal` a valid out pointer.
+            if unsafe { libc::sigwait(&set, &mut signal) } != 0 {
+                continue;
+            }
+            let removed = sweeptrace::atomic::remove_pending_files();
+            let name = if signal == libc::SIGINT {
+                "SIGINT"
+            } else {
+                "SIGTERM"
+            };
+            eprintln!(
+                "\ninterrupted ({name}): {}",
+                match removed.len() {
+                    0 => "no unfinished output to remove".to_string(),
+                    1 => "removed the unfinished output".to_string(),
+                    n => format!("removed the {n} unfinished outputs"),
+                }
+            );
+            // SAFETY: ends the process at once, without running destructors
+            // or atexit handlers of other threads' state (the outputs are
+            // removed and none can be renamed into place any more).
+            unsafe { libc::_exit(128 + signal) };
+        }
+    }
 }

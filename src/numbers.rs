@@ -130,6 +130,20 @@ pub fn parse_f64(s: &str) -> Option<f64> {
         .then_some(if negative { -value } else { value })
 }
 
+/// `noun` or `noun`s for `n` of them (regular plurals; see [`counted`]).
+pub fn plural(n: u64, noun: &str) -> String {
+    if n == 1 {
+        noun.to_string()
+    } else {
+        format!("{noun}s")
+    }
+}
+
+/// `n` and the word for that many: `1 vertex`, `3 vertices`.
+pub fn counted(n: u64, one: &str, many: &str) -> String {
+    format!("{n} {}", if n == 1 { one } else { many })
+}
+
 #[cfg(test)]
 mod tests {
     use super::{hex_float, parse_f64};

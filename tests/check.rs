@@ -52,6 +52,7 @@ pub fn tests() -> Vec<Trial> {
         trial!(blessed_trace_passes),
         trial!(wrong_engine_config_fixture_fails_with_frame_and_reason),
         trial!(wrong_engine_config_fixture_binary_exit_1),
+        trial!(wrong_engine_config_fixture_is_what_its_generator_makes),
         trial!(no_expected_channel_is_not_a_pass),
         trial!(binary_errors_exit_2),
         trial!(trace_discovery_in_directories),
@@ -1065,6 +1066,18 @@ fn differences_below_the_shown_digits_are_shown_in_full() -> Result<(), String> 
         out.contains("the same test with other numbers")
             || out.contains("only the fields above differ"),
         "{out}"
+    );
+    Ok(())
+}
+
+/// The committed fixture is byte for byte what its generator
+/// (`generate_wrong_engine_config`) makes today.
+fn wrong_engine_config_fixture_is_what_its_generator_makes() -> Result<(), String> {
+    let committed = std::fs::read(fixture_path()).map_err(|e| e.to_string())?;
+    ensure!(
+        fixture_bytes()? == committed,
+        "{FIXTURE} differs from its generator's bytes: regenerate it with \
+         `cargo test --test integration -- --ignored check::generate_wrong_engine_config`"
     );
     Ok(())
 }

@@ -312,9 +312,11 @@ fn repository_file(path: &str) -> PathBuf {
 }
 
 fn old_trace_without_it_reads_as_before() -> Result<(), String> {
-    // A trace written before the record existed (committed sample), and one
+    // A trace written before the record existed (a sample as committed
+    // then, kept as a fixture), and one
     // written now without a source: no source, the same events and reports.
-    let old = repository_file("traces/record_cube_corner_margin.mcap");
+    let old =
+        repository_file("tests/fixtures/before_expected_source/record_cube_corner_margin.mcap");
     let bytes = std::fs::read(&old).map_err(|e| e.to_string())?;
     let (events, source, error, _) = read(&bytes, "old.mcap");
     ensure!(error.is_none(), "{error:?}");

@@ -16,8 +16,11 @@ mod engine;
 mod error_messages;
 mod expected_source;
 mod faults;
+mod first_hour;
 mod foxglove;
 mod fuzz_corpus;
+mod help;
+mod interrupts;
 mod junit;
 mod oracle;
 mod out_of_order;
@@ -125,6 +128,9 @@ fn main() {
     trials.extend(expected_source::tests());
     trials.extend(out_of_order::tests());
     trials.extend(fuzz_corpus::tests());
+    trials.extend(interrupts::tests());
+    trials.extend(help::tests());
+    trials.extend(first_hour::tests());
     let trials = mark_slow(trials);
     libtest_mimic::run(&args, trials).exit();
 }

@@ -331,6 +331,28 @@ fn unreachable_viewer_is_a_clear_error() -> Result<(), String> {
     if status.code() != Some(2) || !stderr.contains(url) {
         return Err(format!("exit {:?}: {stderr}", status.code()));
     }
+    // One figure of time, the true one: how long it tried in all (not the
+    // SDK's own count next to a different timeout of ours).
+    let error = stderr
+        .lines()
+        .find(|l| l.starts_with("error: "))
+        .ok_or_else(|| format!("no error line: {stderr}"))?;
+    let words: Vec<&str> = error
+        .split_whitespace()
+        .map(|w| w.trim_matches(|c: char| "(),;:".contains(c)))
+        .collect();
+    let number = |w: &str| !w.is_empty() && w.parse::<f64>().is_ok();
+    let figures = words
+        .iter()
+        .enumerate()
+        .filter(|(i, w)| {
+            let glued = w.strip_suffix('s').is_some_and(number);
+            glued || (number(w) && words.get(i + 1) == Some(&"s"))
+        })
+        .count();
+    if figures != 1 || error.contains("within") {
+        return Err(format!("not one figure of time: {error}"));
+    }
     Ok(())
 }
 

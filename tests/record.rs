@@ -19,6 +19,7 @@ use crate::{ensure, trial};
 pub fn tests() -> Vec<Trial> {
     vec![
         trial!(same_seed_gives_identical_bytes),
+        trial!(regenerate_script_reproduces_every_sample_trace),
         trial!(expected_equals_sweep_mesh_rerun_on_recorded_sweeps),
         trial!(no_nan_and_balls_stay_in_the_play_volume),
         trial!(runaway_balls_are_stopped_not_nan),
@@ -602,12 +603,12 @@ fn bad_obj_is_a_clear_error() -> Result<(), String> {
         (
             "parse.obj",
             "v 0 0 0\nv 1 zero 0\nv 0 1 0\nf 1 2 3\n",
-            "not a valid Wavefront OBJ",
+            "not a valid Wavefront OBJ file: line 2 (`v 1 zero 0`)",
         ),
         (
             "range.obj",
             "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 9\n",
-            "not a valid Wavefront OBJ",
+            "not a valid Wavefront OBJ file: line 4 (`f 1 2 9`)",
         ),
         (
             "empty.obj",
@@ -689,4 +690,97 @@ fn sample_traces_cover_every_kind() -> Result<(), String> {
     ensure!(margin, "no sample trace has a non-zero margin");
     ensure!(strict, "no sample trace uses the strict facing rule");
     Ok(())
+}
+
+/// `scripts/regenerate_traces.sh` rebuilds `traces/` bit for bit: each of
+/// its `record NAME ARGS` lines, run with this build into a temporary
+/// directory, gives the committed `traces/NAME` byte for byte, and every
+/// committed trace is made by one of them. (A sample written by an older
+/// recorder, such as `"feature": 0` where `record` now writes `null` for a
+/// face, fails here: regenerate the samples with the script.)
+fn regenerate_script_reproduces_every_sample_trace() -> Result<(), String> {
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    let script = std::fs::read_to_string(root.join("scripts/regenerate_traces.sh"))
+        .map_err(|e| format!("scripts/regenerate_traces.sh: {e}"))?;
+    let commands: Vec<(String, Vec<String>)> = script
+        .lines()
+        .filter_map(|l| l.strip_prefix("record "))
+        .map(|rest| {
+            let mut words = rest.split_whitespace().map(str::to_string);
+            let name = words.next().unwrap_or_default();
+            (name, words.collect())
+        })
+        .collect();
+    ensure!(
+        commands.len() >= 5,
+        "record lines found in the script: {commands:?}"
+    );
+    let dir = tempfile::tempdir().map_err(|e| e.to_string())?;
+    let mut problems = Vec::new();
+    let mut made = BTreeSet::new();
+    for (name, args) in &commands {
+        let fresh = dir.path().join(name);
+        let out = std::process::Command::new(env!("CARGO_BIN_EXE_sweeptrace"))
+            .arg("record")
+            .args(args)
+            .arg("-o")
+            .arg(&fresh)
+            .output()
+            .map_err(|e| e.to_string())?;
+        ensure!(
+            out.status.success(),
+            "record {}: {}",
+            args.join(" "),
+            String::from_utf8_lossy(&out.stderr)
+        );
+        made.insert(name.clone());
+        let fresh = std::fs::read(&fresh).map_err(|e| e.to_string())?;
+        let committed = std::fs::read(root.join("traces").join(name))
+            .map_err(|e| format!("traces/{name}: {e}"))?;
+        if fresh != committed {
+            let at = fresh
+                .iter()
+                .zip(&committed)
+                .position(|(a, b)| a != b)
+                .unwrap_or(fresh.len().min(committed.len()));
+            let why = match (trace_events(&fresh), trace_events(&committed)) {
+                (Ok(a), Ok(b)) if a == b => "the same messages, other bytes (the container \
+                     or library string changed)"
+                    .to_string(),
+                (Ok(a), Ok(b)) => match a.iter().zip(&b).position(|(x, y)| x != y) {
+                    Some(i) => format!(
+                        "message {i} differs: the script makes {:?}, the committed file holds {:?}",
+                        a[i], b[i]
+                    ),
+                    None => format!("{} messages made, {} committed", a.len(), b.len()),
+                },
+                (a, b) => format!("reading them: {:?} / {:?}", a.err(), b.err()),
+            };
+            problems.push(format!(
+                "traces/{name}: {} bytes made, {} committed, first difference at byte {at}: {why}",
+                fresh.len(),
+                committed.len()
+            ));
+        }
+    }
+    for entry in std::fs::read_dir(root.join("traces")).map_err(|e| e.to_string())? {
+        let name = entry.map_err(|e| e.to_string())?.file_name();
+        let name = name.to_string_lossy();
+        if name.ends_with(".mcap") && !made.contains(name.as_ref()) {
+            problems.push(format!("traces/{name} is not made by the script"));
+        }
+    }
+    ensure!(
+        problems.is_empty(),
+        "regenerate with scripts/regenerate_traces.sh:\n{}",
+        problems.join("\n")
+    );
+    Ok(())
+}
+
+/// Every trace event of `bytes`, in order.
+fn trace_events(bytes: &[u8]) -> Result<Vec<TraceEvent>, String> {
+    TraceReader::new(bytes, "<memory>")
+        .collect::<Result<Vec<_>, _>>()
+        .map_err(|e| e.to_string())
 }

@@ -501,7 +501,7 @@ fn sweep_sources() -> Result<(), String> {
     ])?;
     ensure!(code == 0, "exit {code}\n{out}\n{err}");
     ensure!(
-        out.contains("scene ramp (1 triangles)")
+        out.contains("scene ramp (1 triangle)")
             && out.contains("edge collision at alpha = 0.43333"),
         "sweep --mesh:\n{out}"
     );

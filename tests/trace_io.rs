@@ -1211,12 +1211,12 @@ fn info_renders_python_fixture() -> Result<(), String> {
     for needle in [
         "trace:       python_written.mcap",
         &format!(
-            "file:        {} bytes, 1 chunks, compression lz4, summary present",
+            "file:        {} bytes, 1 chunk, compression lz4, summary present",
             bytes.len()
         ),
         "library:     python fixture for sweeptrace",
         "scenes:      1",
-        "`triangle` (message 0, log_time 0 ns): 3 vertices, 1 triangles, 0 degenerate, margin 0, facing non_strict",
+        "`triangle` (message 0, log_time 0 ns): 3 vertices, 1 triangle, 0 degenerate, margin 0, facing non_strict",
         "sweeps:      5 (2 balls: 0, 1)",
         "frames:      0 to 3",
         "log_time:    0 ns to 66666668 ns",

@@ -64,6 +64,7 @@ pub fn tests() -> Vec<Trial> {
         trial!(filters_and_scenes_reset_the_jump),
         trial!(recording_marks_the_tunnel),
         trial!(sample_traces_have_none),
+        trial!(fixtures_are_what_their_generator_makes),
         trial!(simulation_has_none),
         Trial::test("tunnel::generate_fixtures", || {
             generate_fixtures().map_err(Failed::from)
@@ -795,5 +796,19 @@ fn simulation_has_none() -> Result<(), String> {
         "only {sweeps} sweeps, {hits} collisions"
     );
     eprintln!("    {sweeps} simulated sweeps, {hits} collisions: no tunnel");
+    Ok(())
+}
+
+/// The committed fixtures are byte for byte what `generate_fixtures` makes today.
+fn fixtures_are_what_their_generator_makes() -> Result<(), String> {
+    for (name, bytes) in [(FLOOR, floor_bytes()?), (WALL, wall_bytes()?)] {
+        let committed = std::fs::read(fixture(name)).map_err(|e| format!("{name}: {e}"))?;
+        if bytes != committed {
+            return Err(format!(
+                "{name} differs from its generator's bytes: regenerate it with \
+                 `cargo test --test integration -- --ignored tunnel::generate_fixtures`"
+            ));
+        }
+    }
     Ok(())
 }

@@ -7,6 +7,7 @@ use std::path::PathBuf;
 
 use anyhow::bail;
 
+use sweeptrace::numbers::counted;
 use sweeptrace::regress::bless_file;
 use sweeptrace::replay::ReplayOptions;
 use sweeptrace::run::RunOutcome;
@@ -15,8 +16,8 @@ use sweeptrace::run::RunOutcome;
 #[derive(Debug, clap::Args)]
 #[command(after_help = "\
 Examples:
-  sweeptrace bless run.mcap -o run.blessed.mcap
-  sweeptrace bless traces/bowl.mcap --in-place
+  sweeptrace bless traces/record_mini_golf.mcap -o golf.mcap
+  sweeptrace bless golf.mcap --in-place         # the file the first example wrote
 
 Each sweep gets the outcome the core computes with the scene's own margin
 and facing rule. The output is written under a temporary name next to it
@@ -53,17 +54,20 @@ pub fn run(args: Args) -> anyhow::Result<RunOutcome> {
         None => String::new(),
     };
     eprintln!(
-        "wrote {}: {} expectations from {}{replaced} (replacing {}), {} other messages, \
-         {} channels, {} schemas, {} metadata records and {} attachments kept",
+        "wrote {}: {} from {}{replaced} (replacing {}), {}, {}, {}, {} and {} kept",
         output.display(),
-        summary.expected_written,
+        counted(summary.expected_written, "expectation", "expectations"),
         summary.expected_source,
         summary.expected_dropped,
-        summary.messages_copied,
-        summary.channels_copied,
-        summary.schemas_copied,
-        summary.metadata_copied,
-        summary.attachments_copied
+        counted(summary.messages_copied, "other message", "other messages"),
+        counted(summary.channels_copied, "channel", "channels"),
+        counted(summary.schemas_copied, "schema", "schemas"),
+        counted(
+            summary.metadata_copied,
+            "metadata record",
+            "metadata records"
+        ),
+        counted(summary.attachments_copied, "attachment", "attachments"),
     );
     Ok(RunOutcome::Success)
 }

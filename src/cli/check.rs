@@ -26,12 +26,14 @@ const RRD_CONTEXT_FRAMES: u64 = 10;
 #[command(after_help = "\
 Examples:
   sweeptrace check traces/                     # every *.mcap under traces/
-  sweeptrace check run.mcap --tolerance 1e-4 --normal-tolerance 0.5
-  sweeptrace check traces/ --json --rrd-on-failure /tmp/failures
-  sweeptrace check traces/ --engine 'python3 examples/engines/sweep_engine.py'
-  git bisect run sweeptrace check traces/ --engine ./build/engine
-  sweeptrace check rapier.mcap --fields kind,alpha --tolerance 1e-5
+  sweeptrace check traces/record_mini_golf.mcap --tolerance 1e-4 --normal-tolerance 0.5
+  sweeptrace check tests/fixtures/wrong_engine_config.mcap --json --rrd-on-failure failures
+  sweeptrace check traces/record_cube_corner_margin.mcap --engine 'python3 examples/engines/sweep_engine.py'
+  sweeptrace check examples/rapier/rapier_mini_golf.mcap --fields kind,alpha --tolerance 1e-5
   sweeptrace check traces/ --junit report.xml   # a test report for CI
+
+Under `git bisect run sweeptrace check traces/ --engine ./build/engine`,
+an engine that cannot be started skips the commit (exit 125).
 
 With --engine, the engine runs as a child process and answers every sweep
 over stdin/stdout (docs/ENGINE_PROTOCOL.md); its answers are compared with
@@ -179,10 +181,6 @@ pub fn run(args: Args) -> anyhow::Result<RunOutcome> {
         );
         return Ok(RunOutcome::Success);
     }
-    if let Some(dir) = &args.rrd_on_failure {
-        std::fs::create_dir_all(dir)
-            .with_context(|| format!("creating the directory {}", dir.display()))?;
-    }
     let options = CheckOptions {
         max_details: args.max_details,
         hex: args.hex,
@@ -278,6 +276,11 @@ fn write_failure_rrd(trace: &Path, dir: &Path, report: &TraceReport) -> anyhow::
         .map(|s| s.to_string_lossy().into_owned())
         .unwrap_or_else(|| "trace".to_string());
     let target = dir.join(format!("{stem}.rrd"));
+    // Created with the first recording: a check that writes none leaves
+    // no directory behind.
+    std::fs::create_dir_all(dir)
+        .with_context(|| format!("creating the directory {}", dir.display()))?;
+    super::warn_unfinished(&target);
     let temp = PendingFile::new(&target)
         .with_context(|| format!("creating a temporary file in {}", dir.display()))?;
     let options = ReplayOptions {

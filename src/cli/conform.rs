@@ -13,11 +13,11 @@ use sweeptrace::trace::TraceEvent;
 #[command(after_help = "\
 Examples:
   sweeptrace conform --engine 'python3 examples/engines/sweep_engine.py'
-  sweeptrace conform --engine ./build/engine --json
-  sweeptrace conform --engine ./build/engine --case vertex.hit/1
+  sweeptrace conform --engine 'python3 examples/engines/trivial_engine.py' --json
+  sweeptrace conform --engine 'python3 examples/engines/sweep_engine.py' --case vertex.hit/1
   sweeptrace conform --list
   sweeptrace conform --case vertex.hit --write-trace cases.mcap
-  sweeptrace conform --engine ./build/engine --junit conform.xml
+  sweeptrace conform --engine 'python3 examples/engines/sweep_engine.py' --junit conform.xml
 
 Every case is a small scene and one sweep (sent to the engine as in `check
 --engine`, docs/ENGINE_PROTOCOL.md), grouped by the rule of
@@ -104,9 +104,9 @@ pub fn run(args: Args) -> anyhow::Result<RunOutcome> {
         })
         .with_context(|| format!("writing {}", path.display()))?;
         eprintln!(
-            "wrote {} ({} cases; frame N is case N: {})",
+            "wrote {} ({}; frame N is case N: {})",
             path.display(),
-            cases.len(),
+            sweeptrace::numbers::counted(cases.len() as u64, "case", "cases"),
             cases
                 .iter()
                 .map(|c| format!("{} {}", c.sweep.frame, c.id()))

@@ -6,13 +6,13 @@ use std::fs::File;
 use std::io::BufReader;
 use std::path::{Path, PathBuf};
 
-use anyhow::Context;
+use anyhow::{Context, bail};
 
 use sweeptrace::core::Facing;
 use sweeptrace::numbers::{self, Rule};
 use sweeptrace::regress::diff::{render_json, render_text};
 use sweeptrace::regress::{Side, diff};
-use sweeptrace::replay::{FrameRange, ReplayOptions};
+use sweeptrace::replay::{FrameRange, ReplayOptions, Selection};
 use sweeptrace::run::RunOutcome;
 use sweeptrace::trace::TraceReader;
 
@@ -20,12 +20,19 @@ use sweeptrace::trace::TraceReader;
 #[derive(Debug, clap::Args)]
 #[command(after_help = "\
 Examples:
-  sweeptrace diff old.mcap new.mcap
-  sweeptrace diff run.mcap run.mcap --facing-b strict     # what the strict rule changes
-  sweeptrace diff run.mcap run.mcap --margin-b 0.01 --json
+  sweeptrace diff traces/record_box_strict.mcap traces/record_box_strict.mcap --facing-b non_strict
+  sweeptrace diff traces/record_mini_golf.mcap traces/record_mini_golf.mcap --margin-b 0.01 --json
+  sweeptrace diff traces/record_mini_golf.mcap tests/fixtures/wrong_engine_config.mcap --allow-different-scenes
 
-Sweeps are matched by (frame, ball). Exit status: 0 same outcomes, 1
-different, 2 error.")]
+The first shows what the non-strict rule changes in a trace recorded with the
+strict one; before and after a change of the engine, `sweeptrace diff
+before.mcap after.mcap`.
+
+Sweeps are matched by (frame, ball), so the two traces must have the same
+scenes (vertex and triangle counts, geometry, margin and facing rule, scene
+by scene): when they differ that is an error naming the differences, unless
+--allow-different-scenes. A --frames or --ball filter that selects no sweep
+of a trace is an error. Exit status: 0 same outcomes, 1 different, 2 error.")]
 pub struct Args {
     /// Trace A.
     #[arg(value_name = "A")]
@@ -56,6 +63,11 @@ pub struct Args {
     /// Print one JSON object instead of text.
     #[arg(long)]
     pub json: bool,
+    /// Compare the sweeps even when the two traces' scenes differ (vertex or
+    /// triangle counts, geometry, margin, facing rule): without it that is
+    /// an error, since the same (frame, ball) then means another sweep.
+    #[arg(long)]
+    pub allow_different_scenes: bool,
 }
 
 fn side(path: &Path, options: ReplayOptions) -> anyhow::Result<Side> {
@@ -94,7 +106,40 @@ pub fn run(args: Args) -> anyhow::Result<RunOutcome> {
             ..base
         },
     )?;
+    for side in [&a, &b] {
+        let selection = side.summary.selection(&side.options);
+        if selection.is_nothing() {
+            bail!("{}: {selection}", side.name);
+        }
+    }
     let report = diff(&a, &b, &tolerances);
+    if !report.scene_differences.is_empty() {
+        let list = report.scene_differences.join("\n  ");
+        if !args.allow_different_scenes {
+            bail!(
+                "the scenes of {} and {} differ, so the same (frame, ball) is not the same \
+                 sweep:\n  {list}\ncompare them anyway with --allow-different-scenes",
+                a.name,
+                b.name
+            );
+        }
+        eprintln!(
+            "warning: the scenes differ (compared anyway, --allow-different-scenes):\n  {list}"
+        );
+    }
+    let mut kept: Vec<String> = Vec::new();
+    for side in [&a, &b] {
+        if let part @ Selection::Part { .. } = side.summary.selection(&side.options) {
+            let line = format!("{}: {part}", side.name);
+            // `diff T T ...` replays one trace twice: say it once.
+            if !kept.contains(&line) {
+                kept.push(line);
+            }
+        }
+    }
+    for line in kept {
+        eprintln!("{line}");
+    }
     if args.json {
         print!("{}", render_json(&report));
     } else {

@@ -13,7 +13,7 @@ use sweeptrace::trace::info::{collect, render_json, render_text};
 
 /// Arguments of `info`.
 #[derive(Debug, clap::Args)]
-#[command(after_help = "Example:\n  sweeptrace info run.mcap --json")]
+#[command(after_help = "Example:\n  sweeptrace info traces/record_mini_golf.mcap --json")]
 pub struct Args {
     /// The trace (an MCAP file).
     pub trace: PathBuf,
@@ -23,11 +23,26 @@ pub struct Args {
 }
 
 /// Prints the report. A trace that cannot be read to its end still gets the
-/// report of what came before the error, then the error.
+/// report of what came before the error, then the error; an input that is
+/// not an MCAP file at all (it cannot be read, is empty, has no MCAP
+/// header) gets only the error, and nothing on stdout.
 pub fn run(args: Args) -> anyhow::Result<RunOutcome> {
     let name = args.trace.display().to_string();
     let file = File::open(&args.trace).with_context(|| format!("cannot open trace {name}"))?;
-    let (info, error) = collect(TraceReader::new_indexed(BufReader::new(file), &name));
+    let file_bytes = file
+        .metadata()
+        .ok()
+        .filter(|m| m.is_file())
+        .map(|m| m.len());
+    let (mut info, error) = collect(TraceReader::new_indexed(BufReader::new(file), &name));
+    info.file_bytes = file_bytes;
+    let (error, not_mcap) = match error {
+        Some(err) if !info.stats.header_read => (None, Some(err)),
+        other => (other, None),
+    };
+    if let Some(err) = not_mcap {
+        return Err(err).name_file_once("reading the trace", &name);
+    }
     let report = if args.json {
         render_json(&info)
     } else {

@@ -84,7 +84,7 @@ pub struct ToleranceArgs {
     /// field the expectation holds). For engines whose answers differ from
     /// the core's by design in the others: `--fields kind,alpha` for an
     /// engine that reports the contact normal, not the face normal.
-    #[arg(long, value_name = "FIELD,...", value_delimiter = ',')]
+    #[arg(long, value_name = "FIELD,...", value_delimiter = ',', value_parser = field_parser())]
     pub fields: Vec<sweeptrace::regress::Field>,
 }
 
@@ -124,6 +124,20 @@ impl ToleranceArgs {
     fn field_set(&self) -> Option<sweeptrace::regress::FieldSet> {
         (!self.fields.is_empty()).then(|| sweeptrace::regress::FieldSet::of(&self.fields))
     }
+}
+
+/// The parser of `--fields`: a name that is not a field is an error listing
+/// the valid ones (and the nearest, on a typo).
+fn field_parser() -> impl clap::builder::TypedValueParser<Value = sweeptrace::regress::Field> {
+    use clap::builder::TypedValueParser;
+    use strum::IntoEnumIterator;
+    let names: Vec<&'static str> = sweeptrace::regress::Field::iter()
+        .map(<&'static str>::from)
+        .collect();
+    clap::builder::PossibleValuesParser::new(names).try_map(|name: String| {
+        name.parse::<sweeptrace::regress::Field>()
+            .map_err(|_| format!("`{name}` is not a field"))
+    })
 }
 
 /// The recording id of a replay of `trace` for `purpose` (`replay`,
@@ -184,9 +198,13 @@ pub fn warn_unfinished(target: &std::path::Path) {
     }
     let names: Vec<String> = found.iter().map(|p| p.display().to_string()).collect();
     eprintln!(
-        "warning: {} unfinished temporary file(s) of {} from an interrupted earlier run \
+        "warning: {} of {} from an interrupted earlier run \
          (the target itself was not touched); remove them with: rm {}",
-        found.len(),
+        sweeptrace::numbers::counted(
+            found.len() as u64,
+            "unfinished temporary file",
+            "unfinished temporary files"
+        ),
         target.display(),
         names.join(" ")
     );

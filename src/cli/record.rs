@@ -20,7 +20,7 @@ use sweeptrace::trace::write_trace_file;
 #[command(after_help = "Examples:\n  \
     sweeptrace record --scene mini_golf -o mini_golf.mcap\n  \
     sweeptrace record --scene terrain --terrain-cells 64 --balls 4 --seed 7 --frames 600 -o hills.mcap\n  \
-    sweeptrace record --mesh level.obj --radius 0.2 --position 0,0,5 --margin 0.01 -o level.mcap")]
+    sweeptrace record --mesh tests/fixtures/scanned/bunny_res4.obj --radius 0.005 --position 0,0.1,0.3 --margin 0.001 --frames 200 -o bunny.mcap")]
 pub struct Args {
     /// Built-in scene: `mini_golf` (green, walls, ramp, cup), `bowl`, `box`
     /// (closed, ball inside), `terrain` (height field, 100,352 triangles by
@@ -36,7 +36,7 @@ pub struct Args {
     /// 1 to 4096).
     #[arg(long, default_value_t = scenes::TERRAIN_DEFAULT_CELLS, value_name = "N")]
     pub terrain_cells: usize,
-    /// Output trace file [default: `<scene>.mcap`]. Written atomically: a
+    /// Output trace file [default: <scene>.mcap]. Written atomically: a
     /// failed run leaves no file behind.
     #[arg(short, long, value_name = "OUT")]
     pub output: Option<PathBuf>,
@@ -131,9 +131,13 @@ pub fn run(args: Args) -> anyhow::Result<RunOutcome> {
             .map(|d| d.index.to_string())
             .collect();
         eprintln!(
-            "warning: scene `{}`: {} degenerate triangle(s) left out (first: {})",
+            "warning: scene `{}`: {} left out (first: {})",
             scene.name,
-            mesh.degenerate().len(),
+            sweeptrace::numbers::counted(
+                mesh.degenerate().len() as u64,
+                "degenerate triangle",
+                "degenerate triangles"
+            ),
             first.join(", ")
         );
     }
@@ -203,28 +207,29 @@ pub fn summary_paragraph(
     s: &SimSummary,
     file: &str,
 ) -> String {
+    use sweeptrace::numbers::counted;
     let mut text = format!(
-        "Recorded {} sweeps of {} ball(s) of radius {} over {} frames ({} trace frames with sub-steps) \
-         in scene `{scene}` ({triangles} triangles, margin {}, facing {}, seed {}): {} collisions \
-         ({} face, {} edge, {} vertex) and {} misses.",
-        s.sweeps,
-        options.balls,
+        "Recorded {} of {} of radius {} over {} ({} with sub-steps) in scene `{scene}` \
+         ({}, margin {}, facing {}, seed {}): {} ({} face, {} edge, {} vertex) and {}.",
+        counted(s.sweeps, "sweep", "sweeps"),
+        counted(u64::from(options.balls), "ball", "balls"),
         options.radius,
-        s.sim_frames,
-        s.trace_frames,
+        counted(s.sim_frames, "frame", "frames"),
+        counted(s.trace_frames, "trace frame", "trace frames"),
+        counted(triangles as u64, "triangle", "triangles"),
         options.margin,
         options.facing,
         options.seed,
-        s.collisions(),
+        counted(s.collisions(), "collision", "collisions"),
         s.face,
         s.edge,
         s.vertex,
-        s.none,
+        counted(s.none, "miss", "misses"),
     );
     if s.truncated > 0 {
         text.push_str(&format!(
-            " {} ball-frames ran out of sub-steps.",
-            s.truncated
+            " {} ran out of sub-steps.",
+            counted(s.truncated, "ball-frame", "ball-frames")
         ));
     }
     if !s.stopped.is_empty() {
@@ -235,7 +240,8 @@ pub fn summary_paragraph(
             .count();
         let bad = s.stopped.len() - left;
         text.push_str(&format!(
-            " {left} ball(s) left the play volume and stopped recording"
+            " {} left the play volume and stopped recording",
+            counted(left as u64, "ball", "balls")
         ));
         if bad > 0 {
             text.push_str(&format!(", {bad} stopped on a non-finite value"));

@@ -8,6 +8,7 @@ use std::io::{BufReader, BufWriter, IsTerminal, Read, Write};
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use std::sync::atomic::{AtomicU64, Ordering};
+use std::time::Instant;
 
 use anyhow::{Context, bail};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
@@ -15,10 +16,10 @@ use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use sweeptrace::atomic::PendingFile;
 use sweeptrace::core::Facing;
 use sweeptrace::foxglove::{FoxgloveFile, FoxgloveOptions};
-use sweeptrace::numbers::{self, Rule};
+use sweeptrace::numbers::{self, Rule, plural};
 use sweeptrace::regress::Tolerances;
 use sweeptrace::replay::{
-    Detail, FrameRange, ReplayError, ReplayEvent, ReplayOptions, replay_events_parallel,
+    Detail, FrameRange, ReplayError, ReplayEvent, ReplayOptions, Selection, replay_events_parallel,
 };
 use sweeptrace::run::RunOutcome;
 use sweeptrace::trace::TraceReader;
@@ -37,16 +38,22 @@ pub const DEFAULT_CONNECT_URL: &str = "rerun+http://127.0.0.1:9876/proxy";
 #[derive(Debug, clap::Args)]
 #[command(after_help = "\
 Examples:
-  sweeptrace replay traces/bowl.mcap                      # writes ./bowl.rrd
-  sweeptrace replay traces/bowl.mcap --spawn --frames 100..200 --detail candidates
-  sweeptrace replay traces/bowl.mcap --outcomes - --rrd /tmp/bowl.rrd --ball 0
-  sweeptrace replay traces/bowl.mcap --foxglove bowl.foxglove.mcap   # open in Foxglove
+  sweeptrace replay traces/record_mini_golf.mcap          # writes ./record_mini_golf.rrd
+  sweeptrace replay traces/record_mini_golf.mcap --frames 100..200 --detail candidates --rrd golf.rrd
+  sweeptrace replay traces/record_mini_golf.mcap --outcomes - --rrd golf.rrd --ball 0
+  sweeptrace replay traces/record_mini_golf.mcap --foxglove golf.foxglove.mcap   # open in Foxglove
 
-Without --outcomes, --rrd, --foxglove, --spawn or --connect the recording is
+To watch in a Rerun viewer, add --spawn (starts `rerun`, which must be on
+PATH) or --connect (streams to a viewer already running).
+
+A --frames or --ball filter that selects no sweep is an error naming the
+trace's balls and frames, and writes nothing; one that selects part says how
+many sweeps it kept. Without --outcomes, --rrd, --foxglove, --spawn or --connect the recording is
 written to <trace stem>.rrd in the current directory. The outputs combine:
 one replay can write outcomes, a Rerun recording and a Foxglove file. Files
 are written under a temporary name next to the target and renamed once
-complete.")]
+complete: an error (or Ctrl-C, SIGTERM) leaves none of them, only a trace
+that ends early (exit 3) keeps what was read before its end.")]
 pub struct Args {
     /// The trace (an MCAP file).
     #[arg(value_name = "TRACE")]
@@ -160,6 +167,7 @@ impl OutcomeSink {
 
 /// Runs the replay.
 pub fn run(args: Args) -> anyhow::Result<RunOutcome> {
+    let started = Instant::now();
     let trace_path = &args.trace;
     let file =
         File::open(trace_path).with_context(|| format!("opening {}", trace_path.display()))?;
@@ -201,6 +209,7 @@ pub fn run(args: Args) -> anyhow::Result<RunOutcome> {
     // The recording.
     let mut rrd_file = None;
     let mut logger = None;
+    let mut viewer_since = None;
     if record {
         let trace =
             File::open(trace_path).with_context(|| format!("opening {}", trace_path.display()))?;
@@ -218,6 +227,9 @@ pub fn run(args: Args) -> anyhow::Result<RunOutcome> {
                 })?;
             sinks.push(Box::new(sink));
             rrd_file = Some((pending, writer));
+        }
+        if args.spawn || args.connect.is_some() {
+            viewer_since = Some(Instant::now());
         }
         if args.spawn {
             let info = rerun::spawn(&rerun::SpawnOptions::default())
@@ -378,10 +390,24 @@ pub fn run(args: Args) -> anyhow::Result<RunOutcome> {
     );
     if let Err(err) = result {
         progress.finish_and_clear();
+        abandon(logger, args.spawn || args.connect.is_some());
         return Err(err);
     }
     progress.finish_and_clear();
     let summary = events.summary();
+
+    // Nothing is written unless the run completed (or ended at a
+    // truncation, whose outputs hold what was read): the pending files are
+    // dropped here, which removes them.
+    if let Some(err) = trace_error.take_if(|err| !err.is_truncation()) {
+        abandon(logger, args.spawn || args.connect.is_some());
+        return Err(err).name_file_once("replaying", &source_name);
+    }
+    let selection = summary.selection(&options);
+    if selection.is_nothing() {
+        abandon(logger, args.spawn || args.connect.is_some());
+        bail!("{source_name}: {selection}; nothing written");
+    }
 
     // Finish the files: the recording's footer is written when the last
     // clone of the stream is dropped.
@@ -399,11 +425,20 @@ pub fn run(args: Args) -> anyhow::Result<RunOutcome> {
             // (and dropping the stream) wait forever.
             if let Err(err) = rec.flush_with_timeout(VIEWER_FLUSH_TIMEOUT) {
                 std::mem::forget(rec);
+                let at = args.connect.as_deref().unwrap_or("the spawned viewer");
+                // One figure: how long the stream tried, from its start.
+                let tried = viewer_since.map_or(0.0, |t| t.elapsed().as_secs_f64());
+                let what = match err {
+                    rerun::sink::SinkFlushError::Timeout => {
+                        format!("no viewer took the recording (waited {tried:.0} s in all)")
+                    }
+                    rerun::sink::SinkFlushError::Failed { .. } => {
+                        format!("could not connect (tried for {tried:.0} s)")
+                    }
+                };
                 bail!(
-                    "streaming to the viewer at {}: {err} within {} s; is a Rerun viewer \
-                     running there? (start one with `rerun`, or write a file with --rrd)",
-                    args.connect.as_deref().unwrap_or("the spawned viewer"),
-                    VIEWER_FLUSH_TIMEOUT.as_secs()
+                    "streaming to the viewer at {at}: {what}; is a Rerun viewer running there? \
+                     (start one with `rerun`, or write a file with --rrd)"
                 );
             }
         } else {
@@ -411,24 +446,23 @@ pub fn run(args: Args) -> anyhow::Result<RunOutcome> {
         }
         drop(rec);
     }
-    if let Some((pending, writer)) = rrd_file {
-        let target = pending.target().to_path_buf();
-        writer.finish().map_err(|e| {
-            anyhow::anyhow!("writing the recording {}: {}", target.display(), e.reason)
-        })?;
-        complete(pending)?;
-        eprintln!("wrote the recording to {}", target.display());
-    }
-    if let Some(file) = foxglove {
-        let target = args.foxglove.as_deref().unwrap_or(Path::new("")).display();
-        let counts = file.commit()?;
-        eprintln!(
-            "wrote the Foxglove file {target} ({} scenes, {} sweeps, {} messages)",
-            counts.scenes, counts.sweeps, counts.messages
-        );
-    }
-    match outcomes {
-        Some(OutcomeSink::Stdout(mut w)) => w.flush().context(writing_outcomes.clone())?,
+    // Every file finished before any is renamed into place, so that an
+    // error finishing one leaves none of them.
+    let rrd_done = match rrd_file {
+        Some((pending, writer)) => {
+            let target = pending.target().to_path_buf();
+            writer.finish().map_err(|e| {
+                anyhow::anyhow!("writing the recording {}: {}", target.display(), e.reason)
+            })?;
+            Some(pending)
+        }
+        None => None,
+    };
+    let outcomes_done = match outcomes {
+        Some(OutcomeSink::Stdout(mut w)) => {
+            w.flush().context(writing_outcomes.clone())?;
+            None
+        }
         Some(OutcomeSink::File(mut w, pending)) => {
             w.flush().context(writing_outcomes.clone())?;
             let file = w
@@ -436,29 +470,63 @@ pub fn run(args: Args) -> anyhow::Result<RunOutcome> {
                 .map_err(|e| e.into_error())
                 .context(writing_outcomes.clone())?;
             sweeptrace::atomic::sync(&file).context(writing_outcomes.clone())?;
-            let target = pending.target().to_path_buf();
-            complete(pending)?;
-            eprintln!("wrote the outcomes to {}", target.display());
+            Some(pending)
         }
-        None => {}
+        None => None,
+    };
+    let mut wrote = Vec::new();
+    if let Some(file) = foxglove {
+        let target = args.foxglove.as_deref().unwrap_or(Path::new("")).display();
+        let counts = file.commit()?;
+        wrote.push(format!(
+            "wrote the Foxglove file {target} ({} {}, {} {}, {} {})",
+            counts.scenes,
+            plural(counts.scenes, "scene"),
+            counts.sweeps,
+            plural(counts.sweeps, "sweep"),
+            counts.messages,
+            plural(counts.messages, "message"),
+        ));
+    }
+    if let Some(pending) = rrd_done {
+        let target = pending.target().to_path_buf();
+        complete(pending)?;
+        wrote.push(format!("wrote the recording to {}", target.display()));
+    }
+    if let Some(pending) = outcomes_done {
+        let target = pending.target().to_path_buf();
+        complete(pending)?;
+        wrote.push(format!("wrote the outcomes to {}", target.display()));
+    }
+    for line in wrote {
+        eprintln!("{line}");
     }
     if args.spawn || args.connect.is_some() {
         eprintln!("streamed the recording to the viewer");
     }
-    eprint!("{}", summary.render());
+    eprint!("{}", summary.render_timed(Some(started.elapsed())));
+    if let Selection::Part { .. } = selection {
+        eprintln!("{selection}");
+    }
     if let Some(err) = trace_error {
         eprintln!(
-            "error: {err:#}\nthe outputs hold the {} sweeps read before it{}",
-            summary.sweeps,
+            "error: {err:#}\nthe outputs hold the {} read before it{}",
+            numbers::counted(summary.sweeps, "sweep", "sweeps"),
             last_frame.map_or(String::new(), |f| format!(" (up to frame {f})"))
         );
-        return Ok(if err.is_truncation() {
-            RunOutcome::IncompleteInput
-        } else {
-            RunOutcome::Error
-        });
+        return Ok(RunOutcome::IncompleteInput);
     }
     Ok(RunOutcome::Success)
+}
+
+/// Drops a recording that will not be finished. A stream to a viewer is
+/// leaked instead: dropping it flushes, which waits forever for a viewer
+/// that cannot be reached (the process ends soon after).
+fn abandon(logger: Option<viz::Logger>, to_viewer: bool) {
+    match logger {
+        Some(l) if to_viewer => std::mem::forget(l),
+        other => drop(other),
+    }
 }
 
 /// A progress bar on stderr (hidden when stderr is not a terminal): `what`,

@@ -4,7 +4,7 @@ use std::fmt::Write;
 
 use serde_json::json;
 
-use sweeptrace::core::explain::{describe, num};
+use sweeptrace::core::explain::{describe, miss_distance, num};
 use sweeptrace::core::{Options, Outcome, Sweep, TestRecord, Verdict};
 use sweeptrace::regress::SweepInputs;
 use sweeptrace::trace::messages::OutcomeMsg;
@@ -82,11 +82,20 @@ pub fn outcome_json(o: &Outcome) -> serde_json::Value {
 
 /// Whether a test "came close": it hit, or failed only at the last checks
 /// (contact off the edge, touch point outside the triangle, back-facing).
-pub fn came_close(r: &TestRecord) -> bool {
-    matches!(
-        r.verdict(),
-        Verdict::Hit | Verdict::OffEdge | Verdict::OutsideTriangle | Verdict::BackFacing
-    )
+/// A back-facing face test whose path stays on one side of the plane,
+/// farther than the detection radius `rho` from it, did not come close:
+/// the ball never got near that face.
+pub fn came_close(r: &TestRecord, rho: f64) -> bool {
+    match r {
+        TestRecord::Face(f) if f.verdict == Verdict::BackFacing => {
+            let crosses = (f.h0 <= 0.0) != (f.h1 <= 0.0);
+            crosses || f.h0.abs().min(f.h1.abs()) <= rho
+        }
+        _ => matches!(
+            r.verdict(),
+            Verdict::Hit | Verdict::OffEdge | Verdict::OutsideTriangle | Verdict::BackFacing
+        ),
+    }
 }
 
 /// A marker for the primary test and for other hits tied with it
@@ -101,15 +110,39 @@ fn role(o: &Outcome, t: &TestRecord) -> &'static str {
     }
 }
 
-/// The records to show, ordered by triangle, then face, edges, vertices.
-fn shown_records<'a>(r: &SweepReport<'a>) -> Vec<&'a TestRecord> {
-    let mut shown: Vec<&TestRecord> = r
-        .records
-        .iter()
-        .filter(|t| r.all || came_close(t))
-        .collect();
-    shown.sort_by_key(|t| (t.triangle(), t.kind(), t.feature()));
-    shown
+/// How many tests that came close are shown without `--all` (every hit
+/// is shown, then the nearest misses up to this many in all).
+pub const SHOWN_CLOSE_TESTS: usize = 5;
+
+/// The records to show and how many more came close: with `--all` every
+/// record, ordered by triangle, then face, edges, vertices; otherwise the
+/// tests that came close ranked by how close (hits by α, then misses by
+/// [`miss_distance`], ties in triangle and feature order), every hit and
+/// the nearest misses up to [`SHOWN_CLOSE_TESTS`].
+fn shown_records<'a>(r: &SweepReport<'a>) -> (Vec<&'a TestRecord>, usize) {
+    if r.all {
+        let mut shown: Vec<&TestRecord> = r.records.iter().collect();
+        shown.sort_by_key(|t| (t.triangle(), t.kind(), t.feature()));
+        return (shown, 0);
+    }
+    let rho = r.sweep.radius - r.options.margin;
+    let mut close: Vec<&TestRecord> = r.records.iter().filter(|t| came_close(t, rho)).collect();
+    let rank = |t: &TestRecord| match (t.verdict(), t.alpha()) {
+        (Verdict::Hit, Some(alpha)) => (0u8, alpha),
+        _ => (1u8, miss_distance(t).unwrap_or(f64::INFINITY)),
+    };
+    close.sort_by(|a, b| {
+        let (ka, da) = rank(a);
+        let (kb, db) = rank(b);
+        ka.cmp(&kb)
+            .then(da.total_cmp(&db))
+            .then((a.triangle(), a.kind(), a.feature()).cmp(&(b.triangle(), b.kind(), b.feature())))
+    });
+    let hits = close.iter().filter(|t| t.verdict() == Verdict::Hit).count();
+    let keep = hits.max(SHOWN_CLOSE_TESTS).min(close.len());
+    let more = close.len() - keep;
+    close.truncate(keep);
+    (close, more)
 }
 
 /// Everything the `sweep` command reports.
@@ -143,9 +176,9 @@ pub fn sweep_text(r: &SweepReport) -> String {
     }
     writeln!(
         s,
-        "scene {} ({} triangles), radius {}, margin {} (ρ = {}), facing {}",
+        "scene {} ({}), radius {}, margin {} (ρ = {}), facing {}",
         r.scene,
-        r.triangles,
+        sweeptrace::numbers::counted(r.triangles as u64, "triangle", "triangles"),
         num(r.sweep.radius),
         num(r.options.margin),
         num(rho),
@@ -175,13 +208,13 @@ pub fn sweep_text(r: &SweepReport) -> String {
         )
         .unwrap();
     }
-    let shown = shown_records(r);
-    let hidden = r.records.len() - shown.len();
+    let (shown, more_close) = shown_records(r);
+    let hidden = r.records.len() - shown.len() - more_close;
     if shown.is_empty() {
         writeln!(
             s,
-            "no test came close ({} tests run; --all explains each)",
-            r.records.len()
+            "no test came close ({} run; --all explains each)",
+            sweeptrace::numbers::counted(r.records.len() as u64, "test", "tests")
         )
         .unwrap();
     } else {
@@ -191,17 +224,26 @@ pub fn sweep_text(r: &SweepReport) -> String {
             if r.all {
                 ""
             } else {
-                " that came close (hits, contacts off the feature, back-facing)"
+                " that came close (hits, contacts off the feature, back-facing), the closest first"
             }
         )
         .unwrap();
         for t in shown {
             writeln!(s, "  {}{}", describe(t), role(r.outcome, t)).unwrap();
         }
+        if more_close > 0 {
+            writeln!(
+                s,
+                "({} came close too, less so; --all explains each)",
+                sweeptrace::numbers::counted(more_close as u64, "other test", "other tests")
+            )
+            .unwrap();
+        }
         if hidden > 0 {
             writeln!(
                 s,
-                "({hidden} other tests missed earlier; --all explains each)"
+                "({} missed earlier; --all explains each)",
+                sweeptrace::numbers::counted(hidden as u64, "other test", "other tests")
             )
             .unwrap();
         }
@@ -211,7 +253,8 @@ pub fn sweep_text(r: &SweepReport) -> String {
 
 /// The `sweep` report as one JSON object.
 pub fn sweep_json(r: &SweepReport) -> String {
-    let tests: Vec<serde_json::Value> = shown_records(r)
+    let (shown, more_close) = shown_records(r);
+    let tests: Vec<serde_json::Value> = shown
         .into_iter()
         .map(|t| {
             let mut v = serde_json::to_value(t).unwrap_or(serde_json::Value::Null);
@@ -232,6 +275,7 @@ pub fn sweep_json(r: &SweepReport) -> String {
         "facing": r.options.facing,
         "outcome": outcome_json(r.outcome),
         "tests": tests,
+        "close_tests_not_shown": more_close,
     });
     let mut value = value;
     if let Some(object) = value.as_object_mut() {

@@ -13,7 +13,7 @@ use sweeptrace::trace::{TraceReader, write_trace_file};
 /// Arguments of `repro`.
 #[derive(Debug, clap::Args)]
 #[command(after_help = "Example:
-  sweeptrace repro run.mcap --frame 120 --ball 0 -o case.mcap > repro_test.rs
+  sweeptrace repro traces/record_mini_golf.mcap --frame 120 --ball 0 -o case.mcap > repro_test.rs
 
 Writes OUT: the sweep, the triangles within its reach (renumbered in their
 order; the scene's name and a `sweeptrace.repro` metadata record give each

@@ -17,8 +17,8 @@ use sweeptrace::trace::messages::OutcomeMsg;
 #[derive(Debug, clap::Args)]
 #[command(after_help = "Examples:
   sweeptrace sweep --scene cube --radius 0.5 --from 0,3,0.2 --to 0.9,-3,0.2
-  sweeptrace sweep --mesh level.obj --radius 0.2 --from 1,2,5 --to 1,2,-1 --margin 0.01
-  sweeptrace sweep --trace run.mcap --frame 120 --ball 0      # that sweep, its scene, margin, facing
+  sweeptrace sweep --mesh tests/fixtures/scanned/bunny_res4.obj --radius 0.01 --from 0,0.1,0.2 --to 0,0.1,-0.2 --margin 0.001
+  sweeptrace sweep --trace traces/record_mini_golf.mcap --frame 120 --ball 0   # that sweep, its scene, margin, facing
 
 Numbers may be written in hexadecimal floating point (0x1.8p+1), read exactly.")]
 pub struct Args {

@@ -15,13 +15,17 @@ use serde::Serialize;
 use serde_json::json;
 
 use crate::core::explain::num;
+use crate::numbers::plural;
 use crate::regress::{
     Agreement, ExpectedTest, FieldDiff, Tolerances, agreement, compare, expected_tests,
     explain_outcome, explained_records,
 };
-use crate::replay::{ReplayError, ReplayEvent, ReplayOptions, SweepResult, replay_events};
+use crate::replay::{
+    ReplayError, ReplayEvent, ReplayOptions, ReplaySummary, SceneState, SweepResult, replay_events,
+};
 use crate::trace::messages::OutcomeMsg;
 use crate::trace::{TraceError, TraceEvent};
+use std::sync::Arc;
 
 /// One side's replayed sweeps, by `(frame, ball)`.
 pub struct Side {
@@ -33,6 +37,11 @@ pub struct Side {
     /// Sweeps that share a `(frame, ball)` with an earlier one (only the
     /// first is compared).
     pub duplicates: u64,
+    /// The scenes, in trace order.
+    pub scenes: Vec<Arc<SceneState>>,
+    /// The replay's counts (what the frame and ball filters kept:
+    /// [`ReplaySummary::selection`]).
+    pub summary: ReplaySummary,
 }
 
 impl Side {
@@ -51,10 +60,13 @@ impl Side {
             options,
             sweeps: BTreeMap::new(),
             duplicates: 0,
+            scenes: Vec::new(),
+            summary: ReplaySummary::default(),
         };
-        for event in replay_events(events, options) {
+        let mut replay = replay_events(events, options);
+        for event in replay.by_ref() {
             match event? {
-                ReplayEvent::Scene(_) => {}
+                ReplayEvent::Scene(scene) => side.scenes.push(scene),
                 ReplayEvent::Sweep(r) => {
                     let key = (r.frame, r.ball);
                     if let std::collections::btree_map::Entry::Vacant(e) = side.sweeps.entry(key) {
@@ -65,6 +77,7 @@ impl Side {
                 }
             }
         }
+        side.summary = replay.summary();
         Ok(side)
     }
 
@@ -132,6 +145,9 @@ pub struct DiffReport {
     pub first: Option<FirstDifference>,
     /// The first sweep present on one side only: `(frame, ball, side)`.
     pub first_unmatched: Option<(u64, u32, char)>,
+    /// How the two sides' scenes differ, one line per difference
+    /// ([`scene_differences`]); empty when they are the same.
+    pub scene_differences: Vec<String>,
     /// The tolerances used.
     pub tolerances: Tolerances,
 }
@@ -158,6 +174,92 @@ fn describe_side(side: &Side) -> String {
     s
 }
 
+/// How the scenes of two replays differ, one line per difference (empty
+/// when they are the same): their number, and scene by scene (in trace
+/// order) the vertex and triangle counts, the geometry, and the margin and
+/// facing rule (those two only when neither side overrides them: an
+/// override is the point of `diff T T --margin-b 0.01`).
+pub fn scene_differences(a: &Side, b: &Side) -> Vec<String> {
+    let mut out = Vec::new();
+    if a.scenes.len() != b.scenes.len() {
+        out.push(format!(
+            "A has {} {}, B has {}",
+            a.scenes.len(),
+            plural(a.scenes.len() as u64, "scene"),
+            b.scenes.len()
+        ));
+    }
+    for (i, (sa, sb)) in a.scenes.iter().zip(&b.scenes).enumerate() {
+        let at = if sa.index == sb.index {
+            format!("scene {i} (message {})", sa.index)
+        } else {
+            format!("scene {i} (message {} in A, {} in B)", sa.index, sb.index)
+        };
+        let (va, vb) = (sa.mesh.vertices().len(), sb.mesh.vertices().len());
+        let (ta, tb) = (
+            sa.mesh.input_triangle_count(),
+            sb.mesh.input_triangle_count(),
+        );
+        if va != vb || ta != tb {
+            out.push(format!(
+                "{at}: {va} {} and {ta} {} in A, {vb} and {tb} in B",
+                if va == 1 { "vertex" } else { "vertices" },
+                plural(ta as u64, "triangle"),
+            ));
+        } else if !same_geometry(sa, sb) {
+            out.push(format!(
+                "{at}: the same counts ({va} {}, {ta} {}), other vertex positions or triangles",
+                if va == 1 { "vertex" } else { "vertices" },
+                plural(ta as u64, "triangle"),
+            ));
+        }
+        if a.options.margin.is_none()
+            && b.options.margin.is_none()
+            && sa.options.margin.to_bits() != sb.options.margin.to_bits()
+        {
+            out.push(format!(
+                "{at}: margin {} in A, {} in B",
+                num(sa.options.margin),
+                num(sb.options.margin)
+            ));
+        }
+        if a.options.facing.is_none()
+            && b.options.facing.is_none()
+            && sa.options.facing != sb.options.facing
+        {
+            out.push(format!(
+                "{at}: facing {} in A, {} in B",
+                sa.options.facing, sb.options.facing
+            ));
+        }
+    }
+    out
+}
+
+/// Whether two scenes have the same vertices (bit for bit) and triangles.
+fn same_geometry(a: &SceneState, b: &SceneState) -> bool {
+    let bits = |s: &SceneState| -> Vec<[u64; 3]> {
+        s.mesh
+            .vertices()
+            .iter()
+            .map(|p| [p.x.to_bits(), p.y.to_bits(), p.z.to_bits()])
+            .collect()
+    };
+    let triangles = |s: &SceneState| -> Vec<(u32, [u32; 3])> {
+        let mut t: Vec<(u32, [u32; 3])> = s
+            .mesh
+            .triangles()
+            .iter()
+            .map(|t| (t.index, t.vertex_indices))
+            .collect();
+        t.sort_unstable();
+        t
+    };
+    let degenerate =
+        |s: &SceneState| -> Vec<usize> { s.mesh.degenerate().iter().map(|d| d.index).collect() };
+    bits(a) == bits(b) && triangles(a) == triangles(b) && degenerate(a) == degenerate(b)
+}
+
 /// Compares two replays sweep by sweep.
 pub fn diff(a: &Side, b: &Side, tolerances: &Tolerances) -> DiffReport {
     let mut report = DiffReport {
@@ -173,6 +275,7 @@ pub fn diff(a: &Side, b: &Side, tolerances: &Tolerances) -> DiffReport {
         by_field: BTreeMap::new(),
         first: None,
         first_unmatched: None,
+        scene_differences: scene_differences(a, b),
         tolerances: *tolerances,
     };
     let unmatched = |key: (u64, u32), side: char, report: &mut DiffReport| {
@@ -240,6 +343,12 @@ pub fn diff(a: &Side, b: &Side, tolerances: &Tolerances) -> DiffReport {
 pub fn render_text(r: &DiffReport) -> String {
     let mut s = String::new();
     let _ = writeln!(s, "A: {}\nB: {}", r.a, r.b);
+    if !r.scene_differences.is_empty() {
+        let _ = writeln!(s, "the scenes differ:");
+        for d in &r.scene_differences {
+            let _ = writeln!(s, "  {d}");
+        }
+    }
     if r.is_same() {
         if r.ties > 0 {
             let _ = writeln!(
@@ -249,14 +358,21 @@ pub fn render_text(r: &DiffReport) -> String {
                 r.compared, r.ties
             );
         } else {
-            let _ = writeln!(s, "same: {} sweeps, identical outcomes", r.compared);
+            let _ = writeln!(
+                s,
+                "same: {}, identical outcomes",
+                crate::numbers::counted(r.compared, "sweep", "sweeps")
+            );
         }
         return s;
     }
     let _ = writeln!(
         s,
-        "different: {} of {} sweeps differ; {} only in A, {} only in B",
-        r.different, r.compared, r.only_in_a, r.only_in_b
+        "different: {} of {} differ; {} only in A, {} only in B",
+        r.different,
+        crate::numbers::counted(r.compared, "sweep", "sweeps"),
+        r.only_in_a,
+        r.only_in_b
     );
     if !r.by_kind.is_empty() {
         let _ = writeln!(s, "by kind (A -> B):");

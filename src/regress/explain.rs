@@ -102,8 +102,12 @@ pub fn expected_tests(
         };
         let why = match scene {
             Some(s) if triangle as usize >= s.mesh.input_triangle_count() => format!(
-                "triangle {triangle} does not exist: the scene has {} triangles",
-                s.mesh.input_triangle_count()
+                "triangle {triangle} does not exist: the scene has {}",
+                crate::numbers::counted(
+                    s.mesh.input_triangle_count() as u64,
+                    "triangle",
+                    "triangles"
+                )
             ),
             Some(s)
                 if s.mesh

@@ -232,8 +232,11 @@ pub fn render_text(r: &TraceReport) -> String {
     let mut s = String::new();
     let sides = sides_of(r);
     let mut counts = format!(
-        "{} sweeps, {} compared, {} without expectation, {} expectations without a sweep",
-        r.sweeps, r.compared, r.sweeps_without_expectation, r.expectations_without_sweep
+        "{}, {} compared, {} without expectation, {} without a sweep",
+        crate::numbers::counted(r.sweeps, "sweep", "sweeps"),
+        r.compared,
+        r.sweeps_without_expectation,
+        crate::numbers::counted(r.expectations_without_sweep, "expectation", "expectations"),
     );
     if !r.tolerances.fields.is_all() {
         let _ = write!(counts, ", fields compared: {}", r.tolerances.fields.names());
@@ -241,8 +244,8 @@ pub fn render_text(r: &TraceReport) -> String {
     if r.ties > 0 {
         let _ = write!(
             counts,
-            ", {} ties (the expectation names another member of the tie set: a match)",
-            r.ties
+            ", {} (the expectation names another member of the tie set: a match)",
+            crate::numbers::counted(r.ties, "tie", "ties")
         );
     }
     if r.fragile_divergent > 0 {

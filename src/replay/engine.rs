@@ -215,6 +215,7 @@ impl Replay {
         index: u64,
         msg: SweepMsg,
     ) -> Result<(), ReplayError> {
+        self.summary.seen.add(msg.frame, msg.ball);
         if self.pending.first().is_some_and(|p| p.frame != msg.frame) {
             self.release_pending();
         }
@@ -250,6 +251,7 @@ impl Replay {
         let Some(computed) = computed else {
             return self.sweep(log_time_nanos, index, msg);
         };
+        self.summary.seen.add(msg.frame, msg.ball);
         if self.pending.first().is_some_and(|p| p.frame != msg.frame) {
             self.release_pending();
         }

@@ -23,6 +23,7 @@ mod error;
 mod iter;
 mod options;
 mod primary;
+mod selection;
 mod summary;
 mod tunnel;
 
@@ -33,5 +34,6 @@ pub use iter::{
 };
 pub use options::{Detail, FrameRange, ReplayOptions};
 pub use primary::{CollectPrimary, primary_records};
+pub use selection::{Selection, SweepExtent};
 pub use summary::{LISTED_TUNNELS, ReplaySummary, TunnelAt};
 pub use tunnel::{Tunnel, TunnelKind, sweep_end, tunnel_during_sweep};

@@ -25,10 +25,22 @@ pub enum Detail {
     /// normal); when nothing hits, the one test that came nearest
     /// ([`crate::core::explain::miss_distance`]) among the BVH candidates.
     #[default]
+    #[cfg_attr(
+        feature = "cli",
+        value(
+            help = "The tests that report the primary collision (the primary test first, \
+                      then every other hit tied with it, which share the averaged normal); \
+                      when nothing hits, the one test that came nearest among the BVH candidates"
+        )
+    )]
     Primary,
     /// Every test of every triangle the BVH visited.
     Candidates,
     /// Every test of every triangle ([`crate::core::Broadphase::Exhaustive`]).
+    #[cfg_attr(
+        feature = "cli",
+        value(help = "Every test of every triangle (no broadphase)")
+    )]
     All,
 }
 
@@ -158,6 +170,19 @@ impl ReplayOptions {
             or_star(self.margin.map(|m| format!("{m:e}")), "scene"),
             or_star(self.facing.map(|f| f.to_string()), "scene"),
         )
+    }
+
+    /// The frame and ball filters in words (`frames 100..200, ball 0`), or
+    /// `None` when there is none.
+    pub fn filter_text(&self) -> Option<String> {
+        let mut parts = Vec::new();
+        if self.frames != FrameRange::default() {
+            parts.push(format!("frames {}", self.frames));
+        }
+        if let Some(b) = self.ball {
+            parts.push(format!("ball {b}"));
+        }
+        (!parts.is_empty()).then(|| parts.join(", "))
     }
 
     /// Whether the frame and ball filters keep the sweep of `ball` at `frame`.

@@ -6,7 +6,10 @@ use std::time::Duration;
 use crate::core::explain::num;
 use crate::core::{FragileReason, Kind, Verdict};
 
+use super::ReplayOptions;
+use super::selection::{Selection, SweepExtent};
 use super::tunnel::{Tunnel, TunnelKind};
+use crate::numbers::plural;
 
 /// How many tunnels the summary lists.
 pub const LISTED_TUNNELS: usize = 5;
@@ -55,6 +58,8 @@ pub struct ReplaySummary {
     pub sweeps: u64,
     /// Sweeps skipped by the frame and ball filters.
     pub filtered_out: u64,
+    /// The frames and balls of every sweep read, filtered out or not.
+    pub seen: SweepExtent,
     /// Replayed sweeps by the kind of their outcome (`none` included).
     pub outcomes: BTreeMap<Kind, u64>,
     /// Verdicts of every test run by the explained query (over the visited
@@ -106,8 +111,20 @@ impl ReplaySummary {
         }
     }
 
-    /// A few lines for people.
+    /// What the frame and ball filters of `options` (the replay's) kept.
+    pub fn selection(&self, options: &ReplayOptions) -> Selection {
+        Selection::of(options, &self.seen, self.sweeps)
+    }
+
+    /// A few lines for people, ending with the time in the core.
     pub fn render(&self) -> String {
+        self.render_timed(None)
+    }
+
+    /// A few lines for people, ending with the time the whole run took
+    /// (`total`, when given: reading, the core, the outputs) and the time
+    /// in the core.
+    pub fn render_timed(&self, total: Option<Duration>) -> String {
         use std::fmt::Write;
         let mut s = String::new();
         let kinds = [Kind::Face, Kind::Edge, Kind::Vertex]
@@ -117,11 +134,14 @@ impl ReplaySummary {
             .join(", ");
         let _ = writeln!(
             s,
-            "{} sweeps replayed ({} filtered out) over {} scene(s): {} collisions ({kinds}), {} without",
+            "{} {} replayed ({} filtered out) over {} {}: {} {} ({kinds}), {} without",
             self.sweeps,
+            plural(self.sweeps, "sweep"),
             self.filtered_out,
             self.scenes,
+            plural(self.scenes as u64, "scene"),
             self.collisions(),
+            plural(self.collisions(), "collision"),
             self.outcomes.get(&Kind::None).copied().unwrap_or(0),
         );
         if !self.verdicts.is_empty() {
@@ -183,7 +203,19 @@ impl ReplaySummary {
                 self.degenerate_triangles
             );
         }
-        let _ = writeln!(s, "time in the core: {:.3} s", self.elapsed.as_secs_f64());
+        match total {
+            Some(total) => {
+                let _ = writeln!(
+                    s,
+                    "time: {:.3} s in all, {:.3} s of it in the core",
+                    total.as_secs_f64(),
+                    self.elapsed.as_secs_f64()
+                );
+            }
+            None => {
+                let _ = writeln!(s, "time in the core: {:.3} s", self.elapsed.as_secs_f64());
+            }
+        }
         s
     }
 }

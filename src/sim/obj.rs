@@ -59,8 +59,72 @@ pub fn load_obj(path: &std::path::Path) -> Result<SceneMesh, ObjError> {
 }
 
 /// Parses Wavefront OBJ text from a reader (see [`load_obj`]); errors name
-/// the source `<input>`.
+/// the source `<input>`, and a parse error its line (`line 2 (`v 1 zero
+/// 0`): ...`).
 pub fn obj_from_reader(reader: &mut impl std::io::BufRead) -> Result<SceneMesh, ObjError> {
+    let mut text = Vec::new();
+    reader
+        .read_to_end(&mut text)
+        .map_err(|cause| ObjError::Io {
+            path: "<input>".into(),
+            cause,
+        })?;
+    match parse(&text) {
+        Err(ObjError::Parse { path, reason }) => {
+            let reason = match first_failing_line(&text) {
+                Some((number, line)) => format!("line {number} (`{line}`): {reason}"),
+                None => reason,
+            };
+            Err(ObjError::Parse { path, reason })
+        }
+        other => other,
+    }
+}
+
+/// The first line (from 1) at which the file stops parsing, with its text
+/// (shortened): the shortest prefix of whole lines that does not parse
+/// ends with it. The parser reports no line itself; a prefix that parses
+/// keeps parsing with fewer lines, so a binary search over the lines finds
+/// it with a logarithmic number of parses (on the error path only).
+fn first_failing_line(text: &[u8]) -> Option<(usize, String)> {
+    let mut ends: Vec<usize> = text
+        .iter()
+        .enumerate()
+        .filter(|(_, b)| **b == b'\n')
+        .map(|(i, _)| i + 1)
+        .collect();
+    if ends.last().is_none_or(|&e| e < text.len()) {
+        ends.push(text.len());
+    }
+    let fails = |k: usize| matches!(parse(&text[..ends[k]]), Err(ObjError::Parse { .. }));
+    let last = ends.len().checked_sub(1)?;
+    if !fails(last) {
+        return None;
+    }
+    let (mut lo, mut hi) = (0usize, last);
+    while lo < hi {
+        let mid = lo + (hi - lo) / 2;
+        if fails(mid) {
+            hi = mid;
+        } else {
+            lo = mid + 1;
+        }
+    }
+    let start = if lo == 0 { 0 } else { ends[lo - 1] };
+    let line = String::from_utf8_lossy(&text[start..ends[lo]]);
+    let line = line.trim();
+    let shown: String = line.chars().take(60).collect();
+    let shown = if shown.len() < line.len() {
+        format!("{shown}...")
+    } else {
+        shown
+    };
+    Some((lo + 1, shown))
+}
+
+/// Parses a whole OBJ text.
+fn parse(mut text: &[u8]) -> Result<SceneMesh, ObjError> {
+    let reader = &mut text;
     let options = tobj::LoadOptions {
         triangulate: true,
         single_index: false,

@@ -49,6 +49,12 @@ pub enum TraceError {
         /// The I/O error.
         cause: std::io::Error,
     },
+    /// The file is empty (0 bytes): not a trace, and not a truncated one.
+    #[error("{file}: empty file (0 bytes): not an MCAP trace")]
+    Empty {
+        /// File name.
+        file: String,
+    },
     /// The file ends in the middle of a record (or before its footer).
     #[error(
         "{file}: the file is truncated: it ends in the middle of a record after {messages} complete messages \

@@ -13,6 +13,7 @@ use super::error::TraceError;
 use super::messages::{EXPECTED_TOPIC, SCENE_TOPIC, SWEEP_TOPIC};
 use super::read::{ReadStats, TraceEvent, TraceReader};
 use crate::core::{Mesh, MeshError};
+use crate::numbers::counted;
 
 /// Scenes listed one by one; beyond this only their number is kept.
 pub const MAX_LISTED_SCENES: usize = 64;
@@ -71,6 +72,9 @@ pub struct TraceInfo {
     pub expected_source: Option<super::ExpectedSource>,
     /// What the reader saw: channels, chunks, compression, bytes, metadata.
     pub stats: ReadStats,
+    /// The size of the file, when known (the reader's `stats.bytes` counts
+    /// the bytes read, fewer when reading stopped early).
+    pub file_bytes: Option<u64>,
     /// The error that ended reading early, if any (the rest of the report
     /// covers the messages before it).
     pub error: Option<String>,
@@ -100,6 +104,7 @@ pub fn collect<R: Read>(mut reader: TraceReader<R>) -> (TraceInfo, Option<TraceE
         expected_by_kind: BTreeMap::new(),
         expected_source: None,
         stats: ReadStats::default(),
+        file_bytes: None,
         error: None,
     };
     let mut error = None;
@@ -177,17 +182,31 @@ fn seconds(nanos: u64) -> String {
 pub fn render_text(info: &TraceInfo) -> String {
     let mut out = String::new();
     let s = &info.stats;
-    let compression = if s.compression.is_empty() {
+    let compression = if s.compression.is_empty() && info.error.is_some() {
+        // Reading stopped before a complete chunk: whether the rest of the
+        // file holds chunks is not known.
+        "no complete chunk read".to_string()
+    } else if s.compression.is_empty() {
         "not chunked".to_string()
     } else {
         let list: Vec<&str> = s.compression.iter().map(String::as_str).collect();
-        format!("{} chunks, compression {}", s.chunks, list.join(", "))
+        format!(
+            "{}, compression {}",
+            counted(s.chunks, "chunk", "chunks"),
+            list.join(", ")
+        )
     };
     let _ = writeln!(out, "trace:       {}", info.file);
     let _ = writeln!(
         out,
-        "file:        {} bytes, {compression}, summary {}",
-        s.bytes,
+        "file:        {}, {compression}, summary {}",
+        match info.file_bytes {
+            Some(size) if size != s.bytes => format!("{size} bytes ({} read)", s.bytes),
+            Some(size) => format!("{size} bytes"),
+            // Read to its end: every byte was read.
+            None if info.error.is_none() => format!("{} bytes", s.bytes),
+            None => format!("{} bytes read", s.bytes),
+        },
         if s.has_summary { "present" } else { "absent" }
     );
     if s.read_through_chunk_indexes {
@@ -212,11 +231,11 @@ pub fn render_text(info: &TraceInfo) -> String {
             .unwrap_or_else(|| "(unnamed)".to_string());
         let _ = write!(
             out,
-            "  {name} (message {}, log_time {} ns): {} vertices, {} triangles, {} degenerate, margin {}, facing {}",
+            "  {name} (message {}, log_time {} ns): {}, {}, {} degenerate, margin {}, facing {}",
             scene.index,
             scene.log_time_nanos,
-            scene.vertices,
-            scene.triangles,
+            counted(scene.vertices as u64, "vertex", "vertices"),
+            counted(scene.triangles as u64, "triangle", "triangles"),
             scene.degenerate,
             scene.margin,
             scene.facing
@@ -237,10 +256,17 @@ pub fn render_text(info: &TraceInfo) -> String {
     let more = if info.balls_truncated { ", ..." } else { "" };
     let _ = writeln!(
         out,
-        "sweeps:      {} ({} balls: {}{more})",
+        "sweeps:      {}{}",
         info.sweeps,
-        info.balls.len(),
-        balls.join(", ")
+        if info.balls.is_empty() {
+            String::new()
+        } else {
+            format!(
+                " ({}: {}{more})",
+                counted(info.balls.len() as u64, "ball", "balls"),
+                balls.join(", ")
+            )
+        }
     );
     match info.frames {
         Some((lo, hi)) => {
@@ -277,8 +303,8 @@ pub fn render_text(info: &TraceInfo) -> String {
         };
         let _ = writeln!(
             out,
-            "expected:    present, {} outcomes{kinds}",
-            info.expected
+            "expected:    present, {}{kinds}",
+            counted(info.expected, "outcome", "outcomes")
         );
     } else {
         let _ = writeln!(out, "expected:    absent");
@@ -297,14 +323,14 @@ pub fn render_text(info: &TraceInfo) -> String {
         let note = if ours { "" } else { ", skipped" };
         let _ = writeln!(
             out,
-            "  {topic}  {schema} [{} / {}]  {} messages{note}",
+            "  {topic}  {schema} [{} / {}]  {}{note}",
             if c.schema_encoding.is_empty() {
                 "-"
             } else {
                 c.schema_encoding.as_str()
             },
             c.message_encoding,
-            c.messages
+            counted(c.messages, "message", "messages")
         );
     }
     if s.metadata.is_empty() {

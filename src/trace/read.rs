@@ -176,6 +176,9 @@ pub struct ReadStats {
     /// field of their own.)
     #[serde(skip)]
     pub expected_source: Option<ExpectedSource>,
+    /// Whether the file's magic and header record were read: the input is
+    /// an MCAP file (what follows may still be damaged).
+    pub header_read: bool,
     /// The header's library string.
     pub library: String,
     /// The header's profile.
@@ -373,6 +376,9 @@ impl State {
         let messages = self.stats.messages;
         let limit = self.limits.record_bytes;
         match err {
+            McapError::UnexpectedEof if !in_chunk && self.stats.bytes == 0 => {
+                TraceError::Empty { file }
+            }
             McapError::UnexpectedEof if !in_chunk => TraceError::Truncated { file, messages },
             McapError::RecordTooLarge { opcode, len } => TraceError::TooLarge {
                 file,
@@ -465,6 +471,7 @@ impl State {
         };
         match record {
             Record::Header(header) => {
+                self.stats.header_read = true;
                 self.stats.library = header.library;
                 self.stats.profile = header.profile;
             }

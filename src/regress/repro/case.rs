@@ -463,11 +463,11 @@ impl ReproCase {
         let mut s = String::new();
         let _ = writeln!(
             s,
-            "frame {}, ball {}: {} of {} triangles within reach{}",
+            "frame {}, ball {}: {} of {} within reach{}",
             self.frame,
             self.ball,
             self.original_triangles.len(),
-            self.original_triangle_count,
+            crate::numbers::counted(self.original_triangle_count as u64, "triangle", "triangles"),
             match self.extent_triangle {
                 Some(t) => format!(" (with triangle {t}, kept for the scene's extent)"),
                 None => String::new(),

@@ -2,6 +2,7 @@
 //! expectation, and why it may not be found.
 
 use crate::core::{MeshError, Options, Sweep, SweepError};
+use crate::replay::SweepExtent;
 use crate::trace::messages::{OutcomeMsg, SceneMsg, SweepMsg};
 use crate::trace::{TraceError, TraceEvent};
 
@@ -13,7 +14,7 @@ pub enum ReproError {
     #[error(transparent)]
     Trace(#[from] TraceError),
     /// No sweep has that frame and ball.
-    #[error("{trace} has no sweep of frame {frame}, ball {ball} ({sweeps} sweeps read)")]
+    #[error("{trace} has no sweep of frame {frame}, ball {ball}: it has {seen}")]
     NotFound {
         /// The trace.
         trace: String,
@@ -23,6 +24,8 @@ pub enum ReproError {
         ball: u32,
         /// Sweeps in the trace.
         sweeps: u64,
+        /// The frames and balls of the trace's sweeps.
+        seen: SweepExtent,
     },
     /// The sweep has no scene before it.
     #[error("{trace}: the sweep of frame {frame}, ball {ball} has no scene before it")]
@@ -99,7 +102,7 @@ where
     let mut scene: Option<SceneMsg> = None;
     let mut early: Option<OutcomeMsg> = None;
     let mut found: Option<TraceSweep> = None;
-    let mut sweeps = 0u64;
+    let mut seen = SweepExtent::default();
     for event in events {
         let event = match event {
             Ok(e) => e,
@@ -119,7 +122,7 @@ where
                 log_time_nanos,
                 ..
             } => {
-                sweeps += 1;
+                seen.add(sweep.frame, sweep.ball);
                 if let Some(f) = &found {
                     if sweep.frame != f.sweep.frame {
                         break;
@@ -158,6 +161,7 @@ where
         trace: name.to_string(),
         frame,
         ball,
-        sweeps,
+        sweeps: seen.sweeps,
+        seen,
     })
 }

@@ -969,9 +969,7 @@ unsafe fn serve(
                 // points into `scene`, alive until the next scene.
                 let status = unsafe { on_scene(user, &view) };
                 if status != 0 {
-                    let name = message
-                        .name
-                        .map_or_else(String::new, |n| format!(" `{n}`"));
+                    let name = message.name.map_or_else(String::new, |n| format!(" `{n}`"));
                     return Err(Stop(format!(
                         "on_scene returned {status} for the scene{name} ({at})"
                     )));
@@ -1014,7 +1012,8 @@ unsafe fn serve(
                     normal: answer.normal,
                     contact: answer.contact,
                 };
-                let invalid = |message: String| Stop(format!("invalid answer to {which}: {message}"));
+                let invalid =
+                    |message: String| Stop(format!("invalid answer to {which}: {message}"));
                 let message = outcome_message(&outcome, Some(current.triangles.len() / 3))
                     .map_err(|f| invalid(f.message))?;
                 validate_outcome(&message)
@@ -1079,7 +1078,15 @@ pub unsafe extern "C" fn sweeptrace_serve_engine(
         let stdin = std::io::stdin();
         let stdout = std::io::stdout();
         // SAFETY: the callbacks' contract is the caller's.
-        unsafe { serve(on_scene, on_sweep, user, &mut stdin.lock(), &mut stdout.lock()) }
+        unsafe {
+            serve(
+                on_scene,
+                on_sweep,
+                user,
+                &mut stdin.lock(),
+                &mut stdout.lock(),
+            )
+        }
     }));
     let message = match result {
         Ok(Ok(())) => return 0,

@@ -172,11 +172,17 @@ mod tests {
             parse_request(br#"{"type":"hello","x":1}"#).unwrap(),
             Request::Other("hello".to_string())
         );
-        assert!(parse_request(br#"{"frame":3}"#).unwrap_err().contains("type"));
         assert!(
-            parse_request(br#"{"type":"sweep","frame":3,"radius":1,"p0":[0,0,0],"p1":[0,0,0],"speed":2}"#)
+            parse_request(br#"{"frame":3}"#)
                 .unwrap_err()
-                .contains("speed")
+                .contains("type")
+        );
+        assert!(
+            parse_request(
+                br#"{"type":"sweep","frame":3,"radius":1,"p0":[0,0,0],"p1":[0,0,0],"speed":2}"#
+            )
+            .unwrap_err()
+            .contains("speed")
         );
         let answer = OutcomeMsg::miss(3, 1);
         let line = answer_line(&answer).unwrap();

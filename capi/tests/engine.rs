@@ -462,3 +462,27 @@ fn bad_input_and_a_null_callback_are_errors() {
         "`engine->on_sweep` is a null pointer",
     );
 }
+
+#[test]
+fn minimal_engine_runs_through_conform_and_the_docs_show_it_unchanged() {
+    let example = std::fs::read_to_string(root().join("examples/c/minimal_engine.c"))
+        .expect("reading examples/c/minimal_engine.c");
+    for doc in ["capi/README.md", "docs/ENGINE_PROTOCOL.md"] {
+        let text = std::fs::read_to_string(root().join(doc)).expect("reading the docs");
+        assert!(
+            text.contains(&format!("```c\n{example}```\n")),
+            "{doc} does not show examples/c/minimal_engine.c as it is: copy the file into its ```c block"
+        );
+    }
+    let Some(program) = compile("examples/c/minimal_engine.c", false) else {
+        return;
+    };
+    // It answers "no collision" everywhere: no fault, the miss rules pass,
+    // the hit rules fail.
+    let failing = conform_failures(&command(&program, ""));
+    assert!(failing.contains(&"face.hit".to_string()), "{failing:?}");
+    assert!(
+        !failing.iter().any(|r| r.starts_with("face.miss")),
+        "{failing:?}"
+    );
+}

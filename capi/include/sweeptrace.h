@@ -45,6 +45,15 @@ typedef enum SweeptraceStatus {
   SWEEPTRACE_STATUS_PANIC = 6,
 } SweeptraceStatus;
 
+// The facing rule of a scene (docs/SEMANTICS.md): which direction of
+// travel lets a triangle report a collision.
+typedef enum SweeptraceFacing {
+  // `n · d ≤ 0`: toward the front, or parallel to the plane (default).
+  SWEEPTRACE_FACING_NON_STRICT = 0,
+  // `n · d < 0`: strictly toward the front.
+  SWEEPTRACE_FACING_STRICT = 1,
+} SweeptraceFacing;
+
 // The kind of a collision, for [`SweeptraceOutcome::kind`].
 typedef enum SweeptraceKind {
   // Nothing touched: the ball moves all the way (`alpha` 1).
@@ -56,15 +65,6 @@ typedef enum SweeptraceKind {
   // A vertex of a triangle.
   SWEEPTRACE_KIND_VERTEX = 3,
 } SweeptraceKind;
-
-// The facing rule of a scene (docs/SEMANTICS.md): which direction of
-// travel lets a triangle report a collision.
-typedef enum SweeptraceFacing {
-  // `n · d ≤ 0`: toward the front, or parallel to the plane (default).
-  SWEEPTRACE_FACING_NON_STRICT = 0,
-  // `n · d < 0`: strictly toward the front.
-  SWEEPTRACE_FACING_STRICT = 1,
-} SweeptraceFacing;
 
 // A trace being written. Opaque: made by [`sweeptrace_writer_open`],
 // released by [`sweeptrace_writer_free`]. Use each writer from one thread
@@ -100,6 +100,106 @@ typedef struct SweeptraceOutcome {
   // Contact point on the mesh.
   double contact[3];
 } SweeptraceOutcome;
+
+// A scene, as [`sweeptrace_serve_engine`] gives it to
+// [`SweeptraceEngine::on_scene`]. Every pointer in it stays valid until the
+// next scene arrives (the next `on_scene` call) or the loop returns; copy
+// what you need to keep longer.
+typedef struct SweeptraceScene {
+  // The scene's name (UTF-8, NUL-terminated), or null when it has none.
+  // A name holding a NUL character is cut there.
+  const char *name;
+  // `vertex_count` points as `x, y, z` triples (`3 * vertex_count`
+  // doubles, all finite); null when `vertex_count` is 0.
+  const double *vertices;
+  // How many vertices `vertices` holds.
+  size_t vertex_count;
+  // `triangle_count` triples of vertex indices (each below
+  // `vertex_count`), counter-clockwise seen from the front; null when
+  // `triangle_count` is 0. Degenerate triangles are passed as they are.
+  const uint32_t *triangles;
+  // How many triangles `triangles` holds. A scene with none is passed
+  // like any other: every sweep against it misses.
+  size_t triangle_count;
+  // The margin `ε` (`≥ 0`, finite): detect at `ρ = radius - margin`.
+  double margin;
+  // The facing rule.
+  enum SweeptraceFacing facing;
+} SweeptraceScene;
+
+// Called with each scene: return 0, or nonzero to stop the loop (it then
+// returns 1 after printing an error naming the scene).
+typedef int (*SweeptraceSceneFn)(void *user, const struct SweeptraceScene *scene);
+
+// A sweep, as [`sweeptrace_serve_engine`] gives it to
+// [`SweeptraceEngine::on_sweep`]: ball `ball` of radius `radius` moving
+// from `p0` to `p1`, against the last scene. The numbers are finite and
+// `radius` is above the scene's margin.
+typedef struct SweeptraceSweep {
+  // The sweep's frame.
+  uint64_t frame;
+  // The sweep's ball.
+  uint32_t ball;
+  // The ball's radius.
+  double radius;
+  // Start of the ball's center.
+  double p0[3];
+  // End of the ball's center.
+  double p1[3];
+} SweeptraceSweep;
+
+// An engine's answer to one sweep, filled in by
+// [`SweeptraceEngine::on_sweep`]; the loop writes it as the sweep's
+// outcome line (with the sweep's frame and ball).
+//
+// Before each call it holds "no collision" (`kind` none, `alpha` 1,
+// `fields` 0), so a callback that sets nothing answers a miss. `fields`
+// says which of `triangle`, `feature`, `normal` and `contact` the engine
+// gives (`SWEEPTRACE_FIELD_*` or-ed); a field left out is not compared. A
+// given field is written as its value when the kind has one (`triangle`,
+// `normal`, `contact` for a face, edge or vertex; `feature` for an edge
+// or vertex) and as `null` otherwise, exactly as [`SweeptraceOutcome`].
+//
+// An invalid answer (a NaN or `alpha` outside `[0, 1]`, a `kind` that is
+// not a [`SweeptraceKind`], unknown bits in `fields`, a given `feature`
+// above 2 on an edge or vertex, a given `triangle` out of the scene's
+// range, a given `normal` or `contact` that is not finite) is not written:
+// the loop prints why on stderr and returns 1.
+typedef struct SweeptraceAnswer {
+  // A [`SweeptraceKind`] value.
+  uint32_t kind;
+  // Fraction of the sweep travelled before the contact, in `[0, 1]`.
+  double alpha;
+  // Which of the fields below are given: `SWEEPTRACE_FIELD_*` or-ed.
+  uint32_t fields;
+  // Index of the triangle hit, in the current scene.
+  uint32_t triangle;
+  // Edge or vertex of the triangle hit: 0, 1 or 2 (the edge from vertex
+  // `feature` to the next, or vertex `feature`).
+  uint32_t feature;
+  // Unit normal at the contact, pointing toward the ball.
+  double normal[3];
+  // Contact point on the mesh.
+  double contact[3];
+} SweeptraceAnswer;
+
+// Called with each sweep: fill in `*out` and return 0, or return nonzero
+// to stop the loop (it then returns 1 after printing an error naming the
+// sweep; nothing is written for it).
+typedef int (*SweeptraceSweepFn)(void *user,
+                                 const struct SweeptraceSweep *sweep,
+                                 struct SweeptraceAnswer *out);
+
+// An engine for [`sweeptrace_serve_engine`]: its two callbacks, both
+// required. The callbacks must not write to standard output (it carries
+// the answers; log to stderr) and must not unwind (a C++ exception must
+// not leave them).
+typedef struct SweeptraceEngine {
+  // Receives each scene.
+  SweeptraceSceneFn on_scene;
+  // Answers each sweep.
+  SweeptraceSweepFn on_sweep;
+} SweeptraceEngine;
 
 #ifdef __cplusplus
 extern "C" {
@@ -226,6 +326,38 @@ const char *sweeptrace_last_error(void);
 // The name of a status (`"ok"`, `"null_pointer"`, ...), for messages.
 // Unknown values give `"unknown"`.
 const char *sweeptrace_status_name(uint32_t status);
+
+// Runs the engine protocol (docs/ENGINE_PROTOCOL.md) on the process's
+// standard input and output: reads each line sweeptrace sends, calls
+// `engine->on_scene(user, scene)` for a scene and
+// `engine->on_sweep(user, sweep, answer)` for a sweep, writes and flushes
+// each answer as its outcome line, in order, and ignores messages of an
+// unknown type (and blank lines). Your engine is a `main` that calls it:
+// `return sweeptrace_serve_engine(&engine, NULL);`.
+//
+// Returns 0 at the end of input (stdin closed), having printed nothing
+// more. Returns 1 after printing one line `sweeptrace engine: ...` on
+// stderr (also given by [`sweeptrace_last_error`]) when:
+// - `engine` or one of its callbacks is null (nothing is read);
+// - a callback returns nonzero (the message names the scene or sweep and
+//   the value returned);
+// - a sweep arrives before any scene;
+// - an answer is invalid (see [`SweeptraceAnswer`]): nothing is written
+//   for it;
+// - an input line is not a protocol message (not JSON, no `type`, a
+//   missing, mistyped or unknown field of a scene or sweep) or its values
+//   are invalid (a NaN, an index out of range, a radius not above the
+//   margin): the message names the input line and the field;
+// - reading or writing fails, or the library panics (a bug).
+//
+// sweeptrace then reports the engine's exit while the sweep awaited its
+// answer, with these stderr lines. Nothing panics across the boundary.
+// Call it from one thread; it returns only at the end.
+//
+// # Safety
+// `engine` is null or points to a [`SweeptraceEngine`] whose callbacks
+// are null or valid functions, safe to call with `user`.
+int sweeptrace_serve_engine(const struct SweeptraceEngine *engine, void *user);
 
 #ifdef __cplusplus
 }  // extern "C"

@@ -16,12 +16,19 @@
 //! without being closed, or a process that dies while writing, leaves no
 //! file under the target name.
 //!
+//! It also serves an engine written in C or C++ to `sweeptrace check
+//! --engine` and `sweeptrace conform --engine`:
+//! [`sweeptrace_serve_engine`] runs the engine protocol
+//! (docs/ENGINE_PROTOCOL.md) on standard input and output and calls the
+//! engine back with each scene and sweep ([`SweeptraceEngine`]), so the
+//! engine's author writes no JSON.
+//!
 //! `include/sweeptrace.h` is generated from this file by cbindgen.
 
 #![warn(missing_docs)]
 
 use std::cell::RefCell;
-use std::ffi::{CStr, CString, c_char};
+use std::ffi::{CStr, CString, c_char, c_int, c_void};
 use std::panic::{AssertUnwindSafe, catch_unwind};
 use std::path::PathBuf;
 
@@ -735,4 +742,361 @@ pub extern "C" fn sweeptrace_status_name(status: u32) -> *const c_char {
         _ => c"unknown",
     };
     name.as_ptr()
+}
+
+// ---------------------------------------------------------------------------
+// Serving an engine: the engine protocol (docs/ENGINE_PROTOCOL.md) on the
+// process's standard input and output, with the engine as two callbacks.
+
+/// A scene, as [`sweeptrace_serve_engine`] gives it to
+/// [`SweeptraceEngine::on_scene`]. Every pointer in it stays valid until the
+/// next scene arrives (the next `on_scene` call) or the loop returns; copy
+/// what you need to keep longer.
+#[repr(C)]
+#[derive(Debug)]
+pub struct SweeptraceScene {
+    /// The scene's name (UTF-8, NUL-terminated), or null when it has none.
+    /// A name holding a NUL character is cut there.
+    pub name: *const c_char,
+    /// `vertex_count` points as `x, y, z` triples (`3 * vertex_count`
+    /// doubles, all finite); null when `vertex_count` is 0.
+    pub vertices: *const f64,
+    /// How many vertices `vertices` holds.
+    pub vertex_count: usize,
+    /// `triangle_count` triples of vertex indices (each below
+    /// `vertex_count`), counter-clockwise seen from the front; null when
+    /// `triangle_count` is 0. Degenerate triangles are passed as they are.
+    pub triangles: *const u32,
+    /// How many triangles `triangles` holds. A scene with none is passed
+    /// like any other: every sweep against it misses.
+    pub triangle_count: usize,
+    /// The margin `ε` (`≥ 0`, finite): detect at `ρ = radius - margin`.
+    pub margin: f64,
+    /// The facing rule.
+    pub facing: SweeptraceFacing,
+}
+
+/// A sweep, as [`sweeptrace_serve_engine`] gives it to
+/// [`SweeptraceEngine::on_sweep`]: ball `ball` of radius `radius` moving
+/// from `p0` to `p1`, against the last scene. The numbers are finite and
+/// `radius` is above the scene's margin.
+#[repr(C)]
+#[derive(Clone, Copy, Debug)]
+pub struct SweeptraceSweep {
+    /// The sweep's frame.
+    pub frame: u64,
+    /// The sweep's ball.
+    pub ball: u32,
+    /// The ball's radius.
+    pub radius: f64,
+    /// Start of the ball's center.
+    pub p0: [f64; 3],
+    /// End of the ball's center.
+    pub p1: [f64; 3],
+}
+
+/// An engine's answer to one sweep, filled in by
+/// [`SweeptraceEngine::on_sweep`]; the loop writes it as the sweep's
+/// outcome line (with the sweep's frame and ball).
+///
+/// Before each call it holds "no collision" (`kind` none, `alpha` 1,
+/// `fields` 0), so a callback that sets nothing answers a miss. `fields`
+/// says which of `triangle`, `feature`, `normal` and `contact` the engine
+/// gives (`SWEEPTRACE_FIELD_*` or-ed); a field left out is not compared. A
+/// given field is written as its value when the kind has one (`triangle`,
+/// `normal`, `contact` for a face, edge or vertex; `feature` for an edge
+/// or vertex) and as `null` otherwise, exactly as [`SweeptraceOutcome`].
+///
+/// An invalid answer (a NaN or `alpha` outside `[0, 1]`, a `kind` that is
+/// not a [`SweeptraceKind`], unknown bits in `fields`, a given `feature`
+/// above 2 on an edge or vertex, a given `triangle` out of the scene's
+/// range, a given `normal` or `contact` that is not finite) is not written:
+/// the loop prints why on stderr and returns 1.
+#[repr(C)]
+#[derive(Clone, Copy, Debug)]
+pub struct SweeptraceAnswer {
+    /// A [`SweeptraceKind`] value.
+    pub kind: u32,
+    /// Fraction of the sweep travelled before the contact, in `[0, 1]`.
+    pub alpha: f64,
+    /// Which of the fields below are given: `SWEEPTRACE_FIELD_*` or-ed.
+    pub fields: u32,
+    /// Index of the triangle hit, in the current scene.
+    pub triangle: u32,
+    /// Edge or vertex of the triangle hit: 0, 1 or 2 (the edge from vertex
+    /// `feature` to the next, or vertex `feature`).
+    pub feature: u32,
+    /// Unit normal at the contact, pointing toward the ball.
+    pub normal: [f64; 3],
+    /// Contact point on the mesh.
+    pub contact: [f64; 3],
+}
+
+impl SweeptraceAnswer {
+    const MISS: SweeptraceAnswer = SweeptraceAnswer {
+        kind: SweeptraceKind::None as u32,
+        alpha: 1.0,
+        fields: 0,
+        triangle: 0,
+        feature: 0,
+        normal: [0.0; 3],
+        contact: [0.0; 3],
+    };
+}
+
+/// Called with each scene: return 0, or nonzero to stop the loop (it then
+/// returns 1 after printing an error naming the scene).
+pub type SweeptraceSceneFn =
+    Option<unsafe extern "C" fn(user: *mut c_void, scene: *const SweeptraceScene) -> c_int>;
+
+/// Called with each sweep: fill in `*out` and return 0, or return nonzero
+/// to stop the loop (it then returns 1 after printing an error naming the
+/// sweep; nothing is written for it).
+pub type SweeptraceSweepFn = Option<
+    unsafe extern "C" fn(
+        user: *mut c_void,
+        sweep: *const SweeptraceSweep,
+        out: *mut SweeptraceAnswer,
+    ) -> c_int,
+>;
+
+/// An engine for [`sweeptrace_serve_engine`]: its two callbacks, both
+/// required. The callbacks must not write to standard output (it carries
+/// the answers; log to stderr) and must not unwind (a C++ exception must
+/// not leave them).
+#[repr(C)]
+#[derive(Clone, Copy, Debug)]
+pub struct SweeptraceEngine {
+    /// Receives each scene.
+    pub on_scene: SweeptraceSceneFn,
+    /// Answers each sweep.
+    pub on_sweep: SweeptraceSweepFn,
+}
+
+/// Why the loop stopped early.
+struct Stop(String);
+
+/// The current scene's storage, kept alive for the engine's pointers.
+struct SceneData {
+    name: Option<CString>,
+    vertices: Vec<f64>,
+    triangles: Vec<u32>,
+    margin: f64,
+}
+
+/// The loop of [`sweeptrace_serve_engine`] over `input` and `output`.
+///
+/// # Safety
+/// The callbacks are callable with `user` as the contract says.
+unsafe fn serve(
+    on_scene: unsafe extern "C" fn(*mut c_void, *const SweeptraceScene) -> c_int,
+    on_sweep: unsafe extern "C" fn(
+        *mut c_void,
+        *const SweeptraceSweep,
+        *mut SweeptraceAnswer,
+    ) -> c_int,
+    user: *mut c_void,
+    input: &mut impl std::io::BufRead,
+    output: &mut impl std::io::Write,
+) -> Result<(), Stop> {
+    use sweeptrace::engine::protocol::{Request, answer_line, parse_request};
+    use sweeptrace::trace::validate::{validate_outcome, validate_scene, validate_sweep};
+
+    let mut scene: Option<SceneData> = None;
+    let mut line = Vec::new();
+    let mut number = 0u64;
+    loop {
+        line.clear();
+        let read = input
+            .read_until(b'\n', &mut line)
+            .map_err(|e| Stop(format!("cannot read standard input: {e}")))?;
+        if read == 0 {
+            return Ok(());
+        }
+        number += 1;
+        if line.iter().all(u8::is_ascii_whitespace) {
+            continue;
+        }
+        let at = format!("input line {number}");
+        let request = parse_request(&line)
+            .map_err(|e| Stop(format!("{at} is not a protocol message: {e}")))?;
+        match request {
+            Request::Other(_) => {}
+            Request::Scene(message) => {
+                validate_scene(&message).map_err(|p| {
+                    Stop(format!("{at}: scene: field `{}`: {}", p.field, p.problem))
+                })?;
+                let mut triangles = Vec::with_capacity(message.triangles.len() * 3);
+                for index in message.triangles.iter().flatten() {
+                    // Below the vertex count (validated), which fits a u32
+                    // unless the scene has more than 2^32 vertices.
+                    triangles.push(u32::try_from(*index).map_err(|_| {
+                        Stop(format!(
+                            "{at}: scene: vertex index {index} does not fit the C API's uint32_t"
+                        ))
+                    })?);
+                }
+                let data = SceneData {
+                    name: message.name.as_deref().map(c_message),
+                    vertices: message.vertices.iter().flatten().copied().collect(),
+                    triangles,
+                    margin: message.margin,
+                };
+                let view = SweeptraceScene {
+                    name: data.name.as_ref().map_or(std::ptr::null(), |n| n.as_ptr()),
+                    vertices: if data.vertices.is_empty() {
+                        std::ptr::null()
+                    } else {
+                        data.vertices.as_ptr()
+                    },
+                    vertex_count: message.vertices.len(),
+                    triangles: if data.triangles.is_empty() {
+                        std::ptr::null()
+                    } else {
+                        data.triangles.as_ptr()
+                    },
+                    triangle_count: message.triangles.len(),
+                    margin: data.margin,
+                    facing: match message.facing {
+                        Facing::NonStrict => SweeptraceFacing::NonStrict,
+                        Facing::Strict => SweeptraceFacing::Strict,
+                    },
+                };
+                // The previous scene's storage lives until here: replaced
+                // only once the engine has the new one.
+                scene = Some(data);
+                // SAFETY: the callback's contract is the caller's; `view`
+                // points into `scene`, alive until the next scene.
+                let status = unsafe { on_scene(user, &view) };
+                if status != 0 {
+                    let name = message.name.map_or_else(String::new, |n| format!(" `{n}`"));
+                    return Err(Stop(format!(
+                        "on_scene returned {status} for the scene{name} ({at})"
+                    )));
+                }
+            }
+            Request::Sweep(sweep) => {
+                let which = format!("frame {}, ball {}", sweep.frame, sweep.ball);
+                let Some(current) = &scene else {
+                    return Err(Stop(format!(
+                        "{at}: the sweep of {which} arrived before any scene"
+                    )));
+                };
+                validate_sweep(&sweep, Some(current.margin)).map_err(|p| {
+                    Stop(format!(
+                        "{at}: sweep of {which}: field `{}`: {}",
+                        p.field, p.problem
+                    ))
+                })?;
+                let view = SweeptraceSweep {
+                    frame: sweep.frame,
+                    ball: sweep.ball,
+                    radius: sweep.radius,
+                    p0: sweep.p0,
+                    p1: sweep.p1,
+                };
+                let mut answer = SweeptraceAnswer::MISS;
+                // SAFETY: the callback's contract is the caller's.
+                let status = unsafe { on_sweep(user, &view, &mut answer) };
+                if status != 0 {
+                    return Err(Stop(format!("on_sweep returned {status} for {which}")));
+                }
+                let outcome = SweeptraceOutcome {
+                    frame: sweep.frame,
+                    ball: sweep.ball,
+                    kind: answer.kind,
+                    alpha: answer.alpha,
+                    fields: answer.fields,
+                    triangle: answer.triangle,
+                    feature: answer.feature,
+                    normal: answer.normal,
+                    contact: answer.contact,
+                };
+                let invalid =
+                    |message: String| Stop(format!("invalid answer to {which}: {message}"));
+                let message = outcome_message(&outcome, Some(current.triangles.len() / 3))
+                    .map_err(|f| invalid(f.message))?;
+                validate_outcome(&message)
+                    .map_err(|p| invalid(format!("field `{}`: {}", p.field, p.problem)))?;
+                let text = answer_line(&message).map_err(|e| invalid(e.to_string()))?;
+                output
+                    .write_all(text.as_bytes())
+                    .and_then(|()| output.flush())
+                    .map_err(|e| Stop(format!("cannot write the answer to {which}: {e}")))?;
+            }
+        }
+    }
+}
+
+/// Runs the engine protocol (docs/ENGINE_PROTOCOL.md) on the process's
+/// standard input and output: reads each line sweeptrace sends, calls
+/// `engine->on_scene(user, scene)` for a scene and
+/// `engine->on_sweep(user, sweep, answer)` for a sweep, writes and flushes
+/// each answer as its outcome line, in order, and ignores messages of an
+/// unknown type (and blank lines). Your engine is a `main` that calls it:
+/// `return sweeptrace_serve_engine(&engine, NULL);`.
+///
+/// Returns 0 at the end of input (stdin closed), having printed nothing
+/// more. Returns 1 after printing one line `sweeptrace engine: ...` on
+/// stderr (also given by [`sweeptrace_last_error`]) when:
+/// - `engine` or one of its callbacks is null (nothing is read);
+/// - a callback returns nonzero (the message names the scene or sweep and
+///   the value returned);
+/// - a sweep arrives before any scene;
+/// - an answer is invalid (see [`SweeptraceAnswer`]): nothing is written
+///   for it;
+/// - an input line is not a protocol message (not JSON, no `type`, a
+///   missing, mistyped or unknown field of a scene or sweep) or its values
+///   are invalid (a NaN, an index out of range, a radius not above the
+///   margin): the message names the input line and the field;
+/// - reading or writing fails, or the library panics (a bug).
+///
+/// sweeptrace then reports the engine's exit while the sweep awaited its
+/// answer, with these stderr lines. Nothing panics across the boundary.
+/// Call it from one thread; it returns only at the end.
+///
+/// # Safety
+/// `engine` is null or points to a [`SweeptraceEngine`] whose callbacks
+/// are null or valid functions, safe to call with `user`.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn sweeptrace_serve_engine(
+    engine: *const SweeptraceEngine,
+    user: *mut c_void,
+) -> c_int {
+    let result = catch_unwind(AssertUnwindSafe(|| -> Result<(), Stop> {
+        if engine.is_null() {
+            return Err(Stop("`engine` is a null pointer".to_string()));
+        }
+        // SAFETY: non-null, a SweeptraceEngine by the contract.
+        let engine = unsafe { *engine };
+        let on_scene = engine
+            .on_scene
+            .ok_or_else(|| Stop("`engine->on_scene` is a null pointer".to_string()))?;
+        let on_sweep = engine
+            .on_sweep
+            .ok_or_else(|| Stop("`engine->on_sweep` is a null pointer".to_string()))?;
+        let stdin = std::io::stdin();
+        let stdout = std::io::stdout();
+        // SAFETY: the callbacks' contract is the caller's.
+        unsafe {
+            serve(
+                on_scene,
+                on_sweep,
+                user,
+                &mut stdin.lock(),
+                &mut stdout.lock(),
+            )
+        }
+    }));
+    let message = match result {
+        Ok(Ok(())) => return 0,
+        Ok(Err(Stop(message))) => message,
+        Err(payload) => panic_message(payload.as_ref()),
+    };
+    set_thread_error(&message);
+    let _ = catch_unwind(|| {
+        use std::io::Write;
+        let _ = writeln!(std::io::stderr(), "sweeptrace engine: {message}");
+    });
+    1
 }

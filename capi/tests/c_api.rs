@@ -5,4 +5,5 @@
 //! `scripts/check_header.sh`, in CI.)
 
 mod bad_calls;
+mod engine;
 mod programs;

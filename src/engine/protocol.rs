@@ -22,6 +22,57 @@ pub fn sweep_line(sweep: &SweepMsg) -> Result<String, serde_json::Error> {
     tagged("sweep", serde_json::to_string(sweep)?)
 }
 
+/// `{"type":"outcome", ...the /expected fields}` and a newline: an
+/// engine's answer as [`parse_answer`] reads it.
+pub fn answer_line(outcome: &OutcomeMsg) -> Result<String, serde_json::Error> {
+    tagged("outcome", serde_json::to_string(outcome)?)
+}
+
+/// A line sent to an engine, as the engine's side of the protocol reads it.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Request {
+    /// A `scene` line.
+    Scene(SceneMsg),
+    /// A `sweep` line.
+    Sweep(SweepMsg),
+    /// A line of another `type`, which a version-1 engine ignores.
+    Other(String),
+}
+
+/// Parses one line sent to an engine (the engine's side of the protocol):
+/// a JSON object with a string `type`; `scene` and `sweep` with the fields
+/// of `/scene` and `/sweep` (an unknown field is an error), any other type
+/// [`Request::Other`]. The error says what is wrong, naming the field.
+/// The values are not validated ([`crate::trace::validate`] does that).
+pub fn parse_request(line: &[u8]) -> Result<Request, String> {
+    let text = std::str::from_utf8(line).map_err(|_| "it is not UTF-8 text".to_string())?;
+    let mut object: Map<String, Value> = match serde_json::from_str::<Value>(text.trim()) {
+        Ok(Value::Object(o)) => o,
+        Ok(_) => return Err("it is not a JSON object".to_string()),
+        Err(e) => return Err(format!("it is not valid JSON ({e})")),
+    };
+    let kind = match object.remove("type") {
+        Some(Value::String(t)) => t,
+        Some(other) => return Err(format!("field `type`: must be a string, got {other}")),
+        None => return Err("field `type` is missing".to_string()),
+    };
+    fn fields<T: serde::de::DeserializeOwned>(object: Map<String, Value>) -> Result<T, String> {
+        serde_path_to_error::deserialize(Value::Object(object)).map_err(|e| {
+            let path = e.path().to_string();
+            if path == "." {
+                e.inner().to_string()
+            } else {
+                format!("field `{path}`: {}", e.inner())
+            }
+        })
+    }
+    match kind.as_str() {
+        "scene" => fields(object).map(Request::Scene),
+        "sweep" => fields(object).map(Request::Sweep),
+        _ => Ok(Request::Other(kind)),
+    }
+}
+
 fn tagged(tag: &str, object: String) -> Result<String, serde_json::Error> {
     // `object` is a JSON object with at least one field: `{"..`.
     let rest = object.strip_prefix('{').unwrap_or(&object);
@@ -101,5 +152,41 @@ mod tests {
                 .unwrap_err()
                 .contains("kind")
         );
+    }
+
+    #[test]
+    fn requests_read_back_what_is_sent() {
+        let sweep = SweepMsg {
+            frame: 3,
+            ball: 1,
+            radius: 0.5,
+            p0: [0.1, 0.0, 3.0],
+            p1: [0.1, 0.0, -3.0],
+        };
+        let line = sweep_line(&sweep).unwrap();
+        assert_eq!(
+            parse_request(line.as_bytes()).unwrap(),
+            Request::Sweep(sweep)
+        );
+        assert_eq!(
+            parse_request(br#"{"type":"hello","x":1}"#).unwrap(),
+            Request::Other("hello".to_string())
+        );
+        assert!(
+            parse_request(br#"{"frame":3}"#)
+                .unwrap_err()
+                .contains("type")
+        );
+        assert!(
+            parse_request(
+                br#"{"type":"sweep","frame":3,"radius":1,"p0":[0,0,0],"p1":[0,0,0],"speed":2}"#
+            )
+            .unwrap_err()
+            .contains("speed")
+        );
+        let answer = OutcomeMsg::miss(3, 1);
+        let line = answer_line(&answer).unwrap();
+        assert!(line.starts_with("{\"type\":\"outcome\",") && line.ends_with("}\n"));
+        assert_eq!(parse_answer(line.as_bytes()).unwrap(), answer);
     }
 }

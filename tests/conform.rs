@@ -284,7 +284,7 @@ fn repro_command_runs_one_case() -> Result<(), String> {
         "first failing case: vertex.hit/1 (slanted onto vertex 2)",
         "kind: engine none, core vertex",
         "primary: vertex 0.2",
-        "1 rules, 1 cases",
+        "1 rule, 1 case",
     ] {
         ensure!(stdout.contains(want), "missing `{want}` in:\n{stdout}");
     }

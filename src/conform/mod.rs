@@ -437,19 +437,19 @@ pub fn render_text(r: &ConformReport) -> String {
     let failing = r.rules.iter().filter(|x| x.failed > 0).count();
     let _ = writeln!(
         s,
-        "{} rules, {} cases: {} passed, {} failed, {} fragile{}; {} {}",
-        r.rules.len(),
-        r.cases,
+        "{}, {}: {} passed, {} failed, {} fragile{}; {} {}",
+        crate::numbers::counted(r.rules.len() as u64, "rule", "rules"),
+        crate::numbers::counted(r.cases, "case", "cases"),
         r.passed,
         r.failed,
         r.fragile,
         match (r.fragile > 0, r.strict) {
             (false, _) => "",
             (true, true) => {
-                " (fragile: divergences on decisions rounding could change; they fail, --lenient lets them pass)"
+                " (fragile: divergences a perturbation of the inputs reproduces; they fail, --lenient lets them pass)"
             }
             (true, false) => {
-                " (fragile: divergences on decisions rounding could change; not failures under --lenient)"
+                " (fragile: divergences a perturbation of the inputs reproduces; not failures under --lenient)"
             }
         },
         failing,

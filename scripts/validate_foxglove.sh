@@ -69,8 +69,9 @@ for trace in "${traces[@]}"; do
         failed=1
         continue
     fi
-    # "wrote the Foxglove file F (S scenes, N sweeps, M messages)"
-    counts="$(grep -o '([0-9]* scenes, [0-9]* sweeps' "$out/log" | tr -dc '0-9 ' | tr -s ' ')"
+    # "wrote the Foxglove file F (S scenes, N sweeps, M messages)", in the
+    # singular for a count of one ("1 scene")
+    counts="$(grep -o '([0-9]* scenes\?, [0-9]* sweeps\?' "$out/log" | tr -dc '0-9 ' | tr -s ' ')"
     read -r scenes sweeps <<<"$counts"
     if ! "$PYTHON" scripts/foxglove_dump.py "$file" --scenes "$scenes" --sweeps "$sweeps" \
         --dump "$out/$name.jsonl"; then

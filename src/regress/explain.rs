@@ -138,7 +138,7 @@ fn expected_test(r: &TestRecord, expected: &OutcomeMsg, got: &Outcome) -> Expect
     let why_not = match r.alpha() {
         None => format!("it reports no collision ({verdict})"),
         Some(a) if decides && a == expected.alpha => format!(
-            "it is the test that decides the sweep, at the expected α = {}: \
+            "it is the test that decides the sweep, at the compared answer's α = {}: \
              only the fields above differ",
             num(a)
         ),
@@ -150,9 +150,9 @@ fn expected_test(r: &TestRecord, expected: &OutcomeMsg, got: &Outcome) -> Expect
             };
             format!(
                 "it is the test that decides the sweep, at α = {here} where the \
-                 expectation has α = {there}: the same test with other numbers (an \
-                 engine less precise than the tolerances, or one with another margin \
-                 or facing rule)"
+                 compared answer has α = {there}: the same test with other numbers (a \
+                 computation less precise than the tolerances, or another margin or \
+                 facing rule)"
             )
         }
         Some(a) if got.is_hit() && !got.ties_with(a) => format!(
@@ -161,13 +161,13 @@ fn expected_test(r: &TestRecord, expected: &OutcomeMsg, got: &Outcome) -> Expect
             num(got.alpha)
         ),
         Some(a) if (a - expected.alpha).abs() > 1e-12 && got.is_hit() => format!(
-            "it hits at α = {} (expected α = {}); the primary collision is at α = {}",
+            "it hits at α = {} (the compared answer: α = {}); the primary collision is at α = {}",
             num(a),
             num(expected.alpha),
             num(got.alpha)
         ),
         Some(a) if got.is_hit() => format!(
-            "it hits at α = {}, as expected, tied with the primary test, which the tie \
+            "it hits at α = {}, the compared answer's α, tied with the primary test, which the tie \
              order puts first (face < edge < vertex, then lower triangle, then lower feature)",
             num(a)
         ),

@@ -35,7 +35,7 @@ use crate::core::{
 use crate::replay::SweepResult;
 use crate::trace::messages::OutcomeMsg;
 
-use super::compare::{FieldDiff, Tolerances, compare};
+use super::compare::{Field, FieldDiff, Tolerances, compare};
 
 /// How an answer stands against an expectation: the one judgement.
 #[derive(Clone, Debug, PartialEq)]
@@ -338,6 +338,20 @@ fn judge(
         return Agreement::Match;
     }
     let fragile = result.outcome.fragile;
+    // Against the core's own outcome, a difference in α or the normal alone
+    // cannot be another tie member (the members share the decision's α and
+    // averaged normal): no need to run the core again, unless rounding may
+    // explain it.
+    let values_only = fields
+        .iter()
+        .all(|f| matches!(f.field, Field::Alpha | Field::Normal));
+    if got_is_core && values_only && fragile.is_robust() {
+        return Agreement::Diverges {
+            fields,
+            fragile,
+            reproduced: None,
+        };
+    }
     let mesh = &result.scene.mesh;
     let Some(decision) = Decision::of(mesh, &result.sweep, &result.options) else {
         return Agreement::Diverges {

@@ -15,7 +15,8 @@ use std::io::Write;
 
 use criterion::{BenchmarkId, Criterion, Throughput, criterion_group};
 use sweeptrace::replay::{
-    DEFAULT_BATCH_EVENTS, Detail, ReplayEvent, ReplayOptions, replay_events_parallel,
+    DEFAULT_BATCH_EVENTS, Detail, PipelineOptions, ReplayEvent, ReplayOptions,
+    replay_events_parallel, run_pipeline_unrecorded,
 };
 use sweeptrace::trace::TraceReader;
 use sweeptrace::trace::prefetch::{self, prefetch};
@@ -59,14 +60,25 @@ fn outcomes(bytes: &[u8]) -> u64 {
         prefetch::DEFAULT_DEPTH,
     )
     .expect("reader thread");
-    let events = replay_events_parallel(read_ahead, options, DEFAULT_BATCH_EVENTS, None);
-    for event in events {
-        if let ReplayEvent::Sweep(r) = event.expect("valid trace") {
-            serde_json::to_writer(&mut sink, &r.outcome_msg()).expect("sink");
-            sink.write_all(b"\n").expect("sink");
-            n += 1;
-        }
-    }
+    let mut events = replay_events_parallel(read_ahead, options, DEFAULT_BATCH_EVENTS, None);
+    let pool = rayon::ThreadPoolBuilder::new()
+        .build()
+        .expect("worker threads");
+    // The command's own pipeline: the outcome lines built on the workers.
+    let pipeline = PipelineOptions {
+        outcome_lines: true,
+        batch_events: DEFAULT_BATCH_EVENTS,
+    };
+    let result: Result<(), Box<dyn std::error::Error>> =
+        run_pipeline_unrecorded(&mut events, &pool, pipeline, |event, line| {
+            if let ReplayEvent::Sweep(_) = event? {
+                sink.write_all(line.ok_or("no outcome line")?.as_bytes())?;
+                sink.write_all(b"\n")?;
+                n += 1;
+            }
+            Ok(())
+        });
+    result.expect("valid trace");
     n
 }
 
@@ -80,12 +92,14 @@ fn rrd(bytes: &[u8], detail: Detail, path: &std::path::Path) -> u64 {
         ..ReplayOptions::default()
     };
     let id = viz::recording_id(&[bytes, detail.as_str().as_bytes()]);
-    // The command's own file writer (with the footer, as `replay --rrd`).
-    let (sink, writer) = viz::rrd_file::create(path, Default::default()).expect("rrd file");
-    let rec = viz::builder(&id, "bench")
-        .set_sinks(vec![Box::new(sink) as Box<dyn rerun::sink::LogSink>])
+    // The command's own recording (a file with its footer, the rows
+    // spilled beside it until the end, as `replay --rrd`).
+    let target = viz::RecordingTarget {
+        file: Some(path.to_path_buf()),
+        ..viz::RecordingTarget::default()
+    };
+    let mut recording = viz::Recording::open(&id, "bench", target, viz::LoggerOptions::default())
         .expect("recording");
-    let mut logger = viz::Logger::new(rec, true).expect("recording");
     let read_ahead = prefetch(
         TraceReader::new(std::io::Cursor::new(bytes.to_vec()), "bench.mcap"),
         prefetch::DEFAULT_CHUNK,
@@ -98,11 +112,11 @@ fn rrd(bytes: &[u8], detail: Detail, path: &std::path::Path) -> u64 {
         .expect("worker threads");
     let mut n = 0;
     // The command's own pipeline (outcome lines off: the recording alone).
-    let result: Result<(), Box<dyn std::error::Error>> = viz::pipeline::run_pipeline(
+    let result: Result<(), Box<dyn std::error::Error>> = sweeptrace::replay::run_pipeline(
         &mut events,
         &pool,
-        Some(&mut logger),
-        viz::pipeline::PipelineOptions::default(),
+        Some(recording.logger()),
+        PipelineOptions::default(),
         |event, _| {
             if let ReplayEvent::Sweep(_) = event? {
                 n += 1;
@@ -111,11 +125,11 @@ fn rrd(bytes: &[u8], detail: Detail, path: &std::path::Path) -> u64 {
         },
     );
     result.expect("valid trace");
-    logger.flush().expect("flush");
-    let rec = logger.finish();
-    rec.flush_blocking().expect("flush");
-    drop(rec);
-    writer.finish().expect("rrd file");
+    recording
+        .finish(|_, _| {})
+        .expect("recording")
+        .commit()
+        .expect("recording");
     n
 }
 

@@ -17,7 +17,7 @@
 
 use std::collections::BTreeMap;
 use std::fs::File;
-use std::io;
+use std::io::{self, BufWriter, Write as _};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::{Mutex, MutexGuard};
@@ -165,6 +165,24 @@ impl PendingFile {
         &self.target
     }
 
+    /// Finishes the file written through `file` and renames it to its
+    /// target: [`PendingFile::seal`], then [`PendingFile::commit`]. The one
+    /// way an output file is finished; a caller that writes several files
+    /// seals each one before committing any (so that an error finishing one
+    /// leaves none of them).
+    pub fn finish(self, file: BufWriter<File>) -> Result<(), FinishError> {
+        self.seal(file)?;
+        self.commit().map_err(FinishStep::Renaming.with())
+    }
+
+    /// Makes the file written through `file` complete and durable under
+    /// its temporary name: flushes the buffer, syncs the file to the disk
+    /// ([`sync`]) and closes it. The file is renamed into place by
+    /// [`PendingFile::commit`].
+    pub fn seal(&self, file: BufWriter<File>) -> Result<(), FinishError> {
+        seal(file)
+    }
+
     /// Renames the finished file to its target. The registry is held
     /// during the rename, so a signal either removes the temporary file
     /// before it or finds it renamed.
@@ -206,6 +224,53 @@ pub fn unfinished_temporaries(target: &Path) -> Vec<PathBuf> {
         .collect();
     found.sort();
     found
+}
+
+/// Which step of finishing an output file failed.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum FinishStep {
+    /// Writing what was still buffered.
+    Flushing,
+    /// Syncing the file to the disk.
+    Syncing,
+    /// Renaming the finished file to its target.
+    Renaming,
+}
+
+impl FinishStep {
+    /// The step in words: "flushing", "syncing", "renaming the finished
+    /// file into place".
+    pub fn doing(self) -> &'static str {
+        match self {
+            FinishStep::Flushing => "flushing",
+            FinishStep::Syncing => "syncing",
+            FinishStep::Renaming => "renaming the finished file into place",
+        }
+    }
+
+    fn with(self) -> impl FnOnce(io::Error) -> FinishError {
+        move |cause| FinishError { step: self, cause }
+    }
+}
+
+/// Finishing an output file failed: the step, and the operating system's
+/// error. The callers name the file in their own error types.
+#[derive(Debug, thiserror::Error)]
+#[error("{}: {}", step.doing(), crate::error_text::full_text(.cause))]
+pub struct FinishError {
+    /// What failed.
+    pub step: FinishStep,
+    /// The operating system's error.
+    pub cause: io::Error,
+}
+
+/// Flushes `file`'s buffer, syncs the file ([`sync`]) and closes it.
+pub fn seal(mut file: BufWriter<File>) -> Result<(), FinishError> {
+    file.flush().map_err(FinishStep::Flushing.with())?;
+    let file = file
+        .into_inner()
+        .map_err(|e| FinishStep::Flushing.with()(e.into_error()))?;
+    sync(&file).map_err(FinishStep::Syncing.with())
 }
 
 /// Makes a finished output durable: syncs a regular file to the disk; a

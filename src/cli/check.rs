@@ -6,7 +6,6 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context, bail};
 
-use sweeptrace::atomic::PendingFile;
 use sweeptrace::engine::{EngineCommand, EngineOptions};
 use sweeptrace::regress::{Against, check_file_with_engine};
 use sweeptrace::regress::{
@@ -281,8 +280,6 @@ fn write_failure_rrd(trace: &Path, dir: &Path, report: &TraceReport) -> anyhow::
     std::fs::create_dir_all(dir)
         .with_context(|| format!("creating the directory {}", dir.display()))?;
     super::warn_unfinished(&target);
-    let temp = PendingFile::new(&target)
-        .with_context(|| format!("creating a temporary file in {}", dir.display()))?;
     let options = ReplayOptions {
         frames,
         detail: Detail::Candidates,
@@ -293,15 +290,16 @@ fn write_failure_rrd(trace: &Path, dir: &Path, report: &TraceReport) -> anyhow::
     let bytes = std::fs::read(trace).with_context(|| format!("reading {name}"))?;
     let id = super::recording_id(bytes.as_slice(), "check", &options)
         .with_context(|| format!("reading {name}"))?;
-    let rrd_error = |e: viz::rrd_file::RrdFileError| {
-        anyhow::anyhow!("writing {}: {}", target.display(), e.reason)
-    };
-    let (sink, writer) =
-        viz::rrd_file::create(temp.path(), Default::default()).map_err(rrd_error)?;
-    let rec = viz::builder(&id, &format!("{name} (check, frames {frames})"))
-        .set_sinks(vec![Box::new(sink) as Box<dyn rerun::sink::LogSink>])
-        .context("creating the recording")?;
-    let mut logger = viz::Logger::new(rec, true).context("starting the recording")?;
+    let mut recording = viz::Recording::open(
+        &id,
+        &format!("{name} (check, frames {frames})"),
+        viz::RecordingTarget {
+            file: Some(target.clone()),
+            ..viz::RecordingTarget::default()
+        },
+        viz::LoggerOptions::default(),
+    )?;
+    let logger = recording.logger();
     for event in replay_events(
         TraceReader::new_indexed(std::io::Cursor::new(bytes.as_slice()), &name),
         options,
@@ -318,11 +316,6 @@ fn write_failure_rrd(trace: &Path, dir: &Path, report: &TraceReport) -> anyhow::
             Err(err) => return Err(err).name_file_once("replaying", &name),
         }
     }
-    let rec = logger.finish();
-    rec.flush_blocking().context("flushing the recording")?;
-    drop(rec);
-    writer.finish().map_err(rrd_error)?;
-    temp.commit()
-        .with_context(|| format!("renaming the finished file to {}", target.display()))?;
+    recording.finish(|_, _| {})?.commit()?;
     Ok(target)
 }

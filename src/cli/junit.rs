@@ -10,7 +10,7 @@ use std::time::{Duration, Instant, SystemTime};
 
 use anyhow::Context;
 
-use sweeptrace::atomic::PendingFile;
+use sweeptrace::atomic::{FinishStep, PendingFile};
 use sweeptrace::junit::{Detail, JunitOptions};
 use sweeptrace::regress::TraceReport;
 
@@ -54,7 +54,7 @@ pub enum DetailArg {
 #[derive(Debug)]
 pub struct JunitOutput {
     pending: PendingFile,
-    file: std::fs::File,
+    file: std::io::BufWriter<std::fs::File>,
     options: JunitOptions,
     started: Instant,
 }
@@ -84,7 +84,7 @@ impl JunitArgs {
             .map_or(0, |d| d.as_secs());
         Ok(Some(JunitOutput {
             pending,
-            file,
+            file: std::io::BufWriter::new(file),
             options: JunitOptions {
                 detail: match self.junit_detail {
                     DetailArg::Traces => Detail::Traces,
@@ -113,11 +113,14 @@ impl JunitOutput {
         let target = self.pending.target().to_path_buf();
         let writing = || format!("writing the JUnit report {}", target.display());
         self.file.write_all(xml.as_bytes()).with_context(writing)?;
-        self.file.flush().with_context(writing)?;
-        sweeptrace::atomic::sync(&self.file).with_context(writing)?;
-        drop(self.file);
-        self.pending.commit().with_context(|| {
-            format!("renaming the finished JUnit report to {}", target.display())
+        self.pending.finish(self.file).map_err(|e| match e.step {
+            FinishStep::Renaming => anyhow::Error::new(e.cause).context(format!(
+                "renaming the finished JUnit report to {}",
+                target.display()
+            )),
+            FinishStep::Flushing | FinishStep::Syncing => {
+                anyhow::Error::new(e.cause).context(writing())
+            }
         })?;
         eprintln!("wrote the JUnit report {}", target.display());
         Ok(())

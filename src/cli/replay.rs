@@ -19,17 +19,15 @@ use sweeptrace::foxglove::{FoxgloveFile, FoxgloveOptions};
 use sweeptrace::numbers::{self, Rule, plural};
 use sweeptrace::regress::Tolerances;
 use sweeptrace::replay::{
-    Detail, FrameRange, ReplayError, ReplayEvent, ReplayOptions, Selection, replay_events_parallel,
+    Detail, FrameRange, PipelineOptions, ReplayError, ReplayEvent, ReplayOptions, Selection,
+    replay_events_parallel, run_pipeline,
 };
 use sweeptrace::run::RunOutcome;
 use sweeptrace::trace::TraceReader;
 use sweeptrace::trace::prefetch::{self, prefetch};
-use sweeptrace::viz;
-use sweeptrace::viz::pipeline::{PipelineOptions, run_pipeline};
-
-/// How long the end of a replay waits for a viewer (`--spawn`, `--connect`)
-/// to take the last messages before saying it cannot be reached.
-const VIEWER_FLUSH_TIMEOUT: std::time::Duration = std::time::Duration::from_secs(5);
+use sweeptrace::viz::{
+    self, FinishedRecording, Recording, RecordingError, RecordingTarget, Viewer,
+};
 
 /// The viewer address `--connect` uses when given no URL.
 pub const DEFAULT_CONNECT_URL: &str = "rerun+http://127.0.0.1:9876/proxy";
@@ -135,37 +133,8 @@ impl<R: Read> Read for CountingReader<R> {
     }
 }
 
-/// A temporary file next to `target`, with the error naming where.
-fn pending_file(target: &Path) -> anyhow::Result<PendingFile> {
-    super::warn_unfinished(target);
-    PendingFile::new(target)
-        .with_context(|| format!("creating a temporary file next to {}", target.display()))
-}
-
-/// Renames a finished file into place, with the error naming where.
-fn complete(pending: PendingFile) -> anyhow::Result<()> {
-    let target = pending.target().to_path_buf();
-    pending
-        .commit()
-        .with_context(|| format!("renaming the finished file to {}", target.display()))
-}
-
-/// Where the outcomes go.
-enum OutcomeSink {
-    Stdout(BufWriter<std::io::Stdout>),
-    File(BufWriter<File>, PendingFile),
-}
-
-impl OutcomeSink {
-    fn writer(&mut self) -> &mut dyn Write {
-        match self {
-            OutcomeSink::Stdout(w) => w,
-            OutcomeSink::File(w, _) => w,
-        }
-    }
-}
-
-/// Runs the replay.
+/// Runs the replay: the options in, the outputs opened, the pipeline, the
+/// outputs finished, the summary printed.
 pub fn run(args: Args) -> anyhow::Result<RunOutcome> {
     let started = Instant::now();
     let trace_path = &args.trace;
@@ -173,156 +142,29 @@ pub fn run(args: Args) -> anyhow::Result<RunOutcome> {
         File::open(trace_path).with_context(|| format!("opening {}", trace_path.display()))?;
     let total_bytes = file.metadata().map(|m| m.len()).unwrap_or(0);
     let source_name = trace_path.display().to_string();
-
-    let no_output = args.outcomes.is_none()
-        && args.rrd.is_none()
-        && args.foxglove.is_none()
-        && !args.spawn
-        && args.connect.is_none();
-    let rrd_path = match (&args.rrd, no_output) {
-        (Some(p), _) => Some(p.clone()),
-        (None, true) => {
-            let stem = trace_path
-                .file_stem()
-                .map(|s| s.to_string_lossy().into_owned())
-                .unwrap_or("replay".into());
-            Some(PathBuf::from(format!("{stem}.rrd")))
-        }
-        (None, false) => None,
-    };
-    let record = rrd_path.is_some() || args.spawn || args.connect.is_some();
     if let Some(m) = args.margin {
         numbers::check(m, Rule::NonNegative).map_err(|e| anyhow::anyhow!("--margin {e}"))?;
     }
-
+    let target = recording_target(&args);
     let options = ReplayOptions {
         frames: args.frames.unwrap_or_default(),
         ball: args.ball,
         detail: args.detail,
         // The decision lines of the recording and of the Foxglove file
         // describe the decisive test: keep the records.
-        explain: record || args.foxglove.is_some(),
+        explain: target.is_some() || args.foxglove.is_some(),
         margin: args.margin,
         facing: args.facing,
     };
-
-    // The recording.
-    let mut rrd_file = None;
-    let mut logger = None;
-    let mut viewer_since = None;
-    if record {
-        let trace =
-            File::open(trace_path).with_context(|| format!("opening {}", trace_path.display()))?;
-        let id = super::recording_id(BufReader::new(trace), "replay", &options)
-            .with_context(|| format!("reading {}", trace_path.display()))?;
-        let mut sinks: Vec<Box<dyn rerun::sink::LogSink>> = Vec::new();
-        if let Some(path) = &rrd_path {
-            let pending = pending_file(path)?;
-            let file_options = viz::rrd_file::RrdFileOptions {
-                footer: !args.no_rrd_footer,
-            };
-            let (sink, writer) =
-                viz::rrd_file::create(pending.path(), file_options).map_err(|e| {
-                    anyhow::anyhow!("writing the recording {}: {}", path.display(), e.reason)
-                })?;
-            sinks.push(Box::new(sink));
-            rrd_file = Some((pending, writer));
-        }
-        if args.spawn || args.connect.is_some() {
-            viewer_since = Some(Instant::now());
-        }
-        if args.spawn {
-            let info = rerun::spawn(&rerun::SpawnOptions::default())
-                .context("starting the Rerun viewer (is `rerun` on PATH?)")?;
-            let uri = format!("rerun+http://127.0.0.1:{}/proxy", info.port);
-            sinks.push(Box::new(rerun::sink::GrpcSink::new(
-                uri.parse().context("viewer address")?,
-            )));
-        }
-        if let Some(url) = &args.connect {
-            let uri = url
-                .parse()
-                .map_err(|e| anyhow::anyhow!("--connect `{url}`: {e}"))?;
-            sinks.push(Box::new(rerun::sink::GrpcSink::new(uri)));
-        }
-        let name = trace_path
-            .file_name()
-            .map(|n| n.to_string_lossy().into_owned())
-            .unwrap_or_default();
-        let rec = viz::builder(&id, &name)
-            .set_sinks(sinks)
-            .context("creating the recording")?;
-        let logger_options = viz::LoggerOptions {
-            blueprint: !args.no_blueprint,
-            prepare: viz::PrepareOptions {
-                follow_ball: args.ball.unwrap_or(0),
-                ..viz::PrepareOptions::default()
-            },
-            flush_timeout: (args.spawn || args.connect.is_some()).then_some(VIEWER_FLUSH_TIMEOUT),
-        };
-        let mut l =
-            viz::Logger::with_options(rec, logger_options).context("starting the recording")?;
-        // To a file only: the rows wait in a temporary file beside it and
-        // go out at the end in long chunks (a live viewer would see nothing
-        // until then).
-        if let Some((pending, _)) = &rrd_file
-            && !args.spawn
-            && args.connect.is_none()
-        {
-            let dir = match pending.path().parent() {
-                Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
-                _ => std::path::PathBuf::from("."),
-            };
-            l = l
-                .with_spill(&dir, pending.target())
-                .context("starting the recording")?;
-        }
-        logger = Some(l);
-    }
-
-    // The outcomes.
-    let writing_outcomes = match &args.outcomes {
-        Some(p) if p.as_os_str() != "-" => format!("writing the outcomes to {}", p.display()),
-        _ => "writing the outcomes to stdout".to_string(),
-    };
-    let mut outcomes = match &args.outcomes {
-        None => None,
-        Some(p) if p.as_os_str() == "-" => {
-            Some(OutcomeSink::Stdout(BufWriter::new(std::io::stdout())))
-        }
-        Some(p) => {
-            super::warn_unfinished(p);
-            let (pending, f) = PendingFile::create(p)
-                .with_context(|| format!("creating a temporary file next to {}", p.display()))?;
-            Some(OutcomeSink::File(BufWriter::new(f), pending))
-        }
-    };
-
-    // The Foxglove file.
-    let mut foxglove = match &args.foxglove {
-        None => None,
-        Some(p) => {
-            super::warn_unfinished(p);
-            let options = FoxgloveOptions {
-                trace_name: trace_path
-                    .file_name()
-                    .map(|n| n.to_string_lossy().into_owned())
-                    .unwrap_or_default(),
-                tolerances: Tolerances::default(),
-            };
-            Some(FoxgloveFile::create(p, options)?)
-        }
-    };
-
+    let mut outputs = Outputs::open(&args, target, &options)?;
     if args.threads == Some(0) {
         bail!("--threads must be at least 1");
     }
-    let pool = Arc::new(
-        rayon::ThreadPoolBuilder::new()
-            .num_threads(args.threads.unwrap_or(0))
-            .build()
-            .context("starting the worker threads")?,
-    );
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(args.threads.unwrap_or(0))
+        .build()
+        .context("starting the worker threads")?;
+    let pool = Arc::new(pool);
 
     let count = Arc::new(AtomicU64::new(0));
     let reader = CountingReader {
@@ -337,171 +179,67 @@ pub fn run(args: Args) -> anyhow::Result<RunOutcome> {
         prefetch::DEFAULT_DEPTH,
     )
     .context("starting the trace reader thread")?;
-    let mut events = replay_events_parallel(
-        read_ahead,
-        options,
-        options.detail.batch_events(),
-        Some(pool.clone()),
-    );
+    let batch_events = options.detail.batch_events();
+    let mut events = replay_events_parallel(read_ahead, options, batch_events, Some(pool.clone()));
     let mut trace_error = None;
     let mut last_frame = None;
     let pipeline = PipelineOptions {
-        outcome_lines: outcomes.is_some(),
-        batch_events: options.detail.batch_events(),
+        outcome_lines: outputs.sinks.outcomes.is_some(),
+        batch_events,
     };
+    let (recording, sinks) = outputs.split();
     let result = run_pipeline(
         &mut events,
         &pool,
-        logger.as_mut(),
+        recording.map(Recording::logger),
         pipeline,
         |event, line| -> anyhow::Result<()> {
             progress.set_position(count.load(Ordering::Relaxed));
-            if let (Some(file), Ok(event)) = (foxglove.as_mut(), &event) {
-                file.writer().event(event)?;
-            }
             match event {
-                Ok(ReplayEvent::Scene(scene)) => {
-                    for d in scene.mesh.degenerate() {
-                        progress.suspend(|| {
-                            eprintln!("warning: scene {}: {d}, left out", scene.number)
-                        });
+                Ok(event) => {
+                    sinks.event(&event, line)?;
+                    match &event {
+                        ReplayEvent::Scene(scene) => {
+                            for d in scene.mesh.degenerate() {
+                                progress.suspend(|| {
+                                    eprintln!("warning: scene {}: {d}, left out", scene.number)
+                                });
+                            }
+                        }
+                        ReplayEvent::Sweep(result) => last_frame = Some(result.frame),
                     }
                 }
-                Ok(ReplayEvent::Sweep(result)) => {
-                    last_frame = Some(result.frame);
-                    if let Some(o) = outcomes.as_mut() {
-                        let line = match line {
-                            Some(line) => line,
-                            None => result.outcome_line().context("serializing an outcome")?,
-                        };
-                        writeln!(o.writer(), "{line}").with_context(|| writing_outcomes.clone())?;
-                    }
-                }
-                Err(ReplayError::Trace(err)) => {
-                    // The reader stops here; what was read is still replayed.
-                    trace_error = Some(err);
-                }
-                Err(err) => {
-                    return Err(err).name_file_once("replaying", &source_name);
-                }
+                // The reader stops here; what was read is still replayed.
+                Err(ReplayError::Trace(err)) => trace_error = Some(err),
+                Err(err) => return Err(err).name_file_once("replaying", &source_name),
             }
             Ok(())
         },
     );
+    progress.finish_and_clear();
     if let Err(err) = result {
-        progress.finish_and_clear();
-        abandon(logger, args.spawn || args.connect.is_some());
+        outputs.abandon();
         return Err(err);
     }
-    progress.finish_and_clear();
     let summary = events.summary();
 
     // Nothing is written unless the run completed (or ended at a
     // truncation, whose outputs hold what was read): the pending files are
     // dropped here, which removes them.
     if let Some(err) = trace_error.take_if(|err| !err.is_truncation()) {
-        abandon(logger, args.spawn || args.connect.is_some());
+        outputs.abandon();
         return Err(err).name_file_once("replaying", &source_name);
     }
     let selection = summary.selection(&options);
     if selection.is_nothing() {
-        abandon(logger, args.spawn || args.connect.is_some());
+        outputs.abandon();
         bail!("{source_name}: {selection}; nothing written");
     }
-
-    // Finish the files: the recording's footer is written when the last
-    // clone of the stream is dropped.
-    if let Some(mut l) = logger {
-        let writing = progress_bar(0, "writing the recording");
-        l.send_all_with(|done, total| {
-            writing.set_length(total);
-            writing.set_position(done);
-        })
-        .context("logging the last frames")?;
-        writing.finish_and_clear();
-        let rec = l.finish();
-        if args.spawn || args.connect.is_some() {
-            // A viewer that cannot be reached would make a blocking flush
-            // (and dropping the stream) wait forever.
-            if let Err(err) = rec.flush_with_timeout(VIEWER_FLUSH_TIMEOUT) {
-                std::mem::forget(rec);
-                let at = args.connect.as_deref().unwrap_or("the spawned viewer");
-                // One figure: how long the stream tried, from its start.
-                let tried = viewer_since.map_or(0.0, |t| t.elapsed().as_secs_f64());
-                let what = match err {
-                    rerun::sink::SinkFlushError::Timeout => {
-                        format!("no viewer took the recording (waited {tried:.0} s in all)")
-                    }
-                    rerun::sink::SinkFlushError::Failed { .. } => {
-                        format!("could not connect (tried for {tried:.0} s)")
-                    }
-                };
-                bail!(
-                    "streaming to the viewer at {at}: {what}; is a Rerun viewer running there? \
-                     (start one with `rerun`, or write a file with --rrd)"
-                );
-            }
-        } else {
-            rec.flush_blocking().context("flushing the recording")?;
-        }
-        drop(rec);
-    }
-    // Every file finished before any is renamed into place, so that an
-    // error finishing one leaves none of them.
-    let rrd_done = match rrd_file {
-        Some((pending, writer)) => {
-            let target = pending.target().to_path_buf();
-            writer.finish().map_err(|e| {
-                anyhow::anyhow!("writing the recording {}: {}", target.display(), e.reason)
-            })?;
-            Some(pending)
-        }
-        None => None,
-    };
-    let outcomes_done = match outcomes {
-        Some(OutcomeSink::Stdout(mut w)) => {
-            w.flush().context(writing_outcomes.clone())?;
-            None
-        }
-        Some(OutcomeSink::File(mut w, pending)) => {
-            w.flush().context(writing_outcomes.clone())?;
-            let file = w
-                .into_inner()
-                .map_err(|e| e.into_error())
-                .context(writing_outcomes.clone())?;
-            sweeptrace::atomic::sync(&file).context(writing_outcomes.clone())?;
-            Some(pending)
-        }
-        None => None,
-    };
-    let mut wrote = Vec::new();
-    if let Some(file) = foxglove {
-        let target = args.foxglove.as_deref().unwrap_or(Path::new("")).display();
-        let counts = file.commit()?;
-        wrote.push(format!(
-            "wrote the Foxglove file {target} ({} {}, {} {}, {} {})",
-            counts.scenes,
-            plural(counts.scenes, "scene"),
-            counts.sweeps,
-            plural(counts.sweeps, "sweep"),
-            counts.messages,
-            plural(counts.messages, "message"),
-        ));
-    }
-    if let Some(pending) = rrd_done {
-        let target = pending.target().to_path_buf();
-        complete(pending)?;
-        wrote.push(format!("wrote the recording to {}", target.display()));
-    }
-    if let Some(pending) = outcomes_done {
-        let target = pending.target().to_path_buf();
-        complete(pending)?;
-        wrote.push(format!("wrote the outcomes to {}", target.display()));
-    }
-    for line in wrote {
+    let streamed = outputs.streams_to_viewer();
+    for line in outputs.finish()? {
         eprintln!("{line}");
     }
-    if args.spawn || args.connect.is_some() {
+    if streamed {
         eprintln!("streamed the recording to the viewer");
     }
     eprint!("{}", summary.render_timed(Some(started.elapsed())));
@@ -519,13 +257,247 @@ pub fn run(args: Args) -> anyhow::Result<RunOutcome> {
     Ok(RunOutcome::Success)
 }
 
-/// Drops a recording that will not be finished. A stream to a viewer is
-/// leaked instead: dropping it flushes, which waits forever for a viewer
-/// that cannot be reached (the process ends soon after).
-fn abandon(logger: Option<viz::Logger>, to_viewer: bool) {
-    match logger {
-        Some(l) if to_viewer => std::mem::forget(l),
-        other => drop(other),
+/// Where the recording goes, if anywhere: `--rrd`, `--spawn`,
+/// `--connect`; with no output named at all, `<trace stem>.rrd`.
+fn recording_target(args: &Args) -> Option<RecordingTarget> {
+    let viewer = match (&args.connect, args.spawn) {
+        (Some(url), _) => Viewer::Connect(url.clone()),
+        (None, true) => Viewer::Spawn,
+        (None, false) => Viewer::None,
+    };
+    let no_output = args.outcomes.is_none()
+        && args.rrd.is_none()
+        && args.foxglove.is_none()
+        && !viewer.is_some();
+    let file = match (&args.rrd, no_output) {
+        (Some(p), _) => Some(p.clone()),
+        (None, true) => {
+            let stem = args
+                .trace
+                .file_stem()
+                .map(|s| s.to_string_lossy().into_owned())
+                .unwrap_or("replay".into());
+            Some(PathBuf::from(format!("{stem}.rrd")))
+        }
+        (None, false) => None,
+    };
+    (file.is_some() || viewer.is_some()).then(|| RecordingTarget {
+        file,
+        file_options: viz::rrd_file::RrdFileOptions {
+            footer: !args.no_rrd_footer,
+        },
+        viewer,
+    })
+}
+
+/// Where the outcomes go.
+enum OutcomeSink {
+    Stdout(BufWriter<std::io::Stdout>),
+    File(BufWriter<File>, PendingFile),
+}
+
+/// The outputs besides the recording, which take each event in trace
+/// order: the outcome lines and the Foxglove file.
+struct Sinks {
+    outcomes: Option<OutcomeSink>,
+    /// "writing the outcomes to FILE", for the errors.
+    writing_outcomes: String,
+    foxglove: Option<FoxgloveFile>,
+}
+
+impl Sinks {
+    fn event(&mut self, event: &ReplayEvent, line: Option<String>) -> anyhow::Result<()> {
+        if let Some(file) = self.foxglove.as_mut() {
+            file.writer().event(event)?;
+        }
+        if let (Some(o), ReplayEvent::Sweep(result)) = (self.outcomes.as_mut(), event) {
+            let line = match line {
+                Some(line) => line,
+                None => result.outcome_line().context("serializing an outcome")?,
+            };
+            let w: &mut dyn Write = match o {
+                OutcomeSink::Stdout(w) => w,
+                OutcomeSink::File(w, _) => w,
+            };
+            writeln!(w, "{line}").with_context(|| self.writing_outcomes.clone())?;
+        }
+        Ok(())
+    }
+}
+
+/// Every output of one replay, from their opening to their finish.
+struct Outputs {
+    recording: Option<Recording>,
+    sinks: Sinks,
+    foxglove_target: Option<PathBuf>,
+}
+
+impl Outputs {
+    /// Opens the recording (when `target` asks for one), the outcomes and
+    /// the Foxglove file.
+    fn open(
+        args: &Args,
+        target: Option<RecordingTarget>,
+        options: &ReplayOptions,
+    ) -> anyhow::Result<Outputs> {
+        let trace_path = &args.trace;
+        let recording = match target {
+            None => None,
+            Some(target) => {
+                let trace = File::open(trace_path)
+                    .with_context(|| format!("opening {}", trace_path.display()))?;
+                let id = super::recording_id(BufReader::new(trace), "replay", options)
+                    .with_context(|| format!("reading {}", trace_path.display()))?;
+                if let Some(path) = &target.file {
+                    super::warn_unfinished(path);
+                }
+                let name = trace_path
+                    .file_name()
+                    .map(|n| n.to_string_lossy().into_owned())
+                    .unwrap_or_default();
+                let logger_options = viz::LoggerOptions {
+                    blueprint: !args.no_blueprint,
+                    prepare: viz::PrepareOptions {
+                        follow_ball: args.ball.unwrap_or(0),
+                        ..viz::PrepareOptions::default()
+                    },
+                    ..viz::LoggerOptions::default()
+                };
+                let recording =
+                    Recording::open(&id, &name, target, logger_options).map_err(|e| match e {
+                        RecordingError::Address { url, reason } => {
+                            anyhow::anyhow!("--connect `{url}`: {reason}")
+                        }
+                        e => anyhow::Error::new(e),
+                    })?;
+                Some(recording)
+            }
+        };
+        let writing_outcomes = match &args.outcomes {
+            Some(p) if p.as_os_str() != "-" => format!("writing the outcomes to {}", p.display()),
+            _ => "writing the outcomes to stdout".to_string(),
+        };
+        let outcomes = match &args.outcomes {
+            None => None,
+            Some(p) if p.as_os_str() == "-" => {
+                Some(OutcomeSink::Stdout(BufWriter::new(std::io::stdout())))
+            }
+            Some(p) => {
+                super::warn_unfinished(p);
+                let (pending, f) = PendingFile::create(p).with_context(|| {
+                    format!("creating a temporary file next to {}", p.display())
+                })?;
+                Some(OutcomeSink::File(BufWriter::new(f), pending))
+            }
+        };
+        let foxglove = match &args.foxglove {
+            None => None,
+            Some(p) => {
+                super::warn_unfinished(p);
+                let options = FoxgloveOptions {
+                    trace_name: trace_path
+                        .file_name()
+                        .map(|n| n.to_string_lossy().into_owned())
+                        .unwrap_or_default(),
+                    tolerances: Tolerances::default(),
+                };
+                Some(FoxgloveFile::create(p, options)?)
+            }
+        };
+        Ok(Outputs {
+            recording,
+            sinks: Sinks {
+                outcomes,
+                writing_outcomes,
+                foxglove,
+            },
+            foxglove_target: args.foxglove.clone(),
+        })
+    }
+
+    /// The recording and the other outputs, apart, for the pipeline.
+    fn split(&mut self) -> (Option<&mut Recording>, &mut Sinks) {
+        (self.recording.as_mut(), &mut self.sinks)
+    }
+
+    fn streams_to_viewer(&self) -> bool {
+        self.recording
+            .as_ref()
+            .is_some_and(Recording::streams_to_viewer)
+    }
+
+    /// Drops every output unfinished: their temporary files are removed.
+    fn abandon(self) {
+        if let Some(r) = self.recording {
+            r.abandon();
+        }
+    }
+
+    /// Finishes every output, then renames them into place (so that an
+    /// error finishing one leaves none of them); returns what it wrote, a
+    /// line each.
+    fn finish(self) -> anyhow::Result<Vec<String>> {
+        let recording = match self.recording {
+            Some(r) => {
+                let writing = progress_bar(0, "writing the recording");
+                let done = r.finish(|done, total| {
+                    writing.set_length(total);
+                    writing.set_position(done);
+                });
+                writing.finish_and_clear();
+                Some(done?)
+            }
+            None => None,
+        };
+        let Sinks {
+            outcomes,
+            writing_outcomes,
+            foxglove,
+        } = self.sinks;
+        let outcomes = match outcomes {
+            Some(OutcomeSink::Stdout(mut w)) => {
+                w.flush().context(writing_outcomes.clone())?;
+                None
+            }
+            Some(OutcomeSink::File(w, pending)) => {
+                pending
+                    .seal(w)
+                    .map_err(|e| anyhow::Error::new(e.cause))
+                    .context(writing_outcomes.clone())?;
+                Some(pending)
+            }
+            None => None,
+        };
+        let mut wrote = Vec::new();
+        if let Some(file) = foxglove {
+            let target = self.foxglove_target.as_deref().unwrap_or(Path::new(""));
+            let counts = file.commit()?;
+            wrote.push(format!(
+                "wrote the Foxglove file {} ({} {}, {} {}, {} {})",
+                target.display(),
+                counts.scenes,
+                plural(counts.scenes, "scene"),
+                counts.sweeps,
+                plural(counts.sweeps, "sweep"),
+                counts.messages,
+                plural(counts.messages, "message"),
+            ));
+        }
+        if let Some(path) = recording
+            .map(FinishedRecording::commit)
+            .transpose()?
+            .flatten()
+        {
+            wrote.push(format!("wrote the recording to {}", path.display()));
+        }
+        if let Some(pending) = outcomes {
+            let target = pending.target().to_path_buf();
+            pending
+                .commit()
+                .with_context(|| format!("renaming the finished file to {}", target.display()))?;
+            wrote.push(format!("wrote the outcomes to {}", target.display()));
+        }
+        Ok(wrote)
     }
 }
 

@@ -326,15 +326,9 @@ impl FoxgloveFile {
         };
         let counts = self.writer.counts();
         let buffered = self.writer.finish()?;
-        let file = buffered
-            .into_inner()
-            .map_err(|e| e.into_error())
-            .map_err(io("flushing"))?;
-        crate::atomic::sync(&file).map_err(io("syncing"))?;
-        drop(file);
         self.pending
-            .commit()
-            .map_err(io("renaming the finished file into place"))?;
+            .finish(buffered)
+            .map_err(|e| io(e.step.doing())(e.cause))?;
         Ok(counts)
     }
 }

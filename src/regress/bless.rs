@@ -33,7 +33,7 @@ use mcap::records::{MessageHeader, Record};
 use mcap::{Attachment, McapError};
 use thiserror::Error;
 
-use crate::atomic::PendingFile;
+use crate::atomic::{FinishStep, PendingFile};
 use crate::error_text::full_text;
 use crate::replay::{ReplayError, ReplayEvent, ReplayOptions, replay_events};
 use crate::trace::messages::{EXPECTED_TOPIC, OUTCOME_SCHEMA, OutcomeMsg, SWEEP_TOPIC};
@@ -446,15 +446,12 @@ pub fn bless_file(
         .map_err(io(&out_name, "creating a temporary file next to it"))?;
     let (summary, buffered) =
         bless_into(&bytes, &in_name, BufWriter::new(file), &out_name, options)?;
-    let file = buffered.into_inner().map_err(|e| BlessError::Io {
-        file: out_name.clone(),
-        what: "writing".to_string(),
-        cause: e.into_error(),
+    pending.finish(buffered).map_err(|e| {
+        let what = match e.step {
+            FinishStep::Renaming => e.step.doing(),
+            FinishStep::Flushing | FinishStep::Syncing => "writing",
+        };
+        io(&out_name, what)(e.cause)
     })?;
-    crate::atomic::sync(&file).map_err(io(&out_name, "writing"))?;
-    drop(file);
-    pending
-        .commit()
-        .map_err(io(&out_name, "renaming the finished file into place"))?;
     Ok(summary)
 }

@@ -22,6 +22,7 @@ mod engine;
 mod error;
 mod iter;
 mod options;
+mod pipeline;
 mod primary;
 mod selection;
 mod summary;
@@ -33,6 +34,11 @@ pub use iter::{
     DEFAULT_BATCH_EVENTS, ParallelReplayIter, ReplayIter, replay_events, replay_events_parallel,
 };
 pub use options::{Detail, FrameRange, ReplayOptions};
+pub(crate) use pipeline::sweep_of;
+pub use pipeline::{
+    BatchRecorder, Event as PipelineEvent, NoRecorder, PipelineOptions, run_pipeline,
+    run_pipeline_unrecorded,
+};
 pub use primary::{CollectPrimary, primary_records};
 pub use selection::{Selection, SweepExtent};
 pub use summary::{LISTED_TUNNELS, ReplaySummary, TunnelAt};

@@ -373,10 +373,7 @@ impl PendingTrace {
             cause,
         };
         let buffered = writer.finish()?;
-        let file = buffered.into_inner().map_err(|e| io(e.into_error()))?;
-        crate::atomic::sync(&file).map_err(io)?;
-        drop(file);
-        pending.commit().map_err(io)
+        pending.finish(buffered).map_err(|e| io(e.cause))
     }
 }
 

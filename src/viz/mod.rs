@@ -10,6 +10,8 @@
 //! The files, by job:
 //!
 //! - `ids`: recording ids ([`recording_id`], [`IdHasher`]);
+//! - `recording`: [`Recording`], a recording from its opening (a file, a
+//!   viewer, or both) to its finish, the one path every caller takes;
 //! - `logger`: [`Logger`], and [`prepare_sweeps`] which builds a run of
 //!   sweeps' rows on a worker thread;
 //! - `rows`: the rows of one sweep (ball, sweep, contact, primary feature,
@@ -31,7 +33,8 @@ mod edge_frame;
 mod ids;
 mod logger;
 pub mod paths;
-pub mod pipeline;
+mod pipeline;
+mod recording;
 mod rows;
 pub mod rrd_file;
 mod spill;
@@ -43,6 +46,10 @@ pub use ids::{IdHasher, recording_id};
 pub use logger::{
     DEFAULT_FLUSH_BYTES, DEFAULT_FLUSH_ROWS, Logger, LoggerOptions, PREPARE_GROUP_SWEEPS,
     PrepareOptions, PreparedSweeps, SPILL_FLUSH_BYTES, prepare_sweeps, prepare_sweeps_into,
+};
+pub use pipeline::LogError;
+pub use recording::{
+    FinishedRecording, Recording, RecordingError, RecordingTarget, VIEWER_FLUSH_TIMEOUT, Viewer,
 };
 pub use rerun::RecordingStreamError;
 pub use rows::Shown;

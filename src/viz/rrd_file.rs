@@ -19,7 +19,7 @@
 //! rejects the file ("Missing RRD footer").
 
 use std::fs::File;
-use std::io::{BufWriter, Write as _};
+use std::io::BufWriter;
 use std::path::{Path, PathBuf};
 use std::sync::{Arc, Mutex, MutexGuard};
 use std::time::Duration;
@@ -176,10 +176,8 @@ impl RrdFileWriter {
                 .take()
                 .ok_or_else(|| "the recording was already finished".to_string())?;
             encoder.finish().map_err(|e| reason_of(&e))?;
-            let mut writer = encoder.into_inner().map_err(|e| reason_of(&e))?;
-            writer.flush().map_err(|e| e.to_string())?;
-            let file = writer.into_inner().map_err(|e| e.error().to_string())?;
-            crate::atomic::sync(&file).map_err(|e| e.to_string())
+            let writer = encoder.into_inner().map_err(|e| reason_of(&e))?;
+            crate::atomic::seal(writer).map_err(|e| e.cause.to_string())
         })();
         result.map_err(|reason| RrdFileError {
             path: self.path.clone(),

@@ -281,7 +281,7 @@ fn recording_target(args: &Args) -> Option<RecordingTarget> {
         }
         (None, false) => None,
     };
-    (file.is_some() || viewer.is_some()).then(|| RecordingTarget {
+    (file.is_some() || viewer.is_some()).then_some(RecordingTarget {
         file,
         file_options: viz::rrd_file::RrdFileOptions {
             footer: !args.no_rrd_footer,

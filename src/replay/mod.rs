@@ -34,6 +34,7 @@ pub use iter::{
     DEFAULT_BATCH_EVENTS, ParallelReplayIter, ReplayIter, replay_events, replay_events_parallel,
 };
 pub use options::{Detail, FrameRange, ReplayOptions};
+#[cfg(feature = "viewer")]
 pub(crate) use pipeline::sweep_of;
 pub use pipeline::{
     BatchRecorder, Event as PipelineEvent, NoRecorder, PipelineOptions, run_pipeline,

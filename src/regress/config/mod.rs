@@ -1,0 +1,142 @@
+//! `check`'s suite configuration: `sweeptrace.toml` files beside the
+//! traces, so that a folder of traces carries the settings it passes with.
+//!
+//! A trace's settings are found the way rustfmt and ruff find theirs: the
+//! file `sweeptrace.toml` in the trace's folder and in each of its parents,
+//! up to the repository root (the first folder holding `.git`; the
+//! filesystem root when there is none) ([`find_config_files`]). Each file
+//! is a [`ConfigFile`]; [`resolve`] (pure) layers them, key by key, from the
+//! lowest precedence to the highest:
+//!
+//! 1. the defaults;
+//! 2. each file, the farthest first: its top-level keys, then each of its
+//!    `[[traces]]` blocks whose `match` glob matches the trace (in the
+//!    file's order: the last matching block wins);
+//! 3. the command line ([`Overrides`]).
+//!
+//! So a nearer file overrides a farther one for every key it sets, even a
+//! key the farther file sets in a `[[traces]]` block. Each resolved value
+//! keeps where it came from ([`Source`]), for `check --print-config`.
+//!
+//! ```toml
+//! # Settings of every trace under this folder.
+//! fields = ["kind", "triangle", "feature", "alpha", "contact"]
+//! strict = false
+//! allow_tunnels = false
+//!
+//! [tolerances]
+//! alpha = 1e-5
+//! normal_degrees = 0.01
+//! contact = 1e-5
+//!
+//! # Settings of the traces the glob matches (relative to this file's folder).
+//! [[traces]]
+//! match = "rapier/*.mcap"
+//! fields = ["kind", "alpha"]
+//! tolerances = { alpha = 1e-4 }
+//! ```
+//!
+//! Unknown keys and bad values are errors naming the file, line and column
+//! ([`ConfigError`]).
+
+mod file;
+mod settings;
+#[cfg(test)]
+mod tests;
+
+use std::path::{Component, Path, PathBuf};
+
+pub use file::{ConfigError, ConfigFile};
+use settings::Layer;
+pub use settings::{
+    Overrides, Setting, Settings, Source, render_settings_json, render_settings_text,
+};
+
+/// The name of a suite configuration file.
+pub const CONFIG_FILE_NAME: &str = "sweeptrace.toml";
+
+/// The settings of `trace`: the defaults, then `files` (nearest first, as
+/// [`find_config_files`] gives them; the farthest applies first), then the
+/// command line. Pure. `trace` and the files' paths must be in the same
+/// frame (both absolute, or both relative to one folder) for the
+/// `[[traces]]` globs to match; [`load_config_files`] gives absolute paths.
+pub fn resolve(files: &[ConfigFile], trace: &Path, command_line: &Overrides) -> Settings {
+    let mut settings = Settings::default();
+    for file in files.iter().rev() {
+        file.apply(trace, &mut settings);
+    }
+    Layer::of_command_line(command_line).apply(&mut settings);
+    settings
+}
+
+/// `path` with `.` removed and `..` taken against the component before it,
+/// without touching the file system (a `..` at the start stays).
+pub fn normalize(path: &Path) -> PathBuf {
+    let mut out = PathBuf::new();
+    for c in path.components() {
+        match c {
+            Component::CurDir => {}
+            Component::ParentDir => {
+                if matches!(out.components().next_back(), Some(Component::Normal(_))) {
+                    out.pop();
+                } else if !out.has_root() {
+                    out.push("..");
+                }
+            }
+            other => out.push(other),
+        }
+    }
+    out
+}
+
+/// The `sweeptrace.toml` files that apply to `trace`, nearest first: in the
+/// trace's folder and each parent, up to the first folder holding `.git`
+/// (the repository root, included) or the filesystem root. Absolute,
+/// normalized paths.
+pub fn find_config_files(trace: &Path) -> Result<Vec<PathBuf>, ConfigError> {
+    let absolute = std::path::absolute(trace).map_err(|e| ConfigError::Read {
+        file: trace.display().to_string(),
+        cause: e.to_string(),
+    })?;
+    let absolute = normalize(&absolute);
+    let mut found = Vec::new();
+    for dir in absolute.ancestors().skip(1) {
+        let candidate = dir.join(CONFIG_FILE_NAME);
+        if candidate.is_file() {
+            found.push(candidate);
+        }
+        if dir.join(".git").exists() {
+            break;
+        }
+    }
+    Ok(found)
+}
+
+/// The configuration files of `trace` ([`find_config_files`]), read and
+/// parsed, each named relative to the working directory when under it.
+pub fn load_config_files(trace: &Path) -> Result<Vec<ConfigFile>, ConfigError> {
+    let cwd = std::env::current_dir().ok().map(|d| normalize(&d));
+    find_config_files(trace)?
+        .into_iter()
+        .map(|path| {
+            let shown = cwd
+                .as_ref()
+                .and_then(|cwd| path.strip_prefix(cwd).ok())
+                .unwrap_or(&path)
+                .display()
+                .to_string();
+            ConfigFile::read(&path, &shown)
+        })
+        .collect()
+}
+
+/// The settings of `trace` from its configuration files
+/// ([`load_config_files`]) and the command line.
+pub fn settings_for(trace: &Path, command_line: &Overrides) -> Result<Settings, ConfigError> {
+    let files = load_config_files(trace)?;
+    let absolute = std::path::absolute(trace).map_err(|e| ConfigError::Read {
+        file: trace.display().to_string(),
+        cause: e.to_string(),
+    })?;
+    Ok(resolve(&files, &absolute, command_line))
+}

@@ -51,7 +51,7 @@ pub struct EngineCheck {
 
 /// Checks the trace at `path` against a running engine: the engine answers
 /// every sweep ([`EngineAnswers`]) and the answers are judged by an
-/// ordinary check ([`check_events_judged`]): with [`Against::Core`] they
+/// ordinary check ([`check_events_judged`](super::check_events_judged)): with [`Against::Core`] they
 /// are the expectations and the core's outcomes are compared with them
 /// (the trace's `/expected` is not used); with [`Against::Expected`] they
 /// are compared with the trace's `/expected` ([`judge_answer_against_expected`]).

@@ -33,7 +33,7 @@
 //! let bytes = writer.finish()?.into_inner();
 //!
 //! let report = check_reader(bytes.as_slice(), "example.mcap", &CheckOptions::default());
-//! assert_eq!(report.status, Status::Ok);
+//! assert_eq!(report.status(), Status::Ok);
 //!
 //! let mut sweeps = 0;
 //! for event in TraceReader::new(bytes.as_slice(), "example.mcap") {

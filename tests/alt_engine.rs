@@ -522,7 +522,7 @@ fn differently_rounding_engine() -> Result<(), String> {
         let report = check_reader(bytes.as_slice(), &name, &options);
         let text = render_text(&report);
         ensure!(
-            report.divergent == 0 && report.status == Status::Ok,
+            report.divergent == 0 && report.status() == Status::Ok,
             "{name}: a rule-following engine must not diverge on a robust decision:\n{text}"
         );
         if std::env::var_os("ALT_ENGINE_VERBOSE").is_some() {

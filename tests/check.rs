@@ -94,7 +94,7 @@ fn trace_trials() -> Vec<Trial> {
                         .map_err(|e| e.to_string())?;
                     let report =
                         check_file(&path, &settings.check_options(CheckOptions::default()));
-                    ensure!(report.status == Status::Ok, "{}", render_text(&report));
+                    ensure!(report.status() == Status::Ok, "{}", render_text(&report));
                     Ok(())
                 })
             })
@@ -426,7 +426,7 @@ fn blessed_trace_passes() -> Result<(), String> {
     let plain = write_trace(&scene_t(0.1), &fixture_sweeps(), &[]);
     let blessed = bless_with(&plain, ReplayOptions::default())?;
     let report = check_bytes(&blessed);
-    ensure!(report.status == Status::Ok, "{}", render_text(&report));
+    ensure!(report.status() == Status::Ok, "{}", render_text(&report));
     ensure!(
         report.compared == 5 && report.sweeps_without_expectation == 0,
         "counts: {report:?}"
@@ -442,9 +442,9 @@ fn blessed_trace_passes() -> Result<(), String> {
 fn check_fixture_report(report: &sweeptrace::regress::TraceReport) -> Result<(), String> {
     let text = render_text(report);
     ensure!(
-        report.status == Status::Fail,
+        report.status() == Status::Fail,
         "status {:?}\n{text}",
-        report.status
+        report.status()
     );
     ensure!(
         report.divergent == 2,
@@ -519,9 +519,9 @@ fn no_expected_channel_is_not_a_pass() -> Result<(), String> {
     let plain = write_trace(&scene_t(0.0), &fixture_sweeps(), &[]);
     let report = check_bytes(&plain);
     ensure!(
-        report.status == Status::NoExpectations,
+        report.status() == Status::NoExpectations,
         "status {:?}",
-        report.status
+        report.status()
     );
     let text = render_text(&report);
     ensure!(
@@ -650,12 +650,12 @@ fn trace_discovery_in_directories() -> Result<(), String> {
 fn bless_round_trip_fixes_wrong_expectations() -> Result<(), String> {
     let wrong = fixture_bytes()?;
     ensure!(
-        check_bytes(&wrong).status == Status::Fail,
+        check_bytes(&wrong).status() == Status::Fail,
         "the input must fail"
     );
     let blessed = bless_with(&wrong, ReplayOptions::default())?;
     let report = check_bytes(&blessed);
-    ensure!(report.status == Status::Ok, "{}", render_text(&report));
+    ensure!(report.status() == Status::Ok, "{}", render_text(&report));
     ensure!(
         report.compared == 5 && report.expectations_without_sweep == 0,
         "one expectation per sweep, old ones gone: {report:?}"
@@ -851,12 +851,12 @@ fn contents(bytes: &[u8]) -> Result<Contents, String> {
 fn bless_keeps_foreign_channel_metadata_attachment() -> Result<(), String> {
     let input = foreign_trace()?;
     ensure!(
-        check_bytes(&input).status == Status::Fail,
+        check_bytes(&input).status() == Status::Fail,
         "input expectations are wrong"
     );
     let output = bless_with(&input, ReplayOptions::default())?;
     let report = check_bytes(&output);
-    ensure!(report.status == Status::Ok, "{}", render_text(&report));
+    ensure!(report.status() == Status::Ok, "{}", render_text(&report));
     let (s_in, c_in, mut m_in, md_in, a_in, h_in) = contents(&input)?;
     let (s_out, c_out, mut m_out, md_out, a_out, h_out) = contents(&output)?;
     ensure!(s_in == s_out, "schemas:\n{s_in:?}\n{s_out:?}");

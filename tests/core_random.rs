@@ -8,7 +8,7 @@ use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use sweeptrace::core::{
     Broadphase, CollectRecords, Facing, Kind, Mesh, NoObserver, Options, Outcome, Sweep,
-    sweep_mesh, sweep_mesh_with,
+    VerdictCounts, sweep_mesh, sweep_mesh_with,
 };
 use sweeptrace::replay::{CollectPrimary, primary_records};
 
@@ -436,12 +436,8 @@ fn primary_collector_equals_collecting_every_record() -> Result<(), String> {
                 if format!("{outcome:?}") != format!("{again:?}") {
                     return Err(format!("{p0:?} -> {p1:?}: outcomes differ"));
                 }
-                let mut counts = std::collections::BTreeMap::new();
-                for r in &every.records {
-                    *counts.entry(r.verdict()).or_insert(0u64) += 1;
-                }
-                let got: std::collections::BTreeMap<_, _> =
-                    primary.verdict_counts().into_iter().collect();
+                let counts: VerdictCounts = every.records.iter().map(|r| r.verdict()).collect();
+                let got = primary.verdict_counts();
                 if got != counts {
                     return Err(format!(
                         "{p0:?} -> {p1:?}: verdict counts {got:?}, expected {counts:?}"

@@ -330,7 +330,7 @@ fn old_trace_without_it_reads_as_before() -> Result<(), String> {
         serde_json::from_str(&info::render_json(&info)).map_err(|e| e.to_string())?;
     ensure!(json["expected_source"].is_null(), "{json}");
     let report = check_file(&old, &CheckOptions::default());
-    ensure!(report.status == Status::Ok, "{}", render_text(&report));
+    ensure!(report.status() == Status::Ok, "{}", render_text(&report));
     let text = render_text(&report);
     ensure!(
         !text.contains("expectations from") && text.lines().count() == 1,
@@ -471,7 +471,7 @@ fn check_shows_it_in_text_and_json() -> Result<(), String> {
     let text = render_text(&report);
     let lines: Vec<&str> = text.lines().collect();
     ensure!(
-        report.status == Status::Fail
+        report.status() == Status::Fail
             && lines[0].starts_with("FAIL fail.mcap")
             && lines[1] == format!("  expectations from {RAPIER_TEXT}"),
         "{text}"

@@ -46,7 +46,7 @@ fn rapier_recording_passes_check_with_the_readme_options() -> Result<(), String>
     };
     let report = check_file(&output, &readme);
     ensure!(
-        report.status == Status::Ok
+        report.status() == Status::Ok
             && report.compared + report.sweeps_without_expectation == sweeps
             && report.sweeps_without_expectation == starting_in_contact,
         "{}",
@@ -82,6 +82,6 @@ fn rapier_recording_passes_check_with_the_readme_options() -> Result<(), String>
     );
     // With the defaults Rapier's α (to about 1e-5) does not pass.
     let report = check_file(&output, &CheckOptions::default());
-    ensure!(report.status == Status::Fail, "{}", render_text(&report));
+    ensure!(report.status() == Status::Fail, "{}", render_text(&report));
     Ok(())
 }

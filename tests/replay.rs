@@ -496,7 +496,7 @@ fn scene_overrides_apply() -> Result<(), String> {
     };
     let (r, _) = run(events_for(triangle_scene(), &[sweep]), options)?;
     ensure!(
-        r[0].options.margin == 0.25 && r[0].options.facing == Facing::Strict,
+        r[0].options().margin == 0.25 && r[0].options().facing == Facing::Strict,
         "overrides not applied"
     );
     ensure!(

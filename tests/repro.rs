@@ -313,7 +313,7 @@ fn fixture_case() -> Result<(), String> {
         let bytes = case_bytes(&case)?;
         let report = check_reader(bytes.as_slice(), "case", &CheckOptions::default());
         ensure!(
-            report.status == Status::Fail && report.divergent == 1,
+            report.status() == Status::Fail && report.divergent == 1,
             "frame {frame}: the case must fail as the trace does:\n{}",
             render_text(&report)
         );
@@ -383,7 +383,7 @@ fn sample_cases() -> Result<(), String> {
                 &CheckOptions::default(),
             );
             ensure!(
-                report.status == Status::Ok,
+                report.status() == Status::Ok,
                 "{name} {frame}/{ball}:\n{}",
                 render_text(&report)
             );
@@ -602,7 +602,7 @@ fn infer_wrong_engine_config() -> Result<(), String> {
         &root().join("traces/record_cube_corner_margin.mcap"),
         &CheckOptions::default(),
     );
-    ensure!(ok.status == Status::Ok && ok.inferred.is_none(), "{ok:?}");
+    ensure!(ok.status() == Status::Ok && ok.inferred.is_none(), "{ok:?}");
     Ok(())
 }
 
@@ -674,7 +674,7 @@ fn infer_parallel_hit() -> Result<(), String> {
     let (scene, sweeps) = floor_and_sweeps(0.0, Facing::Strict);
     let bytes = recorded_by(&scene, &sweeps, 0.05, Facing::NonStrict)?;
     let report = check_reader(bytes.as_slice(), "floor", &CheckOptions::default());
-    ensure!(report.status == Status::Fail, "{}", render_text(&report));
+    ensure!(report.status() == Status::Fail, "{}", render_text(&report));
     let inferred = report.inferred.as_ref().ok_or("nothing inferred")?;
     let text = render_text(&report);
     ensure!(

@@ -509,7 +509,7 @@ fn check_on_a_scanned_mesh_reports_ties_not_divergences() -> Result<(), String> 
     let report = check_reader(bytes.as_slice(), "bunny", &check_options);
     let text = render_text(&report);
     ensure!(
-        report.divergent == 0 && report.status == Status::Ok,
+        report.divergent == 0 && report.status() == Status::Ok,
         "a rule-following engine must not diverge on a robust decision:\n{text}"
     );
     let multi = contacts.iter().filter(|c| c.expected.len() > 1).count();

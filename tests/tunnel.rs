@@ -407,7 +407,7 @@ fn tunnels_of(results: &[SweepResult]) -> Vec<(u64, u32, TunnelKind, u32)> {
 
 fn check_floor_report(report: &sweeptrace::regress::TraceReport) -> Result<(), String> {
     let text = render_text(report);
-    ensure!(report.status == Status::Fail, "status\n{text}");
+    ensure!(report.status() == Status::Fail, "status\n{text}");
     ensure!(
         report.divergent == 0 && report.compared == 10,
         "the expectations all match:\n{text}"
@@ -471,7 +471,7 @@ fn floor_fixture_check() -> Result<(), String> {
         },
     );
     let text = render_text(&allowed);
-    ensure!(allowed.status == Status::Ok, "{text}");
+    ensure!(allowed.status() == Status::Ok, "{text}");
     ensure!(
         text.contains("1 tunnel (not failures: tunnels allowed)")
             && text.contains("tunnel: frame 4"),
@@ -482,7 +482,7 @@ fn floor_fixture_check() -> Result<(), String> {
 
 fn check_wall_report(report: &sweeptrace::regress::TraceReport) -> Result<(), String> {
     let text = render_text(report);
-    ensure!(report.status == Status::Fail, "status\n{text}");
+    ensure!(report.status() == Status::Fail, "status\n{text}");
     ensure!(report.divergent == 0, "the expectations all match:\n{text}");
     ensure!(report.tunnels == 1, "one tunnel:\n{text}");
     let t = report.tunnel_details.first().ok_or("no tunnel detail")?;

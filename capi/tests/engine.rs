@@ -197,7 +197,7 @@ fn c_engine_passes_check_on_the_sample_traces() {
         )
         .unwrap_or_else(|e| panic!("the engine cannot be started: {e}"));
         let text = render_text(&report);
-        assert_eq!(report.status, Status::Ok, "{text}");
+        assert_eq!(report.status(), Status::Ok, "{text}");
         assert!(
             report.sweeps > 0 && report.compared == report.sweeps,
             "{text}"
@@ -256,7 +256,7 @@ fn cpp_lambda_engine_passes_a_trace() {
     )
     .unwrap_or_else(|e| panic!("the engine cannot be started: {e}"));
     let text = render_text(&report);
-    assert_eq!(report.status, Status::Ok, "{text}");
+    assert_eq!(report.status(), Status::Ok, "{text}");
     assert_eq!((report.sweeps, report.compared), (4, 4), "{text}");
 }
 

@@ -78,7 +78,7 @@ fn assert_check_passes(trace: &Path) {
         render_text(&report)
     );
     assert!(
-        report.status == Status::Ok,
+        report.status() == Status::Ok,
         "check does not pass:\n{}",
         render_text(&report)
     );

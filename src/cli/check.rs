@@ -219,7 +219,7 @@ pub fn run(args: Args) -> anyhow::Result<RunOutcome> {
             print!("{}", render_text(&report));
             super::junit::print_github_annotations(&report);
         }
-        if report.status == Status::Fail
+        if report.status() == Status::Fail
             && let Some(dir) = &args.rrd_on_failure
         {
             match write_failure_rrd(path, dir, &report) {
@@ -235,7 +235,7 @@ pub fn run(args: Args) -> anyhow::Result<RunOutcome> {
     if args.json {
         print!("{}", render_json(&reports));
     } else if traces.len() > 1 {
-        let count = |s: Status| reports.iter().filter(|r| r.status == s).count();
+        let count = |s: Status| reports.iter().filter(|r| r.status() == s).count();
         println!(
             "{} traces: {} ok, {} FAIL, {} NO EXPECTATIONS, {} ERROR",
             reports.len(),

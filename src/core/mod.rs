@@ -43,7 +43,7 @@ pub use options::{
 pub use path::{Sweep, SweptPath};
 pub use record::{
     CollectRecords, EdgeHit, EdgeRecord, FaceHit, FaceRecord, Kind, NoObserver, Observer,
-    TestRecord, Verdict, VertexRecord,
+    TestRecord, Verdict, VerdictCounts, VertexRecord,
 };
 pub use sweep_edge::sweep_edge;
 pub use sweep_face::{barycentric, barycentric_and_distance, sweep_face};

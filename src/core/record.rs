@@ -106,6 +106,66 @@ impl std::fmt::Display for Verdict {
     }
 }
 
+// `VerdictCounts` counts at `verdict as usize`: that must be the verdict's
+// index in `Verdict::ALL`.
+const _: () = {
+    let mut i = 0;
+    while i < Verdict::ALL.len() {
+        assert!(Verdict::ALL[i] as usize == i);
+        i += 1;
+    }
+};
+
+/// How many tests ended with each verdict.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct VerdictCounts([u64; Verdict::ALL.len()]);
+
+impl VerdictCounts {
+    /// Counts one test that ended with `verdict`.
+    #[inline]
+    pub fn add(&mut self, verdict: Verdict) {
+        self.0[verdict as usize] += 1;
+    }
+
+    /// How many tests ended with `verdict`.
+    pub fn get(&self, verdict: Verdict) -> u64 {
+        self.0[verdict as usize]
+    }
+
+    /// Whether no test was counted.
+    pub fn is_empty(&self) -> bool {
+        self.0.iter().all(|&n| n == 0)
+    }
+
+    /// The verdicts that occurred with their counts, in the order of
+    /// [`Verdict::ALL`].
+    pub fn iter(&self) -> impl Iterator<Item = (Verdict, u64)> + '_ {
+        Verdict::ALL
+            .iter()
+            .zip(self.0)
+            .filter(|(_, n)| *n > 0)
+            .map(|(v, n)| (*v, n))
+    }
+}
+
+impl std::ops::AddAssign for VerdictCounts {
+    fn add_assign(&mut self, other: VerdictCounts) {
+        for (n, m) in self.0.iter_mut().zip(other.0) {
+            *n += m;
+        }
+    }
+}
+
+impl FromIterator<Verdict> for VerdictCounts {
+    fn from_iter<I: IntoIterator<Item = Verdict>>(verdicts: I) -> Self {
+        let mut counts = VerdictCounts::default();
+        for v in verdicts {
+            counts.add(v);
+        }
+        counts
+    }
+}
+
 /// Everything the face test computed.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
 pub struct FaceRecord {

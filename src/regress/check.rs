@@ -16,9 +16,13 @@
 
 use std::collections::BTreeMap;
 
-use serde::Serialize;
+use serde::{Serialize, Serializer};
 
-use crate::replay::{ReplayError, ReplayEvent, ReplayOptions, SweepResult, Tunnel, TunnelAt};
+use crate::core::{Facing, FragileReason, Kind};
+
+use crate::replay::{
+    ReplayError, ReplayEvent, ReplayOptions, SweepResult, Tunnel, TunnelAt, TunnelKind,
+};
 use crate::run::RunOutcome;
 use crate::trace::messages::{EXPECTED_TOPIC, OutcomeMsg};
 use crate::trace::{TraceError, TraceEvent, TraceReader};
@@ -100,7 +104,7 @@ pub struct Divergence {
     /// The margin and facing rule the core used.
     pub margin: f64,
     /// The facing rule the core used.
-    pub facing: String,
+    pub facing: Facing,
     /// The tests that decided the core's outcome, in words: the primary
     /// test and the other hits at the same `α`, or the nearest miss.
     pub got_explanation: Vec<String>,
@@ -155,7 +159,22 @@ impl TraceReport {
         if self.errors.len() < MAX_ERRORS {
             self.errors.push(message);
         }
-        self.status = status_of(self);
+    }
+
+    /// The verdict, from the counts: [`Status::Error`] when anything could
+    /// not be checked; [`Status::Fail`] on a divergence (or a tunnel that
+    /// fails the check); [`Status::NoExpectations`] when nothing was
+    /// compared; otherwise [`Status::Ok`].
+    pub fn status(&self) -> Status {
+        if !self.errors.is_empty() {
+            Status::Error
+        } else if self.divergent > 0 || self.fails_on_tunnels() {
+            Status::Fail
+        } else if self.compared == 0 {
+            Status::NoExpectations
+        } else {
+            Status::Ok
+        }
     }
 
     /// Whether tunnels were found and fail the check.
@@ -168,7 +187,7 @@ impl TraceReport {
     /// [`RunOutcome::IncompleteInput`]; any other error, or nothing to
     /// compare, [`RunOutcome::Error`].
     pub fn outcome(&self) -> RunOutcome {
-        match self.status {
+        match self.status() {
             Status::Ok => RunOutcome::Success,
             Status::Fail => RunOutcome::Differences,
             Status::Error if self.incomplete && self.errors.len() == 1 => {
@@ -213,13 +232,12 @@ impl Default for CheckOptions {
     }
 }
 
-/// The result of checking one trace.
-#[derive(Clone, Debug, PartialEq, Serialize)]
+/// The result of checking one trace. Its verdict is [`TraceReport::status`]
+/// (in the JSON, `status` after `trace`).
+#[derive(Clone, Debug, PartialEq)]
 pub struct TraceReport {
     /// The trace's name (its path as given).
     pub trace: String,
-    /// The verdict.
-    pub status: Status,
     /// Sweeps replayed.
     pub sweeps: u64,
     /// Sweeps compared with an expectation.
@@ -240,7 +258,7 @@ pub struct TraceReport {
     /// `divergent`.
     pub fragile_divergent: u64,
     /// Fragile divergences by reason (one sweep can have several).
-    pub fragile_by_reason: BTreeMap<String, u64>,
+    pub fragile_by_reason: BTreeMap<FragileReason, u64>,
     /// The first fragile divergences, in detail (without `strict`).
     pub fragile_divergences: Vec<Divergence>,
     /// Whether fragile divergences fail the check (`--strict`).
@@ -249,8 +267,8 @@ pub struct TraceReport {
     /// during a sweep or between two sweeps of the ball. They fail the
     /// check unless `fail_on_tunnel` is off.
     pub tunnels: u64,
-    /// Tunnels by kind (`during_sweep`, `between_sweeps`).
-    pub tunnels_by_kind: BTreeMap<String, u64>,
+    /// Tunnels by kind.
+    pub tunnels_by_kind: BTreeMap<TunnelKind, u64>,
     /// The first tunnels (at most [`MAX_LISTED_TUNNELS`]), in trace order.
     pub tunnel_details: Vec<TunnelReport>,
     /// Whether tunnels fail the check.
@@ -264,8 +282,9 @@ pub struct TraceReport {
     pub expectations: u64,
     /// Whether the trace has an `/expected` channel at all.
     pub has_expected_channel: bool,
-    /// Divergent sweeps by `(expected kind, got kind)`.
-    pub by_kind: BTreeMap<String, u64>,
+    /// Divergent sweeps by the kinds of the expectation and of the outcome
+    /// it is compared with.
+    pub by_kind: BTreeMap<KindChange, u64>,
     /// The first divergences, in detail (at most `max_details`).
     pub divergences: Vec<Divergence>,
     /// Frames of the first divergent sweeps (up to 100), in trace order.
@@ -274,24 +293,166 @@ pub struct TraceReport {
     pub errors: Vec<String>,
     /// Whether the trace ends early (it is truncated): the sweeps before
     /// the end were checked. Only in the JSON when true.
-    #[serde(skip_serializing_if = "std::ops::Not::not")]
     pub incomplete: bool,
     /// The tolerances used.
     pub tolerances: Tolerances,
     /// When expectations fail: the recording engine's margin and facing
     /// rule as its expectations imply them, and how many expectations
     /// match when the trace is replayed with them ([`Inferred`]).
-    #[serde(skip_serializing_if = "Option::is_none")]
     pub inferred: Option<Inferred>,
     /// When a running engine was checked (`check --engine`): its command
     /// and what its answers were compared with.
-    #[serde(skip_serializing_if = "Option::is_none")]
     pub engine: Option<super::engine_check::EngineCheck>,
     /// Who computed the trace's `/expected` outcomes, as its
     /// `sweeptrace.expected_source` record says (`null` when it does not).
     /// With `check --engine` and `against` `core` the report's
     /// expectations are the engine's answers instead (`engine`).
     pub expected_source: Option<crate::trace::ExpectedSource>,
+}
+
+/// The kinds of a divergent sweep's expectation and of the outcome it is
+/// compared with; written `expected -> got` (`face -> edge`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub struct KindChange {
+    /// The expectation's kind.
+    pub expected: Kind,
+    /// The compared outcome's kind.
+    pub got: Kind,
+}
+
+impl std::fmt::Display for KindChange {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{} -> {}", self.expected, self.got)
+    }
+}
+
+impl Serialize for KindChange {
+    fn serialize<S: Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        serializer.collect_str(self)
+    }
+}
+
+/// Counts by key, listed by the keys' names in alphabetical order: the
+/// order of the report's text and of its JSON objects.
+pub(crate) fn counts_by_name<K: std::fmt::Display>(
+    counts: &BTreeMap<K, u64>,
+) -> Vec<(String, u64)> {
+    let mut named: Vec<(String, u64)> = counts.iter().map(|(k, n)| (k.to_string(), *n)).collect();
+    named.sort();
+    named
+}
+
+/// A count map written as a JSON object whose keys are the names, in
+/// alphabetical order.
+fn serialize_by_name<K, S>(counts: &BTreeMap<K, u64>, serializer: S) -> Result<S::Ok, S::Error>
+where
+    K: std::fmt::Display,
+    S: Serializer,
+{
+    serializer.collect_map(counts_by_name(counts))
+}
+
+/// The JSON of a report: its fields in declaration order, with the
+/// computed [`TraceReport::status`] after `trace`.
+impl Serialize for TraceReport {
+    fn serialize<S: Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        #[derive(Serialize)]
+        struct Json<'a> {
+            trace: &'a str,
+            status: Status,
+            sweeps: u64,
+            compared: u64,
+            divergent: u64,
+            ties: u64,
+            fragile_divergent: u64,
+            #[serde(serialize_with = "serialize_by_name")]
+            fragile_by_reason: &'a BTreeMap<FragileReason, u64>,
+            fragile_divergences: &'a [Divergence],
+            strict: bool,
+            tunnels: u64,
+            #[serde(serialize_with = "serialize_by_name")]
+            tunnels_by_kind: &'a BTreeMap<TunnelKind, u64>,
+            tunnel_details: &'a [TunnelReport],
+            fail_on_tunnel: bool,
+            sweeps_without_expectation: u64,
+            expectations_without_sweep: u64,
+            expectations: u64,
+            has_expected_channel: bool,
+            #[serde(serialize_with = "serialize_by_name")]
+            by_kind: &'a BTreeMap<KindChange, u64>,
+            divergences: &'a [Divergence],
+            divergent_frames: &'a [u64],
+            errors: &'a [String],
+            #[serde(skip_serializing_if = "std::ops::Not::not")]
+            incomplete: bool,
+            tolerances: &'a Tolerances,
+            #[serde(skip_serializing_if = "Option::is_none")]
+            inferred: &'a Option<Inferred>,
+            #[serde(skip_serializing_if = "Option::is_none")]
+            engine: &'a Option<super::engine_check::EngineCheck>,
+            expected_source: &'a Option<crate::trace::ExpectedSource>,
+        }
+        // Every field, named: a new field does not compile until it is
+        // written here too.
+        let TraceReport {
+            trace,
+            sweeps,
+            compared,
+            divergent,
+            ties,
+            fragile_divergent,
+            fragile_by_reason,
+            fragile_divergences,
+            strict,
+            tunnels,
+            tunnels_by_kind,
+            tunnel_details,
+            fail_on_tunnel,
+            sweeps_without_expectation,
+            expectations_without_sweep,
+            expectations,
+            has_expected_channel,
+            by_kind,
+            divergences,
+            divergent_frames,
+            errors,
+            incomplete,
+            tolerances,
+            inferred,
+            engine,
+            expected_source,
+        } = self;
+        Json {
+            trace,
+            status: self.status(),
+            sweeps: *sweeps,
+            compared: *compared,
+            divergent: *divergent,
+            ties: *ties,
+            fragile_divergent: *fragile_divergent,
+            fragile_by_reason,
+            fragile_divergences,
+            strict: *strict,
+            tunnels: *tunnels,
+            tunnels_by_kind,
+            tunnel_details,
+            fail_on_tunnel: *fail_on_tunnel,
+            sweeps_without_expectation: *sweeps_without_expectation,
+            expectations_without_sweep: *expectations_without_sweep,
+            expectations: *expectations,
+            has_expected_channel: *has_expected_channel,
+            by_kind,
+            divergences,
+            divergent_frames,
+            errors,
+            incomplete: *incomplete,
+            tolerances,
+            inferred,
+            engine,
+            expected_source,
+        }
+        .serialize(serializer)
+    }
 }
 
 /// How many compared sweeps (the first ones) the inference of the
@@ -319,10 +480,11 @@ fn check_trace<R: std::io::Read>(
     name: &str,
     options: &CheckOptions,
 ) -> TraceReport {
-    let mut report = check_events(reader.by_ref(), name, options);
+    let (mut report, _) = check_stream(reader.by_ref(), name, options, |result| {
+        judge_against_core(result, &options.tolerances)
+    });
     report.has_expected_channel = reader.stats().channels.contains_key(EXPECTED_TOPIC);
     report.expected_source = reader.expected_source().cloned();
-    report.status = status_of(&report);
     report
 }
 
@@ -372,8 +534,27 @@ pub fn check_events_judged<I, J>(
     events: I,
     name: &str,
     options: &CheckOptions,
-    mut judge: J,
+    judge: J,
 ) -> TraceReport
+where
+    I: Iterator<Item = Result<TraceEvent, TraceError>>,
+    J: FnMut(&SweepResult) -> Option<Judged>,
+{
+    let (mut report, saw_expected) = check_stream(events, name, options, judge);
+    report.has_expected_channel = saw_expected;
+    report
+}
+
+/// The check of a stream of events with `judge`, except whether the trace
+/// has an `/expected` channel (`has_expected_channel` is left false: each
+/// caller sets it once, from what it knows); returns the report and whether
+/// any `/expected` message was seen.
+pub(crate) fn check_stream<I, J>(
+    events: I,
+    name: &str,
+    options: &CheckOptions,
+    mut judge: J,
+) -> (TraceReport, bool)
 where
     I: Iterator<Item = Result<TraceEvent, TraceError>>,
     J: FnMut(&SweepResult) -> Option<Judged>,
@@ -390,7 +571,6 @@ where
     };
     let mut report = TraceReport {
         trace: name.to_string(),
-        status: Status::Ok,
         sweeps: 0,
         compared: 0,
         divergent: 0,
@@ -426,10 +606,7 @@ where
                 report.sweeps += 1;
                 for t in &result.tunnels {
                     report.tunnels += 1;
-                    *report
-                        .tunnels_by_kind
-                        .entry(t.kind.as_str().to_string())
-                        .or_default() += 1;
+                    *report.tunnels_by_kind.entry(t.kind).or_default() += 1;
                     if report.tunnel_details.len() < MAX_LISTED_TUNNELS {
                         report.tunnel_details.push(TunnelReport {
                             frame: result.frame,
@@ -454,7 +631,7 @@ where
                         ball: result.ball,
                         sweep: result.sweep,
                         expected: *expected,
-                        replayed_face: (result.outcome.kind == crate::core::Kind::Face)
+                        replayed_face: (result.outcome.kind == Kind::Face)
                             .then_some(result.outcome.triangle)
                             .flatten(),
                     });
@@ -480,10 +657,7 @@ where
                 if reproduced.is_some() {
                     report.fragile_divergent += 1;
                     for reason in fragile.iter() {
-                        *report
-                            .fragile_by_reason
-                            .entry(reason.as_str().to_string())
-                            .or_default() += 1;
+                        *report.fragile_by_reason.entry(reason).or_default() += 1;
                     }
                     if !options.strict {
                         if report.fragile_divergences.len() < options.max_details {
@@ -495,7 +669,10 @@ where
                 report.divergent += 1;
                 *report
                     .by_kind
-                    .entry(format!("{} -> {}", expected.kind, got.kind))
+                    .entry(KindChange {
+                        expected: expected.kind,
+                        got: got.kind,
+                    })
                     .or_default() += 1;
                 if report.divergent_frames.len() < MAX_DIVERGENT_FRAMES {
                     report.divergent_frames.push(result.frame);
@@ -518,24 +695,10 @@ where
     drop(replay);
     report.expectations_without_sweep = summary.expected_unmatched;
     report.expectations = summary.expected_matched + summary.expected_unmatched;
-    report.has_expected_channel = saw_expected;
     if report.divergent + report.fragile_divergent > 0 {
         report.inferred = infer(&compared, &options.tolerances);
     }
-    report.status = status_of(&report);
-    report
-}
-
-fn status_of(r: &TraceReport) -> Status {
-    if !r.errors.is_empty() {
-        Status::Error
-    } else if r.divergent > 0 || r.fails_on_tunnels() {
-        Status::Fail
-    } else if r.compared == 0 {
-        Status::NoExpectations
-    } else {
-        Status::Ok
-    }
+    (report, saw_expected)
 }
 
 /// A divergent sweep explained as `check` reports it (render it with
@@ -550,7 +713,7 @@ pub fn divergence_details(
     hex: bool,
 ) -> Divergence {
     let records = explained_records(result);
-    let inputs = SweepInputs::of(&result.sweep, &result.options);
+    let inputs = SweepInputs::of(&result.sweep, result.options());
     Divergence {
         inputs,
         inputs_hex: hex.then(|| inputs.hex()),
@@ -563,8 +726,8 @@ pub fn divergence_details(
         fragile: result.outcome.fragile,
         reproduced: None,
         names_tie_member: false,
-        margin: result.options.margin,
-        facing: result.options.facing.to_string(),
+        margin: result.options().margin,
+        facing: result.options().facing,
         got_explanation: explain_outcome(&result.outcome, &records),
         expected_tests: expected_tests(&expected, &result.outcome, &records, Some(&result.scene)),
     }
@@ -608,8 +771,7 @@ pub fn check_file(path: &std::path::Path, options: &CheckOptions) -> TraceReport
         ),
         Err(err) => {
             let mut report = check_events(std::iter::empty(), &name, options);
-            report.errors.push(format!("{name}: cannot open: {err}"));
-            report.status = Status::Error;
+            report.add_error(format!("{name}: cannot open: {err}"));
             report
         }
     }

@@ -120,8 +120,8 @@ pub fn write_divergence_line(s: &mut String, r: &SweepResult, diffs: &[FieldDiff
     let _ = write!(
         s,
         " (margin {}, facing {})",
-        Num(r.options.margin),
-        r.options.facing
+        Num(r.options().margin),
+        r.options().facing
     );
 }
 

@@ -16,7 +16,7 @@ use crate::trace::TraceReader;
 use crate::trace::messages::{EXPECTED_TOPIC, OutcomeMsg};
 
 use super::check::{
-    CheckOptions, Judged, TraceReport, check_events, check_events_judged, check_file,
+    CheckOptions, Judged, TraceReport, check_file, check_stream, judge_against_core,
 };
 use super::compare::Tolerances;
 use super::judge::agreement_of;
@@ -51,7 +51,7 @@ pub struct EngineCheck {
 
 /// Checks the trace at `path` against a running engine: the engine answers
 /// every sweep ([`EngineAnswers`]) and the answers are judged by an
-/// ordinary check ([`check_events_judged`]): with [`Against::Core`] they
+/// ordinary check ([`check_events_judged`](super::check_events_judged)): with [`Against::Core`] they
 /// are the expectations and the core's outcomes are compared with them
 /// (the trace's `/expected` is not used); with [`Against::Expected`] they
 /// are compared with the trace's `/expected` ([`judge_answer_against_expected`]).
@@ -87,7 +87,9 @@ pub fn check_file_with_engine(
     let (mut report, run) = match against {
         Against::Core => {
             let mut answers = EngineAnswers::new(reader.by_ref(), session, engine.window);
-            let report = check_events(answers.by_ref(), &name, options);
+            let (report, _) = check_stream(answers.by_ref(), &name, options, |result| {
+                judge_against_core(result, &options.tolerances)
+            });
             (report, answers.finish())
         }
         Against::Expected => {
@@ -98,7 +100,7 @@ pub fn check_file_with_engine(
                 engine.window,
                 sink.clone(),
             );
-            let report = check_events_judged(answers.by_ref(), &name, options, |result| {
+            let (report, _) = check_stream(answers.by_ref(), &name, options, |result| {
                 let answer = sink.borrow_mut().remove(&(result.frame, result.ball))?;
                 judge_answer_against_expected(result, answer, &options.tolerances)
             });

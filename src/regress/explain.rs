@@ -30,7 +30,7 @@ pub fn explained_records(result: &SweepResult) -> Vec<TestRecord> {
     match sweep_mesh_with(
         &result.scene.mesh,
         &result.sweep,
-        &result.options,
+        result.options(),
         Broadphase::Exhaustive,
         &mut collect,
     ) {

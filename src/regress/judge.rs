@@ -353,7 +353,7 @@ fn judge(
         };
     }
     let mesh = &result.scene.mesh;
-    let Some(decision) = Decision::of(mesh, &result.sweep, &result.options) else {
+    let Some(decision) = Decision::of(mesh, &result.sweep, result.options()) else {
         return Agreement::Diverges {
             fields,
             fragile,
@@ -406,14 +406,14 @@ fn reproduce(
     tol: &Tolerances,
 ) -> Option<Reproduced> {
     let mesh = &result.scene.mesh;
-    let u = rounding_unit(mesh, &result.sweep, &result.options)?;
+    let u = rounding_unit(mesh, &result.sweep, result.options())?;
     let mut on_expected: Option<Option<Perturbation>> = (!expected_open).then_some(None);
     let mut on_got: Option<Option<Perturbation>> = (!got_open).then_some(None);
     for p in perturbations(u) {
         if on_expected.is_some() && on_got.is_some() {
             break;
         }
-        let Some(decision) = Decision::of(mesh, &p.apply(&result.sweep), &result.options) else {
+        let Some(decision) = Decision::of(mesh, &p.apply(&result.sweep), result.options()) else {
             continue;
         };
         if on_expected.is_none() && decision.disagreement(expected, tol).is_none() {

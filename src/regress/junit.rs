@@ -52,7 +52,7 @@ pub fn check_junit(reports: &[TraceReport], times: &[Duration], options: &JunitO
 /// why. `None` for a trace that passed.
 pub fn first_problem(r: &TraceReport) -> Option<String> {
     let sides = sides_of(r);
-    match r.status {
+    match r.status() {
         Status::Ok => None,
         Status::Fail => {
             let mut parts: Vec<String> = Vec::new();
@@ -91,7 +91,7 @@ pub fn first_problem(r: &TraceReport) -> Option<String> {
             // The status line's reason, before the counts.
             let text = render_text(r);
             let line = text.lines().next().unwrap_or_default();
-            let prefix = format!("{} {}: ", r.status, r.trace);
+            let prefix = format!("{} {}: ", r.status(), r.trace);
             let why = line.strip_prefix(&prefix).unwrap_or(line);
             Some(why.split_once("; ").map_or(why, |(w, _)| w).to_string())
         }
@@ -134,7 +134,7 @@ fn trace_suite(r: &TraceReport, time: Option<Duration>, options: &JunitOptions) 
         kind: kind.to_string(),
         body: text.clone(),
     };
-    let result = match (r.status, first_problem(r)) {
+    let result = match (r.status(), first_problem(r)) {
         (Status::Ok, _) | (_, None) => CaseResult::Passed,
         (Status::Fail, Some(m)) => CaseResult::Failure(problem(
             if r.divergent > 0 {
@@ -230,7 +230,7 @@ fn trace_suite(r: &TraceReport, time: Option<Duration>, options: &JunitOptions) 
 pub fn github_annotations(r: &TraceReport) -> String {
     let sides = sides_of(r);
     let mut lines: Vec<(String, String)> = Vec::new();
-    match r.status {
+    match r.status() {
         Status::Ok => {}
         Status::Fail => {
             for d in &r.divergences {
@@ -262,7 +262,7 @@ pub fn github_annotations(r: &TraceReport) -> String {
         }
         Status::Error | Status::NoExpectations => {
             if let Some(message) = first_problem(r) {
-                lines.push((format!("sweeptrace check: {}", r.status), message));
+                lines.push((format!("sweeptrace check: {}", r.status()), message));
             }
         }
     }

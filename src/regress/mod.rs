@@ -39,9 +39,9 @@ pub mod repro;
 
 pub use bless::{BlessError, BlessSummary, bless_bytes, bless_file};
 pub use check::{
-    CheckOptions, DEFAULT_MAX_DETAILS, Divergence, Judged, MAX_LISTED_TUNNELS, Status, TraceReport,
-    TunnelReport, check_events, check_events_judged, check_file, check_reader, divergence_details,
-    find_traces, frames_around, judge_against_core,
+    CheckOptions, DEFAULT_MAX_DETAILS, Divergence, Judged, KindChange, MAX_LISTED_TUNNELS, Status,
+    TraceReport, TunnelReport, check_events, check_events_judged, check_file, check_reader,
+    divergence_details, find_traces, frames_around, judge_against_core,
 };
 pub use compare::{
     DEFAULT_ALPHA_TOLERANCE, DEFAULT_CONTACT_TOLERANCE, DEFAULT_NORMAL_TOLERANCE_DEGREES, Field,

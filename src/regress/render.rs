@@ -8,7 +8,7 @@ use crate::core::Kind;
 use crate::core::explain::num;
 use crate::run::RunOutcome;
 
-use super::check::{Divergence, Status, TraceReport};
+use super::check::{Divergence, Status, TraceReport, counts_by_name};
 
 /// A JSON value in words: numbers as [`num`], null as `null`.
 pub fn value_text(v: &Value) -> String {
@@ -249,8 +249,7 @@ pub fn render_text(r: &TraceReport) -> String {
         );
     }
     if r.fragile_divergent > 0 {
-        let reasons = r
-            .fragile_by_reason
+        let reasons = counts_by_name(&r.fragile_by_reason)
             .iter()
             .map(|(k, n)| format!("{k}: {n}"))
             .collect::<Vec<_>>()
@@ -295,7 +294,7 @@ pub fn render_text(r: &TraceReport) -> String {
             s.push_str(&render_divergence_as(d, "    ", sides));
         }
     };
-    match r.status {
+    match r.status() {
         Status::Ok => {
             let _ = writeln!(s, "ok {}: {counts}", r.trace);
             tunnel_lines(&mut s);
@@ -304,8 +303,7 @@ pub fn render_text(r: &TraceReport) -> String {
         Status::Fail => {
             let mut failures: Vec<String> = Vec::new();
             if r.divergent > 0 || !r.fails_on_tunnels() {
-                let kinds = r
-                    .by_kind
+                let kinds = counts_by_name(&r.by_kind)
                     .iter()
                     .map(|(k, n)| format!("{k}: {n}"))
                     .collect::<Vec<_>>()
@@ -320,7 +318,7 @@ pub fn render_text(r: &TraceReport) -> String {
                     "{} {} (a ball's centre went through a triangle from its front to its back: {})",
                     r.tunnels,
                     tunnel_words(r.tunnels),
-                    r.tunnels_by_kind
+                    counts_by_name(&r.tunnels_by_kind)
                         .iter()
                         .map(|(k, n)| format!("{k}: {n}"))
                         .collect::<Vec<_>>()
@@ -445,7 +443,11 @@ fn tunnel_words(n: u64) -> &'static str {
 /// The reports as one JSON document: `{"status": ..., "traces": [...]}`
 /// (pretty-printed, ending with a newline).
 pub fn render_json(reports: &[TraceReport]) -> String {
-    let overall = reports.iter().map(|r| r.status).max().unwrap_or(Status::Ok);
+    let overall = reports
+        .iter()
+        .map(|r| r.status())
+        .max()
+        .unwrap_or(Status::Ok);
     let doc = json!({
         "status": overall,
         "exit_code": RunOutcome::worst(reports.iter().map(TraceReport::outcome)).exit_code(),

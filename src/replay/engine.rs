@@ -7,7 +7,7 @@ use std::time::{Duration, Instant};
 
 use crate::core::explain::nearest_miss;
 use crate::core::{
-    Broadphase, CollectRecords, Mesh, Observer, Options, Outcome, Sweep, TestRecord, Verdict,
+    Broadphase, CollectRecords, Mesh, Observer, Options, Outcome, Sweep, TestRecord, VerdictCounts,
     sweep_mesh, sweep_mesh_with,
 };
 use crate::trace::TraceEvent;
@@ -62,8 +62,6 @@ pub struct SweepResult {
     pub scene: Arc<SceneState>,
     /// The sweep.
     pub sweep: Sweep,
-    /// The options used.
-    pub options: Options,
     /// The core's outcome.
     pub outcome: Outcome,
     /// The test records kept at the chosen [`Detail`] (empty when not
@@ -113,9 +111,14 @@ impl SweepResult {
         }
     }
 
+    /// The options used: those of its scene.
+    pub fn options(&self) -> &Options {
+        &self.scene.options
+    }
+
     /// The detection radius `ρ = r - ε`.
     pub fn rho(&self) -> f64 {
-        self.sweep.radius - self.options.margin
+        self.sweep.radius - self.options().margin
     }
 }
 
@@ -302,9 +305,7 @@ impl Replay {
         for t in &tunnels {
             self.summary.tunnel(msg.frame, msg.ball, t);
         }
-        for (v, n) in verdicts {
-            *self.summary.verdicts.entry(v).or_default() += n;
-        }
+        self.summary.verdicts += verdicts;
         let expected = self.early_expected.remove(&(msg.frame, msg.ball));
         if expected.is_some() {
             self.summary.expected_matched += 1;
@@ -325,7 +326,6 @@ impl Replay {
             index,
             scene: Arc::clone(scene),
             sweep,
-            options: scene.options,
             outcome,
             records,
             expected,
@@ -418,7 +418,7 @@ pub struct ComputedSweep {
     sweep: Sweep,
     outcome: Outcome,
     records: Vec<TestRecord>,
-    verdicts: Vec<(Verdict, u64)>,
+    verdicts: VerdictCounts,
     /// The tunnel during the sweep, if any.
     during: Option<Tunnel>,
     elapsed: Duration,
@@ -440,7 +440,7 @@ pub fn compute_sweep(
         index,
         cause,
     };
-    let mut verdicts: Vec<(Verdict, u64)> = Vec::new();
+    let mut verdicts = VerdictCounts::default();
     let (outcome, records) = if options.explain {
         let broadphase = match options.detail {
             Detail::All => Broadphase::Exhaustive,
@@ -459,13 +459,7 @@ pub fn compute_sweep(
             Detail::Candidates | Detail::All => {
                 let mut collect = CollectRecords::default();
                 let outcome = explained(scene, &sweep, broadphase, &mut collect).map_err(err)?;
-                for r in &collect.records {
-                    let v = r.verdict();
-                    match verdicts.iter_mut().find(|(w, _)| *w == v) {
-                        Some((_, n)) => *n += 1,
-                        None => verdicts.push((v, 1)),
-                    }
-                }
+                verdicts = collect.records.iter().map(TestRecord::verdict).collect();
                 (outcome, collect.records)
             }
         }

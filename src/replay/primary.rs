@@ -6,7 +6,9 @@
 use crate::core::explain::{
     edge_miss_distance, face_miss_distance, nearest_miss, vertex_miss_distance,
 };
-use crate::core::{EdgeRecord, FaceRecord, Observer, Outcome, TestRecord, Verdict, VertexRecord};
+use crate::core::{
+    EdgeRecord, FaceRecord, Observer, Outcome, TestRecord, Verdict, VerdictCounts, VertexRecord,
+};
 
 /// An observer that keeps, of a sweep's records, only what
 /// [`primary_records`] can return (every hit; while nothing is hit, the
@@ -24,19 +26,9 @@ pub struct CollectPrimary {
     /// looked for once something is hit (the outcome is then a hit, whose
     /// records are hits).
     nearest: Option<(f64, TestRecord)>,
-    /// Tests run, by verdict (index in [`Verdict::ALL`]).
-    verdicts: [u64; Verdict::ALL.len()],
+    /// Tests run, by verdict.
+    verdicts: VerdictCounts,
 }
-
-// `CollectPrimary` counts verdicts at `verdict as usize`: that must be the
-// verdict's index in `Verdict::ALL`.
-const _: () = {
-    let mut i = 0;
-    while i < Verdict::ALL.len() {
-        assert!(Verdict::ALL[i] as usize == i);
-        i += 1;
-    }
-};
 
 impl CollectPrimary {
     /// One test's record: its verdict, whether it hit (`alpha`), its
@@ -50,7 +42,7 @@ impl CollectPrimary {
         distance: impl FnOnce() -> Option<f64>,
         record: impl Fn() -> TestRecord,
     ) {
-        self.verdicts[verdict as usize] += 1;
+        self.verdicts.add(verdict);
         if let Some(a) = alpha {
             self.hits.push(record());
             self.found_hit |= a < f64::INFINITY;
@@ -65,14 +57,9 @@ impl CollectPrimary {
         }
     }
 
-    /// The tests run by verdict, the verdicts that occurred only.
-    pub fn verdict_counts(&self) -> Vec<(Verdict, u64)> {
-        Verdict::ALL
-            .iter()
-            .zip(self.verdicts)
-            .filter(|(_, n)| *n > 0)
-            .map(|(v, n)| (*v, n))
-            .collect()
+    /// The tests run, by verdict.
+    pub fn verdict_counts(&self) -> VerdictCounts {
+        self.verdicts
     }
 
     /// [`primary_records`] of every record this observer saw.

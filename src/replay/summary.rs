@@ -4,7 +4,7 @@ use std::collections::BTreeMap;
 use std::time::Duration;
 
 use crate::core::explain::num;
-use crate::core::{FragileReason, Kind, Verdict};
+use crate::core::{FragileReason, Kind, VerdictCounts};
 
 use super::ReplayOptions;
 use super::selection::{Selection, SweepExtent};
@@ -65,7 +65,7 @@ pub struct ReplaySummary {
     /// Verdicts of every test run by the explained query (over the visited
     /// triangles at `primary`/`candidates`, every triangle at `all`), before
     /// the detail level drops records.
-    pub verdicts: BTreeMap<Verdict, u64>,
+    pub verdicts: VerdictCounts,
     /// `/expected` messages attached to a replayed sweep.
     pub expected_matched: u64,
     /// `/expected` messages for a replayed `(frame, ball)` that arrived too

@@ -85,7 +85,7 @@ fn choose_first<'r>(
     };
     let can_run = |triangle: u32| {
         r.scene.mesh.triangle_by_index(triangle).is_some()
-            && SweptPath::new(&r.sweep, &r.options).is_ok()
+            && SweptPath::new(&r.sweep, r.options()).is_ok()
     };
     match decisive {
         Some(TestRecord::Edge(e)) => Some((First::Recorded(e), Slot0::Decisive)),
@@ -200,16 +200,16 @@ fn total_order_key(x: f64) -> i64 {
 /// Edge test `edge` of `triangle`, run here.
 fn edge_of(r: &SweepResult, triangle: u32, edge: u8) -> Option<EdgeRecord> {
     let t = r.scene.mesh.triangle_by_index(triangle)?;
-    let path = SweptPath::new(&r.sweep, &r.options).ok()?;
-    Some(sweep_edge(t, edge, &path, r.options.facing))
+    let path = SweptPath::new(&r.sweep, r.options()).ok()?;
+    Some(sweep_edge(t, edge, &path, r.options().facing))
 }
 
 /// The nearest of the three edge tests of `triangle`, run here.
 fn nearest_edge_of(r: &SweepResult, triangle: u32) -> Option<EdgeRecord> {
     let t = r.scene.mesh.triangle_by_index(triangle)?;
-    let path = SweptPath::new(&r.sweep, &r.options).ok()?;
+    let path = SweptPath::new(&r.sweep, r.options()).ok()?;
     (0..3u8)
-        .map(|i| sweep_edge(t, i, &path, r.options.facing))
+        .map(|i| sweep_edge(t, i, &path, r.options().facing))
         .reduce(|a, b| if better(&b, &a) { b } else { a })
 }
 

@@ -131,7 +131,6 @@ fn result_of(
             options,
         }),
         sweep,
-        options,
         outcome,
         records: Vec::new(),
         expected,

@@ -252,17 +252,16 @@ fn alt_sweep(mesh: &[AltTriangle], s: &SweepMsg, margin: f64, facing: Facing) ->
 
 /// A trace of `scene` and `sweeps` with the alternative engine's outcomes
 /// as expectations.
-pub(crate) fn alt_trace(scene: &SceneMsg, sweeps: &[SweepMsg]) -> Result<Vec<u8>, String> {
+pub(crate) fn alt_trace(scene: &SceneMsg, sweeps: &[SweepMsg]) -> anyhow::Result<Vec<u8>> {
     let mesh = alt_mesh(scene);
-    let mut w = TraceWriter::new(Cursor::new(Vec::new())).map_err(|e| e.to_string())?;
-    w.scene(0, scene).map_err(|e| e.to_string())?;
+    let mut w = TraceWriter::new(Cursor::new(Vec::new()))?;
+    w.scene(0, scene)?;
     for (i, s) in sweeps.iter().enumerate() {
         let t = 1 + i as u64;
-        w.sweep(t, s).map_err(|e| e.to_string())?;
-        w.expected(t, &alt_sweep(&mesh, s, scene.margin, scene.facing))
-            .map_err(|e| e.to_string())?;
+        w.sweep(t, s)?;
+        w.expected(t, &alt_sweep(&mesh, s, scene.margin, scene.facing))?;
     }
-    Ok(w.finish().map_err(|e| e.to_string())?.into_inner())
+    Ok(w.finish()?.into_inner())
 }
 
 fn sweep(frame: u64, radius: f64, target: V, from: V) -> SweepMsg {
@@ -507,7 +506,7 @@ fn scenes() -> Vec<(SceneMsg, Vec<SweepMsg>)> {
     out
 }
 
-fn differently_rounding_engine() -> Result<(), String> {
+fn differently_rounding_engine() -> anyhow::Result<()> {
     let mut totals = [0u64; 4];
     let mut lines = Vec::new();
     for (scene, sweeps) in scenes() {
@@ -558,7 +557,7 @@ fn differently_rounding_engine() -> Result<(), String> {
 /// it touches both at once, at two points. An engine reporting the second
 /// face with its own contact point is a tie; the same with the first
 /// face's contact is a divergence.
-fn valley_tie_contact() -> Result<(), String> {
+fn valley_tie_contact() -> anyhow::Result<()> {
     let scene = SceneMsg {
         name: Some("valley".into()),
         vertices: vec![
@@ -580,14 +579,12 @@ fn valley_tie_contact() -> Result<(), String> {
         p0: [0.0, 0.25, 5.0],
         p1: [0.0, 0.25, 0.0],
     };
-    let core = sweeptrace::Mesh::new(scene.vertices.clone(), &scene.triangles)
-        .map_err(|e| e.to_string())?;
+    let core = sweeptrace::Mesh::new(scene.vertices.clone(), &scene.triangles)?;
     let outcome = sweeptrace::sweep_mesh(
         &core,
         &sweeptrace::Sweep::new(s.p0, s.p1, s.radius),
         &Default::default(),
-    )
-    .map_err(|e| e.to_string())?;
+    )?;
     ensure!(
         outcome.kind == Kind::Face && outcome.triangle == Some(0),
         "the core: face 0 (the lower of the two tied faces): {outcome:?}"
@@ -603,12 +600,12 @@ fn valley_tie_contact() -> Result<(), String> {
         normal: Some(Some([0.0, 0.0, 1.0])),
         contact: Some(Some([h, 0.25, h])),
     };
-    let judge = |e: &OutcomeMsg| -> Result<sweeptrace::regress::TraceReport, String> {
-        let mut w = TraceWriter::new(Cursor::new(Vec::new())).map_err(|e| e.to_string())?;
-        w.scene(0, &scene).map_err(|e| e.to_string())?;
-        w.sweep(1, &s).map_err(|e| e.to_string())?;
-        w.expected(1, e).map_err(|e| e.to_string())?;
-        let bytes = w.finish().map_err(|e| e.to_string())?.into_inner();
+    let judge = |e: &OutcomeMsg| -> anyhow::Result<sweeptrace::regress::TraceReport> {
+        let mut w = TraceWriter::new(Cursor::new(Vec::new()))?;
+        w.scene(0, &scene)?;
+        w.sweep(1, &s)?;
+        w.expected(1, e)?;
+        let bytes = w.finish()?.into_inner();
         Ok(check_reader(
             bytes.as_slice(),
             "valley",

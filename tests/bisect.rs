@@ -20,7 +20,7 @@ pub fn tests() -> Vec<Trial> {
 }
 
 /// Runs git in `repo` with `args`; its stdout, or an error with its output.
-fn git(repo: &Path, args: &[&str]) -> Result<String, String> {
+fn git(repo: &Path, args: &[&str]) -> anyhow::Result<String> {
     let out = Command::new("git")
         .current_dir(repo)
         .args([
@@ -34,15 +34,15 @@ fn git(repo: &Path, args: &[&str]) -> Result<String, String> {
         .env_remove("GIT_DIR")
         .env_remove("GIT_WORK_TREE")
         .output()
-        .map_err(|e| format!("running git: {e}"))?;
+        .map_err(|e| anyhow::anyhow!("running git: {e}"))?;
     let stdout = String::from_utf8_lossy(&out.stdout).into_owned();
     if !out.status.success() {
-        return Err(format!(
+        anyhow::bail!(
             "git {}: {}\n{stdout}\n{}",
             args.join(" "),
             out.status,
             String::from_utf8_lossy(&out.stderr)
-        ));
+        );
     }
     Ok(stdout)
 }
@@ -54,38 +54,37 @@ fn commit(
     engine: Option<&str>,
     executable: bool,
     message: &str,
-) -> Result<String, String> {
+) -> anyhow::Result<String> {
     let path = repo.join("engine.py");
     if let Some(source) = engine {
-        std::fs::write(&path, source).map_err(|e| e.to_string())?;
+        std::fs::write(&path, source)?;
     }
     #[cfg(unix)]
     if path.exists() {
         use std::os::unix::fs::PermissionsExt;
         let mode = if executable { 0o755 } else { 0o644 };
-        std::fs::set_permissions(&path, std::fs::Permissions::from_mode(mode))
-            .map_err(|e| e.to_string())?;
+        std::fs::set_permissions(&path, std::fs::Permissions::from_mode(mode))?;
     }
-    std::fs::write(repo.join("CHANGES"), format!("{message}\n")).map_err(|e| e.to_string())?;
+    std::fs::write(repo.join("CHANGES"), format!("{message}\n"))?;
     git(repo, &["add", "-A"])?;
     git(repo, &["commit", "-q", "-m", message])?;
     Ok(git(repo, &["rev-parse", "HEAD"])?.trim().to_string())
 }
 
-fn git_bisect_run_finds_the_commit_that_broke_the_engine() -> Result<(), String> {
+fn git_bisect_run_finds_the_commit_that_broke_the_engine() -> anyhow::Result<()> {
     if Command::new("git").arg("--version").output().is_err() {
-        return Err("git is not installed".to_string());
+        return Err(anyhow::anyhow!("git is not installed"));
     }
-    let dir = tempfile::tempdir().map_err(|e| e.to_string())?;
+    let dir = tempfile::tempdir()?;
     let repo = dir.path().join("engine-repo");
-    std::fs::create_dir(&repo).map_err(|e| e.to_string())?;
+    std::fs::create_dir(&repo)?;
     let trace = dir.path().join("examples.mcap");
-    std::fs::write(&trace, worked_examples_trace()).map_err(|e| e.to_string())?;
+    std::fs::write(&trace, worked_examples_trace())?;
     git(&repo, &["init", "-q"])?;
     git(&repo, &["config", "user.name", "Bisect Test"])?;
     git(&repo, &["config", "user.email", "bisect@example.invalid"])?;
 
-    let good = std::fs::read_to_string(example_engine()).map_err(|e| e.to_string())?;
+    let good = std::fs::read_to_string(example_engine())?;
     let renamed = good
         .replace("def sweep(", "def sweep_one(")
         .replace("answer = sweep(", "answer = sweep_one(");
@@ -147,8 +146,7 @@ fn git_bisect_run_finds_the_commit_that_broke_the_engine() -> Result<(), String>
     let status = Command::new(sweeptrace)
         .current_dir(&repo)
         .args(["check", &trace_arg, "--engine", "./engine.py"])
-        .output()
-        .map_err(|e| e.to_string())?
+        .output()?
         .status;
     ensure!(
         status.code() == Some(125),

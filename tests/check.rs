@@ -36,6 +36,7 @@ use crate::ensure;
 use crate::os;
 use crate::support::run_bin;
 use crate::trial;
+use anyhow::Context as _;
 
 const FIXTURE: &str = "tests/fixtures/wrong_engine_config.mcap";
 
@@ -90,8 +91,7 @@ fn trace_trials() -> Vec<Trial> {
                     .display()
                     .to_string();
                 trial(&format!("check::trace::{name}"), move || {
-                    let settings = config::settings_for(&path, &config::Overrides::default())
-                        .map_err(|e| e.to_string())?;
+                    let settings = config::settings_for(&path, &config::Overrides::default())?;
                     let report =
                         check_file(&path, &settings.check_options(CheckOptions::default()));
                     ensure!(report.status() == Status::Ok, "{}", render_text(&report));
@@ -157,14 +157,14 @@ fn write_trace(scene: &SceneMsg, sweeps: &[SweepMsg], expected: &[OutcomeMsg]) -
 }
 
 /// Blesses `bytes` in memory with `options`.
-fn bless_with(bytes: &[u8], options: ReplayOptions) -> Result<Vec<u8>, String> {
+fn bless_with(bytes: &[u8], options: ReplayOptions) -> anyhow::Result<Vec<u8>> {
     bless_bytes(bytes, "<memory>", Cursor::new(Vec::new()), options)
         .map(|(_, c)| c.into_inner())
-        .map_err(|e| e.to_string())
+        .map_err(anyhow::Error::from)
 }
 
 /// The fixture's bytes: scene margin 0.1, expectations from margin 0.
-fn fixture_bytes() -> Result<Vec<u8>, String> {
+fn fixture_bytes() -> anyhow::Result<Vec<u8>> {
     let plain = write_trace(&scene_t(0.1), &fixture_sweeps(), &[]);
     bless_with(
         &plain,
@@ -198,7 +198,7 @@ fn full(frame: u64, alpha: f64, kind: Kind) -> OutcomeMsg {
 
 // ---------------------------------------------------------------- compare
 
-fn compare_only_fields_present() -> Result<(), String> {
+fn compare_only_fields_present() -> anyhow::Result<()> {
     let got = full(0, 0.5, Kind::Face);
     let expected = OutcomeMsg {
         triangle: None,
@@ -227,7 +227,7 @@ fn compare_only_fields_present() -> Result<(), String> {
     Ok(())
 }
 
-fn compare_null_is_compared() -> Result<(), String> {
+fn compare_null_is_compared() -> anyhow::Result<()> {
     let got = full(0, 0.5, Kind::Face);
     let expected = OutcomeMsg {
         normal: Some(None),
@@ -244,7 +244,7 @@ fn compare_null_is_compared() -> Result<(), String> {
     Ok(())
 }
 
-fn compare_tolerances() -> Result<(), String> {
+fn compare_tolerances() -> anyhow::Result<()> {
     let tol = Tolerances {
         alpha: 1e-3,
         normal_degrees: 1.0,
@@ -284,7 +284,7 @@ fn compare_tolerances() -> Result<(), String> {
 /// An engine that reports the contact normal at an edge hit (Rapier does):
 /// the normal differs from the core's face normal, and `--fields` leaves it
 /// out of the comparison.
-fn compare_only_selected_fields() -> Result<(), String> {
+fn compare_only_selected_fields() -> anyhow::Result<()> {
     let got = full(0, 0.5, Kind::Edge);
     let expected = OutcomeMsg {
         normal: Some(Some([0.0, -0.6, 0.8])),
@@ -323,7 +323,7 @@ fn rapier_sample() -> PathBuf {
 
 /// `check --fields`: the report names the compared fields; an unknown
 /// field is a usage error (exit 2).
-fn check_fields_option_binary() -> Result<(), String> {
+fn check_fields_option_binary() -> anyhow::Result<()> {
     let trace = rapier_sample();
     // Before the path: the option takes one comma-separated value, not the
     // path after it.
@@ -350,10 +350,9 @@ fn check_fields_option_binary() -> Result<(), String> {
 /// of its settings (Rapier reports the contact normal at an edge hit; its
 /// α and witness points are accurate to about 1e-5), so every setting is
 /// needed and the test of the sample can fail.
-fn rapier_sample_needs_its_settings_file() -> Result<(), String> {
+fn rapier_sample_needs_its_settings_file() -> anyhow::Result<()> {
     let trace = rapier_sample();
-    let settings =
-        config::settings_for(&trace, &config::Overrides::default()).map_err(|e| e.to_string())?;
+    let settings = config::settings_for(&trace, &config::Overrides::default())?;
     let tolerances = settings.tolerances();
     ensure!(
         tolerances.fields.names() == "kind,triangle,feature,alpha,contact"
@@ -402,7 +401,7 @@ fn rapier_sample_needs_its_settings_file() -> Result<(), String> {
     Ok(())
 }
 
-fn compare_nan_never_matches() -> Result<(), String> {
+fn compare_nan_never_matches() -> anyhow::Result<()> {
     let expected = full(0, 0.5, Kind::Face);
     let got = OutcomeMsg {
         alpha: f64::NAN,
@@ -422,7 +421,7 @@ fn compare_nan_never_matches() -> Result<(), String> {
 
 // ---------------------------------------------------------------- check
 
-fn blessed_trace_passes() -> Result<(), String> {
+fn blessed_trace_passes() -> anyhow::Result<()> {
     let plain = write_trace(&scene_t(0.1), &fixture_sweeps(), &[]);
     let blessed = bless_with(&plain, ReplayOptions::default())?;
     let report = check_bytes(&blessed);
@@ -439,7 +438,7 @@ fn blessed_trace_passes() -> Result<(), String> {
     Ok(())
 }
 
-fn check_fixture_report(report: &sweeptrace::regress::TraceReport) -> Result<(), String> {
+fn check_fixture_report(report: &sweeptrace::regress::TraceReport) -> anyhow::Result<()> {
     let text = render_text(report);
     ensure!(
         report.status() == Status::Fail,
@@ -450,7 +449,7 @@ fn check_fixture_report(report: &sweeptrace::regress::TraceReport) -> Result<(),
         report.divergent == 2,
         "two sweeps diverge (2 and 3):\n{text}"
     );
-    let first = report.divergences.first().ok_or("no divergence detail")?;
+    let first = report.divergences.first().context("no divergence detail")?;
     ensure!(
         first.frame == 2,
         "first divergent frame is 2, got {}",
@@ -483,14 +482,13 @@ fn check_fixture_report(report: &sweeptrace::regress::TraceReport) -> Result<(),
     Ok(())
 }
 
-fn wrong_engine_config_fixture_fails_with_frame_and_reason() -> Result<(), String> {
+fn wrong_engine_config_fixture_fails_with_frame_and_reason() -> anyhow::Result<()> {
     let report = check_file(&fixture_path(), &CheckOptions::default());
     check_fixture_report(&report)?;
     // The committed fixture is what the generator makes.
     let fresh = check_bytes(&fixture_bytes()?);
     check_fixture_report(&fresh)?;
-    let json: serde_json::Value =
-        serde_json::from_str(&render_json(&[report])).map_err(|e| e.to_string())?;
+    let json: serde_json::Value = serde_json::from_str(&render_json(&[report]))?;
     ensure!(json["exit_code"] == 1, "json exit code: {json}");
     ensure!(
         json["traces"][0]["divergences"][0]["frame"] == 2,
@@ -499,7 +497,7 @@ fn wrong_engine_config_fixture_fails_with_frame_and_reason() -> Result<(), Strin
     Ok(())
 }
 
-fn wrong_engine_config_fixture_binary_exit_1() -> Result<(), String> {
+fn wrong_engine_config_fixture_binary_exit_1() -> anyhow::Result<()> {
     let fixture = fixture_path();
     let (code, out, err) = run_bin(os!["check", fixture.as_os_str()])?;
     ensure!(code == 1, "exit {code}\n{out}\n{err}");
@@ -507,7 +505,8 @@ fn wrong_engine_config_fixture_binary_exit_1() -> Result<(), String> {
     ensure!(out.contains("first divergence: frame 2"), "stdout:\n{out}");
     let (code, out, err) = run_bin(os!["check", fixture.as_os_str(), "--json"])?;
     ensure!(code == 1, "exit {code}\n{out}\n{err}");
-    let json: serde_json::Value = serde_json::from_str(&out).map_err(|e| format!("{e}: {out}"))?;
+    let json: serde_json::Value =
+        serde_json::from_str(&out).map_err(|e| anyhow::anyhow!("{e}: {out}"))?;
     ensure!(json["traces"][0]["status"] == "fail", "json: {json}");
     // A tolerance wide enough for frame 3's α still fails on frame 2's kind.
     let (code, _, _) = run_bin(os!["check", fixture.as_os_str(), "--tolerance", "0.5"])?;
@@ -515,7 +514,7 @@ fn wrong_engine_config_fixture_binary_exit_1() -> Result<(), String> {
     Ok(())
 }
 
-fn no_expected_channel_is_not_a_pass() -> Result<(), String> {
+fn no_expected_channel_is_not_a_pass() -> anyhow::Result<()> {
     let plain = write_trace(&scene_t(0.0), &fixture_sweeps(), &[]);
     let report = check_bytes(&plain);
     ensure!(
@@ -537,9 +536,9 @@ fn no_expected_channel_is_not_a_pass() -> Result<(), String> {
         "{text}"
     );
     // Through the binary: exit 2.
-    let dir = tempfile::tempdir().map_err(|e| e.to_string())?;
+    let dir = tempfile::tempdir()?;
     let path = dir.path().join("plain.mcap");
-    std::fs::write(&path, &plain).map_err(|e| e.to_string())?;
+    std::fs::write(&path, &plain)?;
     let (code, out, _) = run_bin(os!["check", path.as_os_str()])?;
     ensure!(
         code == 2 && out.contains("NO EXPECTATIONS"),
@@ -548,8 +547,8 @@ fn no_expected_channel_is_not_a_pass() -> Result<(), String> {
     Ok(())
 }
 
-fn binary_errors_exit_2() -> Result<(), String> {
-    let dir = tempfile::tempdir().map_err(|e| e.to_string())?;
+fn binary_errors_exit_2() -> anyhow::Result<()> {
+    let dir = tempfile::tempdir()?;
     let missing = dir.path().join("missing.mcap");
     let (code, out, _) = run_bin(os!["check", missing.as_os_str()])?;
     ensure!(
@@ -557,7 +556,7 @@ fn binary_errors_exit_2() -> Result<(), String> {
         "missing file: exit {code}: {out}"
     );
     let garbage = dir.path().join("garbage.mcap");
-    std::fs::write(&garbage, b"not an mcap file").map_err(|e| e.to_string())?;
+    std::fs::write(&garbage, b"not an mcap file")?;
     let (code, out, _) = run_bin(os!["check", garbage.as_os_str()])?;
     ensure!(
         code == 2 && out.contains("ERROR"),
@@ -569,7 +568,7 @@ fn binary_errors_exit_2() -> Result<(), String> {
         ReplayOptions::default(),
     )?;
     let cut = dir.path().join("cut.mcap");
-    std::fs::write(&cut, &good[..good.len() * 2 / 3]).map_err(|e| e.to_string())?;
+    std::fs::write(&cut, &good[..good.len() * 2 / 3])?;
     let (code, out, _) = run_bin(os!["check", cut.as_os_str()])?;
     ensure!(code == 3, "truncated: exit {code}: {out}");
     // Every command gives a truncated trace the same exit code (3,
@@ -597,18 +596,18 @@ fn binary_errors_exit_2() -> Result<(), String> {
     Ok(())
 }
 
-fn trace_discovery_in_directories() -> Result<(), String> {
-    let dir = tempfile::tempdir().map_err(|e| e.to_string())?;
+fn trace_discovery_in_directories() -> anyhow::Result<()> {
+    let dir = tempfile::tempdir()?;
     let sub = dir.path().join("b");
-    std::fs::create_dir_all(&sub).map_err(|e| e.to_string())?;
+    std::fs::create_dir_all(&sub)?;
     let good = bless_with(
         &write_trace(&scene_t(0.0), &fixture_sweeps(), &[]),
         ReplayOptions::default(),
     )?;
-    std::fs::write(dir.path().join("a.mcap"), &good).map_err(|e| e.to_string())?;
-    std::fs::write(sub.join("c.mcap"), &good).map_err(|e| e.to_string())?;
-    std::fs::write(sub.join("notes.txt"), b"x").map_err(|e| e.to_string())?;
-    let found = find_traces(&[dir.path().to_path_buf()])?;
+    std::fs::write(dir.path().join("a.mcap"), &good)?;
+    std::fs::write(sub.join("c.mcap"), &good)?;
+    std::fs::write(sub.join("notes.txt"), b"x")?;
+    let found = find_traces(&[dir.path().to_path_buf()]).map_err(anyhow::Error::msg)?;
     let names: Vec<String> = found
         .iter()
         .map(|p| {
@@ -630,7 +629,7 @@ fn trace_discovery_in_directories() -> Result<(), String> {
     ensure!(code == 0, "exit {code}\n{out}\n{err}");
     ensure!(out.contains("2 traces: 2 ok"), "{out}");
     // One failing trace among passing ones: exit 1, and an .rrd of it.
-    std::fs::copy(fixture_path(), sub.join("wrong.mcap")).map_err(|e| e.to_string())?;
+    std::fs::copy(fixture_path(), sub.join("wrong.mcap"))?;
     let rrd_dir = dir.path().join("rrd");
     let (code, out, err) = run_bin(os![
         "check",
@@ -647,7 +646,7 @@ fn trace_discovery_in_directories() -> Result<(), String> {
 
 // ---------------------------------------------------------------- bless
 
-fn bless_round_trip_fixes_wrong_expectations() -> Result<(), String> {
+fn bless_round_trip_fixes_wrong_expectations() -> anyhow::Result<()> {
     let wrong = fixture_bytes()?;
     ensure!(
         check_bytes(&wrong).status() == Status::Fail,
@@ -669,14 +668,14 @@ fn bless_round_trip_fixes_wrong_expectations() -> Result<(), String> {
 /// A trace written with the raw `mcap` writer: a foreign channel with its
 /// own schema, a channel without schema, a metadata record, an attachment,
 /// and wrong expectations.
-fn foreign_trace() -> Result<Vec<u8>, String> {
+fn foreign_trace() -> anyhow::Result<Vec<u8>> {
     foreign_trace_with(true)
 }
 
 /// [`foreign_trace`], with or without its `/expected` channel.
-fn foreign_trace_with(with_expected: bool) -> Result<Vec<u8>, String> {
+fn foreign_trace_with(with_expected: bool) -> anyhow::Result<Vec<u8>> {
     use sweeptrace::trace::schemas::{OUTCOME_SCHEMA_JSON, SCENE_SCHEMA_JSON, SWEEP_SCHEMA_JSON};
-    let e = |e: mcap::McapError| e.to_string();
+    let e = |e: mcap::McapError| anyhow::Error::from(e);
     let mut w = mcap::WriteOptions::new()
         .library("some-engine 3.1")
         .profile("game")
@@ -735,7 +734,7 @@ fn foreign_trace_with(with_expected: bool) -> Result<Vec<u8>, String> {
             },
             data,
         )
-        .map_err(|e| e.to_string())
+        .map_err(anyhow::Error::from)
     };
     let json = |v: &dyn erased::Ser| v.json();
     put(&mut w, scene_c, 0, &json(&scene_t(0.0)))?;
@@ -799,15 +798,15 @@ type Contents = (
     String,
 );
 
-fn contents(bytes: &[u8]) -> Result<Contents, String> {
+fn contents(bytes: &[u8]) -> anyhow::Result<Contents> {
     let mut schemas = BTreeMap::new();
     let mut channels = BTreeMap::new();
     let mut messages: BTreeMap<String, Vec<(u64, Vec<u8>)>> = BTreeMap::new();
     let mut metadata = Vec::new();
     let mut attachments = Vec::new();
     let mut header = String::new();
-    for r in mcap::read::ChunkFlattener::new(bytes).map_err(|e| e.to_string())? {
-        match r.map_err(|e| e.to_string())? {
+    for r in mcap::read::ChunkFlattener::new(bytes)? {
+        match r? {
             mcap::records::Record::Header(h) => header = format!("{} / {}", h.profile, h.library),
             mcap::records::Record::Schema { header, data } => {
                 schemas.insert(header.id, (header.name, header.encoding, data.into_owned()));
@@ -848,7 +847,7 @@ fn contents(bytes: &[u8]) -> Result<Contents, String> {
     Ok((schemas, channels, messages, metadata, attachments, header))
 }
 
-fn bless_keeps_foreign_channel_metadata_attachment() -> Result<(), String> {
+fn bless_keeps_foreign_channel_metadata_attachment() -> anyhow::Result<()> {
     let input = foreign_trace()?;
     ensure!(
         check_bytes(&input).status() == Status::Fail,
@@ -899,11 +898,11 @@ fn bless_keeps_foreign_channel_metadata_attachment() -> Result<(), String> {
     Ok(())
 }
 
-fn bless_binary_requires_output_and_keeps_input() -> Result<(), String> {
-    let dir = tempfile::tempdir().map_err(|e| e.to_string())?;
+fn bless_binary_requires_output_and_keeps_input() -> anyhow::Result<()> {
+    let dir = tempfile::tempdir()?;
     let input = dir.path().join("wrong.mcap");
-    std::fs::copy(fixture_path(), &input).map_err(|e| e.to_string())?;
-    let before = std::fs::read(&input).map_err(|e| e.to_string())?;
+    std::fs::copy(fixture_path(), &input)?;
+    let before = std::fs::read(&input)?;
     let (code, _, err) = run_bin(os!["bless", input.as_os_str()])?;
     ensure!(
         code == 2 && err.contains("-o"),
@@ -912,7 +911,7 @@ fn bless_binary_requires_output_and_keeps_input() -> Result<(), String> {
     let out = dir.path().join("blessed.mcap");
     let (code, _, err) = run_bin(os!["bless", input.as_os_str(), "-o", out.as_os_str()])?;
     ensure!(code == 0, "bless -o: exit {code}: {err}");
-    let after = std::fs::read(&input).map_err(|e| e.to_string())?;
+    let after = std::fs::read(&input)?;
     ensure!(before == after, "the input changed");
     let (code, stdout, _) = run_bin(os!["check", out.as_os_str()])?;
     ensure!(code == 0, "check after bless: exit {code}: {stdout}");
@@ -923,15 +922,14 @@ fn bless_binary_requires_output_and_keeps_input() -> Result<(), String> {
         code == 0,
         "check after bless --in-place: exit {code}: {stdout}"
     );
-    let leftovers: Vec<_> = std::fs::read_dir(dir.path())
-        .map_err(|e| e.to_string())?
+    let leftovers: Vec<_> = std::fs::read_dir(dir.path())?
         .filter_map(Result::ok)
         .filter(|e| e.file_name().to_string_lossy().contains(".partial-"))
         .collect();
     ensure!(leftovers.is_empty(), "temporary files left: {leftovers:?}");
     // A trace that cannot be replayed is refused and nothing is written.
     let cut = dir.path().join("cut.mcap");
-    std::fs::write(&cut, &before[..before.len() / 2]).map_err(|e| e.to_string())?;
+    std::fs::write(&cut, &before[..before.len() / 2])?;
     let never = dir.path().join("never.mcap");
     let (code, _, err) = run_bin(os!["bless", cut.as_os_str(), "-o", never.as_os_str()])?;
     ensure!(
@@ -951,29 +949,28 @@ fn facing_trace() -> Vec<u8> {
     write_trace(&scene_t(0.0), &sweeps, &[])
 }
 
-fn diff_same_trace_is_same() -> Result<(), String> {
+fn diff_same_trace_is_same() -> anyhow::Result<()> {
     let bytes = facing_trace();
     let side = |o| Side::replay(TraceReader::new(bytes.as_slice(), "t"), "t", o);
-    let a = side(ReplayOptions::default()).map_err(|e| e.to_string())?;
-    let b = side(ReplayOptions::default()).map_err(|e| e.to_string())?;
+    let a = side(ReplayOptions::default())?;
+    let b = side(ReplayOptions::default())?;
     let r = diff(&a, &b, &Tolerances::default());
     ensure!(r.is_same() && r.compared == 6, "{r:?}");
     Ok(())
 }
 
-fn diff_strict_facing_reports_first_divergence() -> Result<(), String> {
+fn diff_strict_facing_reports_first_divergence() -> anyhow::Result<()> {
     let bytes = facing_trace();
     let side = |o| Side::replay(TraceReader::new(bytes.as_slice(), "t"), "t", o);
-    let a = side(ReplayOptions::default()).map_err(|e| e.to_string())?;
+    let a = side(ReplayOptions::default())?;
     let b = side(ReplayOptions {
         facing: Some(Facing::Strict),
         ..ReplayOptions::default()
-    })
-    .map_err(|e| e.to_string())?;
+    })?;
     let r = diff(&a, &b, &Tolerances::default());
     let text = sweeptrace::regress::diff::render_text(&r);
     ensure!(!r.is_same() && r.different == 1, "{text}");
-    let first = r.first.as_ref().ok_or("no first divergence")?;
+    let first = r.first.as_ref().context("no first divergence")?;
     ensure!(first.frame == 5, "first divergence at frame 5: {text}");
     ensure!(r.by_kind.get("edge -> none") == Some(&1), "{text}");
     ensure!(
@@ -984,10 +981,10 @@ fn diff_strict_facing_reports_first_divergence() -> Result<(), String> {
     Ok(())
 }
 
-fn diff_binary_exit_codes() -> Result<(), String> {
-    let dir = tempfile::tempdir().map_err(|e| e.to_string())?;
+fn diff_binary_exit_codes() -> anyhow::Result<()> {
+    let dir = tempfile::tempdir()?;
     let t = dir.path().join("t.mcap");
-    std::fs::write(&t, facing_trace()).map_err(|e| e.to_string())?;
+    std::fs::write(&t, facing_trace())?;
     let (code, out, err) = run_bin(os!["diff", t.as_os_str(), t.as_os_str()])?;
     ensure!(code == 0, "same: exit {code}\n{out}\n{err}");
     let (code, out, err) = run_bin(os![
@@ -1007,7 +1004,8 @@ fn diff_binary_exit_codes() -> Result<(), String> {
         "0.1",
         "--json"
     ])?;
-    let json: serde_json::Value = serde_json::from_str(&out).map_err(|e| format!("{e}: {out}"))?;
+    let json: serde_json::Value =
+        serde_json::from_str(&out).map_err(|e| anyhow::anyhow!("{e}: {out}"))?;
     ensure!(
         code == 1 && json["same_outcomes"] == false,
         "margin: exit {code}: {json}"
@@ -1024,9 +1022,9 @@ fn diff_binary_exit_codes() -> Result<(), String> {
 
 // ---------------------------------------------------------------- fixture
 
-fn generate_wrong_engine_config() -> Result<(), String> {
+fn generate_wrong_engine_config() -> anyhow::Result<()> {
     let bytes = fixture_bytes()?;
-    std::fs::write(fixture_path(), bytes).map_err(|e| e.to_string())
+    std::fs::write(fixture_path(), bytes).map_err(anyhow::Error::from)
 }
 
 /// The Rapier sample differs from the core by about 1e-6 (more than the
@@ -1034,7 +1032,7 @@ fn generate_wrong_engine_config() -> Result<(), String> {
 /// the same in the report (they are printed in full when their short forms
 /// agree), and a test that decides the sweep is said to be the same test
 /// with other numbers, not a question about the margin.
-fn differences_below_the_shown_digits_are_shown_in_full() -> Result<(), String> {
+fn differences_below_the_shown_digits_are_shown_in_full() -> anyhow::Result<()> {
     let trace = rapier_sample();
     // Without its settings file (examples/sweeptrace.toml), which excuses
     // those differences.
@@ -1056,7 +1054,7 @@ fn differences_below_the_shown_digits_are_shown_in_full() -> Result<(), String> 
         }
         let (expected, got) = rest
             .split_once(", got ")
-            .ok_or_else(|| format!("no `got` in `{line}`"))?;
+            .with_context(|| format!("no `got` in `{line}`"))?;
         let got = got.split(" (").next().unwrap_or(got);
         ensure!(expected != got, "the two sides read the same: `{line}`");
         fields += 1;
@@ -1072,8 +1070,8 @@ fn differences_below_the_shown_digits_are_shown_in_full() -> Result<(), String> 
 
 /// The committed fixture is byte for byte what its generator
 /// (`generate_wrong_engine_config`) makes today.
-fn wrong_engine_config_fixture_is_what_its_generator_makes() -> Result<(), String> {
-    let committed = std::fs::read(fixture_path()).map_err(|e| e.to_string())?;
+fn wrong_engine_config_fixture_is_what_its_generator_makes() -> anyhow::Result<()> {
+    let committed = std::fs::read(fixture_path())?;
     ensure!(
         fixture_bytes()? == committed,
         "{FIXTURE} differs from its generator's bytes: regenerate it with \

@@ -45,7 +45,7 @@ pub fn tests() -> Vec<Trial> {
     ]
 }
 
-fn every_case_decides_the_kind_of_its_rule() -> Result<(), String> {
+fn every_case_decides_the_kind_of_its_rule() -> anyhow::Result<()> {
     let all = cases();
     for rule in RULES {
         ensure!(
@@ -67,14 +67,14 @@ fn every_case_decides_the_kind_of_its_rule() -> Result<(), String> {
             case.sweep.frame
         );
         let mesh = Mesh::new(case.scene.vertices.clone(), &case.scene.triangles)
-            .map_err(|e| format!("{}: {e}", case.id()))?;
+            .map_err(|e| anyhow::anyhow!("{}: {e}", case.id()))?;
         let options = Options {
             margin: case.scene.margin,
             facing: case.scene.facing,
         };
         let s = &case.sweep;
         let outcome = sweep_mesh(&mesh, &Sweep::new(s.p0, s.p1, s.radius), &options)
-            .map_err(|e| format!("{}: {e}", case.id()))?;
+            .map_err(|e| anyhow::anyhow!("{}: {e}", case.id()))?;
         ensure!(
             outcome.kind == case.kind,
             "{} ({}): the core decides {}, the case says {}",
@@ -89,11 +89,11 @@ fn every_case_decides_the_kind_of_its_rule() -> Result<(), String> {
 
 /// `conform --json` with the example engine and `extra` arguments: exit
 /// code and the document.
-fn conform_json(extra: &str) -> Result<(i32, serde_json::Value), String> {
+fn conform_json(extra: &str) -> anyhow::Result<(i32, serde_json::Value)> {
     let engine = example_engine_command(extra);
     let (code, stdout, stderr) = run_bin(os!("conform", "--engine", &engine, "--json"))?;
-    let doc =
-        serde_json::from_str(&stdout).map_err(|e| format!("not JSON ({e}): {stdout}\n{stderr}"))?;
+    let doc = serde_json::from_str(&stdout)
+        .map_err(|e| anyhow::anyhow!("not JSON ({e}): {stdout}\n{stderr}"))?;
     Ok((code, doc))
 }
 
@@ -108,7 +108,7 @@ fn failing_rules(doc: &serde_json::Value) -> Vec<String> {
         .unwrap_or_default()
 }
 
-fn example_engine_passes_every_rule() -> Result<(), String> {
+fn example_engine_passes_every_rule() -> anyhow::Result<()> {
     let (code, doc) = conform_json("")?;
     ensure!(code == 0, "exit {code}: {doc}");
     let total = cases().len() as u64;
@@ -123,7 +123,7 @@ fn example_engine_passes_every_rule() -> Result<(), String> {
     Ok(())
 }
 
-fn expect_failing(bug: &str, want: &[&str]) -> Result<serde_json::Value, String> {
+fn expect_failing(bug: &str, want: &[&str]) -> anyhow::Result<serde_json::Value> {
     let (code, doc) = conform_json(&format!("--bug {bug}"))?;
     ensure!(code == 1, "--bug {bug}: exit {code}, want 1");
     let got = failing_rules(&doc);
@@ -145,7 +145,7 @@ fn expect_failing(bug: &str, want: &[&str]) -> Result<serde_json::Value, String>
     Ok(doc)
 }
 
-fn skip_vertex_bug_fails_exactly_the_vertex_rules() -> Result<(), String> {
+fn skip_vertex_bug_fails_exactly_the_vertex_rules() -> anyhow::Result<()> {
     expect_failing(
         "skip-vertex",
         &[
@@ -160,7 +160,7 @@ fn skip_vertex_bug_fails_exactly_the_vertex_rules() -> Result<(), String> {
     Ok(())
 }
 
-fn ignore_margin_bug_fails_exactly_the_margin_rules() -> Result<(), String> {
+fn ignore_margin_bug_fails_exactly_the_margin_rules() -> anyhow::Result<()> {
     expect_failing(
         "ignore-margin",
         &["margin.face-hit", "margin.edge-miss", "margin.vertex-hit"],
@@ -168,7 +168,7 @@ fn ignore_margin_bug_fails_exactly_the_margin_rules() -> Result<(), String> {
     Ok(())
 }
 
-fn strict_facing_bug_fails_exactly_the_in_plane_rules() -> Result<(), String> {
+fn strict_facing_bug_fails_exactly_the_in_plane_rules() -> anyhow::Result<()> {
     // Both are paths with n·d = 0 for a triangle that must report the hit:
     // the in-plane approach, and the cube edge whose +x triangle the path
     // runs parallel to (its normal then misses from the average).
@@ -200,7 +200,7 @@ fn tie_order_of(doc: &serde_json::Value, rule: &str) -> String {
         .to_string()
 }
 
-fn tie_highest_triangle_bug_fails_exactly_the_triangle_order_rules() -> Result<(), String> {
+fn tie_highest_triangle_bug_fails_exactly_the_triangle_order_rules() -> anyhow::Result<()> {
     let doc = expect_failing(
         "tie-highest-triangle",
         &[
@@ -225,7 +225,7 @@ fn tie_highest_triangle_bug_fails_exactly_the_triangle_order_rules() -> Result<(
     Ok(())
 }
 
-fn tie_vertex_first_bug_fails_exactly_the_kind_order_rules() -> Result<(), String> {
+fn tie_vertex_first_bug_fails_exactly_the_kind_order_rules() -> anyhow::Result<()> {
     let doc = expect_failing(
         "tie-vertex-first",
         &[
@@ -254,13 +254,13 @@ fn tie_vertex_first_bug_fails_exactly_the_kind_order_rules() -> Result<(), Strin
     Ok(())
 }
 
-fn lenient_lets_tie_choices_pass() -> Result<(), String> {
+fn lenient_lets_tie_choices_pass() -> anyhow::Result<()> {
     for bug in ["tie-highest-triangle", "tie-vertex-first"] {
         let engine = example_engine_command(&format!("--bug {bug}"));
         let (code, stdout, stderr) =
             run_bin(os!("conform", "--engine", &engine, "--lenient", "--json"))?;
         let doc: serde_json::Value = serde_json::from_str(&stdout)
-            .map_err(|e| format!("not JSON ({e}): {stdout}\n{stderr}"))?;
+            .map_err(|e| anyhow::anyhow!("not JSON ({e}): {stdout}\n{stderr}"))?;
         ensure!(
             code == 0 && doc["failed"] == 0,
             "--bug {bug} --lenient: exit {code}: {doc}"
@@ -269,7 +269,7 @@ fn lenient_lets_tie_choices_pass() -> Result<(), String> {
     Ok(())
 }
 
-fn repro_command_runs_one_case() -> Result<(), String> {
+fn repro_command_runs_one_case() -> anyhow::Result<()> {
     let engine = example_engine_command("--bug skip-vertex");
     let (code, stdout, stderr) = run_bin(os!(
         "conform",
@@ -296,7 +296,7 @@ fn repro_command_runs_one_case() -> Result<(), String> {
     Ok(())
 }
 
-fn conform_engine_not_found_exits_125() -> Result<(), String> {
+fn conform_engine_not_found_exits_125() -> anyhow::Result<()> {
     let (code, _, stderr) = run_bin(os!("conform", "--engine", "./no/such/engine"))?;
     ensure!(
         code == 125 && stderr.contains("cannot be started"),
@@ -305,8 +305,8 @@ fn conform_engine_not_found_exits_125() -> Result<(), String> {
     Ok(())
 }
 
-fn cases_written_as_a_trace_check_the_same() -> Result<(), String> {
-    let dir = tempfile::tempdir().map_err(|e| e.to_string())?;
+fn cases_written_as_a_trace_check_the_same() -> anyhow::Result<()> {
+    let dir = tempfile::tempdir()?;
     let trace = dir.path().join("vertex.mcap");
     let (code, _, stderr) = run_bin(os!(
         "conform",

@@ -15,6 +15,7 @@ use sweeptrace::core::{
 use crate::ensure;
 use crate::support::{close, edge, face, mesh, run, triangle_t, vertex};
 use crate::trial;
+use anyhow::Context as _;
 
 const NS: Facing = Facing::NonStrict;
 const TOL: f64 = 1e-12;
@@ -61,7 +62,7 @@ pub fn tests() -> Vec<Trial> {
     ]
 }
 
-fn face_hit_worked_example_1() -> Result<(), String> {
+fn face_hit_worked_example_1() -> anyhow::Result<()> {
     // h0 = 3, h1 = -3, β = (3 - 0.5) / 6 = 5/12, touch (1,1,0), barycentric
     // (1 - 0.25 - 0.25, 0.25, 0.25).
     let (o, recs) = run(
@@ -77,7 +78,7 @@ fn face_hit_worked_example_1() -> Result<(), String> {
     close("h0", f.h0, 3.0, TOL)?;
     close("h1", f.h1, -3.0, TOL)?;
     close("beta", f.beta.unwrap_or(f64::NAN), 5.0 / 12.0, TOL)?;
-    let b = f.barycentric.ok_or("no barycentric")?;
+    let b = f.barycentric.context("no barycentric")?;
     close("bary a", b[0], 0.5, TOL)?;
     close("bary b", b[1], 0.25, TOL)?;
     ensure!(
@@ -85,14 +86,14 @@ fn face_hit_worked_example_1() -> Result<(), String> {
         "outcome {o:?}"
     );
     close("alpha", o.alpha, 5.0 / 12.0, TOL)?;
-    let c = o.contact.ok_or("no contact")?;
+    let c = o.contact.context("no contact")?;
     close("contact x", c.x, 1.0, TOL)?;
     close("contact z", c.z, 0.0, TOL)?;
-    let n = o.normal.ok_or("no normal")?;
+    let n = o.normal.context("no normal")?;
     close("normal z", n.z, 1.0, TOL)
 }
 
-fn face_starts_too_close() -> Result<(), String> {
+fn face_starts_too_close() -> anyhow::Result<()> {
     // h0 = 0.3 < ρ = 0.5: the ball starts within ρ of the plane.
     let (_, recs) = run(
         &triangle_t(),
@@ -111,7 +112,7 @@ fn face_starts_too_close() -> Result<(), String> {
     close("h0", f.h0, 0.3, TOL)
 }
 
-fn face_parallel() -> Result<(), String> {
+fn face_parallel() -> anyhow::Result<()> {
     // h0 = h1 = 3.
     let (o, recs) = run(
         &triangle_t(),
@@ -130,7 +131,7 @@ fn face_parallel() -> Result<(), String> {
     Ok(())
 }
 
-fn face_back_facing() -> Result<(), String> {
+fn face_back_facing() -> anyhow::Result<()> {
     // Moving away from the front: h0 = 3, h1 = 5, n·d = 2 > 0.
     let (_, recs) = run(
         &triangle_t(),
@@ -145,7 +146,7 @@ fn face_back_facing() -> Result<(), String> {
     close("n.d", f.normal_dot_d, 2.0, TOL)
 }
 
-fn face_beyond_end() -> Result<(), String> {
+fn face_beyond_end() -> anyhow::Result<()> {
     // h0 = 3, h1 = 2: β = 2.5 / 1 = 2.5 > 1.
     let (_, recs) = run(
         &triangle_t(),
@@ -160,7 +161,7 @@ fn face_beyond_end() -> Result<(), String> {
     close("beta", f.beta.unwrap_or(f64::NAN), 2.5, TOL)
 }
 
-fn face_outside_triangle() -> Result<(), String> {
+fn face_outside_triangle() -> anyhow::Result<()> {
     // β = 5/12, touch (3,3,0): barycentric (1 - 0.75 - 0.75, 0.75, 0.75) = (-0.5, ...).
     let (_, recs) = run(
         &triangle_t(),
@@ -176,10 +177,10 @@ fn face_outside_triangle() -> Result<(), String> {
         "verdict {:?}",
         f.verdict
     );
-    close("bary a", f.barycentric.ok_or("no bary")?[0], -0.5, TOL)
+    close("bary a", f.barycentric.context("no bary")?[0], -0.5, TOL)
 }
 
-fn edge_hit_worked_example_2_start_before_s0() -> Result<(), String> {
+fn edge_hit_worked_example_2_start_before_s0() -> anyhow::Result<()> {
     // Worked example 2. p0 → (2, 3, 0.3), p1 → (2, -3, 0.3). A = 36, B = -36,
     // C = 9 + 0.09 - 0.25 = 8.84, disc = 1296 - 1272.96 = 23.04 (√ = 4.8),
     // roots (36 ∓ 4.8) / 72 = 0.43333, 0.56667; xc = 2; n·d = -6: α = 13/30.
@@ -200,7 +201,7 @@ fn edge_hit_worked_example_2_start_before_s0() -> Result<(), String> {
     close("B", e.b, -36.0, 1e-9)?;
     close("C", e.c, 8.84, 1e-9)?;
     close("disc", e.discriminant, 23.04, 1e-9)?;
-    let (s0, s1) = e.roots.ok_or("no roots")?;
+    let (s0, s1) = e.roots.context("no roots")?;
     close("s0", s0, 13.0 / 30.0, 1e-12)?;
     close("s1", s1, 17.0 / 30.0, 1e-12)?;
     close("xc", e.xc.unwrap_or(f64::NAN), 2.0, 1e-12)?;
@@ -216,12 +217,12 @@ fn edge_hit_worked_example_2_start_before_s0() -> Result<(), String> {
         "outcome {o:?}"
     );
     close("alpha", o.alpha, 13.0 / 30.0, 1e-12)?;
-    let c = o.contact.ok_or("no contact")?;
+    let c = o.contact.context("no contact")?;
     close("contact x", c.x, 2.0, 1e-12)?;
     close("contact y", c.y, 0.0, 1e-12)
 }
 
-fn edge_start_between_s0_and_s1() -> Result<(), String> {
+fn edge_start_between_s0_and_s1() -> anyhow::Result<()> {
     // Start between S0 and S1 (the ball starts within ρ of the edge's line).
     // p0 → (2, 0.2, 0.3), p1 → (2, -3, 0.3): dy = -3.2, A = 10.24,
     // B = 2 (0.2 · -3.2) = -1.28, C = 0.04 + 0.09 - 0.25 = -0.12,
@@ -236,14 +237,14 @@ fn edge_start_between_s0_and_s1() -> Result<(), String> {
         NS,
     );
     let e = edge(&recs, 0, 0);
-    let (s0, s1) = e.roots.ok_or("no roots")?;
+    let (s0, s1) = e.roots.context("no roots")?;
     close("s0", s0, -0.0625, 1e-12)?;
     close("s1", s1, 0.1875, 1e-12)?;
     ensure!(e.verdict == Verdict::BeforeStart, "verdict {:?}", e.verdict);
     Ok(())
 }
 
-fn edge_start_after_s1() -> Result<(), String> {
+fn edge_start_after_s1() -> anyhow::Result<()> {
     // Start after S1: p0 → (2, -3, 0.3), p1 → (2, -6, 0.3): A = 9, B = 18,
     // C = 8.84, disc = 324 - 318.24 = 5.76 (√ = 2.4), roots (-18 ∓ 2.4) / 18
     // = -1.13333, -0.86667: both negative.
@@ -256,14 +257,14 @@ fn edge_start_after_s1() -> Result<(), String> {
         NS,
     );
     let e = edge(&recs, 0, 0);
-    let (s0, s1) = e.roots.ok_or("no roots")?;
+    let (s0, s1) = e.roots.context("no roots")?;
     close("s0", s0, -20.4 / 18.0, 1e-12)?;
     close("s1", s1, -15.6 / 18.0, 1e-12)?;
     ensure!(e.verdict == Verdict::BeforeStart, "verdict {:?}", e.verdict);
     Ok(())
 }
 
-fn edge_beyond_end() -> Result<(), String> {
+fn edge_beyond_end() -> anyhow::Result<()> {
     // p0 → (2, 3, 0.3), p1 → (2, 1, 0.3): A = 4, B = -12, C = 8.84,
     // disc = 144 - 141.44 = 2.56 (√ = 1.6), roots (12 ∓ 1.6) / 8 = 1.3, 1.7.
     let (_, recs) = run(
@@ -275,12 +276,12 @@ fn edge_beyond_end() -> Result<(), String> {
         NS,
     );
     let e = edge(&recs, 0, 0);
-    close("s0", e.roots.ok_or("no roots")?.0, 1.3, 1e-12)?;
+    close("s0", e.roots.context("no roots")?.0, 1.3, 1e-12)?;
     ensure!(e.verdict == Verdict::BeyondEnd, "verdict {:?}", e.verdict);
     Ok(())
 }
 
-fn edge_double_root_tangent() -> Result<(), String> {
+fn edge_double_root_tangent() -> anyhow::Result<()> {
     // The path passes at exactly ρ from the edge's line: p0 → (2, 3, 0.5),
     // p1 → (2, -3, 0.5): A = 36, B = -36, C = 9 + 0.25 - 0.25 = 9,
     // disc = 1296 - 1296 = 0 (every value exact in binary): a double root
@@ -301,7 +302,7 @@ fn edge_double_root_tangent() -> Result<(), String> {
     Ok(())
 }
 
-fn edge_parallel_path() -> Result<(), String> {
+fn edge_parallel_path() -> anyhow::Result<()> {
     // Rolling along edge 0: p0 → (1, 0.2, 0.3), p1 → (3, 0.2, 0.3), A = 0.
     let (_, recs) = run(
         &triangle_t(),
@@ -317,7 +318,7 @@ fn edge_parallel_path() -> Result<(), String> {
     Ok(())
 }
 
-fn edge_no_real_roots() -> Result<(), String> {
+fn edge_no_real_roots() -> anyhow::Result<()> {
     // p0 → (2, 3, 2), p1 → (2, -3, 2): A = 36, B = -36, C = 9 + 4 - 0.25 =
     // 12.75, disc = 1296 - 1836 = -540.
     let (_, recs) = run(
@@ -338,7 +339,7 @@ fn edge_no_real_roots() -> Result<(), String> {
     Ok(())
 }
 
-fn edge_off_edge() -> Result<(), String> {
+fn edge_off_edge() -> anyhow::Result<()> {
     // As example 2 but at x = 5: s0 = 13/30, xc = 5 > L = 4.
     let (_, recs) = run(
         &triangle_t(),
@@ -354,7 +355,7 @@ fn edge_off_edge() -> Result<(), String> {
     Ok(())
 }
 
-fn edge_back_facing() -> Result<(), String> {
+fn edge_back_facing() -> anyhow::Result<()> {
     // Example 2 reversed: p0 → (2, -3, 0.3), p1 → (2, 3, 0.3): A = 36,
     // B = -36, same roots, xc = 2, but n·d = +6.
     let (o, recs) = run(
@@ -366,13 +367,13 @@ fn edge_back_facing() -> Result<(), String> {
         NS,
     );
     let e = edge(&recs, 0, 0);
-    close("s0", e.roots.ok_or("no roots")?.0, 13.0 / 30.0, 1e-12)?;
+    close("s0", e.roots.context("no roots")?.0, 13.0 / 30.0, 1e-12)?;
     ensure!(e.verdict == Verdict::BackFacing, "verdict {:?}", e.verdict);
     ensure!(o.kind == Kind::None, "outcome {o:?}");
     Ok(())
 }
 
-fn edge_strict_facing_rejects_n_dot_d_zero() -> Result<(), String> {
+fn edge_strict_facing_rejects_n_dot_d_zero() -> anyhow::Result<()> {
     // Edge 0 approached sideways within the plane's parallel: p0 = (2, -3, 0),
     // p1 = (2, 3, 0): n·d = 0. Frame: p0 → (2, 0, 3), p1 → (2, 0, -3);
     // A = 36, B = -36, C = 9 - 0.25 = 8.75, disc = 36, roots (36 ∓ 6)/72 =
@@ -408,7 +409,7 @@ fn edge_strict_facing_rejects_n_dot_d_zero() -> Result<(), String> {
     Ok(())
 }
 
-fn hit_exactly_at_alpha_1_worked_example_4() -> Result<(), String> {
+fn hit_exactly_at_alpha_1_worked_example_4() -> anyhow::Result<()> {
     // Worked example 4: r = 0.625, p0 = (2, -0.375, 3), p1 = (2, -0.375, 0.5).
     // Frame: (2, 3, 0.375) → (2, 0.5, 0.375). A = 2.5² = 6.25,
     // B = 2 · 3 · -2.5 = -15, C = 9 + 0.140625 - 0.390625 = 8.75,
@@ -435,7 +436,7 @@ fn hit_exactly_at_alpha_1_worked_example_4() -> Result<(), String> {
     Ok(())
 }
 
-fn zero_length_path() -> Result<(), String> {
+fn zero_length_path() -> anyhow::Result<()> {
     // d = 0: face parallel, edges parallel (A = 0), vertices not moving.
     let (o, recs) = run(
         &triangle_t(),
@@ -461,7 +462,7 @@ fn zero_length_path() -> Result<(), String> {
     Ok(())
 }
 
-fn vertex_hit_worked_example_3() -> Result<(), String> {
+fn vertex_hit_worked_example_3() -> anyhow::Result<()> {
     // Worked example 3: p0 = (-0.3, -0.2, 3), p1 = (-0.3, -0.2, -3).
     // Edge 0 touches its line at s ≈ 0.4236 with xc = -0.3 < 0 (off the edge);
     // edge 2 (from (0,4,0) to (0,0,0)) touches its line beyond its end;
@@ -492,18 +493,18 @@ fn vertex_hit_worked_example_3() -> Result<(), String> {
     close("B", v.b, -36.0, 1e-12)?;
     close("C", v.c, 8.88, 1e-12)?;
     let want = (36.0 - 17.28f64.sqrt()) / 72.0;
-    close("s0", v.roots.ok_or("roots")?.0, want, 1e-12)?;
+    close("s0", v.roots.context("roots")?.0, want, 1e-12)?;
     ensure!(
         o.kind == Kind::Vertex && o.feature == Some(0),
         "outcome {o:?}"
     );
     close("alpha", o.alpha, 0.44226, 1e-5)?;
-    let c = o.contact.ok_or("contact")?;
+    let c = o.contact.context("contact")?;
     ensure!(c.coords.norm() == 0.0, "contact {c:?} is the vertex");
     Ok(())
 }
 
-fn vertex_no_real_roots() -> Result<(), String> {
+fn vertex_no_real_roots() -> anyhow::Result<()> {
     // p0 = (-2, -2, 3): C = 4 + 4 + 9 - 0.25 = 16.75, disc = 1296 - 2412 < 0.
     let (_, recs) = run(
         &triangle_t(),
@@ -519,7 +520,7 @@ fn vertex_no_real_roots() -> Result<(), String> {
     Ok(())
 }
 
-fn vertex_before_start() -> Result<(), String> {
+fn vertex_before_start() -> anyhow::Result<()> {
     // The ball starts overlapping vertex 0: C = 0.03 - 0.25 < 0, so s0 < 0.
     let (_, recs) = run(
         &triangle_t(),
@@ -535,7 +536,7 @@ fn vertex_before_start() -> Result<(), String> {
     Ok(())
 }
 
-fn vertex_beyond_end() -> Result<(), String> {
+fn vertex_beyond_end() -> anyhow::Result<()> {
     // d = (0,0,-1): A = 1, B = -6, C = 8.88, disc = 0.48, s0 = (6 - √0.48)/2 = 2.6536.
     let (_, recs) = run(
         &triangle_t(),
@@ -548,7 +549,7 @@ fn vertex_beyond_end() -> Result<(), String> {
     let v = vertex(&recs, 0, 0);
     close(
         "s0",
-        v.roots.ok_or("roots")?.0,
+        v.roots.context("roots")?.0,
         (6.0 - 0.48f64.sqrt()) / 2.0,
         1e-12,
     )?;
@@ -556,7 +557,7 @@ fn vertex_beyond_end() -> Result<(), String> {
     Ok(())
 }
 
-fn vertex_back_facing() -> Result<(), String> {
+fn vertex_back_facing() -> anyhow::Result<()> {
     // Example 3 reversed: same quadratic up to the sign of B... m = (-0.3,
     // -0.2, -3), d = (0,0,6): B = -36, s0 = 0.44226, but n·d = 6 > 0.
     let (o, recs) = run(
@@ -570,7 +571,7 @@ fn vertex_back_facing() -> Result<(), String> {
     let v = vertex(&recs, 0, 0);
     close(
         "s0",
-        v.roots.ok_or("roots")?.0,
+        v.roots.context("roots")?.0,
         (36.0 - 17.28f64.sqrt()) / 72.0,
         1e-12,
     )?;
@@ -579,7 +580,7 @@ fn vertex_back_facing() -> Result<(), String> {
     Ok(())
 }
 
-fn endpoint_contact_exactly_at_xc_eq_l_is_edge() -> Result<(), String> {
+fn endpoint_contact_exactly_at_xc_eq_l_is_edge() -> anyhow::Result<()> {
     // Example 4 moved to x = 4 = L: edge 0 gives s0 = 1 with xc = 4 = L
     // (accepted, boundary included); vertex 1 = (4,0,0) gives A = 6.25,
     // B = 2 (0,0,-2.5)·(0,-0.375,3) = -15, C = 0.140625 + 9 - 0.390625 = 8.75:
@@ -630,7 +631,7 @@ fn ridge_path(u: [f64; 2], d: [f64; 3]) -> ([f64; 3], [f64; 3]) {
     (p0, p1)
 }
 
-fn shared_edge_reported_for_both() -> Result<(), String> {
+fn shared_edge_reported_for_both() -> anyhow::Result<()> {
     // Contact direction u = (0, -1/2, √3/2) lies between both front normals;
     // d = (0,0,-6): n0·d = -6, n1·d = -6/√2: both front-facing. The ball
     // reaches the line at β = 0.5 (entering: u·d < 0). The faces' touch
@@ -646,11 +647,11 @@ fn shared_edge_reported_for_both() -> Result<(), String> {
         e0.verdict,
         e1.verdict
     );
-    close("alpha 0", e0.roots.ok_or("roots")?.0, 0.5, 1e-12)?;
-    close("alpha 1", e1.roots.ok_or("roots")?.0, 0.5, 1e-12)?;
+    close("alpha 0", e0.roots.context("roots")?.0, 0.5, 1e-12)?;
+    close("alpha 1", e1.roots.context("roots")?.0, 0.5, 1e-12)?;
     ensure!(o.kind == Kind::Edge, "outcome {o:?}");
     close("alpha", o.alpha, 0.5, 1e-12)?;
-    let n = o.normal.ok_or("normal")?;
+    let n = o.normal.context("normal")?;
     // normalize((0,0,1) + (0,-1,1)/√2)
     let s = std::f64::consts::FRAC_1_SQRT_2;
     let want = nalgebra::Vector3::new(0.0, -s, 1.0 + s).normalize();
@@ -658,7 +659,7 @@ fn shared_edge_reported_for_both() -> Result<(), String> {
     close("normal z", n.z, want.z, 1e-12)
 }
 
-fn shared_edge_reported_for_one() -> Result<(), String> {
+fn shared_edge_reported_for_one() -> anyhow::Result<()> {
     // u = (0, -1/2, √3/2), d = (0, -2, -1.8): n0·d = -1.8 ≤ 0 (front),
     // n1·d = (2 - 1.8)/√2 > 0 (back-facing); u·d = 1 - 1.56 < 0 (entering).
     let (p0, p1) = ridge_path([-0.5, 3f64.sqrt() / 2.0], [0.0, -2.0, -1.8]);
@@ -676,11 +677,11 @@ fn shared_edge_reported_for_one() -> Result<(), String> {
         "outcome {o:?}"
     );
     close("alpha", o.alpha, 0.5, 1e-12)?;
-    let n = o.normal.ok_or("normal")?;
+    let n = o.normal.context("normal")?;
     close("normal z", n.z, 1.0, 1e-12)
 }
 
-fn shared_edge_reported_for_neither() -> Result<(), String> {
+fn shared_edge_reported_for_neither() -> anyhow::Result<()> {
     // From behind: u = (0, √3/2, -1/2), d = (0,0,2): n0·d = 2 > 0,
     // n1·d = 2/√2 > 0, u·d = -1 < 0: the line is reached at β = 0.5 within
     // the edge, and both triangles reject it as back-facing.
@@ -693,24 +694,21 @@ fn shared_edge_reported_for_neither() -> Result<(), String> {
             "triangle {t}: {:?}",
             e.verdict
         );
-        close("s0", e.roots.ok_or("roots")?.0, 0.5, 1e-12)?;
+        close("s0", e.roots.context("roots")?.0, 0.5, 1e-12)?;
     }
     ensure!(o.kind == Kind::None, "outcome {o:?}");
     Ok(())
 }
 
-fn cube_shared_edge_averaged_normal_worked_example_5() -> Result<(), String> {
+fn cube_shared_edge_averaged_normal_worked_example_5() -> anyhow::Result<()> {
     // Worked example 5: distance to the edge x = 1, z = 1 is 0.5 when
     // 0.0625 + (z - 1)² = 0.25, z = 1.43301, β = (3 - 1.43301)/6 = 0.26116.
-    let cube = sweeptrace::sim::scenes::cube()
-        .to_mesh()
-        .map_err(|e| e.to_string())?;
+    let cube = sweeptrace::sim::scenes::cube().to_mesh()?;
     let o = sweep_mesh(
         &cube,
         &Sweep::new([1.25, 0.125, 3.0], [1.25, 0.125, -3.0], 0.5),
         &Options::default(),
-    )
-    .map_err(|e| e.to_string())?;
+    )?;
     ensure!(o.kind == Kind::Edge, "outcome {o:?}");
     close(
         "alpha",
@@ -718,14 +716,14 @@ fn cube_shared_edge_averaged_normal_worked_example_5() -> Result<(), String> {
         (3.0 - (1.0 + 0.1875f64.sqrt())) / 6.0,
         1e-12,
     )?;
-    let n = o.normal.ok_or("normal")?;
+    let n = o.normal.context("normal")?;
     let s = std::f64::consts::FRAC_1_SQRT_2;
     close("normal x", n.x, s, 1e-12)?;
     close("normal y", n.y, 0.0, 1e-12)?;
     close("normal z", n.z, s, 1e-12)
 }
 
-fn margin_shrinks_detection_radius() -> Result<(), String> {
+fn margin_shrinks_detection_radius() -> anyhow::Result<()> {
     // Example 1 with r = 0.5, ε = 0.25: ρ = 0.25, β = (3 - 0.25)/6 = 11/24;
     // the contact is on the plane.
     let (o, _) = run(
@@ -737,15 +735,13 @@ fn margin_shrinks_detection_radius() -> Result<(), String> {
         NS,
     );
     close("alpha", o.alpha, 11.0 / 24.0, 1e-12)?;
-    close("contact z", o.contact.ok_or("contact")?.z, 0.0, 1e-12)
+    close("contact z", o.contact.context("contact")?.z, 0.0, 1e-12)
 }
 
-fn standard_frame_round_trip() -> Result<(), String> {
+fn standard_frame_round_trip() -> anyhow::Result<()> {
     // For every edge of every cube triangle: v0 → origin, v1 → (L,0,0), the
     // third vertex at y = 0, z ≤ 0; world_from_edge inverts to_edge.
-    let cube = sweeptrace::sim::scenes::cube()
-        .to_mesh()
-        .map_err(|e| e.to_string())?;
+    let cube = sweeptrace::sim::scenes::cube().to_mesh()?;
     for t in cube.triangles() {
         for i in 0..3 {
             let f = &t.edges[i];
@@ -770,7 +766,7 @@ fn standard_frame_round_trip() -> Result<(), String> {
     Ok(())
 }
 
-fn bad_input_errors() -> Result<(), String> {
+fn bad_input_errors() -> anyhow::Result<()> {
     let m = triangle_t();
     let opts = Options::default();
     let e = sweep_mesh(&m, &Sweep::new([f64::NAN, 0.0, 0.0], [0.0; 3], 0.5), &opts).err();
@@ -843,7 +839,7 @@ fn bad_input_errors() -> Result<(), String> {
     Ok(())
 }
 
-fn degenerate_triangles_reported_and_skipped() -> Result<(), String> {
+fn degenerate_triangles_reported_and_skipped() -> anyhow::Result<()> {
     // Triangle 1 repeats an index, triangle 2 is collinear; both are left
     // out and never produce NaN; triangle 0 still works.
     let m = Mesh::new(
@@ -854,8 +850,7 @@ fn degenerate_triangles_reported_and_skipped() -> Result<(), String> {
             [8.0, 0.0, 0.0],
         ],
         &[[0, 1, 2], [0, 0, 1], [0, 1, 3]],
-    )
-    .map_err(|e| e.to_string())?;
+    )?;
     let d: Vec<usize> = m.degenerate().iter().map(|d| d.index).collect();
     ensure!(d == vec![1, 2], "degenerate {d:?}");
     ensure!(
@@ -866,8 +861,7 @@ fn degenerate_triangles_reported_and_skipped() -> Result<(), String> {
         &m,
         &Sweep::new([6.0, 0.0, 3.0], [6.0, 0.0, -3.0], 0.5),
         &Options::default(),
-    )
-    .map_err(|e| e.to_string())?;
+    )?;
     ensure!(
         o.kind == Kind::None && !o.alpha.is_nan(),
         "through the collinear triangle: {o:?}"
@@ -890,22 +884,21 @@ fn degenerate_triangles_reported_and_skipped() -> Result<(), String> {
     Ok(())
 }
 
-fn both_broadphases(m: &Mesh, p0: [f64; 3], p1: [f64; 3], r: f64) -> Result<Outcome, String> {
+fn both_broadphases(m: &Mesh, p0: [f64; 3], p1: [f64; 3], r: f64) -> anyhow::Result<Outcome> {
     let sweep = Sweep::new(p0, p1, r);
-    let fast = sweep_mesh(m, &sweep, &Options::default()).map_err(|e| e.to_string())?;
+    let fast = sweep_mesh(m, &sweep, &Options::default())?;
     let all = sweep_mesh_with(
         m,
         &sweep,
         &Options::default(),
         Broadphase::Exhaustive,
         &mut NoObserver,
-    )
-    .map_err(|e| e.to_string())?;
+    )?;
     ensure!(fast == all, "bvh {fast:?} != exhaustive {all:?}");
     Ok(all)
 }
 
-fn edge_far_start_small_radius_discriminant_without_cancellation() -> Result<(), String> {
+fn edge_far_start_small_radius_discriminant_without_cancellation() -> anyhow::Result<()> {
     // r = 1e-3, a path of length 2e5 straight down past edge 0 of T
     // (p0 = (2, -y, 1e5), p1 = (2, -y, -1e5)), so |p0| / ρ = 1e8.
     // In edge 0's frame p0 → (2, 1e5, y), p1 → (2, -1e5, y):
@@ -947,7 +940,7 @@ fn edge_far_start_small_radius_discriminant_without_cancellation() -> Result<(),
     Ok(())
 }
 
-fn very_long_path_never_nan() -> Result<(), String> {
+fn very_long_path_never_nan() -> anyhow::Result<()> {
     // A finite path of length 2e100: B = 2 d·m ≈ -4e200, so B² overflows to
     // infinity, 4AC too, and B² - 4AC = inf - inf = NaN, which passed every
     // comparison and was reported as a hit with α = NaN.
@@ -994,7 +987,7 @@ fn very_long_path_never_nan() -> Result<(), String> {
     close("alpha", o.alpha, 0.5, 1e-15)
 }
 
-fn sliver_triangle_face_hit_barycentric_without_cancellation() -> Result<(), String> {
+fn sliver_triangle_face_hit_barycentric_without_cancellation() -> anyhow::Result<()> {
     // A sliver a = (0,0,0), b = (1,0,0), c = (0.3, h, 0), h = 1e-9: |(b-a)×(c-a)|
     // = 1e-9 > DEGENERATE_TOLERANCE · longest² = 1e-12, so it is usable.
     // r = 0.25, p0 = (0.4, h/3, 2), p1 = (0.4, h/3, -2): h0 = 2, h1 = -2,
@@ -1012,7 +1005,7 @@ fn sliver_triangle_face_hit_barycentric_without_cancellation() -> Result<(), Str
     );
     let (o, recs) = run(&m, [0.4, h / 3.0, 2.0], [0.4, h / 3.0, -2.0], 0.25, 0.0, NS);
     let f = face(&recs, 0);
-    let b = f.barycentric.ok_or("no barycentric")?;
+    let b = f.barycentric.context("no barycentric")?;
     close("bary a", b[0], 1.0 - 0.3 - 1.0 / 3.0, 1e-6)?;
     close("bary b", b[1], 0.3, 1e-6)?;
     close("bary c", b[2], 1.0 / 3.0, 1e-6)?;
@@ -1025,7 +1018,7 @@ fn sliver_triangle_face_hit_barycentric_without_cancellation() -> Result<(), Str
     let y = 1.01 * (6.0 / 7.0) * h;
     let (_, recs) = run(&m, [0.4, y, 2.0], [0.4, y, -2.0], 0.25, 0.0, NS);
     let f = face(&recs, 0);
-    let b = f.barycentric.ok_or("no barycentric")?;
+    let b = f.barycentric.context("no barycentric")?;
     ensure!(b.iter().all(|w| w.is_finite()), "barycentric {b:?}");
     ensure!(
         f.verdict == Verdict::OutsideTriangle && (b[0] + 0.006).abs() < 1e-4,
@@ -1040,7 +1033,7 @@ fn sliver_triangle_face_hit_barycentric_without_cancellation() -> Result<(), Str
 /// ulp further from edge 0's line than `ρ`: in the edge frame `B = 0`, the
 /// discriminant (computed as `4 (ρ² A − w²)`) rounds to 0 and `C > 0`, so
 /// the exact answer is no root. It used to be a phantom edge hit at `α = 0`.
-fn zero_q_gives_a_double_root_only_when_c_is_zero() -> Result<(), String> {
+fn zero_q_gives_a_double_root_only_when_c_is_zero() -> anyhow::Result<()> {
     let rho = 0.3650434993895252;
     let height = 0.36504349938952524;
     ensure!(height > rho, "the start is above ρ");
@@ -1066,7 +1059,7 @@ fn zero_q_gives_a_double_root_only_when_c_is_zero() -> Result<(), String> {
 /// nearly parallel path, `h0 - h1` (two dot products of long vectors,
 /// subtracted) and `-(n · d)` disagree in their last bits and sometimes in
 /// sign; every verdict must follow `n · d`.
-fn face_decides_direction_by_n_dot_d_alone() -> Result<(), String> {
+fn face_decides_direction_by_n_dot_d_alone() -> anyhow::Result<()> {
     use sweeptrace::core::{PARALLEL_TOLERANCE, SweptPath, sweep_face};
     let mut state = 0x9e37_79b9_7f4a_7c15u64;
     let mut next = move || {
@@ -1087,8 +1080,7 @@ fn face_decides_direction_by_n_dot_d_alone() -> Result<(), String> {
         let p0 = nalgebra::Point3::new(next(), next(), next()) + n * (0.5 + next());
         let d = (along + n * (1e-8 * next())) * 1e-3;
         let p1 = p0 + d;
-        let path = SweptPath::new(&Sweep::new(p0.into(), p1.into(), 0.25), &Options::default())
-            .map_err(|e| e.to_string())?;
+        let path = SweptPath::new(&Sweep::new(p0.into(), p1.into(), 0.25), &Options::default())?;
         let r = sweep_face(&t, &path, NS);
         let nd = r.normal_dot_d;
         if (r.h0 - r.h1 > 0.0) != (-nd > 0.0) {

@@ -14,6 +14,7 @@ use crate::core_random::{random_patch, random_sweep, random_triangle, uniform, u
 use crate::ensure;
 use crate::support::{close, mesh, run};
 use crate::trial;
+use anyhow::Context as _;
 
 pub fn tests() -> Vec<Trial> {
     vec![
@@ -40,7 +41,7 @@ pub(crate) fn options() -> Options {
 /// edge 0 of triangle 1 (run the other way). The path meets the shared edge
 /// first; both edge tests hit at the same α up to rounding, and the rules
 /// give the lower triangle. Rounding used to give triangle 1.
-fn shared_edge_tie_goes_to_the_lower_triangle() -> Result<(), String> {
+fn shared_edge_tie_goes_to_the_lower_triangle() -> anyhow::Result<()> {
     let m = mesh(
         &[
             [0.0, 0.0, 0.0],
@@ -59,8 +60,7 @@ fn shared_edge_tie_goes_to_the_lower_triangle() -> Result<(), String> {
             &options(),
             broadphase,
             &mut records,
-        )
-        .map_err(|e| e.to_string())?;
+        )?;
         ensure!(
             o.kind == Kind::Edge && o.triangle == Some(0) && o.feature == Some(0),
             "{broadphase:?}: outcome {o:?}"
@@ -86,7 +86,7 @@ fn shared_edge_tie_goes_to_the_lower_triangle() -> Result<(), String> {
 /// triangles' boundary, so both faces hit at the same α and the rules give
 /// a face hit on the lower triangle (not the diagonal edge that rounding
 /// used to choose when both touch points came out just outside).
-fn quad_centre_drop_is_a_face_hit() -> Result<(), String> {
+fn quad_centre_drop_is_a_face_hit() -> anyhow::Result<()> {
     let vertices = [
         [0.0, 0.0, 0.0],
         [2.0, 0.0, -2.0],
@@ -96,7 +96,7 @@ fn quad_centre_drop_is_a_face_hit() -> Result<(), String> {
     for triangles in [[[0, 1, 2], [0, 2, 3]], [[0, 1, 3], [1, 2, 3]]] {
         let m = mesh(&vertices, &triangles);
         let (p0, p1) = ([3.0, 3.0, 0.0], [-1.0, -1.0, -4.0]);
-        let o = sweep_mesh(&m, &Sweep::new(p0, p1, 0.25), &options()).map_err(|e| e.to_string())?;
+        let o = sweep_mesh(&m, &Sweep::new(p0, p1, 0.25), &options())?;
         ensure!(
             o.kind == Kind::Face && o.triangle == Some(0) && o.feature.is_none(),
             "{triangles:?}: outcome {o:?}"
@@ -105,10 +105,9 @@ fn quad_centre_drop_is_a_face_hit() -> Result<(), String> {
         // the plane along the path of length 4√3: α = (2√3 - 0.25) / (4√3).
         let s3 = 3f64.sqrt();
         close("alpha", o.alpha, (2.0 * s3 - 0.25) / (4.0 * s3), 1e-12)?;
-        let n = o.normal.ok_or("no normal")?;
+        let n = o.normal.context("no normal")?;
         close("normal x", n.x, 1.0 / s3, 1e-12)?;
-        let (_, ties) =
-            sweep_ties(&m, &Sweep::new(p0, p1, 0.25), &options()).map_err(|e| e.to_string())?;
+        let (_, ties) = sweep_ties(&m, &Sweep::new(p0, p1, 0.25), &options())?;
         ensure!(
             ties.first()
                 .is_some_and(|t| t.kind == Kind::Face && t.triangle == 0),
@@ -125,12 +124,10 @@ fn quad_centre_drop_is_a_face_hit() -> Result<(), String> {
 /// The cube of worked example 5: the edge x = 1, z = 1 is hit by a triangle
 /// of the +x face and one of the +z face. The tie set holds both, the
 /// primary first, and `matches` accepts either as an expectation.
-fn tie_set_lists_every_tied_hit_primary_first() -> Result<(), String> {
-    let m = sweeptrace::sim::scenes::cube()
-        .to_mesh()
-        .map_err(|e| e.to_string())?;
+fn tie_set_lists_every_tied_hit_primary_first() -> anyhow::Result<()> {
+    let m = sweeptrace::sim::scenes::cube().to_mesh()?;
     let sweep = Sweep::new([1.25, 0.125, 3.0], [1.25, 0.125, -3.0], 0.5);
-    let (o, ties) = sweep_ties(&m, &sweep, &options()).map_err(|e| e.to_string())?;
+    let (o, ties) = sweep_ties(&m, &sweep, &options())?;
     ensure!(o.kind == Kind::Edge, "outcome {o:?}");
     ensure!(ties.len() >= 2, "tie set {ties:?}");
     ensure!(
@@ -155,7 +152,7 @@ fn tie_set_lists_every_tied_hit_primary_first() -> Result<(), String> {
 
 /// Worked example 1: a face hit in the middle of the triangle, head on, is
 /// robust and its tie set is itself.
-fn clear_hit_is_robust_with_a_single_member_tie_set() -> Result<(), String> {
+fn clear_hit_is_robust_with_a_single_member_tie_set() -> anyhow::Result<()> {
     let (o, records) = run(
         &crate::support::triangle_t(),
         [1.0, 1.0, 3.0],
@@ -186,15 +183,15 @@ fn clear_hit_is_robust_with_a_single_member_tie_set() -> Result<(), String> {
     Ok(())
 }
 
-fn fragile_serializes_as_reason_names() -> Result<(), String> {
+fn fragile_serializes_as_reason_names() -> anyhow::Result<()> {
     use sweeptrace::core::Fragility;
     let f = Fragility::ROBUST
         .with(FragileReason::NearBoundary)
         .with(FragileReason::Tie);
-    let json = serde_json::to_string(&f).map_err(|e| e.to_string())?;
+    let json = serde_json::to_string(&f)?;
     ensure!(json == r#"["tie","near_boundary"]"#, "json {json}");
     ensure!(f.to_string() == "tie, near_boundary", "text {f}");
-    let json = serde_json::to_string(&Fragility::ROBUST).map_err(|e| e.to_string())?;
+    let json = serde_json::to_string(&Fragility::ROBUST)?;
     ensure!(json == "[]", "json {json}");
     Ok(())
 }
@@ -356,7 +353,7 @@ fn exact_tie_set(m: &IntMesh, x: [i64; 3], w: [i64; 3], d: [i64; 3]) -> Vec<(Kin
 /// with `ρ` an integer length: the exact first contact is that point, the
 /// tests that touch there are known exactly, and the core's primary must be
 /// the first of them in the rules' order, whatever rounding did.
-fn exact_ties_on_boxes_and_terrains_follow_the_rules() -> Result<(), String> {
+fn exact_ties_on_boxes_and_terrains_follow_the_rules() -> anyhow::Result<()> {
     let mut rng = ChaCha8Rng::seed_from_u64(0x7135);
     let candidates = rational_length_vectors();
     let (mut checked, mut multi, mut by_kind) = (0usize, 0usize, [0usize; 3]);
@@ -439,8 +436,7 @@ fn exact_ties_on_boxes_and_terrains_follow_the_rules() -> Result<(), String> {
                         &options(),
                         broadphase,
                         &mut sweeptrace::core::NoObserver,
-                    )
-                    .map_err(|e| e.to_string())?;
+                    )?;
                     let got = (
                         o.kind,
                         o.triangle.unwrap_or(u32::MAX),
@@ -533,7 +529,7 @@ fn aimed_sweep(
 /// the radius, or a coordinate of one mesh vertex) by one ulp never changes
 /// a decision that is not flagged: same kind, triangle and feature, `α`
 /// within 1e-6.
-fn unflagged_decisions_survive_one_ulp_changes() -> Result<(), String> {
+fn unflagged_decisions_survive_one_ulp_changes() -> anyhow::Result<()> {
     use std::collections::BTreeMap;
     let mut rng = ChaCha8Rng::seed_from_u64(0x0f1a_6e11);
     let (mut robust, mut robust_hits, mut fragile) = (0usize, 0usize, 0usize);
@@ -552,7 +548,7 @@ fn unflagged_decisions_survive_one_ulp_changes() -> Result<(), String> {
             };
             base = Some(mesh(&vertices, &triangles));
         }
-        let m = base.as_ref().ok_or("no mesh")?;
+        let m = base.as_ref().context("no mesh")?;
         let (p0, p1, radius, margin, facing) = if rng.random_bool(0.5) {
             random_sweep(&mut rng, &vertices, &triangles)
         } else {
@@ -560,7 +556,7 @@ fn unflagged_decisions_survive_one_ulp_changes() -> Result<(), String> {
             (p0, p1, r, 0.0, Facing::NonStrict)
         };
         let options = Options { margin, facing };
-        let o = sweep_mesh(m, &Sweep::new(p0, p1, radius), &options).map_err(|e| e.to_string())?;
+        let o = sweep_mesh(m, &Sweep::new(p0, p1, radius), &options)?;
         let flagged = !o.fragile.is_robust();
         if flagged {
             fragile += 1;
@@ -572,7 +568,7 @@ fn unflagged_decisions_survive_one_ulp_changes() -> Result<(), String> {
             robust_hits += usize::from(o.is_hit());
         }
         let mut changed = false;
-        let mut check = |what: &str, o2: &sweeptrace::core::Outcome| -> Result<(), String> {
+        let mut check = |what: &str, o2: &sweeptrace::core::Outcome| -> anyhow::Result<()> {
             let same = decision(o2) == decision(&o) && (o2.alpha - o.alpha).abs() <= 1e-6;
             changed |= !same;
             ensure!(
@@ -594,7 +590,7 @@ fn unflagged_decisions_survive_one_ulp_changes() -> Result<(), String> {
             if r <= margin {
                 continue;
             }
-            let o2 = sweep_mesh(m, &Sweep::new(q0, q1, r), &options).map_err(|e| e.to_string())?;
+            let o2 = sweep_mesh(m, &Sweep::new(q0, q1, r), &options)?;
             check(
                 ["p0.x", "p0.y", "p0.z", "p1.x", "p1.y", "p1.z", "radius"][k],
                 &o2,
@@ -604,8 +600,7 @@ fn unflagged_decisions_survive_one_ulp_changes() -> Result<(), String> {
         let (v, k) = (rng.random_range(0..moved.len()), rng.random_range(0..3));
         moved[v][k] = ulp_step(moved[v][k], rng.random_bool(0.5));
         let m2 = mesh(&moved, &triangles);
-        let o2 =
-            sweep_mesh(&m2, &Sweep::new(p0, p1, radius), &options).map_err(|e| e.to_string())?;
+        let o2 = sweep_mesh(&m2, &Sweep::new(p0, p1, radius), &options)?;
         check(&format!("vertex {v} coordinate {k}"), &o2)?;
         fragile_changed += usize::from(changed && flagged);
     }

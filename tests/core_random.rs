@@ -171,14 +171,13 @@ fn oracle_triangles(case: &Case) -> Vec<OTri> {
         .collect()
 }
 
-fn run_core(case: &Case) -> Result<(Mesh, Outcome), String> {
-    let mesh = Mesh::new(case.vertices.clone(), &case.triangles).map_err(|e| e.to_string())?;
+fn run_core(case: &Case) -> anyhow::Result<(Mesh, Outcome)> {
+    let mesh = Mesh::new(case.vertices.clone(), &case.triangles)?;
     let options = Options {
         margin: case.margin,
         facing: case.facing,
     };
-    let o = sweep_mesh(&mesh, &Sweep::new(case.p0, case.p1, case.radius), &options)
-        .map_err(|e| e.to_string())?;
+    let o = sweep_mesh(&mesh, &Sweep::new(case.p0, case.p1, case.radius), &options)?;
     Ok((mesh, o))
 }
 
@@ -189,7 +188,7 @@ fn describe(case: &Case, o: &Outcome) -> String {
     )
 }
 
-fn oracle_agreement_100k_sweeps() -> Result<(), String> {
+fn oracle_agreement_100k_sweeps() -> anyhow::Result<()> {
     let mut rng = ChaCha8Rng::seed_from_u64(0x5EED_0001);
     const N: usize = 100_000;
     let mut excluded: std::collections::BTreeMap<&str, usize> = Default::default();
@@ -246,16 +245,16 @@ fn oracle_agreement_100k_sweeps() -> Result<(), String> {
         "too many exclusions: {total_excluded}"
     );
     if !failures.is_empty() {
-        return Err(format!(
+        anyhow::bail!(
             "{} disagreements, first:\n{}",
             failures.len(),
             failures[..failures.len().min(5)].join("\n")
-        ));
+        );
     }
     Ok(())
 }
 
-fn parry_agreement_front_facing() -> Result<(), String> {
+fn parry_agreement_front_facing() -> anyhow::Result<()> {
     use parry3d_f64::math::{Pose, Vector};
     use parry3d_f64::query::{ShapeCastOptions, cast_shapes};
     use parry3d_f64::shape::{Ball, Triangle};
@@ -307,7 +306,7 @@ fn parry_agreement_front_facing() -> Result<(), String> {
             &shape,
             ShapeCastOptions::with_max_time_of_impact(1.0),
         )
-        .map_err(|_| "parry: unsupported shapes".to_string())?;
+        .map_err(|_| anyhow::anyhow!("parry: unsupported shapes"))?;
         if hit.is_some_and(|h| h.time_of_impact <= 0.0) {
             skipped += 1; // starts penetrating
             continue;
@@ -341,11 +340,11 @@ fn parry_agreement_front_facing() -> Result<(), String> {
         failures.len()
     );
     if !failures.is_empty() {
-        return Err(format!(
+        anyhow::bail!(
             "{} disagreements, first:\n{}",
             failures.len(),
             failures[..failures.len().min(5)].join("\n")
-        ));
+        );
     }
     // An agreement over misses only would say nothing about the hits:
     // most sweeps are compared, and a good share of them hit.
@@ -361,8 +360,8 @@ fn parry_agreement_front_facing() -> Result<(), String> {
 fn mesh_and_usable(
     vertices: &[[f64; 3]],
     triangles: &[[u64; 3]],
-) -> Result<(Mesh, Vec<[u64; 3]>), String> {
-    let mesh = Mesh::new(vertices.to_vec(), triangles).map_err(|e| e.to_string())?;
+) -> anyhow::Result<(Mesh, Vec<[u64; 3]>)> {
+    let mesh = Mesh::new(vertices.to_vec(), triangles)?;
     let usable = mesh
         .triangles()
         .iter()
@@ -416,7 +415,7 @@ fn random_mesh(rng: &mut ChaCha8Rng, m: usize) -> (Vec<[f64; 3]>, Vec<[u64; 3]>)
 /// miss while the tests run (`CollectPrimary`); it must give exactly what
 /// collecting every record and then choosing (`primary_records`) gives,
 /// and the same verdict counts.
-fn primary_collector_equals_collecting_every_record() -> Result<(), String> {
+fn primary_collector_equals_collecting_every_record() -> anyhow::Result<()> {
     let mut rng = ChaCha8Rng::seed_from_u64(0x5EED_0004);
     let (mut checked, mut hits, mut ties) = (0, 0, 0);
     for m in 0..6 {
@@ -428,27 +427,23 @@ fn primary_collector_equals_collecting_every_record() -> Result<(), String> {
             let options = Options { margin, facing };
             for broadphase in [Broadphase::Bvh, Broadphase::Exhaustive] {
                 let mut every = CollectRecords::default();
-                let outcome = sweep_mesh_with(&mesh, &sweep, &options, broadphase, &mut every)
-                    .map_err(|e| e.to_string())?;
+                let outcome = sweep_mesh_with(&mesh, &sweep, &options, broadphase, &mut every)?;
                 let mut primary = CollectPrimary::default();
-                let again = sweep_mesh_with(&mesh, &sweep, &options, broadphase, &mut primary)
-                    .map_err(|e| e.to_string())?;
+                let again = sweep_mesh_with(&mesh, &sweep, &options, broadphase, &mut primary)?;
                 if format!("{outcome:?}") != format!("{again:?}") {
-                    return Err(format!("{p0:?} -> {p1:?}: outcomes differ"));
+                    anyhow::bail!("{p0:?} -> {p1:?}: outcomes differ");
                 }
                 let counts: VerdictCounts = every.records.iter().map(|r| r.verdict()).collect();
                 let got = primary.verdict_counts();
                 if got != counts {
-                    return Err(format!(
-                        "{p0:?} -> {p1:?}: verdict counts {got:?}, expected {counts:?}"
-                    ));
+                    anyhow::bail!("{p0:?} -> {p1:?}: verdict counts {got:?}, expected {counts:?}");
                 }
                 let want = primary_records(&outcome, every.records);
                 let got = primary.into_primary_records(&outcome);
                 if got != want {
-                    return Err(format!(
+                    anyhow::bail!(
                         "{p0:?} -> {p1:?} ({broadphase:?}): records {got:?}, expected {want:?}"
-                    ));
+                    );
                 }
                 checked += 1;
                 hits += usize::from(outcome.is_hit());
@@ -458,14 +453,12 @@ fn primary_collector_equals_collecting_every_record() -> Result<(), String> {
     }
     // The comparison covers hits, misses and ties.
     if hits < checked / 10 || hits > checked * 9 / 10 || ties == 0 {
-        return Err(format!(
-            "{checked} sweeps: {hits} hits, {ties} with ties: not a useful mix"
-        ));
+        anyhow::bail!("{checked} sweeps: {hits} hits, {ties} with ties: not a useful mix");
     }
     Ok(())
 }
 
-fn bvh_equals_exhaustive() -> Result<(), String> {
+fn bvh_equals_exhaustive() -> anyhow::Result<()> {
     let mut rng = ChaCha8Rng::seed_from_u64(0x5EED_0003);
     let mut checked = 0;
     let mut hits = 0;
@@ -476,23 +469,22 @@ fn bvh_equals_exhaustive() -> Result<(), String> {
             let (p0, p1, radius, margin, facing) = random_sweep(&mut rng, &vertices, &usable);
             let sweep = Sweep::new(p0, p1, radius);
             let options = Options { margin, facing };
-            let fast = sweep_mesh(&mesh, &sweep, &options).map_err(|e| e.to_string())?;
+            let fast = sweep_mesh(&mesh, &sweep, &options)?;
             let all = sweep_mesh_with(
                 &mesh,
                 &sweep,
                 &options,
                 Broadphase::Exhaustive,
                 &mut NoObserver,
-            )
-            .map_err(|e| e.to_string())?;
+            )?;
             checked += 1;
             if fast.kind != Kind::None {
                 hits += 1;
             }
             if fast != all {
-                return Err(format!(
+                anyhow::bail!(
                     "mesh {m}: p0 {p0:?} p1 {p1:?} r {radius} margin {margin}: bvh {fast:?} != exhaustive {all:?}"
-                ));
+                );
             }
         }
     }

@@ -88,12 +88,12 @@ pub fn worked_examples_trace() -> Vec<u8> {
 
 /// A temporary directory holding the worked examples' trace and `engine.py`
 /// with `source`.
-fn setup(source: &str) -> Result<(tempfile::TempDir, PathBuf, String), String> {
-    let dir = tempfile::tempdir().map_err(|e| e.to_string())?;
+fn setup(source: &str) -> anyhow::Result<(tempfile::TempDir, PathBuf, String)> {
+    let dir = tempfile::tempdir()?;
     let trace = dir.path().join("examples.mcap");
-    std::fs::write(&trace, worked_examples_trace()).map_err(|e| e.to_string())?;
+    std::fs::write(&trace, worked_examples_trace())?;
     let engine = dir.path().join("engine.py");
-    std::fs::write(&engine, source).map_err(|e| e.to_string())?;
+    std::fs::write(&engine, source)?;
     let command = format!("python3 '{}'", engine.display());
     Ok((dir, trace, command))
 }
@@ -115,7 +115,7 @@ fn faulty_engine(good: u64, then: &str) -> String {
     )
 }
 
-fn example_engine_passes_the_sample_traces() -> Result<(), String> {
+fn example_engine_passes_the_sample_traces() -> anyhow::Result<()> {
     let traces = Path::new(env!("CARGO_MANIFEST_DIR")).join("traces");
     let cube = traces.join("record_cube_corner_margin.mcap");
     let strict = traces.join("record_box_strict.mcap");
@@ -135,7 +135,7 @@ fn example_engine_passes_the_sample_traces() -> Result<(), String> {
     Ok(())
 }
 
-fn wrong_engine_report_explains_the_missed_vertex() -> Result<(), String> {
+fn wrong_engine_report_explains_the_missed_vertex() -> anyhow::Result<()> {
     let (_dir, trace, _) = setup("")?;
     let engine = example_engine_command("--bug skip-vertex");
     let (code, stdout, stderr) = run_bin(os!("check", trace.as_os_str(), "--engine", &engine))?;
@@ -156,7 +156,7 @@ fn wrong_engine_report_explains_the_missed_vertex() -> Result<(), String> {
     Ok(())
 }
 
-fn engine_not_found_exits_125() -> Result<(), String> {
+fn engine_not_found_exits_125() -> anyhow::Result<()> {
     let (dir, trace, _) = setup("")?;
     let missing = dir.path().join("build/engine");
     let (code, stdout, stderr) = run_bin(os!(
@@ -173,7 +173,7 @@ fn engine_not_found_exits_125() -> Result<(), String> {
     Ok(())
 }
 
-fn engine_crash_shows_its_stderr_tail() -> Result<(), String> {
+fn engine_crash_shows_its_stderr_tail() -> anyhow::Result<()> {
     let then =
         "sys.stderr.write('reading the vertex table\\nboom: index 7 out of range\\n'); sys.exit(3)";
     let (_dir, trace, command) = setup(&faulty_engine(2, then))?;
@@ -190,7 +190,7 @@ fn engine_crash_shows_its_stderr_tail() -> Result<(), String> {
     Ok(())
 }
 
-fn engine_garbage_line_is_an_error() -> Result<(), String> {
+fn engine_garbage_line_is_an_error() -> anyhow::Result<()> {
     let then = "out.write('collision at 0.4\\n'); out.flush(); continue";
     let (_dir, trace, command) = setup(&faulty_engine(1, then))?;
     let (code, stdout, stderr) = run_bin(os!("check", trace.as_os_str(), "--engine", &command))?;
@@ -205,7 +205,7 @@ fn engine_garbage_line_is_an_error() -> Result<(), String> {
     Ok(())
 }
 
-fn engine_wrong_frame_is_an_error() -> Result<(), String> {
+fn engine_wrong_frame_is_an_error() -> anyhow::Result<()> {
     let then = "m['frame'] += 1";
     let (_dir, trace, command) = setup(&faulty_engine(3, then))?;
     let (code, stdout, stderr) = run_bin(os!("check", trace.as_os_str(), "--engine", &command))?;
@@ -216,7 +216,7 @@ fn engine_wrong_frame_is_an_error() -> Result<(), String> {
     Ok(())
 }
 
-fn engine_timeout_stops_it() -> Result<(), String> {
+fn engine_timeout_stops_it() -> anyhow::Result<()> {
     // It never answers the first sweep: whether the timeout runs out while
     // Python starts or while it sleeps, the message is the same (the test
     // does not depend on how fast the engine starts).
@@ -245,7 +245,7 @@ fn engine_timeout_stops_it() -> Result<(), String> {
 
 /// An engine run through `sh -c` that never answers: stopping it at the
 /// timeout stops the shell's child too (the whole process group).
-fn engine_started_through_a_shell_is_stopped_with_its_children() -> Result<(), String> {
+fn engine_started_through_a_shell_is_stopped_with_its_children() -> anyhow::Result<()> {
     let (dir, trace, _) = setup("")?;
     let pid_file = dir.path().join("child.pid");
     // The shell starts a long sleep in the background, writes its pid,
@@ -264,10 +264,10 @@ fn engine_started_through_a_shell_is_stopped_with_its_children() -> Result<(), S
     ))?;
     ensure!(code == 2, "exit {code}, want 2:\n{stdout}\n{stderr}");
     let pid: i32 = std::fs::read_to_string(&pid_file)
-        .map_err(|e| format!("the shell wrote no pid: {e}"))?
+        .map_err(|e| anyhow::anyhow!("the shell wrote no pid: {e}"))?
         .trim()
         .parse()
-        .map_err(|e| format!("pid: {e}"))?;
+        .map_err(|e| anyhow::anyhow!("pid: {e}"))?;
     // Killed by the time check returned; it may take a moment to be reaped
     // by init, so look at its state rather than at its existence.
     let alive = |pid: i32| {
@@ -286,12 +286,12 @@ fn engine_started_through_a_shell_is_stopped_with_its_children() -> Result<(), S
     unsafe {
         libc::kill(pid, libc::SIGKILL);
     }
-    Err(format!(
+    Err(anyhow::anyhow!(
         "the engine's child {pid} still runs after check returned"
     ))
 }
 
-fn engine_extra_output_after_the_end_is_an_error() -> Result<(), String> {
+fn engine_extra_output_after_the_end_is_an_error() -> anyhow::Result<()> {
     // Answers every sweep, then prints one more line when its input ends.
     let source = format!("{}out.write('done\\n')\n", faulty_engine(100, "pass"));
     let (_dir, trace, command) = setup(&source)?;
@@ -303,7 +303,7 @@ fn engine_extra_output_after_the_end_is_an_error() -> Result<(), String> {
     Ok(())
 }
 
-fn engine_json_report_names_the_engine() -> Result<(), String> {
+fn engine_json_report_names_the_engine() -> anyhow::Result<()> {
     let (_dir, trace, command) = setup(&faulty_engine(100, "pass"))?;
     let (code, stdout, stderr) = run_bin(os!(
         "check",
@@ -313,7 +313,7 @@ fn engine_json_report_names_the_engine() -> Result<(), String> {
         "--json"
     ))?;
     ensure!(code == 1, "exit {code}, want 1:\n{stdout}\n{stderr}");
-    let doc: serde_json::Value = serde_json::from_str(&stdout).map_err(|e| e.to_string())?;
+    let doc: serde_json::Value = serde_json::from_str(&stdout)?;
     let report = &doc["traces"][0];
     ensure!(
         report["engine"]["command"] == command.as_str() && report["engine"]["against"] == "core",
@@ -327,7 +327,7 @@ fn engine_json_report_names_the_engine() -> Result<(), String> {
     Ok(())
 }
 
-fn against_expected_compares_answers_with_the_trace() -> Result<(), String> {
+fn against_expected_compares_answers_with_the_trace() -> anyhow::Result<()> {
     let trace = Path::new(env!("CARGO_MANIFEST_DIR")).join("traces/record_cube_corner_margin.mcap");
     // The trace's expectations were recorded by the core with margin 0.05:
     // the correct engine decides every sweep the same.
@@ -370,7 +370,7 @@ fn against_expected_compares_answers_with_the_trace() -> Result<(), String> {
         "--json"
     ))?;
     ensure!(code == 2, "no expectations: exit {code}:\n{stdout}");
-    let doc: serde_json::Value = serde_json::from_str(&stdout).map_err(|e| e.to_string())?;
+    let doc: serde_json::Value = serde_json::from_str(&stdout)?;
     ensure!(
         doc["traces"][0]["status"] == "no_expectations"
             && doc["traces"][0]["engine"]["against"] == "expected",

@@ -8,6 +8,7 @@ use std::path::Path;
 use libtest_mimic::Trial;
 
 use crate::{ensure, trial};
+use anyhow::Context as _;
 
 pub fn tests() -> Vec<Trial> {
     vec![trial!(failing_commands_say_each_thing_once)]
@@ -23,33 +24,30 @@ struct Case {
     must_say: Vec<&'static str>,
 }
 
-fn failing_commands_say_each_thing_once() -> Result<(), String> {
-    let dir = tempfile::tempdir().map_err(|e| e.to_string())?;
+fn failing_commands_say_each_thing_once() -> anyhow::Result<()> {
+    let dir = tempfile::tempdir()?;
     let at = |name: &str| dir.path().join(name);
     let sample = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/tunnel_floor.mcap");
-    let bytes = std::fs::read(&sample).map_err(|e| e.to_string())?;
+    let bytes = std::fs::read(&sample)?;
 
     // A corrupt chunk, a truncated file, a bad field of a sweep.
     let mut corrupt = bytes.clone();
-    let (start, len) = crate::trace_io::first_chunk(&corrupt).ok_or("no chunk")?;
+    let (start, len) = crate::trace_io::first_chunk(&corrupt).context("no chunk")?;
     corrupt[start + 9 + len - len / 3] ^= 0x5a;
-    std::fs::write(at("corrupt.mcap"), &corrupt).map_err(|e| e.to_string())?;
-    std::fs::write(at("truncated.mcap"), &bytes[..bytes.len() * 2 / 3])
-        .map_err(|e| e.to_string())?;
+    std::fs::write(at("corrupt.mcap"), &corrupt)?;
+    std::fs::write(at("truncated.mcap"), &bytes[..bytes.len() * 2 / 3])?;
     let scene = br#"{"vertices":[[0,0,0],[4,0,0],[0,4,0]],"triangles":[[0,1,2]]}"#;
     let bad_sweep = br#"{"frame":7,"radius":-1,"p0":[1,1,1],"p1":[1,1,-1]}"#;
     let bad_type = br#"{"frame":8,"radius":0.5,"p0":[1,"x",1],"p1":[1,1,-1]}"#;
     std::fs::write(
         at("bad_field.mcap"),
         crate::trace_io::raw_trace(&[("/scene", 0, scene), ("/sweep", 1, bad_sweep)]),
-    )
-    .map_err(|e| e.to_string())?;
+    )?;
     std::fs::write(
         at("bad_type.mcap"),
         crate::trace_io::raw_trace(&[("/scene", 0, scene), ("/sweep", 1, bad_type)]),
-    )
-    .map_err(|e| e.to_string())?;
-    std::fs::write(at("level.obj"), "v 0 0 0\nv 1 0 0\nf 1 2 9\n").map_err(|e| e.to_string())?;
+    )?;
+    std::fs::write(at("level.obj"), "v 0 0 0\nv 1 0 0\nf 1 2 9\n")?;
 
     let path = |name: &str| at(name).display().to_string();
     let sample_name = sample.display().to_string();
@@ -183,7 +181,7 @@ fn failing_commands_say_each_thing_once() -> Result<(), String> {
             .find(|l| {
                 l.starts_with("error: ") || l.starts_with("ERROR ") || l.starts_with("incomplete: ")
             })
-            .ok_or_else(|| format!("{what}: no error line: {stdout}{stderr}"))?;
+            .with_context(|| format!("{what}: no error line: {stdout}{stderr}"))?;
         ensure!(
             message.matches(case.file.as_str()).count() == 1,
             "{what}: the message does not name {} exactly once: {message}",
@@ -196,9 +194,7 @@ fn failing_commands_say_each_thing_once() -> Result<(), String> {
             );
         }
         if let Some(repeated) = sweeptrace::error_text::repeated_segment(message) {
-            return Err(format!(
-                "{what}: the message repeats `{repeated}`: {message}"
-            ));
+            anyhow::bail!("{what}: the message repeats `{repeated}`: {message}");
         }
     }
     Ok(())

@@ -22,6 +22,7 @@ use sweeptrace::trace::{
 use crate::engine::example_engine_command;
 use crate::support::run_bin;
 use crate::{ensure, os, trial};
+use anyhow::Context as _;
 
 pub fn tests() -> Vec<Trial> {
     vec![
@@ -80,25 +81,25 @@ fn face_hit(frame: u64) -> OutcomeMsg {
 
 /// Three sweeps with matching expectations, written by the project's
 /// writer with `source` (if any) before the first message.
-fn trace_bytes(source: Option<&ExpectedSource>) -> Result<Vec<u8>, String> {
-    let mut w = TraceWriter::new(Cursor::new(Vec::new())).map_err(|e| e.to_string())?;
+fn trace_bytes(source: Option<&ExpectedSource>) -> anyhow::Result<Vec<u8>> {
+    let mut w = TraceWriter::new(Cursor::new(Vec::new()))?;
     if let Some(source) = source {
-        w.expected_source(source).map_err(|e| e.to_string())?;
+        w.expected_source(source)?;
     }
-    w.scene(0, &scene()).map_err(|e| e.to_string())?;
+    w.scene(0, &scene())?;
     for frame in 0..3 {
         let t = 1_000 + frame * 1_000_000;
-        w.sweep(t, &sweep(frame)).map_err(|e| e.to_string())?;
-        w.expected(t, &face_hit(frame)).map_err(|e| e.to_string())?;
+        w.sweep(t, &sweep(frame))?;
+        w.expected(t, &face_hit(frame))?;
     }
-    Ok(w.finish().map_err(|e| e.to_string())?.into_inner())
+    Ok(w.finish()?.into_inner())
 }
 
 /// A trace written with the `mcap` crate directly, with the metadata
 /// records `records` before its messages (the project's writer refuses a
 /// malformed expected source, other writers may not).
-fn raw_trace(records: &[BTreeMap<String, String>]) -> Result<Vec<u8>, String> {
-    let err = |e: mcap::McapError| e.to_string();
+fn raw_trace(records: &[BTreeMap<String, String>]) -> anyhow::Result<Vec<u8>> {
+    let err = |e: mcap::McapError| anyhow::Error::from(e);
     let mut w = mcap::WriteOptions::new()
         .create(Cursor::new(Vec::new()))
         .map_err(err)?;
@@ -115,7 +116,7 @@ fn raw_trace(records: &[BTreeMap<String, String>]) -> Result<Vec<u8>, String> {
     let sweep_channel = w
         .add_channel(0, "/sweep", "json", &BTreeMap::new())
         .map_err(err)?;
-    let json = |e: serde_json::Error| e.to_string();
+    let json = |e: serde_json::Error| anyhow::Error::from(e);
     for (sequence, (channel_id, data)) in [
         (scene_channel, serde_json::to_vec(&scene()).map_err(json)?),
         (sweep_channel, serde_json::to_vec(&sweep(0)).map_err(json)?),
@@ -173,7 +174,7 @@ fn read(
     (events, reader.expected_source().cloned(), error, records)
 }
 
-fn writer_and_reader_round_trip() -> Result<(), String> {
+fn writer_and_reader_round_trip() -> anyhow::Result<()> {
     let source = rapier()
         .setting("dt", 1.0 / 60.0)
         .setting("solver", "pgs, 4 iterations");
@@ -197,7 +198,7 @@ fn writer_and_reader_round_trip() -> Result<(), String> {
         .metadata
         .iter()
         .find(|(n, _)| n == EXPECTED_SOURCE_METADATA)
-        .ok_or("no record")?;
+        .context("no record")?;
     let want = entries(&[
         ("engine", "rapier3d-f64"),
         ("version", "0.36.1"),
@@ -211,8 +212,8 @@ fn writer_and_reader_round_trip() -> Result<(), String> {
     Ok(())
 }
 
-fn writer_refuses_invalid_sources_and_a_second_one() -> Result<(), String> {
-    let mut w = TraceWriter::new(Cursor::new(Vec::new())).map_err(|e| e.to_string())?;
+fn writer_refuses_invalid_sources_and_a_second_one() -> anyhow::Result<()> {
+    let mut w = TraceWriter::new(Cursor::new(Vec::new()))?;
     let cases = [
         (ExpectedSource::new("", "1"), "`engine` is empty"),
         (
@@ -240,7 +241,7 @@ fn writer_refuses_invalid_sources_and_a_second_one() -> Result<(), String> {
         let err = w
             .expected_source(&source)
             .err()
-            .ok_or_else(|| format!("accepted {source:?}"))?;
+            .with_context(|| format!("accepted {source:?}"))?;
         let text = err.to_string();
         ensure!(
             matches!(err, TraceError::ExpectedSource { .. })
@@ -253,16 +254,16 @@ fn writer_refuses_invalid_sources_and_a_second_one() -> Result<(), String> {
     let err = w
         .metadata(EXPECTED_SOURCE_METADATA, entries(&[("engin", "x")]))
         .err()
-        .ok_or("metadata accepted a bad record")?;
+        .context("metadata accepted a bad record")?;
     ensure!(err.to_string().contains("unknown key `engin`"), "{err}");
-    w.expected_source(&rapier()).map_err(|e| e.to_string())?;
+    w.expected_source(&rapier())?;
     let err = w
         .expected_source(&rapier())
         .err()
-        .ok_or("a second source was accepted")?;
+        .context("a second source was accepted")?;
     ensure!(err.to_string().contains("already written"), "{err}");
-    w.scene(0, &scene()).map_err(|e| e.to_string())?;
-    let bytes = w.finish().map_err(|e| e.to_string())?.into_inner();
+    w.scene(0, &scene())?;
+    let bytes = w.finish()?.into_inner();
     let (_, read_back, error, records) = read(&bytes, "w.mcap");
     ensure!(error.is_none(), "{error:?}");
     ensure!(
@@ -272,21 +273,20 @@ fn writer_refuses_invalid_sources_and_a_second_one() -> Result<(), String> {
     Ok(())
 }
 
-fn write_trace_file_with_a_bad_source_leaves_no_file() -> Result<(), String> {
-    let dir = tempfile::tempdir().map_err(|e| e.to_string())?;
+fn write_trace_file_with_a_bad_source_leaves_no_file() -> anyhow::Result<()> {
+    let dir = tempfile::tempdir()?;
     let path = dir.path().join("bad.mcap");
     let result = write_trace_file(&path, |w| -> Result<(), TraceError> {
         w.scene(0, &scene())?;
         w.expected_source(&ExpectedSource::new("", "1"))
     });
-    let err = result.err().ok_or("an empty engine name was accepted")?;
+    let err = result.err().context("an empty engine name was accepted")?;
     let text = err.to_string();
     ensure!(
         text.starts_with(&path.display().to_string()) && text.contains("`engine` is empty"),
         "{text}"
     );
-    let left: Vec<_> = std::fs::read_dir(dir.path())
-        .map_err(|e| e.to_string())?
+    let left: Vec<_> = std::fs::read_dir(dir.path())?
         .filter_map(Result::ok)
         .map(|e| e.file_name())
         .collect();
@@ -296,9 +296,8 @@ fn write_trace_file_with_a_bad_source_leaves_no_file() -> Result<(), String> {
     write_trace_file(&path, |w| -> Result<(), TraceError> {
         w.expected_source(&rapier())?;
         w.scene(0, &scene())
-    })
-    .map_err(|e| e.to_string())?;
-    let bytes = std::fs::read(&path).map_err(|e| e.to_string())?;
+    })?;
+    let bytes = std::fs::read(&path)?;
     let (_, read_back, error, _) = read(&bytes, "good.mcap");
     ensure!(
         error.is_none() && read_back == Some(rapier()),
@@ -311,13 +310,13 @@ fn repository_file(path: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join(path)
 }
 
-fn old_trace_without_it_reads_as_before() -> Result<(), String> {
+fn old_trace_without_it_reads_as_before() -> anyhow::Result<()> {
     // A trace written before the record existed (a sample as committed
     // then, kept as a fixture), and one
     // written now without a source: no source, the same events and reports.
     let old =
         repository_file("tests/fixtures/before_expected_source/record_cube_corner_margin.mcap");
-    let bytes = std::fs::read(&old).map_err(|e| e.to_string())?;
+    let bytes = std::fs::read(&old)?;
     let (events, source, error, _) = read(&bytes, "old.mcap");
     ensure!(error.is_none(), "{error:?}");
     ensure!(source.is_none(), "{source:?}");
@@ -326,8 +325,7 @@ fn old_trace_without_it_reads_as_before() -> Result<(), String> {
     ensure!(error.is_none(), "{error:?}");
     let text = info::render_text(&info);
     ensure!(!text.contains("expected by"), "{text}");
-    let json: serde_json::Value =
-        serde_json::from_str(&info::render_json(&info)).map_err(|e| e.to_string())?;
+    let json: serde_json::Value = serde_json::from_str(&info::render_json(&info))?;
     ensure!(json["expected_source"].is_null(), "{json}");
     let report = check_file(&old, &CheckOptions::default());
     ensure!(report.status() == Status::Ok, "{}", render_text(&report));
@@ -336,8 +334,7 @@ fn old_trace_without_it_reads_as_before() -> Result<(), String> {
         !text.contains("expectations from") && text.lines().count() == 1,
         "{text}"
     );
-    let json: serde_json::Value =
-        serde_json::from_str(&render_json(&[report])).map_err(|e| e.to_string())?;
+    let json: serde_json::Value = serde_json::from_str(&render_json(&[report]))?;
     ensure!(
         json["traces"][0]
             .as_object()
@@ -354,7 +351,7 @@ fn old_trace_without_it_reads_as_before() -> Result<(), String> {
     Ok(())
 }
 
-fn malformed_records_are_errors_naming_the_file() -> Result<(), String> {
+fn malformed_records_are_errors_naming_the_file() -> anyhow::Result<()> {
     let good = entries(&[("engine", "e"), ("version", "1")]);
     let cases: Vec<(Vec<BTreeMap<String, String>>, &str)> = vec![
         (vec![entries(&[("version", "1")])], "no `engine` key"),
@@ -373,11 +370,11 @@ fn malformed_records_are_errors_naming_the_file() -> Result<(), String> {
         ),
         (vec![good.clone(), good.clone()], "the file holds two"),
     ];
-    let dir = tempfile::tempdir().map_err(|e| e.to_string())?;
+    let dir = tempfile::tempdir()?;
     for (records, want) in cases {
         let bytes = raw_trace(&records)?;
         let (_, _, error, _) = read(&bytes, "bad.mcap");
-        let error = error.ok_or_else(|| format!("no error for {records:?}"))?;
+        let error = error.with_context(|| format!("no error for {records:?}"))?;
         let text = error.to_string();
         ensure!(
             matches!(error, TraceError::ExpectedSource { .. })
@@ -387,7 +384,7 @@ fn malformed_records_are_errors_naming_the_file() -> Result<(), String> {
         );
         // The commands: `info` and `check` exit 2 with the message.
         let path = dir.path().join("bad.mcap");
-        std::fs::write(&path, &bytes).map_err(|e| e.to_string())?;
+        std::fs::write(&path, &bytes)?;
         let (code, stdout, stderr) = run_bin(os!("info", path.as_os_str()))?;
         ensure!(
             code == 2 && stderr.contains(want) && stderr.contains("bad.mcap"),
@@ -408,10 +405,10 @@ fn malformed_records_are_errors_naming_the_file() -> Result<(), String> {
     Ok(())
 }
 
-fn info_shows_it() -> Result<(), String> {
-    let dir = tempfile::tempdir().map_err(|e| e.to_string())?;
+fn info_shows_it() -> anyhow::Result<()> {
+    let dir = tempfile::tempdir()?;
     let path = dir.path().join("rapier.mcap");
-    std::fs::write(&path, trace_bytes(Some(&rapier()))?).map_err(|e| e.to_string())?;
+    std::fs::write(&path, trace_bytes(Some(&rapier()))?)?;
     let (code, stdout, stderr) = run_bin(os!("info", path.as_os_str()))?;
     ensure!(code == 0, "exit {code}\n{stderr}");
     ensure!(
@@ -420,7 +417,7 @@ fn info_shows_it() -> Result<(), String> {
     );
     let (code, stdout, stderr) = run_bin(os!("info", path.as_os_str(), "--json"))?;
     ensure!(code == 0, "exit {code}\n{stderr}");
-    let json: serde_json::Value = serde_json::from_str(&stdout).map_err(|e| e.to_string())?;
+    let json: serde_json::Value = serde_json::from_str(&stdout)?;
     ensure!(
         json["expected_source"]
             == serde_json::json!({
@@ -433,10 +430,10 @@ fn info_shows_it() -> Result<(), String> {
     Ok(())
 }
 
-fn check_shows_it_in_text_and_json() -> Result<(), String> {
-    let dir = tempfile::tempdir().map_err(|e| e.to_string())?;
+fn check_shows_it_in_text_and_json() -> anyhow::Result<()> {
+    let dir = tempfile::tempdir()?;
     let path = dir.path().join("rapier.mcap");
-    std::fs::write(&path, trace_bytes(Some(&rapier()))?).map_err(|e| e.to_string())?;
+    std::fs::write(&path, trace_bytes(Some(&rapier()))?)?;
     let report = check_file(&path, &CheckOptions::default());
     ensure!(report.expected_source == Some(rapier()), "{report:?}");
     let (code, stdout, stderr) = run_bin(os!("check", path.as_os_str()))?;
@@ -450,7 +447,7 @@ fn check_shows_it_in_text_and_json() -> Result<(), String> {
     );
     let (code, stdout, stderr) = run_bin(os!("check", path.as_os_str(), "--json"))?;
     ensure!(code == 0, "exit {code}\n{stdout}\n{stderr}");
-    let json: serde_json::Value = serde_json::from_str(&stdout).map_err(|e| e.to_string())?;
+    let json: serde_json::Value = serde_json::from_str(&stdout)?;
     let source = &json["traces"][0]["expected_source"];
     ensure!(
         source["engine"] == "rapier3d-f64"
@@ -459,14 +456,14 @@ fn check_shows_it_in_text_and_json() -> Result<(), String> {
         "{json}"
     );
     // A failing trace keeps the line under its status line.
-    let mut w = TraceWriter::new(Cursor::new(Vec::new())).map_err(|e| e.to_string())?;
-    w.expected_source(&rapier()).map_err(|e| e.to_string())?;
-    w.scene(0, &scene()).map_err(|e| e.to_string())?;
-    w.sweep(1, &sweep(0)).map_err(|e| e.to_string())?;
+    let mut w = TraceWriter::new(Cursor::new(Vec::new()))?;
+    w.expected_source(&rapier())?;
+    w.scene(0, &scene())?;
+    w.sweep(1, &sweep(0))?;
     let mut wrong = face_hit(0);
     wrong.alpha = 0.5;
-    w.expected(1, &wrong).map_err(|e| e.to_string())?;
-    let bytes = w.finish().map_err(|e| e.to_string())?.into_inner();
+    w.expected(1, &wrong)?;
+    let bytes = w.finish()?.into_inner();
     let report = sweeptrace::check_reader(bytes.as_slice(), "fail.mcap", &CheckOptions::default());
     let text = render_text(&report);
     let lines: Vec<&str> = text.lines().collect();
@@ -479,10 +476,10 @@ fn check_shows_it_in_text_and_json() -> Result<(), String> {
     Ok(())
 }
 
-fn check_engine_says_the_engine_answered() -> Result<(), String> {
-    let dir = tempfile::tempdir().map_err(|e| e.to_string())?;
+fn check_engine_says_the_engine_answered() -> anyhow::Result<()> {
+    let dir = tempfile::tempdir()?;
     let path = dir.path().join("rapier.mcap");
-    std::fs::write(&path, trace_bytes(Some(&rapier()))?).map_err(|e| e.to_string())?;
+    std::fs::write(&path, trace_bytes(Some(&rapier()))?)?;
     let engine = example_engine_command("");
     let (code, stdout, stderr) = run_bin(os!("check", path.as_os_str(), "--engine", &engine))?;
     ensure!(code == 0, "exit {code}\n{stdout}\n{stderr}");
@@ -507,7 +504,7 @@ fn check_engine_says_the_engine_answered() -> Result<(), String> {
         "--json"
     ))?;
     ensure!(code == 0, "exit {code}\n{stdout}\n{stderr}");
-    let json: serde_json::Value = serde_json::from_str(&stdout).map_err(|e| e.to_string())?;
+    let json: serde_json::Value = serde_json::from_str(&stdout)?;
     let report = &json["traces"][0];
     ensure!(
         report["expected_source"]["engine"] == "rapier3d-f64"
@@ -529,9 +526,9 @@ fn check_engine_says_the_engine_answered() -> Result<(), String> {
     Ok(())
 }
 
-fn record_names_sweeptrace_and_bless_replaces_the_source() -> Result<(), String> {
+fn record_names_sweeptrace_and_bless_replaces_the_source() -> anyhow::Result<()> {
     let version = env!("CARGO_PKG_VERSION");
-    let dir = tempfile::tempdir().map_err(|e| e.to_string())?;
+    let dir = tempfile::tempdir()?;
     let recorded = dir.path().join("recorded.mcap");
     let (code, stdout, stderr) = run_bin(os!(
         "record",
@@ -547,7 +544,7 @@ fn record_names_sweeptrace_and_bless_replaces_the_source() -> Result<(), String>
         recorded.as_os_str()
     ))?;
     ensure!(code == 0, "record: exit {code}\n{stdout}\n{stderr}");
-    let bytes = std::fs::read(&recorded).map_err(|e| e.to_string())?;
+    let bytes = std::fs::read(&recorded)?;
     let (_, source, error, records) = read(&bytes, "recorded.mcap");
     let want = ExpectedSource::new("sweeptrace", version)
         .setting("margin", "0.05")
@@ -559,10 +556,7 @@ fn record_names_sweeptrace_and_bless_replaces_the_source() -> Result<(), String>
     // The record comes before every message: a streaming reader has it
     // with the first event.
     let mut reader = TraceReader::new(bytes.as_slice(), "recorded.mcap");
-    reader
-        .next()
-        .ok_or("no event")?
-        .map_err(|e| e.to_string())?;
+    reader.next().context("no event")??;
     ensure!(
         reader.expected_source() == Some(&want),
         "not before the first message"
@@ -571,7 +565,7 @@ fn record_names_sweeptrace_and_bless_replaces_the_source() -> Result<(), String>
     // Bless a trace whose expectations came from Rapier: they come from
     // sweeptrace now, with the scene's margin and facing.
     let input = dir.path().join("rapier.mcap");
-    std::fs::write(&input, trace_bytes(Some(&rapier()))?).map_err(|e| e.to_string())?;
+    std::fs::write(&input, trace_bytes(Some(&rapier()))?)?;
     let blessed = dir.path().join("blessed.mcap");
     let (code, stdout, stderr) =
         run_bin(os!("bless", input.as_os_str(), "-o", blessed.as_os_str()))?;
@@ -585,7 +579,7 @@ fn record_names_sweeptrace_and_bless_replaces_the_source() -> Result<(), String>
         )),
         "{stderr}"
     );
-    let bytes = std::fs::read(&blessed).map_err(|e| e.to_string())?;
+    let bytes = std::fs::read(&blessed)?;
     let (events, source, error, records) = read(&bytes, "blessed.mcap");
     ensure!(
         error.is_none() && records == 1 && source.as_ref() == Some(&want),
@@ -594,10 +588,10 @@ fn record_names_sweeptrace_and_bless_replaces_the_source() -> Result<(), String>
     ensure!(events.len() == 7, "{} events", events.len());
     // A trace without a source gets one too.
     let plain = dir.path().join("plain.mcap");
-    std::fs::write(&plain, trace_bytes(None)?).map_err(|e| e.to_string())?;
+    std::fs::write(&plain, trace_bytes(None)?)?;
     let (code, _, stderr) = run_bin(os!("bless", plain.as_os_str(), "--in-place"))?;
     ensure!(code == 0 && !stderr.contains("were from"), "{stderr}");
-    let bytes = std::fs::read(&plain).map_err(|e| e.to_string())?;
+    let bytes = std::fs::read(&plain)?;
     let (_, source, error, _) = read(&bytes, "plain.mcap");
     ensure!(
         error.is_none() && source.as_ref() == Some(&want),
@@ -606,24 +600,23 @@ fn record_names_sweeptrace_and_bless_replaces_the_source() -> Result<(), String>
     Ok(())
 }
 
-fn python_reads_the_record() -> Result<Completion, String> {
+fn python_reads_the_record() -> anyhow::Result<Completion> {
     if let Err(skipped) = crate::support::python_with_mcap()? {
         return Ok(skipped);
     }
-    let dir = tempfile::tempdir().map_err(|e| e.to_string())?;
+    let dir = tempfile::tempdir()?;
     let with = dir.path().join("with.mcap");
     let source = rapier().setting("dt", "0.01");
-    std::fs::write(&with, trace_bytes(Some(&source))?).map_err(|e| e.to_string())?;
+    std::fs::write(&with, trace_bytes(Some(&source))?)?;
     let without = dir.path().join("without.mcap");
-    std::fs::write(&without, trace_bytes(None)?).map_err(|e| e.to_string())?;
+    std::fs::write(&without, trace_bytes(None)?)?;
     let script = repository_file("scripts/read_with_python.py");
-    let run = |trace: &Path, extra: &[&str]| -> Result<(bool, String), String> {
+    let run = |trace: &Path, extra: &[&str]| -> anyhow::Result<(bool, String)> {
         let out = std::process::Command::new("python3")
             .arg(&script)
             .arg(trace)
             .args(extra)
-            .output()
-            .map_err(|e| e.to_string())?;
+            .output()?;
         Ok((
             out.status.success(),
             format!(
@@ -673,7 +666,7 @@ fn python_reads_the_record() -> Result<Completion, String> {
     // A malformed record written by another writer fails the script too.
     let bad = dir.path().join("bad.mcap");
     let raw = raw_trace(&[entries(&[("engine", "e"), ("engin", "x")])])?;
-    std::fs::write(&bad, raw).map_err(|e| e.to_string())?;
+    std::fs::write(&bad, raw)?;
     let (ok, output) = run(&bad, &[])?;
     ensure!(!ok && output.contains("unknown key 'engin'"), "{output}");
     Ok(Completion::Completed)

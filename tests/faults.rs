@@ -15,6 +15,7 @@ use std::time::{Duration, Instant};
 use libtest_mimic::{Completion, Trial};
 
 use crate::{ensure, trial};
+use anyhow::Context as _;
 
 /// Set to `1` (CI does) to make these tests fail, instead of being
 /// skipped, where a tmpfs cannot be mounted.
@@ -44,8 +45,8 @@ struct Tmpfs {
 impl Tmpfs {
     /// Mounts a tmpfs of `size_kib` KiB: `Ok(Err(reason))` when this
     /// machine cannot (not root, no mount permission).
-    fn mount(size_kib: u64) -> Result<Result<Tmpfs, String>, String> {
-        let dir = tempfile::tempdir().map_err(|e| e.to_string())?;
+    fn mount(size_kib: u64) -> anyhow::Result<Result<Tmpfs, String>> {
+        let dir = tempfile::tempdir()?;
         let out = Command::new("mount")
             .args(["-t", "tmpfs", "-o", &format!("size={size_kib}k"), "tmpfs"])
             .arg(dir.path())
@@ -65,31 +66,29 @@ impl Tmpfs {
     }
 
     /// Makes the file system read-only.
-    fn remount_read_only(&self) -> Result<(), String> {
+    fn remount_read_only(&self) -> anyhow::Result<()> {
         let status = Command::new("mount")
             .args(["-o", "remount,ro"])
             .arg(self.path())
-            .status()
-            .map_err(|e| e.to_string())?;
+            .status()?;
         ensure!(status.success(), "mount -o remount,ro failed");
         Ok(())
     }
 
     /// Fills the file system but for about `free_kib` KiB.
-    fn fill_leaving(&self, free_kib: u64) -> Result<(), String> {
+    fn fill_leaving(&self, free_kib: u64) -> anyhow::Result<()> {
         let stat = Command::new("df")
             .args(["--output=avail", "-k"])
             .arg(self.path())
-            .output()
-            .map_err(|e| e.to_string())?;
+            .output()?;
         let text = String::from_utf8_lossy(&stat.stdout);
         let available: u64 = text
             .lines()
             .nth(1)
             .and_then(|l| l.trim().parse().ok())
-            .ok_or_else(|| format!("cannot read df's output: {text}"))?;
+            .with_context(|| format!("cannot read df's output: {text}"))?;
         let filler = available.saturating_sub(free_kib) as usize * 1024;
-        std::fs::write(self.path().join("filler"), vec![0u8; filler]).map_err(|e| e.to_string())
+        std::fs::write(self.path().join("filler"), vec![0u8; filler]).map_err(anyhow::Error::from)
     }
 }
 
@@ -111,14 +110,14 @@ impl Drop for Tmpfs {
 
 /// A tmpfs, or the completion of a test that cannot run here: ignored with
 /// the reason, or a failure where mounting is required.
-fn tmpfs(size_kib: u64) -> Result<Result<Tmpfs, Completion>, String> {
+fn tmpfs(size_kib: u64) -> anyhow::Result<Result<Tmpfs, Completion>> {
     match Tmpfs::mount(size_kib)? {
         Ok(mount) => Ok(Ok(mount)),
         Err(reason) => {
             let required = std::env::var_os(REQUIRE_MOUNT).is_some_and(|v| v == "1")
                 || std::env::var_os("CI").is_some_and(|v| v == "true");
             if required {
-                Err(format!(
+                Err(anyhow::anyhow!(
                     "{reason}; CI (or {REQUIRE_MOUNT}=1) requires this test (run it as root)"
                 ))
             } else {
@@ -147,33 +146,32 @@ fn repository_file(relative: &str) -> PathBuf {
 
 /// Runs the binary with `args`, killing it if it has not ended within
 /// [`LIMIT`]: exit code and stderr.
-fn run_bounded(args: &[&std::ffi::OsStr]) -> Result<(i32, String), String> {
+fn run_bounded(args: &[&std::ffi::OsStr]) -> anyhow::Result<(i32, String)> {
     let child = crate::support::bin()
         .args(args)
         .stdout(Stdio::null())
         .stderr(Stdio::piped())
-        .spawn()
-        .map_err(|e| e.to_string())?;
+        .spawn()?;
     wait_bounded(child, &format!("{args:?}"))
 }
 
-fn wait_bounded(mut child: std::process::Child, what: &str) -> Result<(i32, String), String> {
+fn wait_bounded(mut child: std::process::Child, what: &str) -> anyhow::Result<(i32, String)> {
     let deadline = Instant::now() + LIMIT;
     let status = loop {
-        if let Some(status) = child.try_wait().map_err(|e| e.to_string())? {
+        if let Some(status) = child.try_wait()? {
             break status;
         }
         if Instant::now() > deadline {
             let _ = child.kill();
             let _ = child.wait();
-            return Err(format!("{what} did not end within {} s", LIMIT.as_secs()));
+            anyhow::bail!("{what} did not end within {} s", LIMIT.as_secs());
         }
         std::thread::sleep(Duration::from_millis(20));
     };
     let mut stderr = String::new();
     if let Some(mut e) = child.stderr.take() {
         use std::io::Read;
-        e.read_to_string(&mut stderr).map_err(|e| e.to_string())?;
+        e.read_to_string(&mut stderr)?;
     }
     Ok((status.code().unwrap_or(-1), stderr))
 }
@@ -185,12 +183,12 @@ fn check_error(
     (code, stderr): &(i32, String),
     target: &Path,
     reason: &str,
-) -> Result<(), String> {
+) -> anyhow::Result<()> {
     ensure!(*code == 2, "{what}: exit {code}, want 2: {stderr}");
     let error = stderr
         .lines()
         .find(|l| l.starts_with("error: "))
-        .ok_or_else(|| format!("{what}: no error line: {stderr}"))?;
+        .with_context(|| format!("{what}: no error line: {stderr}"))?;
     ensure!(
         error.contains(&target.display().to_string()),
         "{what}: the error does not name {}: {error}",
@@ -201,15 +199,15 @@ fn check_error(
         "{what}: the error does not say `{reason}` exactly once: {error}"
     );
     if let Some(repeated) = sweeptrace::error_text::repeated_segment(error) {
-        return Err(format!("{what}: the error repeats `{repeated}`: {error}"));
+        anyhow::bail!("{what}: the error repeats `{repeated}`: {error}");
     }
     Ok(())
 }
 
 /// The names of the files in `dir`, but `keep`.
-fn files_in(dir: &Path, keep: &[&str]) -> Result<Vec<String>, String> {
+fn files_in(dir: &Path, keep: &[&str]) -> anyhow::Result<Vec<String>> {
     let mut names: Vec<String> = std::fs::read_dir(dir)
-        .map_err(|e| format!("{}: {e}", dir.display()))?
+        .map_err(|e| anyhow::anyhow!("{}: {e}", dir.display()))?
         .filter_map(Result::ok)
         .map(|e| e.file_name().to_string_lossy().into_owned())
         .filter(|n| !keep.contains(&n.as_str()))
@@ -236,7 +234,7 @@ fn arguments(args: &[&str], target: &Path) -> Vec<std::ffi::OsString> {
 /// Runs `args` with `TARGET` a file named `target_name` on a tmpfs with
 /// about 64 KiB free (every output here is larger): exit 2, the file and
 /// "No space left on device" named once, nothing left on the disk.
-fn onto_full_disk(what: &str, target_name: &str, args: &[&str]) -> Result<Completion, String> {
+fn onto_full_disk(what: &str, target_name: &str, args: &[&str]) -> anyhow::Result<Completion> {
     let disk = mounted!(512);
     disk.fill_leaving(64)?;
     let target = disk.path().join(target_name);
@@ -253,7 +251,7 @@ fn onto_full_disk(what: &str, target_name: &str, args: &[&str]) -> Result<Comple
 }
 
 /// `replay --rrd` onto a full disk: it used to hang in the SDK's flush.
-fn full_disk_replay_rrd() -> Result<Completion, String> {
+fn full_disk_replay_rrd() -> anyhow::Result<Completion> {
     onto_full_disk(
         "replay --rrd",
         "golf.rrd",
@@ -262,7 +260,7 @@ fn full_disk_replay_rrd() -> Result<Completion, String> {
 }
 
 /// `replay --outcomes` onto a full disk (the outcomes take about 340 KiB).
-fn full_disk_replay_outcomes() -> Result<Completion, String> {
+fn full_disk_replay_outcomes() -> anyhow::Result<Completion> {
     onto_full_disk(
         "replay --outcomes",
         "outcomes.jsonl",
@@ -271,7 +269,7 @@ fn full_disk_replay_outcomes() -> Result<Completion, String> {
 }
 
 /// `record` onto a full disk (the trace takes about 190 KiB).
-fn full_disk_record() -> Result<Completion, String> {
+fn full_disk_record() -> anyhow::Result<Completion> {
     onto_full_disk(
         "record",
         "golf.mcap",
@@ -281,7 +279,7 @@ fn full_disk_record() -> Result<Completion, String> {
 
 /// `bless -o` onto a full disk: the message names the output (it used to
 /// name the input).
-fn full_disk_bless() -> Result<Completion, String> {
+fn full_disk_bless() -> anyhow::Result<Completion> {
     onto_full_disk(
         "bless -o",
         "blessed.mcap",
@@ -291,16 +289,15 @@ fn full_disk_bless() -> Result<Completion, String> {
 
 /// `bless --in-place` of a trace on a disk with room for one copy only:
 /// the error names the trace and the trace is left byte for byte as it was.
-fn full_disk_bless_in_place_keeps_the_trace() -> Result<Completion, String> {
+fn full_disk_bless_in_place_keeps_the_trace() -> anyhow::Result<Completion> {
     let disk = mounted!(512);
-    let original = std::fs::read(repository_file("traces/record_mini_golf.mcap"))
-        .map_err(|e| e.to_string())?;
+    let original = std::fs::read(repository_file("traces/record_mini_golf.mcap"))?;
     let trace = disk.path().join("golf.mcap");
-    std::fs::write(&trace, &original).map_err(|e| e.to_string())?;
+    std::fs::write(&trace, &original)?;
     disk.fill_leaving(64)?;
     let result = run_bounded(crate::os!("bless", &trace, "--in-place"))?;
     check_error("bless --in-place", &result, &trace, FULL)?;
-    let now = std::fs::read(&trace).map_err(|e| e.to_string())?;
+    let now = std::fs::read(&trace)?;
     ensure!(
         now == original,
         "bless --in-place changed the trace on failing"
@@ -312,12 +309,11 @@ fn full_disk_bless_in_place_keeps_the_trace() -> Result<Completion, String> {
 
 /// Every output into a read-only file system: exit 2 naming the file and
 /// "Read-only file system" once; `bless --in-place` keeps the trace.
-fn read_only_file_system() -> Result<Completion, String> {
+fn read_only_file_system() -> anyhow::Result<Completion> {
     let disk = mounted!(1024);
-    let original = std::fs::read(repository_file("traces/record_cube_corner_margin.mcap"))
-        .map_err(|e| e.to_string())?;
+    let original = std::fs::read(repository_file("traces/record_cube_corner_margin.mcap"))?;
     let trace = disk.path().join("cube.mcap");
-    std::fs::write(&trace, &original).map_err(|e| e.to_string())?;
+    std::fs::write(&trace, &original)?;
     disk.remount_read_only()?;
     let reason = "Read-only file system";
     for (what, target, args) in [
@@ -355,7 +351,7 @@ fn read_only_file_system() -> Result<Completion, String> {
         let left = files_in(disk.path(), &["cube.mcap"])?;
         ensure!(left.is_empty(), "{what}: files left: {left:?}");
     }
-    let now = std::fs::read(&trace).map_err(|e| e.to_string())?;
+    let now = std::fs::read(&trace)?;
     ensure!(now == original, "bless --in-place changed the trace");
     Ok(Completion::Completed)
 }
@@ -364,10 +360,10 @@ fn read_only_file_system() -> Result<Completion, String> {
 /// it: once its temporary file has appeared, the directory goes; the command
 /// ends with exit 2 naming the target and the reason, and nothing is
 /// created under the target's name (no directory is made again).
-fn directory_removed_during_replay() -> Result<(), String> {
-    let top = tempfile::tempdir().map_err(|e| e.to_string())?;
+fn directory_removed_during_replay() -> anyhow::Result<()> {
+    let top = tempfile::tempdir()?;
     let dir = top.path().join("out");
-    std::fs::create_dir(&dir).map_err(|e| e.to_string())?;
+    std::fs::create_dir(&dir)?;
     let target = dir.join("golf.rrd");
     let child = crate::support::bin()
         .arg("replay")
@@ -376,8 +372,7 @@ fn directory_removed_during_replay() -> Result<(), String> {
         .arg(&target)
         .stdout(Stdio::null())
         .stderr(Stdio::piped())
-        .spawn()
-        .map_err(|e| e.to_string())?;
+        .spawn()?;
     // Wait for the temporary file (not a measurement: a bound on a hang).
     let deadline = Instant::now() + Duration::from_secs(60);
     loop {
@@ -391,7 +386,7 @@ fn directory_removed_during_replay() -> Result<(), String> {
         );
         std::thread::sleep(Duration::from_millis(5));
     }
-    std::fs::remove_dir_all(&dir).map_err(|e| e.to_string())?;
+    std::fs::remove_dir_all(&dir)?;
     let result = wait_bounded(child, "replay --rrd into a removed directory")?;
     check_error(
         "replay --rrd into a removed directory",

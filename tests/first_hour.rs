@@ -10,6 +10,7 @@ use libtest_mimic::Trial;
 
 use crate::trial;
 use crate::{ensure, os};
+use anyhow::Context as _;
 
 pub fn tests() -> Vec<Trial> {
     vec![
@@ -35,12 +36,12 @@ fn golf() -> PathBuf {
 }
 
 /// Runs the binary in `dir`: exit code, stdout, stderr.
-fn run_in(dir: &Path, args: &[&OsStr]) -> Result<(i32, String, String), String> {
+fn run_in(dir: &Path, args: &[&OsStr]) -> anyhow::Result<(i32, String, String)> {
     let out = std::process::Command::new(env!("CARGO_BIN_EXE_sweeptrace"))
         .args(args)
         .current_dir(dir)
         .output()
-        .map_err(|e| format!("running sweeptrace: {e}"))?;
+        .map_err(|e| anyhow::anyhow!("running sweeptrace: {e}"))?;
     Ok((
         out.status.code().unwrap_or(-1),
         String::from_utf8_lossy(&out.stdout).into_owned(),
@@ -48,9 +49,8 @@ fn run_in(dir: &Path, args: &[&OsStr]) -> Result<(i32, String, String), String> 
     ))
 }
 
-fn entries(dir: &Path) -> Result<Vec<String>, String> {
-    let mut names: Vec<String> = std::fs::read_dir(dir)
-        .map_err(|e| e.to_string())?
+fn entries(dir: &Path) -> anyhow::Result<Vec<String>> {
+    let mut names: Vec<String> = std::fs::read_dir(dir)?
         .filter_map(Result::ok)
         .map(|e| e.file_name().to_string_lossy().into_owned())
         .collect();
@@ -60,14 +60,14 @@ fn entries(dir: &Path) -> Result<Vec<String>, String> {
 
 /// The balls and frames of the mini-golf sample, as `info` reads them
 /// (`sweeps: N (4 balls: 0, 1, 2, 3)`, `frames: A to B`).
-fn golf_contents() -> Result<(u32, u32, u64, u64), String> {
+fn golf_contents() -> anyhow::Result<(u32, u32, u64, u64)> {
     let (code, out, err) = crate::support::run_bin(os!["info", golf().as_os_str()])?;
     ensure!(code == 0, "info: {err}");
     let line = |key: &str| {
         out.lines()
             .find_map(|l| l.strip_prefix(key))
             .map(str::trim)
-            .ok_or_else(|| format!("no `{key}` in {out}"))
+            .with_context(|| format!("no `{key}` in {out}"))
     };
     let balls = line("sweeps:")?;
     let list = balls
@@ -75,19 +75,19 @@ fn golf_contents() -> Result<(u32, u32, u64, u64), String> {
         .map(|(_, l)| l.trim_end_matches(')'))
         .unwrap_or("");
     let balls: Vec<u32> = list.split(", ").filter_map(|b| b.parse().ok()).collect();
-    let (lo, hi) = line("frames:")?.split_once(" to ").ok_or("frames line")?;
+    let (lo, hi) = line("frames:")?.split_once(" to ").context("frames line")?;
     Ok((
-        *balls.iter().min().ok_or("no ball")?,
-        *balls.iter().max().ok_or("no ball")?,
-        lo.parse().map_err(|_| "frame")?,
-        hi.parse().map_err(|_| "frame")?,
+        *balls.iter().min().context("no ball")?,
+        *balls.iter().max().context("no ball")?,
+        lo.parse().map_err(|_| anyhow::anyhow!("frame"))?,
+        hi.parse().map_err(|_| anyhow::anyhow!("frame"))?,
     ))
 }
 
 /// `--ball 99` or `--frames 5000..6000` on a trace of balls 0..=3 and
 /// frames 0..=591 is an error (exit 2) naming what the trace has, in every
 /// command that takes a frame or ball, and writes nothing.
-fn filter_selecting_nothing_is_an_error_naming_the_trace_contents() -> Result<(), String> {
+fn filter_selecting_nothing_is_an_error_naming_the_trace_contents() -> anyhow::Result<()> {
     let (b_lo, b_hi, f_lo, f_hi) = golf_contents()?;
     let has = format!("balls {b_lo}..={b_hi}, frames {f_lo}..={f_hi}");
     let trace = golf();
@@ -117,7 +117,7 @@ fn filter_selecting_nothing_is_an_error_naming_the_trace_contents() -> Result<()
         os!["sweep", "--trace", t, "--frame", &beyond_frame].to_vec(),
     ];
     for args in cases {
-        let dir = tempfile::tempdir().map_err(|e| e.to_string())?;
+        let dir = tempfile::tempdir()?;
         let (code, out, err) = run_in(dir.path(), &args)?;
         ensure!(code == 2, "{args:?}: exit {code}\n{out}{err}");
         ensure!(err.contains(&has), "{args:?}: does not say `{has}`: {err}");
@@ -129,8 +129,8 @@ fn filter_selecting_nothing_is_an_error_naming_the_trace_contents() -> Result<()
 }
 
 /// A filter that keeps part of the trace says how much it kept.
-fn filter_selecting_part_says_how_much() -> Result<(), String> {
-    let dir = tempfile::tempdir().map_err(|e| e.to_string())?;
+fn filter_selecting_part_says_how_much() -> anyhow::Result<()> {
+    let dir = tempfile::tempdir()?;
     let trace = golf();
     let (code, _, err) = run_in(
         dir.path(),
@@ -144,8 +144,7 @@ fn filter_selecting_part_says_how_much() -> Result<(), String> {
         ],
     )?;
     ensure!(code == 0, "exit {code}: {err}");
-    let kept = std::fs::read_to_string(dir.path().join("out.jsonl"))
-        .map_err(|e| e.to_string())?
+    let kept = std::fs::read_to_string(dir.path().join("out.jsonl"))?
         .lines()
         .count();
     let (code, all, _) = run_in(
@@ -174,7 +173,7 @@ fn filter_selecting_part_says_how_much() -> Result<(), String> {
 /// `replay README.md` (not a trace) exits 2 and leaves no `.rrd` (nor any
 /// other output, nor a temporary file), and says it wrote nothing; so do
 /// the other commands that write files.
-fn non_trace_input_leaves_no_output() -> Result<(), String> {
+fn non_trace_input_leaves_no_output() -> anyhow::Result<()> {
     let readme = root().join("README.md");
     let r = readme.as_os_str();
     let cases: Vec<Vec<&OsStr>> = vec![
@@ -196,7 +195,7 @@ fn non_trace_input_leaves_no_output() -> Result<(), String> {
         os!["record", "--mesh", r, "-o", "r.mcap"].to_vec(),
     ];
     for args in cases {
-        let dir = tempfile::tempdir().map_err(|e| e.to_string())?;
+        let dir = tempfile::tempdir()?;
         let (code, out, err) = run_in(dir.path(), &args)?;
         ensure!(code == 2, "{args:?}: exit {code}\n{out}{err}");
         ensure!(!err.contains("wrote"), "{args:?}: says it wrote: {err}");
@@ -208,9 +207,9 @@ fn non_trace_input_leaves_no_output() -> Result<(), String> {
 
 /// A 0-byte file is not a truncated trace: exit 2, `empty file`, in every
 /// command that reads traces.
-fn empty_file_is_not_a_truncated_trace() -> Result<(), String> {
-    let dir = tempfile::tempdir().map_err(|e| e.to_string())?;
-    std::fs::write(dir.path().join("empty.mcap"), b"").map_err(|e| e.to_string())?;
+fn empty_file_is_not_a_truncated_trace() -> anyhow::Result<()> {
+    let dir = tempfile::tempdir()?;
+    std::fs::write(dir.path().join("empty.mcap"), b"")?;
     for args in [
         os!["info", "empty.mcap"].to_vec(),
         os!["replay", "empty.mcap", "--outcomes", "-"].to_vec(),
@@ -229,18 +228,16 @@ fn empty_file_is_not_a_truncated_trace() -> Result<(), String> {
 
 /// A trace cut off after some complete chunks: the documented exception,
 /// exit 3, and the outputs hold what was read.
-fn truncated_trace_still_writes_what_was_read() -> Result<(), String> {
-    let dir = tempfile::tempdir().map_err(|e| e.to_string())?;
-    let bytes = std::fs::read(golf()).map_err(|e| e.to_string())?;
-    std::fs::write(dir.path().join("cut.mcap"), &bytes[..bytes.len() * 2 / 3])
-        .map_err(|e| e.to_string())?;
+fn truncated_trace_still_writes_what_was_read() -> anyhow::Result<()> {
+    let dir = tempfile::tempdir()?;
+    let bytes = std::fs::read(golf())?;
+    std::fs::write(dir.path().join("cut.mcap"), &bytes[..bytes.len() * 2 / 3])?;
     let (code, _, err) = run_in(
         dir.path(),
         os!["replay", "cut.mcap", "--outcomes", "cut.jsonl"],
     )?;
     ensure!(code == 3, "exit {code}: {err}");
-    let lines = std::fs::read_to_string(dir.path().join("cut.jsonl"))
-        .map_err(|e| e.to_string())?
+    let lines = std::fs::read_to_string(dir.path().join("cut.jsonl"))?
         .lines()
         .count();
     ensure!(
@@ -252,9 +249,9 @@ fn truncated_trace_still_writes_what_was_read() -> Result<(), String> {
 
 /// `info` of a directory, of a file that is not MCAP, of an empty file:
 /// the error only, nothing on stdout.
-fn info_of_a_non_trace_prints_nothing_on_stdout() -> Result<(), String> {
-    let dir = tempfile::tempdir().map_err(|e| e.to_string())?;
-    std::fs::write(dir.path().join("empty.mcap"), b"").map_err(|e| e.to_string())?;
+fn info_of_a_non_trace_prints_nothing_on_stdout() -> anyhow::Result<()> {
+    let dir = tempfile::tempdir()?;
+    std::fs::write(dir.path().join("empty.mcap"), b"")?;
     let traces = root().join("traces");
     let readme = root().join("README.md");
     for input in [
@@ -279,17 +276,17 @@ fn info_of_a_non_trace_prints_nothing_on_stdout() -> Result<(), String> {
 /// A chunked trace cut off inside its first chunk: whether it is chunked is
 /// not known, so it is not said to be `not chunked`; the file's size is
 /// its size, not the bytes read.
-fn info_of_a_cut_chunked_trace_does_not_say_not_chunked() -> Result<(), String> {
-    let dir = tempfile::tempdir().map_err(|e| e.to_string())?;
-    let bytes = std::fs::read(golf()).map_err(|e| e.to_string())?;
+fn info_of_a_cut_chunked_trace_does_not_say_not_chunked() -> anyhow::Result<()> {
+    let dir = tempfile::tempdir()?;
+    let bytes = std::fs::read(golf())?;
     let cut = &bytes[..bytes.len() / 8];
-    std::fs::write(dir.path().join("cut.mcap"), cut).map_err(|e| e.to_string())?;
+    std::fs::write(dir.path().join("cut.mcap"), cut)?;
     let (code, out, err) = run_in(dir.path(), os!["info", "cut.mcap"])?;
     ensure!(code == 3, "exit {code}: {out}{err}");
     let file = out
         .lines()
         .find(|l| l.starts_with("file:"))
-        .ok_or_else(|| format!("no file line: {out}"))?;
+        .with_context(|| format!("no file line: {out}"))?;
     ensure!(!file.contains("not chunked"), "{file}");
     ensure!(file.contains(&format!("{} bytes", cut.len())), "{file}");
     let (_, whole, _) = crate::support::run_bin(os!["info", golf().as_os_str()])?;
@@ -303,7 +300,7 @@ fn info_of_a_cut_chunked_trace_does_not_say_not_chunked() -> Result<(), String> 
 /// `diff` of two traces of different scenes says how they differ and
 /// refuses (exit 2) unless --allow-different-scenes; an override of the
 /// margin or facing rule is not a difference of scenes.
-fn diff_of_different_scenes_is_refused() -> Result<(), String> {
+fn diff_of_different_scenes_is_refused() -> anyhow::Result<()> {
     let golf = golf();
     let bowl = root().join("traces/record_bowl_margin.mcap");
     let box_strict = root().join("traces/record_box_strict.mcap");
@@ -355,7 +352,7 @@ fn diff_of_different_scenes_is_refused() -> Result<(), String> {
 
 /// The replay summary: singular where one, the total time as well as the
 /// time in the core.
-fn replay_summary_reads_right() -> Result<(), String> {
+fn replay_summary_reads_right() -> anyhow::Result<()> {
     let trace = golf();
     let (code, _, err) = crate::support::run_bin(os![
         "replay",
@@ -387,7 +384,7 @@ fn replay_summary_reads_right() -> Result<(), String> {
 /// `sweep` shows the few tests that came closest, ranked, and the count
 /// of the rest; a back-facing face the ball never comes near is not among
 /// them; --all shows every test.
-fn sweep_lists_the_closest_tests_only() -> Result<(), String> {
+fn sweep_lists_the_closest_tests_only() -> anyhow::Result<()> {
     let inside_box = os![
         "sweep",
         "--scene",

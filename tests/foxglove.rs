@@ -23,6 +23,7 @@ use sweeptrace::trace::{TraceReader, TraceWriter};
 
 use crate::support::run_bin;
 use crate::{ensure, os, trial};
+use anyhow::Context as _;
 
 pub fn tests() -> Vec<Trial> {
     vec![
@@ -80,8 +81,8 @@ fn expected(frame: u64, ball: u32, alpha: f64, kind: Kind) -> OutcomeMsg {
 
 /// Two scenes; ball 0 hits the triangle's face at α = 5/12 each frame,
 /// ball 1 misses. Frame 1's expectation for ball 0 (α = 0.3) diverges.
-fn two_scene_trace() -> Result<Vec<u8>, String> {
-    let e = |e: sweeptrace::trace::TraceError| e.to_string();
+fn two_scene_trace() -> anyhow::Result<Vec<u8>> {
+    let e = |e: sweeptrace::trace::TraceError| anyhow::Error::from(e);
     let mut w = TraceWriter::new(Cursor::new(Vec::new())).map_err(e)?;
     w.scene(0, &triangle("first", 4.0)).map_err(e)?;
     for frame in 0..3u64 {
@@ -103,7 +104,7 @@ fn two_scene_trace() -> Result<Vec<u8>, String> {
 }
 
 /// The Foxglove file of `trace`, through the library.
-fn foxglove_bytes(trace: &[u8]) -> Result<Vec<u8>, String> {
+fn foxglove_bytes(trace: &[u8]) -> anyhow::Result<Vec<u8>> {
     let options = ReplayOptions {
         explain: true,
         ..ReplayOptions::default()
@@ -115,20 +116,19 @@ fn foxglove_bytes(trace: &[u8]) -> Result<Vec<u8>, String> {
             trace_name: TRACE_NAME.to_string(),
             ..FoxgloveOptions::default()
         },
-    )
-    .map_err(|e| e.to_string())?;
+    )?;
     for event in replay_events(TraceReader::new(trace, TRACE_NAME), options) {
-        let event = event.map_err(|e| e.to_string())?;
-        writer.event(&event).map_err(|e| e.to_string())?;
+        let event = event?;
+        writer.event(&event)?;
     }
-    Ok(writer.finish().map_err(|e| e.to_string())?.into_inner())
+    Ok(writer.finish()?.into_inner())
 }
 
 /// Every message: (topic, schema name, log_time, JSON).
-fn messages(bytes: &[u8]) -> Result<Vec<(String, String, u64, Value)>, String> {
+fn messages(bytes: &[u8]) -> anyhow::Result<Vec<(String, String, u64, Value)>> {
     let mut out = Vec::new();
-    for m in mcap::MessageStream::new(bytes).map_err(|e| e.to_string())? {
-        let m = m.map_err(|e| e.to_string())?;
+    for m in mcap::MessageStream::new(bytes)? {
+        let m = m?;
         let schema = m
             .channel
             .schema
@@ -136,7 +136,7 @@ fn messages(bytes: &[u8]) -> Result<Vec<(String, String, u64, Value)>, String> {
             .map(|s| s.name.clone())
             .unwrap_or_default();
         let json: Value = serde_json::from_slice(&m.data)
-            .map_err(|e| format!("{}: not JSON: {e}", m.channel.topic))?;
+            .map_err(|e| anyhow::anyhow!("{}: not JSON: {e}", m.channel.topic))?;
         out.push((m.channel.topic.clone(), schema, m.log_time, json));
     }
     Ok(out)
@@ -149,13 +149,11 @@ fn on<'a>(all: &'a [(String, String, u64, Value)], topic: &str) -> Vec<&'a Value
         .collect()
 }
 
-fn foxglove_file_reads_back_with_the_mcap_crate() -> Result<(), String> {
+fn foxglove_file_reads_back_with_the_mcap_crate() -> anyhow::Result<()> {
     let bytes = foxglove_bytes(&two_scene_trace()?)?;
 
     // Channels, schemas, encodings; the embedded schemas are the checked-in copies.
-    let summary = mcap::Summary::read(&bytes)
-        .map_err(|e| e.to_string())?
-        .ok_or("no summary")?;
+    let summary = mcap::Summary::read(&bytes)?.context("no summary")?;
     let channels: BTreeMap<String, (String, String, String)> = summary
         .channels
         .values()
@@ -194,7 +192,7 @@ fn foxglove_file_reads_back_with_the_mcap_crate() -> Result<(), String> {
             "foxglove.SceneUpdate" => SCENE_UPDATE_SCHEMA_JSON,
             "foxglove.Log" => LOG_SCHEMA_JSON,
             "sweeptrace.SweepNumbers" => SWEEP_NUMBERS_SCHEMA_JSON,
-            other => return Err(format!("unexpected schema {other}")),
+            other => anyhow::bail!("unexpected schema {other}"),
         };
         ensure!(
             schema.data.as_ref() == text.as_bytes(),
@@ -280,7 +278,7 @@ fn foxglove_file_reads_back_with_the_mcap_crate() -> Result<(), String> {
     ensure!(first["id"] == "ball/0", "first ball {}", first["id"]);
     let zs: Vec<f64> = first["spheres"]
         .as_array()
-        .ok_or("spheres")?
+        .context("spheres")?
         .iter()
         .map(|s| s["pose"]["position"]["z"].as_f64().unwrap_or(f64::NAN))
         .collect();
@@ -372,7 +370,7 @@ fn foxglove_file_reads_back_with_the_mcap_crate() -> Result<(), String> {
     Ok(())
 }
 
-fn arrow_rotation_takes_x_to_the_normal() -> Result<(), String> {
+fn arrow_rotation_takes_x_to_the_normal() -> anyhow::Result<()> {
     use nalgebra::{Quaternion, UnitQuaternion, Vector3};
     for n in [
         Vector3::new(0.0, 0.0, 1.0),
@@ -392,8 +390,9 @@ fn arrow_rotation_takes_x_to_the_normal() -> Result<(), String> {
     Ok(())
 }
 
-fn run(cmd: &mut std::process::Command) -> Result<std::process::Output, String> {
-    cmd.output().map_err(|e| format!("running {cmd:?}: {e}"))
+fn run(cmd: &mut std::process::Command) -> anyhow::Result<std::process::Output> {
+    cmd.output()
+        .map_err(|e| anyhow::anyhow!("running {cmd:?}: {e}"))
 }
 
 fn output_text(o: &std::process::Output) -> String {
@@ -409,7 +408,7 @@ fn required(var: &str) -> bool {
     std::env::var_os(var).is_some_and(|v| v == "1")
 }
 
-fn python_and_node_read_and_validate_the_foxglove_file() -> Result<Completion, String> {
+fn python_and_node_read_and_validate_the_foxglove_file() -> anyhow::Result<Completion> {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
     let python_missing = match std::process::Command::new("python3")
         .args(["-c", "import mcap"])
@@ -421,15 +420,15 @@ fn python_and_node_read_and_validate_the_foxglove_file() -> Result<Completion, S
     };
     if let Some(missing) = python_missing {
         if required(REQUIRE_PYTHON) {
-            return Err(format!("{missing}, and {REQUIRE_PYTHON}=1 requires it"));
+            anyhow::bail!("{missing}, and {REQUIRE_PYTHON}=1 requires it");
         }
         return Ok(Completion::ignored_with(format!(
             "skipped: {missing}; {REQUIRE_PYTHON}=1 makes this a failure"
         )));
     }
-    let dir = tempfile::tempdir().map_err(|e| e.to_string())?;
+    let dir = tempfile::tempdir()?;
     let file = dir.path().join("two_scenes.foxglove.mcap");
-    std::fs::write(&file, foxglove_bytes(&two_scene_trace()?)?).map_err(|e| e.to_string())?;
+    std::fs::write(&file, foxglove_bytes(&two_scene_trace()?)?)?;
     let dump = dir.path().join("dump.jsonl");
     let script = root.join("scripts/foxglove_dump.py");
     let python = |extra: &[&str]| {
@@ -462,7 +461,7 @@ fn python_and_node_read_and_validate_the_foxglove_file() -> Result<Completion, S
     };
     if let Some(missing) = node_missing {
         if required(REQUIRE_NODE) {
-            return Err(format!("{missing}, and {REQUIRE_NODE}=1 requires it"));
+            anyhow::bail!("{missing}, and {REQUIRE_NODE}=1 requires it");
         }
         return Ok(Completion::ignored_with(format!(
             "Python read the file; the schema validation was skipped: {missing}; \
@@ -477,10 +476,9 @@ fn python_and_node_read_and_validate_the_foxglove_file() -> Result<Completion, S
         output_text(&node)
     );
     // And it can fail: a Log level outside the schema's.
-    let text = std::fs::read_to_string(&dump).map_err(|e| e.to_string())?;
+    let text = std::fs::read_to_string(&dump)?;
     let broken = dir.path().join("broken.jsonl");
-    std::fs::write(&broken, text.replacen("\"level\": 2", "\"level\": 7", 1))
-        .map_err(|e| e.to_string())?;
+    std::fs::write(&broken, text.replacen("\"level\": 2", "\"level\": 7", 1))?;
     let node = run(std::process::Command::new("node")
         .arg(&validate)
         .arg(&broken))?;
@@ -497,9 +495,8 @@ fn sample_trace() -> PathBuf {
 }
 
 /// The names of the entries of `dir`, sorted.
-fn entries(dir: &Path) -> Result<Vec<String>, String> {
-    let mut names: Vec<String> = std::fs::read_dir(dir)
-        .map_err(|e| e.to_string())?
+fn entries(dir: &Path) -> anyhow::Result<Vec<String>> {
+    let mut names: Vec<String> = std::fs::read_dir(dir)?
         .filter_map(Result::ok)
         .map(|e| e.file_name().to_string_lossy().into_owned())
         .collect();
@@ -507,8 +504,8 @@ fn entries(dir: &Path) -> Result<Vec<String>, String> {
     Ok(names)
 }
 
-fn replay_foxglove_writes_only_the_foxglove_file() -> Result<(), String> {
-    let dir = tempfile::tempdir().map_err(|e| e.to_string())?;
+fn replay_foxglove_writes_only_the_foxglove_file() -> anyhow::Result<()> {
+    let dir = tempfile::tempdir()?;
     let out = run(crate::support::bin()
         .current_dir(dir.path())
         .arg("replay")
@@ -526,7 +523,7 @@ fn replay_foxglove_writes_only_the_foxglove_file() -> Result<(), String> {
         "files written: {:?}",
         entries(dir.path())?
     );
-    let bytes = std::fs::read(dir.path().join("out.mcap")).map_err(|e| e.to_string())?;
+    let bytes = std::fs::read(dir.path().join("out.mcap"))?;
     let all = messages(&bytes)?;
     let frames: Vec<u64> = on(&all, "/numbers")
         .iter()
@@ -544,8 +541,8 @@ fn replay_foxglove_writes_only_the_foxglove_file() -> Result<(), String> {
     Ok(())
 }
 
-fn replay_foxglove_errors_name_the_file_and_leave_no_partial_file() -> Result<(), String> {
-    let dir = tempfile::tempdir().map_err(|e| e.to_string())?;
+fn replay_foxglove_errors_name_the_file_and_leave_no_partial_file() -> anyhow::Result<()> {
+    let dir = tempfile::tempdir()?;
     let bad = dir.path().join("bad.mcap");
     let target = dir.path().join("out.mcap");
     // A target in a directory that does not exist: an error naming it.
@@ -568,7 +565,7 @@ fn replay_foxglove_errors_name_the_file_and_leave_no_partial_file() -> Result<()
     );
     // Data that is not MCAP: an error (exit 2) that leaves no output at all
     // (only a trace that ends early keeps what was read), and no `wrote`.
-    std::fs::write(&bad, b"this is not an MCAP file at all").map_err(|e| e.to_string())?;
+    std::fs::write(&bad, b"this is not an MCAP file at all")?;
     let (code, _, stderr) = run_bin(os!(
         "replay",
         bad.as_os_str(),
@@ -605,11 +602,11 @@ fn replay_foxglove_errors_name_the_file_and_leave_no_partial_file() -> Result<()
     Ok(())
 }
 
-fn replay_foxglove_keeps_what_was_read_of_a_truncated_trace() -> Result<(), String> {
-    let dir = tempfile::tempdir().map_err(|e| e.to_string())?;
-    let bytes = std::fs::read(sample_trace()).map_err(|e| e.to_string())?;
+fn replay_foxglove_keeps_what_was_read_of_a_truncated_trace() -> anyhow::Result<()> {
+    let dir = tempfile::tempdir()?;
+    let bytes = std::fs::read(sample_trace())?;
     let cut = dir.path().join("cut.mcap");
-    std::fs::write(&cut, &bytes[..bytes.len() * 2 / 3]).map_err(|e| e.to_string())?;
+    std::fs::write(&cut, &bytes[..bytes.len() * 2 / 3])?;
     let target = dir.path().join("out.mcap");
     let (code, _, stderr) = run_bin(os!(
         "replay",
@@ -618,16 +615,14 @@ fn replay_foxglove_keeps_what_was_read_of_a_truncated_trace() -> Result<(), Stri
         target.as_os_str()
     ))?;
     ensure!(code == 3, "exit {code}: {stderr}");
-    let written = std::fs::read(&target).map_err(|e| e.to_string())?;
+    let written = std::fs::read(&target)?;
     let all = messages(&written)?;
     ensure!(
         !on(&all, "/numbers").is_empty() && on(&all, "/mesh").len() == 1,
         "the sweeps read before the cut are in the file"
     );
     ensure!(
-        mcap::Summary::read(&written)
-            .map_err(|e| e.to_string())?
-            .is_some(),
+        mcap::Summary::read(&written)?.is_some(),
         "the file written from a truncated trace is complete (summary)"
     );
     Ok(())
@@ -636,8 +631,8 @@ fn replay_foxglove_keeps_what_was_read_of_a_truncated_trace() -> Result<(), Stri
 /// `replay --foxglove` killed (SIGKILL) at several moments: the target is
 /// absent or a complete file (its summary reads), never a partial one; what
 /// is left besides is a temporary file named after the target.
-fn replay_foxglove_killed_leaves_no_partial_target() -> Result<(), String> {
-    let dir = tempfile::tempdir().map_err(|e| e.to_string())?;
+fn replay_foxglove_killed_leaves_no_partial_target() -> anyhow::Result<()> {
+    let dir = tempfile::tempdir()?;
     let target = dir.path().join("golf.mcap");
     let trace = Path::new(env!("CARGO_MANIFEST_DIR")).join("traces/record_mini_golf.mcap");
     // The delays only vary where the run is when killed; the property must
@@ -650,13 +645,12 @@ fn replay_foxglove_killed_leaves_no_partial_target() -> Result<(), String> {
             .arg(&target)
             .stdout(std::process::Stdio::null())
             .stderr(std::process::Stdio::null())
-            .spawn()
-            .map_err(|e| e.to_string())?;
+            .spawn()?;
         std::thread::sleep(std::time::Duration::from_millis(delay_ms));
         let _ = child.kill();
         let _ = child.wait();
         if target.exists() {
-            let bytes = std::fs::read(&target).map_err(|e| e.to_string())?;
+            let bytes = std::fs::read(&target)?;
             ensure!(
                 mcap::Summary::read(&bytes).is_ok_and(|s| s.is_some()),
                 "after a kill at {delay_ms} ms the target is not a complete file"
@@ -670,7 +664,7 @@ fn replay_foxglove_killed_leaves_no_partial_target() -> Result<(), String> {
                 name.starts_with(".golf.mcap.partial-"),
                 "an unexpected file is left: {name}"
             );
-            std::fs::remove_file(dir.path().join(name)).map_err(|e| e.to_string())?;
+            std::fs::remove_file(dir.path().join(name))?;
         }
     }
     Ok(())

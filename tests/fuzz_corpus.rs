@@ -15,6 +15,7 @@ use sweeptrace::trace::validate::validate_sweep;
 use sweeptrace::trace::{TraceError, TraceReader};
 
 use crate::{ensure, trial};
+use anyhow::Context as _;
 
 type Check = fn(&[u8]) -> Result<(), String>;
 
@@ -43,36 +44,36 @@ pub fn tests() -> Vec<Trial> {
     trials
 }
 
-fn fixture(name: &str) -> Result<Vec<u8>, String> {
+fn fixture(name: &str) -> anyhow::Result<Vec<u8>> {
     let path = Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("tests/fixtures/fuzz")
         .join(name);
-    std::fs::read(&path).map_err(|e| format!("{}: {e}", path.display()))
+    std::fs::read(&path).map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))
 }
 
 /// Runs `check` on `input`, a panic included, naming the input on failure.
-fn run_one(check: Check, input: &[u8], what: &str) -> Result<(), String> {
+fn run_one(check: Check, input: &[u8], what: &str) -> anyhow::Result<()> {
     match std::panic::catch_unwind(|| check(input)) {
         Ok(Ok(())) => Ok(()),
-        Ok(Err(broken)) => Err(format!("{what}: {broken}")),
-        Err(_) => Err(format!("{what}: panicked on {input:02x?}")),
+        Ok(Err(broken)) => Err(anyhow::anyhow!("{what}: {broken}")),
+        Err(_) => Err(anyhow::anyhow!("{what}: panicked on {input:02x?}")),
     }
 }
 
 /// Every file of `fuzz/corpus/TARGET/`; the corpus must not be empty.
-fn run_corpus(target: &str, check: Check) -> Result<(), String> {
+fn run_corpus(target: &str, check: Check) -> anyhow::Result<()> {
     let dir: PathBuf = Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("fuzz/corpus")
         .join(target);
     let mut files: Vec<PathBuf> = std::fs::read_dir(&dir)
-        .map_err(|e| format!("{}: {e}", dir.display()))?
+        .map_err(|e| anyhow::anyhow!("{}: {e}", dir.display()))?
         .filter_map(Result::ok)
         .map(|e| e.path())
         .collect();
     files.sort();
     ensure!(!files.is_empty(), "{} holds no corpus", dir.display());
     for file in files {
-        let input = std::fs::read(&file).map_err(|e| e.to_string())?;
+        let input = std::fs::read(&file)?;
         run_one(check, &input, &file.display().to_string())?;
     }
     Ok(())
@@ -81,12 +82,12 @@ fn run_corpus(target: &str, check: Check) -> Result<(), String> {
 /// The fuzzer's first find: a header record of a few bytes whose profile
 /// string declares 0xfdffffff bytes made the `mcap` crate reserve 4 GiB.
 /// The reader now refuses it before parsing, naming the file.
-fn header_declaring_a_4_gib_string_is_refused() -> Result<(), String> {
+fn header_declaring_a_4_gib_string_is_refused() -> anyhow::Result<()> {
     let input = fixture("header_declares_4_gib_string.mcap")?;
     run_one(check_trace_reader, &input, "the fuzzer's input")?;
     let error = TraceReader::new(input.as_slice(), "found.mcap")
         .find_map(Result::err)
-        .ok_or("no error")?;
+        .context("no error")?;
     ensure!(
         matches!(
             error,
@@ -103,12 +104,12 @@ fn header_declaring_a_4_gib_string_is_refused() -> Result<(), String> {
 /// The third find: a metadata record whose string map ends inside an
 /// entry's length; the crate read that length from the bytes after the
 /// map (2.3 GB asked for). Lengths must now lie inside their map.
-fn metadata_map_whose_last_length_lies_past_its_end_is_refused() -> Result<(), String> {
+fn metadata_map_whose_last_length_lies_past_its_end_is_refused() -> anyhow::Result<()> {
     let input = fixture("metadata_map_length_past_its_end.mcap")?;
     run_one(check_trace_reader, &input, "the fuzzer's input")?;
     let error = TraceReader::new(input.as_slice(), "found.mcap")
         .find_map(Result::err)
-        .ok_or("no error")?;
+        .context("no error")?;
     ensure!(
         matches!(error, TraceError::FieldTooLong { .. }),
         "{error:?}"
@@ -121,7 +122,7 @@ fn metadata_map_whose_last_length_lies_past_its_end_is_refused() -> Result<(), S
 /// for chunk indexes: the summary is now read with the same length checks,
 /// and a summary that fails them is ignored (the file is read in file
 /// order, which reports what is wrong with it).
-fn summary_declaring_a_4_gib_string_is_read_in_file_order() -> Result<(), String> {
+fn summary_declaring_a_4_gib_string_is_read_in_file_order() -> anyhow::Result<()> {
     let input = fixture("summary_channel_declares_4_gib_string.mcap")?;
     run_one(check_trace_reader, &input, "the fuzzer's input")?;
     let mut reader = TraceReader::new_indexed(std::io::Cursor::new(&input), "found.mcap");
@@ -136,20 +137,20 @@ fn summary_declaring_a_4_gib_string_is_read_in_file_order() -> Result<(), String
 /// A sweep whose ends are finite but so far apart that the path's length
 /// overflows (`p0` at z = 1e300) passed the trace validation and was then
 /// refused by the core: the validation now refuses it, on `p1`.
-fn sweep_whose_path_length_overflows_is_refused() -> Result<(), String> {
+fn sweep_whose_path_length_overflows_is_refused() -> anyhow::Result<()> {
     let input = fixture("sweep_path_length_overflows.json")?;
     run_one(check_message_validation, &input, "the fuzzer's input")?;
-    let sweep: SweepMsg = serde_json::from_slice(&input).map_err(|e| e.to_string())?;
+    let sweep: SweepMsg = serde_json::from_slice(&input)?;
     match validate_sweep(&sweep, Some(0.0)) {
         Err(problem) if problem.field == "p1" && problem.problem.contains("overflows") => Ok(()),
-        other => Err(format!("validated as {other:?}")),
+        other => Err(anyhow::anyhow!("validated as {other:?}")),
     }
 }
 
 /// The fuzzer's message check found the name of an unknown field said
 /// twice (`field `x`: unknown field `x`, expected one of ...`): the field
 /// is now named once.
-fn unknown_field_is_named_once() -> Result<(), String> {
+fn unknown_field_is_named_once() -> anyhow::Result<()> {
     let input = br#"{"frame":0,"radius":0.5,"p0":[0,0,0],"p1":[0,0,1],"speed":2}"#;
     run_one(check_message_validation, input, "the message")?;
     let at = sweeptrace::trace::MessageAt {
@@ -160,7 +161,7 @@ fn unknown_field_is_named_once() -> Result<(), String> {
     };
     let error = sweeptrace::trace::validate::parse_message::<SweepMsg>(input, at)
         .err()
-        .ok_or("the message was accepted")?
+        .context("the message was accepted")?
         .to_string();
     ensure!(
         error.matches("speed").count() == 1
@@ -172,7 +173,7 @@ fn unknown_field_is_named_once() -> Result<(), String> {
 
 /// Generated inputs for the core: random bytes, decoded by the same
 /// `Numbers` as the fuzz target (small dyadic values, specials, raw bits).
-fn seeded_core_numbers() -> Result<(), String> {
+fn seeded_core_numbers() -> anyhow::Result<()> {
     let mut rng = ChaCha8Rng::seed_from_u64(14);
     for case in 0..5_000 {
         let mut input = vec![0u8; rng.random_range(0..160)];
@@ -184,7 +185,7 @@ fn seeded_core_numbers() -> Result<(), String> {
 
 /// Generated messages: each of the three messages with numbers drawn from
 /// ordinary, huge, tiny and out-of-range values, and fields left out.
-fn seeded_message_json() -> Result<(), String> {
+fn seeded_message_json() -> anyhow::Result<()> {
     const NUMBERS: [&str; 12] = [
         "0",
         "-0.0",
@@ -235,11 +236,11 @@ fn seeded_message_json() -> Result<(), String> {
 }
 
 /// Generated traces: the small fixtures with a few bytes changed.
-fn seeded_trace_reader() -> Result<(), String> {
+fn seeded_trace_reader() -> anyhow::Result<()> {
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures");
     let mut originals = Vec::new();
     for name in ["tunnel_floor.mcap", "python_written.mcap"] {
-        originals.push(std::fs::read(dir.join(name)).map_err(|e| e.to_string())?);
+        originals.push(std::fs::read(dir.join(name))?);
     }
     let mut rng = ChaCha8Rng::seed_from_u64(14);
     for case in 0..300 {

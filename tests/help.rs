@@ -10,6 +10,7 @@ use libtest_mimic::Trial;
 use crate::support::run_bin;
 use crate::trial;
 use crate::{ensure, os};
+use anyhow::Context as _;
 
 pub fn tests() -> Vec<Trial> {
     vec![
@@ -24,7 +25,7 @@ fn root() -> &'static Path {
 }
 
 /// The subcommands, from the top-level help's `Commands:` list.
-fn subcommands() -> Result<Vec<String>, String> {
+fn subcommands() -> anyhow::Result<Vec<String>> {
     let (code, out, err) = run_bin(os!["--help"])?;
     ensure!(code == 0, "--help: exit {code}: {err}");
     let list: Vec<String> = out
@@ -40,7 +41,7 @@ fn subcommands() -> Result<Vec<String>, String> {
     Ok(list)
 }
 
-fn help_of(sub: &str) -> Result<String, String> {
+fn help_of(sub: &str) -> anyhow::Result<String> {
     let (code, out, err) = run_bin(os![sub, "--help"])?;
     ensure!(code == 0, "{sub} --help: exit {code}: {err}");
     Ok(out)
@@ -48,7 +49,7 @@ fn help_of(sub: &str) -> Result<String, String> {
 
 /// Rustdoc's link syntax (``[`Type`]``, `[text](target)`, `crate::` paths)
 /// means nothing in a terminal.
-fn help_has_no_rustdoc_syntax() -> Result<(), String> {
+fn help_has_no_rustdoc_syntax() -> anyhow::Result<()> {
     let mut helps = vec![("(top level)".to_string(), run_bin(os!["--help"])?.1)];
     for sub in subcommands()? {
         helps.push((sub.clone(), help_of(&sub)?));
@@ -87,21 +88,21 @@ fn examples(help: &str) -> Vec<String> {
 }
 
 /// Copies `from` (a file or a directory) to `to`.
-fn copy_tree(from: &Path, to: &Path) -> Result<(), String> {
+fn copy_tree(from: &Path, to: &Path) -> anyhow::Result<()> {
     if let Some(parent) = to.parent() {
-        std::fs::create_dir_all(parent).map_err(|e| e.to_string())?;
+        std::fs::create_dir_all(parent)?;
     }
     if from.is_dir() {
-        std::fs::create_dir_all(to).map_err(|e| e.to_string())?;
-        for entry in std::fs::read_dir(from).map_err(|e| e.to_string())? {
-            let entry = entry.map_err(|e| e.to_string())?;
+        std::fs::create_dir_all(to)?;
+        for entry in std::fs::read_dir(from)? {
+            let entry = entry?;
             copy_tree(&entry.path(), &to.join(entry.file_name()))?;
         }
         Ok(())
     } else {
         std::fs::copy(from, to)
             .map(|_| ())
-            .map_err(|e| format!("{}: {e}", from.display()))
+            .map_err(|e| anyhow::anyhow!("{}: {e}", from.display()))
     }
 }
 
@@ -110,14 +111,14 @@ fn copy_tree(from: &Path, to: &Path) -> Result<(), String> {
 /// there), with this build's `sweeptrace` first on PATH: each must end
 /// with 0 or 1 (1: differences found, a legitimate result of `check`,
 /// `diff`, `conform`), never an error, and leave the repository as it was.
-fn help_examples_run_as_written() -> Result<(), String> {
+fn help_examples_run_as_written() -> anyhow::Result<()> {
     let mut lines = Vec::new();
     for sub in subcommands()? {
         let found = examples(&help_of(&sub)?);
         ensure!(!found.is_empty(), "`{sub} --help` has no example");
         lines.extend(found);
     }
-    let dir = tempfile::tempdir().map_err(|e| e.to_string())?;
+    let dir = tempfile::tempdir()?;
     // The repository paths the examples name (a word, or the value of
     // `--opt=` or inside quotes), copied to the same place.
     let mut copied = BTreeSet::new();
@@ -136,12 +137,11 @@ fn help_examples_run_as_written() -> Result<(), String> {
     let before = top_level_entries(root())?;
     let bin_dir = Path::new(env!("CARGO_BIN_EXE_sweeptrace"))
         .parent()
-        .ok_or("the binary has no directory")?
+        .context("the binary has no directory")?
         .to_path_buf();
     let path = std::env::join_paths(std::iter::once(bin_dir).chain(std::env::split_paths(
         &std::env::var_os("PATH").unwrap_or_default(),
-    )))
-    .map_err(|e| e.to_string())?;
+    )))?;
     let mut failures = Vec::new();
     for line in &lines {
         let out = std::process::Command::new("sh")
@@ -152,7 +152,7 @@ fn help_examples_run_as_written() -> Result<(), String> {
             .stdout(std::process::Stdio::null())
             .stderr(std::process::Stdio::piped())
             .output()
-            .map_err(|e| format!("running sh: {e}"))?;
+            .map_err(|e| anyhow::anyhow!("running sh: {e}"))?;
         let code = out.status.code();
         if !matches!(code, Some(0 | 1)) {
             failures.push(format!(
@@ -177,16 +177,15 @@ fn help_examples_run_as_written() -> Result<(), String> {
     Ok(())
 }
 
-fn top_level_entries(dir: &Path) -> Result<BTreeSet<String>, String> {
-    Ok(std::fs::read_dir(dir)
-        .map_err(|e| e.to_string())?
+fn top_level_entries(dir: &Path) -> anyhow::Result<BTreeSet<String>> {
+    Ok(std::fs::read_dir(dir)?
         .filter_map(Result::ok)
         .map(|e| e.file_name().to_string_lossy().into_owned())
         .collect())
 }
 
 /// A typo in an option with a fixed set of values names the valid ones.
-fn enum_options_list_their_values_on_a_typo() -> Result<(), String> {
+fn enum_options_list_their_values_on_a_typo() -> anyhow::Result<()> {
     let trace = root().join("traces/record_mini_golf.mcap");
     let trace = trace.as_os_str();
     let cases: [(&[&std::ffi::OsStr], &[&str]); 7] = [

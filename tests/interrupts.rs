@@ -26,9 +26,8 @@ pub fn tests() -> Vec<Trial> {
 /// Not a measurement: a bound that only a hang exceeds.
 const LONG_WAIT: Duration = Duration::from_secs(120);
 
-fn partial_files(dir: &Path) -> Result<Vec<String>, String> {
-    let mut names: Vec<String> = std::fs::read_dir(dir)
-        .map_err(|e| e.to_string())?
+fn partial_files(dir: &Path) -> anyhow::Result<Vec<String>> {
+    let mut names: Vec<String> = std::fs::read_dir(dir)?
         .filter_map(Result::ok)
         .map(|e| e.file_name().to_string_lossy().into_owned())
         .filter(|n| n.contains(".partial-"))
@@ -38,53 +37,48 @@ fn partial_files(dir: &Path) -> Result<Vec<String>, String> {
 }
 
 /// Waits until `count` partial files are in `dir` (the run is writing).
-fn wait_for_partials(child: &mut Child, dir: &Path, count: usize) -> Result<(), String> {
+fn wait_for_partials(child: &mut Child, dir: &Path, count: usize) -> anyhow::Result<()> {
     let deadline = Instant::now() + LONG_WAIT;
     loop {
         if partial_files(dir)?.len() >= count {
             return Ok(());
         }
-        if let Some(status) = child.try_wait().map_err(|e| e.to_string())? {
-            return Err(format!(
-                "the run ended ({status}) before its outputs appeared"
-            ));
+        if let Some(status) = child.try_wait()? {
+            anyhow::bail!("the run ended ({status}) before its outputs appeared");
         }
         if Instant::now() > deadline {
             let _ = child.kill();
-            return Err(format!(
-                "no {count} partial files in {} in time",
-                dir.display()
-            ));
+            anyhow::bail!("no {count} partial files in {} in time", dir.display());
         }
         std::thread::sleep(Duration::from_millis(20));
     }
 }
 
 /// Sends `signal` and waits for the exit: its code and stderr.
-fn signal_and_wait(mut child: Child, signal: i32) -> Result<(Option<i32>, String), String> {
-    let pid = libc::pid_t::try_from(child.id()).map_err(|e| e.to_string())?;
+fn signal_and_wait(mut child: Child, signal: i32) -> anyhow::Result<(Option<i32>, String)> {
+    let pid = libc::pid_t::try_from(child.id())?;
     // SAFETY: sends a signal to our own child, which has not been waited for.
     if unsafe { libc::kill(pid, signal) } != 0 {
-        return Err(format!("kill: {}", std::io::Error::last_os_error()));
+        anyhow::bail!("kill: {}", std::io::Error::last_os_error());
     }
     let deadline = Instant::now() + LONG_WAIT;
     let status = loop {
-        if let Some(status) = child.try_wait().map_err(|e| e.to_string())? {
+        if let Some(status) = child.try_wait()? {
             break status;
         }
         if Instant::now() > deadline {
             let _ = child.kill();
-            return Err(format!(
+            anyhow::bail!(
                 "still running {} s after signal {signal}",
                 LONG_WAIT.as_secs()
-            ));
+            );
         }
         std::thread::sleep(Duration::from_millis(20));
     };
     let mut stderr = String::new();
     if let Some(mut e) = child.stderr.take() {
         use std::io::Read;
-        e.read_to_string(&mut stderr).map_err(|e| e.to_string())?;
+        e.read_to_string(&mut stderr)?;
     }
     Ok((status.code(), stderr))
 }
@@ -95,51 +89,47 @@ fn check_exit(
     code: Option<i32>,
     stderr: &str,
     signal: i32,
-) -> Result<(), String> {
+) -> anyhow::Result<()> {
     if code != Some(128 + signal) {
-        return Err(format!(
+        anyhow::bail!(
             "{what}: exit {code:?} after signal {signal}, want {}: {stderr}",
             128 + signal
-        ));
+        );
     }
-    let left: Vec<String> = std::fs::read_dir(dir)
-        .map_err(|e| e.to_string())?
+    let left: Vec<String> = std::fs::read_dir(dir)?
         .filter_map(Result::ok)
         .map(|e| e.file_name().to_string_lossy().into_owned())
         .collect();
     if !left.is_empty() {
-        return Err(format!("{what}: left behind {left:?}; stderr: {stderr}"));
+        anyhow::bail!("{what}: left behind {left:?}; stderr: {stderr}");
     }
     if !stderr.contains("interrupted") {
-        return Err(format!(
-            "{what}: stderr does not say it was interrupted: {stderr}"
-        ));
+        anyhow::bail!("{what}: stderr does not say it was interrupted: {stderr}");
     }
     Ok(())
 }
 
 /// A recording of a hundred million frames on a fine terrain: it is still
 /// writing its trace whenever the signal comes.
-fn record_until_signal(signal: i32) -> Result<(), String> {
-    let dir = tempfile::tempdir().map_err(|e| e.to_string())?;
+fn record_until_signal(signal: i32) -> anyhow::Result<()> {
+    let dir = tempfile::tempdir()?;
     let mut child = Command::new(env!("CARGO_BIN_EXE_sweeptrace"))
         .args(["record", "--scene", "terrain", "--terrain-cells", "128"])
         .args(["--balls", "16", "--frames", "100000000", "-o"])
         .arg(dir.path().join("long.mcap"))
         .stdout(Stdio::null())
         .stderr(Stdio::piped())
-        .spawn()
-        .map_err(|e| e.to_string())?;
+        .spawn()?;
     wait_for_partials(&mut child, dir.path(), 1)?;
     let (code, stderr) = signal_and_wait(child, signal)?;
     check_exit("record", dir.path(), code, &stderr, signal)
 }
 
-fn interrupted_record_removes_its_partial_file() -> Result<(), String> {
+fn interrupted_record_removes_its_partial_file() -> anyhow::Result<()> {
     record_until_signal(libc::SIGINT)
 }
 
-fn terminated_record_removes_its_partial_file() -> Result<(), String> {
+fn terminated_record_removes_its_partial_file() -> anyhow::Result<()> {
     record_until_signal(libc::SIGTERM)
 }
 
@@ -147,8 +137,8 @@ fn terminated_record_removes_its_partial_file() -> Result<(), String> {
 /// a stdout pipe that is never read: once the pipe is full (the outcomes of
 /// the sample's 2,103 sweeps are far more than a pipe holds) it waits, with
 /// both files unfinished.
-fn replay_until_signal(signal: i32) -> Result<(), String> {
-    let dir = tempfile::tempdir().map_err(|e| e.to_string())?;
+fn replay_until_signal(signal: i32) -> anyhow::Result<()> {
+    let dir = tempfile::tempdir()?;
     let trace = Path::new(env!("CARGO_MANIFEST_DIR")).join("traces/record_mini_golf.mcap");
     let mut child = Command::new(env!("CARGO_BIN_EXE_sweeptrace"))
         .arg("replay")
@@ -160,8 +150,7 @@ fn replay_until_signal(signal: i32) -> Result<(), String> {
         .args(["--outcomes", "-"])
         .stdout(Stdio::piped())
         .stderr(Stdio::piped())
-        .spawn()
-        .map_err(|e| e.to_string())?;
+        .spawn()?;
     // Held open, unread, until the child has exited.
     let stdout = child.stdout.take();
     wait_for_partials(&mut child, dir.path(), 2)?;
@@ -170,10 +159,10 @@ fn replay_until_signal(signal: i32) -> Result<(), String> {
     check_exit("replay", dir.path(), code, &stderr, signal)
 }
 
-fn interrupted_replay_removes_every_partial_output() -> Result<(), String> {
+fn interrupted_replay_removes_every_partial_output() -> anyhow::Result<()> {
     replay_until_signal(libc::SIGINT)
 }
 
-fn terminated_replay_removes_every_partial_output() -> Result<(), String> {
+fn terminated_replay_removes_every_partial_output() -> anyhow::Result<()> {
     replay_until_signal(libc::SIGTERM)
 }

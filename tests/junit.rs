@@ -17,6 +17,7 @@ use sweeptrace::regress::{CheckOptions, check_file, render_text};
 use crate::engine::example_engine_command;
 use crate::support::run_bin;
 use crate::{ensure, os, trial};
+use anyhow::Context as _;
 
 pub fn tests() -> Vec<Trial> {
     vec![
@@ -48,32 +49,32 @@ fn s(p: &Path) -> &str {
     p.to_str().expect("test paths are UTF-8")
 }
 
-fn tempdir() -> Result<tempfile::TempDir, String> {
-    tempfile::tempdir().map_err(|e| e.to_string())
+fn tempdir() -> anyhow::Result<tempfile::TempDir> {
+    tempfile::tempdir().map_err(anyhow::Error::from)
 }
 
-fn read(path: &Path) -> Result<String, String> {
-    std::fs::read_to_string(path).map_err(|e| format!("reading {}: {e}", path.display()))
+fn read(path: &Path) -> anyhow::Result<String> {
+    std::fs::read_to_string(path).map_err(|e| anyhow::anyhow!("reading {}: {e}", path.display()))
 }
 
 /// The document, parsed by a strict XML 1.0 parser.
-fn parse(xml: &str) -> Result<Document<'_>, String> {
-    Document::parse(xml).map_err(|e| format!("not well-formed XML: {e}\n{xml}"))
+fn parse(xml: &str) -> anyhow::Result<Document<'_>> {
+    Document::parse(xml).map_err(|e| anyhow::anyhow!("not well-formed XML: {e}\n{xml}"))
 }
 
-fn attr<'a>(node: Node<'a, '_>, name: &str) -> Result<&'a str, String> {
+fn attr<'a>(node: Node<'a, '_>, name: &str) -> anyhow::Result<&'a str> {
     node.attribute(name)
-        .ok_or_else(|| format!("<{}> without {name}", node.tag_name().name()))
+        .with_context(|| format!("<{}> without {name}", node.tag_name().name()))
 }
 
-fn count(node: Node, name: &str) -> Result<u64, String> {
+fn count(node: Node, name: &str) -> anyhow::Result<u64> {
     attr(node, name)?
         .parse()
-        .map_err(|e| format!("{name}: {e}"))
+        .map_err(|e| anyhow::anyhow!("{name}: {e}"))
 }
 
 /// tests, failures, errors, skipped of a suite or the root.
-fn counts(node: Node) -> Result<[u64; 4], String> {
+fn counts(node: Node) -> anyhow::Result<[u64; 4]> {
     Ok([
         count(node, "tests")?,
         count(node, "failures")?,
@@ -100,7 +101,7 @@ fn result_of<'a>(case: Node<'a, '_>) -> &'a str {
 
 /// Checks that every suite's and the root's counts are those of the cases
 /// they hold.
-fn counts_add_up(doc: &Document) -> Result<(), String> {
+fn counts_add_up(doc: &Document) -> anyhow::Result<()> {
     let top = doc.root_element();
     ensure!(top.has_tag_name("testsuites"), "root: {:?}", top.tag_name());
     let mut total = [0u64; 4];
@@ -142,17 +143,16 @@ fn property<'a>(suite: Node<'a, '_>, name: &str) -> Option<&'a str> {
         .and_then(|p| p.attribute("value"))
 }
 
-fn suite_named<'a, 'i>(doc: &'a Document<'i>, name: &str) -> Result<Node<'a, 'i>, String> {
+fn suite_named<'a, 'i>(doc: &'a Document<'i>, name: &str) -> anyhow::Result<Node<'a, 'i>> {
     children(doc.root_element(), "testsuite")
         .into_iter()
         .find(|s| s.attribute("name") == Some(name))
-        .ok_or_else(|| format!("no testsuite {name}"))
+        .with_context(|| format!("no testsuite {name}"))
 }
 
 /// Only `keep` is left in `dir`: no temporary file of the report.
-fn only_files(dir: &Path, keep: &[&str]) -> Result<(), String> {
-    let mut names: Vec<String> = std::fs::read_dir(dir)
-        .map_err(|e| e.to_string())?
+fn only_files(dir: &Path, keep: &[&str]) -> anyhow::Result<()> {
+    let mut names: Vec<String> = std::fs::read_dir(dir)?
         .filter_map(Result::ok)
         .map(|e| e.file_name().to_string_lossy().into_owned())
         .collect();
@@ -163,12 +163,12 @@ fn only_files(dir: &Path, keep: &[&str]) -> Result<(), String> {
     Ok(())
 }
 
-fn check_junit_of_passing_traces_has_one_suite_per_trace() -> Result<(), String> {
+fn check_junit_of_passing_traces_has_one_suite_per_trace() -> anyhow::Result<()> {
     let dir = tempdir()?;
     let report = dir.path().join("r.xml");
     let (code, stdout, stderr) = run_bin(os!["check", s(&at("traces")), "--junit", s(&report)])?;
     ensure!(code == 0, "exit {code}\n{stdout}{stderr}");
-    let traces = sweeptrace::regress::find_traces(&[at("traces")])?;
+    let traces = sweeptrace::regress::find_traces(&[at("traces")]).map_err(anyhow::Error::msg)?;
     let xml = read(&report)?;
     let doc = parse(&xml)?;
     counts_add_up(&doc)?;
@@ -204,7 +204,7 @@ fn check_junit_of_passing_traces_has_one_suite_per_trace() -> Result<(), String>
         );
         let time: f64 = attr(case, "time")?
             .parse()
-            .map_err(|e| format!("time: {e}"))?;
+            .map_err(|e| anyhow::anyhow!("time: {e}"))?;
         ensure!(time >= 0.0, "time {time}");
         ensure!(result_of(case) == "passed", "{name}: {}", result_of(case));
         let out = children(case, "system-out");
@@ -225,10 +225,10 @@ fn check_junit_of_passing_traces_has_one_suite_per_trace() -> Result<(), String>
     only_files(dir.path(), &["r.xml"])
 }
 
-fn check_junit_failure_and_error_carry_the_first_problem() -> Result<(), String> {
+fn check_junit_failure_and_error_carry_the_first_problem() -> anyhow::Result<()> {
     let dir = tempdir()?;
     let not_a_trace = dir.path().join("not_a_trace.mcap");
-    std::fs::write(&not_a_trace, "plain text, not MCAP\n").map_err(|e| e.to_string())?;
+    std::fs::write(&not_a_trace, "plain text, not MCAP\n")?;
     let report = dir.path().join("f.xml");
     let wrong = at(WRONG_CONFIG);
     let (code, stdout, stderr) = run_bin(os![
@@ -246,7 +246,7 @@ fn check_junit_failure_and_error_carry_the_first_problem() -> Result<(), String>
 
     let suite = suite_named(&doc, s(&wrong))?;
     let case = children(suite, "testcase")[0];
-    let failure = outcome(case).ok_or("no failure")?;
+    let failure = outcome(case).context("no failure")?;
     ensure!(failure.has_tag_name("failure"), "{xml}");
     let message = attr(failure, "message")?;
     ensure!(
@@ -267,7 +267,7 @@ fn check_junit_failure_and_error_carry_the_first_problem() -> Result<(), String>
 
     let suite = suite_named(&doc, s(&not_a_trace))?;
     let case = children(suite, "testcase")[0];
-    let error = outcome(case).ok_or("no error")?;
+    let error = outcome(case).context("no error")?;
     ensure!(error.has_tag_name("error"), "{xml}");
     let message = attr(error, "message")?;
     ensure!(
@@ -284,7 +284,7 @@ fn check_junit_failure_and_error_carry_the_first_problem() -> Result<(), String>
     only_files(dir.path(), &["f.xml", "not_a_trace.mcap"])
 }
 
-fn check_junit_detail_sweeps_adds_divergences_and_tunnels() -> Result<(), String> {
+fn check_junit_detail_sweeps_adds_divergences_and_tunnels() -> anyhow::Result<()> {
     let dir = tempdir()?;
     let report = dir.path().join("d.xml");
     let (wrong, tunnel) = (at(WRONG_CONFIG), at(TUNNEL));
@@ -315,7 +315,7 @@ fn check_junit_detail_sweeps_adds_divergences_and_tunnels() -> Result<(), String
         cases.iter().all(|c| result_of(*c) == "failure"),
         "every case fails: {xml}"
     );
-    let sweep = outcome(cases[2]).ok_or("no failure")?;
+    let sweep = outcome(cases[2]).context("no failure")?;
     ensure!(
         attr(cases[2], "classname")? == "check.sweep"
             && attr(sweep, "message")?
@@ -338,7 +338,7 @@ fn check_junit_detail_sweeps_adds_divergences_and_tunnels() -> Result<(), String
         "tunnel suite: {} cases\n{xml}",
         cases.len()
     );
-    let trace_failure = outcome(cases[0]).ok_or("no failure")?;
+    let trace_failure = outcome(cases[0]).context("no failure")?;
     ensure!(
         attr(trace_failure, "type")? == "tunnel"
             && attr(trace_failure, "message")?
@@ -348,7 +348,7 @@ fn check_junit_detail_sweeps_adds_divergences_and_tunnels() -> Result<(), String
     );
     ensure!(
         attr(cases[1], "classname")? == "check.tunnel"
-            && attr(outcome(cases[1]).ok_or("no failure")?, "message")?
+            && attr(outcome(cases[1]).context("no failure")?, "message")?
                 == "tunnel: frame 4, ball 0: through triangle 0 during its sweep at (1, -2, 0)",
         "tunnel case"
     );
@@ -371,7 +371,7 @@ fn check_junit_detail_sweeps_adds_divergences_and_tunnels() -> Result<(), String
     only_files(dir.path(), &["d.xml"])
 }
 
-fn check_junit_fragile_divergences_are_skipped_unless_strict() -> Result<(), String> {
+fn check_junit_fragile_divergences_are_skipped_unless_strict() -> anyhow::Result<()> {
     // Recorded with the strict facing rule, the scene declares non_strict:
     // they differ only on a path parallel to the floor, a divergence
     // rounding explains (tests/repro.rs, infer_strict_by_replay).
@@ -379,7 +379,7 @@ fn check_junit_fragile_divergences_are_skipped_unless_strict() -> Result<(), Str
     let bytes = crate::repro::recorded_by(&scene, &sweeps, 0.0, Facing::Strict)?;
     let dir = tempdir()?;
     let trace = dir.path().join("fragile.mcap");
-    std::fs::write(&trace, bytes).map_err(|e| e.to_string())?;
+    std::fs::write(&trace, bytes)?;
     let report = dir.path().join("s.xml");
 
     let (code, stdout, stderr) = run_bin(os!["check", s(&trace), "--junit", s(&report)])?;
@@ -390,7 +390,7 @@ fn check_junit_fragile_divergences_are_skipped_unless_strict() -> Result<(), Str
     ensure!(counts(doc.root_element())? == [2, 0, 0, 1], "{xml}");
     let suite = suite_named(&doc, s(&trace))?;
     let cases = children(suite, "testcase");
-    let skipped = outcome(cases[1]).ok_or("no skipped")?;
+    let skipped = outcome(cases[1]).context("no skipped")?;
     ensure!(
         skipped.has_tag_name("skipped")
             && attr(cases[1], "classname")? == "check.fragile"
@@ -420,7 +420,7 @@ fn check_junit_fragile_divergences_are_skipped_unless_strict() -> Result<(), Str
     Ok(())
 }
 
-fn conform_junit_fails_exactly_the_failing_rules() -> Result<(), String> {
+fn conform_junit_fails_exactly_the_failing_rules() -> anyhow::Result<()> {
     let dir = tempdir()?;
     let report = dir.path().join("c.xml");
     let engine = example_engine_command("--bug skip-vertex");
@@ -435,16 +435,17 @@ fn conform_junit_fails_exactly_the_failing_rules() -> Result<(), String> {
         "sweeps"
     ])?;
     ensure!(code == 1, "exit {code}\n{stderr}");
-    let json: Value = serde_json::from_str(&stdout).map_err(|e| format!("{e}: {stdout}"))?;
+    let json: Value =
+        serde_json::from_str(&stdout).map_err(|e| anyhow::anyhow!("{e}: {stdout}"))?;
     let mut failing: Vec<String> = json["failing_rules"]
         .as_array()
-        .ok_or("failing_rules")?
+        .context("failing_rules")?
         .iter()
         .filter_map(|v| v.as_str().map(str::to_string))
         .collect();
     failing.sort();
     ensure!(!failing.is_empty(), "the buggy engine fails rules");
-    let rules = json["rules"].as_array().ok_or("rules")?;
+    let rules = json["rules"].as_array().context("rules")?;
 
     let xml = read(&report)?;
     let doc = parse(&xml)?;
@@ -473,8 +474,8 @@ fn conform_junit_fails_exactly_the_failing_rules() -> Result<(), String> {
                         let rule = rules
                             .iter()
                             .find(|r| r["rule"] == name)
-                            .ok_or_else(|| format!("{name} not in the JSON"))?;
-                        let message = attr(outcome(case).ok_or("failure")?, "message")?;
+                            .with_context(|| format!("{name} not in the JSON"))?;
+                        let message = attr(outcome(case).context("failure")?, "message")?;
                         let want = format!(
                             "{} of {} cases fail; first failing case: {} (",
                             rule["failed"],
@@ -509,7 +510,7 @@ fn conform_junit_fails_exactly_the_failing_rules() -> Result<(), String> {
     Ok(())
 }
 
-fn check_engine_junit_names_the_engine() -> Result<(), String> {
+fn check_engine_junit_names_the_engine() -> anyhow::Result<()> {
     let dir = tempdir()?;
     let report = dir.path().join("e.xml");
     // An engine that ignores the margin diverges on a trace with one.
@@ -536,7 +537,7 @@ fn check_engine_junit_names_the_engine() -> Result<(), String> {
         "properties: {xml}"
     );
     let case = children(suite, "testcase")[0];
-    let failure = outcome(case).ok_or("no failure")?;
+    let failure = outcome(case).context("no failure")?;
     ensure!(
         failure.has_tag_name("failure")
             && attr(failure, "message")?
@@ -546,12 +547,12 @@ fn check_engine_junit_names_the_engine() -> Result<(), String> {
     Ok(())
 }
 
-fn github_annotations_only_in_github_actions() -> Result<(), String> {
+fn github_annotations_only_in_github_actions() -> anyhow::Result<()> {
     let dir = tempdir()?;
     // A name with the characters a property must escape.
     let trace = dir.path().join("a,b:c.mcap");
-    std::fs::copy(at(WRONG_CONFIG), &trace).map_err(|e| e.to_string())?;
-    let run = |github: Option<&str>, json: bool| -> Result<String, String> {
+    std::fs::copy(at(WRONG_CONFIG), &trace)?;
+    let run = |github: Option<&str>, json: bool| -> anyhow::Result<String> {
         let mut cmd = crate::support::bin();
         cmd.arg("check").arg(&trace);
         if json {
@@ -561,7 +562,7 @@ fn github_annotations_only_in_github_actions() -> Result<(), String> {
             Some(v) => cmd.env("GITHUB_ACTIONS", v),
             None => cmd.env_remove("GITHUB_ACTIONS"),
         };
-        let out = cmd.output().map_err(|e| e.to_string())?;
+        let out = cmd.output()?;
         ensure!(out.status.code() == Some(1), "exit {:?}", out.status.code());
         Ok(String::from_utf8_lossy(&out.stdout).into_owned())
     };
@@ -592,13 +593,13 @@ fn github_annotations_only_in_github_actions() -> Result<(), String> {
             "GITHUB_ACTIONS={github:?}, --json {json}: annotations printed\n{stdout}"
         );
         if json {
-            serde_json::from_str::<Value>(&stdout).map_err(|e| format!("--json: {e}"))?;
+            serde_json::from_str::<Value>(&stdout).map_err(|e| anyhow::anyhow!("--json: {e}"))?;
         }
     }
     Ok(())
 }
 
-fn junit_not_writable_fails_before_checking_and_leaves_nothing() -> Result<(), String> {
+fn junit_not_writable_fails_before_checking_and_leaves_nothing() -> anyhow::Result<()> {
     let dir = tempdir()?;
     let traces = at("traces");
     // A directory that does not exist.
@@ -618,7 +619,7 @@ fn junit_not_writable_fails_before_checking_and_leaves_nothing() -> Result<(), S
     );
     // The run fails before the report is complete: no file, no temporary.
     let empty = dir.path().join("empty");
-    std::fs::create_dir(&empty).map_err(|e| e.to_string())?;
+    std::fs::create_dir(&empty)?;
     let report = dir.path().join("r.xml");
     let (code, _, stderr) = run_bin(os!["check", s(&empty), "--junit", s(&report)])?;
     ensure!(
@@ -639,7 +640,7 @@ fn junit_not_writable_fails_before_checking_and_leaves_nothing() -> Result<(), S
     only_files(dir.path(), &["empty"])
 }
 
-fn junit_reports_validate_against_the_schema_and_read_back() -> Result<Completion, String> {
+fn junit_reports_validate_against_the_schema_and_read_back() -> anyhow::Result<Completion> {
     if let Err(skipped) = crate::support::python_with_modules(
         &["xmlschema", "junitparser"],
         "pip install xmlschema==4.3.2 junitparser==5.0.3",
@@ -649,14 +650,13 @@ fn junit_reports_validate_against_the_schema_and_read_back() -> Result<Completio
     let dir = tempdir()?;
     let file = |name: &str| dir.path().join(name);
     let not_a_trace = file("not_a_trace.mcap");
-    std::fs::write(&not_a_trace, "plain text\n").map_err(|e| e.to_string())?;
+    std::fs::write(&not_a_trace, "plain text\n")?;
     let (scene, sweeps) = crate::repro::floor_and_sweeps(0.0, Facing::NonStrict);
     let fragile = file("fragile.mcap");
     std::fs::write(
         &fragile,
         crate::repro::recorded_by(&scene, &sweeps, 0.0, Facing::Strict)?,
-    )
-    .map_err(|e| e.to_string())?;
+    )?;
     let engine = example_engine_command("--bug skip-vertex");
     let runs: Vec<(&str, Vec<String>, i32)> = vec![
         ("pass.xml", vec!["check".into(), s(&at("traces")).into()], 0),
@@ -701,7 +701,7 @@ fn junit_reports_validate_against_the_schema_and_read_back() -> Result<Completio
             .arg(at(SCHEMA))
             .args(files)
             .output()
-            .map_err(|e| format!("running python3: {e}"))
+            .map_err(|e| anyhow::anyhow!("running python3: {e}"))
     };
     let out = validate(&reports)?;
     let stdout = String::from_utf8_lossy(&out.stdout);
@@ -714,7 +714,7 @@ fn junit_reports_validate_against_the_schema_and_read_back() -> Result<Completio
         .lines()
         .map(serde_json::from_str)
         .collect::<Result<_, _>>()
-        .map_err(|e| format!("{e}: {stdout}"))?;
+        .map_err(|e| anyhow::anyhow!("{e}: {stdout}"))?;
     ensure!(read_back.len() == reports.len(), "{stdout}");
     for (report, back) in reports.iter().zip(&read_back) {
         let xml = read(report)?;
@@ -727,13 +727,13 @@ fn junit_reports_validate_against_the_schema_and_read_back() -> Result<Completio
             "{}: junitparser reads {theirs:?}, the file says {c:?}",
             report.display()
         );
-        let suites = back["suites"].as_array().ok_or("suites")?;
+        let suites = back["suites"].as_array().context("suites")?;
         let ours = children(doc.root_element(), "testsuite");
         ensure!(suites.len() == ours.len(), "{}: suites", report.display());
         for (theirs, ours) in suites.iter().zip(ours) {
             let results: Vec<&str> = theirs["cases"]
                 .as_array()
-                .ok_or("cases")?
+                .context("cases")?
                 .iter()
                 .filter_map(|c| c["result"].as_str())
                 .collect();
@@ -779,16 +779,15 @@ fn junit_reports_validate_against_the_schema_and_read_back() -> Result<Completio
     // name, counts that do not add up.
     let xml = read(&reports[0])?;
     let broken = file("broken.xml");
-    let name = xml.find("<testcase name=\"").ok_or("no testcase")?;
+    let name = xml.find("<testcase name=\"").context("no testcase")?;
     let mut unnamed = xml.clone();
     unnamed.replace_range(name..name + "<testcase name=\"".len(), "<testcase label=\"");
-    std::fs::write(&broken, unnamed).map_err(|e| e.to_string())?;
+    std::fs::write(&broken, unnamed)?;
     let miscounted = file("miscounted.xml");
     std::fs::write(
         &miscounted,
         xml.replacen("failures=\"0\"", "failures=\"1\"", 1),
-    )
-    .map_err(|e| e.to_string())?;
+    )?;
     for bad in [broken, miscounted] {
         let out = validate(std::slice::from_ref(&bad))?;
         ensure!(

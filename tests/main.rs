@@ -61,14 +61,17 @@ impl TrialResult for Completion {
     }
 }
 
-/// Builds a trial from a function returning `Result<(), String>` (or
-/// `Result<Completion, String>`).
-pub fn trial<T: TrialResult>(
+/// Builds a trial from a function returning `anyhow::Result<()>` (or
+/// `anyhow::Result<Completion>`); a failure prints the error with its
+/// context chain. (A `String` error is accepted too, for code not moved
+/// to `anyhow` yet.)
+pub fn trial<T: TrialResult, E: support::Fail>(
     name: &str,
-    f: impl FnOnce() -> Result<T, String> + Send + 'static,
+    f: impl FnOnce() -> Result<T, E> + Send + 'static,
 ) -> Trial {
     Trial::ignorable_test(name, move || {
-        f().map(TrialResult::into_completion).map_err(Failed::from)
+        f().map(TrialResult::into_completion)
+            .map_err(|e| Failed::from(e.message()))
     })
 }
 
@@ -171,7 +174,9 @@ fn mark_slow(trials: Vec<Trial>) -> Vec<Trial> {
         if missing.is_empty() {
             Ok(())
         } else {
-            Err(format!("SLOW names no registered test: {missing:?}"))
+            Err(anyhow::anyhow!(
+                "SLOW names no registered test: {missing:?}"
+            ))
         }
     }));
     out

@@ -45,17 +45,17 @@ fn events_of<R: std::io::Read>(
     (events, error, indexed)
 }
 
-fn open(path: &Path) -> Result<std::io::BufReader<std::fs::File>, String> {
+fn open(path: &Path) -> anyhow::Result<std::io::BufReader<std::fs::File>> {
     std::fs::File::open(path)
         .map(std::io::BufReader::new)
-        .map_err(|e| format!("{}: {e}", path.display()))
+        .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))
 }
 
-fn overlapping_chunks_written_by_python() -> Result<Completion, String> {
+fn overlapping_chunks_written_by_python() -> anyhow::Result<Completion> {
     if let Err(skipped) = crate::support::python_with_mcap()? {
         return Ok(skipped);
     }
-    let dir = tempfile::tempdir().map_err(|e| e.to_string())?;
+    let dir = tempfile::tempdir()?;
     let with_summary = dir.path().join("overlapping.mcap");
     let without_summary = dir.path().join("overlapping_no_summary.mcap");
     let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("scripts/write_out_of_order.py");
@@ -64,8 +64,7 @@ fn overlapping_chunks_written_by_python() -> Result<Completion, String> {
         .arg(source())
         .arg(&with_summary)
         .arg(&without_summary)
-        .output()
-        .map_err(|e| e.to_string())?;
+        .output()?;
     ensure!(
         out.status.success(),
         "the script failed: {}",
@@ -95,7 +94,7 @@ fn overlapping_chunks_written_by_python() -> Result<Completion, String> {
     );
     // Read as a stream (no seeking), the same file is out of order: this is
     // the file the indexes are needed for.
-    let bytes = std::fs::read(&with_summary).map_err(|e| e.to_string())?;
+    let bytes = std::fs::read(&with_summary)?;
     let (_, error, _) = events_of(TraceReader::new(bytes.as_slice(), &name));
     ensure!(
         matches!(error, Some(TraceError::OutOfOrder { .. })),
@@ -133,7 +132,7 @@ fn overlapping_chunks_written_by_python() -> Result<Completion, String> {
             at.file == name && at.channel == "/sweep" && at.frame == Some(1),
             "the error is at {at}"
         ),
-        other => return Err(format!("without a summary: {other:?}")),
+        other => anyhow::bail!("without a summary: {other:?}"),
     }
     let (code, stdout, stderr) = crate::support::run_bin(os!("check", &without_summary))?;
     ensure!(
@@ -143,7 +142,7 @@ fn overlapping_chunks_written_by_python() -> Result<Completion, String> {
         "check without a summary: exit {code}: {stdout}{stderr}"
     );
     if let Some(repeated) = sweeptrace::error_text::repeated_segment(&stdout) {
-        return Err(format!("check repeats `{repeated}`: {stdout}"));
+        anyhow::bail!("check repeats `{repeated}`: {stdout}");
     }
     Ok(Completion::Completed)
 }

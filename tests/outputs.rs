@@ -5,6 +5,7 @@
 use libtest_mimic::Trial;
 
 use crate::trial;
+use anyhow::Context as _;
 
 pub fn tests() -> Vec<Trial> {
     vec![
@@ -23,76 +24,69 @@ fn sample_trace() -> std::path::PathBuf {
     std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("traces/record_cube_corner_margin.mcap")
 }
 
-fn replay_outcomes(target: &std::path::Path) -> Result<std::process::Output, String> {
+fn replay_outcomes(target: &std::path::Path) -> anyhow::Result<std::process::Output> {
     std::process::Command::new(env!("CARGO_BIN_EXE_sweeptrace"))
         .arg("replay")
         .arg(sample_trace())
         .arg("--outcomes")
         .arg(target)
         .output()
-        .map_err(|e| e.to_string())
+        .map_err(anyhow::Error::from)
 }
 
 /// `--outcomes link.jsonl` where the link points at another file: the link
 /// stays a link and the file it points at holds the outcomes.
-fn symlink_target_keeps_the_link() -> Result<(), String> {
-    let dir = tempfile::tempdir().map_err(|e| e.to_string())?;
+fn symlink_target_keeps_the_link() -> anyhow::Result<()> {
+    let dir = tempfile::tempdir()?;
     let real = dir.path().join("real.jsonl");
     let link = dir.path().join("link.jsonl");
-    std::fs::write(&real, "old\n").map_err(|e| e.to_string())?;
-    std::os::unix::fs::symlink(&real, &link).map_err(|e| e.to_string())?;
+    std::fs::write(&real, "old\n")?;
+    std::os::unix::fs::symlink(&real, &link)?;
     let out = replay_outcomes(&link)?;
     if !out.status.success() {
-        return Err(format!(
-            "replay failed: {}",
-            String::from_utf8_lossy(&out.stderr)
-        ));
+        anyhow::bail!("replay failed: {}", String::from_utf8_lossy(&out.stderr));
     }
-    let meta = std::fs::symlink_metadata(&link).map_err(|e| e.to_string())?;
+    let meta = std::fs::symlink_metadata(&link)?;
     if !meta.file_type().is_symlink() {
-        return Err("the symbolic link was replaced by a file".into());
+        return Err(anyhow::anyhow!("the symbolic link was replaced by a file"));
     }
-    let text = std::fs::read_to_string(&real).map_err(|e| e.to_string())?;
+    let text = std::fs::read_to_string(&real)?;
     if !(text.starts_with("{\"frame\":") && text.lines().count() > 100) {
-        return Err(format!(
-            "the linked file holds {} lines",
-            text.lines().count()
-        ));
+        anyhow::bail!("the linked file holds {} lines", text.lines().count());
     }
     Ok(())
 }
 
 /// `--outcomes fifo`: the pipe is written to (a reader receives every line)
 /// and is still a pipe afterwards, not a regular file renamed over it.
-fn named_pipe_is_written_directly() -> Result<(), String> {
-    let dir = tempfile::tempdir().map_err(|e| e.to_string())?;
+fn named_pipe_is_written_directly() -> anyhow::Result<()> {
+    let dir = tempfile::tempdir()?;
     let fifo = dir.path().join("outcomes.fifo");
     let status = std::process::Command::new("mkfifo")
         .arg(&fifo)
         .status()
-        .map_err(|e| format!("mkfifo: {e}"))?;
+        .map_err(|e| anyhow::anyhow!("mkfifo: {e}"))?;
     if !status.success() {
-        return Err("mkfifo failed".into());
+        return Err(anyhow::anyhow!("mkfifo failed"));
     }
     let reader = {
         let fifo = fifo.clone();
-        std::thread::spawn(move || std::fs::read_to_string(fifo).map_err(|e| e.to_string()))
+        std::thread::spawn(move || std::fs::read_to_string(fifo).map_err(anyhow::Error::from))
     };
     let out = replay_outcomes(&fifo)?;
-    let text = reader.join().map_err(|_| "reader panicked")??;
+    let text = reader
+        .join()
+        .map_err(|_| anyhow::anyhow!("reader panicked"))??;
     if !out.status.success() {
-        return Err(format!(
-            "replay failed: {}",
-            String::from_utf8_lossy(&out.stderr)
-        ));
+        anyhow::bail!("replay failed: {}", String::from_utf8_lossy(&out.stderr));
     }
     use std::os::unix::fs::FileTypeExt;
-    let meta = std::fs::symlink_metadata(&fifo).map_err(|e| e.to_string())?;
+    let meta = std::fs::symlink_metadata(&fifo)?;
     if !meta.file_type().is_fifo() {
-        return Err("the named pipe was replaced by a file".into());
+        return Err(anyhow::anyhow!("the named pipe was replaced by a file"));
     }
     if text.lines().count() < 100 {
-        return Err(format!("the reader got {} lines", text.lines().count()));
+        anyhow::bail!("the reader got {} lines", text.lines().count());
     }
     Ok(())
 }
@@ -101,9 +95,11 @@ fn named_pipe_is_written_directly() -> Result<(), String> {
 /// write with "No space left on device"): it ends within seconds (the SDK's
 /// own file writer used to hang here), exits 2 and names the file and the
 /// operating system's reason.
-fn full_disk_is_a_clear_error() -> Result<(), String> {
+fn full_disk_is_a_clear_error() -> anyhow::Result<()> {
     if !std::path::Path::new("/dev/full").exists() {
-        return Err("/dev/full is missing: this test needs a Linux system".into());
+        return Err(anyhow::anyhow!(
+            "/dev/full is missing: this test needs a Linux system"
+        ));
     }
     for args in [["--rrd", "/dev/full"], ["--outcomes", "/dev/full"]] {
         let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_sweeptrace"))
@@ -112,35 +108,29 @@ fn full_disk_is_a_clear_error() -> Result<(), String> {
             .args(args)
             .stdout(std::process::Stdio::null())
             .stderr(std::process::Stdio::piped())
-            .spawn()
-            .map_err(|e| e.to_string())?;
+            .spawn()?;
         // Not a measurement: a bound that only a hang exceeds.
         let deadline = std::time::Instant::now() + std::time::Duration::from_secs(120);
         let status = loop {
-            if let Some(status) = child.try_wait().map_err(|e| e.to_string())? {
+            if let Some(status) = child.try_wait()? {
                 break status;
             }
             if std::time::Instant::now() > deadline {
                 let _ = child.kill();
-                return Err(format!("replay {args:?} hangs on a full device"));
+                anyhow::bail!("replay {args:?} hangs on a full device");
             }
             std::thread::sleep(std::time::Duration::from_millis(50));
         };
         let mut stderr = String::new();
         if let Some(mut e) = child.stderr.take() {
             use std::io::Read;
-            e.read_to_string(&mut stderr).map_err(|e| e.to_string())?;
+            e.read_to_string(&mut stderr)?;
         }
         if status.code() != Some(2) {
-            return Err(format!(
-                "replay {args:?}: exit {:?}: {stderr}",
-                status.code()
-            ));
+            anyhow::bail!("replay {args:?}: exit {:?}: {stderr}", status.code());
         }
         if !(stderr.contains("/dev/full") && stderr.contains("No space left on device")) {
-            return Err(format!(
-                "replay {args:?}: the error names neither file nor cause: {stderr}"
-            ));
+            anyhow::bail!("replay {args:?}: the error names neither file nor cause: {stderr}");
         }
     }
     Ok(())
@@ -150,8 +140,8 @@ fn full_disk_is_a_clear_error() -> Result<(), String> {
 /// under the target name is intact or replaced by a complete new one (never
 /// a partial file), and what is left over is a temporary file whose name
 /// says what it is, which the next run reports with how to remove it.
-fn killed_mid_write_leaves_the_target_intact() -> Result<(), String> {
-    let dir = tempfile::tempdir().map_err(|e| e.to_string())?;
+fn killed_mid_write_leaves_the_target_intact() -> anyhow::Result<()> {
+    let dir = tempfile::tempdir()?;
     let target = dir.path().join("golf.rrd");
     let trace =
         std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("traces/record_mini_golf.mcap");
@@ -167,30 +157,28 @@ fn killed_mid_write_leaves_the_target_intact() -> Result<(), String> {
             .stderr(std::process::Stdio::piped());
         command
     };
-    let first = replay(&[]).output().map_err(|e| e.to_string())?;
+    let first = replay(&[]).output()?;
     if !first.status.success() {
-        return Err(String::from_utf8_lossy(&first.stderr).into_owned());
+        anyhow::bail!("{}", String::from_utf8_lossy(&first.stderr));
     }
-    let complete = std::fs::read(&target).map_err(|e| e.to_string())?;
+    let complete = std::fs::read(&target)?;
     // Kill at several points of a run (the delays only vary where the run
     // is when killed; the property must hold at any of them).
     for delay_ms in [0u64, 20, 60, 150, 400] {
-        let mut child = replay(&["--detail", "all"])
-            .spawn()
-            .map_err(|e| e.to_string())?;
+        let mut child = replay(&["--detail", "all"]).spawn()?;
         std::thread::sleep(std::time::Duration::from_millis(delay_ms));
         let _ = child.kill();
         let _ = child.wait();
-        let now = std::fs::read(&target).map_err(|e| e.to_string())?;
+        let now = std::fs::read(&target)?;
         // Intact, or a complete recording of the new run (Rerun's decoder
         // reads it to its end): never a partial file.
         if now != complete {
             crate::replay::decode_rrd(&target).map_err(|e| {
-                format!("after a kill at {delay_ms} ms the target does not decode: {e}")
+                anyhow::anyhow!("after a kill at {delay_ms} ms the target does not decode: {e}")
             })?;
         }
         leftovers_are_reported(dir.path(), "golf.rrd", || replay(&[]).output())
-            .map_err(|e| format!("after a kill at {delay_ms} ms: {e}"))?;
+            .map_err(|e| anyhow::anyhow!("after a kill at {delay_ms} ms: {e}"))?;
     }
     Ok(())
 }
@@ -200,8 +188,8 @@ fn killed_mid_write_leaves_the_target_intact() -> Result<(), String> {
 /// complete new one that reads to its end, and what is left over is a
 /// `.NAME.partial-*` temporary file, which the next run reports with how
 /// to remove it.
-fn killed_bless_and_record_leave_the_target_intact() -> Result<(), String> {
-    let dir = tempfile::tempdir().map_err(|e| e.to_string())?;
+fn killed_bless_and_record_leave_the_target_intact() -> anyhow::Result<()> {
+    let dir = tempfile::tempdir()?;
     let target = dir.path().join("golf.mcap");
     let terrain =
         std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("traces/record_terrain.mcap");
@@ -225,27 +213,24 @@ fn killed_bless_and_record_leave_the_target_intact() -> Result<(), String> {
     ];
     for (what, args) in commands {
         for delay_ms in [0u64, 20, 60, 150, 400] {
-            std::fs::copy(&terrain, &target).map_err(|e| e.to_string())?;
-            let before = std::fs::read(&target).map_err(|e| e.to_string())?;
+            std::fs::copy(&terrain, &target)?;
+            let before = std::fs::read(&target)?;
             let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_sweeptrace"))
                 .args(&args)
                 .stdout(std::process::Stdio::null())
                 .stderr(std::process::Stdio::null())
-                .spawn()
-                .map_err(|e| e.to_string())?;
+                .spawn()?;
             std::thread::sleep(std::time::Duration::from_millis(delay_ms));
             let _ = child.kill();
             let _ = child.wait();
-            let now = std::fs::read(&target).map_err(|e| e.to_string())?;
+            let now = std::fs::read(&target)?;
             if now != before {
                 // A complete new trace: it reads to its end without an error.
                 let name = target.display().to_string();
                 if let Some(err) =
                     sweeptrace::TraceReader::new(now.as_slice(), &name).find_map(Result::err)
                 {
-                    return Err(format!(
-                        "{what} killed at {delay_ms} ms left a broken target: {err}"
-                    ));
+                    anyhow::bail!("{what} killed at {delay_ms} ms left a broken target: {err}");
                 }
             }
             leftovers_are_reported(dir.path(), "golf.mcap", || {
@@ -254,7 +239,7 @@ fn killed_bless_and_record_leave_the_target_intact() -> Result<(), String> {
                     .arg(&target)
                     .output()
             })
-            .map_err(|e| format!("{what} killed at {delay_ms} ms: {e}"))?;
+            .map_err(|e| anyhow::anyhow!("{what} killed at {delay_ms} ms: {e}"))?;
         }
     }
     Ok(())
@@ -268,32 +253,29 @@ fn leftovers_are_reported(
     dir: &std::path::Path,
     target_name: &str,
     next: impl FnOnce() -> std::io::Result<std::process::Output>,
-) -> Result<(), String> {
-    let leftovers: Vec<String> = std::fs::read_dir(dir)
-        .map_err(|e| e.to_string())?
+) -> anyhow::Result<()> {
+    let leftovers: Vec<String> = std::fs::read_dir(dir)?
         .filter_map(Result::ok)
         .map(|e| e.file_name().to_string_lossy().into_owned())
         .filter(|n| n != target_name)
         .collect();
     let temporary = format!(".{target_name}.partial-");
     if let Some(odd) = leftovers.iter().find(|n| !n.starts_with(&temporary)) {
-        return Err(format!("an unexpected file is left: {odd}"));
+        anyhow::bail!("an unexpected file is left: {odd}");
     }
     if leftovers.is_empty() {
         return Ok(());
     }
-    let next = next().map_err(|e| e.to_string())?;
+    let next = next()?;
     let stderr = String::from_utf8_lossy(&next.stderr);
     if !(next.status.success()
         && stderr.contains("unfinished temporary file")
         && stderr.contains("rm "))
     {
-        return Err(format!(
-            "the next run does not report the leftovers: {stderr}"
-        ));
+        anyhow::bail!("the next run does not report the leftovers: {stderr}");
     }
     for name in leftovers {
-        std::fs::remove_file(dir.join(name)).map_err(|e| e.to_string())?;
+        std::fs::remove_file(dir.join(name))?;
     }
     Ok(())
 }
@@ -301,7 +283,7 @@ fn leftovers_are_reported(
 /// `replay --connect` to a viewer that is not there (nothing listens on
 /// port 1): the command ends (it used to wait forever), exits 2 and names
 /// the address.
-fn unreachable_viewer_is_a_clear_error() -> Result<(), String> {
+fn unreachable_viewer_is_a_clear_error() -> anyhow::Result<()> {
     let url = "rerun+http://127.0.0.1:1/proxy";
     let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_sweeptrace"))
         .arg("replay")
@@ -309,34 +291,35 @@ fn unreachable_viewer_is_a_clear_error() -> Result<(), String> {
         .args(["--connect", url])
         .stdout(std::process::Stdio::null())
         .stderr(std::process::Stdio::piped())
-        .spawn()
-        .map_err(|e| e.to_string())?;
+        .spawn()?;
     // Not a measurement: a bound that only a hang exceeds.
     let deadline = std::time::Instant::now() + std::time::Duration::from_secs(180);
     let status = loop {
-        if let Some(status) = child.try_wait().map_err(|e| e.to_string())? {
+        if let Some(status) = child.try_wait()? {
             break status;
         }
         if std::time::Instant::now() > deadline {
             let _ = child.kill();
-            return Err("replay --connect hangs on an unreachable viewer".into());
+            return Err(anyhow::anyhow!(
+                "replay --connect hangs on an unreachable viewer"
+            ));
         }
         std::thread::sleep(std::time::Duration::from_millis(100));
     };
     let mut stderr = String::new();
     if let Some(mut e) = child.stderr.take() {
         use std::io::Read;
-        e.read_to_string(&mut stderr).map_err(|e| e.to_string())?;
+        e.read_to_string(&mut stderr)?;
     }
     if status.code() != Some(2) || !stderr.contains(url) {
-        return Err(format!("exit {:?}: {stderr}", status.code()));
+        anyhow::bail!("exit {:?}: {stderr}", status.code());
     }
     // One figure of time, the true one: how long it tried in all (not the
     // SDK's own count next to a different timeout of ours).
     let error = stderr
         .lines()
         .find(|l| l.starts_with("error: "))
-        .ok_or_else(|| format!("no error line: {stderr}"))?;
+        .with_context(|| format!("no error line: {stderr}"))?;
     let words: Vec<&str> = error
         .split_whitespace()
         .map(|w| w.trim_matches(|c: char| "(),;:".contains(c)))
@@ -351,7 +334,7 @@ fn unreachable_viewer_is_a_clear_error() -> Result<(), String> {
         })
         .count();
     if figures != 1 || error.contains("within") {
-        return Err(format!("not one figure of time: {error}"));
+        anyhow::bail!("not one figure of time: {error}");
     }
     Ok(())
 }
@@ -359,36 +342,35 @@ fn unreachable_viewer_is_a_clear_error() -> Result<(), String> {
 /// `replay --outcomes -` whose reader goes away at once (`| head -0`): the
 /// command ends like other command-line tools, by SIGPIPE, without an
 /// error message and without waiting.
-fn closed_stdout_ends_quietly() -> Result<(), String> {
+fn closed_stdout_ends_quietly() -> anyhow::Result<()> {
     let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_sweeptrace"))
         .arg("replay")
         .arg(sample_trace())
         .args(["--outcomes", "-"])
         .stdout(std::process::Stdio::piped())
         .stderr(std::process::Stdio::piped())
-        .spawn()
-        .map_err(|e| e.to_string())?;
+        .spawn()?;
     drop(child.stdout.take());
     // Not a measurement: a bound that only a hang exceeds.
     let deadline = std::time::Instant::now() + std::time::Duration::from_secs(60);
     let status = loop {
-        if let Some(status) = child.try_wait().map_err(|e| e.to_string())? {
+        if let Some(status) = child.try_wait()? {
             break status;
         }
         if std::time::Instant::now() > deadline {
             let _ = child.kill();
-            return Err("replay hangs when its stdout is closed".into());
+            return Err(anyhow::anyhow!("replay hangs when its stdout is closed"));
         }
         std::thread::sleep(std::time::Duration::from_millis(20));
     };
     let mut stderr = String::new();
     if let Some(mut e) = child.stderr.take() {
         use std::io::Read;
-        e.read_to_string(&mut stderr).map_err(|e| e.to_string())?;
+        e.read_to_string(&mut stderr)?;
     }
     use std::os::unix::process::ExitStatusExt;
     if status.signal() != Some(SIGPIPE) || stderr.contains("error") {
-        return Err(format!("status {status:?}, stderr: {stderr}"));
+        anyhow::bail!("status {status:?}, stderr: {stderr}");
     }
     Ok(())
 }
@@ -400,15 +382,15 @@ const SIGPIPE: i32 = 13;
 /// with seeks, so the pipe is refused with exit 2 and a message naming it
 /// (the MCAP writer used to panic on a target that cannot seek), and the
 /// pipe is left as it was.
-fn trace_to_a_pipe_is_refused() -> Result<(), String> {
-    let dir = tempfile::tempdir().map_err(|e| e.to_string())?;
+fn trace_to_a_pipe_is_refused() -> anyhow::Result<()> {
+    let dir = tempfile::tempdir()?;
     let fifo = dir.path().join("trace.mcap");
     let status = std::process::Command::new("mkfifo")
         .arg(&fifo)
         .status()
-        .map_err(|e| format!("mkfifo: {e}"))?;
+        .map_err(|e| anyhow::anyhow!("mkfifo: {e}"))?;
     if !status.success() {
-        return Err("mkfifo failed".into());
+        return Err(anyhow::anyhow!("mkfifo failed"));
     }
     let commands: [Vec<std::ffi::OsString>; 2] = [
         vec![
@@ -430,19 +412,18 @@ fn trace_to_a_pipe_is_refused() -> Result<(), String> {
     for args in commands {
         let out = std::process::Command::new(env!("CARGO_BIN_EXE_sweeptrace"))
             .args(&args)
-            .output()
-            .map_err(|e| e.to_string())?;
+            .output()?;
         let stderr = String::from_utf8_lossy(&out.stderr);
         if out.status.code() != Some(2)
             || !stderr.contains("trace.mcap")
             || !stderr.contains("not a regular file")
         {
-            return Err(format!("{args:?}: exit {:?}: {stderr}", out.status.code()));
+            anyhow::bail!("{args:?}: exit {:?}: {stderr}", out.status.code());
         }
         use std::os::unix::fs::FileTypeExt;
-        let meta = std::fs::symlink_metadata(&fifo).map_err(|e| e.to_string())?;
+        let meta = std::fs::symlink_metadata(&fifo)?;
         if !meta.file_type().is_fifo() {
-            return Err(format!("{args:?} replaced the pipe"));
+            anyhow::bail!("{args:?} replaced the pipe");
         }
     }
     Ok(())

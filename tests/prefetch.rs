@@ -22,18 +22,14 @@ pub fn tests() -> Vec<Trial> {
     ]
 }
 
-fn keeps_order_and_errors() -> Result<(), String> {
+fn keeps_order_and_errors() -> anyhow::Result<()> {
     let source = (0..10_000u32).map(|i| if i % 997 == 0 { Err(i) } else { Ok(i) });
     let want: Vec<Result<u32, u32>> = source.clone().collect();
     for (chunk, depth) in [(1, 1), (7, 2), (1024, 4), (20_000, 1)] {
-        let got: Vec<_> = prefetch(source.clone(), chunk, depth)
-            .map_err(|e| e.to_string())?
-            .collect();
+        let got: Vec<_> = prefetch(source.clone(), chunk, depth)?.collect();
         ensure!(got == want, "chunk {chunk} depth {depth}: items differ");
     }
-    let empty: Vec<u8> = prefetch(std::iter::empty::<u8>(), 8, 2)
-        .map_err(|e| e.to_string())?
-        .collect();
+    let empty: Vec<u8> = prefetch(std::iter::empty::<u8>(), 8, 2)?.collect();
     ensure!(empty.is_empty(), "empty source yields {empty:?}");
     Ok(())
 }
@@ -52,13 +48,13 @@ impl Iterator for Endless {
     }
 }
 
-fn dropping_stops_the_thread() -> Result<(), String> {
+fn dropping_stops_the_thread() -> anyhow::Result<()> {
     let (tx, rx) = channel();
     let source = Endless {
         next: 0,
         _dropped: tx,
     };
-    let mut it = prefetch(source, 16, 2).map_err(|e| e.to_string())?;
+    let mut it = prefetch(source, 16, 2)?;
     let first: Vec<u64> = it.by_ref().take(5).collect();
     ensure!(first == vec![1, 2, 3, 4, 5], "first items {first:?}");
     drop(it);
@@ -67,22 +63,21 @@ fn dropping_stops_the_thread() -> Result<(), String> {
     match rx.recv_timeout(Duration::from_secs(10)) {
         Err(RecvTimeoutError::Disconnected) => {}
         Err(RecvTimeoutError::Timeout) => {
-            return Err("the source was not dropped within 10 s".to_string());
+            return Err(anyhow::anyhow!("the source was not dropped within 10 s"));
         }
-        Ok(()) => return Err("the source sent a value".to_string()),
+        Ok(()) => return Err(anyhow::anyhow!("the source sent a value")),
     }
     Ok(())
 }
 
-fn same_events_as_the_reader() -> Result<(), String> {
+fn same_events_as_the_reader() -> anyhow::Result<()> {
     let path =
         std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("traces/record_mini_golf.mcap");
-    let bytes = std::fs::read(&path).map_err(|e| format!("{}: {e}", path.display()))?;
+    let bytes = std::fs::read(&path).map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
     let direct: Vec<String> = TraceReader::new(std::io::Cursor::new(bytes.clone()), "t")
         .map(|e| format!("{e:?}"))
         .collect();
-    let ahead: Vec<String> = prefetch(TraceReader::new(std::io::Cursor::new(bytes), "t"), 100, 3)
-        .map_err(|e| e.to_string())?
+    let ahead: Vec<String> = prefetch(TraceReader::new(std::io::Cursor::new(bytes), "t"), 100, 3)?
         .map(|e| format!("{e:?}"))
         .collect();
     ensure!(direct.len() > 4000, "only {} events", direct.len());

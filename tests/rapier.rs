@@ -12,6 +12,7 @@ use sweeptrace::sim::BuiltinScene;
 use crate::ensure;
 use crate::rapier_record::{Args, run};
 use crate::trial;
+use anyhow::Context as _;
 
 pub fn tests() -> Vec<Trial> {
     vec![trial!(
@@ -19,8 +20,8 @@ pub fn tests() -> Vec<Trial> {
     )]
 }
 
-fn rapier_recording_passes_check_with_the_readme_options() -> Result<(), String> {
-    let dir = tempfile::tempdir().map_err(|e| e.to_string())?;
+fn rapier_recording_passes_check_with_the_readme_options() -> anyhow::Result<()> {
+    let dir = tempfile::tempdir()?;
     let output = dir.path().join("rapier_mini_golf.mcap");
     let mut options = BuiltinScene::MiniGolf.sim_options();
     options.frames = 60;
@@ -30,7 +31,8 @@ fn rapier_recording_passes_check_with_the_readme_options() -> Result<(), String>
         mesh: None,
         output: output.clone(),
         options,
-    })?;
+    })
+    .map_err(anyhow::Error::msg)?;
     ensure!(
         sweeps == 8 * 60 && hits > 0,
         "{sweeps} sweeps, {hits} hits, {starting_in_contact} starting in contact"
@@ -57,7 +59,7 @@ fn rapier_recording_passes_check_with_the_readme_options() -> Result<(), String>
     let source = report
         .expected_source
         .as_ref()
-        .ok_or("no expected source")?;
+        .context("no expected source")?;
     ensure!(
         source.engine == "rapier3d-f64"
             && source.version == rapier3d_f64::VERSION

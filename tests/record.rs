@@ -15,6 +15,7 @@ use sweeptrace::trace::messages::{OutcomeMsg, SceneMsg, SweepMsg};
 use sweeptrace::trace::{TraceEvent, TraceReader, TraceWriter};
 
 use crate::{ensure, trial};
+use anyhow::Context as _;
 
 pub fn tests() -> Vec<Trial> {
     vec![
@@ -44,29 +45,27 @@ fn scene(name: &str) -> SceneMesh {
 }
 
 /// Records `scene` with `options` into memory, as `sweeptrace record` does.
-fn record(scene: &SceneMesh, options: &SimOptions) -> Result<Vec<u8>, String> {
-    let mesh = scene.to_mesh().map_err(|e| e.to_string())?;
-    let mut writer = TraceWriter::new(Cursor::new(Vec::new())).map_err(|e| e.to_string())?;
-    writer
-        .scene(0, &sim::scene_message(scene, options))
-        .map_err(|e| e.to_string())?;
+fn record(scene: &SceneMesh, options: &SimOptions) -> anyhow::Result<Vec<u8>> {
+    let mesh = scene.to_mesh()?;
+    let mut writer = TraceWriter::new(Cursor::new(Vec::new()))?;
+    writer.scene(0, &sim::scene_message(scene, options))?;
     sim::simulate(&mesh, options, |event| -> Result<(), BoxError> {
         writer.sweep(event.log_time_nanos, &event.sweep)?;
         writer.expected(event.log_time_nanos, &event.outcome)?;
         Ok(())
     })
-    .map_err(|e| e.to_string())?;
-    Ok(writer.finish().map_err(|e| e.to_string())?.into_inner())
+    .map_err(|e| anyhow::anyhow!(e))?;
+    Ok(writer.finish()?.into_inner())
 }
 
 /// Every sweep and outcome of a simulation, without a trace.
-fn events(mesh: &Mesh, options: &SimOptions) -> Result<(Vec<sim::Event>, sim::SimSummary), String> {
+fn events(mesh: &Mesh, options: &SimOptions) -> anyhow::Result<(Vec<sim::Event>, sim::SimSummary)> {
     let mut out = Vec::new();
     let summary = sim::simulate(mesh, options, |e| -> Result<(), SimError> {
         out.push(*e);
         Ok(())
     })
-    .map_err(|e| e.to_string())?;
+    .map_err(|e| anyhow::anyhow!(e))?;
     Ok((out, summary))
 }
 
@@ -76,14 +75,14 @@ struct Read {
     expected: Vec<OutcomeMsg>,
 }
 
-fn read(bytes: &[u8], name: &str) -> Result<Read, String> {
+fn read(bytes: &[u8], name: &str) -> anyhow::Result<Read> {
     let mut r = Read {
         scenes: Vec::new(),
         sweeps: Vec::new(),
         expected: Vec::new(),
     };
     for event in TraceReader::new(Cursor::new(bytes), name) {
-        match event.map_err(|e| e.to_string())? {
+        match event? {
             TraceEvent::Scene { scene, .. } => r.scenes.push(scene),
             TraceEvent::Sweep {
                 sweep,
@@ -96,7 +95,7 @@ fn read(bytes: &[u8], name: &str) -> Result<Read, String> {
     Ok(r)
 }
 
-fn same_seed_gives_identical_bytes() -> Result<(), String> {
+fn same_seed_gives_identical_bytes() -> anyhow::Result<()> {
     for name in ["mini_golf", "terrain"] {
         let s = scene(name);
         let options = SimOptions {
@@ -127,7 +126,7 @@ fn same_seed_gives_identical_bytes() -> Result<(), String> {
     Ok(())
 }
 
-fn expected_equals_sweep_mesh_rerun_on_recorded_sweeps() -> Result<(), String> {
+fn expected_equals_sweep_mesh_rerun_on_recorded_sweeps() -> anyhow::Result<()> {
     for (name, margin, facing) in [
         ("bowl", 0.02, Facing::NonStrict),
         ("cube", 0.05, Facing::NonStrict),
@@ -155,8 +154,7 @@ fn expected_equals_sweep_mesh_rerun_on_recorded_sweeps() -> Result<(), String> {
             scene_msg.margin == margin && scene_msg.facing == facing,
             "{name}: scene options not recorded"
         );
-        let mesh = Mesh::new(scene_msg.vertices.clone(), &scene_msg.triangles)
-            .map_err(|e| e.to_string())?;
+        let mesh = Mesh::new(scene_msg.vertices.clone(), &scene_msg.triangles)?;
         let core = Options {
             margin: scene_msg.margin,
             facing: scene_msg.facing,
@@ -170,7 +168,7 @@ fn expected_equals_sweep_mesh_rerun_on_recorded_sweeps() -> Result<(), String> {
         );
         for ((_, sweep), expected) in trace.sweeps.iter().zip(&trace.expected) {
             let outcome = sweep_mesh(&mesh, &Sweep::new(sweep.p0, sweep.p1, sweep.radius), &core)
-                .map_err(|e| format!("{name} frame {}: {e}", sweep.frame))?;
+                .map_err(|e| anyhow::anyhow!("{name} frame {}: {e}", sweep.frame))?;
             let again = OutcomeMsg::from_outcome(sweep.frame, sweep.ball, &outcome);
             ensure!(
                 again == *expected,
@@ -187,7 +185,7 @@ fn finite(p: &[f64; 3]) -> bool {
     p.iter().all(|v| v.is_finite())
 }
 
-fn check_bounded(name: &str, mesh: &Mesh, options: &SimOptions) -> Result<sim::SimSummary, String> {
+fn check_bounded(name: &str, mesh: &Mesh, options: &SimOptions) -> anyhow::Result<sim::SimSummary> {
     let (lo, hi) = sim::play_volume(mesh, options.radius);
     let (events, summary) = events(mesh, options)?;
     ensure!(!events.is_empty(), "{name}: no sweeps");
@@ -230,10 +228,10 @@ fn check_bounded(name: &str, mesh: &Mesh, options: &SimOptions) -> Result<sim::S
     Ok(summary)
 }
 
-fn no_nan_and_balls_stay_in_the_play_volume() -> Result<(), String> {
+fn no_nan_and_balls_stay_in_the_play_volume() -> anyhow::Result<()> {
     for name in BuiltinScene::all().map(BuiltinScene::name) {
         let s = scene(name);
-        let mesh = s.to_mesh().map_err(|e| e.to_string())?;
+        let mesh = s.to_mesh()?;
         let options = SimOptions {
             frames: 200,
             ..BuiltinScene::from_name(name)
@@ -252,9 +250,9 @@ fn no_nan_and_balls_stay_in_the_play_volume() -> Result<(), String> {
     Ok(())
 }
 
-fn runaway_balls_are_stopped_not_nan() -> Result<(), String> {
+fn runaway_balls_are_stopped_not_nan() -> anyhow::Result<()> {
     let s = scene("triangle");
-    let mesh = s.to_mesh().map_err(|e| e.to_string())?;
+    let mesh = s.to_mesh()?;
     let options = SimOptions {
         balls: 3,
         velocity: [1e6, -3e5, 2e5],
@@ -276,9 +274,9 @@ fn runaway_balls_are_stopped_not_nan() -> Result<(), String> {
     Ok(())
 }
 
-fn sub_steps_are_separate_frames_in_time_order() -> Result<(), String> {
+fn sub_steps_are_separate_frames_in_time_order() -> anyhow::Result<()> {
     let s = scene("box");
-    let mesh = s.to_mesh().map_err(|e| e.to_string())?;
+    let mesh = s.to_mesh()?;
     let options = SimOptions {
         frames: 300,
         ..BuiltinScene::Box.sim_options()
@@ -320,7 +318,7 @@ fn sub_steps_are_separate_frames_in_time_order() -> Result<(), String> {
     Ok(())
 }
 
-fn invalid_options_are_errors() -> Result<(), String> {
+fn invalid_options_are_errors() -> anyhow::Result<()> {
     let base = SimOptions::default();
     let cases: Vec<(&str, SimOptions)> = vec![
         (
@@ -381,27 +379,25 @@ fn invalid_options_are_errors() -> Result<(), String> {
             },
         ),
     ];
-    let mesh = scene("cube").to_mesh().map_err(|e| e.to_string())?;
+    let mesh = scene("cube").to_mesh()?;
     for (field, options) in cases {
         match sim::simulate::<SimError>(&mesh, &options, |_| Ok(())) {
             Err(SimError::Invalid { field: f, .. }) if f == field => {}
             other => {
-                return Err(format!(
-                    "{field}: expected an error naming `{field}`, got {other:?}"
-                ));
+                anyhow::bail!("{field}: expected an error naming `{field}`, got {other:?}");
             }
         }
     }
     Ok(())
 }
 
-fn scenes_have_no_degenerate_triangles() -> Result<(), String> {
+fn scenes_have_no_degenerate_triangles() -> anyhow::Result<()> {
     for name in BuiltinScene::all().map(BuiltinScene::name) {
         let s = BuiltinScene::from_name(name)
             .map(BuiltinScene::mesh)
-            .ok_or(format!("{name} missing"))?;
+            .context(format!("{name} missing"))?;
         ensure!(s.name == *name, "scene `{name}` is named `{}`", s.name);
-        let mesh = s.to_mesh().map_err(|e| format!("{name}: {e}"))?;
+        let mesh = s.to_mesh().map_err(|e| anyhow::anyhow!("{name}: {e}"))?;
         ensure!(
             mesh.degenerate().is_empty(),
             "{name}: degenerate triangles {:?}",
@@ -435,11 +431,11 @@ fn check_sides(
     name: &str,
     plays: impl Fn(&Point3<f64>) -> bool,
     hidden: impl Fn(&Point3<f64>) -> bool,
-) -> Result<(), String> {
+) -> anyhow::Result<()> {
     let s = BuiltinScene::from_name(name)
         .map(BuiltinScene::mesh)
-        .ok_or(format!("{name} missing"))?;
-    let mesh = s.to_mesh().map_err(|e| e.to_string())?;
+        .context(format!("{name} missing"))?;
+    let mesh = s.to_mesh()?;
     for t in mesh.triangles() {
         let [a, b, c] = t.vertices;
         let centroid = Point3::from((a.coords + b.coords + c.coords) / 3.0);
@@ -455,11 +451,11 @@ fn check_sides(
     Ok(())
 }
 
-fn scenes_face_the_play_side() -> Result<(), String> {
+fn scenes_face_the_play_side() -> anyhow::Result<()> {
     // The closed box: inward.
     let h = scenes::BOX_HALF_WIDTH;
     check_sides("box", |p| p.iter().all(|v| v.abs() < h), |_| false)?;
-    let mesh = scenes::closed_box().to_mesh().map_err(|e| e.to_string())?;
+    let mesh = scenes::closed_box().to_mesh()?;
     for t in mesh.triangles() {
         ensure!(
             t.normal
@@ -472,7 +468,7 @@ fn scenes_face_the_play_side() -> Result<(), String> {
     // The bowl: above its surface (the paraboloid is convex, so a point
     // just above a flat triangle is above the surface only near its centre;
     // use the triangle's plane instead: the normal points up).
-    let bowl = scenes::bowl().to_mesh().map_err(|e| e.to_string())?;
+    let bowl = scenes::bowl().to_mesh()?;
     for t in bowl.triangles() {
         ensure!(
             t.normal.z.is_sign_positive(),
@@ -490,7 +486,7 @@ fn scenes_face_the_play_side() -> Result<(), String> {
         );
     }
     // The terrain: up.
-    let terrain = scenes::terrain(16).to_mesh().map_err(|e| e.to_string())?;
+    let terrain = scenes::terrain(16).to_mesh()?;
     ensure!(
         terrain.triangles().iter().all(|t| t.normal.z > 0.0),
         "terrain: a triangle faces down"
@@ -515,16 +511,16 @@ fn scenes_face_the_play_side() -> Result<(), String> {
     Ok(())
 }
 
-fn terrain_has_at_least_100k_triangles() -> Result<(), String> {
+fn terrain_has_at_least_100k_triangles() -> anyhow::Result<()> {
     let t = BuiltinScene::from_name("terrain")
         .map(BuiltinScene::mesh)
-        .ok_or("terrain missing")?;
+        .context("terrain missing")?;
     ensure!(
         t.triangles.len() >= 100_000,
         "terrain has {} triangles",
         t.triangles.len()
     );
-    let mesh = t.to_mesh().map_err(|e| e.to_string())?;
+    let mesh = t.to_mesh()?;
     ensure!(
         mesh.degenerate().is_empty(),
         "terrain: {} degenerate",
@@ -557,14 +553,14 @@ fn terrain_has_at_least_100k_triangles() -> Result<(), String> {
     Ok(())
 }
 
-fn obj_loads() -> Result<(), String> {
-    let dir = tempfile::tempdir().map_err(|e| e.to_string())?;
+fn obj_loads() -> anyhow::Result<()> {
+    let dir = tempfile::tempdir()?;
     let path = dir.path().join("ramp.obj");
     let text = "# a unit quad facing +z and a triangle in another object\n\
                 o quad\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 4\n\
                 o tri\nv 0 0 1\nv 1 0 1\nv 0 1 1\nf 5 6 7\n";
-    std::fs::write(&path, text).map_err(|e| e.to_string())?;
-    let scene = sim::load_obj(&path).map_err(|e| e.to_string())?;
+    std::fs::write(&path, text)?;
+    let scene = sim::load_obj(&path)?;
     ensure!(scene.name == "ramp", "named `{}`", scene.name);
     ensure!(
         scene.triangles.len() == 3,
@@ -576,7 +572,7 @@ fn obj_loads() -> Result<(), String> {
         "{} vertices",
         scene.vertices.len()
     );
-    let mesh = scene.to_mesh().map_err(|e| e.to_string())?;
+    let mesh = scene.to_mesh()?;
     ensure!(
         mesh.triangles().iter().all(|t| t.normal.z > 0.99),
         "OBJ faces must keep their winding (+z)"
@@ -597,8 +593,8 @@ fn obj_loads() -> Result<(), String> {
     Ok(())
 }
 
-fn bad_obj_is_a_clear_error() -> Result<(), String> {
-    let dir = tempfile::tempdir().map_err(|e| e.to_string())?;
+fn bad_obj_is_a_clear_error() -> anyhow::Result<()> {
+    let dir = tempfile::tempdir()?;
     let cases = [
         (
             "parse.obj",
@@ -618,13 +614,13 @@ fn bad_obj_is_a_clear_error() -> Result<(), String> {
     ];
     for (file, text, want) in cases {
         let path = dir.path().join(file);
-        std::fs::write(&path, text).map_err(|e| e.to_string())?;
+        std::fs::write(&path, text)?;
         match sim::load_obj(&path) {
             Ok(s) => {
-                return Err(format!(
+                anyhow::bail!(
                     "{file}: loaded {} triangles, expected an error",
                     s.triangles.len()
-                ));
+                );
             }
             Err(e) => {
                 let msg = e.to_string();
@@ -638,18 +634,18 @@ fn bad_obj_is_a_clear_error() -> Result<(), String> {
     let missing = dir.path().join("missing.obj");
     match sim::load_obj(&missing) {
         Err(e) => ensure!(e.to_string().contains("cannot read"), "missing file: `{e}`"),
-        Ok(_) => return Err("a missing file loaded".into()),
+        Ok(_) => return Err(anyhow::anyhow!("a missing file loaded")),
     }
     Ok(())
 }
 
-fn sample_traces_cover_every_kind() -> Result<(), String> {
+fn sample_traces_cover_every_kind() -> anyhow::Result<()> {
     let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("traces");
     let mut kinds = BTreeSet::new();
     let (mut several_balls, mut margin, mut strict, mut count) = (false, false, false, 0);
-    let entries = std::fs::read_dir(&dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+    let entries = std::fs::read_dir(&dir).map_err(|e| anyhow::anyhow!("{}: {e}", dir.display()))?;
     for entry in entries {
-        let path = entry.map_err(|e| e.to_string())?.path();
+        let path = entry?.path();
         let name = path
             .file_name()
             .map(|n| n.to_string_lossy().into_owned())
@@ -658,7 +654,7 @@ fn sample_traces_cover_every_kind() -> Result<(), String> {
             continue;
         }
         count += 1;
-        let bytes = std::fs::read(&path).map_err(|e| e.to_string())?;
+        let bytes = std::fs::read(&path)?;
         ensure!(
             bytes.len() < 1 << 20,
             "{name} is {} bytes (over 1 MiB)",
@@ -698,10 +694,10 @@ fn sample_traces_cover_every_kind() -> Result<(), String> {
 /// committed trace is made by one of them. (A sample written by an older
 /// recorder, such as `"feature": 0` where `record` now writes `null` for a
 /// face, fails here: regenerate the samples with the script.)
-fn regenerate_script_reproduces_every_sample_trace() -> Result<(), String> {
+fn regenerate_script_reproduces_every_sample_trace() -> anyhow::Result<()> {
     let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
     let script = std::fs::read_to_string(root.join("scripts/regenerate_traces.sh"))
-        .map_err(|e| format!("scripts/regenerate_traces.sh: {e}"))?;
+        .map_err(|e| anyhow::anyhow!("scripts/regenerate_traces.sh: {e}"))?;
     let commands: Vec<(String, Vec<String>)> = script
         .lines()
         .filter_map(|l| l.strip_prefix("record "))
@@ -715,7 +711,7 @@ fn regenerate_script_reproduces_every_sample_trace() -> Result<(), String> {
         commands.len() >= 5,
         "record lines found in the script: {commands:?}"
     );
-    let dir = tempfile::tempdir().map_err(|e| e.to_string())?;
+    let dir = tempfile::tempdir()?;
     let mut problems = Vec::new();
     let mut made = BTreeSet::new();
     for (name, args) in &commands {
@@ -725,8 +721,7 @@ fn regenerate_script_reproduces_every_sample_trace() -> Result<(), String> {
             .args(args)
             .arg("-o")
             .arg(&fresh)
-            .output()
-            .map_err(|e| e.to_string())?;
+            .output()?;
         ensure!(
             out.status.success(),
             "record {}: {}",
@@ -734,9 +729,9 @@ fn regenerate_script_reproduces_every_sample_trace() -> Result<(), String> {
             String::from_utf8_lossy(&out.stderr)
         );
         made.insert(name.clone());
-        let fresh = std::fs::read(&fresh).map_err(|e| e.to_string())?;
+        let fresh = std::fs::read(&fresh)?;
         let committed = std::fs::read(root.join("traces").join(name))
-            .map_err(|e| format!("traces/{name}: {e}"))?;
+            .map_err(|e| anyhow::anyhow!("traces/{name}: {e}"))?;
         if fresh != committed {
             let at = fresh
                 .iter()
@@ -763,8 +758,8 @@ fn regenerate_script_reproduces_every_sample_trace() -> Result<(), String> {
             ));
         }
     }
-    for entry in std::fs::read_dir(root.join("traces")).map_err(|e| e.to_string())? {
-        let name = entry.map_err(|e| e.to_string())?.file_name();
+    for entry in std::fs::read_dir(root.join("traces"))? {
+        let name = entry?.file_name();
         let name = name.to_string_lossy();
         if name.ends_with(".mcap") && !made.contains(name.as_ref()) {
             problems.push(format!("traces/{name} is not made by the script"));
@@ -779,8 +774,8 @@ fn regenerate_script_reproduces_every_sample_trace() -> Result<(), String> {
 }
 
 /// Every trace event of `bytes`, in order.
-fn trace_events(bytes: &[u8]) -> Result<Vec<TraceEvent>, String> {
+fn trace_events(bytes: &[u8]) -> anyhow::Result<Vec<TraceEvent>> {
     TraceReader::new(bytes, "<memory>")
         .collect::<Result<Vec<_>, _>>()
-        .map_err(|e| e.to_string())
+        .map_err(anyhow::Error::from)
 }

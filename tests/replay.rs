@@ -27,6 +27,7 @@ use sweeptrace::viz;
 
 use crate::ensure;
 use crate::trial;
+use anyhow::Context as _;
 
 pub fn tests() -> Vec<Trial> {
     vec![
@@ -131,11 +132,11 @@ fn events_for(scene: SceneMsg, sweeps: &[SweepMsg]) -> Events {
 fn run(
     events: Events,
     options: ReplayOptions,
-) -> Result<(Vec<SweepResult>, ReplaySummary), String> {
+) -> anyhow::Result<(Vec<SweepResult>, ReplaySummary)> {
     let mut it = replay_events(events.into_iter(), options);
     let mut out = Vec::new();
     for e in it.by_ref() {
-        match e.map_err(|e| e.to_string())? {
+        match e? {
             ReplayEvent::Sweep(r) => out.push(*r),
             ReplayEvent::Scene(_) => {}
         }
@@ -151,7 +152,7 @@ fn explained(detail: Detail) -> ReplayOptions {
     }
 }
 
-fn outcomes_equal_sweep_mesh() -> Result<(), String> {
+fn outcomes_equal_sweep_mesh() -> anyhow::Result<()> {
     let scene = cube_scene();
     let mesh = mesh_of(&scene);
     let sweeps = random_sweeps(7, 150, 2);
@@ -173,8 +174,7 @@ fn outcomes_equal_sweep_mesh() -> Result<(), String> {
                 &mesh,
                 &Sweep::new(s.p0, s.p1, s.radius),
                 &Options::default(),
-            )
-            .map_err(|e| e.to_string())?;
+            )?;
             ensure!(
                 r.outcome == want,
                 "{detail}: frame {} ball {}: {:?} != {:?}",
@@ -211,7 +211,7 @@ fn outcomes_equal_sweep_mesh() -> Result<(), String> {
     Ok(())
 }
 
-fn outcomes_equal_without_explanation() -> Result<(), String> {
+fn outcomes_equal_without_explanation() -> anyhow::Result<()> {
     let scene = cube_scene();
     let sweeps = random_sweeps(11, 80, 1);
     let fast = run(events_for(scene.clone(), &sweeps), ReplayOptions::default())?.0;
@@ -232,10 +232,10 @@ fn outcomes_equal_without_explanation() -> Result<(), String> {
     Ok(())
 }
 
-fn frame_and_ball_filters() -> Result<(), String> {
+fn frame_and_ball_filters() -> anyhow::Result<()> {
     let sweeps = random_sweeps(3, 40, 3);
     let options = ReplayOptions {
-        frames: "10..20".parse()?,
+        frames: "10..20".parse().map_err(anyhow::Error::msg)?,
         ball: Some(1),
         ..explained(Detail::Primary)
     };
@@ -251,7 +251,7 @@ fn frame_and_ball_filters() -> Result<(), String> {
     let (open, _) = run(
         events_for(cube_scene(), &sweeps),
         ReplayOptions {
-            frames: "38..".parse()?,
+            frames: "38..".parse().map_err(anyhow::Error::msg)?,
             ..ReplayOptions::default()
         },
     )?;
@@ -263,17 +263,17 @@ fn frame_and_ball_filters() -> Result<(), String> {
     Ok(())
 }
 
-fn frame_range_parsing() -> Result<(), String> {
-    let r: FrameRange = "3..7".parse()?;
+fn frame_range_parsing() -> anyhow::Result<()> {
+    let r: FrameRange = "3..7".parse().map_err(anyhow::Error::msg)?;
     ensure!(
         r.contains(3) && r.contains(6) && !r.contains(7) && !r.contains(2),
         "3..7"
     );
-    let r: FrameRange = "3..=7".parse()?;
+    let r: FrameRange = "3..=7".parse().map_err(anyhow::Error::msg)?;
     ensure!(r.contains(7) && !r.contains(8), "3..=7");
-    let r: FrameRange = "5".parse()?;
+    let r: FrameRange = "5".parse().map_err(anyhow::Error::msg)?;
     ensure!(r.contains(5) && !r.contains(4) && !r.contains(6), "5");
-    let r: FrameRange = "..4".parse()?;
+    let r: FrameRange = "..4".parse().map_err(anyhow::Error::msg)?;
     ensure!(r.contains(0) && !r.contains(4), "..4");
     for bad in ["7..3", "5..5", "a..b", "", "1..2..3", "-1..4"] {
         ensure!(
@@ -284,7 +284,7 @@ fn frame_range_parsing() -> Result<(), String> {
     Ok(())
 }
 
-fn detail_levels_choose_records() -> Result<(), String> {
+fn detail_levels_choose_records() -> anyhow::Result<()> {
     let scene = cube_scene();
     let mesh = mesh_of(&scene);
     let sweeps = random_sweeps(5, 120, 1);
@@ -309,8 +309,7 @@ fn detail_levels_choose_records() -> Result<(), String> {
             &Options::default(),
             Broadphase::Bvh,
             &mut bvh,
-        )
-        .map_err(|e| e.to_string())?;
+        )?;
         ensure!(
             c.records == bvh.records,
             "frame {}: candidates are not the BVH's tests",
@@ -328,7 +327,7 @@ fn detail_levels_choose_records() -> Result<(), String> {
             let first = p
                 .records
                 .first()
-                .ok_or(format!("frame {}: hit without records", p.frame))?;
+                .context(format!("frame {}: hit without records", p.frame))?;
             ensure!(
                 o.is_reported_by(first),
                 "frame {}: first primary record {first:?} is not the primary test {o:?}",
@@ -340,7 +339,7 @@ fn detail_levels_choose_records() -> Result<(), String> {
                 p.frame
             );
             for r in &p.records {
-                let alpha = r.alpha().ok_or(format!(
+                let alpha = r.alpha().context(format!(
                     "frame {}: a non-hit among primary records",
                     p.frame
                 ))?;
@@ -396,7 +395,7 @@ fn detail_levels_choose_records() -> Result<(), String> {
     Ok(())
 }
 
-fn expected_attached_before_and_after() -> Result<(), String> {
+fn expected_attached_before_and_after() -> anyhow::Result<()> {
     let scene = triangle_scene();
     let sweep = |frame| SweepMsg {
         frame,
@@ -480,7 +479,7 @@ fn expected_attached_before_and_after() -> Result<(), String> {
     Ok(())
 }
 
-fn scene_overrides_apply() -> Result<(), String> {
+fn scene_overrides_apply() -> anyhow::Result<()> {
     // Worked example 1 with margin 0.25: ρ = 0.25, β = (3 - 0.25) / 6.
     let sweep = SweepMsg {
         frame: 0,
@@ -515,7 +514,7 @@ fn scene_overrides_apply() -> Result<(), String> {
     Ok(())
 }
 
-fn sweep_before_scene_is_an_error() -> Result<(), String> {
+fn sweep_before_scene_is_an_error() -> anyhow::Result<()> {
     let sweep = SweepMsg {
         frame: 4,
         ball: 0,
@@ -557,28 +556,26 @@ fn sweep_before_scene_is_an_error() -> Result<(), String> {
     Ok(())
 }
 
-fn write_trace(scene: &SceneMsg, sweeps: &[SweepMsg], expected: bool) -> Result<Vec<u8>, String> {
-    let mut w = TraceWriter::new(std::io::Cursor::new(Vec::new())).map_err(|e| e.to_string())?;
-    w.scene(0, scene).map_err(|e| e.to_string())?;
+fn write_trace(scene: &SceneMsg, sweeps: &[SweepMsg], expected: bool) -> anyhow::Result<Vec<u8>> {
+    let mut w = TraceWriter::new(std::io::Cursor::new(Vec::new()))?;
+    w.scene(0, scene)?;
     let mesh = mesh_of(scene);
     for s in sweeps {
         let t = 1_000_000 * (s.frame + 1);
-        w.sweep(t, s).map_err(|e| e.to_string())?;
+        w.sweep(t, s)?;
         if expected {
             let o = sweep_mesh(
                 &mesh,
                 &Sweep::new(s.p0, s.p1, s.radius),
                 &Options::default(),
-            )
-            .map_err(|e| e.to_string())?;
-            w.expected(t, &OutcomeMsg::from_outcome(s.frame, s.ball, &o))
-                .map_err(|e| e.to_string())?;
+            )?;
+            w.expected(t, &OutcomeMsg::from_outcome(s.frame, s.ball, &o))?;
         }
     }
-    Ok(w.finish().map_err(|e| e.to_string())?.into_inner())
+    Ok(w.finish()?.into_inner())
 }
 
-fn through_an_mcap_trace() -> Result<(), String> {
+fn through_an_mcap_trace() -> anyhow::Result<()> {
     let scene = cube_scene();
     let sweeps = random_sweeps(13, 60, 2);
     let bytes = write_trace(&scene, &sweeps, true)?;
@@ -588,10 +585,10 @@ fn through_an_mcap_trace() -> Result<(), String> {
     );
     let mut n = 0;
     for e in it.by_ref() {
-        if let ReplayEvent::Sweep(r) = e.map_err(|e| e.to_string())? {
+        if let ReplayEvent::Sweep(r) = e? {
             let exp = r
                 .expected
-                .ok_or(format!("frame {}: expected not attached", r.frame))?;
+                .context(format!("frame {}: expected not attached", r.frame))?;
             ensure!(
                 exp == r.outcome_msg(),
                 "frame {}: expected {exp:?} != {:?}",
@@ -715,13 +712,13 @@ impl Decoded {
     }
 }
 
-pub(crate) fn decode_rrd(path: &std::path::Path) -> Result<Decoded, String> {
+pub(crate) fn decode_rrd(path: &std::path::Path) -> anyhow::Result<Decoded> {
     use rerun::external::re_log_encoding::DecoderApp;
     use rerun::log::{Chunk, LogMsg};
-    let file = std::fs::File::open(path).map_err(|e| e.to_string())?;
+    let file = std::fs::File::open(path)?;
     let mut d = Decoded::default();
     for msg in DecoderApp::decode_lazy(BufReader::new(file)) {
-        let msg = msg.map_err(|e| format!("decoding {}: {e}", path.display()))?;
+        let msg = msg.map_err(|e| anyhow::anyhow!("decoding {}: {e}", path.display()))?;
         match &msg {
             LogMsg::SetStoreInfo(info) => {
                 if info.info.store_id.kind() == rerun::StoreKind::Blueprint {
@@ -733,7 +730,7 @@ pub(crate) fn decode_rrd(path: &std::path::Path) -> Result<Decoded, String> {
                 }
             }
             LogMsg::ArrowMsg(store, arrow) => {
-                let chunk = Chunk::from_arrow_msg(arrow).map_err(|e| e.to_string())?;
+                let chunk = Chunk::from_arrow_msg(arrow)?;
                 if store.kind() != rerun::StoreKind::Recording {
                     if let Some(paths) = d.blueprint_paths.last_mut() {
                         paths.push(chunk.entity_path().to_string());
@@ -873,7 +870,7 @@ fn write_rrd(
     results_of: Events,
     detail: Detail,
     path: &std::path::Path,
-) -> Result<Vec<SweepResult>, String> {
+) -> anyhow::Result<Vec<SweepResult>> {
     write_rrd_with(results_of.into_iter(), detail, path)
 }
 
@@ -881,16 +878,14 @@ fn write_rrd_with(
     results_of: impl Iterator<Item = Result<TraceEvent, TraceError>>,
     detail: Detail,
     path: &std::path::Path,
-) -> Result<Vec<SweepResult>, String> {
+) -> anyhow::Result<Vec<SweepResult>> {
     let id = viz::recording_id(&[b"test trace", detail.as_str().as_bytes()]);
-    let rec = viz::builder(&id, "test")
-        .save(path)
-        .map_err(|e| e.to_string())?;
-    let mut logger = viz::Logger::new(rec, true).map_err(|e| e.to_string())?;
+    let rec = viz::builder(&id, "test").save(path)?;
+    let mut logger = viz::Logger::new(rec, true)?;
     let mut results = Vec::new();
     for e in replay_events(results_of, explained(detail)) {
-        let e = e.map_err(|e| e.to_string())?;
-        logger.log(&e).map_err(|e| e.to_string())?;
+        let e = e?;
+        logger.log(&e)?;
         if let ReplayEvent::Sweep(r) = e {
             results.push(*r);
         }
@@ -899,8 +894,8 @@ fn write_rrd_with(
     Ok(results)
 }
 
-fn rrd_reads_back_through_rerun() -> Result<(), String> {
-    let dir = tempfile::tempdir().map_err(|e| e.to_string())?;
+fn rrd_reads_back_through_rerun() -> anyhow::Result<()> {
+    let dir = tempfile::tempdir()?;
     let path = dir.path().join("worked.rrd");
     let results = write_rrd(
         events_for(triangle_scene(), &worked_sweeps()),
@@ -942,14 +937,14 @@ fn rrd_reads_back_through_rerun() -> Result<(), String> {
             "/plots/ball/0/alpha".to_string(),
             "Scalars:scalars".to_string(),
         ))
-        .ok_or(format!(
+        .context(format!(
             "no α scalars; have {:?}",
             d.scalars.keys().collect::<Vec<_>>()
         ))?;
     for r in &results {
         let got = alpha
             .get(&(r.frame as i64))
-            .ok_or(format!("no α at frame {}", r.frame))?;
+            .context(format!("no α at frame {}", r.frame))?;
         ensure!(
             got == &vec![r.outcome.alpha],
             "frame {}: α {got:?}, outcome {}",
@@ -970,22 +965,22 @@ fn rrd_reads_back_through_rerun() -> Result<(), String> {
 
     // The roots of the decisive edge test (worked example 2: 0.43333, 0.56667).
     let TestRecord::Edge(edge) = results[1].records[0] else {
-        return Err(format!(
+        anyhow::bail!(
             "frame 1: decisive record is not an edge test: {:?}",
             results[1].records[0]
-        ));
+        );
     };
     // The `series`-th value of `entity`'s row at `frame`.
-    let scalar_at = |entity: &str, series: usize, frame: i64| -> Result<f64, String> {
+    let scalar_at = |entity: &str, series: usize, frame: i64| -> anyhow::Result<f64> {
         d.scalars
             .get(&(entity.to_string(), "Scalars:scalars".to_string()))
             .and_then(|m| m.get(&frame))
             .and_then(|v| v.get(series).copied())
-            .ok_or(format!("no scalar {entity}[{series}] at frame {frame}"))
+            .context(format!("no scalar {entity}[{series}] at frame {frame}"))
     };
     let q = "/plots/ball/0/quadratic";
     let face = "/plots/ball/0/face";
-    let (s0, s1) = edge.roots.ok_or("edge without roots")?;
+    let (s0, s1) = edge.roots.context("edge without roots")?;
     ensure!(scalar_at(q, 4, 1)? == s0, "s0 differs");
     ensure!(scalar_at(q, 5, 1)? == s1, "s1 differs");
     ensure!(
@@ -1017,13 +1012,13 @@ fn rrd_reads_back_through_rerun() -> Result<(), String> {
         .translations
         .get("/world/ball/0/edge/0")
         .and_then(|m| m.get(&1))
-        .ok_or("no edge transform at frame 1")?;
+        .context("no edge transform at frame 1")?;
     ensure!(t.iter().all(|c| c.abs() < 1e-6), "translation {t:?}");
     let q = d
         .quaternions
         .get("/world/ball/0/edge/0")
         .and_then(|m| m.get(&1))
-        .ok_or("no edge rotation at frame 1")?;
+        .context("no edge rotation at frame 1")?;
     let h = std::f32::consts::FRAC_1_SQRT_2;
     let want = [h, 0.0, 0.0, h];
     let same = q.iter().zip(want).all(|(a, b)| (a - b).abs() < 1e-6)
@@ -1065,12 +1060,11 @@ fn rrd_reads_back_through_rerun() -> Result<(), String> {
     Ok(())
 }
 
-fn cli_writes_outcomes_and_rrd() -> Result<(), String> {
-    let dir = tempfile::tempdir().map_err(|e| e.to_string())?;
+fn cli_writes_outcomes_and_rrd() -> anyhow::Result<()> {
+    let dir = tempfile::tempdir()?;
     let trace = dir.path().join("cube run.mcap");
     let sweeps = random_sweeps(21, 30, 2);
-    std::fs::write(&trace, write_trace(&cube_scene(), &sweeps, true)?)
-        .map_err(|e| e.to_string())?;
+    std::fs::write(&trace, write_trace(&cube_scene(), &sweeps, true)?)?;
     let out = std::process::Command::new(env!("CARGO_BIN_EXE_sweeptrace"))
         .current_dir(dir.path())
         .args([
@@ -1085,12 +1079,11 @@ fn cli_writes_outcomes_and_rrd() -> Result<(), String> {
             "--detail",
             "candidates",
         ])
-        .output()
-        .map_err(|e| e.to_string())?;
+        .output()?;
     let stderr = String::from_utf8_lossy(&out.stderr);
     ensure!(out.status.success(), "replay failed: {stderr}");
     ensure!(stderr.contains("40 sweeps replayed"), "summary: {stderr}");
-    let lines = std::fs::read_to_string(dir.path().join("out.jsonl")).map_err(|e| e.to_string())?;
+    let lines = std::fs::read_to_string(dir.path().join("out.jsonl"))?;
     let lines: Vec<&str> = lines.lines().collect();
     ensure!(lines.len() == 40, "{} outcome lines", lines.len());
     let mesh = mesh_of(&cube_scene());
@@ -1099,10 +1092,10 @@ fn cli_writes_outcomes_and_rrd() -> Result<(), String> {
         .filter(|s| (5..25).contains(&s.frame))
         .collect();
     for (line, s) in lines.iter().zip(wanted) {
-        let v: serde_json::Value = serde_json::from_str(line).map_err(|e| e.to_string())?;
+        let v: serde_json::Value = serde_json::from_str(line)?;
         let keys: Vec<&str> = v
             .as_object()
-            .ok_or("not an object")?
+            .context("not an object")?
             .keys()
             .map(String::as_str)
             .collect();
@@ -1117,21 +1110,20 @@ fn cli_writes_outcomes_and_rrd() -> Result<(), String> {
             "fields {keys:?}"
         );
         // The additive `fragile` field; the rest is the outcome record.
-        let mut value: serde_json::Value = serde_json::from_str(line).map_err(|e| e.to_string())?;
+        let mut value: serde_json::Value = serde_json::from_str(line)?;
         let fragile = value
             .as_object_mut()
             .and_then(|o| o.remove("fragile"))
-            .ok_or("no fragile field")?;
+            .context("no fragile field")?;
         value.as_object_mut().and_then(|o| o.remove("tunnel"));
-        let o: OutcomeMsg = serde_json::from_value(value).map_err(|e| e.to_string())?;
+        let o: OutcomeMsg = serde_json::from_value(value)?;
         let want = sweep_mesh(
             &mesh,
             &Sweep::new(s.p0, s.p1, s.radius),
             &Options::default(),
-        )
-        .map_err(|e| e.to_string())?;
+        )?;
         ensure!(
-            fragile == serde_json::to_value(want.fragile).map_err(|e| e.to_string())?,
+            fragile == serde_json::to_value(want.fragile)?,
             "fragile {fragile} vs {}",
             want.fragile
         );
@@ -1146,8 +1138,7 @@ fn cli_writes_outcomes_and_rrd() -> Result<(), String> {
         "ball 1 plotted"
     );
     // Nothing left behind but the inputs and outputs.
-    let mut names: Vec<String> = std::fs::read_dir(dir.path())
-        .map_err(|e| e.to_string())?
+    let mut names: Vec<String> = std::fs::read_dir(dir.path())?
         .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
         .collect();
     names.sort();
@@ -1160,8 +1151,7 @@ fn cli_writes_outcomes_and_rrd() -> Result<(), String> {
     let out = std::process::Command::new(env!("CARGO_BIN_EXE_sweeptrace"))
         .current_dir(dir.path())
         .args(["replay", "cube run.mcap", "--ball", "0"])
-        .output()
-        .map_err(|e| e.to_string())?;
+        .output()?;
     ensure!(
         out.status.success(),
         "replay failed: {}",
@@ -1178,14 +1168,12 @@ fn cli_writes_outcomes_and_rrd() -> Result<(), String> {
 
     // A truncated trace: the readable part is still replayed, the exit code
     // says the input was incomplete.
-    let bytes = std::fs::read(&trace).map_err(|e| e.to_string())?;
-    std::fs::write(dir.path().join("cut.mcap"), &bytes[..bytes.len() * 2 / 3])
-        .map_err(|e| e.to_string())?;
+    let bytes = std::fs::read(&trace)?;
+    std::fs::write(dir.path().join("cut.mcap"), &bytes[..bytes.len() * 2 / 3])?;
     let out = std::process::Command::new(env!("CARGO_BIN_EXE_sweeptrace"))
         .current_dir(dir.path())
         .args(["replay", "cut.mcap", "--outcomes", "cut.jsonl"])
-        .output()
-        .map_err(|e| e.to_string())?;
+        .output()?;
     ensure!(
         out.status.code() == Some(3),
         "truncated trace: exit {:?}",
@@ -1200,24 +1188,22 @@ fn cli_writes_outcomes_and_rrd() -> Result<(), String> {
 /// recording with the same content (the bytes of two `.rrd` files still
 /// differ, see `blueprint_is_reproducible`); several batches of events and
 /// a scene change in the middle.
-fn threads_do_not_change_the_outputs() -> Result<(), String> {
-    let dir = tempfile::tempdir().map_err(|e| e.to_string())?;
+fn threads_do_not_change_the_outputs() -> anyhow::Result<()> {
+    let dir = tempfile::tempdir()?;
     let trace = dir.path().join("two scenes.mcap");
     let sweeps = random_sweeps(5, 600, 8);
-    let mut w = TraceWriter::new(std::io::Cursor::new(Vec::new())).map_err(|e| e.to_string())?;
-    w.scene(0, &cube_scene()).map_err(|e| e.to_string())?;
+    let mut w = TraceWriter::new(std::io::Cursor::new(Vec::new()))?;
+    w.scene(0, &cube_scene())?;
     for (i, s) in sweeps.iter().enumerate() {
         if i == sweeps.len() / 2 {
-            w.scene(1_000_000 * s.frame, &triangle_scene())
-                .map_err(|e| e.to_string())?;
+            w.scene(1_000_000 * s.frame, &triangle_scene())?;
         }
-        w.sweep(1_000_000 * (s.frame + 1), s)
-            .map_err(|e| e.to_string())?;
+        w.sweep(1_000_000 * (s.frame + 1), s)?;
     }
-    let bytes = w.finish().map_err(|e| e.to_string())?.into_inner();
-    std::fs::write(&trace, bytes).map_err(|e| e.to_string())?;
+    let bytes = w.finish()?.into_inner();
+    std::fs::write(&trace, bytes)?;
     let run =
-        |threads: &str, detail: &str, blueprint: bool| -> Result<(Vec<u8>, Vec<u8>), String> {
+        |threads: &str, detail: &str, blueprint: bool| -> anyhow::Result<(Vec<u8>, Vec<u8>)> {
             let outcomes = format!("{threads}-{detail}.jsonl");
             let rrd = format!("{threads}-{detail}-{blueprint}.rrd");
             let mut args = vec![
@@ -1238,16 +1224,15 @@ fn threads_do_not_change_the_outputs() -> Result<(), String> {
             let out = std::process::Command::new(env!("CARGO_BIN_EXE_sweeptrace"))
                 .current_dir(dir.path())
                 .args(&args)
-                .output()
-                .map_err(|e| e.to_string())?;
+                .output()?;
             ensure!(
                 out.status.success(),
                 "replay --threads {threads} failed: {}",
                 String::from_utf8_lossy(&out.stderr)
             );
             Ok((
-                std::fs::read(dir.path().join(&outcomes)).map_err(|e| e.to_string())?,
-                std::fs::read(dir.path().join(&rrd)).map_err(|e| e.to_string())?,
+                std::fs::read(dir.path().join(&outcomes))?,
+                std::fs::read(dir.path().join(&rrd))?,
             ))
         };
     {
@@ -1303,17 +1288,17 @@ enum Message {
     Activation(rerun::external::re_log_types::BlueprintActivationCommand),
 }
 
-fn rrd_messages(path: &std::path::Path) -> Result<Vec<Message>, String> {
+fn rrd_messages(path: &std::path::Path) -> anyhow::Result<Vec<Message>> {
     use rerun::external::re_log_encoding::DecoderApp;
     use rerun::log::{Chunk, LogMsg};
-    let file = std::fs::File::open(path).map_err(|e| e.to_string())?;
+    let file = std::fs::File::open(path)?;
     let mut messages = Vec::new();
     for msg in DecoderApp::decode_lazy(BufReader::new(file)) {
-        let msg = msg.map_err(|e| format!("decoding {}: {e}", path.display()))?;
+        let msg = msg.map_err(|e| anyhow::anyhow!("decoding {}: {e}", path.display()))?;
         messages.push(match msg {
             LogMsg::SetStoreInfo(info) => Message::StoreInfo(info),
             LogMsg::ArrowMsg(store, arrow) => {
-                let chunk = Chunk::from_arrow_msg(&arrow).map_err(|e| e.to_string())?;
+                let chunk = Chunk::from_arrow_msg(&arrow)?;
                 // `Chunk`'s `PartialEq` leaves the chunk id out.
                 Message::Chunk(store, chunk.id().to_string(), chunk)
             }
@@ -1329,9 +1314,9 @@ fn rrd_messages(path: &std::path::Path) -> Result<Vec<Message>, String> {
 /// layout is the default one (three containers, eight views with the
 /// followed ball's camera and the plots' time axes, the viewport, the
 /// panels). Only the recording's store-info row id differs.
-fn blueprint_is_reproducible() -> Result<(), String> {
+fn blueprint_is_reproducible() -> anyhow::Result<()> {
     use rerun::StoreKind;
-    let dir = tempfile::tempdir().map_err(|e| e.to_string())?;
+    let dir = tempfile::tempdir()?;
     let mut runs = Vec::new();
     for name in ["a.rrd", "b.rrd"] {
         let path = dir.path().join(name);
@@ -1431,7 +1416,7 @@ fn blueprint_is_reproducible() -> Result<(), String> {
 /// `replay_events_parallel` yields what `replay_events` yields, batch size
 /// 1 to many, with expected outcomes before and after their sweeps and an
 /// invalid sweep in the middle.
-fn parallel_iterator_equals_sequential() -> Result<(), String> {
+fn parallel_iterator_equals_sequential() -> anyhow::Result<()> {
     use sweeptrace::replay::replay_events_parallel;
     let sweeps = random_sweeps(9, 40, 3);
     let mesh = mesh_of(&cube_scene());
@@ -1445,8 +1430,7 @@ fn parallel_iterator_equals_sequential() -> Result<(), String> {
             &mesh,
             &Sweep::new(s.p0, s.p1, s.radius),
             &Options::default(),
-        )
-        .map_err(|e| e.to_string())?;
+        )?;
         let expected = TraceEvent::Expected {
             log_time_nanos: s.frame,
             index: 0,
@@ -1504,8 +1488,8 @@ fn parallel_iterator_equals_sequential() -> Result<(), String> {
 /// Fragile decisions are marked on the timeline, and only they: on the
 /// cube, a drop onto the shared edge `x = 1, z = 1` (two triangles tie, the
 /// path parallel to the `+x` face) and a drop onto the middle of a face.
-fn rrd_marks_fragile_decisions() -> Result<(), String> {
-    let dir = tempfile::tempdir().map_err(|e| e.to_string())?;
+fn rrd_marks_fragile_decisions() -> anyhow::Result<()> {
+    let dir = tempfile::tempdir()?;
     let path = dir.path().join("cube.rrd");
     let s = |frame, p0, p1| SweepMsg {
         frame,
@@ -1544,8 +1528,8 @@ fn rrd_marks_fragile_decisions() -> Result<(), String> {
 /// (the nearest one for the face and vertex decisions, labelled as such),
 /// with its axes, and cleared when no test ran; plot values cleared where
 /// they stop existing; the followed ball's focus at every frame.
-fn rrd_shows_edges_features_and_explanations() -> Result<(), String> {
-    let dir = tempfile::tempdir().map_err(|e| e.to_string())?;
+fn rrd_shows_edges_features_and_explanations() -> anyhow::Result<()> {
+    let dir = tempfile::tempdir()?;
     let path = dir.path().join("worked.rrd");
     let results = write_rrd(
         events_for(triangle_scene(), &worked_sweeps()),
@@ -1722,7 +1706,7 @@ fn rrd_shows_edges_features_and_explanations() -> Result<(), String> {
     let focus = d
         .translations
         .get("/world/ball/0/focus")
-        .ok_or("no focus transform")?;
+        .context("no focus transform")?;
     ensure!(
         focus
             .keys()
@@ -1756,7 +1740,7 @@ fn rrd_shows_edges_features_and_explanations() -> Result<(), String> {
 /// flag exactly the frames `check` reports; the expected outcome is drawn
 /// at those frames and cleared after; the recording ends with the layout
 /// that leads with the divergences.
-fn viewer_and_check_agree_on_divergences() -> Result<(), String> {
+fn viewer_and_check_agree_on_divergences() -> anyhow::Result<()> {
     use std::collections::BTreeSet;
     use sweeptrace::regress::{CheckOptions, Tolerances, check_file};
     let fixture = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
@@ -1769,8 +1753,8 @@ fn viewer_and_check_agree_on_divergences() -> Result<(), String> {
     );
     let check_frames: BTreeSet<i64> = report.divergent_frames.iter().map(|&f| f as i64).collect();
 
-    let bytes = std::fs::read(&fixture).map_err(|e| e.to_string())?;
-    let dir = tempfile::tempdir().map_err(|e| e.to_string())?;
+    let bytes = std::fs::read(&fixture)?;
+    let dir = tempfile::tempdir()?;
     let path = dir.path().join("fixture.rrd");
     let results = write_rrd_with(
         TraceReader::new(bytes.as_slice(), "fixture.mcap"),
@@ -1806,7 +1790,7 @@ fn viewer_and_check_agree_on_divergences() -> Result<(), String> {
     let status = d
         .scalars
         .get(&("/status/ball/0".to_string(), "Scalars:scalars".to_string()))
-        .ok_or("no status series")?;
+        .context("no status series")?;
     for f in &all {
         let want = if check_frames.contains(f) { 1.0 } else { 0.0 };
         ensure!(
@@ -1862,20 +1846,18 @@ fn viewer_and_check_agree_on_divergences() -> Result<(), String> {
 /// sends its rows after every run of sweeps, as more and smaller chunks,
 /// and the recording holds the same values at the same frames as with the
 /// default bound.
-fn flush_by_bytes_keeps_the_content() -> Result<(), String> {
-    let dir = tempfile::tempdir().map_err(|e| e.to_string())?;
+fn flush_by_bytes_keeps_the_content() -> anyhow::Result<()> {
+    let dir = tempfile::tempdir()?;
     let sweeps = random_sweeps(12, 40, 3);
-    let write = |path: &std::path::Path, flush_bytes: Option<usize>| -> Result<(), String> {
+    let write = |path: &std::path::Path, flush_bytes: Option<usize>| -> anyhow::Result<()> {
         let id = viz::recording_id(&[b"flush by bytes"]);
-        let rec = viz::builder(&id, "test")
-            .save(path)
-            .map_err(|e| e.to_string())?;
-        let mut logger = viz::Logger::new(rec, true).map_err(|e| e.to_string())?;
+        let rec = viz::builder(&id, "test").save(path)?;
+        let mut logger = viz::Logger::new(rec, true)?;
         if let Some(bytes) = flush_bytes {
             logger = logger.with_flush_bytes(bytes);
         }
         log_cube_sweeps(&mut logger, &sweeps)?;
-        logger.flush().map_err(|e| e.to_string())?;
+        logger.flush()?;
         drop(logger.finish());
         Ok(())
     };
@@ -1883,7 +1865,7 @@ fn flush_by_bytes_keeps_the_content() -> Result<(), String> {
     let small_path = dir.path().join("small.rrd");
     write(&default_path, None)?;
     write(&small_path, Some(1))?;
-    let chunks = |path: &std::path::Path| -> Result<usize, String> {
+    let chunks = |path: &std::path::Path| -> anyhow::Result<usize> {
         Ok(rrd_messages(path)?
             .iter()
             .filter(|m| {
@@ -1894,33 +1876,29 @@ fn flush_by_bytes_keeps_the_content() -> Result<(), String> {
     };
     let (default_chunks, small_chunks) = (chunks(&default_path)?, chunks(&small_path)?);
     if small_chunks <= default_chunks {
-        return Err(format!(
+        anyhow::bail!(
             "a one-byte bound gave {small_chunks} temporal chunks, the default {default_chunks}: \
              the bound in bytes did not send the buffer"
-        ));
+        );
     }
     let (default_decoded, small_decoded) = (decode_rrd(&default_path)?, decode_rrd(&small_path)?);
     if default_decoded.components.is_empty() {
-        return Err("the recording holds no rows".into());
+        return Err(anyhow::anyhow!("the recording holds no rows"));
     }
     if default_decoded != small_decoded {
-        return Err(
-            "the recordings with the default and a one-byte bound differ in content".into(),
-        );
+        anyhow::bail!("the recordings with the default and a one-byte bound differ in content");
     }
     Ok(())
 }
 
 /// Replays `sweeps` against the cube scene (explained, `primary`) into
 /// `logger`.
-fn log_cube_sweeps(logger: &mut viz::Logger, sweeps: &[SweepMsg]) -> Result<(), String> {
+fn log_cube_sweeps(logger: &mut viz::Logger, sweeps: &[SweepMsg]) -> anyhow::Result<()> {
     for e in replay_events(
         events_for(cube_scene(), sweeps).into_iter(),
         explained(Detail::Primary),
     ) {
-        logger
-            .log(&e.map_err(|e| e.to_string())?)
-            .map_err(|e| e.to_string())?;
+        logger.log(&e?)?;
     }
     Ok(())
 }
@@ -1930,7 +1908,7 @@ fn log_cube_sweeps(logger: &mut viz::Logger, sweeps: &[SweepMsg]) -> Result<(), 
 type Rows = std::collections::BTreeSet<(String, String, i64, i64, String, String)>;
 
 /// Every row of a recording, whatever the chunks they came in.
-fn rows_of_rrd(path: &std::path::Path) -> Result<Rows, String> {
+fn rows_of_rrd(path: &std::path::Path) -> anyhow::Result<Rows> {
     use rerun::external::arrow::array::Array as _;
     let mut rows = std::collections::BTreeSet::new();
     for m in rrd_messages(path)? {
@@ -1978,8 +1956,8 @@ fn rows_of_rrd(path: &std::path::Path) -> Result<Rows, String> {
 /// At that frame the face plots must show the second sweep's values: its
 /// rows come after the first sweep's clears (the clears used to be written
 /// after the whole run's rows, and won).
-fn clears_keep_their_place_among_the_sweeps_of_a_frame() -> Result<(), String> {
-    let dir = tempfile::tempdir().map_err(|e| e.to_string())?;
+fn clears_keep_their_place_among_the_sweeps_of_a_frame() -> anyhow::Result<()> {
+    let dir = tempfile::tempdir()?;
     let path = dir.path().join("substeps.rrd");
     let w = worked_sweeps();
     let at = |frame, s: &SweepMsg| SweepMsg { frame, ..*s };
@@ -1987,23 +1965,21 @@ fn clears_keep_their_place_among_the_sweeps_of_a_frame() -> Result<(), String> {
     let sweeps = [at(0, &w[0]), at(1, &w[1]), at(1, &w[0])];
     // The three sweeps prepared as one run, as `replay` prepares them.
     let id = viz::recording_id(&[b"sub-steps"]);
-    let rec = viz::builder(&id, "test")
-        .save(&path)
-        .map_err(|e| e.to_string())?;
-    let mut logger = viz::Logger::new(rec, true).map_err(|e| e.to_string())?;
+    let rec = viz::builder(&id, "test").save(&path)?;
+    let mut logger = viz::Logger::new(rec, true)?;
     let mut results = Vec::new();
     for e in replay_events(
         events_for(triangle_scene(), &sweeps).into_iter(),
         explained(Detail::Primary),
     ) {
-        match e.map_err(|e| e.to_string())? {
-            ReplayEvent::Scene(scene) => logger.log_scene(&scene).map_err(|e| e.to_string())?,
+        match e? {
+            ReplayEvent::Scene(scene) => logger.log_scene(&scene)?,
             ReplayEvent::Sweep(r) => results.push(*r),
         }
     }
     let before = logger.shown_before(&results);
     let run = viz::prepare_sweeps(&results, &before, &logger.prepare_options());
-    logger.log_prepared(run).map_err(|e| e.to_string())?;
+    logger.log_prepared(run)?;
     drop(logger.finish());
     let kinds: Vec<_> = results.iter().map(|r| r.outcome.kind).collect();
     ensure!(
@@ -2031,41 +2007,35 @@ fn clears_keep_their_place_among_the_sweeps_of_a_frame() -> Result<(), String> {
 /// A recording whose rows waited in the temporary file (`with_spill`, what
 /// `replay --rrd FILE` does) holds the same rows as one sent at each flush,
 /// in fewer, longer chunks (at most the limit, here 16 rows, each).
-fn spilled_recording_holds_the_same_rows() -> Result<(), String> {
-    let dir = tempfile::tempdir().map_err(|e| e.to_string())?;
+fn spilled_recording_holds_the_same_rows() -> anyhow::Result<()> {
+    let dir = tempfile::tempdir()?;
     let sweeps = random_sweeps(14, 60, 5);
-    let write = |path: &std::path::Path, spill: bool| -> Result<(), String> {
+    let write = |path: &std::path::Path, spill: bool| -> anyhow::Result<()> {
         let (sink, writer) =
-            viz::rrd_file::create(path, viz::rrd_file::RrdFileOptions { footer: true })
-                .map_err(|e| e.to_string())?;
+            viz::rrd_file::create(path, viz::rrd_file::RrdFileOptions { footer: true })?;
         let id = viz::recording_id(&[b"spill"]);
         let rec = viz::builder(&id, "test")
-            .set_sinks(vec![Box::new(sink) as Box<dyn rerun::sink::LogSink>])
-            .map_err(|e| e.to_string())?;
+            .set_sinks(vec![Box::new(sink) as Box<dyn rerun::sink::LogSink>])?;
         // A flush every few sweeps: many parts per entity.
-        let mut logger = viz::Logger::new(rec, true)
-            .map_err(|e| e.to_string())?
-            .with_flush_rows(100);
+        let mut logger = viz::Logger::new(rec, true)?.with_flush_rows(100);
         if spill {
             // Chunks of at most 16 rows: some parts are cut, some chunks
             // go out during the replay.
             logger = logger
-                .with_spill(dir.path(), path)
-                .map_err(|e| e.to_string())?
+                .with_spill(dir.path(), path)?
                 .with_spill_chunk_rows(16);
         }
         log_cube_sweeps(&mut logger, &sweeps)?;
-        logger.send_all().map_err(|e| e.to_string())?;
+        logger.send_all()?;
         drop(logger.finish());
-        writer.finish().map_err(|e| e.to_string())?;
+        writer.finish()?;
         Ok(())
     };
     let direct = dir.path().join("direct.rrd");
     let spilled = dir.path().join("spilled.rrd");
     write(&direct, false)?;
     write(&spilled, true)?;
-    let leftovers: Vec<_> = std::fs::read_dir(dir.path())
-        .map_err(|e| e.to_string())?
+    let leftovers: Vec<_> = std::fs::read_dir(dir.path())?
         .filter_map(|e| e.ok())
         .map(|e| e.file_name())
         .filter(|n| n != "direct.rrd" && n != "spilled.rrd")
@@ -2076,11 +2046,9 @@ fn spilled_recording_holds_the_same_rows() -> Result<(), String> {
     if a != b {
         let only_a = a.difference(&b).next();
         let only_b = b.difference(&a).next();
-        return Err(format!(
-            "the rows differ: only sent directly {only_a:?}, only spilled {only_b:?}"
-        ));
+        anyhow::bail!("the rows differ: only sent directly {only_a:?}, only spilled {only_b:?}");
     }
-    let chunks = |path: &std::path::Path| -> Result<Vec<usize>, String> {
+    let chunks = |path: &std::path::Path| -> anyhow::Result<Vec<usize>> {
         Ok(rrd_messages(path)?
             .iter()
             .filter_map(|m| match m {
@@ -2114,34 +2082,34 @@ fn spilled_recording_holds_the_same_rows() -> Result<(), String> {
 /// The `.rrd` writer adds the footer (the index of every chunk, built in
 /// memory until the end) only when asked: the file with it is larger by
 /// that index, and both hold the same recording.
-fn rrd_footer_only_when_asked() -> Result<(), String> {
-    let dir = tempfile::tempdir().map_err(|e| e.to_string())?;
+fn rrd_footer_only_when_asked() -> anyhow::Result<()> {
+    let dir = tempfile::tempdir()?;
     let sweeps = random_sweeps(13, 30, 2);
-    let write = |path: &std::path::Path, footer: bool| -> Result<u64, String> {
-        let (sink, writer) = viz::rrd_file::create(path, viz::rrd_file::RrdFileOptions { footer })
-            .map_err(|e| e.to_string())?;
+    let write = |path: &std::path::Path, footer: bool| -> anyhow::Result<u64> {
+        let (sink, writer) = viz::rrd_file::create(path, viz::rrd_file::RrdFileOptions { footer })?;
         let id = viz::recording_id(&[b"footer"]);
         let rec = viz::builder(&id, "test")
-            .set_sinks(vec![Box::new(sink) as Box<dyn rerun::sink::LogSink>])
-            .map_err(|e| e.to_string())?;
-        let mut logger = viz::Logger::new(rec, true).map_err(|e| e.to_string())?;
+            .set_sinks(vec![Box::new(sink) as Box<dyn rerun::sink::LogSink>])?;
+        let mut logger = viz::Logger::new(rec, true)?;
         log_cube_sweeps(&mut logger, &sweeps)?;
-        logger.flush().map_err(|e| e.to_string())?;
+        logger.flush()?;
         drop(logger.finish());
-        writer.finish().map_err(|e| e.to_string())?;
-        Ok(std::fs::metadata(path).map_err(|e| e.to_string())?.len())
+        writer.finish()?;
+        Ok(std::fs::metadata(path)?.len())
     };
     let without = dir.path().join("without.rrd");
     let with = dir.path().join("with.rrd");
     let (size_without, size_with) = (write(&without, false)?, write(&with, true)?);
     if size_with <= size_without {
-        return Err(format!(
+        anyhow::bail!(
             "the file with the footer has {size_with} bytes, without it {size_without}: no footer written"
-        ));
+        );
     }
     let (a, b) = (decode_rrd(&without)?, decode_rrd(&with)?);
     if a.components.is_empty() || a != b {
-        return Err("the files with and without the footer hold different recordings".into());
+        return Err(anyhow::anyhow!(
+            "the files with and without the footer hold different recordings"
+        ));
     }
     Ok(())
 }
@@ -2150,8 +2118,8 @@ fn rrd_footer_only_when_asked() -> Result<(), String> {
 /// discriminant, s0, s1 of an edge or vertex test; h0, h1, β of a face
 /// test), with NaN, which the viewer draws as a break in the line, where
 /// the test has no such value (no real roots, no β) or it is not finite.
-fn plots_hold_the_decisive_numbers_nan_where_missing() -> Result<(), String> {
-    let dir = tempfile::tempdir().map_err(|e| e.to_string())?;
+fn plots_hold_the_decisive_numbers_nan_where_missing() -> anyhow::Result<()> {
+    let dir = tempfile::tempdir()?;
     let path = dir.path().join("plots.rrd");
     // One ball, so that each frame has one sweep.
     let results = write_rrd(
@@ -2220,8 +2188,8 @@ fn plots_hold_the_decisive_numbers_nan_where_missing() -> Result<(), String> {
 /// expectation names, run for the recording; an expectation naming a
 /// triangle the mesh does not have gets no edge frame (and the replay and
 /// the recording go on).
-fn expected_edge_test_only_of_an_existing_triangle() -> Result<(), String> {
-    let dir = tempfile::tempdir().map_err(|e| e.to_string())?;
+fn expected_edge_test_only_of_an_existing_triangle() -> anyhow::Result<()> {
+    let dir = tempfile::tempdir()?;
     let path = dir.path().join("expected_edge.rrd");
     // Frames 0 to 2: far from the triangle, so no test runs.
     let sweep = |frame| SweepMsg {

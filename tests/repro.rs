@@ -21,6 +21,7 @@ use crate::ensure;
 use crate::os;
 use crate::support::run_bin;
 use crate::trial;
+use anyhow::Context as _;
 
 pub fn tests() -> Vec<Trial> {
     vec![
@@ -61,21 +62,21 @@ fn fixture() -> PathBuf {
 }
 
 /// The numbers of a `(a, b, c)` group following `label` in `text`.
-fn numbers_after(text: &str, label: &str) -> Result<Vec<f64>, String> {
+fn numbers_after(text: &str, label: &str) -> anyhow::Result<Vec<f64>> {
     let start = text
         .find(label)
-        .ok_or_else(|| format!("no `{label}` in:\n{text}"))?
+        .with_context(|| format!("no `{label}` in:\n{text}"))?
         + label.len();
     let rest = &text[start..];
-    let open = rest.find('(').ok_or("no (")?;
-    let close = rest.find(')').ok_or("no )")?;
+    let open = rest.find('(').context("no (")?;
+    let close = rest.find(')').context("no )")?;
     rest[open + 1..close]
         .split(',')
-        .map(|t| parse_f64(t).ok_or_else(|| format!("`{t}` does not parse")))
+        .map(|t| parse_f64(t).with_context(|| format!("`{t}` does not parse")))
         .collect()
 }
 
-fn same_bits(what: &str, got: &[f64], want: &[f64]) -> Result<(), String> {
+fn same_bits(what: &str, got: &[f64], want: &[f64]) -> anyhow::Result<()> {
     ensure!(
         got.len() == want.len()
             && got
@@ -87,13 +88,13 @@ fn same_bits(what: &str, got: &[f64], want: &[f64]) -> Result<(), String> {
     Ok(())
 }
 
-fn divergence_inputs() -> Result<(), String> {
+fn divergence_inputs() -> anyhow::Result<()> {
     let options = CheckOptions {
         hex: true,
         ..CheckOptions::default()
     };
     let report = check_file(&fixture(), &options);
-    let d = report.divergences.first().ok_or("no divergence")?;
+    let d = report.divergences.first().context("no divergence")?;
     // Frame 2 of the fixture: p0 (2, -0.45, 3), p1 (2, -0.45, -3), r 0.5, margin 0.1.
     same_bits("p0", &d.inputs.p0, &[2.0, -0.45, 3.0])?;
     same_bits("p1", &d.inputs.p1, &[2.0, -0.45, -3.0])?;
@@ -112,10 +113,10 @@ fn divergence_inputs() -> Result<(), String> {
     );
     for d in &report.divergences {
         let block = sweeptrace::regress::render_divergence(d, "");
-        let inputs = &block[block.find("inputs: ").ok_or("inputs line")?..];
+        let inputs = &block[block.find("inputs: ").context("inputs line")?..];
         same_bits("decimal p0", &numbers_after(inputs, "p0 ")?, &d.inputs.p0)?;
         same_bits("decimal p1", &numbers_after(inputs, "p1 ")?, &d.inputs.p1)?;
-        let hex = &block[block.find("inputs (hex): ").ok_or("hex line")?..];
+        let hex = &block[block.find("inputs (hex): ").context("hex line")?..];
         same_bits("hex p0", &numbers_after(hex, "p0 ")?, &d.inputs.p0)?;
         same_bits("hex p1", &numbers_after(hex, "p1 ")?, &d.inputs.p1)?;
         // The pasted inputs make the same decision.
@@ -126,28 +127,29 @@ fn divergence_inputs() -> Result<(), String> {
             margin: 0.1,
             facing: Facing::NonStrict,
         };
-        let mesh =
-            Mesh::new(scene.vertices.clone(), &scene.triangles).map_err(|e| e.to_string())?;
+        let mesh = Mesh::new(scene.vertices.clone(), &scene.triangles)?;
         let again = sweep_mesh(
             &mesh,
             &Sweep::new(
-                numbers_after(hex, "p0 ")?.try_into().map_err(|_| "3")?,
-                numbers_after(hex, "p1 ")?.try_into().map_err(|_| "3")?,
+                numbers_after(hex, "p0 ")?
+                    .try_into()
+                    .map_err(|_| anyhow::anyhow!("3"))?,
+                numbers_after(hex, "p1 ")?
+                    .try_into()
+                    .map_err(|_| anyhow::anyhow!("3"))?,
                 d.inputs.radius,
             ),
             &d.inputs.options(),
-        )
-        .map_err(|e| e.to_string())?;
+        )?;
         ensure!(
             again.alpha.to_bits() == d.got.alpha.to_bits() && again.kind == d.got.kind,
             "pasted inputs decide {again:?}, the report says {:?}",
             d.got
         );
     }
-    let json: serde_json::Value =
-        serde_json::from_str(&render_json(&[report])).map_err(|e| e.to_string())?;
+    let json: serde_json::Value = serde_json::from_str(&render_json(&[report]))?;
     let inputs = &json["traces"][0]["divergences"][0]["inputs"];
-    let p0: Vec<f64> = serde_json::from_value(inputs["p0"].clone()).map_err(|e| e.to_string())?;
+    let p0: Vec<f64> = serde_json::from_value(inputs["p0"].clone())?;
     same_bits("json p0", &p0, &[2.0, -0.45, 3.0])?;
     ensure!(
         json["traces"][0]["divergences"][0]["inputs_hex"]["margin"] == "0x1.999999999999ap-4",
@@ -156,7 +158,7 @@ fn divergence_inputs() -> Result<(), String> {
     Ok(())
 }
 
-fn check_hex_binary() -> Result<(), String> {
+fn check_hex_binary() -> anyhow::Result<()> {
     let f = fixture();
     let (code, out, err) = run_bin(os!["check", f.as_os_str(), "--hex"])?;
     ensure!(code == 1, "exit {code}\n{out}\n{err}");
@@ -172,23 +174,22 @@ fn check_hex_binary() -> Result<(), String> {
     Ok(())
 }
 
-fn case_of(path: &Path, frame: u64, ball: u32) -> Result<ReproCase, String> {
+fn case_of(path: &Path, frame: u64, ball: u32) -> anyhow::Result<ReproCase> {
     let name = path.display().to_string();
-    let bytes = std::fs::read(path).map_err(|e| format!("{name}: {e}"))?;
+    let bytes = std::fs::read(path).map_err(|e| anyhow::anyhow!("{name}: {e}"))?;
     let found = find_sweep(
         TraceReader::new(bytes.as_slice(), &name),
         &name,
         frame,
         ball,
-    )
-    .map_err(|e| e.to_string())?;
-    ReproCase::build(&name, &found, &Tolerances::default()).map_err(|e| e.to_string())
+    )?;
+    ReproCase::build(&name, &found, &Tolerances::default()).map_err(anyhow::Error::from)
 }
 
-fn case_bytes(case: &ReproCase) -> Result<Vec<u8>, String> {
-    let mut w = TraceWriter::new(Cursor::new(Vec::new())).map_err(|e| e.to_string())?;
-    case.write(&mut w).map_err(|e| e.to_string())?;
-    Ok(w.finish().map_err(|e| e.to_string())?.into_inner())
+fn case_bytes(case: &ReproCase) -> anyhow::Result<Vec<u8>> {
+    let mut w = TraceWriter::new(Cursor::new(Vec::new()))?;
+    case.write(&mut w)?;
+    Ok(w.finish()?.into_inner())
 }
 
 /// The float literals of generated code, comments left out, in order.
@@ -209,7 +210,7 @@ fn float_literals(code: &str) -> Vec<String> {
 }
 
 /// The integer triples of the `&[...]` triangle list of generated code.
-fn triangle_literals(code: &str) -> Result<Vec<[u64; 3]>, String> {
+fn triangle_literals(code: &str) -> anyhow::Result<Vec<[u64; 3]>> {
     code.lines()
         .filter(|l| l.trim_start().starts_with('[') && l.contains("// triangle "))
         .map(|l| {
@@ -217,12 +218,17 @@ fn triangle_literals(code: &str) -> Result<Vec<[u64; 3]>, String> {
                 .trim()
                 .strip_prefix('[')
                 .and_then(|r| r.split(']').next())
-                .ok_or_else(|| format!("triangle line `{l}`"))?;
+                .with_context(|| format!("triangle line `{l}`"))?;
             let v: Vec<u64> = inner
                 .split(',')
-                .map(|t| t.trim().parse::<u64>().map_err(|e| format!("`{t}`: {e}")))
+                .map(|t| {
+                    t.trim()
+                        .parse::<u64>()
+                        .map_err(|e| anyhow::anyhow!("`{t}`: {e}"))
+                })
                 .collect::<Result<_, _>>()?;
-            v.try_into().map_err(|_| format!("three indices in `{l}`"))
+            v.try_into()
+                .map_err(|_| anyhow::anyhow!("three indices in `{l}`"))
         })
         .collect()
 }
@@ -230,7 +236,7 @@ fn triangle_literals(code: &str) -> Result<Vec<[u64; 3]>, String> {
 /// The generated test's numbers read back to the case's bits, and the
 /// test's calls, run here on the numbers read back, decide as its
 /// assertion says (it holds exactly when the expectation agrees).
-fn check_generated_test(case: &ReproCase) -> Result<(), String> {
+fn check_generated_test(case: &ReproCase) -> anyhow::Result<()> {
     let tol = Tolerances::default();
     let code = case.rust_test(&tol);
     let literals = float_literals(&code);
@@ -243,7 +249,7 @@ fn check_generated_test(case: &ReproCase) -> Result<(), String> {
     );
     let parsed: Vec<f64> = literals
         .iter()
-        .map(|t| t.parse::<f64>().map_err(|e| format!("`{t}`: {e}")))
+        .map(|t| t.parse::<f64>().map_err(|e| anyhow::anyhow!("`{t}`: {e}")))
         .collect::<Result<_, _>>()?;
     same_bits("generated literals", &parsed, &want)?;
     let nv = case.vertices.len();
@@ -260,13 +266,12 @@ fn check_generated_test(case: &ReproCase) -> Result<(), String> {
         triangles == case.triangles,
         "triangles of the code:\n{code}"
     );
-    let mesh = Mesh::new(vertices, &triangles).map_err(|e| e.to_string())?;
+    let mesh = Mesh::new(vertices, &triangles)?;
     let options = sweeptrace::Options {
         margin,
         facing: case.inputs.facing,
     };
-    let outcome =
-        sweep_mesh(&mesh, &Sweep::new(p0, p1, radius), &options).map_err(|e| e.to_string())?;
+    let outcome = sweep_mesh(&mesh, &Sweep::new(p0, p1, radius), &options)?;
     ensure!(
         outcome.alpha.to_bits() == case.reduced_outcome.alpha.to_bits()
             && outcome.kind == case.reduced_outcome.kind
@@ -277,8 +282,7 @@ fn check_generated_test(case: &ReproCase) -> Result<(), String> {
     let asserted = case.asserted();
     let got = OutcomeMsg::from_outcome(case.frame, case.ball, &outcome);
     let holds = if case.asserts_tie() {
-        let (_, ties) = sweeptrace::core::sweep_ties(&mesh, &Sweep::new(p0, p1, radius), &options)
-            .map_err(|e| e.to_string())?;
+        let (_, ties) = sweeptrace::core::sweep_ties(&mesh, &Sweep::new(p0, p1, radius), &options)?;
         let mut rest = compare(&asserted, &got, &tol);
         rest.retain(|f| {
             !matches!(
@@ -305,7 +309,7 @@ fn check_generated_test(case: &ReproCase) -> Result<(), String> {
     Ok(())
 }
 
-fn fixture_case() -> Result<(), String> {
+fn fixture_case() -> anyhow::Result<()> {
     let full = check_file(&fixture(), &CheckOptions::default());
     for frame in [2u64, 3] {
         let case = case_of(&fixture(), frame, 0)?;
@@ -321,7 +325,7 @@ fn fixture_case() -> Result<(), String> {
             .divergences
             .iter()
             .find(|d| d.frame == frame)
-            .ok_or("frame in the full report")?;
+            .context("frame in the full report")?;
         let got = &report.divergences[0];
         ensure!(
             got.fields
@@ -339,7 +343,7 @@ fn fixture_case() -> Result<(), String> {
 
 /// For every sample trace, a few sweeps of each kind (and fragile ones):
 /// the reduced case makes the same decision and checks `ok` on its own.
-fn sample_cases() -> Result<(), String> {
+fn sample_cases() -> anyhow::Result<()> {
     let mut cases = 0;
     for name in [
         "record_mini_golf.mcap",
@@ -349,7 +353,7 @@ fn sample_cases() -> Result<(), String> {
         "record_bowl_margin.mcap",
     ] {
         let path = root().join("traces").join(name);
-        let bytes = std::fs::read(&path).map_err(|e| e.to_string())?;
+        let bytes = std::fs::read(&path)?;
         let mut picked: Vec<(u64, u32)> = Vec::new();
         let mut seen: std::collections::BTreeMap<String, usize> = Default::default();
         for event in sweeptrace::replay_events(
@@ -395,8 +399,8 @@ fn sample_cases() -> Result<(), String> {
     Ok(())
 }
 
-fn repro_binary() -> Result<(), String> {
-    let dir = tempfile::tempdir().map_err(|e| e.to_string())?;
+fn repro_binary() -> anyhow::Result<()> {
+    let dir = tempfile::tempdir()?;
     let out = dir.path().join("case.mcap");
     let f = fixture();
     let (code, stdout, stderr) = run_bin(os![
@@ -446,7 +450,7 @@ fn repro_binary() -> Result<(), String> {
     Ok(())
 }
 
-fn sweep_sources() -> Result<(), String> {
+fn sweep_sources() -> anyhow::Result<()> {
     let f = fixture();
     let (code, out, err) = run_bin(os!["sweep", "--trace", f.as_os_str(), "--frame", "3"])?;
     ensure!(code == 0, "exit {code}\n{out}\n{err}");
@@ -479,15 +483,16 @@ fn sweep_sources() -> Result<(), String> {
         "3",
         "--json"
     ])?;
-    let json: serde_json::Value = serde_json::from_str(&out).map_err(|e| format!("{e}: {out}"))?;
+    let json: serde_json::Value =
+        serde_json::from_str(&out).map_err(|e| anyhow::anyhow!("{e}: {out}"))?;
     ensure!(
         json["expected"]["kind"] == "face" && json["margin"] == 0.1,
         "json: {json}"
     );
 
-    let dir = tempfile::tempdir().map_err(|e| e.to_string())?;
+    let dir = tempfile::tempdir()?;
     let obj = dir.path().join("ramp.obj");
-    std::fs::write(&obj, "v 0 0 0\nv 4 0 0\nv 0 4 0\nf 1 2 3\n").map_err(|e| e.to_string())?;
+    std::fs::write(&obj, "v 0 0 0\nv 4 0 0\nv 0 4 0\nf 1 2 3\n")?;
     let (code, out, err) = run_bin(os![
         "sweep",
         "--mesh",
@@ -522,7 +527,7 @@ fn sweep_sources() -> Result<(), String> {
     Ok(())
 }
 
-fn sweep_flag_errors() -> Result<(), String> {
+fn sweep_flag_errors() -> anyhow::Result<()> {
     let f = fixture();
     let cases: &[(&[&std::ffi::OsStr], &str)] = &[
         (os!["sweep", "--trace", f.as_os_str()], "--frame"),
@@ -576,9 +581,9 @@ fn sweep_flag_errors() -> Result<(), String> {
     Ok(())
 }
 
-fn infer_wrong_engine_config() -> Result<(), String> {
+fn infer_wrong_engine_config() -> anyhow::Result<()> {
     let report = check_file(&fixture(), &CheckOptions::default());
-    let inferred = report.inferred.as_ref().ok_or("nothing inferred")?;
+    let inferred = report.inferred.as_ref().context("nothing inferred")?;
     ensure!(inferred.margin == Some(0.0), "margin: {inferred:?}");
     ensure!(
         inferred.matches == 5 && inferred.compared == 5 && inferred.face_hits == 1,
@@ -590,8 +595,7 @@ fn infer_wrong_engine_config() -> Result<(), String> {
             && text.contains("expectations match with margin 0 and facing non_strict: 5 of 5"),
         "text:\n{text}"
     );
-    let json: serde_json::Value =
-        serde_json::from_str(&render_json(&[report])).map_err(|e| e.to_string())?;
+    let json: serde_json::Value = serde_json::from_str(&render_json(&[report]))?;
     ensure!(
         json["traces"][0]["inferred"]["margin"] == 0.0
             && json["traces"][0]["inferred"]["matches"] == 5,
@@ -613,13 +617,13 @@ pub(crate) fn recorded_by(
     sweeps: &[SweepMsg],
     margin: f64,
     facing: Facing,
-) -> Result<Vec<u8>, String> {
-    let mut w = TraceWriter::new(Cursor::new(Vec::new())).map_err(|e| e.to_string())?;
-    w.scene(0, scene).map_err(|e| e.to_string())?;
+) -> anyhow::Result<Vec<u8>> {
+    let mut w = TraceWriter::new(Cursor::new(Vec::new()))?;
+    w.scene(0, scene)?;
     for s in sweeps {
-        w.sweep(1 + s.frame, s).map_err(|e| e.to_string())?;
+        w.sweep(1 + s.frame, s)?;
     }
-    let plain = w.finish().map_err(|e| e.to_string())?.into_inner();
+    let plain = w.finish()?.into_inner();
     let options = ReplayOptions {
         margin: Some(margin),
         facing: Some(facing),
@@ -627,7 +631,7 @@ pub(crate) fn recorded_by(
     };
     bless_bytes(&plain, "<memory>", Cursor::new(Vec::new()), options)
         .map(|(_, c)| c.into_inner())
-        .map_err(|e| e.to_string())
+        .map_err(anyhow::Error::from)
 }
 
 /// A floor of two triangles (z = 0, front +z) and drops onto it, plus one
@@ -669,19 +673,19 @@ pub(crate) fn floor_and_sweeps(margin: f64, facing: Facing) -> (SceneMsg, Vec<Sw
     (scene, sweeps)
 }
 
-fn infer_parallel_hit() -> Result<(), String> {
+fn infer_parallel_hit() -> anyhow::Result<()> {
     // The engine: margin 0.05, non_strict; the scene declares margin 0, strict.
     let (scene, sweeps) = floor_and_sweeps(0.0, Facing::Strict);
     let bytes = recorded_by(&scene, &sweeps, 0.05, Facing::NonStrict)?;
     let report = check_reader(bytes.as_slice(), "floor", &CheckOptions::default());
     ensure!(report.status() == Status::Fail, "{}", render_text(&report));
-    let inferred = report.inferred.as_ref().ok_or("nothing inferred")?;
+    let inferred = report.inferred.as_ref().context("nothing inferred")?;
     let text = render_text(&report);
     ensure!(
         inferred.margin == Some(0.05) && inferred.face_hits == 5,
         "margin 0.05 from 5 face hits:\n{text}"
     );
-    let spread = inferred.margin_spread.ok_or("spread")?;
+    let spread = inferred.margin_spread.context("spread")?;
     ensure!(
         (spread.min - 0.05).abs() < 1e-12 && (spread.max - 0.05).abs() < 1e-12,
         "{spread:?}"
@@ -701,7 +705,7 @@ fn infer_parallel_hit() -> Result<(), String> {
     Ok(())
 }
 
-fn infer_strict_by_replay() -> Result<(), String> {
+fn infer_strict_by_replay() -> anyhow::Result<()> {
     // The engine: margin 0, strict; the scene declares non_strict. The
     // parallel path then finds nothing: no hit implies a rule, replaying
     // both finds strict.
@@ -712,7 +716,7 @@ fn infer_strict_by_replay() -> Result<(), String> {
     // The two rules differ only on a path parallel to the plane: a
     // fragile (grazing) divergence, not a failure; still inferred.
     ensure!(report.fragile_divergent == 1, "{text}");
-    let inferred = report.inferred.as_ref().ok_or("nothing inferred")?;
+    let inferred = report.inferred.as_ref().context("nothing inferred")?;
     ensure!(
         inferred.facing == Facing::Strict
             && !inferred.facing_implied

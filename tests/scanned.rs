@@ -35,6 +35,7 @@ use crate::core_decisions::{cross3, dot3, on_segment, options, sub3};
 use crate::ensure;
 use crate::support::close;
 use crate::trial;
+use anyhow::Context as _;
 
 pub fn tests() -> Vec<Trial> {
     vec![
@@ -60,9 +61,9 @@ struct Scanned {
     used: Vec<I3>,
 }
 
-fn load_scanned() -> Result<Scanned, String> {
+fn load_scanned() -> anyhow::Result<Scanned> {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/scanned/bunny_res4.obj");
-    let loaded = sweeptrace::sim::load_obj(&path).map_err(|e| e.to_string())?;
+    let loaded = sweeptrace::sim::load_obj(&path)?;
     ensure!(
         loaded.vertices.len() == 453 && loaded.triangles.len() == 948,
         "the bunny has 453 vertices and 948 triangles: {} {}",
@@ -93,7 +94,7 @@ fn load_scanned() -> Result<Scanned, String> {
         })
         .collect();
     // The core must skip exactly the triangles of zero area.
-    let mesh = scene.to_mesh().map_err(|e| e.to_string())?;
+    let mesh = scene.to_mesh()?;
     let skipped: BTreeSet<usize> = mesh.degenerate().iter().map(|d| d.index).collect();
     let zero: BTreeSet<usize> = (0..triangles.len())
         .filter(|&t| triangles[t].is_none())
@@ -197,7 +198,7 @@ fn extended_gcd(a: i64, b: i64) -> (i64, i64, i64) {
 
 /// A reduced basis of the lattice of integer vectors perpendicular to the
 /// nonzero integer vector `e`.
-fn perpendicular_lattice(e: I3) -> Result<(I3, I3), String> {
+fn perpendicular_lattice(e: I3) -> anyhow::Result<(I3, I3)> {
     let g = gcd(gcd(e[0], e[1]), e[2]);
     let e = e.map(|c| c / g);
     let (mut u, mut v) = if e[0] == 0 && e[1] == 0 {
@@ -229,7 +230,7 @@ fn perpendicular_lattice(e: I3) -> Result<(I3, I3), String> {
 /// `w·(y - a) ≤ 0` for every `y` (the normal cone of the mesh's convex hull
 /// along the edge `a b`), or nothing if `a b` is not an edge of the hull
 /// (or one in a plane of the hull only).
-fn edge_normal_cone(used: &[I3], a: I3, b: I3, max: i64) -> Result<Vec<(I3, i64)>, String> {
+fn edge_normal_cone(used: &[I3], a: I3, b: I3, max: i64) -> anyhow::Result<Vec<(I3, i64)>> {
     let (u, v) = perpendicular_lattice(sub3(b, a))?;
     // The other vertices in lattice coordinates: w = i u + j v has
     // w·(y - a) = i p + j q with (p, q) = (u·(y - a), v·(y - a)).
@@ -347,7 +348,7 @@ fn contact(
 /// hull (directions of integer length up to 24, scaled by up to 40), and at
 /// quarter points of the mesh edges that are edges of the hull (directions
 /// in the lattice perpendicular to the edge, integer length up to 600).
-fn scanned_contacts(m: &Scanned, seed: u64) -> Result<(Vec<Contact>, usize), String> {
+fn scanned_contacts(m: &Scanned, seed: u64) -> anyhow::Result<(Vec<Contact>, usize)> {
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     let mut out = Vec::new();
     let directions = rational_length_vectors(24);
@@ -358,7 +359,7 @@ fn scanned_contacts(m: &Scanned, seed: u64) -> Result<(Vec<Contact>, usize), Str
             .iter()
             .map(|&y| dot3(w0, y))
             .max()
-            .ok_or("no vertex")?;
+            .context("no vertex")?;
         let support: Vec<I3> = m
             .used
             .iter()
@@ -407,9 +408,9 @@ fn scanned_contacts(m: &Scanned, seed: u64) -> Result<(Vec<Contact>, usize), Str
 /// the exact tie set in the rules' order, with both broadphases, its `α` is
 /// the exact one, a tie of two or more tests is flagged `tie`, and the
 /// reported tie set holds every exactly tied test.
-fn exact_ties_on_a_scanned_mesh_follow_the_rules() -> Result<(), String> {
+fn exact_ties_on_a_scanned_mesh_follow_the_rules() -> anyhow::Result<()> {
     let m = load_scanned()?;
-    let mesh = m.scene.to_mesh().map_err(|e| e.to_string())?;
+    let mesh = m.scene.to_mesh()?;
     let (contacts, hull_edges) = scanned_contacts(&m, 0x5ca7)?;
     let (mut multi, mut shared, mut on_edges) = (0usize, 0usize, 0usize);
     let mut by_kind = [0usize; 3];
@@ -417,8 +418,7 @@ fn exact_ties_on_a_scanned_mesh_follow_the_rules() -> Result<(), String> {
         let first = c.expected[0];
         let sweep = Sweep::new(c.p0, c.p1, c.radius);
         for broadphase in [Broadphase::Bvh, Broadphase::Exhaustive] {
-            let o = sweep_mesh_with(&mesh, &sweep, &options(), broadphase, &mut NoObserver)
-                .map_err(|e| e.to_string())?;
+            let o = sweep_mesh_with(&mesh, &sweep, &options(), broadphase, &mut NoObserver)?;
             let got = (
                 o.kind,
                 o.triangle.unwrap_or(u32::MAX),
@@ -440,8 +440,7 @@ fn exact_ties_on_a_scanned_mesh_follow_the_rules() -> Result<(), String> {
                 c.expected.len()
             );
         }
-        let (_, ties) =
-            sweeptrace::core::sweep_ties(&mesh, &sweep, &options()).map_err(|e| e.to_string())?;
+        let (_, ties) = sweeptrace::core::sweep_ties(&mesh, &sweep, &options())?;
         let reported: BTreeSet<(Kind, u32, u8)> = ties
             .iter()
             .map(|t| (t.kind, t.triangle, t.feature.unwrap_or(0)))
@@ -479,7 +478,7 @@ fn exact_ties_on_a_scanned_mesh_follow_the_rules() -> Result<(), String> {
 /// `check` on the bunny: expectations recorded by the differently rounding
 /// engine of `alt_engine` (rule-following, but its own rounding picks among
 /// exactly tied tests) are ties where they differ, never divergences.
-fn check_on_a_scanned_mesh_reports_ties_not_divergences() -> Result<(), String> {
+fn check_on_a_scanned_mesh_reports_ties_not_divergences() -> anyhow::Result<()> {
     let m = load_scanned()?;
     let (contacts, _) = scanned_contacts(&m, 0xb0b)?;
     let scene = SceneMsg {

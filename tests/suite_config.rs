@@ -12,6 +12,7 @@ use crate::ensure;
 use crate::os;
 use crate::support::run_bin_in;
 use crate::trial;
+use anyhow::Context as _;
 use sweeptrace::regress::config::{ConfigFile, Overrides, Source, resolve};
 use sweeptrace::regress::{Field, FieldSet, Tolerances};
 
@@ -36,27 +37,26 @@ fn root() -> &'static Path {
 /// `suite/rapier.mcap`: it fails with the default settings (its normals
 /// and α differ from the core's by design) and passes with
 /// `fields = ["kind", "alpha"]` and an α tolerance of 1e-5.
-fn repository() -> Result<(tempfile::TempDir, PathBuf), String> {
-    let dir = tempfile::tempdir().map_err(|e| e.to_string())?;
+fn repository() -> anyhow::Result<(tempfile::TempDir, PathBuf)> {
+    let dir = tempfile::tempdir()?;
     let repo = dir.path().join("repo");
     let suite = repo.join("suite");
-    std::fs::create_dir_all(repo.join(".git")).map_err(|e| e.to_string())?;
-    std::fs::create_dir_all(&suite).map_err(|e| e.to_string())?;
+    std::fs::create_dir_all(repo.join(".git"))?;
+    std::fs::create_dir_all(&suite)?;
     std::fs::copy(
         root().join("examples/rapier/rapier_mini_golf.mcap"),
         suite.join("rapier.mcap"),
-    )
-    .map_err(|e| e.to_string())?;
+    )?;
     Ok((dir, repo))
 }
 
-fn write(path: &Path, text: &str) -> Result<(), String> {
-    std::fs::write(path, text).map_err(|e| format!("{}: {e}", path.display()))
+fn write(path: &Path, text: &str) -> anyhow::Result<()> {
+    std::fs::write(path, text).map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))
 }
 
 const PASSING: &str = "fields = [\"kind\", \"alpha\"]\n\n[tolerances]\nalpha = 1e-5\n";
 
-fn settings_file_makes_a_trace_pass_with_no_options() -> Result<(), String> {
+fn settings_file_makes_a_trace_pass_with_no_options() -> anyhow::Result<()> {
     let (_dir, repo) = repository()?;
     let (code, out, err) = run_bin_in(&repo, os!["check", "suite"])?;
     ensure!(code == 1, "no settings file: exit {code}: {out}{err}");
@@ -78,7 +78,7 @@ fn settings_file_makes_a_trace_pass_with_no_options() -> Result<(), String> {
         "[[traces]]\nmatch = \"suite/*.mcap\"\nfields = [\"kind\", \"alpha\"]\n\
          tolerances = { alpha = 1e-5 }\n\n[[traces]]\nmatch = \"other/*.mcap\"\nstrict = true\n",
     )?;
-    std::fs::remove_file(repo.join("suite/sweeptrace.toml")).map_err(|e| e.to_string())?;
+    std::fs::remove_file(repo.join("suite/sweeptrace.toml"))?;
     let (code, out, err) = run_bin_in(&repo, os!["check", "suite"])?;
     ensure!(
         code == 0,
@@ -94,7 +94,7 @@ fn settings_file_makes_a_trace_pass_with_no_options() -> Result<(), String> {
     Ok(())
 }
 
-fn nearest_file_first_up_to_the_repository_root() -> Result<(), String> {
+fn nearest_file_first_up_to_the_repository_root() -> anyhow::Result<()> {
     let (dir, repo) = repository()?;
     // Above the repository root: never read (it would be an error).
     write(&dir.path().join("sweeptrace.toml"), "not = [valid\n")?;
@@ -135,13 +135,13 @@ fn nearest_file_first_up_to_the_repository_root() -> Result<(), String> {
 }
 
 /// The line of `--print-config`'s text output that gives `key`.
-fn setting_line<'a>(out: &'a str, key: &str) -> Result<&'a str, String> {
+fn setting_line<'a>(out: &'a str, key: &str) -> anyhow::Result<&'a str> {
     out.lines()
         .find(|l| l.trim_start().starts_with(&format!("{key} = ")))
-        .ok_or_else(|| format!("no `{key}` in:\n{out}"))
+        .with_context(|| format!("no `{key}` in:\n{out}"))
 }
 
-fn command_line_overrides_the_file() -> Result<(), String> {
+fn command_line_overrides_the_file() -> anyhow::Result<()> {
     let (_dir, repo) = repository()?;
     write(
         &repo.join("suite/sweeptrace.toml"),
@@ -196,7 +196,7 @@ fn command_line_overrides_the_file() -> Result<(), String> {
     Ok(())
 }
 
-fn print_config_names_the_source_of_each_setting() -> Result<(), String> {
+fn print_config_names_the_source_of_each_setting() -> anyhow::Result<()> {
     let (_dir, repo) = repository()?;
     write(&repo.join("suite/sweeptrace.toml"), PASSING)?;
     let (code, out, err) = run_bin_in(
@@ -229,7 +229,8 @@ fn print_config_names_the_source_of_each_setting() -> Result<(), String> {
     }
     let (code, out, err) = run_bin_in(&repo, os!["check", "suite", "--print-config", "--json"])?;
     ensure!(code == 0, "--json: exit {code}: {out}{err}");
-    let json: serde_json::Value = serde_json::from_str(&out).map_err(|e| format!("{e}: {out}"))?;
+    let json: serde_json::Value =
+        serde_json::from_str(&out).map_err(|e| anyhow::anyhow!("{e}: {out}"))?;
     let trace = &json["traces"][0];
     ensure!(trace["trace"] == "suite/rapier.mcap", "{json}");
     ensure!(
@@ -243,7 +244,7 @@ fn print_config_names_the_source_of_each_setting() -> Result<(), String> {
     Ok(())
 }
 
-fn bad_key_is_an_error_with_file_and_line() -> Result<(), String> {
+fn bad_key_is_an_error_with_file_and_line() -> anyhow::Result<()> {
     let (_dir, repo) = repository()?;
     write(
         &repo.join("suite/sweeptrace.toml"),
@@ -268,7 +269,7 @@ fn bad_key_is_an_error_with_file_and_line() -> Result<(), String> {
     Ok(())
 }
 
-fn bad_values_are_errors_with_file_and_line() -> Result<(), String> {
+fn bad_values_are_errors_with_file_and_line() -> anyhow::Result<()> {
     let (_dir, repo) = repository()?;
     for (text, message) in [
         (
@@ -303,7 +304,7 @@ fn bad_values_are_errors_with_file_and_line() -> Result<(), String> {
 
 /// The repository's own traces and examples pass with no options: the
 /// Rapier sample by `examples/sweeptrace.toml`.
-fn repository_traces_and_examples_pass_with_no_options() -> Result<(), String> {
+fn repository_traces_and_examples_pass_with_no_options() -> anyhow::Result<()> {
     let (code, out, err) = run_bin_in(root(), os!["check", "traces/", "examples/"])?;
     ensure!(code == 0, "exit {code}: {out}{err}");
     ensure!(
@@ -322,16 +323,14 @@ fn repository_traces_and_examples_pass_with_no_options() -> Result<(), String> {
 
 /// The full example of docs/REGRESSION.md parses, and means what the text
 /// around it says.
-fn regression_md_example_is_a_valid_file() -> Result<(), String> {
-    let doc =
-        std::fs::read_to_string(root().join("docs/REGRESSION.md")).map_err(|e| e.to_string())?;
+fn regression_md_example_is_a_valid_file() -> anyhow::Result<()> {
+    let doc = std::fs::read_to_string(root().join("docs/REGRESSION.md"))?;
     let start = doc
         .find("```toml\n# traces/sweeptrace.toml")
-        .ok_or("no example in docs/REGRESSION.md")?
+        .context("no example in docs/REGRESSION.md")?
         + "```toml\n".len();
-    let end = start + doc[start..].find("```").ok_or("unterminated example")?;
-    let file = ConfigFile::parse(&doc[start..end], Path::new("traces/sweeptrace.toml"))
-        .map_err(|e| e.to_string())?;
+    let end = start + doc[start..].find("```").context("unterminated example")?;
+    let file = ConfigFile::parse(&doc[start..end], Path::new("traces/sweeptrace.toml"))?;
     let files = std::slice::from_ref(&file);
     let none = Overrides::default();
     // Its top level spells out the defaults.

@@ -14,7 +14,7 @@ macro_rules! ensure {
     ($cond:expr, $($arg:tt)+) => {
         if $cond {
         } else {
-            return Err(format!($($arg)+));
+            anyhow::bail!($($arg)+);
         }
     };
 }
@@ -26,11 +26,11 @@ pub fn bin() -> std::process::Command {
 
 /// Runs the binary with `args`: exit code (-1 when killed by a signal),
 /// stdout, stderr.
-pub fn run_bin(args: &[&std::ffi::OsStr]) -> Result<(i32, String, String), String> {
+pub fn run_bin(args: &[&std::ffi::OsStr]) -> anyhow::Result<(i32, String, String)> {
     let out = bin()
         .args(args)
         .output()
-        .map_err(|e| format!("running sweeptrace: {e}"))?;
+        .map_err(|e| anyhow::anyhow!("running sweeptrace: {e}"))?;
     Ok((
         out.status.code().unwrap_or(-1),
         String::from_utf8_lossy(&out.stdout).into_owned(),
@@ -42,12 +42,12 @@ pub fn run_bin(args: &[&std::ffi::OsStr]) -> Result<(i32, String, String), Strin
 pub fn run_bin_in(
     dir: &std::path::Path,
     args: &[&std::ffi::OsStr],
-) -> Result<(i32, String, String), String> {
+) -> anyhow::Result<(i32, String, String)> {
     let out = bin()
         .args(args)
         .current_dir(dir)
         .output()
-        .map_err(|e| format!("running sweeptrace in {}: {e}", dir.display()))?;
+        .map_err(|e| anyhow::anyhow!("running sweeptrace in {}: {e}", dir.display()))?;
     Ok((
         out.status.code().unwrap_or(-1),
         String::from_utf8_lossy(&out.stdout).into_owned(),
@@ -65,10 +65,10 @@ macro_rules! os {
 /// `limit`, so that a test whose code under test hangs fails instead of
 /// hanging the whole run (the stuck thread is left behind; the test binary
 /// ends with the run).
-pub fn with_timeout<T: Send + 'static>(
+pub fn with_timeout<T: Send + 'static, E: Fail + Send + 'static>(
     limit: Duration,
-    f: impl FnOnce() -> Result<T, String> + Send + 'static,
-) -> Result<T, String> {
+    f: impl FnOnce() -> Result<T, E> + Send + 'static,
+) -> Result<T, E> {
     let (tx, rx) = mpsc::channel();
     std::thread::Builder::new()
         .name("test body".to_string())
@@ -76,14 +76,41 @@ pub fn with_timeout<T: Send + 'static>(
             // The receiver is gone only after a timeout: nobody is listening.
             let _ = tx.send(f());
         })
-        .map_err(|e| format!("cannot start the test thread: {e}"))?;
+        .map_err(|e| E::fail(format!("cannot start the test thread: {e}")))?;
     match rx.recv_timeout(limit) {
         Ok(result) => result,
-        Err(RecvTimeoutError::Timeout) => Err(format!(
+        Err(RecvTimeoutError::Timeout) => Err(E::fail(format!(
             "did not finish within {} s (hangs?)",
             limit.as_secs_f64()
-        )),
-        Err(RecvTimeoutError::Disconnected) => Err("the test body panicked".to_string()),
+        ))),
+        Err(RecvTimeoutError::Disconnected) => Err(E::fail("the test body panicked".to_string())),
+    }
+}
+
+/// An error a test can fail with: `anyhow::Error` (the tests' own), or a
+/// `String`.
+pub trait Fail: Sized {
+    /// The error of a failed check, from its message.
+    fn fail(message: String) -> Self;
+    /// The whole message, with the context chain.
+    fn message(self) -> String;
+}
+
+impl Fail for anyhow::Error {
+    fn fail(message: String) -> Self {
+        anyhow::Error::msg(message)
+    }
+    fn message(self) -> String {
+        format!("{self:#}")
+    }
+}
+
+impl Fail for String {
+    fn fail(message: String) -> Self {
+        message
+    }
+    fn message(self) -> String {
+        self
     }
 }
 
@@ -94,7 +121,7 @@ pub const REQUIRE_PYTHON: &str = "SWEEPTRACE_REQUIRE_PYTHON";
 /// Whether `python3` on `PATH` can import `mcap`: `Ok(Ok(()))` when it
 /// can, `Ok(Err(completion))` for a test to skip with the reason, an error
 /// when [`REQUIRE_PYTHON`] requires it.
-pub fn python_with_mcap() -> Result<Result<(), libtest_mimic::Completion>, String> {
+pub fn python_with_mcap() -> anyhow::Result<Result<(), libtest_mimic::Completion>> {
     let missing = match std::process::Command::new("python3")
         .args(["-c", "import mcap"])
         .output()
@@ -110,10 +137,10 @@ pub fn python_with_mcap() -> Result<Result<(), libtest_mimic::Completion>, Strin
         Err(e) => format!("python3 cannot be run ({e})"),
     };
     if std::env::var_os(REQUIRE_PYTHON).is_some_and(|v| v == "1") {
-        return Err(format!(
+        anyhow::bail!(
             "{missing}, and {REQUIRE_PYTHON}=1 requires this cross-check \
              (`pip install mcap==1.6.0` and put that Python first on PATH)"
-        ));
+        );
     }
     Ok(Err(libtest_mimic::Completion::ignored_with(format!(
         "skipped: {missing}; {REQUIRE_PYTHON}=1 makes this a failure"
@@ -127,7 +154,7 @@ pub fn python_with_mcap() -> Result<Result<(), libtest_mimic::Completion>, Strin
 pub fn python_with_modules(
     modules: &[&str],
     install: &str,
-) -> Result<Result<(), libtest_mimic::Completion>, String> {
+) -> anyhow::Result<Result<(), libtest_mimic::Completion>> {
     let missing = match std::process::Command::new("python3")
         .args(["-c", &format!("import {}", modules.join(", "))])
         .output()
@@ -144,10 +171,10 @@ pub fn python_with_modules(
         Err(e) => format!("python3 cannot be run ({e})"),
     };
     if std::env::var_os(REQUIRE_PYTHON).is_some_and(|v| v == "1") {
-        return Err(format!(
+        anyhow::bail!(
             "{missing}, and {REQUIRE_PYTHON}=1 requires this check \
              (`{install}` and put that Python first on PATH)"
-        ));
+        );
     }
     Ok(Err(libtest_mimic::Completion::ignored_with(format!(
         "skipped: {missing}; {REQUIRE_PYTHON}=1 makes this a failure"
@@ -155,11 +182,13 @@ pub fn python_with_modules(
 }
 
 /// `|a - b| ≤ tol`, or an error naming `what`.
-pub fn close(what: &str, got: f64, want: f64, tol: f64) -> Result<(), String> {
+pub fn close(what: &str, got: f64, want: f64, tol: f64) -> anyhow::Result<()> {
     if (got - want).abs() <= tol {
         Ok(())
     } else {
-        Err(format!("{what}: got {got}, want {want} (tolerance {tol})"))
+        Err(anyhow::anyhow!(
+            "{what}: got {got}, want {want} (tolerance {tol})"
+        ))
     }
 }
 

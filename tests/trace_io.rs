@@ -18,6 +18,7 @@ use sweeptrace::trace::{
 
 use crate::ensure;
 use crate::trial;
+use anyhow::Context as _;
 
 pub fn tests() -> Vec<Trial> {
     vec![
@@ -169,9 +170,8 @@ fn no_summary() -> WriteOptions {
         .repeat_schemas(false)
 }
 
-fn write_events(events: &[TraceEvent], opts: WriteOptions) -> Result<Vec<u8>, String> {
-    let mut w =
-        TraceWriter::with_options(Cursor::new(Vec::new()), opts).map_err(|e| e.to_string())?;
+fn write_events(events: &[TraceEvent], opts: WriteOptions) -> anyhow::Result<Vec<u8>> {
+    let mut w = TraceWriter::with_options(Cursor::new(Vec::new()), opts)?;
     for e in events {
         match e {
             TraceEvent::Scene {
@@ -189,10 +189,9 @@ fn write_events(events: &[TraceEvent], opts: WriteOptions) -> Result<Vec<u8>, St
                 outcome,
                 ..
             } => w.expected(*log_time_nanos, outcome),
-        }
-        .map_err(|e| e.to_string())?;
+        }?;
     }
-    Ok(w.finish().map_err(|e| e.to_string())?.into_inner())
+    Ok(w.finish()?.into_inner())
 }
 
 /// Every event, the error that ended reading (if any) and the stats.
@@ -264,13 +263,13 @@ const SCENE_JSON: &[u8] =
     br#"{"name":"t","vertices":[[0,0,0],[4,0,0],[0,4,0]],"triangles":[[0,1,2]]}"#;
 
 /// Reads `bytes`, expects an error, checks its message contains every `needle`.
-fn expect_error(bytes: &[u8], needles: &[&str]) -> Result<(Vec<TraceEvent>, TraceError), String> {
+fn expect_error(bytes: &[u8], needles: &[&str]) -> anyhow::Result<(Vec<TraceEvent>, TraceError)> {
     let (events, error, _) = read_all(bytes);
     let Some(error) = error else {
-        return Err(format!(
+        anyhow::bail!(
             "expected an error, read {} events without one",
             events.len()
-        ));
+        );
     };
     let text = error.to_string();
     for needle in needles {
@@ -283,7 +282,7 @@ fn expect_error(bytes: &[u8], needles: &[&str]) -> Result<(Vec<TraceEvent>, Trac
 }
 
 /// The first difference between two event lists, if any.
-fn same(got: &[TraceEvent], want: &[TraceEvent]) -> Result<(), String> {
+fn same(got: &[TraceEvent], want: &[TraceEvent]) -> anyhow::Result<()> {
     for (i, (g, w)) in got.iter().zip(want).enumerate() {
         ensure!(g == w, "event {i} differs:\n got {g:?}\nwant {w:?}");
     }
@@ -298,7 +297,7 @@ fn same(got: &[TraceEvent], want: &[TraceEvent]) -> Result<(), String> {
 
 // ---------------------------------------------------------------- round trips
 
-fn round_trip_default_writer() -> Result<(), String> {
+fn round_trip_default_writer() -> anyhow::Result<()> {
     let events = sample_events(20);
     let bytes = write_events(&events, default_opts())?;
     let (got, error, stats) = read_all(&bytes);
@@ -348,7 +347,7 @@ fn round_trip_default_writer() -> Result<(), String> {
         let c = stats
             .channels
             .get(topic)
-            .ok_or(format!("no channel {topic}"))?;
+            .context(format!("no channel {topic}"))?;
         ensure!(
             c.schema_name == schema
                 && c.schema_encoding == "jsonschema"
@@ -369,7 +368,7 @@ fn round_trip_default_writer() -> Result<(), String> {
     Ok(())
 }
 
-fn writer_output_is_deterministic() -> Result<(), String> {
+fn writer_output_is_deterministic() -> anyhow::Result<()> {
     let events = sample_events(50);
     let a = write_events(&events, default_opts())?;
     let b = write_events(&events, default_opts())?;
@@ -377,27 +376,27 @@ fn writer_output_is_deterministic() -> Result<(), String> {
     Ok(())
 }
 
-fn reads_unchunked() -> Result<(), String> {
+fn reads_unchunked() -> anyhow::Result<()> {
     flavour(unchunked(), &[])
 }
 
-fn reads_lz4_chunks() -> Result<(), String> {
+fn reads_lz4_chunks() -> anyhow::Result<()> {
     flavour(lz4(), &["lz4"])
 }
 
-fn reads_uncompressed_chunks() -> Result<(), String> {
+fn reads_uncompressed_chunks() -> anyhow::Result<()> {
     flavour(uncompressed_chunks(), &["none"])
 }
 
-fn reads_without_summary_or_indexes() -> Result<(), String> {
+fn reads_without_summary_or_indexes() -> anyhow::Result<()> {
     flavour(no_summary(), &["zstd"])
 }
 
-fn reads_unchunked_without_summary() -> Result<(), String> {
+fn reads_unchunked_without_summary() -> anyhow::Result<()> {
     flavour(no_summary().use_chunks(false), &[])
 }
 
-fn flavour(opts: WriteOptions, compression: &[&str]) -> Result<(), String> {
+fn flavour(opts: WriteOptions, compression: &[&str]) -> anyhow::Result<()> {
     let events = sample_events(300);
     let bytes = write_events(&events, opts)?;
     let (got, error, stats) = read_all(&bytes);
@@ -422,8 +421,8 @@ fn flavour(opts: WriteOptions, compression: &[&str]) -> Result<(), String> {
     Ok(())
 }
 
-fn python_fixture_exact_values() -> Result<(), String> {
-    let bytes = std::fs::read(FIXTURE).map_err(|e| format!("{FIXTURE}: {e}"))?;
+fn python_fixture_exact_values() -> anyhow::Result<()> {
+    let bytes = std::fs::read(FIXTURE).map_err(|e| anyhow::anyhow!("{FIXTURE}: {e}"))?;
     let (events, error, stats) = read_all(&bytes);
     ensure!(error.is_none(), "error: {error:?}");
     ensure!(events.len() == 10, "{} events", events.len());
@@ -433,7 +432,7 @@ fn python_fixture_exact_values() -> Result<(), String> {
         scene,
     } = &events[0]
     else {
-        return Err(format!("first event {:?}", events[0]));
+        anyhow::bail!("first event {:?}", events[0]);
     };
     ensure!(*scene == triangle_scene(), "scene {scene:?}");
     let frame_nanos = 16_666_667;
@@ -570,7 +569,7 @@ fn python_fixture_exact_values() -> Result<(), String> {
     Ok(())
 }
 
-fn foreign_channels_skipped_and_counted() -> Result<(), String> {
+fn foreign_channels_skipped_and_counted() -> anyhow::Result<()> {
     let bytes = raw_trace(&[
         ("/foreign", 0, b"\x00\x01binary"),
         ("/scene", 1, SCENE_JSON),
@@ -605,14 +604,14 @@ fn foreign_channels_skipped_and_counted() -> Result<(), String> {
 
 // ---------------------------------------------------------------- errors
 
-fn error_truncated_every_cut() -> Result<(), String> {
+fn error_truncated_every_cut() -> anyhow::Result<()> {
     let events = sample_events(4);
     let bytes = write_events(&events, unchunked())?;
     let mut saw_partial = false;
     for cut in 0..bytes.len() {
         let (got, error, stats) = read_all(&bytes[..cut]);
         let Some(error) = error else {
-            return Err(format!("cut at {cut} of {}: no error", bytes.len()));
+            anyhow::bail!("cut at {cut} of {}: no error", bytes.len());
         };
         ensure!(
             got.as_slice() == &events[..got.len()],
@@ -634,14 +633,14 @@ fn error_truncated_every_cut() -> Result<(), String> {
             );
             saw_partial |= !got.is_empty() && got.len() < events.len();
         } else if cut >= 8 {
-            return Err(format!("cut at {cut}: not reported as truncated: {error}"));
+            anyhow::bail!("cut at {cut}: not reported as truncated: {error}");
         }
     }
     ensure!(saw_partial, "no cut yielded a partial read");
     Ok(())
 }
 
-fn error_truncated_chunked() -> Result<(), String> {
+fn error_truncated_chunked() -> anyhow::Result<()> {
     let events = sample_events(400);
     let bytes = write_events(&events, lz4())?;
     let (full, _, stats) = read_all(&bytes);
@@ -652,7 +651,7 @@ fn error_truncated_chunked() -> Result<(), String> {
     );
     let cut = bytes.len() * 2 / 3;
     let (got, error, _) = read_all(&bytes[..cut]);
-    let error = error.ok_or("no error")?;
+    let error = error.context("no error")?;
     ensure!(
         matches!(error, TraceError::Truncated { .. }),
         "not truncated: {error}"
@@ -685,18 +684,18 @@ pub fn first_chunk(bytes: &[u8]) -> Option<(usize, usize)> {
     None
 }
 
-fn error_corrupt_zstd_chunk() -> Result<(), String> {
+fn error_corrupt_zstd_chunk() -> anyhow::Result<()> {
     corrupt_chunk(default_opts())
 }
 
-fn error_corrupt_uncompressed_chunk() -> Result<(), String> {
+fn error_corrupt_uncompressed_chunk() -> anyhow::Result<()> {
     corrupt_chunk(uncompressed_chunks())
 }
 
-fn corrupt_chunk(opts: WriteOptions) -> Result<(), String> {
+fn corrupt_chunk(opts: WriteOptions) -> anyhow::Result<()> {
     let events = sample_events(30);
     let mut bytes = write_events(&events, opts)?;
-    let (start, len) = first_chunk(&bytes).ok_or("no chunk")?;
+    let (start, len) = first_chunk(&bytes).context("no chunk")?;
     // A byte inside the records, well past the chunk header.
     let at = start + 9 + len - len / 3;
     bytes[at] ^= 0x5a;
@@ -710,7 +709,7 @@ fn corrupt_chunk(opts: WriteOptions) -> Result<(), String> {
     Ok(())
 }
 
-fn error_not_json() -> Result<(), String> {
+fn error_not_json() -> anyhow::Result<()> {
     let bytes = raw_trace(&[
         ("/scene", 0, SCENE_JSON),
         ("/sweep", 1, b"{frame: 3, radius"),
@@ -726,7 +725,7 @@ fn error_not_json() -> Result<(), String> {
     Ok(())
 }
 
-fn error_missing_field() -> Result<(), String> {
+fn error_missing_field() -> anyhow::Result<()> {
     let bytes = raw_trace(&[
         ("/scene", 0, SCENE_JSON),
         ("/sweep", 1, br#"{"frame":3,"p0":[0,0,1],"p1":[0,0,0]}"#),
@@ -747,7 +746,7 @@ fn error_missing_field() -> Result<(), String> {
     Ok(())
 }
 
-fn error_mistyped_field() -> Result<(), String> {
+fn error_mistyped_field() -> anyhow::Result<()> {
     let bytes = raw_trace(&[
         ("/scene", 0, SCENE_JSON),
         (
@@ -775,7 +774,7 @@ fn error_mistyped_field() -> Result<(), String> {
     Ok(())
 }
 
-fn error_null_for_number() -> Result<(), String> {
+fn error_null_for_number() -> anyhow::Result<()> {
     let bytes = raw_trace(&[
         ("/scene", 0, SCENE_JSON),
         (
@@ -794,7 +793,7 @@ fn error_null_for_number() -> Result<(), String> {
     Ok(())
 }
 
-fn error_number_out_of_range() -> Result<(), String> {
+fn error_number_out_of_range() -> anyhow::Result<()> {
     let bytes = raw_trace(&[
         ("/scene", 0, SCENE_JSON),
         (
@@ -807,7 +806,7 @@ fn error_number_out_of_range() -> Result<(), String> {
     Ok(())
 }
 
-fn error_vertex_index_out_of_range() -> Result<(), String> {
+fn error_vertex_index_out_of_range() -> anyhow::Result<()> {
     let bytes = raw_trace(&[(
         "/scene",
         0,
@@ -827,7 +826,7 @@ fn error_vertex_index_out_of_range() -> Result<(), String> {
     Ok(())
 }
 
-fn error_radius_not_positive() -> Result<(), String> {
+fn error_radius_not_positive() -> anyhow::Result<()> {
     for radius in ["0", "-0.5", "0.0"] {
         let sweep = format!(r#"{{"frame":11,"radius":{radius},"p0":[0,0,1],"p1":[0,0,0]}}"#);
         let bytes = raw_trace(&[("/scene", 0, SCENE_JSON), ("/sweep", 1, sweep.as_bytes())]);
@@ -839,7 +838,7 @@ fn error_radius_not_positive() -> Result<(), String> {
     Ok(())
 }
 
-fn error_margin_not_below_radius() -> Result<(), String> {
+fn error_margin_not_below_radius() -> anyhow::Result<()> {
     let scene = br#"{"vertices":[[0,0,0],[4,0,0],[0,4,0]],"triangles":[[0,1,2]],"margin":0.5}"#;
     let bytes = raw_trace(&[
         ("/scene", 0, scene),
@@ -859,7 +858,7 @@ fn error_margin_not_below_radius() -> Result<(), String> {
     Ok(())
 }
 
-fn error_sweep_before_scene() -> Result<(), String> {
+fn error_sweep_before_scene() -> anyhow::Result<()> {
     let bytes = raw_trace(&[
         (
             "/sweep",
@@ -879,19 +878,19 @@ fn error_sweep_before_scene() -> Result<(), String> {
     Ok(())
 }
 
-fn error_oversized_scene() -> Result<(), String> {
+fn error_oversized_scene() -> anyhow::Result<()> {
     let mut scene = triangle_scene();
     scene.vertices = (0..200).map(|i| [i as f64, 0.5, 0.25]).collect();
-    let mut w = TraceWriter::new(Cursor::new(Vec::new())).map_err(|e| e.to_string())?;
-    w.scene(0, &scene).map_err(|e| e.to_string())?;
-    let bytes = w.finish().map_err(|e| e.to_string())?.into_inner();
+    let mut w = TraceWriter::new(Cursor::new(Vec::new()))?;
+    w.scene(0, &scene)?;
+    let bytes = w.finish()?.into_inner();
     let limits = ReadLimits {
         scene_bytes: 1000,
         ..ReadLimits::default()
     };
     let (events, error, _) = read_all_with(&bytes, limits);
     ensure!(events.is_empty(), "events {events:?}");
-    let error = error.ok_or("no error")?;
+    let error = error.context("no error")?;
     let text = error.to_string();
     ensure!(
         matches!(error, TraceError::MessageTooLarge { .. }),
@@ -923,7 +922,7 @@ fn magic_and_header() -> Vec<u8> {
     out
 }
 
-fn error_huge_declared_record() -> Result<(), String> {
+fn error_huge_declared_record() -> anyhow::Result<()> {
     // A message record declaring a terabyte (a scene "with a billion triangles").
     let mut bytes = magic_and_header();
     bytes.push(0x05);
@@ -937,7 +936,7 @@ fn error_huge_declared_record() -> Result<(), String> {
     Ok(())
 }
 
-fn error_huge_declared_chunk() -> Result<(), String> {
+fn error_huge_declared_chunk() -> anyhow::Result<()> {
     let mut chunk = Vec::new();
     chunk.extend(0u64.to_le_bytes()); // message start time
     chunk.extend(0u64.to_le_bytes()); // message end time
@@ -957,7 +956,7 @@ fn error_huge_declared_chunk() -> Result<(), String> {
     Ok(())
 }
 
-fn error_out_of_order_log_time() -> Result<(), String> {
+fn error_out_of_order_log_time() -> anyhow::Result<()> {
     let bytes = raw_trace(&[
         ("/scene", 0, SCENE_JSON),
         (
@@ -980,13 +979,13 @@ fn error_out_of_order_log_time() -> Result<(), String> {
     Ok(())
 }
 
-fn error_wrong_message_encoding() -> Result<(), String> {
+fn error_wrong_message_encoding() -> anyhow::Result<()> {
     let bytes = raw_trace_with(&[("/scene", 0, SCENE_JSON)], "cbor");
     expect_error(&bytes, &["test.mcap", "`/scene`", "cbor", "json"])?;
     Ok(())
 }
 
-fn error_bad_outcome_alpha() -> Result<(), String> {
+fn error_bad_outcome_alpha() -> anyhow::Result<()> {
     let bytes = raw_trace(&[
         ("/scene", 0, SCENE_JSON),
         ("/expected", 1, br#"{"frame":6,"alpha":1.5,"kind":"none"}"#),
@@ -1004,7 +1003,7 @@ fn error_bad_outcome_alpha() -> Result<(), String> {
     Ok(())
 }
 
-fn random_corruption_never_panics() -> Result<(), String> {
+fn random_corruption_never_panics() -> anyhow::Result<()> {
     let events = sample_events(40);
     let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(0x5eed_7ace);
     let mut seen = BTreeMap::new();
@@ -1052,7 +1051,7 @@ fn variant_name(error: &TraceError) -> String {
 /// The error read from `test.mcap` after `read` good messages names the
 /// file and, where it has one, the message (channel and index, which is at
 /// least `read`) or the number of complete messages before it.
-fn error_names_where(error: &TraceError, read: u64) -> Result<(), String> {
+fn error_names_where(error: &TraceError, read: u64) -> anyhow::Result<()> {
     let text = error.to_string();
     ensure!(
         text.starts_with("test.mcap: "),
@@ -1087,52 +1086,52 @@ fn error_names_where(error: &TraceError, read: u64) -> Result<(), String> {
             *index >= read && text.contains(&format!("message {index}")),
             "the message is not named: {text} ({read} read)"
         ),
-        _ => return Err(format!("unexpected error while reading: {text}")),
+        _ => anyhow::bail!("unexpected error while reading: {text}"),
     }
     Ok(())
 }
 
-fn writer_refuses_invalid_messages() -> Result<(), String> {
-    let mut w = TraceWriter::new(Cursor::new(Vec::new())).map_err(|e| e.to_string())?;
+fn writer_refuses_invalid_messages() -> anyhow::Result<()> {
+    let mut w = TraceWriter::new(Cursor::new(Vec::new()))?;
     let e = w
         .sweep(0, &sweep(3, 0))
         .err()
-        .ok_or("sweep before scene accepted")?;
+        .context("sweep before scene accepted")?;
     ensure!(
         matches!(e, TraceError::SweepBeforeScene { .. }) && e.to_string().contains("frame 3"),
         "{e}"
     );
-    w.scene(0, &triangle_scene()).map_err(|e| e.to_string())?;
+    w.scene(0, &triangle_scene())?;
     let mut s = sweep(4, 0);
     s.radius = f64::NAN;
-    let e = w.sweep(1, &s).err().ok_or("NaN radius accepted")?;
+    let e = w.sweep(1, &s).err().context("NaN radius accepted")?;
     ensure!(
         e.to_string().contains("`radius`") && e.to_string().contains("frame 4"),
         "{e}"
     );
     let mut s = sweep(4, 0);
     s.p1[2] = f64::INFINITY;
-    let e = w.sweep(1, &s).err().ok_or("infinite p1 accepted")?;
+    let e = w.sweep(1, &s).err().context("infinite p1 accepted")?;
     ensure!(e.to_string().contains("`p1[2]`"), "{e}");
     let mut scene = triangle_scene();
     scene.triangles.push([0, 1, 3]);
-    let e = w.scene(1, &scene).err().ok_or("bad index accepted")?;
+    let e = w.scene(1, &scene).err().context("bad index accepted")?;
     ensure!(e.to_string().contains("`triangles[1][2]`"), "{e}");
-    w.sweep(10, &sweep(5, 0)).map_err(|e| e.to_string())?;
+    w.sweep(10, &sweep(5, 0))?;
     let e = w
         .sweep(5, &sweep(6, 0))
         .err()
-        .ok_or("time going back accepted")?;
+        .context("time going back accepted")?;
     ensure!(matches!(e, TraceError::OutOfOrder { .. }), "{e}");
     // The rejected messages were not written: the trace still reads cleanly.
-    let bytes = w.finish().map_err(|e| e.to_string())?.into_inner();
+    let bytes = w.finish()?.into_inner();
     let (events, error, _) = read_all(&bytes);
     ensure!(error.is_none() && events.len() == 2, "{events:?} {error:?}");
     Ok(())
 }
 
-fn write_trace_file_is_atomic() -> Result<(), String> {
-    let dir = tempfile::tempdir().map_err(|e| e.to_string())?;
+fn write_trace_file_is_atomic() -> anyhow::Result<()> {
+    let dir = tempfile::tempdir()?;
     let path = dir.path().join("run.mcap");
     let events = sample_events(5);
     write_trace_file(&path, |w| -> Result<(), TraceError> {
@@ -1156,9 +1155,8 @@ fn write_trace_file_is_atomic() -> Result<(), String> {
             }
         }
         Ok(())
-    })
-    .map_err(|e| e.to_string())?;
-    let bytes = std::fs::read(&path).map_err(|e| e.to_string())?;
+    })?;
+    let bytes = std::fs::read(&path)?;
     ensure!(
         bytes == write_events(&events, default_opts())?,
         "file differs from in-memory write"
@@ -1179,10 +1177,7 @@ fn write_trace_file_is_atomic() -> Result<(), String> {
         Ok(())
     });
     ensure!(result.is_err(), "invalid sweep accepted");
-    ensure!(
-        std::fs::read(&path).map_err(|e| e.to_string())? == bytes,
-        "old file changed"
-    );
+    ensure!(std::fs::read(&path)? == bytes, "old file changed");
     let fresh = dir.path().join("never.mcap");
     let _ = write_trace_file(&fresh, |_| {
         Err::<(), _>(TraceError::SweepBeforeScene {
@@ -1195,16 +1190,15 @@ fn write_trace_file_is_atomic() -> Result<(), String> {
         })
     });
     ensure!(!fresh.exists(), "failed recording left a file");
-    let entries: Vec<_> = std::fs::read_dir(dir.path())
-        .map_err(|e| e.to_string())?
+    let entries: Vec<_> = std::fs::read_dir(dir.path())?
         .filter_map(|e| e.ok().map(|e| e.file_name().to_string_lossy().into_owned()))
         .collect();
     ensure!(entries == ["run.mcap"], "directory holds {entries:?}");
     Ok(())
 }
 
-fn info_renders_python_fixture() -> Result<(), String> {
-    let bytes = std::fs::read(FIXTURE).map_err(|e| format!("{FIXTURE}: {e}"))?;
+fn info_renders_python_fixture() -> anyhow::Result<()> {
+    let bytes = std::fs::read(FIXTURE).map_err(|e| anyhow::anyhow!("{FIXTURE}: {e}"))?;
     let (info, error) = collect(TraceReader::new(bytes.as_slice(), "python_written.mcap"));
     ensure!(error.is_none(), "{error:?}");
     let text = render_text(&info);
@@ -1228,8 +1222,7 @@ fn info_renders_python_fixture() -> Result<(), String> {
         ensure!(text.contains(needle), "report lacks `{needle}`:\n{text}");
     }
     ensure!(!text.contains("incomplete"), "{text}");
-    let json: serde_json::Value =
-        serde_json::from_str(&render_json(&info)).map_err(|e| e.to_string())?;
+    let json: serde_json::Value = serde_json::from_str(&render_json(&info))?;
     ensure!(json["sweeps"] == 5 && json["expected"] == 4, "{json}");
     ensure!(json["stats"]["skipped_by_topic"]["/debug"] == 4, "{json}");
     ensure!(json["scenes"][0]["triangles"] == 1, "{json}");
@@ -1239,10 +1232,9 @@ fn info_renders_python_fixture() -> Result<(), String> {
     scene.triangles.push([0, 0, 1]);
     scene.vertices.push([8.0, 0.0, 0.0]);
     scene.triangles.push([0, 1, 3]);
-    let mut w = TraceWriter::with_options(Cursor::new(Vec::new()), default_opts())
-        .map_err(|e| e.to_string())?;
-    w.scene(0, &scene).map_err(|e| e.to_string())?;
-    let bytes = w.finish().map_err(|e| e.to_string())?.into_inner();
+    let mut w = TraceWriter::with_options(Cursor::new(Vec::new()), default_opts())?;
+    w.scene(0, &scene)?;
+    let bytes = w.finish()?.into_inner();
     let (info, _) = collect(TraceReader::new(bytes.as_slice(), "d.mcap"));
     let text = render_text(&info);
     ensure!(
@@ -1259,11 +1251,11 @@ fn info_renders_python_fixture() -> Result<(), String> {
     Ok(())
 }
 
-fn info_reports_partial_trace() -> Result<(), String> {
+fn info_reports_partial_trace() -> anyhow::Result<()> {
     let bytes = write_events(&sample_events(10), unchunked())?;
     let cut = &bytes[..bytes.len() / 2];
     let (info, error) = collect(TraceReader::new(cut, "cut.mcap"));
-    let error = error.ok_or("no error")?;
+    let error = error.context("no error")?;
     ensure!(matches!(error, TraceError::Truncated { .. }), "{error}");
     let text = render_text(&info);
     ensure!(
@@ -1274,14 +1266,14 @@ fn info_reports_partial_trace() -> Result<(), String> {
     Ok(())
 }
 
-fn python_reads_our_trace() -> Result<Completion, String> {
+fn python_reads_our_trace() -> anyhow::Result<Completion> {
     if let Err(skipped) = crate::support::python_with_mcap()? {
         return Ok(skipped);
     }
-    let dir = tempfile::tempdir().map_err(|e| e.to_string())?;
+    let dir = tempfile::tempdir()?;
     let path = dir.path().join("py.mcap");
     let events = sample_events(30);
-    std::fs::write(&path, write_events(&events, default_opts())?).map_err(|e| e.to_string())?;
+    std::fs::write(&path, write_events(&events, default_opts())?)?;
     let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("scripts/read_with_python.py");
     let run = |extra: &[&str]| {
         std::process::Command::new("python3")
@@ -1290,8 +1282,7 @@ fn python_reads_our_trace() -> Result<Completion, String> {
             .args(extra)
             .output()
     };
-    let ok =
-        run(&["--scenes", "2", "--sweeps", "60", "--expected", "30"]).map_err(|e| e.to_string())?;
+    let ok = run(&["--scenes", "2", "--sweeps", "60", "--expected", "30"])?;
     ensure!(
         ok.status.success(),
         "script failed: {}{}",
@@ -1299,25 +1290,25 @@ fn python_reads_our_trace() -> Result<Completion, String> {
         String::from_utf8_lossy(&ok.stderr)
     );
     // And it can fail.
-    let bad = run(&["--sweeps", "61"]).map_err(|e| e.to_string())?;
+    let bad = run(&["--sweeps", "61"])?;
     ensure!(!bad.status.success(), "script accepted a wrong count");
     Ok(Completion::Completed)
 }
 
 /// The names the reports write (`as_str`, `Display`) are the names the JSON
 /// and the trace format write (serde), for every variant, and read back.
-fn enum_names_in_words_are_their_serde_names() -> Result<(), String> {
+fn enum_names_in_words_are_their_serde_names() -> anyhow::Result<()> {
     use sweeptrace::core::{FragileReason, Verdict};
-    fn same<T>(v: T, words: &str) -> Result<(), String>
+    fn same<T>(v: T, words: &str) -> anyhow::Result<()>
     where
         T: serde::Serialize + serde::de::DeserializeOwned + PartialEq + std::fmt::Debug,
     {
-        let json = serde_json::to_value(&v).map_err(|e| e.to_string())?;
+        let json = serde_json::to_value(&v)?;
         ensure!(
             json == words,
             "{v:?}: serde writes {json}, the words say `{words}`"
         );
-        let back: T = serde_json::from_value(json).map_err(|e| format!("{v:?}: {e}"))?;
+        let back: T = serde_json::from_value(json).map_err(|e| anyhow::anyhow!("{v:?}: {e}"))?;
         ensure!(back == v, "{v:?} reads back as {back:?}");
         Ok(())
     }
@@ -1330,7 +1321,7 @@ fn enum_names_in_words_are_their_serde_names() -> Result<(), String> {
         ensure!(f.to_string() == f.as_str(), "{f:?}: Display");
     }
     for v in Verdict::ALL {
-        let json = serde_json::to_value(v).map_err(|e| e.to_string())?;
+        let json = serde_json::to_value(v)?;
         ensure!(
             json == v.as_str(),
             "{v:?}: serde writes {json}, the words say `{}`",
@@ -1338,7 +1329,7 @@ fn enum_names_in_words_are_their_serde_names() -> Result<(), String> {
         );
     }
     for r in FragileReason::ALL {
-        let json = serde_json::to_value(r).map_err(|e| e.to_string())?;
+        let json = serde_json::to_value(r)?;
         ensure!(
             json == r.as_str(),
             "{r:?}: serde writes {json}, the words say `{}`",

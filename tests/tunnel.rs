@@ -43,6 +43,7 @@ use crate::ensure;
 use crate::support::mesh;
 use crate::support::run_bin;
 use crate::trial;
+use anyhow::Context as _;
 
 const FLOOR: &str = "tests/fixtures/tunnel_floor.mcap";
 const WALL: &str = "tests/fixtures/tunnel_wall_teleport.mcap";
@@ -86,14 +87,14 @@ fn floor_mesh() -> Mesh {
     mesh(&s.vertices, &s.triangles)
 }
 
-fn crossing_front_to_back() -> Result<(), String> {
+fn crossing_front_to_back() -> anyhow::Result<()> {
     let m = floor_mesh();
-    let c = first_crossing(&m, &p(1.0, -2.0, 3.0), &p(1.0, -2.0, -1.0)).ok_or("no crossing")?;
+    let c = first_crossing(&m, &p(1.0, -2.0, 3.0), &p(1.0, -2.0, -1.0)).context("no crossing")?;
     ensure!(c.triangle == 0, "triangle {}", c.triangle);
     ensure!(c.fraction == 0.75, "fraction {}", c.fraction);
     ensure!(c.point == p(1.0, -2.0, 0.0), "point {}", c.point);
     // Oblique, into triangle 1.
-    let c = first_crossing(&m, &p(-3.0, 1.0, 1.0), &p(-1.0, 3.0, -1.0)).ok_or("no crossing")?;
+    let c = first_crossing(&m, &p(-3.0, 1.0, 1.0), &p(-1.0, 3.0, -1.0)).context("no crossing")?;
     ensure!(c.triangle == 1, "triangle {}", c.triangle);
     ensure!(
         (c.point - p(-2.0, 2.0, 0.0)).norm() < 1e-12,
@@ -108,7 +109,7 @@ fn crossing_front_to_back() -> Result<(), String> {
     Ok(())
 }
 
-fn crossing_back_to_front_is_none() -> Result<(), String> {
+fn crossing_back_to_front_is_none() -> anyhow::Result<()> {
     let m = floor_mesh();
     ensure!(
         first_crossing(&m, &p(1.0, -2.0, -1.0), &p(1.0, -2.0, 3.0)).is_none(),
@@ -126,7 +127,7 @@ fn crossing_back_to_front_is_none() -> Result<(), String> {
     Ok(())
 }
 
-fn crossing_parallel_is_none() -> Result<(), String> {
+fn crossing_parallel_is_none() -> anyhow::Result<()> {
     let m = floor_mesh();
     for z in [1.0, 0.0, -1.0, 1e-300, -1e-300] {
         ensure!(
@@ -142,7 +143,7 @@ fn crossing_parallel_is_none() -> Result<(), String> {
     Ok(())
 }
 
-fn crossing_touching_the_plane() -> Result<(), String> {
+fn crossing_touching_the_plane() -> anyhow::Result<()> {
     let m = floor_mesh();
     // Ends on the plane: not behind it.
     ensure!(
@@ -160,7 +161,7 @@ fn crossing_touching_the_plane() -> Result<(), String> {
     // crossing at the start.
     for z0 in [0.0, -0.5 * tau] {
         let c = first_crossing(&m, &p(1.0, -2.0, z0), &p(1.0, -2.0, -1.0))
-            .ok_or(format!("no crossing from z = {z0}"))?;
+            .context(format!("no crossing from z = {z0}"))?;
         ensure!(c.fraction == 0.0, "fraction {}", c.fraction);
     }
     // Starts clearly behind: none.
@@ -171,18 +172,18 @@ fn crossing_touching_the_plane() -> Result<(), String> {
     Ok(())
 }
 
-fn crossing_edge_and_vertex() -> Result<(), String> {
+fn crossing_edge_and_vertex() -> anyhow::Result<()> {
     let m = floor_mesh();
     // Through the shared diagonal: both triangles, the lower one reported.
-    let c = first_crossing(&m, &p(1.0, 1.0, 1.0), &p(1.0, 1.0, -1.0)).ok_or("diagonal")?;
+    let c = first_crossing(&m, &p(1.0, 1.0, 1.0), &p(1.0, 1.0, -1.0)).context("diagonal")?;
     ensure!(c.triangle == 0, "shared edge: triangle {}", c.triangle);
     // Through the shared corner (0 and 2 are shared).
-    let c = first_crossing(&m, &p(5.0, 5.0, 1.0), &p(5.0, 5.0, -1.0)).ok_or("corner")?;
+    let c = first_crossing(&m, &p(5.0, 5.0, 1.0), &p(5.0, 5.0, -1.0)).context("corner")?;
     ensure!(c.triangle == 0, "shared vertex: triangle {}", c.triangle);
-    let c = first_crossing(&m, &p(-5.0, 5.0, 1.0), &p(-5.0, 5.0, -1.0)).ok_or("corner 3")?;
+    let c = first_crossing(&m, &p(-5.0, 5.0, 1.0), &p(-5.0, 5.0, -1.0)).context("corner 3")?;
     ensure!(c.triangle == 1, "vertex of triangle 1 only: {}", c.triangle);
     // Grazing the outer boundary: on it counts (boundary included) ...
-    let c = first_crossing(&m, &p(5.0, 0.0, 1.0), &p(5.0, 0.0, -1.0)).ok_or("outer edge")?;
+    let c = first_crossing(&m, &p(5.0, 0.0, 1.0), &p(5.0, 0.0, -1.0)).context("outer edge")?;
     ensure!(c.triangle == 0, "outer edge: triangle {}", c.triangle);
     // ... just outside it does not.
     for (x, y) in [
@@ -201,13 +202,13 @@ fn crossing_edge_and_vertex() -> Result<(), String> {
         let t: f64 = rng.random_range(-5.0..5.0);
         let (dx, dy) = (rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0));
         let c = first_crossing(&m, &p(t + dx, t + dy, 1.0), &p(t - dx, t - dy, -1.0))
-            .ok_or(format!("diagonal at {t}"))?;
+            .context(format!("diagonal at {t}"))?;
         ensure!(c.triangle == 0, "diagonal at {t}: triangle {}", c.triangle);
     }
     Ok(())
 }
 
-fn crossing_first_of_several() -> Result<(), String> {
+fn crossing_first_of_several() -> anyhow::Result<()> {
     // Two floors, at z = 0 and z = -1, both front +z.
     let m = mesh(
         &[
@@ -220,16 +221,16 @@ fn crossing_first_of_several() -> Result<(), String> {
         ],
         &[[3, 4, 5], [0, 1, 2]],
     );
-    let c = first_crossing(&m, &p(0.0, 0.0, 2.0), &p(0.0, 0.0, -2.0)).ok_or("none")?;
+    let c = first_crossing(&m, &p(0.0, 0.0, 2.0), &p(0.0, 0.0, -2.0)).context("none")?;
     ensure!(c.triangle == 1 && c.fraction == 0.5, "{c:?}");
     // From between them: the lower one.
-    let c = first_crossing(&m, &p(0.0, 0.0, -0.5), &p(0.0, 0.0, -2.0)).ok_or("none")?;
+    let c = first_crossing(&m, &p(0.0, 0.0, -0.5), &p(0.0, 0.0, -2.0)).context("none")?;
     ensure!(c.triangle == 0, "{c:?}");
     Ok(())
 }
 
 /// The BVH query against every triangle tested in turn, on a terrain.
-fn crossing_bvh_matches_every_triangle() -> Result<(), String> {
+fn crossing_bvh_matches_every_triangle() -> anyhow::Result<()> {
     let t = scenes::terrain(16);
     let m = mesh(&t.vertices, &t.triangles);
     let (lo, hi) = m.bounds();
@@ -340,30 +341,28 @@ fn wall_sweeps() -> Vec<SweepMsg> {
 
 /// A trace of `scene` and `sweeps`, each followed by the core's outcome as
 /// its `/expected` message.
-fn write_trace(scene: &SceneMsg, sweeps: &[SweepMsg]) -> Result<Vec<u8>, String> {
+fn write_trace(scene: &SceneMsg, sweeps: &[SweepMsg]) -> anyhow::Result<Vec<u8>> {
     let m = mesh(&scene.vertices, &scene.triangles);
     let options = Options {
         margin: scene.margin,
         facing: scene.facing,
     };
-    let mut w = TraceWriter::new(Cursor::new(Vec::new())).map_err(|e| e.to_string())?;
-    w.scene(0, scene).map_err(|e| e.to_string())?;
+    let mut w = TraceWriter::new(Cursor::new(Vec::new()))?;
+    w.scene(0, scene)?;
     for s in sweeps {
         let t = 1_000_000 * (s.frame + 1);
-        w.sweep(t, s).map_err(|e| e.to_string())?;
-        let o = sweep_mesh(&m, &Sweep::new(s.p0, s.p1, s.radius), &options)
-            .map_err(|e| e.to_string())?;
-        w.expected(t, &OutcomeMsg::from_outcome(s.frame, s.ball, &o))
-            .map_err(|e| e.to_string())?;
+        w.sweep(t, s)?;
+        let o = sweep_mesh(&m, &Sweep::new(s.p0, s.p1, s.radius), &options)?;
+        w.expected(t, &OutcomeMsg::from_outcome(s.frame, s.ball, &o))?;
     }
-    Ok(w.finish().map_err(|e| e.to_string())?.into_inner())
+    Ok(w.finish()?.into_inner())
 }
 
-fn floor_bytes() -> Result<Vec<u8>, String> {
+fn floor_bytes() -> anyhow::Result<Vec<u8>> {
     write_trace(&floor_scene(), &floor_sweeps())
 }
 
-fn wall_bytes() -> Result<Vec<u8>, String> {
+fn wall_bytes() -> anyhow::Result<Vec<u8>> {
     write_trace(&wall_scene(), &wall_sweeps())
 }
 
@@ -375,18 +374,18 @@ fn fixture(name: &str) -> PathBuf {
     root().join(name)
 }
 
-fn generate_fixtures() -> Result<(), String> {
+fn generate_fixtures() -> anyhow::Result<()> {
     for (name, bytes) in [(FLOOR, floor_bytes()?), (WALL, wall_bytes()?)] {
-        std::fs::write(fixture(name), bytes).map_err(|e| format!("{name}: {e}"))?;
+        std::fs::write(fixture(name), bytes).map_err(|e| anyhow::anyhow!("{name}: {e}"))?;
     }
     Ok(())
 }
 
 /// Every sweep result of a trace, replayed sequentially.
-fn replay_all(bytes: &[u8], options: ReplayOptions) -> Result<Vec<SweepResult>, String> {
+fn replay_all(bytes: &[u8], options: ReplayOptions) -> anyhow::Result<Vec<SweepResult>> {
     let mut out = Vec::new();
     for e in replay_events(TraceReader::new(bytes, "<memory>"), options) {
-        if let ReplayEvent::Sweep(r) = e.map_err(|e| e.to_string())? {
+        if let ReplayEvent::Sweep(r) = e? {
             out.push(*r);
         }
     }
@@ -405,7 +404,7 @@ fn tunnels_of(results: &[SweepResult]) -> Vec<(u64, u32, TunnelKind, u32)> {
         .collect()
 }
 
-fn check_floor_report(report: &sweeptrace::regress::TraceReport) -> Result<(), String> {
+fn check_floor_report(report: &sweeptrace::regress::TraceReport) -> anyhow::Result<()> {
     let text = render_text(report);
     ensure!(report.status() == Status::Fail, "status\n{text}");
     ensure!(
@@ -413,7 +412,7 @@ fn check_floor_report(report: &sweeptrace::regress::TraceReport) -> Result<(), S
         "the expectations all match:\n{text}"
     );
     ensure!(report.tunnels == 1, "one tunnel:\n{text}");
-    let t = report.tunnel_details.first().ok_or("no tunnel detail")?;
+    let t = report.tunnel_details.first().context("no tunnel detail")?;
     ensure!(
         t.frame == 4 && t.ball == 0 && t.tunnel.kind == TunnelKind::DuringSweep,
         "{t:?}"
@@ -433,7 +432,7 @@ fn check_floor_report(report: &sweeptrace::regress::TraceReport) -> Result<(), S
     Ok(())
 }
 
-fn floor_fixture_check() -> Result<(), String> {
+fn floor_fixture_check() -> anyhow::Result<()> {
     let report = check_file(&fixture(FLOOR), &CheckOptions::default());
     check_floor_report(&report)?;
     // The committed fixture is what the generator makes.
@@ -443,8 +442,7 @@ fn floor_fixture_check() -> Result<(), String> {
         &CheckOptions::default(),
     );
     check_floor_report(&fresh)?;
-    let json: serde_json::Value =
-        serde_json::from_str(&render_json(&[report])).map_err(|e| e.to_string())?;
+    let json: serde_json::Value = serde_json::from_str(&render_json(&[report]))?;
     let t = &json["traces"][0];
     ensure!(json["exit_code"] == 1 && t["status"] == "fail", "{json}");
     ensure!(
@@ -480,12 +478,12 @@ fn floor_fixture_check() -> Result<(), String> {
     Ok(())
 }
 
-fn check_wall_report(report: &sweeptrace::regress::TraceReport) -> Result<(), String> {
+fn check_wall_report(report: &sweeptrace::regress::TraceReport) -> anyhow::Result<()> {
     let text = render_text(report);
     ensure!(report.status() == Status::Fail, "status\n{text}");
     ensure!(report.divergent == 0, "the expectations all match:\n{text}");
     ensure!(report.tunnels == 1, "one tunnel:\n{text}");
-    let t = report.tunnel_details.first().ok_or("no tunnel detail")?;
+    let t = report.tunnel_details.first().context("no tunnel detail")?;
     ensure!(
         t.frame == 2
             && t.ball == 0
@@ -509,7 +507,7 @@ fn check_wall_report(report: &sweeptrace::regress::TraceReport) -> Result<(), St
     Ok(())
 }
 
-fn wall_fixture_check() -> Result<(), String> {
+fn wall_fixture_check() -> anyhow::Result<()> {
     check_wall_report(&check_file(&fixture(WALL), &CheckOptions::default()))?;
     check_wall_report(&check_reader(
         wall_bytes()?.as_slice(),
@@ -518,7 +516,7 @@ fn wall_fixture_check() -> Result<(), String> {
     ))
 }
 
-fn fixtures_binary_check_exit_1() -> Result<(), String> {
+fn fixtures_binary_check_exit_1() -> anyhow::Result<()> {
     let (floor, wall) = (fixture(FLOOR), fixture(WALL));
     let (code, out, err) = run_bin(&["check".as_ref(), floor.as_os_str(), wall.as_os_str()])?;
     ensure!(code == 1, "exit {code}\n{out}\n{err}");
@@ -530,7 +528,8 @@ fn fixtures_binary_check_exit_1() -> Result<(), String> {
     ensure!(out.contains("2 traces: 0 ok, 2 FAIL"), "stdout:\n{out}");
     let (code, out, err) = run_bin(&["check".as_ref(), floor.as_os_str(), "--json".as_ref()])?;
     ensure!(code == 1, "exit {code}\n{out}\n{err}");
-    let json: serde_json::Value = serde_json::from_str(&out).map_err(|e| format!("{e}: {out}"))?;
+    let json: serde_json::Value =
+        serde_json::from_str(&out).map_err(|e| anyhow::anyhow!("{e}: {out}"))?;
     ensure!(
         json["traces"][0]["tunnel_details"][0]["frame"] == 4,
         "json: {json}"
@@ -543,7 +542,7 @@ fn fixtures_binary_check_exit_1() -> Result<(), String> {
     ensure!(code == 0, "exit {code}\n{out}\n{err}");
     ensure!(out.starts_with("ok "), "stdout:\n{out}");
     // --rrd-on-failure records the frames around a tunnel.
-    let dir = tempfile::tempdir().map_err(|e| e.to_string())?;
+    let dir = tempfile::tempdir()?;
     let (code, out, err) = run_bin(&[
         "check".as_ref(),
         wall.as_os_str(),
@@ -558,7 +557,7 @@ fn fixtures_binary_check_exit_1() -> Result<(), String> {
     Ok(())
 }
 
-fn fixtures_binary_replay_outcomes() -> Result<(), String> {
+fn fixtures_binary_replay_outcomes() -> anyhow::Result<()> {
     for (name, frame, kind) in [(FLOOR, 4, "during_sweep"), (WALL, 2, "between_sweeps")] {
         let path = fixture(name);
         let (code, out, err) = run_bin(&[
@@ -576,15 +575,17 @@ fn fixtures_binary_replay_outcomes() -> Result<(), String> {
         );
         let mut seen = 0;
         for line in out.lines() {
-            let v: serde_json::Value = serde_json::from_str(line).map_err(|e| e.to_string())?;
-            let tunnel = v.get("tunnel").ok_or(format!("no tunnel field: {line}"))?;
+            let v: serde_json::Value = serde_json::from_str(line)?;
+            let tunnel = v
+                .get("tunnel")
+                .context(format!("no tunnel field: {line}"))?;
             if v["frame"] == frame && v["ball"] == 0 {
                 seen += 1;
                 ensure!(
                     tunnel["kind"] == kind && tunnel["triangle"] == 0,
                     "{name}: {line}"
                 );
-                let point = tunnel["point"].as_array().ok_or("point")?;
+                let point = tunnel["point"].as_array().context("point")?;
                 ensure!(point.len() == 3, "{name}: {line}");
             } else {
                 ensure!(tunnel.is_null(), "{name}: a tunnel elsewhere: {line}");
@@ -595,7 +596,7 @@ fn fixtures_binary_replay_outcomes() -> Result<(), String> {
     Ok(())
 }
 
-fn parallel_replay_same_tunnels() -> Result<(), String> {
+fn parallel_replay_same_tunnels() -> anyhow::Result<()> {
     for bytes in [floor_bytes()?, wall_bytes()?] {
         let sequential = replay_all(&bytes, ReplayOptions::default())?;
         for batch in [1, 2, 3, 1000] {
@@ -606,7 +607,7 @@ fn parallel_replay_same_tunnels() -> Result<(), String> {
                 batch,
                 None,
             ) {
-                if let ReplayEvent::Sweep(r) = e.map_err(|e| e.to_string())? {
+                if let ReplayEvent::Sweep(r) = e? {
                     parallel.push(*r);
                 }
             }
@@ -621,11 +622,11 @@ fn parallel_replay_same_tunnels() -> Result<(), String> {
     Ok(())
 }
 
-fn filters_and_scenes_reset_the_jump() -> Result<(), String> {
+fn filters_and_scenes_reset_the_jump() -> anyhow::Result<()> {
     let bytes = wall_bytes()?;
-    let with = |frames: &str| -> Result<Vec<(u64, u32, TunnelKind, u32)>, String> {
+    let with = |frames: &str| -> anyhow::Result<Vec<(u64, u32, TunnelKind, u32)>> {
         let options = ReplayOptions {
-            frames: frames.parse().map_err(|e| format!("{e:?}"))?,
+            frames: frames.parse().map_err(|e| anyhow::anyhow!("{e:?}"))?,
             ..ReplayOptions::default()
         };
         Ok(tunnels_of(&replay_all(&bytes, options)?))
@@ -638,20 +639,20 @@ fn filters_and_scenes_reset_the_jump() -> Result<(), String> {
     // Frame 1 not replayed: where it left the ball is unknown.
     ensure!(with("2..")?.is_empty(), "from frame 2: {:?}", with("2..")?);
     // A new scene between the two sweeps: no jump through the old one.
-    let mut w = TraceWriter::new(Cursor::new(Vec::new())).map_err(|e| e.to_string())?;
+    let mut w = TraceWriter::new(Cursor::new(Vec::new()))?;
     let sweeps = wall_sweeps();
-    w.scene(0, &wall_scene()).map_err(|e| e.to_string())?;
-    w.sweep(1, &sweeps[1]).map_err(|e| e.to_string())?;
-    w.scene(2, &wall_scene()).map_err(|e| e.to_string())?;
-    w.sweep(3, &sweeps[2]).map_err(|e| e.to_string())?;
-    let bytes = w.finish().map_err(|e| e.to_string())?.into_inner();
+    w.scene(0, &wall_scene())?;
+    w.sweep(1, &sweeps[1])?;
+    w.scene(2, &wall_scene())?;
+    w.sweep(3, &sweeps[2])?;
+    let bytes = w.finish()?.into_inner();
     let found = tunnels_of(&replay_all(&bytes, ReplayOptions::default())?);
     ensure!(found.is_empty(), "across scenes: {found:?}");
     Ok(())
 }
 
-fn recording_marks_the_tunnel() -> Result<(), String> {
-    let dir = tempfile::tempdir().map_err(|e| e.to_string())?;
+fn recording_marks_the_tunnel() -> anyhow::Result<()> {
+    let dir = tempfile::tempdir()?;
     let rrd = dir.path().join("floor.rrd");
     let path = fixture(FLOOR);
     let (code, _, err) = run_bin(&[
@@ -671,7 +672,7 @@ fn recording_marks_the_tunnel() -> Result<(), String> {
     let lines = d
         .texts
         .get(&("/divergences".to_string(), "TextLog:text".to_string()))
-        .ok_or("no divergences log")?;
+        .context("no divergences log")?;
     ensure!(
         lines.get(&4).is_some_and(|l| l
             .iter()
@@ -694,7 +695,7 @@ fn recording_marks_the_tunnel() -> Result<(), String> {
     let log = d0
         .texts
         .get(&("/log".to_string(), "TextLog:text".to_string()))
-        .ok_or("no log")?;
+        .context("no log")?;
     ensure!(
         log.get(&4)
             .is_some_and(|l| l.iter().any(|s| s.starts_with("frame 4 ball 0:")
@@ -710,12 +711,12 @@ fn recording_marks_the_tunnel() -> Result<(), String> {
     Ok(())
 }
 
-fn sample_traces_have_none() -> Result<(), String> {
+fn sample_traces_have_none() -> anyhow::Result<()> {
     let dir = root().join("traces");
-    let traces = sweeptrace::regress::find_traces(&[dir]).map_err(|e| e.to_string())?;
+    let traces = sweeptrace::regress::find_traces(&[dir]).map_err(anyhow::Error::msg)?;
     ensure!(!traces.is_empty(), "no sample trace");
     for path in traces {
-        let bytes = std::fs::read(&path).map_err(|e| e.to_string())?;
+        let bytes = std::fs::read(&path)?;
         let found = tunnels_of(&replay_all(&bytes, ReplayOptions::default())?);
         ensure!(found.is_empty(), "{}: {found:?}", path.display());
     }
@@ -726,7 +727,7 @@ fn sample_traces_have_none() -> Result<(), String> {
 /// and with and without a margin, several seeds: its response never moves a
 /// ball through a surface, and no sweep starts where the tests let it
 /// through.
-fn simulation_has_none() -> Result<(), String> {
+fn simulation_has_none() -> anyhow::Result<()> {
     use sweeptrace::sim::{BuiltinScene, SimError, SimOptions, scene_message, simulate};
     use sweeptrace::trace::{TraceError, TraceEvent};
     let (mut sweeps, mut hits) = (0u64, 0u64);
@@ -772,12 +773,11 @@ fn simulation_has_none() -> Result<(), String> {
                     sweep: e.sweep,
                 }));
                 Ok(())
-            })
-            .map_err(|e| e.to_string())?;
+            })?;
             sweeps += events.len() as u64 - 1;
             let mut found = Vec::new();
             for e in replay_events(events.into_iter(), ReplayOptions::default()) {
-                if let ReplayEvent::Sweep(r) = e.map_err(|e| e.to_string())? {
+                if let ReplayEvent::Sweep(r) = e? {
                     hits += u64::from(r.outcome.is_hit());
                     found.extend(r.tunnels.iter().map(|t| (r.frame, r.ball, *t)));
                 }
@@ -800,14 +800,14 @@ fn simulation_has_none() -> Result<(), String> {
 }
 
 /// The committed fixtures are byte for byte what `generate_fixtures` makes today.
-fn fixtures_are_what_their_generator_makes() -> Result<(), String> {
+fn fixtures_are_what_their_generator_makes() -> anyhow::Result<()> {
     for (name, bytes) in [(FLOOR, floor_bytes()?), (WALL, wall_bytes()?)] {
-        let committed = std::fs::read(fixture(name)).map_err(|e| format!("{name}: {e}"))?;
+        let committed = std::fs::read(fixture(name)).map_err(|e| anyhow::anyhow!("{name}: {e}"))?;
         if bytes != committed {
-            return Err(format!(
+            anyhow::bail!(
                 "{name} differs from its generator's bytes: regenerate it with \
                  `cargo test --test integration -- --ignored tunnel::generate_fixtures`"
-            ));
+            );
         }
     }
     Ok(())

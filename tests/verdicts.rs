@@ -19,6 +19,7 @@ use sweeptrace::trace::{TraceEvent, TraceWriter};
 
 use crate::support::run_bin;
 use crate::{ensure, os, trial};
+use anyhow::Context as _;
 
 const LIMIT: Duration = Duration::from_secs(60);
 
@@ -66,14 +67,14 @@ fn cube_edge_sweep() -> SweepMsg {
 fn core_answers(
     scene: &SceneMsg,
     sweep: &SweepMsg,
-) -> Result<(OutcomeMsg, Vec<OutcomeMsg>), String> {
-    let mesh = Mesh::new(scene.vertices.clone(), &scene.triangles).map_err(|e| e.to_string())?;
+) -> anyhow::Result<(OutcomeMsg, Vec<OutcomeMsg>)> {
+    let mesh = Mesh::new(scene.vertices.clone(), &scene.triangles)?;
     let options = Options {
         margin: scene.margin,
         facing: scene.facing,
     };
     let s = Sweep::new(sweep.p0, sweep.p1, sweep.radius);
-    let (outcome, ties) = sweep_ties(&mesh, &s, &options).map_err(|e| e.to_string())?;
+    let (outcome, ties) = sweep_ties(&mesh, &s, &options)?;
     let primary = OutcomeMsg::from_outcome(sweep.frame, sweep.ball, &outcome);
     let mut members = Vec::new();
     for t in ties {
@@ -93,29 +94,29 @@ fn trace(
     scene: &SceneMsg,
     sweep: &SweepMsg,
     expected: Option<&OutcomeMsg>,
-) -> Result<Vec<u8>, String> {
-    let mut w = TraceWriter::new(Cursor::new(Vec::new())).map_err(|e| e.to_string())?;
-    w.scene(0, scene).map_err(|e| e.to_string())?;
-    w.sweep(1_000, sweep).map_err(|e| e.to_string())?;
+) -> anyhow::Result<Vec<u8>> {
+    let mut w = TraceWriter::new(Cursor::new(Vec::new()))?;
+    w.scene(0, scene)?;
+    w.sweep(1_000, sweep)?;
     if let Some(e) = expected {
-        w.expected(1_001, e).map_err(|e| e.to_string())?;
+        w.expected(1_001, e)?;
     }
-    Ok(w.finish().map_err(|e| e.to_string())?.into_inner())
+    Ok(w.finish()?.into_inner())
 }
 
 /// The replayed sweep of a one-sweep trace (with its expectation).
-fn replayed(bytes: Vec<u8>) -> Result<SweepResult, String> {
+fn replayed(bytes: Vec<u8>) -> anyhow::Result<SweepResult> {
     let events = sweeptrace::trace::TraceReader::new(Cursor::new(bytes), "t");
     let events: Vec<Result<TraceEvent, _>> = events.collect();
     for e in replay_events(events.into_iter(), ReplayOptions::default()) {
-        if let ReplayEvent::Sweep(r) = e.map_err(|e| e.to_string())? {
+        if let ReplayEvent::Sweep(r) = e? {
             return Ok(*r);
         }
     }
-    Err("no sweep replayed".into())
+    Err(anyhow::anyhow!("no sweep replayed"))
 }
 
-fn cube_edge_tie_members_are_triangles_1_and_8() -> Result<(), String> {
+fn cube_edge_tie_members_are_triangles_1_and_8() -> anyhow::Result<()> {
     let (primary, members) = core_answers(&cube_scene(), &cube_edge_sweep())?;
     ensure!(
         primary.kind == Kind::Edge && primary.triangle == Some(Some(1)),
@@ -126,7 +127,7 @@ fn cube_edge_tie_members_are_triangles_1_and_8() -> Result<(), String> {
         triangles == [Some(Some(1)), Some(Some(8))],
         "tie set: {triangles:?}"
     );
-    let contact = primary.contact.flatten().ok_or("no contact")?;
+    let contact = primary.contact.flatten().context("no contact")?;
     ensure!(
         (contact[0] - 1.0).abs() < 1e-12 && (contact[2] - 1.0).abs() < 1e-12,
         "the primary's contact is on the edge x = 1, z = 1: {contact:?}"
@@ -162,20 +163,15 @@ fn wrong_answers(primary: &OutcomeMsg, members: &[OutcomeMsg]) -> Vec<(&'static 
 fn setup(
     expected: &OutcomeMsg,
     answer: &OutcomeMsg,
-) -> Result<(tempfile::TempDir, PathBuf, String), String> {
-    let dir = tempfile::tempdir().map_err(|e| e.to_string())?;
+) -> anyhow::Result<(tempfile::TempDir, PathBuf, String)> {
+    let dir = tempfile::tempdir()?;
     let path = dir.path().join("t.mcap");
     std::fs::write(
         &path,
         trace(&cube_scene(), &cube_edge_sweep(), Some(expected))?,
-    )
-    .map_err(|e| e.to_string())?;
+    )?;
     let answer_file = dir.path().join("answer.json");
-    std::fs::write(
-        &answer_file,
-        serde_json::to_string(answer).map_err(|e| e.to_string())?,
-    )
-    .map_err(|e| e.to_string())?;
+    std::fs::write(&answer_file, serde_json::to_string(answer)?)?;
     let engine = dir.path().join("engine.py");
     std::fs::write(
         &engine,
@@ -187,16 +183,15 @@ fn setup(
              answer.update(frame=m['frame'], ball=m['ball'], type='outcome')\n    \
              sys.stdout.write(json.dumps(answer) + '\\n')\n    \
              sys.stdout.flush()\n",
-    )
-    .map_err(|e| e.to_string())?;
+    )?;
     let command = format!("python3 '{}' '{}'", engine.display(), answer_file.display());
     Ok((dir, path, command))
 }
 
-fn check_engine(path: &Path, command: &str, against: &str) -> Result<(i32, String), String> {
+fn check_engine(path: &Path, command: &str, against: &str) -> anyhow::Result<(i32, String)> {
     let (code, stdout, stderr) = run_bin(os!(
         "check",
-        path.as_os_str().to_str().ok_or("path")?,
+        path.as_os_str().to_str().context("path")?,
         "--engine",
         command,
         "--against",
@@ -205,7 +200,7 @@ fn check_engine(path: &Path, command: &str, against: &str) -> Result<(i32, Strin
     Ok((code, format!("{stdout}{stderr}")))
 }
 
-fn wrong_answers_on_the_cube_edge_fail_check_engine() -> Result<(), String> {
+fn wrong_answers_on_the_cube_edge_fail_check_engine() -> anyhow::Result<()> {
     let (primary, members) = core_answers(&cube_scene(), &cube_edge_sweep())?;
     for (what, answer) in wrong_answers(&primary, &members) {
         let (_dir, path, command) = setup(&primary, &answer)?;
@@ -224,7 +219,7 @@ fn wrong_answers_on_the_cube_edge_fail_check_engine() -> Result<(), String> {
     Ok(())
 }
 
-fn rule_answers_on_the_cube_edge_pass_check_engine() -> Result<(), String> {
+fn rule_answers_on_the_cube_edge_pass_check_engine() -> anyhow::Result<()> {
     let (primary, members) = core_answers(&cube_scene(), &cube_edge_sweep())?;
     for (what, answer) in [
         ("the primary", primary),
@@ -244,7 +239,7 @@ fn rule_answers_on_the_cube_edge_pass_check_engine() -> Result<(), String> {
 
 /// The `--against expected` path judges with the same rule as `check`: a
 /// member of the tie set only with that member's own contact.
-fn against_expected_compares_the_tie_members_contact() -> Result<(), String> {
+fn against_expected_compares_the_tie_members_contact() -> anyhow::Result<()> {
     let (primary, members) = core_answers(&cube_scene(), &cube_edge_sweep())?;
     let result = replayed(trace(&cube_scene(), &cube_edge_sweep(), Some(&primary))?)?;
     let tol = Tolerances::default();
@@ -275,7 +270,7 @@ fn against_expected_compares_the_tie_members_contact() -> Result<(), String> {
 /// (α = 1, near_end). "No collision" is what the core gives when p1 is a
 /// rounding unit higher: excused, and the report names that perturbation;
 /// a miss claimed with α = 0.5 is no rounding's answer.
-fn a_fragile_divergence_is_excused_only_by_a_named_perturbation() -> Result<(), String> {
+fn a_fragile_divergence_is_excused_only_by_a_named_perturbation() -> anyhow::Result<()> {
     let scene = SceneMsg {
         name: Some("triangle_t".into()),
         vertices: vec![[0.0, 0.0, 0.0], [4.0, 0.0, 0.0], [0.0, 4.0, 0.0]],
@@ -313,11 +308,11 @@ fn a_fragile_divergence_is_excused_only_by_a_named_perturbation() -> Result<(), 
         ..
     } = &a
     else {
-        return Err(format!("a miss at the end is a rounding's answer: {a:?}"));
+        anyhow::bail!("a miss at the end is a rounding's answer: {a:?}");
     };
     let p = r
         .expected
-        .ok_or("the expectation's side needs a perturbation")?;
+        .context("the expectation's side needs a perturbation")?;
     ensure!(
         r.got.is_none(),
         "the core's side is its own decision: {r:?}"
@@ -327,7 +322,7 @@ fn a_fragile_divergence_is_excused_only_by_a_named_perturbation() -> Result<(), 
         "within the fragility band: {p:?}"
     );
     // The named perturbation does give a miss.
-    let mesh = Mesh::new(scene.vertices.clone(), &scene.triangles).map_err(|e| e.to_string())?;
+    let mesh = Mesh::new(scene.vertices.clone(), &scene.triangles)?;
     let mut moved = Sweep::new(sweep.p0, sweep.p1, sweep.radius);
     match p.input {
         "radius" => moved.radius += p.offset,
@@ -349,8 +344,7 @@ fn a_fragile_divergence_is_excused_only_by_a_named_perturbation() -> Result<(), 
         margin: 0.0,
         facing: Facing::NonStrict,
     };
-    let outcome =
-        sweeptrace::core::sweep_mesh(&mesh, &moved, &options).map_err(|e| e.to_string())?;
+    let outcome = sweeptrace::core::sweep_mesh(&mesh, &moved, &options)?;
     ensure!(
         outcome.kind == Kind::None,
         "with {p} the core misses: {outcome:?}"
@@ -374,7 +368,7 @@ fn a_fragile_divergence_is_excused_only_by_a_named_perturbation() -> Result<(), 
 
 /// Worked example 1 (a face hit in the middle, robust): any other answer
 /// fails, and no perturbation is even tried.
-fn a_robust_decision_is_never_excused() -> Result<(), String> {
+fn a_robust_decision_is_never_excused() -> anyhow::Result<()> {
     let scene = SceneMsg {
         name: None,
         vertices: vec![[0.0, 0.0, 0.0], [4.0, 0.0, 0.0], [0.0, 4.0, 0.0]],

@@ -19,7 +19,8 @@ const LISTED_PER_KIND: usize = 3;
 
 /// Arguments of `mesh`.
 #[derive(Debug, clap::Args)]
-#[command(after_help = "Edge classes (by the dihedral angle between the two triangles' front normals):
+#[command(
+    after_help = "Edge classes (by the dihedral angle between the two triangles' front normals):
   boundary      one triangle only (a hole, the rim of an open surface)
   flat          two coplanar triangles (an internal edge: ghost contacts)
   convex        folded away from the fronts (a ridge, the outside of a cube)
@@ -36,7 +37,8 @@ an invalid mesh).
 
 Examples:
   sweeptrace mesh tests/fixtures/scanned/bunny_res4.obj
-  sweeptrace mesh traces/record_mini_golf.mcap --json")]
+  sweeptrace mesh traces/record_mini_golf.mcap --json"
+)]
 pub struct Args {
     /// A Wavefront OBJ file, or a trace (MCAP) whose every scene is
     /// checked. Told apart by content: a file starting with the MCAP magic
@@ -193,7 +195,11 @@ pub fn render_text(file: &str, reports: &[MeshReport]) -> String {
                 let _ = writeln!(out, "    ... and {} more", of_kind.len() - LISTED_PER_KIND);
             }
         }
-        let serious = r.defects.iter().filter(|d| d.kind.changes_collisions()).count();
+        let serious = r
+            .defects
+            .iter()
+            .filter(|d| d.kind.changes_collisions())
+            .count();
         let warnings = r.defects.len() - serious;
         let _ = writeln!(
             out,
@@ -248,7 +254,8 @@ pub fn run(args: Args) -> anyhow::Result<RunOutcome> {
     };
     let mut reports = Vec::new();
     if head[..n] == *MCAP_MAGIC {
-        let file = std::fs::File::open(&args.file).with_context(|| format!("cannot open {name}"))?;
+        let file =
+            std::fs::File::open(&args.file).with_context(|| format!("cannot open {name}"))?;
         let reader = TraceReader::new_indexed(std::io::BufReader::new(file), &name);
         for event in reader {
             let event = event.name_file_once("reading the trace", &name)?;

@@ -22,6 +22,7 @@ mod fuzz_corpus;
 mod help;
 mod interrupts;
 mod junit;
+mod mesh;
 mod oracle;
 mod out_of_order;
 mod outputs;
@@ -134,6 +135,7 @@ fn main() {
     trials.extend(interrupts::tests());
     trials.extend(help::tests());
     trials.extend(first_hour::tests());
+    trials.extend(mesh::tests());
     let trials = mark_slow(trials);
     libtest_mimic::run(&args, trials).exit();
 }

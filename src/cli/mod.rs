@@ -11,6 +11,7 @@ pub mod conform;
 pub mod diff;
 pub mod info;
 pub mod junit;
+pub mod mesh;
 pub mod record;
 pub mod replay;
 pub mod report;
@@ -33,6 +34,8 @@ pub enum Command {
     Sweep(sweep::Args),
     /// Summarise a trace: scenes, sweeps, frames, channels, compression, metadata.
     Info(info::Args),
+    /// Check a mesh (an OBJ file or a trace's scenes): edges by class, and the defects that change collisions (flipped, cracks, T-junctions, ...).
+    Mesh(mesh::Args),
     /// Replay a trace through the core: outcomes, a Rerun recording or a Foxglove file explaining each sweep.
     Replay(replay::Args),
     /// Compare every sweep's outcome with the trace's /expected channel (regression check).
@@ -57,6 +60,7 @@ pub fn run(cli: Cli) -> anyhow::Result<RunOutcome> {
         Command::Sweep(args) => sweep::run(args),
         Command::Record(args) => record::run(args),
         Command::Info(args) => info::run(args),
+        Command::Mesh(args) => mesh::run(args),
         Command::Replay(args) => replay::run(args),
         Command::Check(args) => check::run(args),
         Command::Conform(args) => conform::run(args),

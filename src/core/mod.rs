@@ -15,6 +15,9 @@
 //! [`first_crossing`] is a separate query: where a segment (a ball's centre
 //! moving) passes through a triangle from its front to its back, the fact
 //! behind a tunnel.
+//!
+//! [`Topology`] is the mesh's adjacency: each edge's triangles and class,
+//! and the defects (flipped windings, cracks, T-junctions, ...).
 
 mod bvh;
 mod crossing;
@@ -31,6 +34,7 @@ mod sweep_face;
 mod sweep_mesh;
 mod sweep_vertex;
 mod ties;
+mod topology;
 
 pub use crossing::{Crossing, crossing_tolerance, first_crossing, triangle_crossing};
 pub use error::{MeshError, SweepError};
@@ -50,3 +54,7 @@ pub use sweep_face::{barycentric, barycentric_and_distance, sweep_face};
 pub use sweep_mesh::{Broadphase, Outcome, sweep_mesh, sweep_mesh_with};
 pub use sweep_vertex::sweep_vertex;
 pub use ties::{CollectTies, Tie, in_tie_window, sweep_ties};
+pub use topology::{
+    Defect, DefectKind, Edge, EdgeClass, EdgeCounts, FLAT_DIHEDRAL_SINE, NEAR_FRACTION,
+    SLIVER_RATIO, Topology,
+};

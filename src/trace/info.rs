@@ -12,7 +12,7 @@ use serde::Serialize;
 use super::error::TraceError;
 use super::messages::{EXPECTED_TOPIC, SCENE_TOPIC, SWEEP_TOPIC};
 use super::read::{ReadStats, TraceEvent, TraceReader};
-use crate::core::{Mesh, MeshError};
+use crate::core::{EdgeCounts, Mesh, MeshError, Topology};
 use crate::numbers::counted;
 
 /// Scenes listed one by one; beyond this only their number is kept.
@@ -41,6 +41,11 @@ pub struct SceneSummary {
     pub margin: f64,
     /// Its facing rule.
     pub facing: String,
+    /// Its edges by class (`None` when no topology can be built: an index
+    /// out of range, a non-finite coordinate).
+    pub edges: Option<EdgeCounts>,
+    /// Its number of mesh defects (see `sweeptrace mesh`).
+    pub defects: Option<usize>,
 }
 
 /// Everything `sweeptrace info` reports.
@@ -128,6 +133,7 @@ pub fn collect<R: Read>(mut reader: TraceReader<R>) -> (TraceInfo, Option<TraceE
                 if info.scenes.len() < MAX_LISTED_SCENES {
                     let vertices = scene.vertices.len();
                     let triangles = scene.triangles.len();
+                    let topology = Topology::new(&scene.vertices, &scene.triangles).ok();
                     let (degenerate, mesh_error) = match Mesh::new(scene.vertices, &scene.triangles)
                     {
                         Ok(mesh) => (mesh.degenerate().len(), None),
@@ -146,6 +152,8 @@ pub fn collect<R: Read>(mut reader: TraceReader<R>) -> (TraceInfo, Option<TraceE
                         mesh_error,
                         margin: scene.margin,
                         facing: scene.facing.as_str().to_string(),
+                        edges: topology.as_ref().map(Topology::edge_counts),
+                        defects: topology.as_ref().map(|t| t.defects().len()),
                     });
                 }
             }
@@ -244,6 +252,18 @@ pub fn render_text(info: &TraceInfo) -> String {
             let _ = write!(out, " (unusable: {err})");
         }
         out.push('\n');
+        if let (Some(e), Some(defects)) = (&scene.edges, scene.defects) {
+            let _ = writeln!(
+                out,
+                "    edges: {} boundary, {} convex, {} flat, {} concave, {} non_manifold; {} (see `sweeptrace mesh`)",
+                e.boundary,
+                e.convex,
+                e.flat,
+                e.concave,
+                e.non_manifold,
+                counted(defects as u64, "mesh defect", "mesh defects")
+            );
+        }
     }
     if info.scene_count > info.scenes.len() as u64 {
         let _ = writeln!(

@@ -1,0 +1,172 @@
+//! `sweeptrace mesh` and the library's `Topology`: each fixture of
+//! `tests/fixtures/mesh/` has exactly one known defect (and the clean box
+//! none), found at the right triangles; the built-in scenes' defects.
+
+use libtest_mimic::Trial;
+use serde_json::Value;
+use sweeptrace::Topology;
+use sweeptrace::core::DefectKind;
+use sweeptrace::sim::BuiltinScene;
+
+use crate::support::run_bin;
+use crate::{ensure, os, trial};
+
+pub fn tests() -> Vec<Trial> {
+    vec![
+        trial!(mesh_fixtures_have_their_one_defect),
+        trial!(mesh_clean_box_has_none),
+        trial!(mesh_bad_input_exits_2),
+        trial!(mesh_builtin_scenes),
+        trial!(mesh_reads_a_traces_scenes),
+    ]
+}
+
+fn fixture(name: &str) -> String {
+    format!("{}/tests/fixtures/mesh/{name}", env!("CARGO_MANIFEST_DIR"))
+}
+
+/// `mesh --json FILE`: exit code and the first mesh's JSON.
+fn mesh_json(file: &str) -> Result<(i32, Value), String> {
+    let (code, out, err) = run_bin(os!["mesh", "--json", file])?;
+    let v: Value = serde_json::from_str(&out)
+        .map_err(|e| format!("{file}: stdout is not JSON ({e}): {out}{err}"))?;
+    Ok((code, v["meshes"][0].clone()))
+}
+
+fn mesh_json_fixture_checks(
+    name: &str,
+    kind: &str,
+    triangles: &[u64],
+    exit: i32,
+) -> Result<(), String> {
+    let (code, m) = mesh_json(&fixture(name))?;
+    let defects = m["defects"]
+        .as_array()
+        .ok_or(format!("{name}: no defects list"))?;
+    ensure!(
+        defects.len() == 1,
+        "{name}: want exactly one defect, got {defects:?}"
+    );
+    let d = &defects[0];
+    ensure!(d["kind"] == kind, "{name}: kind {} want {kind}", d["kind"]);
+    let got: Vec<u64> = d["triangles"]
+        .as_array()
+        .map(|a| a.iter().filter_map(Value::as_u64).collect())
+        .unwrap_or_default();
+    ensure!(
+        got == triangles,
+        "{name}: triangles {got:?} want {triangles:?}"
+    );
+    ensure!(
+        d["vertices"].as_array().is_some_and(|a| !a.is_empty()),
+        "{name}: no vertices in {d}"
+    );
+    ensure!(
+        d["position"].as_array().is_some_and(|a| a.len() == 3),
+        "{name}: position is not a point in {d}"
+    );
+    for class in ["boundary", "convex", "flat", "concave", "non_manifold"] {
+        ensure!(
+            m["edges"][class].is_u64(),
+            "{name}: edges.{class} missing in {}",
+            m["edges"]
+        );
+    }
+    ensure!(code == exit, "{name}: exit {code} want {exit}");
+    Ok(())
+}
+
+fn mesh_fixtures_have_their_one_defect() -> Result<(), String> {
+    mesh_json_fixture_checks("flipped_floor.obj", "flipped", &[9], 1)?;
+    mesh_json_fixture_checks("crack_seam.obj", "crack", &[0, 3], 1)?;
+    mesh_json_fixture_checks("t_junction.obj", "t_junction", &[1, 2, 3], 1)?;
+    mesh_json_fixture_checks("fin.obj", "non_manifold_edge", &[0, 1, 8], 1)?;
+    mesh_json_fixture_checks("duplicate_triangle.obj", "duplicate_triangle", &[3, 8], 1)?;
+    // A sliver is a warning: exit 0.
+    mesh_json_fixture_checks("sliver.obj", "sliver", &[0], 0)?;
+    // The text names the flipped triangle and its neighbours.
+    let (code, out, _) = run_bin(os!["mesh", &fixture("flipped_floor.obj")])?;
+    ensure!(code == 1, "text report exit {code}");
+    ensure!(
+        out.contains("triangle 9") && out.contains("opposite to 3 neighbour(s)'"),
+        "text report: {out}"
+    );
+    ensure!(out.contains("verdict: 1 defect(s)"), "no verdict: {out}");
+    Ok(())
+}
+
+fn mesh_clean_box_has_none() -> Result<(), String> {
+    let (code, m) = mesh_json(&fixture("clean_box.obj"))?;
+    ensure!(code == 0, "exit {code}");
+    ensure!(
+        m["defects"] == Value::Array(vec![]),
+        "defects {}",
+        m["defects"]
+    );
+    ensure!(
+        m["edges"]["convex"] == 12 && m["edges"]["flat"] == 6 && m["edges"]["boundary"] == 0,
+        "edges {}",
+        m["edges"]
+    );
+    Ok(())
+}
+
+fn mesh_bad_input_exits_2() -> Result<(), String> {
+    let dir = tempfile::tempdir().map_err(|e| e.to_string())?;
+    let bad = dir.path().join("bad.obj");
+    std::fs::write(&bad, "v 0 0 0\nv 1 0 0\nf 1 2 7\n").map_err(|e| e.to_string())?;
+    let missing = dir.path().join("missing.obj");
+    for file in [&bad, &missing] {
+        let (code, out, err) = run_bin(&[std::ffi::OsStr::new("mesh"), file.as_os_str()])?;
+        ensure!(code == 2, "{}: exit {code}, {out}{err}", file.display());
+        ensure!(
+            err.contains(&*file.display().to_string()) && !err.contains("panicked"),
+            "{}: error does not name the file: {err}",
+            file.display()
+        );
+    }
+    let (code, out, _) = run_bin(os!["mesh", "--help"])?;
+    ensure!(
+        code == 0 && out.contains("non_manifold") && out.contains("Exit codes"),
+        "help: {out}"
+    );
+    Ok(())
+}
+
+/// Every built-in scene but `mini_golf` is clean. `mini_golf` has eight
+/// T-junctions, a real defect of the scene: each wall's bottom edge spans a
+/// whole side of the green, whose boundary is split at the cup's grid lines
+/// (x = 9.7, 10.3 and y = 1.7, 2.3), so those vertices lie on the walls'
+/// edges.
+fn mesh_builtin_scenes() -> Result<(), String> {
+    for scene in BuiltinScene::all() {
+        let s = scene.mesh();
+        let t = Topology::new(&s.vertices, &s.triangles).map_err(|e| e.to_string())?;
+        let kinds: Vec<DefectKind> = t.defects().iter().map(|d| d.kind).collect();
+        if scene == BuiltinScene::MiniGolf {
+            ensure!(
+                kinds == vec![DefectKind::TJunction; 8],
+                "mini_golf: want its 8 T-junctions, got {kinds:?}"
+            );
+        } else {
+            ensure!(kinds.is_empty(), "{}: defects {kinds:?}", scene.name());
+        }
+    }
+    Ok(())
+}
+
+fn mesh_reads_a_traces_scenes() -> Result<(), String> {
+    let trace = format!(
+        "{}/traces/record_mini_golf.mcap",
+        env!("CARGO_MANIFEST_DIR")
+    );
+    let (code, m) = mesh_json(&trace)?;
+    ensure!(code == 1, "exit {code}");
+    ensure!(m["name"] == "mini_golf", "name {}", m["name"]);
+    ensure!(
+        m["defects"].as_array().is_some_and(|d| d.len() == 8),
+        "defects {}",
+        m["defects"]
+    );
+    Ok(())
+}

@@ -89,6 +89,19 @@ impl de::Error for Error {
     }
 }
 
+/// The value of an IEEE 754 half-precision float (exact in an `f64`).
+fn f64_of_half(bits: u16) -> f64 {
+    let sign = if bits & 0x8000 == 0 { 1.0 } else { -1.0 };
+    let exponent = i32::from((bits >> 10) & 0x1f);
+    let fraction = f64::from(bits & 0x3ff);
+    match exponent {
+        0 => sign * fraction * 2f64.powi(-24),
+        31 if fraction == 0.0 => sign * f64::INFINITY,
+        31 => f64::NAN,
+        _ => sign * (1.0 + fraction / 1024.0) * 2f64.powi(exponent - 15),
+    }
+}
+
 /// A decoding error of `minicbor`, in an item that starts at byte `at`.
 fn decode_error(at: usize, err: minicbor::decode::Error) -> Error {
     if err.is_end_of_input() {
@@ -328,7 +341,18 @@ impl<'de> de::Deserializer<'de> for &mut Deserializer<'de> {
                     "integer `{value}` is out of range"
                 )))
             }
-            Type::F16 | Type::F32 | Type::F64 => {
+            Type::F16 => {
+                let at = self.position();
+                let bytes = self
+                    .decoder
+                    .input()
+                    .get(at + 1..at + 3)
+                    .ok_or_else(|| decode_error(at, minicbor::decode::Error::end_of_input()))?;
+                let value = f64_of_half(u16::from_be_bytes([bytes[0], bytes[1]]));
+                self.decoder.set_position(at + 3);
+                visitor.visit_f64(value)
+            }
+            Type::F32 | Type::F64 => {
                 let value = self.with(|d| d.f64())?;
                 visitor.visit_f64(value)
             }
@@ -446,6 +470,30 @@ mod tests {
         assert_eq!(sweep.radius, 0.5);
         assert_eq!(sweep.p0, [1.0, -1.0, 2.5]);
         assert_eq!(sweep.ball, 0);
+    }
+
+    #[test]
+    fn half_floats_are_exact() {
+        for (bits, value) in [
+            (0x3c00, 1.0),
+            (0x3800, 0.5),
+            (0xc000, -2.0),
+            (0x7bff, 65504.0),
+            (0x0001, 2f64.powi(-24)),
+            (0x0400, 2f64.powi(-14)),
+            (0x8000, -0.0),
+            (0x7c00, f64::INFINITY),
+        ] {
+            assert_eq!(
+                f64_of_half(bits).to_bits(),
+                f64::to_bits(value),
+                "{bits:#06x}"
+            );
+        }
+        assert!(f64_of_half(0x7e00).is_nan());
+        // A truncated half is malformed, not a panic.
+        assert!(read::<f64>(&[0xf9, 0x3c]).unwrap_err().is_malformed());
+        assert_eq!(read::<f64>(&[0xf9, 0x3c, 0x00]).unwrap(), 1.0);
     }
 
     #[test]

@@ -6,16 +6,20 @@ Checks the header's library string, the `sweeptrace` metadata record, the
 `engine`, not empty, `version` and `setting.<name>`; with --engine, that it
 names that engine, --engine-version and exactly the --setting NAME=VALUE
 given; with --no-expected-source, that there is none), the schema names and
-encodings of the three channels, that every message is JSON, and the
-message counts (against the summary's statistics and, when given, against
---scenes/--sweeps/--expected). Exits 1 on any mismatch.
+encodings of the three channels, that every message is a map in the
+channels' message encoding (`json`, or with --encoding cbor, CBOR decoded
+with `cbor2`, whose numbers must then be 8-byte doubles or integers), and
+the message counts (against the summary's statistics and, when given,
+against --scenes/--sweeps/--expected). Exits 1 on any mismatch.
 
     venv/bin/python scripts/read_with_python.py TRACE.mcap [--scenes N] [--sweeps N] [--expected N]
         [--engine NAME [--engine-version V] [--setting NAME=VALUE ...] | --no-expected-source]
+        [--encoding json|cbor]
 """
 
 import argparse
 import json
+import struct
 import sys
 
 from mcap.reader import make_reader
@@ -60,6 +64,45 @@ def check_source(sources, args):
     return problems
 
 
+def cbor_doubles_only(data):
+    """Whether every float of the CBOR item `data` is an 8-byte double.
+
+    cbor2 decodes half, single and double floats alike, so the bytes are
+    walked here: the writer must never shorten a float."""
+    pos = 0
+
+    def item():
+        nonlocal pos
+        initial = data[pos]
+        pos += 1
+        major, info = initial >> 5, initial & 0x1F
+        if major == 7:
+            if info in (25, 26):
+                return False
+            if info == 27:
+                struct.unpack(">d", data[pos:pos + 8])
+                pos += 8
+            return True
+        if info < 24:
+            value = info
+        else:
+            size = {24: 1, 25: 2, 26: 4, 27: 8}[info]
+            value = int.from_bytes(data[pos:pos + size], "big")
+            pos += size
+        if major in (2, 3):
+            pos += value
+            return True
+        if major == 4:
+            return all([item() for _ in range(value)])
+        if major == 5:
+            return all([item() for _ in range(2 * value)])
+        if major == 6:
+            return item()
+        return True
+
+    return item() and pos == len(data)
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("trace")
@@ -72,7 +115,14 @@ def main():
                         type=setting_arg,
                         help="one of its settings (all of them must be given)")
     parser.add_argument("--no-expected-source", action="store_true")
+    parser.add_argument("--encoding", choices=["json", "cbor"], default="json",
+                        help="the message encoding the three channels must use")
     args = parser.parse_args()
+    if args.encoding == "cbor":
+        import cbor2
+        decode = cbor2.loads
+    else:
+        decode = json.loads
     problems = []
 
     with open(args.trace, "rb") as f:
@@ -104,8 +154,8 @@ def main():
                     problems.append(f"{channel.topic}: schema encoding {schema.encoding!r}, expected 'jsonschema'")
                 else:
                     json.loads(schema.data)  # the schema document is JSON
-                if channel.message_encoding != "json":
-                    problems.append(f"{channel.topic}: message encoding {channel.message_encoding!r}, expected 'json'")
+                if channel.message_encoding != args.encoding:
+                    problems.append(f"{channel.topic}: message encoding {channel.message_encoding!r}, expected {args.encoding!r}")
             for topic in CHANNELS:
                 if topic not in seen:
                     problems.append(f"channel {topic} is missing")
@@ -115,10 +165,19 @@ def main():
         counts = {}
         for _schema, channel, message in reader.iter_messages(log_time_order=False):
             counts[channel.topic] = counts.get(channel.topic, 0) + 1
+            if channel.topic not in CHANNELS:
+                continue
             try:
-                json.loads(message.data)
+                value = decode(message.data)
             except ValueError as e:
-                problems.append(f"{channel.topic}: message at log_time {message.log_time} is not JSON: {e}")
+                problems.append(f"{channel.topic}: message at log_time {message.log_time} is not {args.encoding}: {e}")
+                continue
+            if not isinstance(value, dict):
+                problems.append(f"{channel.topic}: message at log_time {message.log_time} is not a map: {value!r}")
+            elif channel.topic == "/sweep" and not isinstance(value.get("radius"), float):
+                problems.append(f"{channel.topic}: message at log_time {message.log_time}: radius {value.get('radius')!r} is not a float")
+            if args.encoding == "cbor" and not cbor_doubles_only(message.data):
+                problems.append(f"{channel.topic}: message at log_time {message.log_time} has a float shorter than 8 bytes")
 
     for topic in CHANNELS:
         if summary_counts and summary_counts.get(topic, 0) != counts.get(topic, 0):

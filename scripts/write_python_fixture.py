@@ -6,11 +6,15 @@ program from docs/TRACE_FORMAT.md alone. The Rust tests read the fixture and
 check every value, so keep the values below in sync with tests/trace_io.rs.
 
     python3 -m venv venv && venv/bin/pip install mcap
-    venv/bin/python scripts/write_python_fixture.py [OUT.mcap]
+    venv/bin/python scripts/write_python_fixture.py [OUT.mcap] [--encoding json|cbor]
+
+With --encoding cbor (needs `cbor2`) the three trace channels are CBOR
+(`message_encoding` `cbor`, the same JSON Schemas): the same trace, which
+the tests write to a temporary file and read like the fixture.
 """
 
+import argparse
 import json
-import sys
 from pathlib import Path
 
 from mcap.writer import CompressionType, Writer
@@ -23,8 +27,17 @@ def schema(name):
 
 
 def main():
-    out = Path(sys.argv[1]) if len(sys.argv) > 1 else ROOT / "tests" / "fixtures" / "python_written.mcap"
-    with open(out, "wb") as f:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("out", nargs="?", type=Path,
+                        default=ROOT / "tests" / "fixtures" / "python_written.mcap")
+    parser.add_argument("--encoding", choices=["json", "cbor"], default="json")
+    args = parser.parse_args()
+    if args.encoding == "cbor":
+        import cbor2
+        encode = cbor2.dumps
+    else:
+        encode = lambda msg: json.dumps(msg).encode()  # noqa: E731
+    with open(args.out, "wb") as f:
         writer = Writer(f, compression=CompressionType.LZ4)
         writer.start(profile="", library="python fixture for sweeptrace")
         writer.add_metadata("recorder", {"engine": "python", "units": "m"})
@@ -35,12 +48,13 @@ def main():
             ("/expected", "sweeptrace.Outcome", "outcome"),
         ]:
             schema_id = writer.register_schema(name=name, encoding="jsonschema", data=schema(file))
-            ids[topic] = writer.register_channel(topic=topic, message_encoding="json", schema_id=schema_id)
+            ids[topic] = writer.register_channel(topic=topic, message_encoding=args.encoding,
+                                                 schema_id=schema_id)
         # A foreign channel: readers skip it and count it.
         ids["/debug"] = writer.register_channel(topic="/debug", message_encoding="json", schema_id=0)
 
         def log(topic, t, msg):
-            data = json.dumps(msg).encode()
+            data = json.dumps(msg).encode() if topic == "/debug" else encode(msg)
             writer.add_message(channel_id=ids[topic], log_time=t, publish_time=t, data=data)
 
         # The triangle of the worked examples, front normal +z.

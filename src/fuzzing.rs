@@ -11,8 +11,8 @@ use crate::core::{
     TestRecord, sweep_edge, sweep_face, sweep_mesh, sweep_mesh_with, sweep_vertex,
 };
 use crate::trace::messages::{OutcomeMsg, SceneMsg, SweepMsg};
-use crate::trace::validate::{parse_message, validate_outcome, validate_scene, validate_sweep};
-use crate::trace::{MessageAt, ReadLimits, TraceEvent, TraceReader};
+use crate::trace::validate::{parse_message_as, validate_outcome, validate_scene, validate_sweep};
+use crate::trace::{Encoding, MessageAt, ReadLimits, TraceEvent, TraceReader};
 
 /// The source name the reader is given; every error must name it.
 const SOURCE_NAME: &str = "fuzz-input.mcap";
@@ -115,19 +115,30 @@ fn check_reading<R: std::io::Read>(mut reader: TraceReader<R>, input: &[u8]) -> 
     Ok(())
 }
 
-/// The message parsing and validation over arbitrary bytes (meant to be
-/// JSON), as each of the three messages: a parse error names the file and
-/// the channel; a message that passes validation survives a round trip
-/// through JSON unchanged, and the core accepts it (a scene builds a mesh
-/// or gives a [`MeshError`]; a sweep runs; an outcome has `α` in [0, 1]).
+/// The message parsing and validation over arbitrary bytes, read as JSON
+/// and as CBOR, as each of the three messages: a parse error names the
+/// file and the channel; a message that passes validation survives a round
+/// trip through both encodings unchanged, and the core accepts it (a scene
+/// builds a mesh or gives a [`MeshError`]; a sweep runs; an outcome has `α`
+/// in [0, 1]).
 pub fn check_message_validation(data: &[u8]) -> Result<(), String> {
-    let at = |channel: &str| MessageAt {
-        file: SOURCE_NAME.to_string(),
-        channel: channel.to_string(),
-        index: 0,
-        frame: None,
+    for encoding in Encoding::all() {
+        check_message_validation_as(data, encoding).map_err(|e| format!("as {encoding}: {e}"))?;
+    }
+    Ok(())
+}
+
+fn check_message_validation_as(data: &[u8], encoding: Encoding) -> Result<(), String> {
+    let at = |channel: &str| {
+        let channel = channel.to_string();
+        move || MessageAt {
+            file: SOURCE_NAME.to_string(),
+            channel,
+            index: 0,
+            frame: None,
+        }
     };
-    match parse_message::<SceneMsg>(data, at("/scene")) {
+    match parse_message_as::<SceneMsg>(data, encoding, at("/scene")) {
         Err(err) => check_error_text(&err, data)?,
         Ok(scene) => {
             if validate_scene(&scene).is_ok() {
@@ -136,7 +147,7 @@ pub fn check_message_validation(data: &[u8]) -> Result<(), String> {
             }
         }
     }
-    match parse_message::<SweepMsg>(data, at("/sweep")) {
+    match parse_message_as::<SweepMsg>(data, encoding, at("/sweep")) {
         Err(err) => check_error_text(&err, data)?,
         Ok(sweep) => {
             if validate_sweep(&sweep, Some(0.0)).is_ok() {
@@ -156,7 +167,7 @@ pub fn check_message_validation(data: &[u8]) -> Result<(), String> {
             }
         }
     }
-    match parse_message::<OutcomeMsg>(data, at("/expected")) {
+    match parse_message_as::<OutcomeMsg>(data, encoding, at("/expected")) {
         Err(err) => check_error_text(&err, data)?,
         Ok(outcome) => {
             if validate_outcome(&outcome).is_ok() {
@@ -338,11 +349,23 @@ fn round_trip<T>(message: &T) -> Result<(), String>
 where
     T: serde::Serialize + serde::de::DeserializeOwned + PartialEq + std::fmt::Debug,
 {
-    let json = serde_json::to_vec(message).map_err(|e| format!("cannot write {message:?}: {e}"))?;
-    let back: T = serde_json::from_slice(&json)
-        .map_err(|e| format!("cannot read back {}: {e}", String::from_utf8_lossy(&json)))?;
-    if &back != message {
-        return Err(format!("round trip changed {message:?} into {back:?}"));
+    for encoding in Encoding::all() {
+        let bytes = encoding
+            .encode(message)
+            .map_err(|e| format!("cannot write {message:?} as {encoding}: {e}"))?;
+        let at = || MessageAt {
+            file: SOURCE_NAME.to_string(),
+            channel: "round trip".to_string(),
+            index: 0,
+            frame: None,
+        };
+        let back: T = parse_message_as(&bytes, encoding, at)
+            .map_err(|e| format!("cannot read back {message:?} from {encoding}: {e}"))?;
+        if &back != message {
+            return Err(format!(
+                "a round trip through {encoding} changed {message:?} into {back:?}"
+            ));
+        }
     }
     Ok(())
 }

@@ -53,9 +53,9 @@
 //!   [`Sweep`] and [`Options`]; the result is an [`Outcome`]; [`sweep_ties`]
 //!   adds its tie set.
 //! - Traces: the messages [`SceneMsg`], [`SweepMsg`], [`OutcomeMsg`];
-//!   [`TraceWriter`] / [`write_trace_file`] to record, [`TraceReader`] to
-//!   read (any `Read`), their events [`TraceEvent`] and errors
-//!   [`TraceError`].
+//!   [`TraceWriter`] / [`write_trace_file`] to record (in JSON or CBOR,
+//!   the [`Encoding`]), [`TraceReader`] to read (any `Read`, either
+//!   encoding), their events [`TraceEvent`] and errors [`TraceError`].
 //! - Replay: [`replay_events`] turns trace events into explained results.
 //! - Regression: [`check_file`] / [`check_reader`] judge a trace's
 //!   expectations with the core ([`CheckOptions`] in, a [`TraceReport`]
@@ -110,7 +110,8 @@ pub use crate::regress::{
 pub use crate::replay::{ReplayOptions, replay_events};
 pub use crate::trace::messages::{OutcomeMsg, SceneMsg, SweepMsg};
 pub use crate::trace::{
-    ExpectedSource, TraceError, TraceEvent, TraceReader, TraceWriter, write_trace_file,
+    Encoding, ExpectedSource, TraceError, TraceEvent, TraceReader, TraceWriter, write_trace_file,
+    write_trace_file_with_encoding,
 };
 
 /// The README's Rust examples, compiled and run as doctests.

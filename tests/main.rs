@@ -7,6 +7,7 @@ use libtest_mimic::{Arguments, Completion, Failed, Trial};
 
 mod alt_engine;
 mod bisect;
+mod cbor;
 mod check;
 mod conform;
 mod core_cases;
@@ -112,6 +113,7 @@ fn main() {
     trials.extend(check::tests());
     trials.extend(suite_config::tests());
     trials.extend(trace_io::tests());
+    trials.extend(cbor::tests());
     trials.extend(replay::tests());
     trials.extend(record::tests());
     trials.extend(prefetch::tests());

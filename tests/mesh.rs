@@ -10,6 +10,7 @@ use sweeptrace::sim::BuiltinScene;
 
 use crate::support::run_bin;
 use crate::{ensure, os, trial};
+use anyhow::Context as _;
 
 pub fn tests() -> Vec<Trial> {
     vec![
@@ -26,10 +27,10 @@ fn fixture(name: &str) -> String {
 }
 
 /// `mesh --json FILE`: exit code and the first mesh's JSON.
-fn mesh_json(file: &str) -> Result<(i32, Value), String> {
+fn mesh_json(file: &str) -> anyhow::Result<(i32, Value)> {
     let (code, out, err) = run_bin(os!["mesh", "--json", file])?;
     let v: Value = serde_json::from_str(&out)
-        .map_err(|e| format!("{file}: stdout is not JSON ({e}): {out}{err}"))?;
+        .map_err(|e| anyhow::anyhow!("{file}: stdout is not JSON ({e}): {out}{err}"))?;
     Ok((code, v["meshes"][0].clone()))
 }
 
@@ -38,11 +39,11 @@ fn mesh_json_fixture_checks(
     kind: &str,
     triangles: &[u64],
     exit: i32,
-) -> Result<(), String> {
+) -> anyhow::Result<()> {
     let (code, m) = mesh_json(&fixture(name))?;
     let defects = m["defects"]
         .as_array()
-        .ok_or(format!("{name}: no defects list"))?;
+        .context(format!("{name}: no defects list"))?;
     ensure!(
         defects.len() == 1,
         "{name}: want exactly one defect, got {defects:?}"
@@ -76,7 +77,7 @@ fn mesh_json_fixture_checks(
     Ok(())
 }
 
-fn mesh_fixtures_have_their_one_defect() -> Result<(), String> {
+fn mesh_fixtures_have_their_one_defect() -> anyhow::Result<()> {
     mesh_json_fixture_checks("flipped_floor.obj", "flipped", &[9], 1)?;
     mesh_json_fixture_checks("crack_seam.obj", "crack", &[0, 3], 1)?;
     mesh_json_fixture_checks("t_junction.obj", "t_junction", &[1, 2, 3], 1)?;
@@ -95,7 +96,7 @@ fn mesh_fixtures_have_their_one_defect() -> Result<(), String> {
     Ok(())
 }
 
-fn mesh_clean_box_has_none() -> Result<(), String> {
+fn mesh_clean_box_has_none() -> anyhow::Result<()> {
     let (code, m) = mesh_json(&fixture("clean_box.obj"))?;
     ensure!(code == 0, "exit {code}");
     ensure!(
@@ -111,10 +112,10 @@ fn mesh_clean_box_has_none() -> Result<(), String> {
     Ok(())
 }
 
-fn mesh_bad_input_exits_2() -> Result<(), String> {
-    let dir = tempfile::tempdir().map_err(|e| e.to_string())?;
+fn mesh_bad_input_exits_2() -> anyhow::Result<()> {
+    let dir = tempfile::tempdir()?;
     let bad = dir.path().join("bad.obj");
-    std::fs::write(&bad, "v 0 0 0\nv 1 0 0\nf 1 2 7\n").map_err(|e| e.to_string())?;
+    std::fs::write(&bad, "v 0 0 0\nv 1 0 0\nf 1 2 7\n")?;
     let missing = dir.path().join("missing.obj");
     for file in [&bad, &missing] {
         let (code, out, err) = run_bin(&[std::ffi::OsStr::new("mesh"), file.as_os_str()])?;
@@ -138,10 +139,10 @@ fn mesh_bad_input_exits_2() -> Result<(), String> {
 /// whole side of the green, whose boundary is split at the cup's grid lines
 /// (x = 9.7, 10.3 and y = 1.7, 2.3), so those vertices lie on the walls'
 /// edges.
-fn mesh_builtin_scenes() -> Result<(), String> {
+fn mesh_builtin_scenes() -> anyhow::Result<()> {
     for scene in BuiltinScene::all() {
         let s = scene.mesh();
-        let t = Topology::new(&s.vertices, &s.triangles).map_err(|e| e.to_string())?;
+        let t = Topology::new(&s.vertices, &s.triangles)?;
         let kinds: Vec<DefectKind> = t.defects().iter().map(|d| d.kind).collect();
         if scene == BuiltinScene::MiniGolf {
             ensure!(
@@ -155,7 +156,7 @@ fn mesh_builtin_scenes() -> Result<(), String> {
     Ok(())
 }
 
-fn mesh_reads_a_traces_scenes() -> Result<(), String> {
+fn mesh_reads_a_traces_scenes() -> anyhow::Result<()> {
     let trace = format!(
         "{}/traces/record_mini_golf.mcap",
         env!("CARGO_MANIFEST_DIR")

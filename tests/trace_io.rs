@@ -64,7 +64,7 @@ pub fn tests() -> Vec<Trial> {
 
 const FIXTURE: &str = "tests/fixtures/python_written.mcap";
 
-fn triangle_scene() -> SceneMsg {
+pub fn triangle_scene() -> SceneMsg {
     SceneMsg {
         name: Some("triangle".to_string()),
         vertices: vec![[0.0, 0.0, 0.0], [4.0, 0.0, 0.0], [0.0, 4.0, 0.0]],
@@ -99,7 +99,7 @@ fn outcome(frame: u64) -> OutcomeMsg {
 
 /// The events a sample trace holds: one scene, `frames` frames of two
 /// balls, an expected outcome per frame for ball 0, a second scene midway.
-fn sample_events(frames: u64) -> Vec<TraceEvent> {
+pub fn sample_events(frames: u64) -> Vec<TraceEvent> {
     let mut events = Vec::new();
     let mut index = 0;
     let mut push = |e: TraceEvent| {
@@ -143,13 +143,13 @@ fn sample_events(frames: u64) -> Vec<TraceEvent> {
     events
 }
 
-fn default_opts() -> WriteOptions {
+pub fn default_opts() -> WriteOptions {
     sweeptrace::trace::write::default_write_options()
 }
-fn unchunked() -> WriteOptions {
+pub fn unchunked() -> WriteOptions {
     default_opts().use_chunks(false)
 }
-fn lz4() -> WriteOptions {
+pub fn lz4() -> WriteOptions {
     default_opts()
         .compression(Some(Compression::Lz4))
         .chunk_size(Some(4096))
@@ -170,7 +170,7 @@ fn no_summary() -> WriteOptions {
         .repeat_schemas(false)
 }
 
-fn write_events(events: &[TraceEvent], opts: WriteOptions) -> anyhow::Result<Vec<u8>> {
+pub fn write_events(events: &[TraceEvent], opts: WriteOptions) -> anyhow::Result<Vec<u8>> {
     let mut w = TraceWriter::with_options(Cursor::new(Vec::new()), opts)?;
     for e in events {
         match e {
@@ -195,7 +195,7 @@ fn write_events(events: &[TraceEvent], opts: WriteOptions) -> anyhow::Result<Vec
 }
 
 /// Every event, the error that ended reading (if any) and the stats.
-fn read_all(bytes: &[u8]) -> (Vec<TraceEvent>, Option<TraceError>, ReadStats) {
+pub fn read_all(bytes: &[u8]) -> (Vec<TraceEvent>, Option<TraceError>, ReadStats) {
     read_all_with(bytes, ReadLimits::default())
 }
 
@@ -224,7 +224,7 @@ pub fn raw_trace(messages: &[(&str, u64, &[u8])]) -> Vec<u8> {
     raw_trace_with(messages, "json")
 }
 
-fn raw_trace_with(messages: &[(&str, u64, &[u8])], encoding: &str) -> Vec<u8> {
+pub fn raw_trace_with(messages: &[(&str, u64, &[u8])], encoding: &str) -> Vec<u8> {
     let mut w = default_opts()
         .create(Cursor::new(Vec::new()))
         .expect("writer");
@@ -259,11 +259,14 @@ fn raw_trace_with(messages: &[(&str, u64, &[u8])], encoding: &str) -> Vec<u8> {
     w.into_inner().into_inner()
 }
 
-const SCENE_JSON: &[u8] =
+pub const SCENE_JSON: &[u8] =
     br#"{"name":"t","vertices":[[0,0,0],[4,0,0],[0,4,0]],"triangles":[[0,1,2]]}"#;
 
 /// Reads `bytes`, expects an error, checks its message contains every `needle`.
-fn expect_error(bytes: &[u8], needles: &[&str]) -> anyhow::Result<(Vec<TraceEvent>, TraceError)> {
+pub fn expect_error(
+    bytes: &[u8],
+    needles: &[&str],
+) -> anyhow::Result<(Vec<TraceEvent>, TraceError)> {
     let (events, error, _) = read_all(bytes);
     let Some(error) = error else {
         anyhow::bail!(
@@ -282,7 +285,7 @@ fn expect_error(bytes: &[u8], needles: &[&str]) -> anyhow::Result<(Vec<TraceEven
 }
 
 /// The first difference between two event lists, if any.
-fn same(got: &[TraceEvent], want: &[TraceEvent]) -> anyhow::Result<()> {
+pub fn same(got: &[TraceEvent], want: &[TraceEvent]) -> anyhow::Result<()> {
     for (i, (g, w)) in got.iter().zip(want).enumerate() {
         ensure!(g == w, "event {i} differs:\n got {g:?}\nwant {w:?}");
     }
@@ -423,7 +426,12 @@ fn flavour(opts: WriteOptions, compression: &[&str]) -> anyhow::Result<()> {
 
 fn python_fixture_exact_values() -> anyhow::Result<()> {
     let bytes = std::fs::read(FIXTURE).map_err(|e| anyhow::anyhow!("{FIXTURE}: {e}"))?;
-    let (events, error, stats) = read_all(&bytes);
+    check_python_fixture(&bytes)
+}
+
+/// The values `scripts/write_python_fixture.py` writes, in either encoding.
+pub fn check_python_fixture(bytes: &[u8]) -> anyhow::Result<()> {
+    let (events, error, stats) = read_all(bytes);
     ensure!(error.is_none(), "error: {error:?}");
     ensure!(events.len() == 10, "{} events", events.len());
     let TraceEvent::Scene {
@@ -980,8 +988,14 @@ fn error_out_of_order_log_time() -> anyhow::Result<()> {
 }
 
 fn error_wrong_message_encoding() -> anyhow::Result<()> {
-    let bytes = raw_trace_with(&[("/scene", 0, SCENE_JSON)], "cbor");
-    expect_error(&bytes, &["test.mcap", "`/scene`", "cbor", "json"])?;
+    let bytes = raw_trace_with(&[("/scene", 0, SCENE_JSON)], "protobuf");
+    expect_error(
+        &bytes,
+        &["test.mcap", "`/scene`", "`protobuf`", "`json` or `cbor`"],
+    )?;
+    // The names are exact: `JSON` is not `json`.
+    let bytes = raw_trace_with(&[("/scene", 0, SCENE_JSON)], "JSON");
+    expect_error(&bytes, &["`/scene`", "`JSON`"])?;
     Ok(())
 }
 
@@ -1039,7 +1053,7 @@ fn random_corruption_never_panics() -> anyhow::Result<()> {
 }
 
 /// The name of the error's variant, from its `Debug` form (`Corrupt { .. }`).
-fn variant_name(error: &TraceError) -> String {
+pub fn variant_name(error: &TraceError) -> String {
     let debug = format!("{error:?}");
     debug
         .split([' ', '{', '('])
@@ -1051,7 +1065,7 @@ fn variant_name(error: &TraceError) -> String {
 /// The error read from `test.mcap` after `read` good messages names the
 /// file and, where it has one, the message (channel and index, which is at
 /// least `read`) or the number of complete messages before it.
-fn error_names_where(error: &TraceError, read: u64) -> anyhow::Result<()> {
+pub fn error_names_where(error: &TraceError, read: u64) -> anyhow::Result<()> {
     let text = error.to_string();
     ensure!(
         text.starts_with("test.mcap: "),

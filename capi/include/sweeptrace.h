@@ -66,6 +66,15 @@ typedef enum SweeptraceKind {
   SWEEPTRACE_KIND_VERTEX = 3,
 } SweeptraceKind;
 
+// The message encoding of a trace, for [`sweeptrace_writer_open_with_encoding`]
+// (docs/TRACE_FORMAT.md): the same messages either way.
+typedef enum SweeptraceEncoding {
+  // JSON text (the default of [`sweeptrace_writer_open`]).
+  SWEEPTRACE_ENCODING_JSON = 0,
+  // CBOR: binary, every number an 8-byte double.
+  SWEEPTRACE_ENCODING_CBOR = 1,
+} SweeptraceEncoding;
+
 // A trace being written. Opaque: made by [`sweeptrace_writer_open`],
 // released by [`sweeptrace_writer_free`]. Use each writer from one thread
 // at a time; different writers may be used on different threads.
@@ -217,6 +226,16 @@ extern "C" {
 // points to writable storage for a pointer.
 enum SweeptraceStatus sweeptrace_writer_open(const char *path,
                                              struct SweeptraceWriter **out_writer);
+
+// [`sweeptrace_writer_open`], writing the trace's messages in `encoding`,
+// a [`SweeptraceEncoding`] (JSON or CBOR). An unknown value returns
+// [`SweeptraceStatus::InvalidArgument`] and creates no file.
+//
+// # Safety
+// As [`sweeptrace_writer_open`].
+enum SweeptraceStatus sweeptrace_writer_open_with_encoding(const char *path,
+                                                           uint32_t encoding,
+                                                           struct SweeptraceWriter **out_writer);
 
 // Says who computed the trace's expected outcomes: the engine's name
 // (`engine`, not empty), its version (`version`; null or empty when not

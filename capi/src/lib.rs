@@ -35,7 +35,7 @@ use std::path::PathBuf;
 use sweeptrace::core::{Facing, Kind};
 use sweeptrace::trace::messages::{OutcomeMsg, SceneMsg, SweepMsg};
 use sweeptrace::trace::source::MAX_SETTINGS;
-use sweeptrace::trace::{ExpectedSource, PendingTrace, TraceError};
+use sweeptrace::trace::{Encoding, ExpectedSource, PendingTrace, TraceError};
 
 /// What a call came to.
 #[repr(C)]
@@ -85,6 +85,17 @@ pub enum SweeptraceFacing {
     NonStrict = 0,
     /// `n · d < 0`: strictly toward the front.
     Strict = 1,
+}
+
+/// The message encoding of a trace, for [`sweeptrace_writer_open_with_encoding`]
+/// (docs/TRACE_FORMAT.md): the same messages either way.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SweeptraceEncoding {
+    /// JSON text (the default of [`sweeptrace_writer_open`]).
+    Json = 0,
+    /// CBOR: binary, every number an 8-byte double.
+    Cbor = 1,
 }
 
 /// [`SweeptraceOutcome::fields`]: `triangle` is given.
@@ -332,6 +343,16 @@ fn kind_from(value: u32) -> Result<Kind, Failure> {
     })
 }
 
+fn encoding_from(value: u32) -> Result<Encoding, Failure> {
+    match value {
+        0 => Ok(Encoding::Json),
+        1 => Ok(Encoding::Cbor),
+        _ => Err(Failure::invalid(format!(
+            "`encoding` must be a SweeptraceEncoding (0 json, 1 cbor), got {value}"
+        ))),
+    }
+}
+
 fn facing_from(value: u32) -> Result<Facing, Failure> {
     match value {
         0 => Ok(Facing::NonStrict),
@@ -371,6 +392,35 @@ pub unsafe extern "C" fn sweeptrace_writer_open(
     path: *const c_char,
     out_writer: *mut *mut SweeptraceWriter,
 ) -> SweeptraceStatus {
+    // SAFETY: the contract is the caller's.
+    unsafe { open(path, SweeptraceEncoding::Json as u32, out_writer) }
+}
+
+/// [`sweeptrace_writer_open`], writing the trace's messages in `encoding`,
+/// a [`SweeptraceEncoding`] (JSON or CBOR). An unknown value returns
+/// [`SweeptraceStatus::InvalidArgument`] and creates no file.
+///
+/// # Safety
+/// As [`sweeptrace_writer_open`].
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn sweeptrace_writer_open_with_encoding(
+    path: *const c_char,
+    encoding: u32,
+    out_writer: *mut *mut SweeptraceWriter,
+) -> SweeptraceStatus {
+    // SAFETY: the contract is the caller's.
+    unsafe { open(path, encoding, out_writer) }
+}
+
+/// The two `open` functions.
+///
+/// # Safety
+/// As [`sweeptrace_writer_open`].
+unsafe fn open(
+    path: *const c_char,
+    encoding: u32,
+    out_writer: *mut *mut SweeptraceWriter,
+) -> SweeptraceStatus {
     let result = catch_unwind(|| -> Result<*mut SweeptraceWriter, Failure> {
         if out_writer.is_null() {
             return Err(Failure::null("out_writer"));
@@ -380,12 +430,13 @@ pub unsafe extern "C" fn sweeptrace_writer_open(
         if path.is_null() {
             return Err(Failure::null("path"));
         }
+        let encoding = encoding_from(encoding)?;
         // SAFETY: non-null, NUL-terminated by the contract.
         let path = path_from(unsafe { CStr::from_ptr(path) })?;
         if path.as_os_str().is_empty() {
             return Err(Failure::invalid("`path` is empty"));
         }
-        let trace = PendingTrace::create(&path).map_err(Failure::from)?;
+        let trace = PendingTrace::create_with_encoding(&path, encoding).map_err(Failure::from)?;
         Ok(Box::into_raw(Box::new(SweeptraceWriter {
             state: State::Open(Box::new(trace)),
             scene_triangles: None,

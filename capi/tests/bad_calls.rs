@@ -559,3 +559,67 @@ fn bad_expected_sources_are_refused_and_the_good_one_is_read_back() {
         .count();
     assert_eq!(sources, 1, "{:?}", reader.stats().metadata);
 }
+
+#[test]
+fn open_with_encoding_writes_cbor_and_refuses_an_unknown_encoding() {
+    let dir = tempfile::tempdir().expect("a temporary directory");
+    let target = dir.path().join("cbor.mcap");
+    let path = CString::new(target.to_str().expect("a UTF-8 path")).expect("no NUL");
+    let mut writer = null_mut();
+    // SAFETY: valid arguments.
+    let status = unsafe { sweeptrace_writer_open_with_encoding(path.as_ptr(), 7, &mut writer) };
+    assert_eq!(status, SweeptraceStatus::InvalidArgument);
+    assert!(
+        writer.is_null(),
+        "a writer was made for an unknown encoding"
+    );
+    let message = text(sweeptrace_last_error());
+    assert!(
+        message.contains("`encoding`") && message.contains("got 7"),
+        "{message}"
+    );
+    assert!(
+        std::fs::read_dir(dir.path())
+            .expect("readable")
+            .next()
+            .is_none()
+    );
+
+    for (encoding, name) in [
+        (SweeptraceEncoding::Cbor, "cbor"),
+        (SweeptraceEncoding::Json, "json"),
+    ] {
+        // SAFETY: valid arguments.
+        let status = unsafe {
+            sweeptrace_writer_open_with_encoding(path.as_ptr(), encoding as u32, &mut writer)
+        };
+        assert_eq!(
+            status,
+            SweeptraceStatus::Ok,
+            "{}",
+            text(sweeptrace_last_error())
+        );
+        assert_eq!(
+            add_scene(writer, &VERTICES, &TRIANGLES),
+            SweeptraceStatus::Ok
+        );
+        assert_eq!(add_sweep(writer, 0, P0), SweeptraceStatus::Ok);
+        assert_eq!(add_expected(writer, &face_outcome(0)), SweeptraceStatus::Ok);
+        // SAFETY: a live writer, closed then freed once.
+        unsafe {
+            assert_eq!(sweeptrace_writer_close(writer), SweeptraceStatus::Ok);
+            sweeptrace_writer_free(writer);
+        }
+        let bytes = std::fs::read(&target).expect("the trace was written");
+        let mut reader = sweeptrace::TraceReader::new(bytes.as_slice(), "cbor.mcap");
+        let events: Vec<_> = reader.by_ref().collect::<Result<_, _>>().expect("reads");
+        assert_eq!(events.len(), 3);
+        for topic in ["/scene", "/sweep", "/expected"] {
+            assert_eq!(reader.stats().channels[topic].message_encoding, name);
+        }
+        match &events[1] {
+            sweeptrace::TraceEvent::Sweep { sweep, .. } => assert_eq!(sweep.p0, P0),
+            other => panic!("not a sweep: {other:?}"),
+        }
+    }
+}

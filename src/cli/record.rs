@@ -12,7 +12,7 @@ use sweeptrace::run::RunOutcome;
 use sweeptrace::sim::scenes::{self, BuiltinScene, SceneMesh};
 use sweeptrace::sim::{self, SimOptions, SimSummary, StopReason};
 use sweeptrace::trace::source::sweeptrace_source;
-use sweeptrace::trace::write_trace_file;
+use sweeptrace::trace::{Encoding, write_trace_file_with_encoding};
 
 /// Arguments of `record`. Every simulation option defaults to the scene's
 /// own choice (`sweeptrace::sim::BuiltinScene::sim_options`).
@@ -20,6 +20,7 @@ use sweeptrace::trace::write_trace_file;
 #[command(after_help = "Examples:\n  \
     sweeptrace record --scene mini_golf -o mini_golf.mcap\n  \
     sweeptrace record --scene terrain --terrain-cells 64 --balls 4 --seed 7 --frames 600 -o hills.mcap\n  \
+    sweeptrace record --scene bowl --encoding cbor -o bowl.mcap\n  \
     sweeptrace record --mesh tests/fixtures/scanned/bunny_res4.obj --radius 0.005 --position 0,0.1,0.3 --margin 0.001 --frames 200 -o bunny.mcap")]
 pub struct Args {
     /// Built-in scene: `mini_golf` (green, walls, ramp, cup), `bowl`, `box`
@@ -88,6 +89,11 @@ pub struct Args {
     /// the last one is dropped.
     #[arg(long)]
     pub max_substeps: Option<u32>,
+    /// Message encoding of the trace: `json` (text) or `cbor` (binary, the
+    /// same messages with every number an 8-byte double, read without
+    /// parsing). See docs/TRACE_FORMAT.md.
+    #[arg(long, value_enum, default_value_t = Encoding::Json, value_name = "ENCODING")]
+    pub encoding: Encoding,
 }
 
 impl Args {
@@ -165,25 +171,29 @@ pub fn run(args: Args) -> anyhow::Result<RunOutcome> {
 
     let bar = progress_bar(options.frames);
     super::warn_unfinished(&output);
-    let summary = write_trace_file(&output, |writer| -> anyhow::Result<SimSummary> {
-        // The expectations are the core's, with the recording's margin and facing.
-        writer.expected_source(&sweeptrace_source(
-            &options.margin.to_string(),
-            options.facing.as_str(),
-        ))?;
-        writer.scene(0, &scene_msg)?;
-        let mut shown = 0;
-        let summary = sim::simulate(&mesh, &options, |event| -> anyhow::Result<()> {
-            writer.sweep(event.log_time_nanos, &event.sweep)?;
-            writer.expected(event.log_time_nanos, &event.outcome)?;
-            if event.sim_frame >= shown + 256 {
-                shown = event.sim_frame;
-                bar.set_position(shown);
-            }
-            Ok(())
-        })?;
-        Ok(summary)
-    })
+    let summary = write_trace_file_with_encoding(
+        &output,
+        args.encoding,
+        |writer| -> anyhow::Result<SimSummary> {
+            // The expectations are the core's, with the recording's margin and facing.
+            writer.expected_source(&sweeptrace_source(
+                &options.margin.to_string(),
+                options.facing.as_str(),
+            ))?;
+            writer.scene(0, &scene_msg)?;
+            let mut shown = 0;
+            let summary = sim::simulate(&mesh, &options, |event| -> anyhow::Result<()> {
+                writer.sweep(event.log_time_nanos, &event.sweep)?;
+                writer.expected(event.log_time_nanos, &event.outcome)?;
+                if event.sim_frame >= shown + 256 {
+                    shown = event.sim_frame;
+                    bar.set_position(shown);
+                }
+                Ok(())
+            })?;
+            Ok(summary)
+        },
+    )
     .name_file_once("recording", output.display())?;
     bar.finish_and_clear();
     println!(

@@ -11,7 +11,9 @@
 //!    is kept verbatim (channel and schema ids may be renumbered), except the
 //!    messages of `/expected` channels, which are dropped; after each `/sweep`
 //!    message its new expectation is written on a `/expected` channel with
-//!    the project's `sweeptrace.Outcome` schema, at the sweep's `log_time`.
+//!    the project's `sweeptrace.Outcome` schema, at the sweep's `log_time`,
+//!    in the message encoding of that sweep's channel (JSON or CBOR: a
+//!    trace keeps its encoding, one `/expected` channel per encoding).
 //!    The expectations now come from sweeptrace: the input's
 //!    `sweeptrace.expected_source` record, if any, is dropped and a new one
 //!    (engine `sweeptrace`, its version, the margin and facing rule the
@@ -37,11 +39,11 @@ use crate::atomic::{FinishStep, PendingFile};
 use crate::error_text::full_text;
 use crate::replay::{ReplayError, ReplayEvent, ReplayOptions, replay_events};
 use crate::trace::messages::{EXPECTED_TOPIC, OUTCOME_SCHEMA, OutcomeMsg, SWEEP_TOPIC};
-use crate::trace::schemas::{MESSAGE_ENCODING, OUTCOME_SCHEMA_JSON, SCHEMA_ENCODING};
+use crate::trace::schemas::{OUTCOME_SCHEMA_JSON, SCHEMA_ENCODING};
 use crate::trace::source::{EXPECTED_SOURCE_METADATA, ExpectedSource, sweeptrace_source};
-use crate::trace::validate::frame_of;
+use crate::trace::validate::frame_of_message;
 use crate::trace::write::default_write_options;
-use crate::trace::{TraceError, TraceReader};
+use crate::trace::{Encoding, TraceError, TraceReader};
 
 /// What went wrong while blessing.
 #[derive(Debug, Error)]
@@ -272,7 +274,10 @@ fn bless_into<W: Write + Seek>(
     let mut schema_ids: HashMap<u16, u16> = HashMap::new();
     let mut channel_ids: HashMap<u16, u16> = HashMap::new();
     let mut channel_topics: HashMap<u16, String> = HashMap::new();
-    let mut expected_channel: Option<u16> = None;
+    // The message encoding of each input channel (trace channels: the
+    // replay pass checked they are `json` or `cbor`).
+    let mut channel_encodings: HashMap<u16, Encoding> = HashMap::new();
+    let mut expected_channels: BTreeMap<Encoding, u16> = BTreeMap::new();
     let mut index: u64 = 0;
     let mut sequence: u32 = 0;
     for record in ChunkFlattener::new(input).map_err(read_err)? {
@@ -295,6 +300,9 @@ fn bless_into<W: Write + Seek>(
                     continue;
                 }
                 channel_topics.insert(c.id, c.topic.clone());
+                if let Some(encoding) = Encoding::from_message_encoding(&c.message_encoding) {
+                    channel_encodings.insert(c.id, encoding);
+                }
                 if c.topic == EXPECTED_TOPIC {
                     continue;
                 }
@@ -345,10 +353,12 @@ fn bless_into<W: Write + Seek>(
                 if topic != Some(SWEEP_TOPIC) {
                     continue;
                 }
-                let ball = serde_json::from_slice::<BallOnly>(&data)
-                    .map(|b| b.ball)
-                    .unwrap_or(0);
-                let Some(outcome) = frame_of(&data)
+                let encoding = channel_encodings
+                    .get(&header.channel_id)
+                    .copied()
+                    .unwrap_or_default();
+                let ball = ball_of(&data, encoding);
+                let Some(outcome) = frame_of_message(&data, encoding)
                     .and_then(|frame| outcomes.get_mut(&(frame, ball)))
                     .and_then(VecDeque::pop_front)
                 else {
@@ -357,8 +367,8 @@ fn bless_into<W: Write + Seek>(
                         index: this,
                     });
                 };
-                let channel_id = match expected_channel {
-                    Some(id) => id,
+                let channel_id = match expected_channels.get(&encoding) {
+                    Some(&id) => id,
                     None => {
                         let schema = writer
                             .add_schema(
@@ -368,13 +378,18 @@ fn bless_into<W: Write + Seek>(
                             )
                             .map_err(write_err)?;
                         let id = writer
-                            .add_channel(schema, EXPECTED_TOPIC, MESSAGE_ENCODING, &BTreeMap::new())
+                            .add_channel(
+                                schema,
+                                EXPECTED_TOPIC,
+                                encoding.as_str(),
+                                &BTreeMap::new(),
+                            )
                             .map_err(write_err)?;
-                        expected_channel = Some(id);
+                        expected_channels.insert(encoding, id);
                         id
                     }
                 };
-                let json = serde_json::to_vec(&outcome).map_err(|e| BlessError::Io {
+                let encoded = encoding.encode(&outcome).map_err(|e| BlessError::Io {
                     file: name.to_string(),
                     what: format!("serializing the outcome of frame {}", outcome.frame),
                     cause: std::io::Error::other(e),
@@ -387,7 +402,7 @@ fn bless_into<W: Write + Seek>(
                             log_time: header.log_time,
                             publish_time: header.log_time,
                         },
-                        &json,
+                        &encoded,
                     )
                     .map_err(write_err)?;
                 sequence = sequence.wrapping_add(1);
@@ -424,6 +439,19 @@ fn bless_into<W: Write + Seek>(
 struct BallOnly {
     #[serde(default)]
     ball: u32,
+}
+
+/// The ball of a sweep message (0 when it cannot be read: the replay pass
+/// already read every sweep).
+fn ball_of(data: &[u8], encoding: Encoding) -> u32 {
+    use serde::Deserialize;
+    match encoding {
+        Encoding::Cbor => {
+            BallOnly::deserialize(&mut crate::trace::cbor::Deserializer::from_slice(data)).ok()
+        }
+        Encoding::Json => serde_json::from_slice::<BallOnly>(data).ok(),
+    }
+    .map_or(0, |b| b.ball)
 }
 
 /// Blesses the file `input` into `output` (which may be the same path, for

@@ -167,9 +167,9 @@ pub enum TraceError {
         /// The largest log time seen before it.
         previous_nanos: u64,
     },
-    /// A trace channel does not use the JSON message encoding.
+    /// A trace channel uses a message encoding other than `json` and `cbor`.
     #[error(
-        "{file}: channel `{channel}` has message encoding `{encoding}`; trace channels must use `json`"
+        "{file}: channel `{channel}` has message encoding `{encoding}`; trace channels must use `json` or `cbor`"
     )]
     WrongEncoding {
         /// File name.

@@ -332,6 +332,9 @@ pub fn render_text(info: &TraceInfo) -> String {
     if let Some(source) = &info.expected_source {
         let _ = writeln!(out, "expected by: {source}");
     }
+    if let Some(line) = encoding_line(s) {
+        let _ = writeln!(out, "encoding:    {line}");
+    }
     let _ = writeln!(out, "channels:");
     for (topic, c) in &s.channels {
         let ours = [SCENE_TOPIC, SWEEP_TOPIC, EXPECTED_TOPIC].contains(&topic.as_str());
@@ -366,6 +369,32 @@ pub fn render_text(info: &TraceInfo) -> String {
         let _ = writeln!(out, "incomplete:  {err}");
     }
     out
+}
+
+/// The message encodings of the trace channels: `cbor` when they all use
+/// one, else each with its channels (`cbor (/scene, /sweep), json
+/// (/expected)`); `None` without a trace channel.
+fn encoding_line(stats: &ReadStats) -> Option<String> {
+    let mut by_encoding: BTreeMap<&str, Vec<&str>> = BTreeMap::new();
+    for (topic, c) in &stats.channels {
+        if [SCENE_TOPIC, SWEEP_TOPIC, EXPECTED_TOPIC].contains(&topic.as_str()) {
+            by_encoding
+                .entry(c.message_encoding.as_str())
+                .or_default()
+                .push(topic);
+        }
+    }
+    match by_encoding.len() {
+        0 => None,
+        1 => by_encoding.into_keys().next().map(str::to_string),
+        _ => Some(
+            by_encoding
+                .iter()
+                .map(|(encoding, topics)| format!("{encoding} ({})", topics.join(", ")))
+                .collect::<Vec<_>>()
+                .join(", "),
+        ),
+    }
 }
 
 /// The report as one pretty-printed JSON object.

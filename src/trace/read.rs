@@ -45,19 +45,20 @@ use mcap::McapError;
 use mcap::records::{Record, op};
 use mcap::sans_io::{LinearReadEvent, LinearReader, LinearReaderOptions};
 
+use super::encoding::Encoding;
 use super::error::{MessageAt, TraceError};
 use super::messages::{EXPECTED_TOPIC, OutcomeMsg, SCENE_TOPIC, SWEEP_TOPIC, SceneMsg, SweepMsg};
 use super::source::{EXPECTED_SOURCE_METADATA, ExpectedSource};
-use super::validate::{parse_message, validate_outcome, validate_scene, validate_sweep};
+use super::validate::{parse_message_as, validate_outcome, validate_scene, validate_sweep};
 use log_time_order::LogTimeOrder;
 
 mod log_time_order;
 
 /// Largest record, or chunk (compressed or uncompressed), accepted: 256 MiB.
 pub const MAX_RECORD_BYTES: u64 = 256 * 1024 * 1024;
-/// Largest `/scene` message accepted: 64 MiB of JSON.
+/// Largest `/scene` message accepted: 64 MiB (JSON or CBOR).
 pub const MAX_SCENE_BYTES: u64 = 64 * 1024 * 1024;
-/// Largest `/sweep` or `/expected` message accepted: 64 KiB of JSON.
+/// Largest `/sweep` or `/expected` message accepted: 64 KiB (JSON or CBOR).
 pub const MAX_SMALL_MESSAGE_BYTES: u64 = 64 * 1024;
 
 /// Size limits of a [`TraceReader`]; the defaults are the `MAX_*` constants.
@@ -188,6 +189,9 @@ pub struct ReadStats {
 #[derive(Debug, Clone)]
 struct ChannelInfo {
     topic: String,
+    /// The message encoding of a trace channel (`None` for other topics,
+    /// whose messages are skipped whatever their encoding).
+    encoding: Option<Encoding>,
 }
 
 /// Everything but the byte sources, so records borrowed from a reader can be
@@ -362,15 +366,6 @@ fn clamp(n: u64) -> usize {
 }
 
 impl State {
-    fn at(&self, channel: &str, index: u64, frame: Option<u64>) -> MessageAt {
-        MessageAt {
-            file: self.source_name.clone(),
-            channel: channel.to_string(),
-            index,
-            frame,
-        }
-    }
-
     fn mcap_error(&self, err: McapError, context: &str, in_chunk: bool) -> TraceError {
         let file = self.source_name.clone();
         let messages = self.stats.messages;
@@ -482,13 +477,15 @@ impl State {
             Record::Channel(channel) => {
                 let is_trace =
                     [SCENE_TOPIC, SWEEP_TOPIC, EXPECTED_TOPIC].contains(&channel.topic.as_str());
-                if is_trace && channel.message_encoding != "json" {
+                let encoding = Encoding::from_message_encoding(&channel.message_encoding);
+                if is_trace && encoding.is_none() {
                     return Err(TraceError::WrongEncoding {
                         file: self.source_name.clone(),
                         channel: channel.topic,
                         encoding: channel.message_encoding,
                     });
                 }
+                let encoding = encoding.filter(|_| is_trace);
                 let (schema_name, schema_encoding) = self
                     .schemas
                     .get(&channel.schema_id)
@@ -506,6 +503,7 @@ impl State {
                     channel.id,
                     ChannelInfo {
                         topic: channel.topic,
+                        encoding,
                     },
                 );
             }
@@ -559,26 +557,30 @@ impl State {
                 channel_id,
             });
         };
-        let topic = channel.topic.clone();
-        let limit = match topic.as_str() {
-            SCENE_TOPIC => self.limits.scene_bytes,
-            SWEEP_TOPIC | EXPECTED_TOPIC => self.limits.small_message_bytes,
-            _ => {
-                self.stats.messages += 1;
-                *self
-                    .stats
-                    .skipped_by_topic
-                    .entry(topic.clone())
-                    .or_default() += 1;
-                if let Some(c) = self.stats.channels.get_mut(&topic) {
-                    c.messages += 1;
-                }
-                return Ok(None);
+        let Some(encoding) = channel.encoding else {
+            let topic = channel.topic.clone();
+            self.stats.messages += 1;
+            if let Some(c) = self.stats.channels.get_mut(&topic) {
+                c.messages += 1;
             }
+            *self.stats.skipped_by_topic.entry(topic).or_default() += 1;
+            return Ok(None);
+        };
+        let topic = channel.topic.as_str();
+        let limit = match topic {
+            SCENE_TOPIC => self.limits.scene_bytes,
+            _ => self.limits.small_message_bytes,
+        };
+        // Where the message is, made only for an error.
+        let at = |frame: Option<u64>| MessageAt {
+            file: self.source_name.clone(),
+            channel: topic.to_string(),
+            index,
+            frame,
         };
         if data.len() as u64 > limit {
             return Err(TraceError::MessageTooLarge {
-                at: Box::new(self.at(&topic, index, None)),
+                at: Box::new(at(None)),
                 bytes: data.len() as u64,
                 limit,
             });
@@ -589,18 +591,18 @@ impl State {
             let frame = if topic == SCENE_TOPIC {
                 None
             } else {
-                super::validate::frame_of(data)
+                super::validate::frame_of_message(data, encoding)
             };
             return Err(TraceError::OutOfOrder {
-                at: Box::new(self.at(&topic, index, frame)),
+                at: Box::new(at(frame)),
                 log_time_nanos,
                 previous_nanos,
             });
         }
-        let event = match topic.as_str() {
+        let event = match topic {
             SCENE_TOPIC => {
-                let scene: SceneMsg = parse_message(data, self.at(&topic, index, None))?;
-                validate_scene(&scene).map_err(|p| p.at(self.at(&topic, index, None)))?;
+                let scene: SceneMsg = parse_message_as(data, encoding, || at(None))?;
+                validate_scene(&scene).map_err(|p| p.at(at(None)))?;
                 self.scene_margin = Some(scene.margin);
                 TraceEvent::Scene {
                     log_time_nanos,
@@ -609,12 +611,14 @@ impl State {
                 }
             }
             SWEEP_TOPIC => {
-                let sweep: SweepMsg = parse_message(data, self.at(&topic, index, None))?;
-                let at = || self.at(&topic, index, Some(sweep.frame));
+                let sweep: SweepMsg = parse_message_as(data, encoding, || at(None))?;
                 if self.scene_margin.is_none() {
-                    return Err(TraceError::SweepBeforeScene { at: Box::new(at()) });
+                    return Err(TraceError::SweepBeforeScene {
+                        at: Box::new(at(Some(sweep.frame))),
+                    });
                 }
-                validate_sweep(&sweep, self.scene_margin).map_err(|p| p.at(at()))?;
+                validate_sweep(&sweep, self.scene_margin)
+                    .map_err(|p| p.at(at(Some(sweep.frame))))?;
                 TraceEvent::Sweep {
                     log_time_nanos,
                     index,
@@ -622,9 +626,8 @@ impl State {
                 }
             }
             _ => {
-                let outcome: OutcomeMsg = parse_message(data, self.at(&topic, index, None))?;
-                validate_outcome(&outcome)
-                    .map_err(|p| p.at(self.at(&topic, index, Some(outcome.frame))))?;
+                let outcome: OutcomeMsg = parse_message_as(data, encoding, || at(None))?;
+                validate_outcome(&outcome).map_err(|p| p.at(at(Some(outcome.frame))))?;
                 TraceEvent::Expected {
                     log_time_nanos,
                     index,
@@ -632,11 +635,11 @@ impl State {
                 }
             }
         };
-        self.last_log_time = Some(log_time_nanos);
-        self.stats.messages += 1;
-        if let Some(c) = self.stats.channels.get_mut(&topic) {
+        if let Some(c) = self.stats.channels.get_mut(topic) {
             c.messages += 1;
         }
+        self.last_log_time = Some(log_time_nanos);
+        self.stats.messages += 1;
         Ok(Some(event))
     }
 }

@@ -6,9 +6,11 @@ pub const SCENE_SCHEMA_JSON: &str = include_str!("../../schemas/scene.schema.jso
 pub const SWEEP_SCHEMA_JSON: &str = include_str!("../../schemas/sweep.schema.json");
 /// JSON Schema of `/expected` messages (`sweeptrace.Outcome`).
 pub const OUTCOME_SCHEMA_JSON: &str = include_str!("../../schemas/outcome.schema.json");
-/// Schema encoding of the three channels.
+/// Schema encoding of the three channels, in either message encoding (the
+/// JSON Schemas describe the CBOR messages too: the same maps and fields).
 pub const SCHEMA_ENCODING: &str = "jsonschema";
-/// Message encoding of the three channels.
+/// Message encoding of the three channels written by default (the reader
+/// also reads `cbor`: [`Encoding`](super::Encoding)).
 pub const MESSAGE_ENCODING: &str = "json";
 /// Value of `format_version` in the `sweeptrace` metadata record.
 pub const FORMAT_VERSION: &str = "1";

@@ -1,7 +1,8 @@
-//! Parsing and validation of the JSON messages of a trace.
+//! Parsing and validation of the messages of a trace, JSON or CBOR.
 //!
 //! The reader parses every message of the three channels through
-//! [`parse_message`] (so a JSON error names the field by its path) and then
+//! [`parse_message_as`] (so an error names the field by its path, in either
+//! encoding) and then
 //! checks the values with [`validate_scene`], [`validate_sweep`] and
 //! [`validate_outcome`]. The writer runs the same checks, so a trace written
 //! by this crate is always readable by it.
@@ -9,6 +10,7 @@
 use serde::Deserialize;
 use serde::de::DeserializeOwned;
 
+use super::encoding::Encoding;
 use super::error::{MessageAt, TraceError};
 use super::messages::{OutcomeMsg, SceneMsg, SweepMsg};
 use crate::numbers::{self, Rule};
@@ -50,56 +52,141 @@ struct FrameOnly {
 
 /// The frame of a JSON message, if one can be read from it.
 pub fn frame_of(data: &[u8]) -> Option<u64> {
-    serde_json::from_slice::<FrameOnly>(data)
-        .ok()
-        .and_then(|f| f.frame)
+    frame_of_message(data, Encoding::Json)
+}
+
+/// The frame of a message in `encoding`, if one can be read from it.
+pub fn frame_of_message(data: &[u8], encoding: Encoding) -> Option<u64> {
+    match encoding {
+        Encoding::Json => serde_json::from_slice::<FrameOnly>(data).ok(),
+        Encoding::Cbor => {
+            FrameOnly::deserialize(&mut super::cbor::Deserializer::from_slice(data)).ok()
+        }
+    }
+    .and_then(|f| f.frame)
 }
 
 /// Parses one JSON message; errors name the field by its path.
 ///
 /// `at` is the message's position; its frame is filled in from the raw
 /// message when it can be read.
-pub fn parse_message<T: DeserializeOwned>(data: &[u8], mut at: MessageAt) -> Result<T, TraceError> {
+pub fn parse_message<T: DeserializeOwned>(data: &[u8], at: MessageAt) -> Result<T, TraceError> {
+    parse_message_as(data, Encoding::Json, || at)
+}
+
+/// Parses one message in `encoding`; errors name the field by its path.
+///
+/// `at` gives the message's position, asked for only on an error; its
+/// frame is filled in from the raw message when it can be read.
+pub fn parse_message_as<T: DeserializeOwned>(
+    data: &[u8],
+    encoding: Encoding,
+    at: impl FnOnce() -> MessageAt,
+) -> Result<T, TraceError> {
+    // The plain parse first; only a message that fails is parsed again,
+    // keeping track of the path, to name the field.
+    let fast = match encoding {
+        Encoding::Json => serde_json::from_slice::<T>(data).ok(),
+        Encoding::Cbor => {
+            let mut de = super::cbor::Deserializer::from_slice(data);
+            T::deserialize(&mut de).ok().filter(|_| de.end().is_ok())
+        }
+    };
+    if let Some(value) = fast {
+        return Ok(value);
+    }
+    let (path, detail) = match encoding {
+        Encoding::Json => json_error::<T>(data),
+        Encoding::Cbor => cbor_error::<T>(data),
+    };
+    let mut at = at();
+    if at.frame.is_none() {
+        at.frame = frame_of_message(data, encoding);
+    }
+    let (field, detail) = match detail {
+        // Reached only if the two parses disagree, which they cannot.
+        None => (".".to_string(), "the message cannot be read".to_string()),
+        Some((message, malformed)) => field_and_detail(path, message, malformed, encoding),
+    };
+    Err(TraceError::Json {
+        at: Box::new(at),
+        field,
+        detail,
+    })
+}
+
+/// The path and the error (its text, whether the bytes are malformed) of
+/// a JSON message that fails to parse.
+fn json_error<T: DeserializeOwned>(data: &[u8]) -> (String, Option<(String, bool)>) {
     let mut de = serde_json::Deserializer::from_slice(data);
     // Trailing characters after the object are an error too.
-    let parsed = match serde_path_to_error::deserialize::<_, T>(&mut de) {
-        Ok(value) => de.end().map(|()| value).map_err(|e| (".".to_string(), e)),
-        Err(err) => Err((err.path().to_string(), err.into_inner())),
-    };
-    match parsed {
-        Ok(value) => Ok(value),
-        Err((path, inner)) => {
-            if at.frame.is_none() {
-                at.frame = frame_of(data);
-            }
-            let message = inner.to_string();
-            let field = match message
-                .strip_prefix("missing field `")
-                .and_then(|rest| rest.split('`').next())
-            {
-                Some(name) if path == "." => name.to_string(),
-                Some(name) => format!("{path}.{name}"),
-                None => path,
-            };
-            let detail = if let Some(rest) = message.strip_prefix("unknown field `")
-                && let Some((_, expected)) = rest.rsplit_once("`, expected ")
-            {
-                // The field's name is already given as the field.
-                format!("not a field of this message; expected {expected}")
-            } else if inner.is_syntax() || inner.is_eof() {
-                format!("the message is not valid JSON: {message}")
-            } else if message.contains("invalid type: null") {
-                format!("{message} (`null` is not a number; JSON has no NaN or infinity)")
-            } else {
-                message
-            };
-            Err(TraceError::Json {
-                at: Box::new(at),
-                field,
-                detail,
-            })
+    match serde_path_to_error::deserialize::<_, T>(&mut de) {
+        Ok(_) => match de.end() {
+            Ok(()) => (".".to_string(), None),
+            Err(e) => (".".to_string(), Some((e.to_string(), true))),
+        },
+        Err(err) => {
+            let path = err.path().to_string();
+            let inner = err.into_inner();
+            let malformed = inner.is_syntax() || inner.is_eof();
+            (path, Some((inner.to_string(), malformed)))
         }
     }
+}
+
+/// As [`json_error`], for a CBOR message.
+fn cbor_error<T: DeserializeOwned>(data: &[u8]) -> (String, Option<(String, bool)>) {
+    let mut de = super::cbor::Deserializer::from_slice(data);
+    match serde_path_to_error::deserialize::<_, T>(&mut de) {
+        Ok(_) => match de.end() {
+            Ok(()) => (".".to_string(), None),
+            Err(e) => (".".to_string(), Some((e.to_string(), true))),
+        },
+        Err(err) => {
+            let path = err.path().to_string();
+            let inner = err.into_inner();
+            let malformed = inner.is_malformed();
+            (path, Some((inner.to_string(), malformed)))
+        }
+    }
+}
+
+/// The field an error names and what it says about it.
+fn field_and_detail(
+    path: String,
+    message: String,
+    malformed: bool,
+    encoding: Encoding,
+) -> (String, String) {
+    let field = match message
+        .strip_prefix("missing field `")
+        .and_then(|rest| rest.split('`').next())
+    {
+        Some(name) if path == "." => name.to_string(),
+        Some(name) => format!("{path}.{name}"),
+        None => path,
+    };
+    let detail = if let Some(rest) = message.strip_prefix("unknown field `")
+        && let Some((_, expected)) = rest.rsplit_once("`, expected ")
+    {
+        // The field's name is already given as the field.
+        format!("not a field of this message; expected {expected}")
+    } else if malformed {
+        match encoding {
+            Encoding::Json => format!("the message is not valid JSON: {message}"),
+            Encoding::Cbor => format!("the message is not valid CBOR: {message}"),
+        }
+    } else if message.contains("invalid type: null") {
+        match encoding {
+            Encoding::Json => {
+                format!("{message} (`null` is not a number; JSON has no NaN or infinity)")
+            }
+            Encoding::Cbor => format!("{message} (`null` is not a number)"),
+        }
+    } else {
+        message
+    };
+    (field, detail)
 }
 
 fn finite3(field: &str, v: &[f64; 3]) -> Result<(), FieldProblem> {

@@ -3,7 +3,8 @@
 //! [`TraceWriter`] writes the project's own flavour of the format: chunked,
 //! zstd, summary and indexes, library string `sweeptrace <version>`, a
 //! `sweeptrace` metadata record with `format_version = "1"`, the three JSON
-//! Schemas, and when given ([`TraceWriter::expected_source`]) the
+//! Schemas, the messages in JSON (the default) or CBOR ([`Encoding`]), and
+//! when given ([`TraceWriter::expected_source`]) the
 //! `sweeptrace.expected_source` record naming who computed the
 //! expectations. Output is deterministic: no clock is read and zstd runs on the
 //! calling thread. Every message is checked with the reader's validation
@@ -23,6 +24,7 @@ use mcap::records::{MessageHeader, Metadata};
 use mcap::{Compression, WriteOptions, Writer};
 use serde::Serialize;
 
+use super::encoding::Encoding;
 use super::error::{MessageAt, TraceError};
 use super::messages::{
     EXPECTED_TOPIC, OUTCOME_SCHEMA, OutcomeMsg, SCENE_SCHEMA, SCENE_TOPIC, SWEEP_SCHEMA,
@@ -30,8 +32,8 @@ use super::messages::{
 };
 use super::read::{MAX_SCENE_BYTES, MAX_SMALL_MESSAGE_BYTES};
 use super::schemas::{
-    FORMAT_VERSION, MESSAGE_ENCODING, METADATA_NAME, OUTCOME_SCHEMA_JSON, SCENE_SCHEMA_JSON,
-    SCHEMA_ENCODING, SWEEP_SCHEMA_JSON,
+    FORMAT_VERSION, METADATA_NAME, OUTCOME_SCHEMA_JSON, SCENE_SCHEMA_JSON, SCHEMA_ENCODING,
+    SWEEP_SCHEMA_JSON,
 };
 use super::source::{EXPECTED_SOURCE_METADATA, ExpectedSource};
 use super::validate::{validate_outcome, validate_scene, validate_sweep};
@@ -56,6 +58,7 @@ pub fn default_write_options() -> WriteOptions {
 pub struct TraceWriter<W: Write + Seek> {
     writer: Writer<W>,
     name: String,
+    encoding: Encoding,
     scene_channel: u16,
     sweep_channel: u16,
     expected_channel: u16,
@@ -76,10 +79,55 @@ impl<W: Write + Seek> TraceWriter<W> {
     /// ...); the schemas, channels and metadata are the same. Meant for
     /// tests and tools; traces recorded by the project use [`TraceWriter::new`].
     pub fn with_options(w: W, options: WriteOptions) -> Result<Self, TraceError> {
-        Self::build(w, options, "<trace being written>".to_string())
+        Self::with_encoding(w, options, Encoding::Json)
     }
 
-    fn build(w: W, options: WriteOptions, name: String) -> Result<Self, TraceError> {
+    /// A writer whose three channels use the message `encoding` (JSON or
+    /// CBOR; [`TraceWriter::new`] and [`TraceWriter::with_options`] write
+    /// JSON), with the container `options` ([`default_write_options`] for
+    /// the project's own).
+    ///
+    /// ```
+    /// use sweeptrace::trace::write::default_write_options;
+    /// use sweeptrace::{Encoding, SceneMsg, TraceReader, TraceWriter};
+    /// let mut w = TraceWriter::with_encoding(
+    ///     std::io::Cursor::new(Vec::new()),
+    ///     default_write_options(),
+    ///     Encoding::Cbor,
+    /// )?;
+    /// let scene = SceneMsg {
+    ///     name: None,
+    ///     vertices: vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]],
+    ///     triangles: vec![[0, 1, 2]],
+    ///     margin: 0.0,
+    ///     facing: Default::default(),
+    /// };
+    /// w.scene(0, &scene)?;
+    /// let bytes = w.finish()?.into_inner();
+    /// let mut reader = TraceReader::new(bytes.as_slice(), "scene.mcap");
+    /// assert!(matches!(reader.next(), Some(Ok(_))));
+    /// assert_eq!(reader.stats().channels["/scene"].message_encoding, "cbor");
+    /// # Ok::<(), sweeptrace::TraceError>(())
+    /// ```
+    pub fn with_encoding(
+        w: W,
+        options: WriteOptions,
+        encoding: Encoding,
+    ) -> Result<Self, TraceError> {
+        Self::build(w, options, "<trace being written>".to_string(), encoding)
+    }
+
+    /// The message encoding of the trace's channels.
+    pub fn encoding(&self) -> Encoding {
+        self.encoding
+    }
+
+    fn build(
+        w: W,
+        options: WriteOptions,
+        name: String,
+        encoding: Encoding,
+    ) -> Result<Self, TraceError> {
         let error = |cause| TraceError::Write {
             file: name.clone(),
             cause,
@@ -100,7 +148,7 @@ impl<W: Write + Seek> TraceWriter<W> {
                 .add_schema(schema, SCHEMA_ENCODING, data.as_bytes())
                 .map_err(error)?;
             writer
-                .add_channel(schema_id, topic, MESSAGE_ENCODING, &BTreeMap::new())
+                .add_channel(schema_id, topic, encoding.as_str(), &BTreeMap::new())
                 .map_err(error)
         };
         let scene_channel = channel(SCENE_SCHEMA, SCENE_SCHEMA_JSON, SCENE_TOPIC)?;
@@ -109,6 +157,7 @@ impl<W: Write + Seek> TraceWriter<W> {
         Ok(TraceWriter {
             writer,
             name,
+            encoding,
             scene_channel,
             sweep_channel,
             expected_channel,
@@ -159,11 +208,14 @@ impl<W: Write + Seek> TraceWriter<W> {
         log_time_nanos: u64,
         msg: &T,
     ) -> Result<(), TraceError> {
-        let data = serde_json::to_vec(msg).map_err(|e| TraceError::Json {
-            at: Box::new(self.at(channel, frame)),
-            field: ".".to_string(),
-            detail: e.to_string(),
-        })?;
+        let data = self
+            .encoding
+            .encode(msg)
+            .map_err(|detail| TraceError::Json {
+                at: Box::new(self.at(channel, frame)),
+                field: ".".to_string(),
+                detail,
+            })?;
         // The reader's limits, so that whatever is written can be read.
         let limit = if channel_id == self.scene_channel {
             MAX_SCENE_BYTES
@@ -331,6 +383,14 @@ impl PendingTrace {
     /// Creates the temporary file next to `path` and starts the trace in
     /// it (header, metadata, schemas, channels). Error messages name `path`.
     pub fn create(path: impl AsRef<Path>) -> Result<PendingTrace, TraceError> {
+        Self::create_with_encoding(path, Encoding::Json)
+    }
+
+    /// [`PendingTrace::create`], with the channels in the message `encoding`.
+    pub fn create_with_encoding(
+        path: impl AsRef<Path>,
+        encoding: Encoding,
+    ) -> Result<PendingTrace, TraceError> {
         let path = path.as_ref();
         let name = path.display().to_string();
         let (pending, file) =
@@ -339,8 +399,12 @@ impl PendingTrace {
                 messages: 0,
                 cause,
             })?;
-        let writer =
-            TraceWriter::build(BufWriter::new(file), default_write_options(), name.clone())?;
+        let writer = TraceWriter::build(
+            BufWriter::new(file),
+            default_write_options(),
+            name.clone(),
+            encoding,
+        )?;
         Ok(PendingTrace {
             pending,
             writer,
@@ -388,7 +452,17 @@ pub fn write_trace_file<T, E: From<TraceError>>(
     path: impl AsRef<Path>,
     f: impl FnOnce(&mut TraceWriter<BufWriter<File>>) -> Result<T, E>,
 ) -> Result<T, E> {
-    let mut trace = PendingTrace::create(path)?;
+    write_trace_file_with_encoding(path, Encoding::Json, f)
+}
+
+/// [`write_trace_file`], with the channels in the message `encoding`
+/// (JSON or CBOR).
+pub fn write_trace_file_with_encoding<T, E: From<TraceError>>(
+    path: impl AsRef<Path>,
+    encoding: Encoding,
+    f: impl FnOnce(&mut TraceWriter<BufWriter<File>>) -> Result<T, E>,
+) -> Result<T, E> {
+    let mut trace = PendingTrace::create_with_encoding(path, encoding)?;
     let value = f(trace.writer())?;
     trace.commit()?;
     Ok(value)

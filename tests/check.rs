@@ -6,9 +6,10 @@
 //! `sweeptrace.toml` files give it (for a trace recorded by another engine,
 //! such as the Rapier sample: `examples/sweeptrace.toml`).
 //!
-//! The fixture `tests/fixtures/wrong_engine_config.mcap` is made by the
-//! ignored generator below, from the project's own writer:
-//! `cargo test --test integration -- --ignored check::generate_wrong_engine_config`.
+//! The fixture `tests/fixtures/wrong_engine_config.mcap` is made by
+//! `fixture_bytes` below, from the project's own writer; a test compares
+//! it with the committed file, and rewrites the file with
+//! `SWEEPTRACE_BLESS=1 cargo test --test integration -- fixture`.
 //! Its scene declares margin 0.1; its `/expected` outcomes were computed
 //! with margin 0 (an engine configuration the scene does not declare), so
 //! the first divergent sweep is frame 2 (expected an edge hit on edge 0.0,
@@ -63,7 +64,6 @@ pub fn tests() -> Vec<Trial> {
         trial!(diff_same_trace_is_same),
         trial!(diff_strict_facing_reports_first_divergence),
         trial!(diff_binary_exit_codes),
-        trial!(generate_wrong_engine_config).with_ignored_flag(true),
     ];
     trials.extend(trace_trials());
     trials
@@ -1022,11 +1022,6 @@ fn diff_binary_exit_codes() -> anyhow::Result<()> {
 
 // ---------------------------------------------------------------- fixture
 
-fn generate_wrong_engine_config() -> anyhow::Result<()> {
-    let bytes = fixture_bytes()?;
-    std::fs::write(fixture_path(), bytes).map_err(anyhow::Error::from)
-}
-
 /// The Rapier sample differs from the core by about 1e-6 (more than the
 /// default tolerances): the two sides of each differing field never read
 /// the same in the report (they are printed in full when their short forms
@@ -1069,13 +1064,7 @@ fn differences_below_the_shown_digits_are_shown_in_full() -> anyhow::Result<()> 
 }
 
 /// The committed fixture is byte for byte what its generator
-/// (`generate_wrong_engine_config`) makes today.
+/// (`fixture_bytes`) makes today (`SWEEPTRACE_BLESS=1` rewrites it).
 fn wrong_engine_config_fixture_is_what_its_generator_makes() -> anyhow::Result<()> {
-    let committed = std::fs::read(fixture_path())?;
-    ensure!(
-        fixture_bytes()? == committed,
-        "{FIXTURE} differs from its generator's bytes: regenerate it with \
-         `cargo test --test integration -- --ignored check::generate_wrong_engine_config`"
-    );
-    Ok(())
+    crate::support::compare_or_bless(&fixture_path(), &fixture_bytes()?)
 }

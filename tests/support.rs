@@ -114,6 +114,32 @@ impl Fail for String {
     }
 }
 
+/// Set to `1` to make the tests that compare a committed fixture with
+/// what its generator makes today rewrite the fixture instead
+/// (`SWEEPTRACE_BLESS=1 cargo test --test integration -- fixture`).
+pub const BLESS: &str = "SWEEPTRACE_BLESS";
+
+/// Compares the committed fixture at `path` with `bytes`, what its
+/// generator makes today; with [`BLESS`] set to `1`, writes `bytes` there
+/// instead (under a temporary name, then renamed).
+pub fn compare_or_bless(path: &std::path::Path, bytes: &[u8]) -> anyhow::Result<()> {
+    use anyhow::Context as _;
+    if std::env::var(BLESS).as_deref() == Ok("1") {
+        let temp = path.with_extension("blessing");
+        std::fs::write(&temp, bytes).with_context(|| format!("writing {}", temp.display()))?;
+        return std::fs::rename(&temp, path)
+            .with_context(|| format!("renaming {} to {}", temp.display(), path.display()));
+    }
+    let committed = std::fs::read(path).with_context(|| format!("reading {}", path.display()))?;
+    ensure!(
+        committed == bytes,
+        "{} differs from what its generator makes today: if the change is intended, \
+         rewrite it with `{BLESS}=1 cargo test --test integration -- fixture`",
+        path.display()
+    );
+    Ok(())
+}
+
 /// Set to `1` (CI does) to make the tests that need Python's `mcap`
 /// package fail, instead of being skipped, when it cannot be imported.
 pub const REQUIRE_PYTHON: &str = "SWEEPTRACE_REQUIRE_PYTHON";

@@ -2,9 +2,10 @@
 //! `replay` and `check`.
 //!
 //! The fixtures `tests/fixtures/tunnel_floor.mcap` and
-//! `tests/fixtures/tunnel_wall_teleport.mcap` are made by the ignored
-//! generator below, from the project's own writer:
-//! `cargo test --test integration -- --ignored tunnel::generate_fixtures`.
+//! `tests/fixtures/tunnel_wall_teleport.mcap` are made by `floor_bytes`
+//! and `wall_bytes` below, from the project's own writer; a test compares
+//! them with the committed files, and rewrites them with
+//! `SWEEPTRACE_BLESS=1 cargo test --test integration -- fixture`.
 //! Their `/expected` outcomes are the core's own (an engine that follows
 //! the rules), so the only thing wrong in them is the tunnel:
 //! - `tunnel_floor`: ball 0 falls onto a floor (two triangles, front `+z`,
@@ -22,7 +23,7 @@
 use std::io::Cursor;
 use std::path::{Path, PathBuf};
 
-use libtest_mimic::{Failed, Trial};
+use libtest_mimic::Trial;
 use nalgebra::Point3;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -67,10 +68,6 @@ pub fn tests() -> Vec<Trial> {
         trial!(sample_traces_have_none),
         trial!(fixtures_are_what_their_generator_makes),
         trial!(simulation_has_none),
-        Trial::test("tunnel::generate_fixtures", || {
-            generate_fixtures().map_err(Failed::from)
-        })
-        .with_ignored_flag(true),
     ]
 }
 
@@ -372,13 +369,6 @@ fn root() -> &'static Path {
 
 fn fixture(name: &str) -> PathBuf {
     root().join(name)
-}
-
-fn generate_fixtures() -> anyhow::Result<()> {
-    for (name, bytes) in [(FLOOR, floor_bytes()?), (WALL, wall_bytes()?)] {
-        std::fs::write(fixture(name), bytes).map_err(|e| anyhow::anyhow!("{name}: {e}"))?;
-    }
-    Ok(())
 }
 
 /// Every sweep result of a trace, replayed sequentially.
@@ -799,16 +789,11 @@ fn simulation_has_none() -> anyhow::Result<()> {
     Ok(())
 }
 
-/// The committed fixtures are byte for byte what `generate_fixtures` makes today.
+/// The committed fixtures are byte for byte what `floor_bytes` and `wall_bytes` make today
+/// (`SWEEPTRACE_BLESS=1` rewrites them).
 fn fixtures_are_what_their_generator_makes() -> anyhow::Result<()> {
     for (name, bytes) in [(FLOOR, floor_bytes()?), (WALL, wall_bytes()?)] {
-        let committed = std::fs::read(fixture(name)).map_err(|e| anyhow::anyhow!("{name}: {e}"))?;
-        if bytes != committed {
-            anyhow::bail!(
-                "{name} differs from its generator's bytes: regenerate it with \
-                 `cargo test --test integration -- --ignored tunnel::generate_fixtures`"
-            );
-        }
+        crate::support::compare_or_bless(&fixture(name), &bytes)?;
     }
     Ok(())
 }

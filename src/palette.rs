@@ -1,11 +1,30 @@
 //! The colors (RGBA, 8 bits each) of what both recordings draw, the Rerun
 //! recording (`viz`) and the Foxglove file (`foxglove`), so the two look
-//! alike.
+//! alike, and how many defect labels they draw.
+
+/// A scene's defects are labelled in the 3D views when it has at most this
+/// many; beyond, their labels would cover the mesh (a modelled scene can
+/// have dozens of T-junctions where parts meet), so only the markers are
+/// drawn and each defect's label is in the data (the Rerun viewer shows it
+/// on hover and can switch the labels on; the Foxglove entity lists them in
+/// its metadata).
+pub const MAX_DRAWN_DEFECT_LABELS: usize = 4;
 
 /// The mesh.
 pub const MESH_COLOR: [u8; 4] = [170, 175, 185, 255];
-/// The mesh's triangle edges.
-pub const WIREFRAME_COLOR: [u8; 4] = [45, 50, 60, 255];
+/// The mesh's flat internal edges (two triangles in one plane): faint,
+/// they are where most of a mesh's edges are and the least interesting.
+pub const FLAT_EDGE_COLOR: [u8; 4] = [45, 50, 60, 90];
+/// The mesh's convex edges (a ridge seen from the front).
+pub const CONVEX_EDGE_COLOR: [u8; 4] = [40, 80, 220, 255];
+/// The mesh's concave edges (a valley seen from the front).
+pub const CONCAVE_EDGE_COLOR: [u8; 4] = [0, 160, 120, 255];
+/// The mesh's boundary edges (one triangle only): loud.
+pub const BOUNDARY_EDGE_COLOR: [u8; 4] = [255, 165, 0, 255];
+/// The mesh's non-manifold edges (three triangles or more): loud.
+pub const NON_MANIFOLD_EDGE_COLOR: [u8; 4] = [150, 40, 255, 255];
+/// The marker of a mesh defect (flipped triangle, crack, ...).
+pub const DEFECT_COLOR: [u8; 4] = [255, 0, 170, 255];
 /// The ball at the start of its sweep.
 pub const P0_COLOR: [u8; 4] = [80, 140, 255, 90];
 /// The ball at the end of its sweep.

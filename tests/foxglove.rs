@@ -29,6 +29,7 @@ pub fn tests() -> Vec<Trial> {
     vec![
         trial!(foxglove_file_reads_back_with_the_mcap_crate),
         trial!(arrow_rotation_takes_x_to_the_normal),
+        trial!(foxglove_mesh_has_edge_classes_and_defects),
         trial!(python_and_node_read_and_validate_the_foxglove_file),
         trial!(replay_foxglove_writes_only_the_foxglove_file),
         trial!(replay_foxglove_errors_name_the_file_and_leave_no_partial_file),
@@ -245,10 +246,13 @@ fn foxglove_file_reads_back_with_the_mcap_crate() -> anyhow::Result<()> {
             t["indices"]
         );
         ensure!(t["points"][1]["x"] == size, "points {}", t["points"]);
+        // The triangle's edges: one entity, the boundary's.
+        let edges = &m["entities"][1];
         ensure!(
-            e["lines"][0]["indices"] == serde_json::json!([0, 1, 0, 2, 1, 2]),
-            "edges {}",
-            e["lines"][0]["indices"]
+            m["entities"].as_array().map(Vec::len) == Some(2)
+                && edges["id"] == "mesh/edges/boundary"
+                && edges["lines"][0]["indices"] == serde_json::json!([0, 1, 0, 2, 1, 2]),
+            "edges {edges}"
         );
     }
     ensure!(
@@ -366,6 +370,68 @@ fn foxglove_file_reads_back_with_the_mcap_crate() -> anyhow::Result<()> {
         numbers[1]["kind"] == "none" && numbers[1]["alpha"] == 1.0 && numbers[1]["failed"] == 0,
         "miss numbers {}",
         numbers[1]
+    );
+    Ok(())
+}
+
+/// The mesh update of a floor with a flipped triangle: the previous
+/// scene's entities deleted, then the mesh, an entity per edge class it has
+/// (a line list, two indices per edge, in the class's colour) and one per
+/// defect kind with one text per defect.
+fn foxglove_mesh_has_edge_classes_and_defects() -> anyhow::Result<()> {
+    let e = |e: sweeptrace::trace::TraceError| anyhow::Error::from(e);
+    let mut w = TraceWriter::new(Cursor::new(Vec::new())).map_err(e)?;
+    w.scene(0, &crate::support::flipped_floor()).map_err(e)?;
+    let trace = w.finish().map_err(e)?.into_inner();
+    let all = messages(&foxglove_bytes(&trace)?)?;
+    let meshes = on(&all, "/mesh");
+    ensure!(meshes.len() == 1, "{} mesh updates", meshes.len());
+    let update = meshes[0];
+    ensure!(
+        update["deletions"][0]["type"] == 1,
+        "deletions {}",
+        update["deletions"]
+    );
+    let entities = update["entities"].as_array().context("no entities")?;
+    let ids: Vec<&str> = entities.iter().filter_map(|e| e["id"].as_str()).collect();
+    ensure!(
+        ids == [
+            "mesh",
+            "mesh/edges/boundary",
+            "mesh/edges/flat",
+            "mesh/defects/flipped"
+        ],
+        "entity ids {ids:?}"
+    );
+    let indices = |i: usize| entities[i]["lines"][0]["indices"].as_array().map(Vec::len);
+    ensure!(
+        indices(1) == Some(2 * 12) && indices(2) == Some(2 * 21),
+        "edge indices: boundary {:?}, flat {:?}",
+        indices(1),
+        indices(2)
+    );
+    ensure!(
+        entities[1]["lines"][0]["color"] != entities[2]["lines"][0]["color"],
+        "boundary and flat edges in one colour"
+    );
+    let texts = entities[3]["texts"].as_array().context("no texts")?;
+    ensure!(
+        texts.len() == 1
+            && texts[0]["text"] == "flipped triangle 9"
+            && entities[3]["spheres"].as_array().map(Vec::len) == Some(1),
+        "defect texts {texts:?}"
+    );
+    // At the flipped triangle's centroid.
+    let p = &texts[0]["pose"]["position"];
+    let centroid = [(1.0 + 1.0 + 2.0) / 3.0, (1.0 + 2.0 + 2.0) / 3.0];
+    ensure!(
+        p["x"]
+            .as_f64()
+            .is_some_and(|x| (x - centroid[0]).abs() < 1e-12)
+            && p["y"]
+                .as_f64()
+                .is_some_and(|y| (y - centroid[1]).abs() < 1e-12),
+        "defect at {p}, centroid {centroid:?}"
     );
     Ok(())
 }

@@ -54,6 +54,7 @@ pub fn tests() -> Vec<Trial> {
         trial!(rrd_footer_only_when_asked),
         trial!(plots_hold_the_decisive_numbers_nan_where_missing),
         trial!(expected_edge_test_only_of_an_existing_triangle),
+        trial!(rrd_draws_edges_by_class_and_labels_each_defect),
     ]
 }
 
@@ -794,7 +795,7 @@ pub(crate) fn decode_rrd(path: &std::path::Path) -> anyhow::Result<Decoded> {
                         }
                     }
                     if name.ends_with("text")
-                        || name.ends_with("labels")
+                        || (name.ends_with("labels") && !name.ends_with("show_labels"))
                         || name == "kind"
                         || name == "verdict"
                         || name == "test"
@@ -1522,7 +1523,7 @@ fn rrd_marks_fragile_decisions() -> anyhow::Result<()> {
 }
 
 /// The picture of the worked examples (face, edge, vertex, miss on the
-/// triangle T): the static wireframe; the primary triangle outlined at
+/// triangle T): the static edges (one class, boundary); the primary triangle outlined at
 /// every decided frame; one label per frame, on the decisive feature, and
 /// none naming p0, p1 or α; the edge frame at every frame with an edge test
 /// (the nearest one for the face and vertex decisions, labelled as such),
@@ -1537,10 +1538,21 @@ fn rrd_shows_edges_features_and_explanations() -> anyhow::Result<()> {
         &path,
     )?;
     let d = decode_rrd(&path)?;
+    // One triangle: its three edges are boundary edges, and that is the
+    // only class logged.
+    let edges: Vec<&String> = d
+        .static_entities
+        .iter()
+        .filter(|e| e.starts_with("/world/mesh/0/edges/"))
+        .collect();
     ensure!(
-        d.static_entities.contains("/world/mesh/0/wireframe"),
-        "no static wireframe: {:?}",
-        d.static_entities
+        edges == ["/world/mesh/0/edges/boundary"]
+            && d.strips
+                .get("/world/mesh/0/edges/boundary")
+                .and_then(|m| m.get(&i64::MIN))
+                == Some(&3),
+        "static edges: {edges:?}, strips {:?}",
+        d.strips.get("/world/mesh/0/edges/boundary")
     );
     let frames = |v: &[i64]| {
         v.iter()
@@ -1580,8 +1592,10 @@ fn rrd_shows_edges_features_and_explanations() -> anyhow::Result<()> {
         "primary strip labels at frame 1: {:?}",
         d.texts_at(primary, "LineStrips3D:labels", 1)
     );
+    // The face decision's label is merged into the nearest edge test's
+    // (one label per place), so the outline has none at frame 0.
     ensure!(
-        d.texts_at(primary, "LineStrips3D:labels", 0) == ["face 0"]
+        d.texts_at(primary, "LineStrips3D:labels", 0).is_empty()
             && d.texts_at(primary, "Points3D:labels", 2) == ["vertex 0.0"],
         "primary labels at frames 0 and 2: {:?}, {:?}",
         d.texts_at(primary, "LineStrips3D:labels", 0),
@@ -1636,13 +1650,11 @@ fn rrd_shows_edges_features_and_explanations() -> anyhow::Result<()> {
         "labels at frame 2: {:?}",
         labels.get(&2)
     );
+    // The face hit and the nearest edge test of its triangle: one label,
+    // on that edge.
     let at0 = labels.get(&0).cloned().unwrap_or_default();
     ensure!(
-        at0.len() == 2
-            && at0.contains(&"face 0".to_string())
-            && at0
-                .iter()
-                .any(|l| l.starts_with("nearest edge test: edge 0.")),
+        at0.len() == 1 && at0[0].starts_with("face 0; nearest edge test: edge 0."),
         "labels at frame 0: {at0:?}"
     );
     for l in labels.values().flatten() {
@@ -1679,7 +1691,7 @@ fn rrd_shows_edges_features_and_explanations() -> anyhow::Result<()> {
         d.texts_at(slot0, "LineStrips3D:labels", 1).is_empty()
             && d.texts_at(slot0, "LineStrips3D:labels", 0).len() == 2
             && d.texts_at(slot0, "LineStrips3D:labels", 0)[0]
-                .starts_with("nearest edge test: edge 0.")
+                .starts_with("face 0; nearest edge test: edge 0.")
             && d.texts_at(slot0, "LineStrips3D:labels", 0)[1].is_empty(),
         "the decisive edge is labelled twice"
     );
@@ -2255,6 +2267,110 @@ fn expected_edge_test_only_of_an_existing_triangle() -> anyhow::Result<()> {
         d.frames_with("/world/ball/0/expected", "Ellipsoids3D:centers") == frames(&[0, 1, 2]),
         "expected outcome at {:?}",
         d.frames_with("/world/ball/0/expected", "Ellipsoids3D:centers")
+    );
+    Ok(())
+}
+
+/// The mesh's edges by class and its defects in the recording: a scene of
+/// the cube (convex and flat edges) and a floor with a flipped triangle
+/// (boundary and flat edges, one defect): one static LineStrips3D per class
+/// the scene has, a segment per edge, in the class's own radius; one static
+/// Points3D per defect kind with one label per defect.
+fn rrd_draws_edges_by_class_and_labels_each_defect() -> anyhow::Result<()> {
+    let dir = tempfile::tempdir()?;
+    let path = dir.path().join("classes.rrd");
+    let floor = crate::support::flipped_floor();
+    let mut events = events_for(cube_scene(), &[]);
+    events.push(Ok(TraceEvent::Scene {
+        log_time_nanos: 1,
+        index: 1,
+        scene: floor.clone(),
+    }));
+    let sweep = SweepMsg {
+        frame: 0,
+        ball: 0,
+        radius: 0.25,
+        p0: [1.5, 1.5, 1.0],
+        p1: [1.5, 1.5, -1.0],
+    };
+    events.push(Ok(TraceEvent::Sweep {
+        log_time_nanos: 2,
+        index: 2,
+        sweep,
+    }));
+    write_rrd(events, Detail::Primary, &path)?;
+    let d = decode_rrd(&path)?;
+    let segments = |entity: &str| -> Option<usize> {
+        d.strips.get(entity).and_then(|m| m.get(&i64::MIN)).copied()
+    };
+    let classes = |scene: usize| -> BTreeMap<String, Option<usize>> {
+        let prefix = format!("/world/mesh/{scene}/edges/");
+        d.static_entities
+            .iter()
+            .filter_map(|e| {
+                e.strip_prefix(&prefix)
+                    .map(|c| (c.to_string(), segments(e)))
+            })
+            .collect()
+    };
+    let want = |v: &[(&str, usize)]| -> BTreeMap<String, Option<usize>> {
+        v.iter().map(|(c, n)| (c.to_string(), Some(*n))).collect()
+    };
+    ensure!(
+        classes(0) == want(&[("convex", 12), ("flat", 6)]),
+        "the cube's edges by class: {:?}",
+        classes(0)
+    );
+    ensure!(
+        classes(1) == want(&[("boundary", 12), ("flat", 21)]),
+        "the floor's edges by class: {:?}",
+        classes(1)
+    );
+    // Flat edges thinner than convex ones, boundary edges thicker (UI
+    // points are negative radii).
+    let radius = |e: &str| {
+        d.radii
+            .get(e)
+            .and_then(|m| m.get(&i64::MIN))
+            .and_then(|r| r.first())
+            .map(|r| r.abs())
+    };
+    let (flat, convex, boundary) = (
+        radius("/world/mesh/0/edges/flat"),
+        radius("/world/mesh/0/edges/convex"),
+        radius("/world/mesh/1/edges/boundary"),
+    );
+    ensure!(
+        matches!((flat, convex, boundary), (Some(f), Some(c), Some(b)) if f < c && c < b),
+        "radii flat {flat:?}, convex {convex:?}, boundary {boundary:?}"
+    );
+    ensure!(
+        !d.static_entities.contains("/world/mesh/0/wireframe"),
+        "the single wireframe is still logged"
+    );
+
+    // Defects: none on the cube; on the floor one flipped triangle, one
+    // label, at its centroid.
+    let defect_entities: Vec<&String> = d
+        .static_entities
+        .iter()
+        .filter(|e| e.contains("/defects"))
+        .collect();
+    ensure!(
+        defect_entities == ["/world/mesh/1/defects/flipped"],
+        "defect entities {defect_entities:?}"
+    );
+    let topology = sweeptrace::core::Topology::new(&floor.vertices, &floor.triangles)?;
+    let labels = d.texts_at("/world/mesh/1/defects/flipped", "Points3D:labels", i64::MIN);
+    ensure!(
+        labels == ["flipped triangle 9"] && labels.len() == topology.defects().len(),
+        "defect labels {labels:?}, defects {:?}",
+        topology.defects()
+    );
+    ensure!(
+        d.frames_with("/world/mesh/1/defects/flipped", "Points3D:positions")
+            == std::collections::BTreeSet::from([i64::MIN]),
+        "the defect has no static position"
     );
     Ok(())
 }

@@ -284,3 +284,32 @@ pub fn vertex(records: &[TestRecord], t: u32, v: u8) -> VertexRecord {
         })
         .expect("vertex record present")
 }
+
+/// A `3 × 3` floor of unit squares at z = 0, two triangles each, fronts +z,
+/// with triangle 9 wound the other way (flipped): 12 boundary edges and 21
+/// flat ones (the turned triangle's edges are classified as if it were
+/// turned back), one defect.
+pub fn flipped_floor() -> sweeptrace::trace::messages::SceneMsg {
+    let mut vertices = Vec::new();
+    for j in 0..4 {
+        for i in 0..4 {
+            vertices.push([f64::from(i), f64::from(j), 0.0]);
+        }
+    }
+    let mut triangles = Vec::new();
+    for j in 0..3u64 {
+        for i in 0..3u64 {
+            let a = j * 4 + i;
+            triangles.push([a, a + 1, a + 5]);
+            triangles.push([a, a + 5, a + 4]);
+        }
+    }
+    triangles[9].swap(1, 2);
+    sweeptrace::trace::messages::SceneMsg {
+        name: Some("flipped floor".into()),
+        vertices,
+        triangles,
+        margin: 0.0,
+        facing: Facing::NonStrict,
+    }
+}

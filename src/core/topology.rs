@@ -301,6 +301,53 @@ impl Defect {
     }
 }
 
+/// An input index of a defect's list, `?` where the list is shorter than
+/// its kind promises (never, for a defect [`Topology::new`] found).
+struct Index(Option<u32>);
+
+impl std::fmt::Display for Index {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self.0 {
+            Some(i) => write!(f, "{i}"),
+            None => f.write_str("?"),
+        }
+    }
+}
+
+/// The defect in a few words, naming its triangles or vertices by input
+/// index: `flipped triangle 812`, `crack between triangles 40 and 41`.
+impl std::fmt::Display for Defect {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let t = |i: usize| Index(self.triangles.get(i).copied());
+        let v = |i: usize| Index(self.vertices.get(i).copied());
+        match self.kind {
+            DefectKind::Flipped => write!(f, "flipped triangle {}", t(0)),
+            DefectKind::Crack => write!(f, "crack between triangles {} and {}", t(0), t(1)),
+            DefectKind::TJunction => write!(
+                f,
+                "T-junction: vertex {} on an edge of triangle {}",
+                v(0),
+                t(0)
+            ),
+            DefectKind::Degenerate => write!(f, "degenerate triangle {}", t(0)),
+            DefectKind::Sliver => write!(f, "sliver triangle {}", t(0)),
+            DefectKind::DuplicateTriangle => {
+                write!(f, "triangle {} duplicates triangle {}", t(1), t(0))
+            }
+            DefectKind::DuplicateVertex => {
+                write!(f, "vertices {} and {} nearly coincide", v(0), v(1))
+            }
+            DefectKind::NonManifoldEdge => write!(
+                f,
+                "edge {}-{} shared by {} triangles",
+                v(0),
+                v(1),
+                self.triangles.len()
+            ),
+        }
+    }
+}
+
 /// A mesh's topology: its weld, edges by class and defects.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct Topology {
@@ -1247,6 +1294,7 @@ mod tests {
         assert_eq!(d.triangles, vec![9]);
         assert_eq!(d.neighbours.len(), 3);
         assert_eq!(topo.flipped(), &[9]);
+        assert_eq!(d.to_string(), "flipped triangle 9");
         // Its edges are classified as if it were turned over: still flat.
         assert_eq!(topo.edge_counts().flat, topo.edge_counts().total() - 12);
     }

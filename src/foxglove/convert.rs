@@ -9,25 +9,55 @@ use super::FRAME_ID;
 use super::messages::{
     ArrowPrimitive, Color, DeletionType, FaceNumbers, KeyValuePair, LinePrimitive, LineType, Log,
     LogLevel, Point3, Pose, QuadraticNumbers, Quaternion, SceneEntity, SceneEntityDeletion,
-    SceneUpdate, SpherePrimitive, SweepNumbers, Time, TriangleListPrimitive, Vector3,
+    SceneUpdate, SpherePrimitive, SweepNumbers, TextPrimitive, Time, TriangleListPrimitive,
+    Vector3,
 };
-use crate::core::TestRecord;
 use crate::core::explain::label;
+use crate::core::{DefectKind, EdgeClass, TestRecord};
 use crate::palette::{
-    CONTACT_BALL_COLOR, EXPECTED_COLOR, HIT_COLOR, MESH_COLOR, NORMAL_COLOR, P0_COLOR, P1_COLOR,
-    SWEEP_COLOR, WIREFRAME_COLOR,
+    BOUNDARY_EDGE_COLOR, CONCAVE_EDGE_COLOR, CONTACT_BALL_COLOR, CONVEX_EDGE_COLOR, DEFECT_COLOR,
+    EXPECTED_COLOR, FLAT_EDGE_COLOR, HIT_COLOR, MAX_DRAWN_DEFECT_LABELS, MESH_COLOR,
+    NON_MANIFOLD_EDGE_COLOR, NORMAL_COLOR, P0_COLOR, P1_COLOR, SWEEP_COLOR,
 };
 use crate::regress::decision::write_decision_line;
 use crate::regress::{FieldDiff, divergence_details, render_divergence};
 use crate::replay::{SceneState, SweepResult};
+use strum::IntoEnumIterator as _;
 
 /// The id of the mesh entity on [`super::MESH_TOPIC`]: one id for every
 /// scene, so a new scene replaces the previous mesh.
 pub const MESH_ENTITY: &str = "mesh";
 
-/// Thickness of the path line and of the wireframe, in screen pixels.
+/// Thickness of the path line, in screen pixels.
 const LINE_PIXELS: f64 = 2.0;
-const WIREFRAME_PIXELS: f64 = 1.0;
+
+/// Height of a defect's label, in screen pixels.
+const DEFECT_FONT_PIXELS: f64 = 14.0;
+
+/// The id of the entity of the mesh's edges of `class` on
+/// [`super::MESH_TOPIC`]: `mesh/edges/flat`, ...
+pub fn edges_entity(class: EdgeClass) -> String {
+    format!("{MESH_ENTITY}/edges/{class}")
+}
+
+/// The id of the entity of the mesh's defects of `kind` on
+/// [`super::MESH_TOPIC`]: `mesh/defects/flipped`, ...
+pub fn defects_entity(kind: DefectKind) -> String {
+    format!("{MESH_ENTITY}/defects/{kind}")
+}
+
+/// The colour and the line thickness (screen pixels) of the mesh's edges
+/// of `class`: flat edges faint and thin, convex and concave in colours of
+/// their own, boundary and non-manifold edges loud and thick.
+fn edge_style(class: EdgeClass) -> ([u8; 4], f64) {
+    match class {
+        EdgeClass::Flat => (FLAT_EDGE_COLOR, 1.0),
+        EdgeClass::Convex => (CONVEX_EDGE_COLOR, 2.0),
+        EdgeClass::Concave => (CONCAVE_EDGE_COLOR, 2.0),
+        EdgeClass::Boundary => (BOUNDARY_EDGE_COLOR, 3.5),
+        EdgeClass::NonManifold => (NON_MANIFOLD_EDGE_COLOR, 4.5),
+    }
+}
 
 /// An 8-bit RGBA color as Foxglove's `[0, 1]` channels.
 pub fn color(rgba: [u8; 4]) -> Color {
@@ -145,11 +175,16 @@ fn delete(time: Time, id: String) -> SceneEntityDeletion {
     }
 }
 
-/// The scene's mesh, on [`super::MESH_TOPIC`]: one entity [`MESH_ENTITY`]
-/// (lifetime zero: it stays until the next scene replaces it, frame-locked
-/// to [`FRAME_ID`]) with the triangles as a triangle list over the mesh's
-/// vertices (degenerate triangles left out, as the core leaves them out)
-/// and every triangle edge once as a line list.
+/// The scene's mesh, on [`super::MESH_TOPIC`], replacing every entity of
+/// the previous scene's (lifetime zero: they stay until the next scene,
+/// frame-locked to [`FRAME_ID`]): the entity [`MESH_ENTITY`] with the
+/// triangles as a triangle list over the mesh's vertices (degenerate
+/// triangles left out, as the core leaves them out); an entity per class
+/// of edge the mesh has ([`edges_entity`]) with those edges as a line list
+/// in the class's colour; an entity per kind of defect the mesh has
+/// ([`defects_entity`]) with a marker and a label at each defect
+/// (`flipped triangle 812`; listed in its metadata instead when the scene
+/// has more than [`MAX_DRAWN_DEFECT_LABELS`]).
 pub fn mesh_update(scene: &SceneState) -> SceneUpdate {
     let time = Time::from_nanos(scene.log_time_nanos);
     let mesh = &scene.mesh;
@@ -162,14 +197,14 @@ pub fn mesh_update(scene: &SceneState) -> SceneUpdate {
         .collect();
     ordered.sort_unstable_by_key(|(index, _)| *index);
     let triangles: Vec<[u32; 3]> = ordered.into_iter().map(|(_, v)| v).collect();
-    let mut edges: Vec<(u32, u32)> = triangles
-        .iter()
-        .flat_map(|v| [(v[0], v[1]), (v[1], v[2]), (v[2], v[0])].map(|(a, b)| (a.min(b), a.max(b))))
-        .collect();
-    edges.sort_unstable();
-    edges.dedup();
-    let mut entity = SceneEntity::new(time, FRAME_ID, MESH_ENTITY.to_string());
-    entity.frame_locked = true;
+    let topology = &scene.topology;
+    let new_entity = |id: String| {
+        let mut entity = SceneEntity::new(time, FRAME_ID, id);
+        entity.frame_locked = true;
+        entity
+    };
+    let mut entity = new_entity(MESH_ENTITY.to_string());
+    let counts = topology.edge_counts();
     entity.metadata = vec![
         key_value("scene", scene.number),
         key_value("name", scene.name.as_deref().unwrap_or("")),
@@ -178,6 +213,12 @@ pub fn mesh_update(scene: &SceneState) -> SceneUpdate {
         key_value("margin", scene.options.margin),
         key_value("facing", scene.options.facing),
     ];
+    entity
+        .metadata
+        .extend(EdgeClass::iter().map(|c| key_value(&format!("{c} edges"), counts.of(c))));
+    entity
+        .metadata
+        .push(key_value("defects", topology.defects().len()));
     entity.triangles = vec![TriangleListPrimitive {
         pose: identity(),
         points: points.clone(),
@@ -185,16 +226,94 @@ pub fn mesh_update(scene: &SceneState) -> SceneUpdate {
         colors: Vec::new(),
         indices: triangles.iter().flatten().copied().collect(),
     }];
-    entity.lines = vec![line(
-        points,
-        edges.iter().flat_map(|&(a, b)| [a, b]).collect(),
-        LineType::LineList,
-        WIREFRAME_PIXELS,
-        WIREFRAME_COLOR,
-    )];
+    let mut entities = vec![entity];
+    let (lo, hi) = mesh.bounds();
+    // (A mesh without a usable triangle has no extent: a small marker.)
+    let marker_radius = Some(0.005 * (hi - lo).norm())
+        .filter(|r| r.is_finite() && *r > 0.0)
+        .unwrap_or(0.01);
+    for class in EdgeClass::iter() {
+        // Every edge of the class once, by its (welded) vertices.
+        let indices: Vec<u32> = topology
+            .edges()
+            .iter()
+            .filter(|e| e.class == class && e.vertices.iter().all(|&v| (v as usize) < points.len()))
+            .flat_map(|e| e.vertices)
+            .collect();
+        if indices.is_empty() {
+            continue;
+        }
+        let (rgba, pixels) = edge_style(class);
+        let mut entity = new_entity(edges_entity(class));
+        entity.metadata = vec![
+            key_value("class", class),
+            key_value("edges", indices.len() / 2),
+        ];
+        entity.lines = vec![line(
+            points.clone(),
+            indices,
+            LineType::LineList,
+            pixels,
+            rgba,
+        )];
+        entities.push(entity);
+    }
+    let draw_labels = topology.defects().len() <= MAX_DRAWN_DEFECT_LABELS;
+    for kind in DefectKind::iter() {
+        let mut entity = new_entity(defects_entity(kind));
+        let mut listed = Vec::new();
+        for (n, d) in topology
+            .defects()
+            .iter()
+            .filter(|d| d.kind == kind)
+            .enumerate()
+        {
+            if !draw_labels {
+                listed.push(key_value(&format!("{kind} {n}"), d));
+                continue;
+            }
+            let [x, y, z] = d.position;
+            let position = Vector3 { x, y, z };
+            let pose = Pose {
+                position,
+                orientation: Quaternion::IDENTITY,
+            };
+            entity.texts.push(TextPrimitive {
+                pose,
+                billboard: true,
+                font_size: DEFECT_FONT_PIXELS,
+                scale_invariant: true,
+                color: color(DEFECT_COLOR),
+                text: d.to_string(),
+            });
+        }
+        if entity.texts.is_empty() && listed.is_empty() {
+            continue;
+        }
+        // A marker at each: a sphere of a hundredth of the mesh's extent.
+        let markers: Vec<SpherePrimitive> = topology
+            .defects()
+            .iter()
+            .filter(|d| d.kind == kind)
+            .map(|d| sphere(&d.position.into(), marker_radius, DEFECT_COLOR))
+            .collect();
+        entity.spheres = markers;
+        entity.metadata = vec![
+            key_value("kind", kind),
+            key_value("defects", entity.spheres.len()),
+        ];
+        entity.metadata.extend(listed);
+        entities.push(entity);
+    }
     SceneUpdate {
-        deletions: Vec::new(),
-        entities: vec![entity],
+        // The previous scene's edges and defects of a class or kind this
+        // one lacks would stay otherwise.
+        deletions: vec![SceneEntityDeletion {
+            timestamp: time,
+            deletion_type: DeletionType::All,
+            id: String::new(),
+        }],
+        entities,
     }
 }
 

@@ -193,9 +193,27 @@ pub struct TriangleListPrimitive {
     pub indices: Vec<u32>,
 }
 
+/// `foxglove.TextPrimitive`: a label.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct TextPrimitive {
+    /// Where the text box's center is (identity orientation: the text in
+    /// the xy-plane, flowing along +x).
+    pub pose: Pose,
+    /// Whether it always faces the camera (ignoring the orientation).
+    pub billboard: bool,
+    /// Height of one line of text.
+    pub font_size: f64,
+    /// Whether `font_size` is in screen pixels (else world units).
+    pub scale_invariant: bool,
+    /// Color.
+    pub color: Color,
+    /// The text.
+    pub text: String,
+}
+
 /// `foxglove.SceneEntity`. The primitive kinds this output never draws
-/// (cubes, cylinders, texts, models) are written as empty lists, which
-/// the schema requires.
+/// (cubes, cylinders, models) are written as empty lists, which the
+/// schema requires.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct SceneEntity {
     /// Timestamp.
@@ -222,8 +240,8 @@ pub struct SceneEntity {
     pub lines: Vec<LinePrimitive>,
     /// Triangle lists.
     pub triangles: Vec<TriangleListPrimitive>,
-    /// Always empty.
-    pub texts: [(); 0],
+    /// Texts.
+    pub texts: Vec<TextPrimitive>,
     /// Always empty.
     pub models: [(); 0],
 }
@@ -244,7 +262,7 @@ impl SceneEntity {
             cylinders: [],
             lines: Vec::new(),
             triangles: Vec::new(),
-            texts: [],
+            texts: Vec::new(),
             models: [],
         }
     }

@@ -8,7 +8,7 @@
 //!
 //! | topic | schema | what |
 //! |---|---|---|
-//! | [`MESH_TOPIC`] | `foxglove.SceneUpdate` | the scene's mesh (triangle list and edges), once per scene |
+//! | [`MESH_TOPIC`] | `foxglove.SceneUpdate` | the scene's mesh (triangle list, edges by class, defects with labels), once per scene |
 //! | [`BALLS_TOPIC`] | `foxglove.SceneUpdate` | per sweep, entity `ball/{ball}`: the ball at `p0`, at the contact, at `p1` |
 //! | [`SWEEPS_TOPIC`] | `foxglove.SceneUpdate` | per sweep, entity `sweep/{ball}`: the path, and the swept sphere (radius ρ) at the contact |
 //! | [`CONTACTS_TOPIC`] | `foxglove.SceneUpdate` | per sweep, entity `contact/{ball}`: the contact point and the reported normal (deleted at a miss) |

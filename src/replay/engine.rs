@@ -7,8 +7,8 @@ use std::time::{Duration, Instant};
 
 use crate::core::explain::nearest_miss;
 use crate::core::{
-    Broadphase, CollectRecords, Mesh, Observer, Options, Outcome, Sweep, TestRecord, VerdictCounts,
-    sweep_mesh, sweep_mesh_with,
+    Broadphase, CollectRecords, Mesh, Observer, Options, Outcome, Sweep, TestRecord, Topology,
+    VerdictCounts, sweep_mesh, sweep_mesh_with,
 };
 use crate::trace::TraceEvent;
 use crate::trace::messages::{OutcomeMsg, SceneMsg, SweepMsg};
@@ -30,6 +30,9 @@ pub struct SceneState {
     pub name: Option<String>,
     /// The mesh.
     pub mesh: Mesh,
+    /// The mesh's topology: its edges by class and its defects, built once
+    /// per scene from the same message as [`SceneState::mesh`].
+    pub topology: Topology,
     /// The options in force: the scene's margin and facing unless overridden.
     pub options: Options,
 }
@@ -186,8 +189,12 @@ impl Replay {
             margin,
             facing,
         } = scene;
+        // From the message, before the mesh takes its vertices. The two
+        // check their input alike, so the mesh's error is the one reported.
+        let topology = Topology::new(&vertices, &triangles);
         let mesh =
             Mesh::new(vertices, &triangles).map_err(|cause| ReplayError::Mesh { index, cause })?;
+        let topology = topology.map_err(|cause| ReplayError::Mesh { index, cause })?;
         let options = Options {
             margin: self.options.margin.unwrap_or(margin),
             facing: self.options.facing.unwrap_or(facing),
@@ -201,6 +208,7 @@ impl Replay {
             log_time_nanos,
             name,
             mesh,
+            topology,
             options,
         });
         self.scene = Some(state.clone());

@@ -4,9 +4,11 @@
 use nalgebra::{UnitQuaternion, Vector3};
 use rerun::{Color, ComponentDescriptor};
 
+use crate::core::EdgeClass;
 pub(crate) use crate::palette::{
-    CONTACT_BALL_COLOR, EXPECTED_COLOR, HIT_COLOR, MESH_COLOR, MISS_COLOR, NORMAL_COLOR, P0_COLOR,
-    P1_COLOR, SWEEP_COLOR, TUNNEL_COLOR, WIREFRAME_COLOR,
+    BOUNDARY_EDGE_COLOR, CONCAVE_EDGE_COLOR, CONTACT_BALL_COLOR, CONVEX_EDGE_COLOR, DEFECT_COLOR,
+    EXPECTED_COLOR, FLAT_EDGE_COLOR, HIT_COLOR, MESH_COLOR, MISS_COLOR, NON_MANIFOLD_EDGE_COLOR,
+    NORMAL_COLOR, P0_COLOR, P1_COLOR, SWEEP_COLOR, TUNNEL_COLOR,
 };
 pub(crate) const EDGE_COLOR: [u8; 4] = [230, 40, 40, 255];
 pub(crate) const CYLINDER_COLOR: [u8; 4] = [255, 120, 120, 255];
@@ -26,10 +28,23 @@ pub(crate) const SERIES_COLORS: [[u8; 4]; 6] = [
 ];
 
 /// Line radii in UI points (the same on screen at every zoom).
-pub(crate) const WIREFRAME_POINTS: f32 = 0.75;
 pub(crate) const OUTLINE_POINTS: f32 = 1.5;
 pub(crate) const BOLD_EDGE_POINTS: f32 = 4.0;
 pub(crate) const VERTEX_POINTS: f32 = 7.0;
+pub(crate) const DEFECT_POINTS: f32 = 6.0;
+
+/// The colour and the line radius (UI points) of the mesh's edges of
+/// `class`: flat edges faint and thin, convex and concave in colours of
+/// their own, boundary and non-manifold edges loud and thick.
+pub(crate) fn edge_style(class: EdgeClass) -> ([u8; 4], f32) {
+    match class {
+        EdgeClass::Flat => (FLAT_EDGE_COLOR, 0.5),
+        EdgeClass::Convex => (CONVEX_EDGE_COLOR, 1.25),
+        EdgeClass::Concave => (CONCAVE_EDGE_COLOR, 1.25),
+        EdgeClass::Boundary => (BOUNDARY_EDGE_COLOR, 1.75),
+        EdgeClass::NonManifold => (NON_MANIFOLD_EDGE_COLOR, 2.25),
+    }
+}
 
 pub(crate) fn f32x3(v: Vector3<f64>) -> [f32; 3] {
     [v.x as f32, v.y as f32, v.z as f32]

@@ -24,7 +24,7 @@ use super::convert::{
 };
 use super::paths::Entity;
 use super::rows::{Out, set};
-use crate::core::explain::{Label, miss_distance};
+use crate::core::explain::miss_distance;
 use crate::core::{EdgeRecord, Kind, SweptPath, TestRecord, sweep_edge};
 use crate::replay::SweepResult;
 
@@ -213,15 +213,13 @@ fn nearest_edge_of(r: &SweepResult, triangle: u32) -> Option<EdgeRecord> {
         .reduce(|a, b| if better(&b, &a) { b } else { a })
 }
 
-/// The rows of the chosen edge tests, one per test; `slot0` as
-/// [`choose_edges`] returned. Slot 0 is labelled only for the followed ball
-/// (`followed`).
+/// The rows of the chosen edge tests, one per test; slot 0's edge labelled
+/// `slot0_label` (see `rows::SweepLabels`).
 pub(crate) fn edge_frame_rows(
     out: &mut Out<'_>,
     r: &SweepResult,
     edges: &[EdgeRecord],
-    slot0: Slot0,
-    followed: bool,
+    slot0_label: Option<&str>,
 ) {
     let b = r.ball;
     let rho = r.rho();
@@ -235,15 +233,8 @@ pub(crate) fn edge_frame_rows(
         edge_frame_values(&mut row, e);
         let hit = e.alpha().is_some();
         let length = e.length as f32;
-        // The edge on +x, then the path. Slot 0's edge is labelled when it
-        // is not the decisive test (whose label is on the primary edge
-        // already): it then says which edge test it is and how it ended.
-        let label = match slot0 {
-            _ if slot > 0 || !followed => None,
-            Slot0::Decisive => None,
-            Slot0::Nearest => Some("nearest edge test"),
-            Slot0::Expected => Some("expected edge test"),
-        };
+        // The edge on +x, then the path; slot 0's edge labelled.
+        let label = slot0_label.filter(|_| slot == 0);
         let p0e = f32x3(e.p0_in_edge.coords);
         let p1e = f32x3(e.p1_in_edge.coords);
         row.put_strips(
@@ -261,12 +252,8 @@ pub(crate) fn edge_frame_rows(
         .put_texts(LineStrips3D::descriptor_labels, |t| {
             // Two labels, the path's empty (not drawn): a single label
             // would be drawn between the two strips.
-            if let Some(what) = label {
-                t.push_fmt(format_args!(
-                    "{what}: {} ({})",
-                    Label(&TestRecord::Edge(*e)),
-                    e.verdict
-                ));
+            if let Some(label) = label {
+                t.push_fmt(format_args!("{label}"));
                 t.push_fmt(format_args!(""));
             }
         });

@@ -6,26 +6,28 @@ use std::collections::{BTreeMap, BTreeSet};
 use std::path::Path;
 use std::sync::Arc;
 
-use rerun::components::Radius;
 use rerun::{
-    AsComponents as _, LineStrips3D, Mesh3D, RecordingStream, RecordingStreamError, SeriesLines,
-    SeriesPoints, ViewCoordinates,
+    AsComponents as _, LineStrips3D, Mesh3D, Points3D, RecordingStream, RecordingStreamError,
+    SeriesLines, SeriesPoints, ViewCoordinates,
 };
+use strum::IntoEnumIterator as _;
 
 use super::blueprint::{self, Layout};
 use super::columns;
 use super::convert::{
-    MESH_COLOR, SERIES_COLORS, WIREFRAME_COLOR, WIREFRAME_POINTS, albedo, f32x3, rgba,
+    DEFECT_COLOR, DEFECT_POINTS, MESH_COLOR, SERIES_COLORS, albedo, edge_style, f32x3, rgba,
+    ui_points,
 };
 use super::edge_frame::{choose_edges, edge_frame_rows};
 use super::paths;
 use super::rows::{
-    Out, PLOT_BITS, Shown, ball_row, expected_rows, focus_rows, plot_entity, plot_rows,
-    plot_series, primary_rows, text_rows, transition_rows, tunnel_rows,
+    Out, PLOT_BITS, Shown, SweepLabels, ball_row, expected_rows, focus_rows, plot_entity,
+    plot_rows, plot_series, primary_rows, text_rows, transition_rows, tunnel_rows,
 };
 use super::spill::Spill;
 use super::{MAX_EDGE_FRAMES, RecordError, TIMESTAMP_THRESHOLD_NANOS};
-use crate::core::{EdgeRecord, Triangle};
+use crate::core::{DefectKind, EdgeClass, EdgeRecord, Triangle};
+use crate::palette::MAX_DRAWN_DEFECT_LABELS;
 use crate::regress::Tolerances;
 use crate::regress::decision::divergence;
 use crate::replay::{ReplayEvent, SceneState, SweepResult};
@@ -211,17 +213,23 @@ pub fn prepare_sweeps_into<'r>(
         if followed {
             focus_rows(&mut out, r, decisive.as_ref(), !diffs.is_empty());
         }
-        let primary = primary_rows(&mut out, r, decisive.as_ref(), followed);
         let slot0 = choose_edges(&mut p.edges, r, decisive.as_ref(), options.max_edge_frames);
-        edge_frame_rows(&mut out, r, &p.edges, slot0, followed);
+        let expected = r.expected.filter(|_| !diffs.is_empty());
+        let labels = SweepLabels::of(
+            r,
+            decisive.as_ref(),
+            &p.edges,
+            slot0,
+            followed,
+            expected.is_some(),
+        );
+        let primary = primary_rows(&mut out, r, decisive.as_ref(), labels.primary);
+        edge_frame_rows(&mut out, r, &p.edges, labels.slot0.as_deref());
         let plotted = plot_rows(&mut out, r, decisive.as_ref());
-        let expected = match (&r.expected, diffs.is_empty()) {
-            (Some(e), false) => {
-                expected_rows(&mut out, r, e);
-                true
-            }
-            _ => false,
-        };
+        if let Some(e) = &expected {
+            expected_rows(&mut out, r, e, labels.expected);
+        }
+        let expected = expected.is_some();
         text_rows(&mut out, r, decisive.as_ref(), &diffs);
         let tunnel = tunnel_rows(&mut out, r);
         // What this sweep drew (`Logger::shown_before` worked out the same
@@ -265,6 +273,20 @@ fn series_styles(
         columns.send_static(rec, entity.path(), batches)?;
     }
     Ok(())
+}
+
+/// The edges of `class` of a scene, a segment each, by the positions of
+/// their (welded) vertices.
+pub(crate) fn edge_strips(scene: &SceneState, class: EdgeClass) -> Vec<[[f32; 3]; 2]> {
+    let vertices = scene.mesh.vertices();
+    let at = |i: u32| vertices.get(i as usize).map(|p| f32x3(p.coords));
+    scene
+        .topology
+        .edges()
+        .iter()
+        .filter(|e| e.class == class)
+        .filter_map(|e| Some([at(e.vertices[0])?, at(e.vertices[1])?]))
+        .collect()
 }
 
 /// The `time` timeline's value of a `log_time`.
@@ -469,8 +491,11 @@ impl Logger {
         }
     }
 
-    /// Logs a scene's mesh (static, one Mesh3D, flat-shaded) and its
-    /// wireframe (static, one LineStrips3D with every edge once).
+    /// Logs a scene's mesh (static, one Mesh3D, flat-shaded), its edges
+    /// (static, one LineStrips3D per class, every edge once) and its
+    /// defects (static, one Points3D per kind, a label each, drawn when the
+    /// scene has at most [`MAX_DRAWN_DEFECT_LABELS`]), from the scene's
+    /// topology.
     pub fn log_scene(&mut self, scene: &Arc<SceneState>) -> Result<(), RecordingStreamError> {
         let mut triangles: Vec<&Triangle> = scene.mesh.triangles().iter().collect();
         triangles.sort_by_key(|t| t.index);
@@ -489,24 +514,36 @@ impl Logger {
             .with_albedo_factor(albedo(MESH_COLOR));
         self.log_static(paths::mesh(scene.number), &mesh)?;
 
-        // Every edge once, by its vertex indices.
-        let mut edges: Vec<(u32, u32)> = triangles
-            .iter()
-            .flat_map(|t| {
-                let v = t.vertex_indices;
-                [(v[0], v[1]), (v[1], v[2]), (v[2], v[0])].map(|(a, b)| (a.min(b), a.max(b)))
-            })
-            .collect();
-        edges.sort_unstable();
-        edges.dedup();
-        let vertices = scene.mesh.vertices();
-        let strips = edges
-            .iter()
-            .map(|&(a, b)| [a, b].map(|i| f32x3(vertices[i as usize].coords)));
-        let wireframe = LineStrips3D::new(strips)
-            .with_radii([Radius::new_ui_points(WIREFRAME_POINTS)])
-            .with_colors([rgba(WIREFRAME_COLOR)]);
-        self.log_static(paths::wireframe(scene.number), &wireframe)?;
+        for class in EdgeClass::iter() {
+            let strips = edge_strips(scene, class);
+            if strips.is_empty() {
+                continue;
+            }
+            let (color, radius) = edge_style(class);
+            let edges = LineStrips3D::new(strips)
+                .with_radii([ui_points(radius)])
+                .with_colors([rgba(color)]);
+            self.log_static(paths::edges(scene.number, class), &edges)?;
+        }
+        let draw_labels = scene.topology.defects().len() <= MAX_DRAWN_DEFECT_LABELS;
+        for kind in DefectKind::iter() {
+            let (at, labels): (Vec<[f32; 3]>, Vec<String>) = scene
+                .topology
+                .defects()
+                .iter()
+                .filter(|d| d.kind == kind)
+                .map(|d| (d.position.map(|c| c as f32), d.to_string()))
+                .unzip();
+            if at.is_empty() {
+                continue;
+            }
+            let defects = Points3D::new(at)
+                .with_radii([ui_points(DEFECT_POINTS)])
+                .with_colors([rgba(DEFECT_COLOR)])
+                .with_labels(labels)
+                .with_show_labels(draw_labels);
+            self.log_static(paths::defects(scene.number, kind), &defects)?;
+        }
         Ok(())
     }
 

@@ -3,7 +3,16 @@
 //! ```text
 //! world                               view coordinates (right-handed, z up), static
 //! world/mesh/{scene}                  Mesh3D of each scene, static
-//! world/mesh/{scene}/wireframe        LineStrips3D: every triangle edge once, static
+//! world/mesh/{scene}/edges/{class}    LineStrips3D: the edges of one class (boundary,
+//!                                     convex, flat, concave, non_manifold; see
+//!                                     `core::EdgeClass`), a strip each, in the class's
+//!                                     colour and width, static (a class the mesh has no
+//!                                     edge of is not logged)
+//! world/mesh/{scene}/defects/{kind}   Points3D: the defects of one kind (flipped,
+//!                                     crack, t_junction, ...; see `core::DefectKind`),
+//!                                     a point at each with one label each
+//!                                     ("flipped triangle 812"), static (a kind the mesh
+//!                                     has none of is not logged)
 //! world/ball/{ball}                   the sweep, one row per sweep:
 //!                                       Ellipsoids3D: the ball at p0, at the contact, at p1
 //!                                       Capsules3D: the volume swept with radius ρ (wireframe)
@@ -72,6 +81,8 @@
 //! slots hold the other recorded edge tests, hits first. The edge-frame
 //! view of the default blueprint looks at `world/ball/{followed}/edge/0`.
 
+use crate::core::{DefectKind, EdgeClass};
+
 /// Root of the 3D world.
 pub const WORLD: &str = "world";
 /// The text log.
@@ -83,9 +94,14 @@ pub const STATUS: &str = "status";
 /// The log of divergent sweeps.
 pub const DIVERGENCES: &str = "divergences";
 
-/// The static wireframe of scene `scene`.
-pub fn wireframe(scene: usize) -> String {
-    format!("world/mesh/{scene}/wireframe")
+/// The static edges of class `class` of scene `scene`.
+pub fn edges(scene: usize, class: EdgeClass) -> String {
+    format!("world/mesh/{scene}/edges/{class}")
+}
+
+/// The static defects of kind `kind` of scene `scene`.
+pub fn defects(scene: usize, kind: DefectKind) -> String {
+    format!("world/mesh/{scene}/defects/{kind}")
 }
 
 /// The mesh of scene `scene` (0-based).

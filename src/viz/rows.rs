@@ -20,11 +20,11 @@ use super::convert::{
     OUTLINE_POINTS, P0_COLOR, P1_COLOR, SWEEP_COLOR, TUNNEL_COLOR, VERTEX_POINTS, albedo,
     any_value, capsule_pose, f32x3, rgba, ui_points,
 };
-use super::edge_frame::count_edges;
+use super::edge_frame::{Slot0, count_edges};
 use super::logger::PrepareOptions;
 use super::paths::{Entity, FACE_NAMES, QUADRATIC_NAMES};
 use crate::core::explain::Label;
-use crate::core::{Kind, TestRecord};
+use crate::core::{EdgeRecord, Kind, TestRecord};
 use crate::regress::FieldDiff;
 use crate::regress::decision::{divergence, write_decision_line, write_divergence_line};
 use crate::replay::SweepResult;
@@ -302,18 +302,111 @@ pub(crate) fn focus_rows(
         );
 }
 
+/// Which of a sweep's archetypes carry a label, so that no two labels say
+/// the same thing in the same place: the primary feature's label, the
+/// expected ball's and slot 0's edge test's (see [`SweepLabels::of`]).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub(crate) struct SweepLabels {
+    /// The primary triangle's label is drawn on its decisive feature.
+    pub(crate) primary: bool,
+    /// The expected ball carries its label.
+    pub(crate) expected: bool,
+    /// Slot 0's edge test's label, on its edge (none for a decisive edge
+    /// test, whose label is the primary edge's).
+    pub(crate) slot0: Option<String>,
+}
+
+impl SweepLabels {
+    /// The labels of a sweep: the primary feature's when it is hit, or for
+    /// the followed ball (`followed`) when it is the nearest miss (so that
+    /// balls that hit nothing do not cover the picture with labels); the
+    /// expected ball's at a divergent sweep (`expected`); slot 0's edge test
+    /// (`edges[0]`, `slot0` as `choose_edges` returned), for the followed
+    /// ball only, when it is not the decisive test.
+    ///
+    /// Two of them say one thing about one place when slot 0 is the nearest
+    /// edge test of a face decision (the face's label sits on the outline of
+    /// the triangle whose edge is labelled) or the expected edge test of a
+    /// divergent sweep (the expected ball sits on that edge): each pair is
+    /// one label then, on slot 0's edge, which every 3D view shows (the
+    /// edge-frame view included): `face 0; nearest edge test: edge 0.1
+    /// (parallel)`, `expected: edge; expected edge test: edge 0.0
+    /// (no_real_roots)`.
+    pub(crate) fn of(
+        r: &SweepResult,
+        decisive: Option<&TestRecord>,
+        edges: &[EdgeRecord],
+        slot0: Slot0,
+        followed: bool,
+        expected: bool,
+    ) -> SweepLabels {
+        let shown = decisive.filter(|t| r.scene.mesh.triangle_by_index(t.triangle()).is_some());
+        let mut labels = SweepLabels {
+            primary: shown.is_some_and(|t| t.alpha().is_some() || followed),
+            expected,
+            slot0: None,
+        };
+        let Some(e) = edges.first().filter(|_| followed) else {
+            return labels;
+        };
+        let edge_test =
+            |what: &str| format!("{what}: {} ({})", Label(&TestRecord::Edge(*e)), e.verdict);
+        labels.slot0 = match slot0 {
+            Slot0::Decisive => None,
+            Slot0::Nearest => match shown {
+                Some(face @ TestRecord::Face(_))
+                    if labels.primary && face.triangle() == e.triangle =>
+                {
+                    labels.primary = false;
+                    Some(format!(
+                        "{}; {}",
+                        primary_text(face),
+                        edge_test("nearest edge test")
+                    ))
+                }
+                _ => Some(edge_test("nearest edge test")),
+            },
+            Slot0::Expected => match r.expected.filter(|_| expected) {
+                Some(x) => {
+                    labels.expected = false;
+                    Some(format!(
+                        "{}; {}",
+                        expected_text(&x),
+                        edge_test("expected edge test")
+                    ))
+                }
+                None => Some(edge_test("expected edge test")),
+            },
+        };
+        labels
+    }
+}
+
+/// The primary feature's label: the test (`edge 12.1`), after `nearest
+/// miss: ` when it does not hit.
+fn primary_text(test: &TestRecord) -> String {
+    let prefix = if test.alpha().is_some() {
+        ""
+    } else {
+        "nearest miss: "
+    };
+    format!("{prefix}{}", Label(test))
+}
+
+/// The expected ball's label.
+fn expected_text(e: &OutcomeMsg) -> String {
+    format!("expected: {}", e.kind)
+}
+
 /// The primary (or nearest-miss) triangle, in one row: filled, its three
 /// edges outlined, its decisive edge bold (a second strip) or its vertex as
-/// a point; one label, on the decisive feature. Returns whether it was
-/// drawn (when not, [`transition_rows`] clears it).
-///
-/// A nearest miss is labelled only for the followed ball (`followed`), so
-/// that the balls that hit nothing do not cover the picture with labels.
+/// a point; with `labelled` one label, on the decisive feature. Returns
+/// whether it was drawn (when not, [`transition_rows`] clears it).
 pub(crate) fn primary_rows(
     out: &mut Out<'_>,
     r: &SweepResult,
     decisive: Option<&TestRecord>,
-    followed: bool,
+    labelled: bool,
 ) -> bool {
     let b = r.ball;
     let triangle = decisive.and_then(|t| r.scene.mesh.triangle_by_index(t.triangle()));
@@ -325,9 +418,7 @@ pub(crate) fn primary_rows(
     // Lift the highlight a little off the mesh so it is not hidden by it.
     let lift = t.normal * (r.rho() * 0.02);
     let verts: [[f32; 3]; 3] = std::array::from_fn(|i| f32x3(t.vertices[i].coords + lift));
-    let label = Label(test);
-    let prefix = if hit { "" } else { "nearest miss: " };
-    let labelled = hit || followed;
+    let label = primary_text(test);
     let f = test.feature() as usize % 3;
     let outline = [verts[0], verts[1], verts[2], verts[0]];
     let bold = [verts[f], verts[(f + 1) % 3]];
@@ -357,11 +448,11 @@ pub(crate) fn primary_rows(
         // test (the outline's label then empty, which is not drawn).
         match test {
             TestRecord::Face(_) if labelled => {
-                s.push_fmt(format_args!("{prefix}{label}"));
+                s.push_fmt(format_args!("{label}"));
             }
             TestRecord::Edge(_) if labelled => {
                 s.push_fmt(format_args!(""));
-                s.push_fmt(format_args!("{prefix}{label}"));
+                s.push_fmt(format_args!("{label}"));
             }
             _ => {}
         }
@@ -371,7 +462,7 @@ pub(crate) fn primary_rows(
     .put::<Color>(Points3D::descriptor_colors, [rgba(color)])
     .put_texts(Points3D::descriptor_labels, |s| {
         if labelled && vertex.is_some() {
-            s.push_fmt(format_args!("{prefix}{label}"));
+            s.push_fmt(format_args!("{label}"));
         }
     });
     true
@@ -380,8 +471,9 @@ pub(crate) fn primary_rows(
 /// The expected outcome beside the replayed one, for a divergent sweep, in
 /// one row: the ball at the expected α, the expected contact (when the
 /// expectation names one) and normal (when it names a contact and a normal
-/// of finite, non-zero length; else none).
-pub(crate) fn expected_rows(out: &mut Out<'_>, r: &SweepResult, e: &OutcomeMsg) {
+/// of finite, non-zero length; else none); the ball labelled with the
+/// expected kind when `labelled`.
+pub(crate) fn expected_rows(out: &mut Out<'_>, r: &SweepResult, e: &OutcomeMsg, labelled: bool) {
     let b = r.ball;
     let p0 = r.sweep.p0;
     let d = r.sweep.p1 - p0;
@@ -416,10 +508,11 @@ pub(crate) fn expected_rows(out: &mut Out<'_>, r: &SweepResult, e: &OutcomeMsg) 
         Ellipsoids3D::descriptor_fill_mode,
         [FillMode::MajorWireframe],
     )
-    .put_fmt(
-        Ellipsoids3D::descriptor_labels,
-        format_args!("expected: {}", e.kind),
-    );
+    .put_texts(Ellipsoids3D::descriptor_labels, |t| {
+        if labelled {
+            t.push_fmt(format_args!("{}", expected_text(e)));
+        }
+    });
     // The contact point alone when the normal is missing or unusable.
     contact_parts(&mut row, contact, normal, [EXPECTED_COLOR; 2]);
 }

@@ -128,6 +128,8 @@ fn result_of(
             log_time_nanos: 0,
             name: None,
             mesh: mesh.clone(),
+            // Not built: the judgement of the sweep reads only the mesh.
+            topology: crate::core::Topology::default(),
             options,
         }),
         sweep,

@@ -16,11 +16,12 @@
 //! prints how often the two libraries agree on hit or miss and the largest
 //! difference in α where both hit.
 //!
-//! The group `session` measures the fast and the explained query on the
-//! sweeps of a real session's shape instead: 4,096 sweeps taken evenly from
-//! the simulation `record --scene terrain --terrain-cells 224 --balls 64
-//! --seed 1 --frames 1954` writes (100,352 triangles; balls falling,
-//! bouncing and rolling on the terrain), in trace order.
+//! The group `session` measures the fast and the explained query and parry
+//! on the sweeps of a real session's shape instead: 4,096 sweeps taken
+//! evenly from the simulation `record --scene terrain --terrain-cells {224,
+//! 708} --balls 64 --seed 1 --frames 1954` writes (100,352 and 1,002,528
+//! triangles; balls falling, bouncing and rolling on the terrain), in trace
+//! order, with the same agreement check.
 
 use std::hash::{Hash, Hasher};
 use std::hint::black_box;

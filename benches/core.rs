@@ -23,12 +23,14 @@
 //! timing it prints the topology's bytes per triangle (the capacities of
 //! its vectors).
 //!
-//! The group `session` measures the fast and the explained query on the
-//! sweeps of a real session's shape instead: 4,096 sweeps taken evenly from
-//! the simulation `record --scene terrain --terrain-cells 224 --balls 64
-//! --seed 1 --frames 1954` writes (100,352 triangles; balls falling,
-//! bouncing and rolling on the terrain), in trace order.
+//! The group `session` measures the fast and the explained query and parry
+//! on the sweeps of a real session's shape instead: 4,096 sweeps taken
+//! evenly from the simulation `record --scene terrain --terrain-cells {224,
+//! 708} --balls 64 --seed 1 --frames 1954` writes (100,352 and 1,002,528
+//! triangles; balls falling, bouncing and rolling on the terrain), in trace
+//! order, with the same agreement check.
 
+use std::hash::{Hash, Hasher};
 use std::hint::black_box;
 
 use criterion::measurement::WallTime;
@@ -137,12 +139,19 @@ fn parry_cast(mesh: &TriMesh, s: &Sweep) -> Option<f64> {
     .map(|h| h.time_of_impact)
 }
 
-fn agreement(s: &Setup) {
+/// Prints how often sweeptrace and parry agree on hit or miss over the
+/// setup's sweeps, the largest difference in α where both hit, and a digest
+/// of every outcome of sweeptrace (its `Debug` text, which writes every
+/// number exactly) to compare two builds' outcomes bit for bit. Panics if no
+/// sweep hits, which would make the bench measure misses only.
+fn agreement(label: &str, s: &Setup) {
     let options = Options::default();
     let (mut both, mut neither, mut only_ours, mut only_parry) = (0, 0, 0, 0);
     let mut worst = 0.0f64;
+    let mut digest = std::hash::DefaultHasher::new();
     for sw in &s.sweeps {
         let ours = sweep_mesh(&s.ours, sw, &options).expect("valid sweep");
+        format!("{ours:?}").hash(&mut digest);
         match (ours.is_hit(), parry_cast(&s.parry, sw)) {
             (true, Some(t)) => {
                 both += 1;
@@ -154,9 +163,11 @@ fn agreement(s: &Setup) {
         }
     }
     println!(
-        "agreement on {} triangles: {both} both hit, {neither} both miss, {only_ours} only sweeptrace, {only_parry} only parry; largest alpha difference {worst:.2e}",
-        s.triangles
+        "agreement, {label} on {} triangles: {both} both hit, {neither} both miss, {only_ours} only sweeptrace, {only_parry} only parry; largest alpha difference {worst:.2e}; outcome digest {:016x}",
+        s.triangles,
+        digest.finish()
     );
+    assert!(both > 0, "no sweep of {label} hits the mesh");
 }
 
 fn bench(c: &mut Criterion) {
@@ -166,7 +177,7 @@ fn bench(c: &mut Criterion) {
     group.measurement_time(std::time::Duration::from_secs(4));
     for n in [22usize, 71, 224, 708] {
         let s = setup(n);
-        agreement(&s);
+        agreement("falling", &s);
         let options = Options::default();
         group.throughput(Throughput::Elements(1));
         let mut i = 0usize;
@@ -228,10 +239,10 @@ fn explained_bench(
     });
 }
 
-/// The session's mesh, options and 4,096 of its sweeps (see the module
-/// documentation).
-fn session() -> (Mesh, Options, Vec<Sweep>) {
-    let scene = BuiltinScene::Terrain.mesh_with_terrain_cells(224);
+/// A session's mesh (for both libraries), options and 4,096 of its sweeps
+/// (see the module documentation) on the terrain of `cells × cells` cells.
+fn session(cells: usize) -> (Setup, Options) {
+    let scene = BuiltinScene::Terrain.mesh_with_terrain_cells(cells);
     let mesh = scene.to_mesh().expect("valid terrain");
     let options = sim::SimOptions {
         balls: 64,
@@ -248,35 +259,69 @@ fn session() -> (Mesh, Options, Vec<Sweep>) {
     .expect("the session simulates");
     let step = (all.len() / SWEEPS).max(1);
     let sweeps: Vec<Sweep> = all.into_iter().step_by(step).take(SWEEPS).collect();
-    (mesh, options.core_options(), sweeps)
+    let parry = TriMesh::new(
+        scene
+            .vertices
+            .iter()
+            .map(|v| Vector::new(v[0], v[1], v[2]))
+            .collect(),
+        scene
+            .triangles
+            .iter()
+            .map(|t| t.map(|i| i as u32))
+            .collect(),
+    )
+    .expect("valid terrain for parry");
+    let setup = Setup {
+        n: cells,
+        triangles: scene.triangles.len(),
+        ours: mesh,
+        parry,
+        sweeps,
+    };
+    (setup, options.core_options())
 }
 
 fn bench_session(c: &mut Criterion) {
-    let (mesh, options, sweeps) = session();
-    let n = sweeps.len();
     let mut group = c.benchmark_group("session");
     group.sample_size(20);
     group.warm_up_time(std::time::Duration::from_secs(1));
     group.measurement_time(std::time::Duration::from_secs(4));
     group.throughput(Throughput::Elements(1));
-    let mut i = 0usize;
-    group.bench_function("sweeptrace", |b| {
-        b.iter(|| {
-            i = (i + 1) % n;
-            black_box(sweep_mesh(&mesh, &sweeps[i], &options).ok())
-        })
-    });
-    let mut i = 0usize;
-    group.bench_function("explained-primary", |b| {
-        b.iter(|| {
-            i = (i + 1) % n;
-            let mut collect = CollectPrimary::default();
-            let outcome =
-                sweep_mesh_with(&mesh, &sweeps[i], &options, Broadphase::Bvh, &mut collect).ok();
-            let verdicts = collect.verdict_counts();
-            black_box((outcome.map(|o| collect.into_primary_records(&o)), verdicts))
-        })
-    });
+    for cells in [224usize, 708] {
+        let (s, options) = session(cells);
+        assert_eq!(options, Options::default(), "parry has no margin");
+        agreement("session", &s);
+        let n = s.sweeps.len();
+        let mut i = 0usize;
+        group.bench_with_input(BenchmarkId::new("sweeptrace", s.triangles), &s, |b, s| {
+            b.iter(|| {
+                i = (i + 1) % n;
+                black_box(sweep_mesh(&s.ours, &s.sweeps[i], &options).ok())
+            })
+        });
+        let mut i = 0usize;
+        group.bench_with_input(
+            BenchmarkId::new("explained-primary", s.triangles),
+            &s,
+            |b, s| {
+                b.iter(|| {
+                    i = (i + 1) % n;
+                    let mut collect = CollectPrimary::default();
+                    let outcome = explained(s, &s.sweeps[i], &options, &mut collect);
+                    let verdicts = collect.verdict_counts();
+                    black_box((outcome.map(|o| collect.into_primary_records(&o)), verdicts))
+                })
+            },
+        );
+        let mut i = 0usize;
+        group.bench_with_input(BenchmarkId::new("parry", s.triangles), &s, |b, s| {
+            b.iter(|| {
+                i = (i + 1) % n;
+                black_box(parry_cast(&s.parry, &s.sweeps[i]))
+            })
+        });
+    }
     group.finish();
 }
 

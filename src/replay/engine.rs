@@ -7,8 +7,8 @@ use std::time::{Duration, Instant};
 
 use crate::core::explain::nearest_miss;
 use crate::core::{
-    Broadphase, CollectRecords, Mesh, Observer, Options, Outcome, Sweep, TestRecord, VerdictCounts,
-    sweep_mesh, sweep_mesh_with,
+    Broadphase, CollectRecords, Mesh, Observer, Options, Outcome, Sweep, TestRecord, Topology,
+    VerdictCounts, sweep_mesh, sweep_mesh_with,
 };
 use crate::trace::TraceEvent;
 use crate::trace::messages::{OutcomeMsg, SceneMsg, SweepMsg};
@@ -30,6 +30,9 @@ pub struct SceneState {
     pub name: Option<String>,
     /// The mesh.
     pub mesh: Mesh,
+    /// The mesh's topology (edges by class, defects), built from the same
+    /// scene message as the mesh; `None` when it cannot be built.
+    pub topology: Option<Topology>,
     /// The options in force: the scene's margin and facing unless overridden.
     pub options: Options,
 }
@@ -186,6 +189,7 @@ impl Replay {
             margin,
             facing,
         } = scene;
+        let topology = Topology::new(&vertices, &triangles).ok();
         let mesh =
             Mesh::new(vertices, &triangles).map_err(|cause| ReplayError::Mesh { index, cause })?;
         let options = Options {
@@ -201,6 +205,7 @@ impl Replay {
             log_time_nanos,
             name,
             mesh,
+            topology,
             options,
         });
         self.scene = Some(state.clone());

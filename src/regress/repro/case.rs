@@ -128,6 +128,8 @@ fn result_of(
             log_time_nanos: 0,
             name: None,
             mesh: mesh.clone(),
+            // A case is judged by its outcome alone.
+            topology: None,
             options,
         }),
         sweep,

@@ -30,6 +30,7 @@ mod outputs;
 mod prefetch;
 mod rapier;
 // The Rapier recorder example, run by `rapier` (its `main` is unused here).
+mod ghost;
 #[allow(dead_code)]
 #[path = "../examples/rapier_record.rs"]
 mod rapier_record;
@@ -119,6 +120,7 @@ fn main() {
     trials.extend(prefetch::tests());
     trials.extend(outputs::tests());
     trials.extend(tunnel::tests());
+    trials.extend(ghost::tests());
     trials.extend(repro::tests());
     trials.extend(alt_engine::tests());
     trials.extend(scanned::tests());

@@ -46,7 +46,10 @@ the sweep, with its last stderr lines.
 
 Per trace: `ok`, `FAIL` (with the first divergences explained, and every
 tunnel: a ball's centre that went through a triangle from its front to its
-back, named by frame, ball, triangle and point), `NO EXPECTATIONS` (no
+back, named by frame, ball, triangle and point; and every ghost contact: an
+expected edge or vertex contact on an internal flat or concave edge whose
+normal leans more than --ghost-degrees off the faces', named by frame,
+ball, edge and angle), `NO EXPECTATIONS` (no
 /expected channel, or none matches a sweep: never a pass) or `ERROR`. Each
 divergence gives the sweep's inputs exactly (--hex: also as hex floats).
 When expectations fail, the recording engine's margin and facing rule are
@@ -56,7 +59,7 @@ explains it: a perturbation of the sweep's inputs within the rounding
 budget (a few units of p0, p1 or the radius) makes the core give the
 expected answer; the report names that perturbation. Exit status: 0 every
 trace matches (ties and divergences rounding explains included, unless
---strict), 1 a divergence or a tunnel was found, 2
+--strict), 1 a divergence, a tunnel or a ghost contact was found, 2
 something could not be checked (bad input, I/O error, no expectations, a
 fault of the engine), 3 a trace ends early, 125 the engine cannot be
 started (git bisect run skips that commit). In GitHub Actions
@@ -106,6 +109,20 @@ pub struct Args {
     /// `--allow-tunnels=false` overrides a settings file's `allow_tunnels = true`.
     #[arg(long, value_name = "BOOL", num_args = 0..=1, require_equals = true, default_missing_value = "true")]
     pub allow_tunnels: Option<bool>,
+    /// Count and list ghost contacts without failing the check. A ghost
+    /// contact is an expectation (or an engine's answer) that is an edge or
+    /// vertex contact on an internal flat or concave edge (or a vertex whose
+    /// every edge is flat or concave) with a normal more than
+    /// --ghost-degrees from the faces' normals there: the normal that bumps
+    /// a ball rolling across a seam. They are judged whatever --fields
+    /// compares; without this flag one fails the check.
+    #[arg(long)]
+    pub allow_ghosts: bool,
+    /// The angle, in degrees, between an edge or vertex contact's normal and
+    /// the nearest adjacent face's normal above which it is a ghost contact
+    /// (docs/SEMANTICS.md), e.g. `--ghost-degrees 5`.
+    #[arg(long, value_name = "DEGREES", default_value_t = sweeptrace::regress::GHOST_DEGREES)]
+    pub ghost_degrees: f64,
     /// Ignore the sweeptrace.toml files: the defaults and the command line only.
     #[arg(long)]
     pub no_config: bool,
@@ -180,9 +197,17 @@ pub fn run(args: Args) -> anyhow::Result<RunOutcome> {
         );
         return Ok(RunOutcome::Success);
     }
+    if !(args.ghost_degrees.is_finite() && (0.0..=180.0).contains(&args.ghost_degrees)) {
+        bail!(
+            "--ghost-degrees must be an angle from 0 to 180, got {}",
+            args.ghost_degrees
+        );
+    }
     let options = CheckOptions {
         max_details: args.max_details,
         hex: args.hex,
+        fail_on_ghost: !args.allow_ghosts,
+        ghost_degrees: args.ghost_degrees,
         ..CheckOptions::default()
     };
     let engine = match &args.engine {

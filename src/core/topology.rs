@@ -363,6 +363,13 @@ pub struct Topology {
     /// Input indices of the flipped triangles, ascending.
     flipped: Vec<u32>,
     near_distance: f64,
+    /// Per input triangle, its welded corners.
+    corners: Vec<[u32; 3]>,
+    /// Per welded vertex `v`, its edges are
+    /// `vertex_edges[vertex_edge_start[v]..vertex_edge_start[v + 1]]`
+    /// (indices into `edges`).
+    vertex_edge_start: Vec<u32>,
+    vertex_edges: Vec<u32>,
 }
 
 fn position_key(p: &[f64; 3]) -> [u64; 3] {
@@ -618,10 +625,77 @@ impl Topology {
         best.map(|(_, _, i)| (i, &self.defects[i]))
     }
 
+    /// The edge between input vertices `a` and `b` (after welding), if
+    /// some usable triangle has it.
+    pub fn edge_between(&self, a: u32, b: u32) -> Option<&Edge> {
+        let (a, b) = (self.welded(a)?, self.welded(b)?);
+        let key = if a < b { [a, b] } else { [b, a] };
+        self.edges
+            .binary_search_by(|e| e.vertices.cmp(&key))
+            .ok()
+            .map(|i| &self.edges[i])
+    }
+
+    /// Edge `feature` of input triangle `triangle` (the edge joining its
+    /// vertices `feature` and `(feature + 1) mod 3`, SEMANTICS.md's
+    /// numbering); `None` for a feature above 2, a triangle out of range,
+    /// or a triangle left out of the adjacency (degenerate, duplicate).
+    pub fn triangle_edge(&self, triangle: u32, feature: u8) -> Option<&Edge> {
+        let c = self.corners.get(triangle as usize)?;
+        let f = usize::from(feature);
+        if f > 2 {
+            return None;
+        }
+        let edge = self.edge_between(c[f], c[(f + 1) % 3])?;
+        edge.triangles().any(|t| t == triangle).then_some(edge)
+    }
+
+    /// The class of edge `feature` of input triangle `triangle` (see
+    /// [`Topology::triangle_edge`]).
+    pub fn triangle_edge_class(&self, triangle: u32, feature: u8) -> Option<EdgeClass> {
+        self.triangle_edge(triangle, feature).map(|e| e.class)
+    }
+
+    /// The welded vertex `feature` (0..2) of input triangle `triangle`.
+    pub fn triangle_vertex(&self, triangle: u32, feature: u8) -> Option<u32> {
+        self.corners
+            .get(triangle as usize)?
+            .get(usize::from(feature))
+            .copied()
+    }
+
+    /// The edges at input vertex `v` (after welding), in the order of
+    /// [`Topology::edges`].
+    pub fn edges_at(&self, v: u32) -> impl Iterator<Item = &Edge> + '_ {
+        let range = self
+            .welded(v)
+            .and_then(|w| {
+                let lo = *self.vertex_edge_start.get(w as usize)? as usize;
+                let hi = *self.vertex_edge_start.get(w as usize + 1)? as usize;
+                Some(lo..hi)
+            })
+            .unwrap_or(0..0);
+        self.vertex_edges[range]
+            .iter()
+            .map(|&e| &self.edges[e as usize])
+    }
+
+    /// Whether input vertex `v` is inside a smooth or hollow part of the
+    /// mesh: it has edges and every one of them is [`EdgeClass::Flat`] or
+    /// [`EdgeClass::Concave`] (no boundary, ridge or non-manifold edge
+    /// meets it).
+    pub fn vertex_is_flat_or_concave(&self, v: u32) -> bool {
+        let mut edges = self.edges_at(v).peekable();
+        edges.peek().is_some()
+            && edges.all(|e| matches!(e.class, EdgeClass::Flat | EdgeClass::Concave))
+    }
+
     /// Bytes the topology holds on the heap (the capacities of its vectors).
     pub fn heap_bytes(&self) -> usize {
         use std::mem::size_of;
         self.weld.capacity() * size_of::<u32>()
+            + self.corners.capacity() * size_of::<[u32; 3]>()
+            + (self.vertex_edge_start.capacity() + self.vertex_edges.capacity()) * size_of::<u32>()
             + self.edges.capacity() * size_of::<Edge>()
             + self.flipped.capacity() * size_of::<u32>()
             + self.defects.capacity() * size_of::<Defect>()
@@ -909,7 +983,29 @@ impl<'a> Builder<'a> {
         defects.sort_by(|a, b| (a.kind, &a.triangles).cmp(&(b.kind, &b.triangles)));
         defects.shrink_to_fit();
         edges.shrink_to_fit();
+        let corners: Vec<[u32; 3]> = (0..n as u32).map(|t| self.welded_tri(t)).collect();
+        // The edges at each welded vertex, counted then placed (CSR).
+        let mut vertex_edge_start = vec![0u32; self.vertices.len() + 1];
+        for e in &edges {
+            for v in e.vertices {
+                vertex_edge_start[v as usize + 1] += 1;
+            }
+        }
+        for v in 0..self.vertices.len() {
+            vertex_edge_start[v + 1] += vertex_edge_start[v];
+        }
+        let mut next = vertex_edge_start.clone();
+        let mut vertex_edges = vec![0u32; 2 * edges.len()];
+        for (i, e) in edges.iter().enumerate() {
+            for v in e.vertices {
+                vertex_edges[next[v as usize] as usize] = i as u32;
+                next[v as usize] += 1;
+            }
+        }
         Topology {
+            corners,
+            vertex_edge_start,
+            vertex_edges,
             triangle_count: n,
             vertex_count: self.vertices.len(),
             welded_vertex_count: self.welded_vertex_count,
@@ -1282,6 +1378,54 @@ mod tests {
         assert_eq!(c.total(), 23);
         assert_eq!(topo.boundary_loops(), 1);
         assert!(!topo.changes_collisions());
+    }
+
+    #[test]
+    fn triangle_edges_and_vertices_by_class() {
+        // 2×2 squares: vertex 4 is the centre, every edge at it internal.
+        let (v, t) = floor(2, 2);
+        let topo = Topology::new(&v, &t).unwrap();
+        // Triangle 0 is (0, 1, 4): edge 0 on the rim, edge 1 inside the
+        // square 1, edge 2 the diagonal shared with triangle 1.
+        assert_eq!(topo.triangle_edge_class(0, 0), Some(EdgeClass::Boundary));
+        assert_eq!(topo.triangle_edge_class(0, 2), Some(EdgeClass::Flat));
+        let diagonal = topo.triangle_edge(0, 2).unwrap();
+        assert_eq!(diagonal.triangles, [0, 1]);
+        assert_eq!(topo.triangle_edge_class(0, 3), None);
+        assert_eq!(topo.triangle_edge_class(99, 0), None);
+        assert_eq!(topo.triangle_vertex(0, 2), Some(4));
+        assert_eq!(topo.edges_at(4).count(), 6);
+        assert!(topo.vertex_is_flat_or_concave(4));
+        assert!(!topo.vertex_is_flat_or_concave(0));
+        assert!(!topo.vertex_is_flat_or_concave(99));
+
+        // Fold the far column up about x = 1: its edges along x = 1 turn
+        // concave (a valley seen from +z), the centre stays internal.
+        let (mut v, t) = floor(2, 2);
+        for p in &mut v {
+            if p[0] > 1.5 {
+                p[2] = 1.0;
+            }
+        }
+        let topo = Topology::new(&v, &t).unwrap();
+        assert_eq!(
+            topo.edge_between(1, 4).map(|e| e.class),
+            Some(EdgeClass::Concave)
+        );
+        assert!(topo.vertex_is_flat_or_concave(4));
+        // Folded down instead, a ridge: the centre meets a convex edge.
+        let (mut v, t) = floor(2, 2);
+        for p in &mut v {
+            if p[0] > 1.5 {
+                p[2] = -1.0;
+            }
+        }
+        let topo = Topology::new(&v, &t).unwrap();
+        assert_eq!(
+            topo.edge_between(4, 1).map(|e| e.class),
+            Some(EdgeClass::Convex)
+        );
+        assert!(!topo.vertex_is_flat_or_concave(4));
     }
 
     #[test]

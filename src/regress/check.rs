@@ -29,6 +29,7 @@ use crate::trace::{TraceError, TraceEvent, TraceReader};
 
 use super::compare::{FieldDiff, Tolerances};
 use super::explain::{ExpectedTest, expected_tests, explain_outcome, explained_records};
+use super::ghost::{GhostContact, GhostJudgement, judge_ghost};
 use super::infer::{ComparedSweep, Inferred, infer};
 use super::judge::{Agreement, agreement};
 use super::repro::{HexInputs, SweepInputs};
@@ -37,6 +38,8 @@ use super::repro::{HexInputs, SweepInputs};
 pub const DEFAULT_MAX_DETAILS: usize = 3;
 /// How many tunnels a report lists, one line each.
 pub const MAX_LISTED_TUNNELS: usize = 10;
+/// How many ghost contacts a report lists, one line each.
+pub const MAX_LISTED_GHOSTS: usize = 10;
 
 /// A tunnel found in a trace: a ball's centre went through a triangle from
 /// its front to its back, during a sweep or between two of its sweeps (see
@@ -168,7 +171,7 @@ impl TraceReport {
     pub fn status(&self) -> Status {
         if !self.errors.is_empty() {
             Status::Error
-        } else if self.divergent > 0 || self.fails_on_tunnels() {
+        } else if self.divergent > 0 || self.fails_on_tunnels() || self.fails_on_ghosts() {
             Status::Fail
         } else if self.compared == 0 {
             Status::NoExpectations
@@ -180,6 +183,11 @@ impl TraceReport {
     /// Whether tunnels were found and fail the check.
     pub fn fails_on_tunnels(&self) -> bool {
         self.tunnels > 0 && self.fail_on_tunnel
+    }
+
+    /// Whether ghost contacts were found and fail the check.
+    pub fn fails_on_ghosts(&self) -> bool {
+        self.ghosts > 0 && self.fail_on_ghost
     }
 
     /// What the check of this trace came to: a divergence is
@@ -210,6 +218,13 @@ pub struct CheckOptions {
     /// Whether a tunnel fails the check (the default: it is a bug of the
     /// recording engine, whatever the expectations say).
     pub fail_on_tunnel: bool,
+    /// Whether a ghost contact fails the check (the default; see
+    /// [`super::ghost`]).
+    pub fail_on_ghost: bool,
+    /// The angle, in degrees, above which an edge or vertex contact on an
+    /// internal flat or concave place is a ghost contact
+    /// ([`super::GHOST_DEGREES`] by default).
+    pub ghost_degrees: f64,
     /// Whether divergences also give their inputs as hexadecimal floating
     /// point ([`Divergence::inputs_hex`]).
     pub hex: bool,
@@ -226,6 +241,8 @@ impl Default for CheckOptions {
             max_details: DEFAULT_MAX_DETAILS,
             strict: false,
             fail_on_tunnel: true,
+            fail_on_ghost: true,
+            ghost_degrees: super::ghost::GHOST_DEGREES,
             hex: false,
             replay: ReplayOptions::default(),
         }
@@ -273,6 +290,22 @@ pub struct TraceReport {
     pub tunnel_details: Vec<TunnelReport>,
     /// Whether tunnels fail the check.
     pub fail_on_tunnel: bool,
+    /// Ghost contacts found: expectations (or an engine's answers) that are
+    /// edge or vertex contacts on an internal flat or concave place with a
+    /// normal more than `ghost_degrees` from the faces' there
+    /// ([`super::ghost`]), whatever the compared fields. They fail the
+    /// check unless `fail_on_ghost` is off.
+    pub ghosts: u64,
+    /// The first ghost contacts (at most [`MAX_LISTED_GHOSTS`]), in trace
+    /// order.
+    pub ghost_contacts: Vec<GhostContact>,
+    /// Edge or vertex contacts on such a place that give no normal, so
+    /// cannot be judged.
+    pub ghosts_unjudged: u64,
+    /// Whether ghost contacts fail the check.
+    pub fail_on_ghost: bool,
+    /// The ghost contacts' threshold, in degrees.
+    pub ghost_degrees: f64,
     /// Replayed sweeps without an expectation.
     pub sweeps_without_expectation: u64,
     /// Expectations that match no replayed sweep (or arrived after theirs was
@@ -374,6 +407,11 @@ impl Serialize for TraceReport {
             tunnels_by_kind: &'a BTreeMap<TunnelKind, u64>,
             tunnel_details: &'a [TunnelReport],
             fail_on_tunnel: bool,
+            ghosts: u64,
+            ghost_contacts: &'a [GhostContact],
+            ghosts_unjudged: u64,
+            fail_on_ghost: bool,
+            ghost_degrees: f64,
             sweeps_without_expectation: u64,
             expectations_without_sweep: u64,
             expectations: u64,
@@ -408,6 +446,11 @@ impl Serialize for TraceReport {
             tunnels_by_kind,
             tunnel_details,
             fail_on_tunnel,
+            ghosts,
+            ghost_contacts,
+            ghosts_unjudged,
+            fail_on_ghost,
+            ghost_degrees,
             sweeps_without_expectation,
             expectations_without_sweep,
             expectations,
@@ -437,6 +480,11 @@ impl Serialize for TraceReport {
             tunnels_by_kind,
             tunnel_details,
             fail_on_tunnel: *fail_on_tunnel,
+            ghosts: *ghosts,
+            ghost_contacts,
+            ghosts_unjudged: *ghosts_unjudged,
+            fail_on_ghost: *fail_on_ghost,
+            ghost_degrees: *ghost_degrees,
             sweeps_without_expectation: *sweeps_without_expectation,
             expectations_without_sweep: *expectations_without_sweep,
             expectations: *expectations,
@@ -583,6 +631,11 @@ where
         tunnels_by_kind: BTreeMap::new(),
         tunnel_details: Vec::new(),
         fail_on_tunnel: options.fail_on_tunnel,
+        ghosts: 0,
+        ghost_contacts: Vec::new(),
+        ghosts_unjudged: 0,
+        fail_on_ghost: options.fail_on_ghost,
+        ghost_degrees: options.ghost_degrees,
         sweeps_without_expectation: 0,
         expectations_without_sweep: 0,
         expectations: 0,
@@ -622,6 +675,29 @@ where
                 };
                 let expected = &judged.expected;
                 report.compared += 1;
+                // The expectation, and an engine's answer when it is not
+                // the core's outcome, judged for ghost contacts whatever
+                // the compared fields.
+                let answer = (!judged.got_is_core).then_some(&judged.got);
+                for (outcome, is_answer) in [(Some(expected), false), (answer, true)] {
+                    let Some(outcome) = outcome else { continue };
+                    match judge_ghost(
+                        &result.scene,
+                        outcome,
+                        result.log_time_nanos,
+                        options.ghost_degrees,
+                    ) {
+                        GhostJudgement::Ghost(mut g) => {
+                            report.ghosts += 1;
+                            if report.ghost_contacts.len() < MAX_LISTED_GHOSTS {
+                                g.answer = is_answer;
+                                report.ghost_contacts.push(g);
+                            }
+                        }
+                        GhostJudgement::NoNormal => report.ghosts_unjudged += 1,
+                        GhostJudgement::Fine | GhostJudgement::NotApplicable => {}
+                    }
+                }
                 // Kept for the inference of the engine's configuration; the
                 // first ones only, so memory stays bounded on long traces.
                 if judged.got_is_core && compared.len() < MAX_INFERENCE_SWEEPS {

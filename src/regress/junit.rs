@@ -4,15 +4,16 @@
 //!
 //! One `<testsuite>` per trace, with the tolerances, the compared fields
 //! and (`check --engine`) the engine's command as `<properties>`. In it, a
-//! `<testcase>` for the trace: a `FAIL` (a divergence, or a tunnel that
-//! fails the check) is a `<failure>` whose `message` is the first
+//! `<testcase>` for the trace: a `FAIL` (a divergence, or a tunnel or
+//! ghost contact that fails the check) is a `<failure>` whose `message` is the first
 //! divergence on one line and whose text is what `check` prints for the
 //! trace; a trace that could not be checked (`ERROR`, `NO EXPECTATIONS`)
 //! is an `<error>`. Each divergence rounding explains (the report's
 //! `fragile_divergences`, kept apart without `--strict`) is a `<skipped>`
 //! test case of its own; under `--strict` it is a divergence like any
 //! other. With [`Detail::Sweeps`], each divergence kept in detail and each
-//! listed tunnel that fails the check is a failing test case too.
+//! listed tunnel or ghost contact that fails the check is a failing test
+//! case too.
 
 use std::time::Duration;
 
@@ -29,6 +30,8 @@ const SWEEP_CLASS: &str = "check.sweep";
 const FRAGILE_CLASS: &str = "check.fragile";
 /// The `classname` of a tunnel's test case (with [`Detail::Sweeps`]).
 const TUNNEL_CLASS: &str = "check.tunnel";
+/// The `classname` of a ghost contact's test case (with [`Detail::Sweeps`]).
+const GHOST_CLASS: &str = "check.ghost_contact";
 
 /// The reports of one `check` run as a JUnit XML document. `times[i]` is
 /// how long `reports[i]` took (a trace without one has no `time`).
@@ -76,6 +79,16 @@ pub fn first_problem(r: &TraceReport) -> Option<String> {
                     "{} {} (a ball's centre went through a triangle from its front to its back){first}",
                     r.tunnels,
                     if r.tunnels == 1 { "tunnel" } else { "tunnels" }
+                ));
+            }
+            if r.fails_on_ghosts() {
+                let first = r
+                    .ghost_contacts
+                    .first()
+                    .map_or_else(String::new, |g| format!("; first ghost contact: {g}"));
+                parts.push(format!(
+                    "{}{first}",
+                    crate::numbers::counted(r.ghosts, "ghost contact", "ghost contacts")
                 ));
             }
             Some(crate::junit::one_line(&parts.join("; ")))
@@ -139,8 +152,10 @@ fn trace_suite(r: &TraceReport, time: Option<Duration>, options: &JunitOptions) 
         (Status::Fail, Some(m)) => CaseResult::Failure(problem(
             if r.divergent > 0 {
                 "divergence"
-            } else {
+            } else if r.fails_on_tunnels() {
                 "tunnel"
+            } else {
+                "ghost_contact"
             },
             m,
         )),
@@ -192,6 +207,25 @@ fn trace_suite(r: &TraceReport, time: Option<Duration>, options: &JunitOptions) 
                             "a ball's centre went through a triangle from its front to its back: {}\n",
                             t.line()
                         ),
+                    }),
+                    system_out: None,
+                });
+            }
+        }
+        if r.fails_on_ghosts() {
+            for g in &r.ghost_contacts {
+                cases.push(Case {
+                    name: format!(
+                        "{}: ghost contact, frame {}, ball {}",
+                        r.trace, g.frame, g.ball
+                    ),
+                    classname: GHOST_CLASS.to_string(),
+                    file: file.clone(),
+                    time_seconds: None,
+                    result: CaseResult::Failure(Problem {
+                        message: format!("ghost contact: {g}"),
+                        kind: "ghost_contact".to_string(),
+                        body: format!("{g}\n"),
                     }),
                     system_out: None,
                 });
@@ -256,6 +290,17 @@ pub fn github_annotations(r: &TraceReport) -> String {
                             "a ball's centre went through a triangle from its front to its back: {}",
                             t.line()
                         ),
+                    ));
+                }
+            }
+            if r.fails_on_ghosts() {
+                for g in &r.ghost_contacts {
+                    lines.push((
+                        format!(
+                            "sweeptrace check: ghost contact, frame {}, ball {}",
+                            g.frame, g.ball
+                        ),
+                        g.to_string(),
                     ));
                 }
             }

@@ -13,6 +13,9 @@
 //! - [`explain`](mod@explain): why a divergent sweep came out as it did;
 //! - [`check`](mod@check): a whole trace checked ([`check_file`]), and
 //!   [`render_text`] / [`render_json`] for its report;
+//! - [`ghost`](mod@ghost): ghost contacts, edge or vertex contacts on an
+//!   internal flat or concave place whose normal leans off the faces
+//!   ([`judge_ghost`]);
 //! - [`junit`](mod@junit): check's reports as JUnit XML and GitHub Actions
 //!   annotations, for CI systems;
 //! - [`config`]: `check`'s suite configuration, the `sweeptrace.toml`
@@ -31,6 +34,7 @@ pub mod decision;
 pub mod diff;
 pub mod engine_check;
 pub mod explain;
+pub mod ghost;
 pub mod infer;
 pub mod judge;
 pub mod junit;
@@ -52,6 +56,7 @@ pub use engine_check::{
     Against, EngineCheck, check_file_with_engine, judge_answer_against_expected,
 };
 pub use explain::{ExpectedTest, expected_tests, explain_outcome, explained_records};
+pub use ghost::{GHOST_DEGREES, GhostContact, GhostJudgement, GhostPlace, judge_ghost};
 pub use infer::{Inferred, Spread, infer};
 pub use judge::{Agreement, Perturbation, Reproduced, agreement, agreement_of, perturbations};
 pub use render::{

@@ -273,6 +273,13 @@ pub fn render_text(r: &TraceReport) -> String {
             tunnel_words(r.tunnels)
         );
     }
+    if r.ghosts > 0 && !r.fail_on_ghost {
+        let _ = write!(
+            counts,
+            ", {} (not failures: ghost contacts allowed)",
+            ghost_words(r.ghosts)
+        );
+    }
     let tunnel_lines = |s: &mut String| {
         for t in &r.tunnel_details {
             let _ = writeln!(s, "  tunnel: {}", t.line());
@@ -282,6 +289,16 @@ pub fn render_text(r: &TraceReport) -> String {
                 s,
                 "  ... {} more tunnels",
                 r.tunnels as usize - r.tunnel_details.len()
+            );
+        }
+        for g in &r.ghost_contacts {
+            let _ = writeln!(s, "  ghost contact: {g}");
+        }
+        if r.ghosts as usize > r.ghost_contacts.len() {
+            let _ = writeln!(
+                s,
+                "  ... {} more ghost contacts",
+                r.ghosts as usize - r.ghost_contacts.len()
             );
         }
     };
@@ -302,7 +319,7 @@ pub fn render_text(r: &TraceReport) -> String {
         }
         Status::Fail => {
             let mut failures: Vec<String> = Vec::new();
-            if r.divergent > 0 || !r.fails_on_tunnels() {
+            if r.divergent > 0 || !(r.fails_on_tunnels() || r.fails_on_ghosts()) {
                 let kinds = counts_by_name(&r.by_kind)
                     .iter()
                     .map(|(k, n)| format!("{k}: {n}"))
@@ -323,6 +340,14 @@ pub fn render_text(r: &TraceReport) -> String {
                         .map(|(k, n)| format!("{k}: {n}"))
                         .collect::<Vec<_>>()
                         .join(", ")
+                ));
+            }
+            if r.fails_on_ghosts() {
+                failures.push(format!(
+                    "{} (an edge or vertex contact on an internal flat or concave place \
+                     with a normal more than {}° off the faces')",
+                    ghost_words(r.ghosts),
+                    crate::core::explain::num(r.ghost_degrees)
                 ));
             }
             let _ = writeln!(s, "FAIL {}: {}; {counts}", r.trace, failures.join("; "));
@@ -434,6 +459,10 @@ fn source_line(r: &TraceReport) -> Option<String> {
         (_, Some(source)) => Some(format!("  expectations from {source}\n")),
         (_, None) => None,
     }
+}
+
+fn ghost_words(n: u64) -> String {
+    crate::numbers::counted(n, "ghost contact", "ghost contacts")
 }
 
 fn tunnel_words(n: u64) -> &'static str {

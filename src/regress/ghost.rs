@@ -103,7 +103,7 @@ fn oriented_normal(scene: &SceneState, topology: &Topology, triangle: u32) -> Op
 }
 
 /// The angle between two vectors, in degrees (`b` of unit length).
-fn angle_degrees(a: &Vector3<f64>, b: &Vector3<f64>) -> f64 {
+pub(crate) fn angle_degrees(a: &Vector3<f64>, b: &Vector3<f64>) -> f64 {
     a.cross(b).norm().atan2(a.dot(b)).to_degrees()
 }
 

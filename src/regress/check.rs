@@ -685,17 +685,9 @@ where
                         &result.scene,
                         outcome,
                         result.log_time_nanos,
+                        result.outcome.normal.as_ref(),
                         options.ghost_degrees,
                     ) {
-                        // The rules' own normal for this sweep (the
-                        // average over its tie set, which at the end of a
-                        // seam takes in the triangles around the vertex)
-                        // is never a ghost.
-                        GhostJudgement::Ghost(g)
-                            if result.outcome.normal.is_some_and(|n| {
-                                super::ghost::angle_degrees(&n, &g.normal.into())
-                                    <= options.ghost_degrees
-                            }) => {}
                         GhostJudgement::Ghost(mut g) => {
                             report.ghosts += 1;
                             if report.ghost_contacts.len() < MAX_LISTED_GHOSTS {

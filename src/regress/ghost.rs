@@ -103,17 +103,20 @@ fn oriented_normal(scene: &SceneState, topology: &Topology, triangle: u32) -> Op
 }
 
 /// The angle between two vectors, in degrees (`b` of unit length).
-pub(crate) fn angle_degrees(a: &Vector3<f64>, b: &Vector3<f64>) -> f64 {
+fn angle_degrees(a: &Vector3<f64>, b: &Vector3<f64>) -> f64 {
     a.cross(b).norm().atan2(a.dot(b)).to_degrees()
 }
 
 /// Judges `outcome` (an expectation or an answer for a sweep against
 /// `scene`, logged at `log_time_nanos`) for a ghost contact, with the
-/// threshold `degrees`.
+/// threshold `degrees`. `rule_normal` is the core's own normal for the
+/// sweep: the rules' average over its tie set (which at the end of a seam
+/// takes in the triangles around the vertex), never a ghost.
 pub fn judge_ghost(
     scene: &SceneState,
     outcome: &OutcomeMsg,
     log_time_nanos: u64,
+    rule_normal: Option<&Vector3<f64>>,
     degrees: f64,
 ) -> GhostJudgement {
     use GhostJudgement::{Fine, Ghost, NoNormal, NotApplicable};
@@ -167,7 +170,7 @@ pub fn judge_ghost(
     let Some((angle, face_normal)) = nearest else {
         return NotApplicable;
     };
-    if angle <= degrees {
+    if angle <= degrees || rule_normal.is_some_and(|n| angle_degrees(&given, n) <= degrees) {
         return Fine;
     }
     Ghost(GhostContact {

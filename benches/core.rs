@@ -155,7 +155,7 @@ fn agreement(label: &str, s: &Setup) {
         match (ours.is_hit(), parry_cast(&s.parry, sw)) {
             (true, Some(t)) => {
                 both += 1;
-                worst = worst.max((t - ours.alpha).abs());
+                worst = worst.max((t - ours.travelled()).abs());
             }
             (false, None) => neither += 1,
             (true, None) => only_ours += 1,

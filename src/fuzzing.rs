@@ -7,7 +7,7 @@
 //! Not part of the public API.
 
 use crate::core::{
-    Broadphase, CollectRecords, Facing, Kind, Mesh, MeshError, Options, Outcome, Sweep, SweptPath,
+    Broadphase, CollectRecords, Facing, Mesh, MeshError, Options, Outcome, Sweep, SweptPath,
     TestRecord, sweep_edge, sweep_face, sweep_mesh, sweep_mesh_with, sweep_vertex,
 };
 use crate::trace::messages::{OutcomeMsg, SceneMsg, SweepMsg};
@@ -290,37 +290,29 @@ pub fn check_core(data: &[u8]) -> Result<(), String> {
 /// unit normal and a finite contact; a finite tie window.
 pub fn check_outcome(mesh: &Mesh, outcome: &Outcome) -> Result<(), String> {
     let fail = |what: &str| Err(format!("{what}: {outcome:?}"));
-    if !(0.0..=1.0).contains(&outcome.alpha) {
-        return fail("alpha outside [0, 1]");
-    }
     if !(outcome.tie_window.is_finite() && outcome.tie_window >= 0.0) {
         return fail("a tie window that is not a finite number ≥ 0");
     }
-    if outcome.kind == Kind::None {
-        if outcome.alpha != 1.0 || outcome.triangle.is_some() || outcome.normal.is_some() {
-            return fail("no hit, but alpha below 1 or a triangle or normal");
-        }
+    let Some(hit) = outcome.hit else {
         return Ok(());
-    }
-    let Some(triangle) = outcome.triangle else {
-        return fail("a hit without a triangle");
     };
-    if mesh.triangle_by_index(triangle).is_none() {
+    if !(0.0..=1.0).contains(&hit.alpha) {
+        return fail("alpha outside [0, 1]");
+    }
+    if mesh.triangle_by_index(hit.triangle).is_none() {
         return fail("a hit on a triangle the mesh does not have");
     }
-    if (outcome.kind == Kind::Face) != outcome.feature.is_none()
-        || outcome.feature.is_some_and(|f| f > 2)
-    {
-        return fail("a feature that does not fit the kind");
+    if hit.feature.index().is_some_and(|f| f > 2) {
+        return fail("a feature index past 2");
     }
-    match outcome.normal {
-        Some(n) if n.iter().all(|c| c.is_finite()) && (n.norm() - 1.0).abs() < 1e-9 => {}
-        _ => return fail("a hit without a finite unit normal"),
+    let n = hit.normal;
+    if !(n.iter().all(|c| c.is_finite()) && (n.norm() - 1.0).abs() < 1e-9) {
+        return fail("a hit without a finite unit normal");
     }
-    match outcome.contact {
-        Some(c) if c.iter().all(|c| c.is_finite()) => Ok(()),
-        _ => fail("a hit without a finite contact"),
+    if !hit.contact.iter().all(|c| c.is_finite()) {
+        return fail("a hit without a finite contact");
     }
+    Ok(())
 }
 
 /// A test's record that says hit has a finite `α` in [0, 1].

@@ -586,14 +586,14 @@ fn valley_tie_contact() -> anyhow::Result<()> {
         &Default::default(),
     )?;
     ensure!(
-        outcome.kind == Kind::Face && outcome.triangle == Some(0),
+        outcome.kind() == Kind::Face && outcome.hit.map(|h| h.triangle) == Some(0),
         "the core: face 0 (the lower of the two tied faces): {outcome:?}"
     );
     let h = 0.5 / 2f64.sqrt();
     let second = OutcomeMsg {
         frame: 0,
         ball: 0,
-        alpha: outcome.alpha,
+        alpha: outcome.travelled(),
         kind: Kind::Face,
         triangle: Some(Some(3)),
         feature: Some(None),

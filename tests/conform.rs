@@ -76,11 +76,11 @@ fn every_case_decides_the_kind_of_its_rule() -> anyhow::Result<()> {
         let outcome = sweep_mesh(&mesh, &Sweep::new(s.p0, s.p1, s.radius), &options)
             .map_err(|e| anyhow::anyhow!("{}: {e}", case.id()))?;
         ensure!(
-            outcome.kind == case.kind,
+            outcome.kind() == case.kind,
             "{} ({}): the core decides {}, the case says {}",
             case.id(),
             case.what,
-            outcome.kind,
+            outcome.kind(),
             case.kind
         );
     }

@@ -82,14 +82,16 @@ fn face_hit_worked_example_1() -> anyhow::Result<()> {
     close("bary a", b[0], 0.5, TOL)?;
     close("bary b", b[1], 0.25, TOL)?;
     ensure!(
-        o.kind == Kind::Face && o.triangle == Some(0) && o.feature.is_none(),
+        o.kind() == Kind::Face
+            && o.hit.map(|h| h.triangle) == Some(0)
+            && o.hit.and_then(|h| h.feature.index()).is_none(),
         "outcome {o:?}"
     );
-    close("alpha", o.alpha, 5.0 / 12.0, TOL)?;
-    let c = o.contact.context("no contact")?;
+    close("alpha", o.travelled(), 5.0 / 12.0, TOL)?;
+    let c = o.hit.map(|h| h.contact).context("no contact")?;
     close("contact x", c.x, 1.0, TOL)?;
     close("contact z", c.z, 0.0, TOL)?;
-    let n = o.normal.context("no normal")?;
+    let n = o.hit.map(|h| h.normal).context("no normal")?;
     close("normal z", n.z, 1.0, TOL)
 }
 
@@ -127,7 +129,10 @@ fn face_parallel() -> anyhow::Result<()> {
         "verdict {:?}",
         face(&recs, 0).verdict
     );
-    ensure!(o.kind == Kind::None && o.alpha == 1.0, "outcome {o:?}");
+    ensure!(
+        o.kind() == Kind::None && o.travelled() == 1.0,
+        "outcome {o:?}"
+    );
     Ok(())
 }
 
@@ -213,11 +218,11 @@ fn edge_hit_worked_example_2_start_before_s0() -> anyhow::Result<()> {
         face(&recs, 0).verdict
     );
     ensure!(
-        o.kind == Kind::Edge && o.feature == Some(0),
+        o.kind() == Kind::Edge && o.hit.and_then(|h| h.feature.index()) == Some(0),
         "outcome {o:?}"
     );
-    close("alpha", o.alpha, 13.0 / 30.0, 1e-12)?;
-    let c = o.contact.context("no contact")?;
+    close("alpha", o.travelled(), 13.0 / 30.0, 1e-12)?;
+    let c = o.hit.map(|h| h.contact).context("no contact")?;
     close("contact x", c.x, 2.0, 1e-12)?;
     close("contact y", c.y, 0.0, 1e-12)
 }
@@ -298,7 +303,10 @@ fn edge_double_root_tangent() -> anyhow::Result<()> {
     ensure!(e.discriminant == 0.0, "discriminant {}", e.discriminant);
     ensure!(e.roots == Some((0.5, 0.5)), "roots {:?}", e.roots);
     ensure!(e.verdict == Verdict::Hit, "verdict {:?}", e.verdict);
-    ensure!(o.kind == Kind::Edge && o.alpha == 0.5, "outcome {o:?}");
+    ensure!(
+        o.kind() == Kind::Edge && o.travelled() == 0.5,
+        "outcome {o:?}"
+    );
     Ok(())
 }
 
@@ -369,7 +377,7 @@ fn edge_back_facing() -> anyhow::Result<()> {
     let e = edge(&recs, 0, 0);
     close("s0", e.roots.context("no roots")?.0, 13.0 / 30.0, 1e-12)?;
     ensure!(e.verdict == Verdict::BackFacing, "verdict {:?}", e.verdict);
-    ensure!(o.kind == Kind::None, "outcome {o:?}");
+    ensure!(o.kind() == Kind::None, "outcome {o:?}");
     Ok(())
 }
 
@@ -391,7 +399,7 @@ fn edge_strict_facing_rejects_n_dot_d_zero() -> anyhow::Result<()> {
         "non_strict {:?}",
         edge(&recs, 0, 0).verdict
     );
-    close("alpha", o.alpha, 5.0 / 12.0, 1e-12)?;
+    close("alpha", o.travelled(), 5.0 / 12.0, 1e-12)?;
     let (o, recs) = run(
         &triangle_t(),
         [2.0, -3.0, 0.0],
@@ -405,7 +413,7 @@ fn edge_strict_facing_rejects_n_dot_d_zero() -> anyhow::Result<()> {
         "strict {:?}",
         edge(&recs, 0, 0).verdict
     );
-    ensure!(o.kind == Kind::None, "strict outcome {o:?}");
+    ensure!(o.kind() == Kind::None, "strict outcome {o:?}");
     Ok(())
 }
 
@@ -430,7 +438,7 @@ fn hit_exactly_at_alpha_1_worked_example_4() -> anyhow::Result<()> {
     );
     ensure!(e.roots == Some((1.0, 1.4)), "roots {:?}", e.roots);
     ensure!(
-        o.kind == Kind::Edge && o.alpha == 1.0 && o.triangle == Some(0),
+        o.kind() == Kind::Edge && o.travelled() == 1.0 && o.hit.map(|h| h.triangle) == Some(0),
         "outcome {o:?}"
     );
     Ok(())
@@ -458,7 +466,10 @@ fn zero_length_path() -> anyhow::Result<()> {
             "vertex {i}"
         );
     }
-    ensure!(o.kind == Kind::None && o.alpha == 1.0, "outcome {o:?}");
+    ensure!(
+        o.kind() == Kind::None && o.travelled() == 1.0,
+        "outcome {o:?}"
+    );
     Ok(())
 }
 
@@ -495,11 +506,11 @@ fn vertex_hit_worked_example_3() -> anyhow::Result<()> {
     let want = (36.0 - 17.28f64.sqrt()) / 72.0;
     close("s0", v.roots.context("roots")?.0, want, 1e-12)?;
     ensure!(
-        o.kind == Kind::Vertex && o.feature == Some(0),
+        o.kind() == Kind::Vertex && o.hit.and_then(|h| h.feature.index()) == Some(0),
         "outcome {o:?}"
     );
-    close("alpha", o.alpha, 0.44226, 1e-5)?;
-    let c = o.contact.context("contact")?;
+    close("alpha", o.travelled(), 0.44226, 1e-5)?;
+    let c = o.hit.map(|h| h.contact).context("contact")?;
     ensure!(c.coords.norm() == 0.0, "contact {c:?} is the vertex");
     Ok(())
 }
@@ -576,7 +587,7 @@ fn vertex_back_facing() -> anyhow::Result<()> {
         1e-12,
     )?;
     ensure!(v.verdict == Verdict::BackFacing, "verdict {:?}", v.verdict);
-    ensure!(o.kind == Kind::None, "outcome {o:?}");
+    ensure!(o.kind() == Kind::None, "outcome {o:?}");
     Ok(())
 }
 
@@ -601,7 +612,9 @@ fn endpoint_contact_exactly_at_xc_eq_l_is_edge() -> anyhow::Result<()> {
         "vertex {v:?}"
     );
     ensure!(
-        o.kind == Kind::Edge && o.feature == Some(0) && o.alpha == 1.0,
+        o.kind() == Kind::Edge
+            && o.hit.and_then(|h| h.feature.index()) == Some(0)
+            && o.travelled() == 1.0,
         "outcome {o:?}"
     );
     Ok(())
@@ -649,9 +662,9 @@ fn shared_edge_reported_for_both() -> anyhow::Result<()> {
     );
     close("alpha 0", e0.roots.context("roots")?.0, 0.5, 1e-12)?;
     close("alpha 1", e1.roots.context("roots")?.0, 0.5, 1e-12)?;
-    ensure!(o.kind == Kind::Edge, "outcome {o:?}");
-    close("alpha", o.alpha, 0.5, 1e-12)?;
-    let n = o.normal.context("normal")?;
+    ensure!(o.kind() == Kind::Edge, "outcome {o:?}");
+    close("alpha", o.travelled(), 0.5, 1e-12)?;
+    let n = o.hit.map(|h| h.normal).context("normal")?;
     // normalize((0,0,1) + (0,-1,1)/√2)
     let s = std::f64::consts::FRAC_1_SQRT_2;
     let want = nalgebra::Vector3::new(0.0, -s, 1.0 + s).normalize();
@@ -673,11 +686,11 @@ fn shared_edge_reported_for_one() -> anyhow::Result<()> {
         e1.verdict
     );
     ensure!(
-        o.kind == Kind::Edge && o.triangle == Some(0),
+        o.kind() == Kind::Edge && o.hit.map(|h| h.triangle) == Some(0),
         "outcome {o:?}"
     );
-    close("alpha", o.alpha, 0.5, 1e-12)?;
-    let n = o.normal.context("normal")?;
+    close("alpha", o.travelled(), 0.5, 1e-12)?;
+    let n = o.hit.map(|h| h.normal).context("normal")?;
     close("normal z", n.z, 1.0, 1e-12)
 }
 
@@ -696,7 +709,7 @@ fn shared_edge_reported_for_neither() -> anyhow::Result<()> {
         );
         close("s0", e.roots.context("roots")?.0, 0.5, 1e-12)?;
     }
-    ensure!(o.kind == Kind::None, "outcome {o:?}");
+    ensure!(o.kind() == Kind::None, "outcome {o:?}");
     Ok(())
 }
 
@@ -709,14 +722,14 @@ fn cube_shared_edge_averaged_normal_worked_example_5() -> anyhow::Result<()> {
         &Sweep::new([1.25, 0.125, 3.0], [1.25, 0.125, -3.0], 0.5),
         &Options::default(),
     )?;
-    ensure!(o.kind == Kind::Edge, "outcome {o:?}");
+    ensure!(o.kind() == Kind::Edge, "outcome {o:?}");
     close(
         "alpha",
-        o.alpha,
+        o.travelled(),
         (3.0 - (1.0 + 0.1875f64.sqrt())) / 6.0,
         1e-12,
     )?;
-    let n = o.normal.context("normal")?;
+    let n = o.hit.map(|h| h.normal).context("normal")?;
     let s = std::f64::consts::FRAC_1_SQRT_2;
     close("normal x", n.x, s, 1e-12)?;
     close("normal y", n.y, 0.0, 1e-12)?;
@@ -734,8 +747,13 @@ fn margin_shrinks_detection_radius() -> anyhow::Result<()> {
         0.25,
         NS,
     );
-    close("alpha", o.alpha, 11.0 / 24.0, 1e-12)?;
-    close("contact z", o.contact.context("contact")?.z, 0.0, 1e-12)
+    close("alpha", o.travelled(), 11.0 / 24.0, 1e-12)?;
+    close(
+        "contact z",
+        o.hit.map(|h| h.contact).context("contact")?.z,
+        0.0,
+        1e-12,
+    )
 }
 
 fn standard_frame_round_trip() -> anyhow::Result<()> {
@@ -863,7 +881,7 @@ fn degenerate_triangles_reported_and_skipped() -> anyhow::Result<()> {
         &Options::default(),
     )?;
     ensure!(
-        o.kind == Kind::None && !o.alpha.is_nan(),
+        o.kind() == Kind::None && !o.travelled().is_nan(),
         "through the collinear triangle: {o:?}"
     );
     let e = Mesh::new(
@@ -922,7 +940,7 @@ fn edge_far_start_small_radius_discriminant_without_cancellation() -> anyhow::Re
         e.discriminant
     );
     close("disc", e.discriminant, -2e5, 1e-3)?;
-    ensure!(o.kind == Kind::None, "outcome {o:?}");
+    ensure!(o.kind() == Kind::None, "outcome {o:?}");
     both_broadphases(&m, p0, p1, r)?;
     // Hit: y = 0.5e-3 = 0.5ρ, w = 100, disc = 4 (4e4 - 1e4) = 1.2e5. The
     // center is ρ from the edge's line at height ρ·√0.75 above it, so
@@ -932,10 +950,15 @@ fn edge_far_start_small_radius_discriminant_without_cancellation() -> anyhow::Re
     let e = edge(&recs, 0, 0);
     close("disc", e.discriminant, 1.2e5, 1e-3)?;
     ensure!(
-        o.kind == Kind::Edge && o.feature == Some(0),
+        o.kind() == Kind::Edge && o.hit.and_then(|h| h.feature.index()) == Some(0),
         "outcome {o:?}"
     );
-    close("alpha", o.alpha, 0.5 - r * 0.75f64.sqrt() / 2e5, 1e-15)?;
+    close(
+        "alpha",
+        o.travelled(),
+        0.5 - r * 0.75f64.sqrt() / 2e5,
+        1e-15,
+    )?;
     both_broadphases(&m, p0, p1, r)?;
     Ok(())
 }
@@ -957,7 +980,9 @@ fn very_long_path_never_nan() -> anyhow::Result<()> {
     let (p0, p1) = ([5.0, 5.0, 1e100], [5.0, 5.0, -1e100]);
     let (o, recs) = run(&m, p0, p1, 0.5, 0.0, NS);
     ensure!(
-        o.kind == Kind::Face && o.alpha == 0.5 && o.fragile.contains(FragileReason::NearBoundary),
+        o.kind() == Kind::Face
+            && o.travelled() == 0.5
+            && o.fragile.contains(FragileReason::NearBoundary),
         "outcome {o:?}"
     );
     ensure!(
@@ -979,12 +1004,12 @@ fn very_long_path_never_nan() -> anyhow::Result<()> {
     let (p0, p1) = ([2.0, -0.3, 1e100], [2.0, -0.3, -1e100]);
     let o = both_broadphases(&m, p0, p1, 0.5)?;
     ensure!(
-        o.kind == Kind::Face
-            && o.feature.is_none()
+        o.kind() == Kind::Face
+            && o.hit.and_then(|h| h.feature.index()).is_none()
             && o.fragile.contains(FragileReason::NearBoundary),
         "outcome {o:?}"
     );
-    close("alpha", o.alpha, 0.5, 1e-15)
+    close("alpha", o.travelled(), 0.5, 1e-15)
 }
 
 fn sliver_triangle_face_hit_barycentric_without_cancellation() -> anyhow::Result<()> {
@@ -1010,8 +1035,8 @@ fn sliver_triangle_face_hit_barycentric_without_cancellation() -> anyhow::Result
     close("bary b", b[1], 0.3, 1e-6)?;
     close("bary c", b[2], 1.0 / 3.0, 1e-6)?;
     ensure!(f.verdict == Verdict::Hit, "face verdict {:?}", f.verdict);
-    ensure!(o.kind == Kind::Face, "outcome {o:?}");
-    close("alpha", o.alpha, 0.4375, TOL)?;
+    ensure!(o.kind() == Kind::Face, "outcome {o:?}");
+    close("alpha", o.travelled(), 0.4375, TOL)?;
     // Just outside edge b-c, which has y = h (1 - x) / 0.7 = (6/7) h at
     // x = 0.4: at y = 1.01 (6/7) h, w_c = 0.865714, w_b = 0.4 - 0.3 w_c =
     // 0.140286, w_a = 1 - w_b - w_c = -0.006 < 0: outside, every weight finite.

@@ -6,7 +6,7 @@ use rand::seq::SliceRandom;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use sweeptrace::core::{
-    Broadphase, CollectRecords, Facing, FragileReason, Kind, Options, Sweep, sweep_mesh,
+    Broadphase, CollectRecords, Facing, Feature, FragileReason, Kind, Options, Sweep, sweep_mesh,
     sweep_mesh_with, sweep_ties,
 };
 
@@ -62,7 +62,9 @@ fn shared_edge_tie_goes_to_the_lower_triangle() -> anyhow::Result<()> {
             &mut records,
         )?;
         ensure!(
-            o.kind == Kind::Edge && o.triangle == Some(0) && o.feature == Some(0),
+            o.kind() == Kind::Edge
+                && o.hit.map(|h| h.triangle) == Some(0)
+                && o.hit.and_then(|h| h.feature.index()) == Some(0),
             "{broadphase:?}: outcome {o:?}"
         );
         ensure!(
@@ -74,7 +76,7 @@ fn shared_edge_tie_goes_to_the_lower_triangle() -> anyhow::Result<()> {
             ties.len() == 2
                 && ties[0].triangle == 0
                 && ties[1].triangle == 1
-                && ties.iter().all(|t| t.kind == Kind::Edge),
+                && ties.iter().all(|t| t.kind() == Kind::Edge),
             "tie set {ties:?}"
         );
     }
@@ -98,23 +100,31 @@ fn quad_centre_drop_is_a_face_hit() -> anyhow::Result<()> {
         let (p0, p1) = ([3.0, 3.0, 0.0], [-1.0, -1.0, -4.0]);
         let o = sweep_mesh(&m, &Sweep::new(p0, p1, 0.25), &options())?;
         ensure!(
-            o.kind == Kind::Face && o.triangle == Some(0) && o.feature.is_none(),
+            o.kind() == Kind::Face
+                && o.hit.map(|h| h.triangle) == Some(0)
+                && o.hit.and_then(|h| h.feature.index()).is_none(),
             "{triangles:?}: outcome {o:?}"
         );
         // From (3,3,0) to the centre (1,1,-2) is 2√3; contact at 0.25 from
         // the plane along the path of length 4√3: α = (2√3 - 0.25) / (4√3).
         let s3 = 3f64.sqrt();
-        close("alpha", o.alpha, (2.0 * s3 - 0.25) / (4.0 * s3), 1e-12)?;
-        let n = o.normal.context("no normal")?;
+        close(
+            "alpha",
+            o.travelled(),
+            (2.0 * s3 - 0.25) / (4.0 * s3),
+            1e-12,
+        )?;
+        let n = o.hit.map(|h| h.normal).context("no normal")?;
         close("normal x", n.x, 1.0 / s3, 1e-12)?;
         let (_, ties) = sweep_ties(&m, &Sweep::new(p0, p1, 0.25), &options())?;
         ensure!(
             ties.first()
-                .is_some_and(|t| t.kind == Kind::Face && t.triangle == 0),
+                .is_some_and(|t| t.kind() == Kind::Face && t.triangle == 0),
             "tie set {ties:?}"
         );
         ensure!(
-            ties.iter().any(|t| t.kind == Kind::Face && t.triangle == 1),
+            ties.iter()
+                .any(|t| t.kind() == Kind::Face && t.triangle == 1),
             "both faces are in the tie set: {ties:?}"
         );
     }
@@ -128,10 +138,11 @@ fn tie_set_lists_every_tied_hit_primary_first() -> anyhow::Result<()> {
     let m = sweeptrace::sim::scenes::cube().to_mesh()?;
     let sweep = Sweep::new([1.25, 0.125, 3.0], [1.25, 0.125, -3.0], 0.5);
     let (o, ties) = sweep_ties(&m, &sweep, &options())?;
-    ensure!(o.kind == Kind::Edge, "outcome {o:?}");
+    ensure!(o.kind() == Kind::Edge, "outcome {o:?}");
     ensure!(ties.len() >= 2, "tie set {ties:?}");
     ensure!(
-        Some(ties[0].triangle) == o.triangle && ties[0].feature == o.feature,
+        Some(ties[0].triangle) == o.hit.map(|h| h.triangle)
+            && o.hit.is_some_and(|h| ties[0].feature == h.feature),
         "primary first: {ties:?} vs {o:?}"
     );
     let triangles: std::collections::BTreeSet<u32> = ties.iter().map(|t| t.triangle).collect();
@@ -139,11 +150,11 @@ fn tie_set_lists_every_tied_hit_primary_first() -> anyhow::Result<()> {
     for t in &ties {
         ensure!(o.ties_with(t.alpha), "{t:?} is in the window");
         ensure!(
-            t.matches(t.kind, Some(Some(t.triangle)), Some(t.feature)),
+            t.matches(t.kind(), Some(Some(t.triangle)), Some(t.feature.index())),
             "{t:?} matches itself"
         );
         ensure!(
-            t.matches(t.kind, None, None),
+            t.matches(t.kind(), None, None),
             "{t:?} matches an expectation without triangle and feature"
         );
     }
@@ -161,11 +172,11 @@ fn clear_hit_is_robust_with_a_single_member_tie_set() -> anyhow::Result<()> {
         0.0,
         NS,
     );
-    ensure!(o.kind == Kind::Face, "outcome {o:?}");
+    ensure!(o.kind() == Kind::Face, "outcome {o:?}");
     ensure!(o.fragile.is_robust(), "flags {}", o.fragile);
     let ties = o.tie_set(&records);
     ensure!(
-        ties.len() == 1 && ties[0].kind == Kind::Face && ties[0].feature.is_none(),
+        ties.len() == 1 && ties[0].kind() == Kind::Face && ties[0].feature == Feature::Face,
         "tie set {ties:?}"
     );
     ensure!(
@@ -438,9 +449,9 @@ fn exact_ties_on_boxes_and_terrains_follow_the_rules() -> anyhow::Result<()> {
                         &mut sweeptrace::core::NoObserver,
                     )?;
                     let got = (
-                        o.kind,
-                        o.triangle.unwrap_or(u32::MAX),
-                        o.feature.unwrap_or(0),
+                        o.kind(),
+                        o.hit.map(|h| h.triangle).unwrap_or(u32::MAX),
+                        o.hit.and_then(|h| h.feature.index()).unwrap_or(0),
                     );
                     ensure!(
                         got == first,
@@ -452,7 +463,7 @@ fn exact_ties_on_boxes_and_terrains_follow_the_rules() -> anyhow::Result<()> {
                             "box"
                         }
                     );
-                    close("alpha", o.alpha, t0 as f64 / (t0 + t1) as f64, 1e-9)?;
+                    close("alpha", o.travelled(), t0 as f64 / (t0 + t1) as f64, 1e-9)?;
                     ensure!(
                         expected.len() < 2 || o.fragile.contains(FragileReason::Tie),
                         "a tie of {} hits is flagged: {o:?}",
@@ -535,7 +546,13 @@ fn unflagged_decisions_survive_one_ulp_changes() -> anyhow::Result<()> {
     let (mut robust, mut robust_hits, mut fragile) = (0usize, 0usize, 0usize);
     let mut fragile_changed = 0usize;
     let mut reasons: BTreeMap<&'static str, usize> = BTreeMap::new();
-    let decision = |o: &sweeptrace::core::Outcome| (o.kind, o.triangle, o.feature);
+    let decision = |o: &sweeptrace::core::Outcome| {
+        (
+            o.kind(),
+            o.hit.map(|h| h.triangle),
+            o.hit.and_then(|h| h.feature.index()),
+        )
+    };
     let mut vertices = Vec::new();
     let mut triangles = Vec::new();
     let mut base = None;
@@ -569,7 +586,8 @@ fn unflagged_decisions_survive_one_ulp_changes() -> anyhow::Result<()> {
         }
         let mut changed = false;
         let mut check = |what: &str, o2: &sweeptrace::core::Outcome| -> anyhow::Result<()> {
-            let same = decision(o2) == decision(&o) && (o2.alpha - o.alpha).abs() <= 1e-6;
+            let same =
+                decision(o2) == decision(&o) && (o2.travelled() - o.travelled()).abs() <= 1e-6;
             changed |= !same;
             ensure!(
                 same || flagged,

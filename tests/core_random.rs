@@ -212,9 +212,12 @@ fn oracle_agreement_100k_sweeps() -> anyhow::Result<()> {
                 kind,
             } => {
                 hits += 1;
-                let tri_ok = o.triangle.is_some_and(|t| touching.contains(&t));
-                let alpha_ok = o.is_hit() && (o.alpha - alpha).abs() <= ALPHA_TOLERANCE;
-                let kind_ok = kind.is_none_or(|k| k == o.kind);
+                let tri_ok = o
+                    .hit
+                    .map(|h| h.triangle)
+                    .is_some_and(|t| touching.contains(&t));
+                let alpha_ok = o.is_hit() && (o.travelled() - alpha).abs() <= ALPHA_TOLERANCE;
+                let kind_ok = kind.is_none_or(|k| k == o.kind());
                 if kind.is_some() {
                     kind_compared += 1;
                 }
@@ -316,7 +319,7 @@ fn parry_agreement_front_facing() -> anyhow::Result<()> {
         match hit {
             Some(h) => {
                 hits += 1;
-                let diff = (h.time_of_impact - o.alpha).abs();
+                let diff = (h.time_of_impact - o.travelled()).abs();
                 if !o.is_hit() || diff > PARRY_TOLERANCE {
                     failures.push(format!(
                         "parry toi {}; {}",
@@ -478,7 +481,7 @@ fn bvh_equals_exhaustive() -> anyhow::Result<()> {
                 &mut NoObserver,
             )?;
             checked += 1;
-            if fast.kind != Kind::None {
+            if fast.kind() != Kind::None {
                 hits += 1;
             }
             if fast != all {

@@ -92,7 +92,7 @@ fn trace(
         let t = 1_000_000 * (frame + 1);
         w.sweep(t, &s)?;
         let o = sweep_mesh(&m, &Sweep::new(s.p0, s.p1, s.radius), &options)?;
-        ensure!(o.kind != Kind::None, "frame {frame}, ball {ball} misses");
+        ensure!(o.kind() != Kind::None, "frame {frame}, ball {ball} misses");
         let mut e = OutcomeMsg::from_outcome(frame, ball, &o);
         e.kind = Kind::Edge;
         e.triangle = Some(Some(triangle));

@@ -500,17 +500,17 @@ fn scene_overrides_apply() -> anyhow::Result<()> {
         "overrides not applied"
     );
     ensure!(
-        (r[0].outcome.alpha - 2.75 / 6.0).abs() < 1e-12,
+        (r[0].outcome.travelled() - 2.75 / 6.0).abs() < 1e-12,
         "α = {}",
-        r[0].outcome.alpha
+        r[0].outcome.travelled()
     );
     let mut scene = triangle_scene();
     scene.margin = 0.1;
     let (r, _) = run(events_for(scene, &[sweep]), ReplayOptions::default())?;
     ensure!(
-        (r[0].outcome.alpha - 2.6 / 6.0).abs() < 1e-12,
+        (r[0].outcome.travelled() - 2.6 / 6.0).abs() < 1e-12,
         "scene margin: α = {}",
-        r[0].outcome.alpha
+        r[0].outcome.travelled()
     );
     Ok(())
 }
@@ -947,10 +947,10 @@ fn rrd_reads_back_through_rerun() -> anyhow::Result<()> {
             .get(&(r.frame as i64))
             .context(format!("no α at frame {}", r.frame))?;
         ensure!(
-            got == &vec![r.outcome.alpha],
+            got == &vec![r.outcome.travelled()],
             "frame {}: α {got:?}, outcome {}",
             r.frame,
-            r.outcome.alpha
+            r.outcome.travelled()
         );
     }
     ensure!(
@@ -1729,7 +1729,7 @@ fn rrd_shows_edges_features_and_explanations() -> anyhow::Result<()> {
         focus.keys().collect::<Vec<_>>()
     );
     let r = &results[1];
-    let c = r.sweep.p0 + (r.sweep.p1 - r.sweep.p0) * r.outcome.alpha;
+    let c = r.sweep.p0 + (r.sweep.p1 - r.sweep.p0) * r.outcome.travelled();
     let f = focus[&1];
     ensure!(
         (f[0] as f64 - c.x).abs() < 1e-5
@@ -1993,7 +1993,7 @@ fn clears_keep_their_place_among_the_sweeps_of_a_frame() -> anyhow::Result<()> {
     let run = viz::prepare_sweeps(&results, &before, &logger.prepare_options());
     logger.log_prepared(run)?;
     drop(logger.finish());
-    let kinds: Vec<_> = results.iter().map(|r| r.outcome.kind).collect();
+    let kinds: Vec<_> = results.iter().map(|r| r.outcome.kind()).collect();
     ensure!(
         kinds == [Kind::Face, Kind::Edge, Kind::Face],
         "the sweeps decide {kinds:?}, the test needs face, edge, face"

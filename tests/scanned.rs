@@ -420,9 +420,9 @@ fn exact_ties_on_a_scanned_mesh_follow_the_rules() -> anyhow::Result<()> {
         for broadphase in [Broadphase::Bvh, Broadphase::Exhaustive] {
             let o = sweep_mesh_with(&mesh, &sweep, &options(), broadphase, &mut NoObserver)?;
             let got = (
-                o.kind,
-                o.triangle.unwrap_or(u32::MAX),
-                o.feature.unwrap_or(0),
+                o.kind(),
+                o.hit.map(|h| h.triangle).unwrap_or(u32::MAX),
+                o.hit.and_then(|h| h.feature.index()).unwrap_or(0),
             );
             ensure!(
                 got == first,
@@ -433,7 +433,7 @@ fn exact_ties_on_a_scanned_mesh_follow_the_rules() -> anyhow::Result<()> {
                 c.radius,
                 c.expected
             );
-            close("alpha", o.alpha, c.alpha, 1e-9)?;
+            close("alpha", o.travelled(), c.alpha, 1e-9)?;
             ensure!(
                 c.expected.len() < 2 || o.fragile.contains(FragileReason::Tie),
                 "contact {n}: a tie of {} tests is flagged: {o:?}",
@@ -443,7 +443,7 @@ fn exact_ties_on_a_scanned_mesh_follow_the_rules() -> anyhow::Result<()> {
         let (_, ties) = sweeptrace::core::sweep_ties(&mesh, &sweep, &options())?;
         let reported: BTreeSet<(Kind, u32, u8)> = ties
             .iter()
-            .map(|t| (t.kind, t.triangle, t.feature.unwrap_or(0)))
+            .map(|t| (t.kind(), t.triangle, t.feature.index().unwrap_or(0)))
             .collect();
         ensure!(
             c.expected.iter().all(|e| reported.contains(e)),

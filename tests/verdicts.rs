@@ -79,9 +79,9 @@ fn core_answers(
     let mut members = Vec::new();
     for t in ties {
         let mut m = primary;
-        m.kind = t.kind;
+        m.kind = t.kind();
         m.triangle = Some(Some(t.triangle));
-        m.feature = Some(t.feature);
+        m.feature = Some(t.feature.index());
         // The member's own contact: its point on the edge `x = 1, z = 1`
         // under the path (the same line for both triangles here).
         m.contact = Some(Some([1.0, sweep.p0[1], 1.0]));
@@ -297,7 +297,7 @@ fn a_fragile_divergence_is_excused_only_by_a_named_perturbation() -> anyhow::Res
     };
     let result = replayed(trace(&scene, &sweep, Some(&miss))?)?;
     ensure!(
-        result.outcome.kind == Kind::Edge && result.outcome.alpha == 1.0,
+        result.outcome.kind() == Kind::Edge && result.outcome.travelled() == 1.0,
         "the core hits at the end: {:?}",
         result.outcome
     );
@@ -346,7 +346,7 @@ fn a_fragile_divergence_is_excused_only_by_a_named_perturbation() -> anyhow::Res
     };
     let outcome = sweeptrace::core::sweep_mesh(&mesh, &moved, &options)?;
     ensure!(
-        outcome.kind == Kind::None,
+        outcome.kind() == Kind::None,
         "with {p} the core misses: {outcome:?}"
     );
     ensure!(

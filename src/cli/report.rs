@@ -19,22 +19,18 @@ pub fn vec3(v: &[f64]) -> String {
 
 /// One line describing an outcome.
 pub fn outcome_line(o: &Outcome) -> String {
-    if !o.is_hit() {
-        return format!("no collision (alpha = {})", num(o.alpha));
-    }
+    let Some(hit) = o.hit else {
+        return format!("no collision (alpha = {})", num(o.travelled()));
+    };
     let mut s = format!(
         "{} collision at alpha = {}: triangle {}, feature {}",
-        o.kind,
-        num(o.alpha),
-        o.triangle.map_or("-".into(), |t| t.to_string()),
-        o.feature.map_or("-".into(), |f| f.to_string()),
+        hit.feature.kind(),
+        num(hit.alpha),
+        hit.triangle,
+        hit.feature.index().map_or("-".into(), |f| f.to_string()),
     );
-    if let Some(n) = o.normal {
-        write!(s, ", normal {}", vec3(n.as_slice())).unwrap();
-    }
-    if let Some(c) = o.contact {
-        write!(s, ", contact {}", vec3(c.coords.as_slice())).unwrap();
-    }
+    write!(s, ", normal {}", vec3(hit.normal.as_slice())).unwrap();
+    write!(s, ", contact {}", vec3(hit.contact.coords.as_slice())).unwrap();
     s
 }
 

@@ -78,7 +78,12 @@ fn tie_order_text(answer: &OutcomeMsg, outcome: &Outcome) -> String {
         answer.triangle.flatten(),
         answer.feature.flatten(),
     );
-    let chosen = (outcome.kind, outcome.triangle, outcome.feature);
+    let hit = outcome.hit.as_ref();
+    let chosen = (
+        outcome.kind(),
+        hit.map(|h| h.triangle),
+        hit.and_then(|h| h.feature.index()),
+    );
     let why = if named.0 != chosen.0 {
         format!(
             "the kind order face < edge < vertex puts {} before {}",
@@ -101,7 +106,7 @@ fn tie_order_text(answer: &OutcomeMsg, outcome: &Outcome) -> String {
         "the engine names {}, a member of the tie set at α = {}; the rule's tie order \
          (kind face < edge < vertex, then triangle index, then feature index) chooses {}: {why}",
         hit_name(named.0, named.1, named.2),
-        num(outcome.alpha),
+        num(outcome.travelled()),
         hit_name(chosen.0, chosen.1, chosen.2),
     )
 }

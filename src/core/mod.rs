@@ -26,6 +26,7 @@ pub mod explain;
 mod fragility;
 mod mesh;
 mod options;
+mod outcome;
 mod path;
 pub mod quadratic;
 mod record;
@@ -44,6 +45,7 @@ pub use options::{
     ALPHA_SENSITIVITY, BROADPHASE_MARGIN, DEGENERATE_TOLERANCE, FRAGILE_ULPS, Facing,
     GRAZING_COSINE, Options, PARALLEL_TOLERANCE, TIE_WINDOW_ULPS,
 };
+pub use outcome::{Feature, Outcome, SweepHit};
 pub use path::{Sweep, SweptPath};
 pub use record::{
     CollectRecords, EdgeHit, EdgeRecord, FaceHit, FaceRecord, Kind, NoObserver, Observer,
@@ -51,7 +53,7 @@ pub use record::{
 };
 pub use sweep_edge::sweep_edge;
 pub use sweep_face::{barycentric, barycentric_and_distance, sweep_face};
-pub use sweep_mesh::{Broadphase, Outcome, sweep_mesh, sweep_mesh_with};
+pub use sweep_mesh::{Broadphase, sweep_mesh, sweep_mesh_with};
 pub use sweep_vertex::sweep_vertex;
 pub use ties::{CollectTies, Tie, in_tie_window, sweep_ties};
 pub use topology::{

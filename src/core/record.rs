@@ -4,6 +4,7 @@ use nalgebra::{Point3, Vector3};
 use serde::Serialize;
 
 use super::mesh::StandardFrame;
+use super::outcome::Feature;
 
 /// The kind of a collision.
 #[derive(
@@ -400,28 +401,14 @@ impl TestRecord {
     }
     /// The kind of feature tested.
     pub fn kind(&self) -> Kind {
-        match self {
-            TestRecord::Face(_) => Kind::Face,
-            TestRecord::Edge(_) => Kind::Edge,
-            TestRecord::Vertex(_) => Kind::Vertex,
-        }
+        self.feature().kind()
     }
-    /// Feature index, for ordering and labels: the edge or vertex index,
-    /// 0 for the face (see [`TestRecord::reported_feature`]).
-    pub fn feature(&self) -> u8 {
+    /// The feature the test is about.
+    pub fn feature(&self) -> Feature {
         match self {
-            TestRecord::Face(_) => 0,
-            TestRecord::Edge(r) => r.edge,
-            TestRecord::Vertex(r) => r.vertex,
-        }
-    }
-    /// The feature as an outcome reports it: the edge or vertex index, or
-    /// `None` for the face (a face has no feature).
-    pub fn reported_feature(&self) -> Option<u8> {
-        match self {
-            TestRecord::Face(_) => None,
-            TestRecord::Edge(r) => Some(r.edge),
-            TestRecord::Vertex(r) => Some(r.vertex),
+            TestRecord::Face(_) => Feature::Face,
+            TestRecord::Edge(r) => Feature::Edge(r.edge),
+            TestRecord::Vertex(r) => Feature::Vertex(r.vertex),
         }
     }
     /// The verdict.

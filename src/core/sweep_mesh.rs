@@ -2,100 +2,18 @@
 //! outcome by the rules of SEMANTICS.md.
 
 use nalgebra::{Point3, Vector3};
-use serde::Serialize;
 
 use super::error::SweepError;
 use super::fragility::{FragileReason, Fragility};
 use super::mesh::{Mesh, Triangle};
 use super::options::{ALPHA_SENSITIVITY, Facing, GRAZING_COSINE, Options};
+use super::outcome::{Feature, Outcome, SweepHit};
 use super::path::{Sweep, SweptPath};
-use super::record::{Kind, NoObserver, Observer, TestRecord, Verdict};
+use super::record::{Kind, NoObserver, Observer, Verdict};
 use super::sweep_edge::sweep_edge;
 use super::sweep_face::{barycentric_and_distance, sweep_face};
 use super::sweep_vertex::sweep_vertex;
-use super::ties::{Tie, in_tie_window};
-
-/// The result of one sweep.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
-pub struct Outcome {
-    /// Fraction of the path travelled at first contact (the minimum `α` over
-    /// every collision); 1 when nothing is hit.
-    pub alpha: f64,
-    /// Kind of the primary collision: chosen among the hits tied with
-    /// `alpha` ([`Outcome::ties_with`]) by the order face < edge < vertex,
-    /// then lower triangle, then lower feature.
-    pub kind: Kind,
-    /// Input index of the primary triangle.
-    pub triangle: Option<u32>,
-    /// Feature of the primary collision: the edge or vertex index (0..3)
-    /// within its triangle; `None` for a face (a face has no feature) and
-    /// when nothing is hit.
-    pub feature: Option<u8>,
-    /// The reported normal: the primary triangle's front normal, or the
-    /// normalised average of the front normals of every triangle with a hit
-    /// tied with `alpha`.
-    pub normal: Option<Vector3<f64>>,
-    /// The point of the mesh the primary test touches (at its own `α`,
-    /// which is tied with `alpha`).
-    pub contact: Option<Point3<f64>>,
-    /// The tie window of this sweep, in `α` ([`SweptPath::tie_window`]): a hit
-    /// at `α ≤ alpha + tie_window` is tied with the primary.
-    pub tie_window: f64,
-    /// Why the decision may not survive a change of the inputs at the level
-    /// of their rounding; empty when it is robust.
-    pub fragile: Fragility,
-}
-
-impl Outcome {
-    /// The outcome of a sweep that touches nothing.
-    pub const NONE: Outcome = Outcome {
-        alpha: 1.0,
-        kind: Kind::None,
-        triangle: None,
-        feature: None,
-        normal: None,
-        contact: None,
-        tie_window: 0.0,
-        fragile: Fragility::ROBUST,
-    };
-
-    /// Whether something was hit.
-    pub fn is_hit(&self) -> bool {
-        self.kind != Kind::None
-    }
-
-    /// Whether `record` is the test that reported this outcome's primary
-    /// collision (a hit on the same triangle, kind and feature).
-    pub fn is_reported_by(&self, record: &TestRecord) -> bool {
-        record.alpha().is_some()
-            && Some(record.triangle()) == self.triangle
-            && record.kind() == self.kind
-            && record.reported_feature() == self.feature
-    }
-
-    /// Whether a hit at `alpha` is tied with this outcome's primary hit: it
-    /// lies within the tie window of the minimum `α` ([`in_tie_window`]).
-    /// Tied hits share the averaged normal, and any of them is an
-    /// acceptable answer to the rules (the primary is the first of them in
-    /// the tie order). Never true when nothing was hit.
-    pub fn ties_with(&self, alpha: f64) -> bool {
-        self.is_hit() && in_tie_window(alpha, self.alpha, self.tie_window)
-    }
-
-    /// The tie set among `records` (the records of this sweep, e.g. from
-    /// [`CollectRecords`](super::CollectRecords) or [`CollectTies`](super::CollectTies)): every
-    /// hit tied with this outcome, in the tie order (the primary first).
-    pub fn tie_set(&self, records: &[TestRecord]) -> Vec<Tie> {
-        let mut ties: Vec<Tie> = records
-            .iter()
-            .filter_map(Tie::of)
-            .filter(|t| self.ties_with(t.alpha))
-            .collect();
-        ties.sort_by_key(|t| t.order());
-        ties.dedup_by_key(|t| t.order());
-        ties
-    }
-}
+use super::ties::in_tie_window;
 
 /// How the candidate triangles are chosen.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -111,10 +29,8 @@ pub enum Broadphase {
 #[derive(Clone, Copy, Debug)]
 struct Hit {
     alpha: f64,
-    kind: Kind,
     triangle: u32,
-    /// Edge or vertex index; 0 for the face.
-    feature: u8,
+    feature: Feature,
     /// Position of the triangle in the mesh's storage order.
     position: u32,
     contact: Point3<f64>,
@@ -131,9 +47,9 @@ struct Hit {
 impl Hit {
     const EMPTY: Hit = Hit {
         alpha: 0.0,
-        kind: Kind::None,
         triangle: 0,
-        feature: 0,
+        // Never read: `Combiner::len` counts the slots that hold hits.
+        feature: Feature::Face,
         position: 0,
         contact: Point3::new(0.0, 0.0, 0.0),
         cosine: 0.0,
@@ -143,7 +59,8 @@ impl Hit {
 
     #[inline]
     fn order(&self) -> (Kind, u32, u8) {
-        (self.kind, self.triangle, self.feature)
+        let (kind, index) = self.feature.order_key();
+        (kind, self.triangle, index)
     }
 }
 
@@ -175,9 +92,8 @@ fn test_triangle<O: Observer, S: Sink>(
     let allowed = facing.allows(facing_value);
     let band = path.fragile_window();
     let band_distance = path.fragile_distance();
-    let hit = |alpha: f64, kind: Kind, feature: u8, contact, cosine, boundary| Hit {
+    let hit = |alpha: f64, feature: Feature, contact, cosine, boundary| Hit {
         alpha,
-        kind,
         triangle: triangle.index,
         feature,
         position: position as u32,
@@ -199,8 +115,7 @@ fn test_triangle<O: Observer, S: Sink>(
             if let Some(h) = face.hit() {
                 sink.hit(hit(
                     h.alpha,
-                    Kind::Face,
-                    0,
+                    Feature::Face,
                     h.touch,
                     facing_cosine,
                     h.boundary_distance,
@@ -293,8 +208,7 @@ fn test_triangle<O: Observer, S: Sink>(
                 if let (Some(h), Some(contact)) = (r.hit(), r.contact()) {
                     sink.hit(hit(
                         h.alpha,
-                        Kind::Edge,
-                        e,
+                        Feature::Edge(e),
                         contact,
                         approach(r.discriminant),
                         h.xc.min(r.length - h.xc),
@@ -326,8 +240,7 @@ fn test_triangle<O: Observer, S: Sink>(
                 if let Some(alpha) = r.alpha() {
                     sink.hit(hit(
                         alpha,
-                        Kind::Vertex,
-                        v,
+                        Feature::Vertex(v),
                         r.position,
                         approach(r.discriminant),
                         f64::INFINITY,
@@ -434,7 +347,7 @@ impl Sink for Decision<'_> {
         }
         self.in_band += 1;
         let f = &mut self.fragile;
-        if h.kind == Kind::Face {
+        if h.feature == Feature::Face {
             if h.cosine < GRAZING_COSINE {
                 f.insert(FragileReason::Grazing);
             }
@@ -577,9 +490,9 @@ fn sweep_path<O: Observer>(
     }
     if combiner.min == f64::INFINITY {
         return Outcome {
+            hit: None,
             tie_window: path.tie_window(),
             fragile,
-            ..Outcome::NONE
         };
     }
     let mut decision = Decision {
@@ -614,8 +527,7 @@ fn sweep_path<O: Observer>(
         decision.fragile.insert(FragileReason::Tie);
     }
     let Some(primary) = decision.primary else {
-        // Unreachable: the minimum is itself a hit within the window.
-        return Outcome::NONE;
+        unreachable!("the minimum α is itself a hit within the tie window");
     };
     let sum = decision.normal_sum;
     let norm = sum.norm();
@@ -625,12 +537,13 @@ fn sweep_path<O: Observer>(
         triangles[primary.position as usize].normal
     };
     Outcome {
-        alpha: combiner.min,
-        kind: primary.kind,
-        triangle: Some(primary.triangle),
-        feature: (primary.kind != Kind::Face).then_some(primary.feature),
-        normal: Some(normal),
-        contact: Some(primary.contact),
+        hit: Some(SweepHit {
+            alpha: combiner.min,
+            triangle: primary.triangle,
+            feature: primary.feature,
+            normal,
+            contact: primary.contact,
+        }),
         tie_window: decision.window,
         fragile: decision.fragile,
     }

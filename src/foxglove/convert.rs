@@ -13,7 +13,7 @@ use super::messages::{
     Vector3,
 };
 use crate::core::explain::label;
-use crate::core::{DefectKind, EdgeClass, TestRecord};
+use crate::core::{DefectKind, EdgeClass, SweepHit, TestRecord};
 use crate::palette::{
     BOUNDARY_EDGE_COLOR, CONCAVE_EDGE_COLOR, CONTACT_BALL_COLOR, CONVEX_EDGE_COLOR, DEFECT_COLOR,
     EXPECTED_COLOR, FLAT_EDGE_COLOR, HIT_COLOR, MAX_DRAWN_DEFECT_LABELS, MESH_COLOR,
@@ -352,7 +352,7 @@ pub fn ball_update(r: &SweepResult) -> SceneUpdate {
     entity.spheres.push(sphere(&r.sweep.p0, radius, P0_COLOR));
     if r.outcome.is_hit() {
         entity.spheres.push(sphere(
-            &center_at(r, r.outcome.alpha),
+            &center_at(r, r.outcome.travelled()),
             radius,
             CONTACT_BALL_COLOR,
         ));
@@ -368,8 +368,8 @@ fn sweep_metadata(r: &SweepResult) -> Vec<KeyValuePair> {
     vec![
         key_value("frame", r.frame),
         key_value("ball", r.ball),
-        key_value("kind", r.outcome.kind),
-        key_value("alpha", r.outcome.alpha),
+        key_value("kind", r.outcome.kind()),
+        key_value("alpha", r.outcome.travelled()),
     ]
 }
 
@@ -389,7 +389,7 @@ pub fn sweep_update(r: &SweepResult) -> SceneUpdate {
     ));
     if r.outcome.is_hit() {
         let mut rho = sphere(
-            &center_at(r, r.outcome.alpha),
+            &center_at(r, r.outcome.travelled()),
             r.rho().max(0.0),
             SWEEP_COLOR,
         );
@@ -408,7 +408,10 @@ pub fn sweep_update(r: &SweepResult) -> SceneUpdate {
 pub fn contact_update(r: &SweepResult) -> SceneUpdate {
     let time = Time::from_nanos(r.log_time_nanos);
     let id = format!("contact/{}", r.ball);
-    let (Some(contact), Some(normal)) = (r.outcome.contact, r.outcome.normal) else {
+    let Some(SweepHit {
+        contact, normal, ..
+    }) = r.outcome.hit
+    else {
         return SceneUpdate {
             deletions: vec![delete(time, id)],
             entities: Vec::new(),
@@ -563,8 +566,8 @@ pub fn sweep_numbers(
         timestamp: Time::from_nanos(r.log_time_nanos),
         frame: r.frame,
         ball: r.ball,
-        alpha: r.outcome.alpha,
-        kind: r.outcome.kind.as_str(),
+        alpha: r.outcome.travelled(),
+        kind: r.outcome.kind().as_str(),
         failed: u8::from(!diffs.is_empty() || !r.tunnels.is_empty()),
         fragile: u8::from(!r.outcome.fragile.is_robust()),
         expected_alpha: r.expected.as_ref().and_then(|e| finite(e.alpha)),

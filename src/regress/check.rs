@@ -18,7 +18,7 @@ use std::collections::BTreeMap;
 
 use serde::{Serialize, Serializer};
 
-use crate::core::{Facing, FragileReason, Kind};
+use crate::core::{Facing, Feature, FragileReason, Kind};
 
 use crate::replay::{
     ReplayError, ReplayEvent, ReplayOptions, SweepResult, Tunnel, TunnelAt, TunnelKind,
@@ -685,7 +685,7 @@ where
                         &result.scene,
                         outcome,
                         result.log_time_nanos,
-                        result.outcome.normal.as_ref(),
+                        result.outcome.hit.as_ref().map(|h| &h.normal),
                         options.ghost_degrees,
                     ) {
                         GhostJudgement::Ghost(mut g) => {
@@ -708,9 +708,11 @@ where
                         ball: result.ball,
                         sweep: result.sweep,
                         expected: *expected,
-                        replayed_face: (result.outcome.kind == Kind::Face)
-                            .then_some(result.outcome.triangle)
-                            .flatten(),
+                        replayed_face: result
+                            .outcome
+                            .hit
+                            .filter(|h| h.feature == Feature::Face)
+                            .map(|h| h.triangle),
                     });
                 }
                 let (fields, fragile, reproduced) = match judged.agreement {

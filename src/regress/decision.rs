@@ -55,10 +55,10 @@ pub fn write_decision_line(
         let _ = write!(
             s,
             "{} collision at α = {} (triangle {}, feature {})",
-            o.kind,
-            Num(o.alpha),
-            OrDash(o.triangle),
-            OrDash(o.feature)
+            o.kind(),
+            Num(o.travelled()),
+            OrDash(o.hit.map(|h| h.triangle)),
+            OrDash(o.hit.and_then(|h| h.feature.index()))
         );
         if let Some(t) = decisive {
             s.push_str(" — ");
@@ -113,9 +113,11 @@ pub fn write_divergence_line(s: &mut String, r: &SweepResult, diffs: &[FieldDiff
             let _ = write!(s, " (triangle {t}, feature {f})");
         }
     }
-    let _ = write!(s, ", replayed {} at α = {}", o.kind, Num(o.alpha));
-    if let (Some(t), Some(f)) = (o.triangle, o.feature) {
-        let _ = write!(s, " (triangle {t}, feature {f})");
+    let _ = write!(s, ", replayed {} at α = {}", o.kind(), Num(o.travelled()));
+    if let Some(h) = o.hit
+        && let Some(f) = h.feature.index()
+    {
+        let _ = write!(s, " (triangle {}, feature {f})", h.triangle);
     }
     let _ = write!(
         s,

@@ -91,7 +91,8 @@ pub fn expected_tests(
         .filter(|r| {
             r.kind() == expected.kind
                 && r.triangle() == triangle
-                && (expected.kind == Kind::Face || feature.is_none_or(|f| f == r.feature()))
+                && (expected.kind == Kind::Face
+                    || feature.is_none_or(|f| Some(f) == r.feature().index()))
         })
         .collect();
     if found.is_empty() {
@@ -158,13 +159,13 @@ fn expected_test(r: &TestRecord, expected: &OutcomeMsg, got: &Outcome) -> Expect
         Some(a) if got.is_hit() && !got.ties_with(a) => format!(
             "it hits at α = {}, later than the primary collision at α = {}",
             num(a),
-            num(got.alpha)
+            num(got.travelled())
         ),
         Some(a) if (a - expected.alpha).abs() > 1e-12 && got.is_hit() => format!(
             "it hits at α = {} (the compared answer: α = {}); the primary collision is at α = {}",
             num(a),
             num(expected.alpha),
-            num(got.alpha)
+            num(got.travelled())
         ),
         Some(a) if got.is_hit() => format!(
             "it hits at α = {}, the compared answer's α, tied with the primary test, which the tie \

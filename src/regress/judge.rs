@@ -291,9 +291,9 @@ impl Decision {
                 continue;
             }
             let mut member = primary;
-            member.kind = tie.kind;
+            member.kind = tie.kind();
             member.triangle = Some(Some(tie.triangle));
-            member.feature = Some(tie.feature);
+            member.feature = Some(tie.feature.index());
             member.contact = Some(r.contact().map(|c| [c.x, c.y, c.z]));
             let d = compare(answer, &member, tol);
             if d.is_empty() {

@@ -320,7 +320,7 @@ impl Replay {
         }
         self.summary.sweeps += 1;
         self.summary.elapsed += elapsed + start.elapsed();
-        *self.summary.outcomes.entry(outcome.kind).or_default() += 1;
+        *self.summary.outcomes.entry(outcome.kind()).or_default() += 1;
         if !outcome.fragile.is_robust() {
             self.summary.fragile += 1;
             for reason in outcome.fragile.iter() {

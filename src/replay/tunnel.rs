@@ -90,10 +90,10 @@ impl Tunnel {
 /// Where the outcome leaves the ball at the end of its sweep: `p0 + α d`,
 /// or exactly `p1` when `α = 1`.
 pub fn sweep_end(sweep: &Sweep, outcome: &Outcome) -> Point3<f64> {
-    if outcome.alpha >= 1.0 {
+    if outcome.travelled() >= 1.0 {
         sweep.p1
     } else {
-        sweep.p0 + (sweep.p1 - sweep.p0) * outcome.alpha
+        sweep.p0 + (sweep.p1 - sweep.p0) * outcome.travelled()
     }
 }
 

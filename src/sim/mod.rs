@@ -33,7 +33,7 @@ use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use thiserror::Error;
 
-use crate::core::{Facing, Kind, Mesh, Options, Sweep, SweepError, sweep_mesh};
+use crate::core::{Facing, Kind, Mesh, Options, Sweep, SweepError, SweepHit, sweep_mesh};
 use crate::numbers::{self, Rule};
 pub mod obj;
 pub mod scenes;
@@ -446,10 +446,9 @@ pub fn simulate<E: From<SimError>>(
                     outcome: OutcomeMsg::from_outcome(frame, index, &outcome),
                 };
                 on_event(&event)?;
-                summary.count(outcome.kind);
-                match (outcome.is_hit(), outcome.normal) {
-                    (true, Some(normal)) => {
-                        let alpha = outcome.alpha;
+                summary.count(outcome.kind());
+                match outcome.hit {
+                    Some(SweepHit { alpha, normal, .. }) => {
                         ball.position = p0 + (p1 - p0) * alpha;
                         let into = ball.velocity.dot(&normal);
                         if into < 0.0 {
@@ -458,7 +457,7 @@ pub fn simulate<E: From<SimError>>(
                         ball.position += normal * push;
                         ball.remaining *= 1.0 - alpha;
                     }
-                    _ => {
+                    None => {
                         ball.position = p1;
                         ball.remaining = 0.0;
                     }

@@ -184,15 +184,16 @@ impl OutcomeMsg {
 
     /// The full outcome record of a core result (every field present).
     pub fn from_outcome(frame: u64, ball: u32, o: &crate::core::Outcome) -> OutcomeMsg {
+        let hit = o.hit.as_ref();
         OutcomeMsg {
             frame,
             ball,
-            alpha: o.alpha,
-            kind: o.kind,
-            triangle: Some(o.triangle),
-            feature: Some(o.feature),
-            normal: Some(o.normal.map(|n| [n.x, n.y, n.z])),
-            contact: Some(o.contact.map(|c| [c.x, c.y, c.z])),
+            alpha: o.travelled(),
+            kind: o.kind(),
+            triangle: Some(hit.map(|h| h.triangle)),
+            feature: Some(hit.and_then(|h| h.feature.index())),
+            normal: Some(hit.map(|h| [h.normal.x, h.normal.y, h.normal.z])),
+            contact: Some(hit.map(|h| [h.contact.x, h.contact.y, h.contact.z])),
         }
     }
 }

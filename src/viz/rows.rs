@@ -187,13 +187,13 @@ pub(crate) fn ball_row(out: &mut Out<'_>, r: &SweepResult) {
     let d = r.sweep.p1 - p0;
     let rho = r.rho();
     let radius = r.sweep.radius as f32;
-    let at_contact = p0 + d * o.alpha;
+    let at_contact = p0 + d * o.travelled();
 
     let hit = o.is_hit();
     let contact_center = hit.then(|| f32x3(at_contact.coords));
     let contact_color = hit.then(|| rgba(CONTACT_BALL_COLOR));
     let (length, rotation) = capsule_pose(&d);
-    let contact = o.contact.zip(o.normal);
+    let contact = o.hit.map(|h| (h.contact, h.normal));
     let mut row = out.row(Entity::Ball(b), set::BALL);
     // One half size for the two or three balls (the viewer repeats it).
     row.put::<HalfSize3D>(
@@ -270,7 +270,7 @@ pub(crate) fn focus_rows(
     let p0 = r.sweep.p0;
     let d = r.sweep.p1 - p0;
     let alpha = if r.outcome.is_hit() {
-        r.outcome.alpha
+        r.outcome.travelled()
     } else if let Some(e) = r.expected.filter(|e| divergent && e.kind != Kind::None) {
         e.alpha
     } else if let Some(t) = decisive.and_then(|t| r.scene.mesh.triangle_by_index(t.triangle())) {
@@ -419,7 +419,7 @@ pub(crate) fn primary_rows(
     let lift = t.normal * (r.rho() * 0.02);
     let verts: [[f32; 3]; 3] = std::array::from_fn(|i| f32x3(t.vertices[i].coords + lift));
     let label = primary_text(test);
-    let f = test.feature() as usize % 3;
+    let f = usize::from(test.feature().index().unwrap_or(0)) % 3;
     let outline = [verts[0], verts[1], verts[2], verts[0]];
     let bold = [verts[f], verts[(f + 1) % 3]];
     let (strips, radii): (&[&[[f32; 3]]], &[f32]) = match test {
@@ -567,8 +567,8 @@ pub(crate) fn plot_rows(out: &mut Out<'_>, r: &SweepResult, decisive: Option<&Te
     let b = r.ball;
     // One row: α and the kind beside it.
     out.row(Entity::Alpha(b), set::KIND)
-        .put::<Scalar>(Scalars::descriptor_scalars, [r.outcome.alpha.into()])
-        .put_strs(|| any_value::<Text>("kind"), [r.outcome.kind.as_str()]);
+        .put::<Scalar>(Scalars::descriptor_scalars, [r.outcome.travelled().into()])
+        .put_strs(|| any_value::<Text>("kind"), [r.outcome.kind().as_str()]);
     let Some((bit, values)) = plot_values(decisive) else {
         return 0;
     };

@@ -206,7 +206,8 @@ impl ReproCase {
         let corners = |t: &[u64; 3]| t.map(|i| scene.vertices[i as usize]);
         let mut keep: Vec<u32> = Vec::new();
         for (i, t) in scene.triangles.iter().enumerate() {
-            let wanted = expected_triangle == Some(i as u32) || outcome.triangle == Some(i as u32);
+            let wanted = expected_triangle == Some(i as u32)
+                || outcome.hit.map(|h| h.triangle) == Some(i as u32);
             if !wanted && degenerate.contains(&i) {
                 continue;
             }
@@ -338,7 +339,7 @@ impl ReproCase {
     /// the same fragility, and the same verdict against the expectation.
     pub fn reproduces(&self) -> bool {
         let (a, b) = (&self.outcome, &self.reduced_outcome);
-        let normal_close = match (a.normal, b.normal) {
+        let normal_close = match (a.hit.map(|h| h.normal), b.hit.map(|h| h.normal)) {
             (Some(x), Some(y)) => (x - y).norm() <= 1e-12,
             (None, None) => true,
             _ => false,
@@ -348,13 +349,16 @@ impl ReproCase {
             (None, None) => true,
             _ => false,
         };
-        a.kind == b.kind
-            && a.triangle == b.triangle.and_then(|t| self.original_triangle(t))
-            && a.feature == b.feature
-            && a.alpha.to_bits() == b.alpha.to_bits()
-            && normal_close
-            && a.fragile == b.fragile
-            && verdicts
+        let same_hit = match (a.hit, b.hit) {
+            (Some(x), Some(y)) => {
+                x.feature == y.feature
+                    && Some(x.triangle) == self.original_triangle(y.triangle)
+                    && x.alpha.to_bits() == y.alpha.to_bits()
+            }
+            (None, None) => true,
+            _ => false,
+        };
+        same_hit && normal_close && a.fragile == b.fragile && verdicts
     }
 
     /// The trace's file name (without its directory).
@@ -434,7 +438,7 @@ impl ReproCase {
     pub fn asserted(&self) -> OutcomeMsg {
         self.expected.unwrap_or_else(|| {
             let mut o = OutcomeMsg::from_outcome(self.frame, self.ball, &self.reduced_outcome);
-            o.alpha = self.outcome.alpha;
+            o.alpha = self.outcome.travelled();
             o
         })
     }
@@ -480,11 +484,12 @@ impl ReproCase {
         let _ = writeln!(
             s,
             "the core decides: {} at α = {}{}{}",
-            o.kind,
-            num(o.alpha),
-            o.triangle
-                .map_or(String::new(), |t| format!(", triangle {t}")),
-            o.feature
+            o.kind(),
+            num(o.travelled()),
+            o.hit
+                .map_or(String::new(), |h| format!(", triangle {}", h.triangle)),
+            o.hit
+                .and_then(|h| h.feature.index())
                 .map_or(String::new(), |f| format!(", feature {f}"))
         );
         match &self.agreement {

@@ -177,18 +177,19 @@ impl ReproCase {
                 s,
                 "    let outcome = sweeptrace::sweep_mesh(&mesh, &sweep, &options).expect(\"valid sweep\");"
             );
-            let _ = writeln!(s, "    assert_eq!(outcome.kind, Kind::{kind});");
+            let _ = writeln!(s, "    assert_eq!(outcome.kind(), Kind::{kind});");
             if let Some(t) = a.triangle {
                 match t {
                     Some(t) => {
                         let _ = writeln!(
                             s,
-                            "    assert_eq!(outcome.triangle, Some({t})); {}",
+                            "    assert_eq!(outcome.hit.map(|h| h.triangle), Some({t})); {}",
                             triangle_note(t).trim_start()
                         );
                     }
                     None => {
-                        let _ = writeln!(s, "    assert_eq!(outcome.triangle, None);");
+                        let _ =
+                            writeln!(s, "    assert_eq!(outcome.hit.map(|h| h.triangle), None);");
                     }
                 }
             }
@@ -197,10 +198,16 @@ impl ReproCase {
             {
                 match feature {
                     Some(x) => {
-                        let _ = writeln!(s, "    assert_eq!(outcome.feature, Some({x}));");
+                        let _ = writeln!(
+                            s,
+                            "    assert_eq!(outcome.hit.and_then(|h| h.feature.index()), Some({x}));"
+                        );
                     }
                     None => {
-                        let _ = writeln!(s, "    assert_eq!(outcome.feature, None);");
+                        let _ = writeln!(
+                            s,
+                            "    assert_eq!(outcome.hit.and_then(|h| h.feature.index()), None);"
+                        );
                     }
                 }
             }
@@ -213,7 +220,7 @@ impl ReproCase {
         );
         let _ = writeln!(
             s,
-            "    assert!((outcome.alpha - alpha).abs() <= tolerance, \"α = {{}}, expected {{alpha}}\", outcome.alpha);"
+            "    assert!((outcome.travelled() - alpha).abs() <= tolerance, \"α = {{}}, expected {{alpha}}\", outcome.travelled());"
         );
         match a.normal {
             Some(Some(n)) => {
@@ -223,7 +230,10 @@ impl ReproCase {
                     v3(&n),
                     f(tol.normal_degrees)
                 );
-                let _ = writeln!(s, "    let n = outcome.normal.expect(\"a normal\");");
+                let _ = writeln!(
+                    s,
+                    "    let n = outcome.hit.expect(\"a hit with a normal\").normal;"
+                );
                 let _ = writeln!(
                     s,
                     "    let cross = [n.y * want[2] - n.z * want[1], n.z * want[0] - n.x * want[2], n.x * want[1] - n.y * want[0]];"
@@ -238,7 +248,7 @@ impl ReproCase {
                 );
             }
             Some(None) => {
-                let _ = writeln!(s, "    assert_eq!(outcome.normal, None);");
+                let _ = writeln!(s, "    assert!(outcome.hit.is_none(), \"no normal\");");
             }
             None => {}
         }
@@ -252,7 +262,7 @@ impl ReproCase {
                 );
                 let _ = writeln!(
                     s,
-                    "    let c = outcome.contact.expect(\"a contact point\");"
+                    "    let c = outcome.hit.expect(\"a hit with a contact point\").contact;"
                 );
                 let _ = writeln!(
                     s,
@@ -264,7 +274,10 @@ impl ReproCase {
                 );
             }
             Some(None) => {
-                let _ = writeln!(s, "    assert_eq!(outcome.contact, None);");
+                let _ = writeln!(
+                    s,
+                    "    assert!(outcome.hit.is_none(), \"no contact point\");"
+                );
             }
             None => {}
         }

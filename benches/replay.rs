@@ -87,8 +87,7 @@ fn rrd(bytes: &[u8], detail: Detail, path: &std::path::Path) -> u64 {
     use sweeptrace::viz;
 
     let options = ReplayOptions {
-        detail,
-        explain: true,
+        explain: Some(detail),
         ..ReplayOptions::default()
     };
     let id = viz::recording_id(&[bytes, detail.as_str().as_bytes()]);

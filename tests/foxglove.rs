@@ -17,7 +17,7 @@ use sweeptrace::foxglove::schemas::{
     LOG_SCHEMA_JSON, SCENE_UPDATE_SCHEMA_JSON, SWEEP_NUMBERS_SCHEMA_JSON,
 };
 use sweeptrace::foxglove::{FoxgloveOptions, FoxgloveWriter};
-use sweeptrace::replay::{ReplayOptions, replay_events};
+use sweeptrace::replay::{Detail, ReplayOptions, replay_events};
 use sweeptrace::trace::messages::{OutcomeMsg, SceneMsg, SweepMsg};
 use sweeptrace::trace::{TraceReader, TraceWriter};
 
@@ -107,7 +107,7 @@ fn two_scene_trace() -> anyhow::Result<Vec<u8>> {
 /// The Foxglove file of `trace`, through the library.
 fn foxglove_bytes(trace: &[u8]) -> anyhow::Result<Vec<u8>> {
     let options = ReplayOptions {
-        explain: true,
+        explain: Some(Detail::Primary),
         ..ReplayOptions::default()
     };
     let mut writer = FoxgloveWriter::new(

@@ -147,8 +147,7 @@ fn run(
 
 fn explained(detail: Detail) -> ReplayOptions {
     ReplayOptions {
-        detail,
-        explain: true,
+        explain: Some(detail),
         ..ReplayOptions::default()
     }
 }

@@ -307,8 +307,7 @@ fn write_failure_rrd(trace: &Path, dir: &Path, report: &TraceReport) -> anyhow::
     super::warn_unfinished(&target);
     let options = ReplayOptions {
         frames,
-        detail: Detail::Candidates,
-        explain: true,
+        explain: Some(Detail::Candidates),
         ..ReplayOptions::default()
     };
     let name = trace.display().to_string();

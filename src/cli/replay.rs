@@ -149,10 +149,9 @@ pub fn run(args: Args) -> anyhow::Result<RunOutcome> {
     let options = ReplayOptions {
         frames: args.frames.unwrap_or_default(),
         ball: args.ball,
-        detail: args.detail,
         // The decision lines of the recording and of the Foxglove file
         // describe the decisive test: keep the records.
-        explain: target.is_some() || args.foxglove.is_some(),
+        explain: (target.is_some() || args.foxglove.is_some()).then_some(args.detail),
         margin: args.margin,
         facing: args.facing,
     };
@@ -179,7 +178,7 @@ pub fn run(args: Args) -> anyhow::Result<RunOutcome> {
         prefetch::DEFAULT_DEPTH,
     )
     .context("starting the trace reader thread")?;
-    let batch_events = options.detail.batch_events();
+    let batch_events = options.batch_events();
     let mut events = replay_events_parallel(read_ahead, options, batch_events, Some(pool.clone()));
     let mut trace_error = None;
     let mut last_frame = None;

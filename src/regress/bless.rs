@@ -154,7 +154,7 @@ fn listed(values: &[String]) -> String {
 
 fn outcomes_of(input: &[u8], name: &str, options: ReplayOptions) -> Result<Replayed, BlessError> {
     let options = ReplayOptions {
-        explain: false,
+        explain: None,
         frames: Default::default(),
         ball: None,
         ..options

@@ -614,7 +614,7 @@ where
         }
     });
     let replay_options = ReplayOptions {
-        explain: false,
+        explain: None,
         ..options.replay
     };
     let mut report = TraceReport {

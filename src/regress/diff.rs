@@ -52,7 +52,7 @@ impl Side {
         I: Iterator<Item = Result<TraceEvent, TraceError>>,
     {
         let options = ReplayOptions {
-            explain: false,
+            explain: None,
             ..options
         };
         let mut side = Side {

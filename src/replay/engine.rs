@@ -449,12 +449,12 @@ pub fn compute_sweep(
         cause,
     };
     let mut verdicts = VerdictCounts::default();
-    let (outcome, records) = if options.explain {
-        let broadphase = match options.detail {
+    let (outcome, records) = if let Some(detail) = options.explain {
+        let broadphase = match detail {
             Detail::All => Broadphase::Exhaustive,
             Detail::Primary | Detail::Candidates => Broadphase::Bvh,
         };
-        match options.detail {
+        match detail {
             Detail::Primary => {
                 // Only what `primary_records` keeps is kept: the hits and
                 // the nearest miss so far, not every record.

@@ -143,11 +143,11 @@ pub struct ReplayOptions {
     pub frames: FrameRange,
     /// Only this ball.
     pub ball: Option<u32>,
-    /// Which test records each result keeps.
-    pub detail: Detail,
-    /// Whether to run the explained query at all. When `false` every sweep
-    /// uses the fast [`crate::core::sweep_mesh`] and results carry no records.
-    pub explain: bool,
+    /// Whether each sweep is explained, and how much: `None` runs the fast
+    /// [`crate::core::sweep_mesh`] and results carry no records (what
+    /// `--outcomes`, `check` and `bless` need); `Some(detail)` runs the
+    /// explained query and keeps `detail`'s records (what a recording needs).
+    pub explain: Option<Detail>,
     /// Overrides every scene's margin `ε`.
     pub margin: Option<f64>,
     /// Overrides every scene's facing rule.
@@ -165,8 +165,8 @@ impl ReplayOptions {
             "frames={};ball={};detail={};explain={};margin={};facing={}",
             self.frames,
             or_star(self.ball.map(|b| b.to_string()), "*"),
-            self.detail,
-            u8::from(self.explain),
+            self.explain.unwrap_or_default(),
+            u8::from(self.explain.is_some()),
             or_star(self.margin.map(|m| format!("{m:e}")), "scene"),
             or_star(self.facing.map(|f| f.to_string()), "scene"),
         )
@@ -183,6 +183,14 @@ impl ReplayOptions {
             parts.push(format!("ball {b}"));
         }
         (!parts.is_empty()).then(|| parts.join(", "))
+    }
+
+    /// Trace events per batch of a parallel replay with these options
+    /// ([`Detail::batch_events`]; the fast query keeps no records, so it
+    /// takes the default batch).
+    pub fn batch_events(&self) -> usize {
+        self.explain
+            .map_or(super::DEFAULT_BATCH_EVENTS, Detail::batch_events)
     }
 
     /// Whether the frame and ball filters keep the sweep of `ball` at `frame`.

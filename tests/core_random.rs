@@ -7,8 +7,9 @@ use nalgebra::{Point3, Rotation3, Vector3};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use sweeptrace::core::{
-    Broadphase, CollectRecords, Facing, Kind, Mesh, NoObserver, Options, Outcome, Sweep,
-    VerdictCounts, sweep_mesh, sweep_mesh_with,
+    Broadphase, CollectRecords, EdgeRecord, FaceRecord, Facing, Kind, Mesh, NoObserver, Observer,
+    Options, Outcome, Skip, SkipCounts, Sweep, TestRecord, VerdictCounts, VertexRecord, sweep_mesh,
+    sweep_mesh_with,
 };
 use sweeptrace::replay::{CollectPrimary, primary_records};
 
@@ -414,13 +415,44 @@ fn random_mesh(rng: &mut ChaCha8Rng, m: usize) -> (Vec<[f64; 3]>, Vec<[u64; 3]>)
     }
 }
 
-/// At `--detail primary` the replay keeps only the hits and the nearest
-/// miss while the tests run (`CollectPrimary`); it must give exactly what
-/// collecting every record and then choosing (`primary_records`) gives,
-/// and the same verdict counts.
+/// Every record, and the triangles skipped with their reasons, of a sweep
+/// that skips what the fast query skips.
+#[derive(Default)]
+struct SkippingRecords {
+    records: Vec<TestRecord>,
+    skipped: Vec<(u32, Skip)>,
+}
+
+impl Observer for SkippingRecords {
+    const TESTS_EVERY_CANDIDATE: bool = false;
+    fn face(&mut self, r: &FaceRecord) {
+        self.records.push(TestRecord::Face(*r));
+    }
+    fn edge(&mut self, r: &EdgeRecord) {
+        self.records.push(TestRecord::Edge(*r));
+    }
+    fn vertex(&mut self, r: &VertexRecord) {
+        self.records.push(TestRecord::Vertex(*r));
+    }
+    fn skipped(&mut self, triangle: u32, reason: Skip) {
+        self.skipped.push((triangle, reason));
+    }
+}
+
+/// At `--detail primary` the core skips, untested, the candidates the fast
+/// query skips, counting them by reason, and the replay keeps only the hits
+/// and the nearest miss of the tested ones while the tests run
+/// (`CollectPrimary`). Against collecting every record of every candidate
+/// (`CollectRecords`): the same outcome; the skipped triangles are exactly
+/// the candidates not tested, none of their tests hits, a back-facing one
+/// moves away from its front (`n · d > 0`) and an out-of-reach one has the
+/// whole path farther than ρ on one side of its plane; the verdicts counted
+/// are those of the tested candidates' records, the skips those listed; and
+/// the records kept are what `primary_records` chooses among the tested.
 fn primary_collector_equals_collecting_every_record() -> anyhow::Result<()> {
     let mut rng = ChaCha8Rng::seed_from_u64(0x5EED_0004);
     let (mut checked, mut hits, mut ties) = (0, 0, 0);
+    let mut skips = SkipCounts::default();
     for m in 0..6 {
         let (vertices, triangles) = random_mesh(&mut rng, m);
         let (mesh, usable) = mesh_and_usable(&vertices, &triangles)?;
@@ -429,24 +461,70 @@ fn primary_collector_equals_collecting_every_record() -> anyhow::Result<()> {
             let sweep = Sweep::new(p0, p1, radius);
             let options = Options { margin, facing };
             for broadphase in [Broadphase::Bvh, Broadphase::Exhaustive] {
+                let at = || format!("{p0:?} -> {p1:?} ({broadphase:?})");
                 let mut every = CollectRecords::default();
                 let outcome = sweep_mesh_with(&mesh, &sweep, &options, broadphase, &mut every)?;
+                let mut skipping = SkippingRecords::default();
+                let again = sweep_mesh_with(&mesh, &sweep, &options, broadphase, &mut skipping)?;
                 let mut primary = CollectPrimary::default();
-                let again = sweep_mesh_with(&mesh, &sweep, &options, broadphase, &mut primary)?;
-                if format!("{outcome:?}") != format!("{again:?}") {
-                    anyhow::bail!("{p0:?} -> {p1:?}: outcomes differ");
+                let third = sweep_mesh_with(&mesh, &sweep, &options, broadphase, &mut primary)?;
+                if format!("{outcome:?}") != format!("{again:?}")
+                    || format!("{outcome:?}") != format!("{third:?}")
+                {
+                    anyhow::bail!("{}: outcomes differ", at());
                 }
-                let counts: VerdictCounts = every.records.iter().map(|r| r.verdict()).collect();
-                let got = primary.verdict_counts();
-                if got != counts {
-                    anyhow::bail!("{p0:?} -> {p1:?}: verdict counts {got:?}, expected {counts:?}");
+                let skipped: std::collections::HashMap<u32, Skip> =
+                    skipping.skipped.iter().copied().collect();
+                if skipped.len() != skipping.skipped.len() {
+                    anyhow::bail!("{}: a triangle skipped twice", at());
                 }
-                let want = primary_records(&outcome, every.records);
+                let tested: Vec<TestRecord> = every
+                    .records
+                    .iter()
+                    .filter(|r| !skipped.contains_key(&r.triangle()))
+                    .copied()
+                    .collect();
+                if tested != skipping.records {
+                    anyhow::bail!("{}: the tested records are not the others", at());
+                }
+                for (&t, &reason) in &skipped {
+                    let of_t: Vec<&TestRecord> =
+                        every.records.iter().filter(|r| r.triangle() == t).collect();
+                    let face = of_t.iter().find_map(|r| match r {
+                        TestRecord::Face(f) => Some(*f),
+                        _ => None,
+                    });
+                    let Some(face) = face.filter(|_| of_t.len() == 7) else {
+                        anyhow::bail!("{}: skipped triangle {t} is not a candidate", at());
+                    };
+                    let rho = sweep.radius - margin;
+                    let fits = match reason {
+                        Skip::BackFacing => face.normal_dot_d > 0.0,
+                        Skip::PlaneOutOfReach => {
+                            (face.h0 > rho && face.h1 > rho) || (face.h0 < -rho && face.h1 < -rho)
+                        }
+                    };
+                    if !fits || of_t.iter().any(|r| r.alpha().is_some()) {
+                        anyhow::bail!("{}: triangle {t} skipped as {reason}: {face:?}", at());
+                    }
+                    skips.add(reason);
+                }
+                let counts: VerdictCounts = tested.iter().map(|r| r.verdict()).collect();
+                if primary.verdict_counts() != counts {
+                    anyhow::bail!(
+                        "{}: verdict counts {:?}, expected {counts:?}",
+                        at(),
+                        primary.verdict_counts()
+                    );
+                }
+                let listed = SkipCounts::from_reasons(skipping.skipped.iter().map(|(_, r)| *r));
+                if primary.skip_counts() != listed {
+                    anyhow::bail!("{}: skip counts differ", at());
+                }
+                let want = primary_records(&outcome, tested);
                 let got = primary.into_primary_records(&outcome);
                 if got != want {
-                    anyhow::bail!(
-                        "{p0:?} -> {p1:?} ({broadphase:?}): records {got:?}, expected {want:?}"
-                    );
+                    anyhow::bail!("{}: records {got:?}, expected {want:?}", at());
                 }
                 checked += 1;
                 hits += usize::from(outcome.is_hit());
@@ -454,9 +532,12 @@ fn primary_collector_equals_collecting_every_record() -> anyhow::Result<()> {
             }
         }
     }
-    // The comparison covers hits, misses and ties.
+    // The comparison covers hits, misses, ties and both reasons to skip.
     if hits < checked / 10 || hits > checked * 9 / 10 || ties == 0 {
         anyhow::bail!("{checked} sweeps: {hits} hits, {ties} with ties: not a useful mix");
+    }
+    if Skip::ALL.iter().any(|&r| skips.get(r) == 0) {
+        anyhow::bail!("{checked} sweeps: skipped {skips:?}: not a useful mix");
     }
     Ok(())
 }

@@ -28,6 +28,7 @@ mod oracle;
 mod out_of_order;
 mod outputs;
 mod prefetch;
+mod primary_skips;
 mod rapier;
 // The Rapier recorder example, run by `rapier` (its `main` is unused here).
 mod ghost;
@@ -116,6 +117,7 @@ fn main() {
     trials.extend(trace_io::tests());
     trials.extend(cbor::tests());
     trials.extend(replay::tests());
+    trials.extend(primary_skips::tests());
     trials.extend(record::tests());
     trials.extend(prefetch::tests());
     trials.extend(outputs::tests());

@@ -359,6 +359,19 @@ pub trait Observer {
     /// triangles whose every test would end back-facing.
     const WANTS_RECORDS: bool = true;
 
+    /// Whether every candidate triangle is tested. When `false`, the sweep
+    /// skips, as the fast query does, the candidates none of whose tests
+    /// can hit or come near a hit ([`Skip`]), and hands each to
+    /// [`Observer::skipped`] instead of its records. By default, only an
+    /// observer that wants no records lets triangles be skipped.
+    const TESTS_EVERY_CANDIDATE: bool = Self::WANTS_RECORDS;
+
+    /// A candidate triangle (its input index) was skipped without testing
+    /// it, for `reason` (only when [`Observer::TESTS_EVERY_CANDIDATE`] is
+    /// `false`).
+    #[inline]
+    fn skipped(&mut self, _triangle: u32, _reason: Skip) {}
+
     /// A face test finished.
     #[inline]
     fn face(&mut self, _record: &FaceRecord) {}
@@ -369,6 +382,130 @@ pub trait Observer {
     #[inline]
     fn vertex(&mut self, _record: &VertexRecord) {}
 }
+
+/// Why the sweep skipped a candidate triangle without testing it (the
+/// fast query's shortcuts; see [`Observer::TESTS_EVERY_CANDIDATE`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Skip {
+    /// The facing rule rejects the direction of travel, by a margin that
+    /// rounding cannot turn: every test would end back-facing.
+    BackFacing,
+    /// The whole path stays on one side of the triangle's plane, farther
+    /// from it than `ρ` plus the broadphase's margin: no test can hit or
+    /// come within the fragility band of a hit.
+    PlaneOutOfReach,
+}
+
+impl Skip {
+    /// Snake-case name.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Skip::BackFacing => "back_facing",
+            Skip::PlaneOutOfReach => "plane_out_of_reach",
+        }
+    }
+
+    /// In words, as the recording's text says it (`12 back-facing
+    /// candidates skipped`).
+    pub fn words(self) -> &'static str {
+        match self {
+            Skip::BackFacing => "back-facing",
+            Skip::PlaneOutOfReach => "out-of-reach",
+        }
+    }
+
+    /// Every reason, in declaration order.
+    pub const ALL: [Skip; 2] = [Skip::BackFacing, Skip::PlaneOutOfReach];
+}
+
+impl std::fmt::Display for Skip {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.as_str())
+    }
+}
+
+/// How many candidate triangles were skipped for each [`Skip`] reason.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct SkipCounts([u64; Skip::ALL.len()]);
+
+impl SkipCounts {
+    /// Counts one triangle skipped for `reason`.
+    #[inline]
+    pub fn add(&mut self, reason: Skip) {
+        self.0[reason as usize] += 1;
+    }
+
+    /// How many were skipped for `reason`.
+    pub fn get(&self, reason: Skip) -> u64 {
+        self.0[reason as usize]
+    }
+
+    /// The counts of `reasons`.
+    pub fn from_reasons(reasons: impl IntoIterator<Item = Skip>) -> Self {
+        let mut counts = SkipCounts::default();
+        for r in reasons {
+            counts.add(r);
+        }
+        counts
+    }
+
+    /// How many were skipped, for any reason.
+    pub fn total(&self) -> u64 {
+        self.0.iter().sum()
+    }
+
+    /// Whether none was skipped.
+    pub fn is_empty(&self) -> bool {
+        self.total() == 0
+    }
+
+    /// The reasons that occurred with their counts, in the order of
+    /// [`Skip::ALL`].
+    pub fn iter(&self) -> impl Iterator<Item = (Skip, u64)> + '_ {
+        Skip::ALL
+            .iter()
+            .zip(self.0)
+            .filter(|(_, n)| *n > 0)
+            .map(|(r, n)| (*r, n))
+    }
+
+    /// In words: `12 back-facing, 3 out-of-reach candidates skipped`
+    /// (`1 back-facing candidate skipped`); empty when none was.
+    pub fn words(&self) -> String {
+        if self.is_empty() {
+            return String::new();
+        }
+        let parts: Vec<String> = self
+            .iter()
+            .map(|(r, n)| format!("{n} {}", r.words()))
+            .collect();
+        let noun = if self.total() == 1 {
+            "candidate"
+        } else {
+            "candidates"
+        };
+        format!("{} {noun} skipped", parts.join(", "))
+    }
+}
+
+impl std::ops::AddAssign for SkipCounts {
+    fn add_assign(&mut self, other: SkipCounts) {
+        for (n, m) in self.0.iter_mut().zip(other.0) {
+            *n += m;
+        }
+    }
+}
+
+// `SkipCounts` counts at `reason as usize`: that must be its index in
+// `Skip::ALL`.
+const _: () = {
+    let mut i = 0;
+    while i < Skip::ALL.len() {
+        assert!(Skip::ALL[i] as usize == i);
+        i += 1;
+    }
+};
 
 /// The observer of the fast path: wants nothing.
 #[derive(Clone, Copy, Debug, Default)]

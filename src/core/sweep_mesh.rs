@@ -9,7 +9,7 @@ use super::mesh::{Mesh, Triangle};
 use super::options::{ALPHA_SENSITIVITY, Facing, GRAZING_COSINE, Options};
 use super::outcome::{Feature, Outcome, SweepHit};
 use super::path::{Sweep, SweptPath};
-use super::record::{Kind, NoObserver, Observer, Verdict};
+use super::record::{Kind, NoObserver, Observer, Skip, Verdict};
 use super::sweep_edge::sweep_edge;
 use super::sweep_face::{barycentric_and_distance, sweep_face};
 use super::sweep_vertex::sweep_vertex;
@@ -389,7 +389,9 @@ pub fn sweep_mesh(mesh: &Mesh, sweep: &Sweep, options: &Options) -> Result<Outco
 
 /// The explained query: like [`sweep_mesh`], and hands the record of every
 /// test it runs to `observer` (the tests of every candidate triangle with
-/// [`Broadphase::Bvh`], of every triangle with [`Broadphase::Exhaustive`]).
+/// [`Broadphase::Bvh`], of every triangle with [`Broadphase::Exhaustive`];
+/// an observer whose [`Observer::TESTS_EVERY_CANDIDATE`] is `false` gets,
+/// for the triangles the fast query skips, only why they were skipped).
 pub fn sweep_mesh_with<O: Observer>(
     mesh: &Mesh,
     sweep: &Sweep,
@@ -408,7 +410,8 @@ pub fn sweep_mesh_with<O: Observer>(
     ))
 }
 
-/// Whether the fast query may skip a triangle without testing it: every
+/// Why the fast query may skip a triangle without testing it (`None`: it
+/// is tested; always, for an observer that tests every candidate): every
 /// test would end back-facing, and its facing value is far enough from 0
 /// that rounding cannot turn the rule (near 0 it is tested for the
 /// `grazing` flag).
@@ -420,18 +423,18 @@ pub fn sweep_mesh_with<O: Observer>(
 /// hit (the line of an edge, its vertices, its face are no nearer than the
 /// plane): the tests would give no hit and no near miss.
 #[inline]
-fn skip<O: Observer>(triangle: &Triangle, path: &SweptPath, facing: Facing) -> bool {
-    if O::WANTS_RECORDS {
-        return false;
+fn skip<O: Observer>(triangle: &Triangle, path: &SweptPath, facing: Facing) -> Option<Skip> {
+    if O::TESTS_EVERY_CANDIDATE {
+        return None;
     }
     let facing_value = triangle.normal.dot(&path.d);
     if !facing.allows(facing_value) && facing_value.abs() >= GRAZING_COSINE * path.length {
-        return true;
+        return Some(Skip::BackFacing);
     }
     let h0 = triangle.normal.dot(&(path.p0 - triangle.vertices[0]));
     let h1 = h0 + facing_value;
     let clear = path.rho + path.broadphase_margin();
-    (h0 > clear && h1 > clear) || (h0 < -clear && h1 < -clear)
+    ((h0 > clear && h1 > clear) || (h0 < -clear && h1 < -clear)).then_some(Skip::PlaneOutOfReach)
 }
 
 fn visit_triangles<O: Observer>(
@@ -445,8 +448,9 @@ fn visit_triangles<O: Observer>(
     let triangles = mesh.triangles();
     let run = |position: usize, combiner: &mut Combiner, observer: &mut O| {
         let t = &triangles[position];
-        if !skip::<O>(t, path, facing) {
-            test_triangle(t, position, path, facing, observer, combiner);
+        match skip::<O>(t, path, facing) {
+            None => test_triangle(t, position, path, facing, observer, combiner),
+            Some(reason) => observer.skipped(t.index, reason),
         }
     };
     match broadphase {
@@ -511,7 +515,7 @@ fn sweep_path<O: Observer>(
         // More hits within the band than the combiner holds: test every
         // triangle again, in mesh order.
         for (position, t) in triangles.iter().enumerate() {
-            if !skip::<NoObserver>(t, path, facing) {
+            if skip::<NoObserver>(t, path, facing).is_none() {
                 test_triangle(t, position, path, facing, &mut NoObserver, &mut decision);
             }
         }

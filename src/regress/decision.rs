@@ -71,10 +71,15 @@ pub fn write_decision_line(
                 s.push_str("; closest candidate rejected: ");
                 let _ = write_describe(s, t);
             }
-            None if r.records.is_empty() => {
+            None if r.records.is_empty() && r.skipped.is_empty() => {
                 s.push_str(" (no triangle's box comes within ρ of the path)")
             }
             None => {}
+        }
+        // At `primary` the nearest miss is the nearest of the tested
+        // candidates: say how many were skipped untested, and why.
+        if !r.skipped.is_empty() {
+            let _ = write!(s, "; {}", r.skipped.words());
         }
     }
     if !o.fragile.is_robust() {

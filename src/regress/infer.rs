@@ -234,6 +234,7 @@ fn count_matches(
                 sweep: c.sweep,
                 outcome,
                 records: Vec::new(),
+                skipped: Default::default(),
                 expected: Some(c.expected),
                 tunnels: Vec::new(),
             };

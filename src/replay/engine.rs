@@ -7,8 +7,8 @@ use std::time::{Duration, Instant};
 
 use crate::core::explain::nearest_miss;
 use crate::core::{
-    Broadphase, CollectRecords, Mesh, Observer, Options, Outcome, Sweep, TestRecord, Topology,
-    VerdictCounts, sweep_mesh, sweep_mesh_with,
+    Broadphase, CollectRecords, Mesh, Observer, Options, Outcome, SkipCounts, Sweep, TestRecord,
+    Topology, VerdictCounts, sweep_mesh, sweep_mesh_with,
 };
 use crate::trace::TraceEvent;
 use crate::trace::messages::{OutcomeMsg, SceneMsg, SweepMsg};
@@ -71,6 +71,11 @@ pub struct SweepResult {
     /// explained). With [`Detail::Primary`] the first record is the primary
     /// test, or the nearest miss.
     pub records: Vec<TestRecord>,
+    /// The candidate triangles the explained query skipped without testing
+    /// them, by reason: at [`Detail::Primary`], what the fast query skips
+    /// (its records, and the nearest miss, cover the tested ones only);
+    /// empty at the other details, which test every candidate.
+    pub skipped: SkipCounts,
     /// The trace's `/expected` outcome for this `(frame, ball)`, if any.
     pub expected: Option<OutcomeMsg>,
     /// Where the ball's centre went through a triangle front to back, in
@@ -294,6 +299,7 @@ impl Replay {
             outcome,
             records,
             verdicts,
+            skipped,
             during,
             elapsed,
         } = computed;
@@ -314,6 +320,7 @@ impl Replay {
             self.summary.tunnel(msg.frame, msg.ball, t);
         }
         self.summary.verdicts += verdicts;
+        self.summary.skipped += skipped;
         let expected = self.early_expected.remove(&(msg.frame, msg.ball));
         if expected.is_some() {
             self.summary.expected_matched += 1;
@@ -336,6 +343,7 @@ impl Replay {
             sweep,
             outcome,
             records,
+            skipped,
             expected,
             tunnels,
         });
@@ -427,6 +435,7 @@ pub struct ComputedSweep {
     outcome: Outcome,
     records: Vec<TestRecord>,
     verdicts: VerdictCounts,
+    skipped: SkipCounts,
     /// The tunnel during the sweep, if any.
     during: Option<Tunnel>,
     elapsed: Duration,
@@ -449,6 +458,7 @@ pub fn compute_sweep(
         cause,
     };
     let mut verdicts = VerdictCounts::default();
+    let mut skipped = SkipCounts::default();
     let (outcome, records) = if let Some(detail) = options.explain {
         let broadphase = match detail {
             Detail::All => Broadphase::Exhaustive,
@@ -457,10 +467,12 @@ pub fn compute_sweep(
         match detail {
             Detail::Primary => {
                 // Only what `primary_records` keeps is kept: the hits and
-                // the nearest miss so far, not every record.
+                // the nearest miss so far, not every record; the candidates
+                // the fast query skips are counted, not tested.
                 let mut collect = CollectPrimary::default();
                 let outcome = explained(scene, &sweep, broadphase, &mut collect).map_err(err)?;
                 verdicts = collect.verdict_counts();
+                skipped = collect.skip_counts();
                 let records = collect.into_primary_records(&outcome);
                 (outcome, records)
             }
@@ -483,6 +495,7 @@ pub fn compute_sweep(
         outcome,
         records,
         verdicts,
+        skipped,
         during,
         elapsed: start.elapsed(),
     })

@@ -2,19 +2,26 @@
 //! [`Detail::Primary`](super::Detail::Primary): the primary test and its
 //! ties, or the nearest miss ([`primary_records`]), and the observer that
 //! keeps only those while the core runs ([`CollectPrimary`]).
+//!
+//! At `primary` the core tests only what the fast query tests: the
+//! candidates it skips (back-facing, plane out of reach) are counted by
+//! reason, not tested, so the verdict counts cover the tested candidates
+//! and the nearest miss is the nearest among them.
 
 use crate::core::explain::{
     edge_miss_distance, face_miss_distance, nearest_miss, vertex_miss_distance,
 };
 use crate::core::{
-    EdgeRecord, FaceRecord, Observer, Outcome, TestRecord, Verdict, VerdictCounts, VertexRecord,
+    EdgeRecord, FaceRecord, Observer, Outcome, Skip, SkipCounts, TestRecord, Verdict,
+    VerdictCounts, VertexRecord,
 };
 
 /// An observer that keeps, of a sweep's records, only what
 /// [`primary_records`] can return (every hit; while nothing is hit, the
 /// nearest miss so far, [`nearest_miss`]'s first of equals) and counts the
-/// verdicts of all: the same answer as collecting every record, without
-/// storing them.
+/// verdicts of all: the same answer as collecting every record of the
+/// tested candidates, without storing them. It lets the core skip what the
+/// fast query skips, and counts those candidates by [`Skip`] reason.
 #[derive(Debug, Default)]
 pub struct CollectPrimary {
     /// Every hit, in the order the tests ran.
@@ -28,6 +35,8 @@ pub struct CollectPrimary {
     nearest: Option<(f64, TestRecord)>,
     /// Tests run, by verdict.
     verdicts: VerdictCounts,
+    /// Candidates skipped without a test, by reason.
+    skipped: SkipCounts,
 }
 
 impl CollectPrimary {
@@ -62,6 +71,11 @@ impl CollectPrimary {
         self.verdicts
     }
 
+    /// The candidates skipped without a test, by reason.
+    pub fn skip_counts(&self) -> SkipCounts {
+        self.skipped
+    }
+
     /// [`primary_records`] of every record this observer saw.
     pub fn into_primary_records(self, outcome: &Outcome) -> Vec<TestRecord> {
         if outcome.is_hit() {
@@ -74,6 +88,12 @@ impl CollectPrimary {
 }
 
 impl Observer for CollectPrimary {
+    const TESTS_EVERY_CANDIDATE: bool = false;
+
+    #[inline]
+    fn skipped(&mut self, _triangle: u32, reason: Skip) {
+        self.skipped.add(reason);
+    }
     #[inline]
     fn face(&mut self, r: &FaceRecord) {
         self.keep(

@@ -4,7 +4,7 @@ use std::collections::BTreeMap;
 use std::time::Duration;
 
 use crate::core::explain::num;
-use crate::core::{FragileReason, Kind, VerdictCounts};
+use crate::core::{FragileReason, Kind, SkipCounts, VerdictCounts};
 
 use super::ReplayOptions;
 use super::selection::{Selection, SweepExtent};
@@ -64,8 +64,12 @@ pub struct ReplaySummary {
     pub outcomes: BTreeMap<Kind, u64>,
     /// Verdicts of every test run by the explained query (over the visited
     /// triangles at `primary`/`candidates`, every triangle at `all`), before
-    /// the detail level drops records.
+    /// the detail level drops records. At `primary` the candidates the fast
+    /// query skips are not tested: they are counted in `skipped`.
     pub verdicts: VerdictCounts,
+    /// Candidate triangles skipped without a test, by reason (at `primary`
+    /// only).
+    pub skipped: SkipCounts,
     /// `/expected` messages attached to a replayed sweep.
     pub expected_matched: u64,
     /// `/expected` messages for a replayed `(frame, ball)` that arrived too
@@ -152,6 +156,9 @@ impl ReplaySummary {
                 .collect::<Vec<_>>()
                 .join(", ");
             let _ = writeln!(s, "test verdicts: {v}");
+        }
+        if !self.skipped.is_empty() {
+            let _ = writeln!(s, "{}, not tested", self.skipped.words());
         }
         if self.expected_matched + self.expected_unmatched > 0 {
             let _ = writeln!(

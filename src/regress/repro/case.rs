@@ -135,6 +135,7 @@ fn result_of(
         sweep,
         outcome,
         records: Vec::new(),
+        skipped: Default::default(),
         expected,
         tunnels: Vec::new(),
     }

@@ -14,8 +14,8 @@ use rand_chacha::ChaCha8Rng;
 
 use sweeptrace::core::explain::miss_distance;
 use sweeptrace::core::{
-    Broadphase, CollectRecords, Facing, Kind, Mesh, Options, Sweep, TestRecord, sweep_mesh,
-    sweep_mesh_with,
+    Broadphase, CollectRecords, EdgeRecord, FaceRecord, Facing, Kind, Mesh, Observer, Options,
+    Sweep, TestRecord, VertexRecord, sweep_mesh, sweep_mesh_with,
 };
 use sweeptrace::replay::{
     Detail, FrameRange, ReplayEvent, ReplayOptions, ReplaySummary, SweepResult, replay_events,
@@ -284,10 +284,37 @@ fn frame_range_parsing() -> anyhow::Result<()> {
     Ok(())
 }
 
+/// The records of the candidates a sweep tests when it skips what the
+/// fast query skips (as `--detail primary` does).
+fn tested_records(mesh: &Mesh, sweep: &Sweep) -> anyhow::Result<Vec<TestRecord>> {
+    struct Tested(Vec<TestRecord>);
+    impl Observer for Tested {
+        const TESTS_EVERY_CANDIDATE: bool = false;
+        fn face(&mut self, r: &FaceRecord) {
+            self.0.push(TestRecord::Face(*r));
+        }
+        fn edge(&mut self, r: &EdgeRecord) {
+            self.0.push(TestRecord::Edge(*r));
+        }
+        fn vertex(&mut self, r: &VertexRecord) {
+            self.0.push(TestRecord::Vertex(*r));
+        }
+    }
+    let mut tested = Tested(Vec::new());
+    sweep_mesh_with(
+        mesh,
+        sweep,
+        &Options::default(),
+        Broadphase::Bvh,
+        &mut tested,
+    )?;
+    Ok(tested.0)
+}
+
 fn detail_levels_choose_records() -> anyhow::Result<()> {
     let scene = cube_scene();
     let mesh = mesh_of(&scene);
-    let sweeps = random_sweeps(5, 120, 1);
+    let sweeps = random_sweeps(5, 300, 1);
     let primary = run(
         events_for(scene.clone(), &sweeps),
         explained(Detail::Primary),
@@ -366,8 +393,25 @@ fn detail_levels_choose_records() -> anyhow::Result<()> {
                 "frame {}: a miss keeps at most the nearest miss",
                 p.frame
             );
-            let best = c
-                .records
+            // At `primary` the nearest miss is the nearest of the tested
+            // candidates: those the fast query does not skip.
+            let tested = tested_records(&mesh, &sweep)?;
+            let triangles = |records: &[TestRecord]| {
+                records
+                    .iter()
+                    .map(TestRecord::triangle)
+                    .collect::<std::collections::BTreeSet<u32>>()
+                    .len() as u64
+            };
+            ensure!(
+                triangles(&c.records) == triangles(&tested) + p.skipped.total(),
+                "frame {}: {} skipped, {} candidates, {} tested",
+                p.frame,
+                p.skipped.total(),
+                triangles(&c.records),
+                triangles(&tested)
+            );
+            let best = tested
                 .iter()
                 .filter_map(miss_distance)
                 .fold(f64::INFINITY, f64::min);
@@ -380,11 +424,7 @@ fn detail_levels_choose_records() -> anyhow::Result<()> {
                         p.frame
                     );
                 }
-                None => ensure!(
-                    c.records.is_empty(),
-                    "frame {}: nearest miss dropped",
-                    p.frame
-                ),
+                None => ensure!(tested.is_empty(), "frame {}: nearest miss dropped", p.frame),
             }
         }
     }

@@ -43,6 +43,7 @@ mod suite_config;
 mod support;
 mod trace_io;
 mod tunnel;
+mod tunnel_through;
 mod verdicts;
 
 /// What a test function returns on success: `()`, or a [`Completion`] for a
@@ -122,6 +123,7 @@ fn main() {
     trials.extend(prefetch::tests());
     trials.extend(outputs::tests());
     trials.extend(tunnel::tests());
+    trials.extend(tunnel_through::tests());
     trials.extend(ghost::tests());
     trials.extend(repro::tests());
     trials.extend(alt_engine::tests());

@@ -769,7 +769,7 @@ fn simulation_has_none() -> anyhow::Result<()> {
             for e in replay_events(events.into_iter(), ReplayOptions::default()) {
                 if let ReplayEvent::Sweep(r) = e? {
                     hits += u64::from(r.outcome.is_hit());
-                    found.extend(r.tunnels.iter().map(|t| (r.frame, r.ball, *t)));
+                    found.extend(r.tunnels.iter().map(|t| (r.frame, r.ball, t.clone())));
                 }
             }
             ensure!(

@@ -20,6 +20,12 @@
 //! crossings within the tie window `TIE_WINDOW_ULPS · u / |q − p|` of it
 //! (several triangles meeting at an edge or vertex) go to the lowest
 //! triangle index.
+//!
+//! A *flipped* triangle (wound against its neighbours, see
+//! [`Topology::flipped`](super::Topology::flipped)) is crossed in either
+//! direction: front to back by its own winding as above, or back to front,
+//! which is front to back by the winding its neighbours give it (the same
+//! rule with `n` reversed). [`first_crossing_with_flipped`] takes that list.
 
 use nalgebra::Point3;
 use serde::Serialize;
@@ -37,6 +43,9 @@ pub struct Crossing {
     pub point: Point3<f64>,
     /// Fraction of the segment `p → q` at that point, in `[0, 1]`.
     pub fraction: f64,
+    /// The segment went from the triangle's back to its front: a flipped
+    /// triangle crossed the way its neighbours face.
+    pub back_to_front: bool,
 }
 
 /// The magnitude `S = max(|p|∞, |q|∞, |mesh bounds|∞)` the rounding of a
@@ -67,7 +76,32 @@ pub fn triangle_crossing(
     q: &Point3<f64>,
     tau: f64,
 ) -> Option<Crossing> {
-    let n = triangle.normal;
+    crossing_along(triangle, 1.0, p, q, tau)
+}
+
+/// The back-to-front crossing of one triangle by `p → q` under tolerance
+/// `tau`, if any: the front-to-back rule with the triangle's normal
+/// reversed (how a flipped triangle is crossed the way its neighbours face).
+#[inline]
+pub fn triangle_crossing_back_to_front(
+    triangle: &Triangle,
+    p: &Point3<f64>,
+    q: &Point3<f64>,
+    tau: f64,
+) -> Option<Crossing> {
+    crossing_along(triangle, -1.0, p, q, tau)
+}
+
+/// The front-to-back crossing of `triangle` with its normal times `sign`.
+#[inline]
+fn crossing_along(
+    triangle: &Triangle,
+    sign: f64,
+    p: &Point3<f64>,
+    q: &Point3<f64>,
+    tau: f64,
+) -> Option<Crossing> {
+    let n = triangle.normal * sign;
     let a = triangle.vertices[0];
     let hp = n.dot(&(p - a));
     let hq = n.dot(&(q - a));
@@ -83,6 +117,24 @@ pub fn triangle_crossing(
         triangle: triangle.index,
         point,
         fraction: t,
+        back_to_front: sign < 0.0,
+    })
+}
+
+/// The crossing of one triangle, in both directions when it is one of the
+/// `flipped` (ascending input indices).
+#[inline]
+fn crossing_of(
+    triangle: &Triangle,
+    flipped: &[u32],
+    p: &Point3<f64>,
+    q: &Point3<f64>,
+    tau: f64,
+) -> Option<Crossing> {
+    triangle_crossing(triangle, p, q, tau).or_else(|| {
+        (!flipped.is_empty() && flipped.binary_search(&triangle.index).is_ok())
+            .then(|| triangle_crossing_back_to_front(triangle, p, q, tau))
+            .flatten()
     })
 }
 
@@ -92,6 +144,18 @@ pub fn triangle_crossing(
 /// it the lowest triangle index. `None` for a segment of length 0 or with a
 /// non-finite coordinate. Allocates nothing.
 pub fn first_crossing(mesh: &Mesh, p: &Point3<f64>, q: &Point3<f64>) -> Option<Crossing> {
+    first_crossing_with_flipped(mesh, &[], p, q)
+}
+
+/// [`first_crossing`], with the triangles of `flipped` (input indices,
+/// ascending: [`Topology::flipped`](super::Topology::flipped)) crossed back
+/// to front too (see the module documentation). Allocates nothing.
+pub fn first_crossing_with_flipped(
+    mesh: &Mesh,
+    flipped: &[u32],
+    p: &Point3<f64>,
+    q: &Point3<f64>,
+) -> Option<Crossing> {
     let d = q - p;
     let length = d.norm();
     let finite = p
@@ -112,7 +176,7 @@ pub fn first_crossing(mesh: &Mesh, p: &Point3<f64>, q: &Point3<f64>) -> Option<C
     let mut first = f64::INFINITY;
     mesh.bvh().traverse(p, &d, grow, 1.0, |range| {
         for position in range {
-            if let Some(c) = triangle_crossing(&triangles[position], p, q, tau) {
+            if let Some(c) = crossing_of(&triangles[position], flipped, p, q, tau) {
                 first = first.min(c.fraction);
             }
         }
@@ -127,7 +191,7 @@ pub fn first_crossing(mesh: &Mesh, p: &Point3<f64>, q: &Point3<f64>) -> Option<C
     let mut best: Option<Crossing> = None;
     mesh.bvh().traverse(p, &d, grow, cutoff, |range| {
         for position in range {
-            if let Some(c) = triangle_crossing(&triangles[position], p, q, tau)
+            if let Some(c) = crossing_of(&triangles[position], flipped, p, q, tau)
                 && c.fraction <= first + window
                 && best.is_none_or(|b| c.triangle < b.triangle)
             {

@@ -37,7 +37,10 @@ mod sweep_vertex;
 mod ties;
 mod topology;
 
-pub use crossing::{Crossing, crossing_tolerance, first_crossing, triangle_crossing};
+pub use crossing::{
+    Crossing, crossing_tolerance, first_crossing, first_crossing_with_flipped, triangle_crossing,
+    triangle_crossing_back_to_front,
+};
 pub use error::{MeshError, SweepError};
 pub use fragility::{FragileReason, Fragility};
 pub use mesh::{DegenerateReason, DegenerateTriangle, Mesh, StandardFrame, Triangle};

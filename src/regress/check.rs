@@ -44,7 +44,7 @@ pub const MAX_LISTED_GHOSTS: usize = 10;
 /// A tunnel found in a trace: a ball's centre went through a triangle from
 /// its front to its back, during a sweep or between two of its sweeps (see
 /// [`crate::replay::Tunnel`]).
-#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct TunnelReport {
     /// Frame of the sweep.
     pub frame: u64,
@@ -64,7 +64,7 @@ impl TunnelReport {
         TunnelAt {
             frame: self.frame,
             ball: self.ball,
-            tunnel: self.tunnel,
+            tunnel: self.tunnel.clone(),
         }
         .to_string()
     }
@@ -665,7 +665,7 @@ where
                             frame: result.frame,
                             ball: result.ball,
                             log_time_nanos: result.log_time_nanos,
-                            tunnel: *t,
+                            tunnel: t.clone(),
                         });
                     }
                 }

@@ -14,7 +14,7 @@ use crate::trace::TraceEvent;
 use crate::trace::messages::{OutcomeMsg, SceneMsg, SweepMsg};
 
 use super::primary::CollectPrimary;
-use super::tunnel::{BallEnds, Tunnel, sweep_end, tunnel_during_sweep};
+use super::tunnel::{BallEnds, Tunnel, TunnelScene, sweep_end, tunnel_during_sweep};
 use super::{Detail, ReplayError, ReplayOptions, ReplaySummary};
 
 /// A scene of the trace, built into a mesh.
@@ -35,6 +35,18 @@ pub struct SceneState {
     pub topology: Topology,
     /// The options in force: the scene's margin and facing unless overridden.
     pub options: Options,
+}
+
+impl SceneState {
+    /// What a tunnel of a ball of `radius` is judged against: the mesh, its
+    /// topology and `ρ = radius − margin`.
+    pub fn tunnel_scene(&self, radius: f64) -> TunnelScene<'_> {
+        TunnelScene {
+            mesh: &self.mesh,
+            topology: &self.topology,
+            rho: radius - self.options.margin,
+        }
+    }
 }
 
 /// Two states are equal when they come from the same scene message with the
@@ -305,10 +317,12 @@ impl Replay {
         } = computed;
         let start = Instant::now();
         let mut tunnels = Vec::new();
-        tunnels.extend(
-            self.ends
-                .jump(msg.ball, scene.number, &scene.mesh, &sweep.p0),
-        );
+        tunnels.extend(self.ends.jump(
+            msg.ball,
+            scene.number,
+            &scene.tunnel_scene(sweep.radius),
+            &sweep.p0,
+        ));
         tunnels.extend(during);
         self.ends.set(
             msg.ball,
@@ -489,7 +503,7 @@ pub fn compute_sweep(
             Vec::new(),
         )
     };
-    let during = tunnel_during_sweep(&scene.mesh, &sweep, &outcome);
+    let during = tunnel_during_sweep(&scene.tunnel_scene(sweep.radius), &sweep, &outcome);
     Ok(ComputedSweep {
         sweep,
         outcome,

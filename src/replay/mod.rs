@@ -43,4 +43,4 @@ pub use pipeline::{
 pub use primary::{CollectPrimary, primary_records};
 pub use selection::{Selection, SweepExtent};
 pub use summary::{LISTED_TUNNELS, ReplaySummary, TunnelAt};
-pub use tunnel::{Tunnel, TunnelKind, sweep_end, tunnel_during_sweep};
+pub use tunnel::{Through, Tunnel, TunnelKind, TunnelScene, sweep_end, tunnel_during_sweep};

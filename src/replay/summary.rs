@@ -15,7 +15,7 @@ use crate::numbers::plural;
 pub const LISTED_TUNNELS: usize = 5;
 
 /// A tunnel with the sweep it was found at.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct TunnelAt {
     /// Frame of the sweep.
     pub frame: u64,
@@ -27,7 +27,9 @@ pub struct TunnelAt {
 
 impl std::fmt::Display for TunnelAt {
     /// `frame F, ball B: through triangle T during its sweep at (x, y, z)`
-    /// (or `between its sweeps of frames P and F`).
+    /// (or `between its sweeps of frames P and F`), with `(back to front)`
+    /// after the triangle for a flipped one crossed that way and `, through
+    /// the flipped triangle 812` (the defect within ρ) at the end.
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         let t = &self.tunnel;
         write!(
@@ -35,6 +37,9 @@ impl std::fmt::Display for TunnelAt {
             "frame {}, ball {}: through triangle {} ",
             self.frame, self.ball, t.triangle
         )?;
+        if t.back_to_front {
+            write!(f, "(back to front) ")?;
+        }
         match (t.kind, t.previous_frame) {
             (TunnelKind::DuringSweep, _) => write!(f, "during its sweep")?,
             (TunnelKind::BetweenSweeps, Some(p)) => {
@@ -43,7 +48,11 @@ impl std::fmt::Display for TunnelAt {
             (TunnelKind::BetweenSweeps, None) => write!(f, "between sweeps")?,
         }
         let [x, y, z] = t.point;
-        write!(f, " at ({}, {}, {})", num(x), num(y), num(z))
+        write!(f, " at ({}, {}, {})", num(x), num(y), num(z))?;
+        if let Some(through) = &t.through {
+            write!(f, ", through {}", through.text)?;
+        }
+        Ok(())
     }
 }
 
@@ -110,7 +119,7 @@ impl ReplaySummary {
             self.first_tunnels.push(TunnelAt {
                 frame,
                 ball,
-                tunnel: *tunnel,
+                tunnel: tunnel.clone(),
             });
         }
     }

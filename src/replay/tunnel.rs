@@ -1,13 +1,17 @@
 //! Tunnels: a ball whose centre went through a triangle from its front to
-//! its back, during a sweep or between two sweeps of the same ball (see
-//! SEMANTICS.md, "Tunnelling", and [`crate::core::first_crossing`]).
+//! its back (or through a flipped triangle either way), during a sweep or
+//! between two sweeps of the same ball, and the mesh defect it went through
+//! when one lies within `ρ` of where it crossed (see SEMANTICS.md,
+//! "Tunnelling", and [`crate::core::first_crossing_with_flipped`]).
 
 use std::collections::HashMap;
 
 use nalgebra::Point3;
 use serde::Serialize;
 
-use crate::core::{Crossing, Mesh, Outcome, Sweep, first_crossing};
+use crate::core::{
+    Crossing, Defect, DefectKind, Mesh, Outcome, Sweep, Topology, first_crossing_with_flipped,
+};
 
 /// Where a tunnel happened.
 #[derive(
@@ -44,8 +48,71 @@ impl TunnelKind {
     }
 }
 
-/// A ball's centre through a triangle, front to back.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+/// The mesh defect a tunnel went through: the one nearest where the centre
+/// crossed, within the ball's `ρ` (one that changes collisions first; see
+/// [`Topology::defect_near`]).
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Through {
+    /// The defect's kind (`flipped`, `crack`, ...), as `mesh --json` names it.
+    pub kind: DefectKind,
+    /// Its triangles (input indices), as `mesh --json` lists them.
+    pub triangles: Vec<u32>,
+    /// Its vertices (input indices).
+    pub vertices: Vec<u32>,
+    /// Where it is (as `mesh` gives it).
+    pub position: [f64; 3],
+    /// From the crossing point to the defect's triangles, edges or vertices.
+    pub distance: f64,
+    /// In words: `the flipped triangle 812`, `the crack between triangles
+    /// 40 and 41`.
+    pub text: String,
+}
+
+impl Through {
+    fn new(defect: &Defect, distance: f64) -> Through {
+        Through {
+            kind: defect.kind,
+            triangles: defect.triangles.clone(),
+            vertices: defect.vertices.clone(),
+            position: defect.position,
+            distance,
+            text: through_words(defect),
+        }
+    }
+}
+
+/// A defect as the object of "through": `the flipped triangle 812`.
+fn through_words(d: &Defect) -> String {
+    let t = |i: usize| d.triangles.get(i).map_or("?".into(), u32::to_string);
+    let v = |i: usize| d.vertices.get(i).map_or("?".into(), u32::to_string);
+    match d.kind {
+        DefectKind::Flipped => format!("the flipped triangle {}", t(0)),
+        DefectKind::Crack => format!("the crack between triangles {} and {}", t(0), t(1)),
+        DefectKind::TJunction => format!(
+            "the T-junction at vertex {} on an edge of triangle {}",
+            v(0),
+            t(0)
+        ),
+        DefectKind::Degenerate => format!("the degenerate triangle {}", t(0)),
+        DefectKind::Sliver => format!("the sliver triangle {}", t(0)),
+        DefectKind::DuplicateTriangle => {
+            format!("the duplicate triangles {} and {}", t(0), t(1))
+        }
+        DefectKind::DuplicateVertex => {
+            format!("the nearly coincident vertices {} and {}", v(0), v(1))
+        }
+        DefectKind::NonManifoldEdge => format!(
+            "the non-manifold edge {}-{} ({} triangles)",
+            v(0),
+            v(1),
+            d.triangles.len()
+        ),
+    }
+}
+
+/// A ball's centre through a triangle, front to back (or a flipped triangle
+/// back to front).
+#[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct Tunnel {
     /// During the sweep or between sweeps.
     pub kind: TunnelKind,
@@ -65,10 +132,58 @@ pub struct Tunnel {
     /// Between sweeps: the frame of the ball's previous sweep.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub previous_frame: Option<u64>,
+    /// The crossing went from the triangle's back to its front: the
+    /// triangle is flipped and the ball came from the side its neighbours
+    /// face. Only in the JSON when true.
+    #[serde(skip_serializing_if = "std::ops::Not::not")]
+    pub back_to_front: bool,
+    /// The mesh defect within `ρ` of [`Tunnel::point`], if any. Only in the
+    /// JSON when there is one.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub through: Option<Through>,
 }
 
-impl Tunnel {
-    fn new(
+/// What a tunnel is judged against: the scene's mesh, its topology (the
+/// flipped triangles, crossed either way, and the defects a tunnel names)
+/// and the ball's detection radius `ρ`.
+#[derive(Clone, Copy, Debug)]
+pub struct TunnelScene<'a> {
+    /// The mesh.
+    pub mesh: &'a Mesh,
+    /// Its topology.
+    pub topology: &'a Topology,
+    /// The detection radius `ρ = r − ε` of the ball: a defect that close to
+    /// the crossing point is named.
+    pub rho: f64,
+}
+
+impl TunnelScene<'_> {
+    /// The first crossing of `p → q` (flipped triangles either way).
+    fn crossing(&self, p: &Point3<f64>, q: &Point3<f64>) -> Option<Crossing> {
+        first_crossing_with_flipped(self.mesh, self.topology.flipped(), p, q)
+    }
+
+    /// The defect within `ρ` of `point`, if any.
+    fn through(&self, point: &Point3<f64>) -> Option<Through> {
+        if self.topology.defects().is_empty() {
+            return None;
+        }
+        let radius = if self.rho.is_finite() {
+            self.rho.max(0.0)
+        } else {
+            0.0
+        };
+        let (_, defect) = self
+            .topology
+            .defect_near(self.mesh.vertices(), point, radius)?;
+        Some(Through::new(
+            defect,
+            defect.distance(self.mesh.vertices(), point),
+        ))
+    }
+
+    fn tunnel(
+        &self,
         kind: TunnelKind,
         c: Crossing,
         from: Point3<f64>,
@@ -83,6 +198,8 @@ impl Tunnel {
             from: from.into(),
             to: to.into(),
             previous_frame,
+            back_to_front: c.back_to_front,
+            through: self.through(&c.point),
         }
     }
 }
@@ -98,11 +215,17 @@ pub fn sweep_end(sweep: &Sweep, outcome: &Outcome) -> Point3<f64> {
 }
 
 /// The tunnel during one sweep, if its centre's path up to where the
-/// outcome stops it crosses a triangle of `mesh` front to back.
-pub fn tunnel_during_sweep(mesh: &Mesh, sweep: &Sweep, outcome: &Outcome) -> Option<Tunnel> {
+/// outcome stops it crosses a triangle of the scene's mesh front to back
+/// (or a flipped one back to front).
+pub fn tunnel_during_sweep(
+    scene: &TunnelScene<'_>,
+    sweep: &Sweep,
+    outcome: &Outcome,
+) -> Option<Tunnel> {
     let end = sweep_end(sweep, outcome);
-    first_crossing(mesh, &sweep.p0, &end)
-        .map(|c| Tunnel::new(TunnelKind::DuringSweep, c, sweep.p0, end, None))
+    scene
+        .crossing(&sweep.p0, &end)
+        .map(|c| scene.tunnel(TunnelKind::DuringSweep, c, sweep.p0, end, None))
 }
 
 /// Where a ball's previous sweep left it.
@@ -122,18 +245,19 @@ pub(crate) struct BallEnds {
 
 impl BallEnds {
     /// The tunnel of the jump from where `ball`'s previous sweep (against
-    /// the same scene) left it to `p0`, if it crosses a triangle of `mesh`
-    /// front to back.
+    /// the same scene, number `scene`) left it to `p0`, if it crosses a
+    /// triangle of `tunnel_scene`'s mesh front to back (or a flipped one
+    /// back to front).
     pub(crate) fn jump(
         &self,
         ball: u32,
         scene: usize,
-        mesh: &Mesh,
+        tunnel_scene: &TunnelScene<'_>,
         p0: &Point3<f64>,
     ) -> Option<Tunnel> {
         let prev = self.ends.get(&ball).filter(|e| e.scene == scene)?;
-        first_crossing(mesh, &prev.position, p0).map(|c| {
-            Tunnel::new(
+        tunnel_scene.crossing(&prev.position, p0).map(|c| {
+            tunnel_scene.tunnel(
                 TunnelKind::BetweenSweeps,
                 c,
                 prev.position,

@@ -625,7 +625,8 @@ pub(crate) fn text_rows(
 }
 
 /// The tunnels of a sweep (a ball's centre through a triangle, front to
-/// back): a marker where each crossed the triangle's plane and a WARN line
+/// back, or a flipped one back to front), each labelled with the defect it
+/// went through if any: a marker where each crossed the triangle's plane and a WARN line
 /// each in the divergences log. Returns whether there was one (the marker
 /// is cleared at the ball's next sweep without one).
 pub(crate) fn tunnel_rows(out: &mut Out<'_>, r: &SweepResult) -> bool {
@@ -644,14 +645,20 @@ pub(crate) fn tunnel_rows(out: &mut Out<'_>, r: &SweepResult) -> bool {
         .put::<Color>(Points3D::descriptor_colors, [rgba(TUNNEL_COLOR)])
         .put_texts(Points3D::descriptor_labels, |t| {
             for tunnel in &r.tunnels {
-                t.push_fmt(format_args!("tunnel: triangle {}", tunnel.triangle));
+                match &tunnel.through {
+                    Some(through) => t.push_fmt(format_args!(
+                        "tunnel: triangle {}, through {}",
+                        tunnel.triangle, through.text
+                    )),
+                    None => t.push_fmt(format_args!("tunnel: triangle {}", tunnel.triangle)),
+                };
             }
         });
     for tunnel in &r.tunnels {
         let at = crate::replay::TunnelAt {
             frame: r.frame,
             ball: r.ball,
-            tunnel: *tunnel,
+            tunnel: tunnel.clone(),
         };
         out.row(Entity::Divergences, set::TEXT_LOG)
             .put_texts(TextLog::descriptor_text, |t| {

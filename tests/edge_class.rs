@@ -1,0 +1,86 @@
+//! The class of the edge (or vertex) an outcome hit: in `replay`'s outcome
+//! lines (`edge_class`) and in the `sweep` explanation ("edge 0.1: a convex
+//! edge shared with triangle 5").
+
+use libtest_mimic::Trial;
+use sweeptrace::core::Kind;
+use sweeptrace::replay::{ReplayEvent, ReplayOptions, replay_events};
+use sweeptrace::trace::TraceReader;
+
+use crate::ensure;
+use crate::support::run_bin;
+use crate::trial;
+use crate::tunnel_through::{floor, sweep, trace};
+use anyhow::Context as _;
+
+pub fn tests() -> Vec<Trial> {
+    vec![
+        trial!(replay_outcome_lines_name_the_edge_class),
+        trial!(sweep_explanation_names_the_edge_class),
+    ]
+}
+
+/// On the 3 × 3 floor (front `+z`): ball 0 falls just outside its edge
+/// `x = 0` (a boundary edge), ball 1 falls onto the middle of triangle 4 (a
+/// face: no class).
+fn replay_outcome_lines_name_the_edge_class() -> anyhow::Result<()> {
+    let bytes = trace(
+        &floor(3, &[]),
+        &[
+            sweep(0, 0, [-0.05, 1.5, 1.0], [-0.05, 1.5, -1.0]),
+            sweep(0, 1, [1.6, 0.4, 1.0], [1.6, 0.4, -1.0]),
+        ],
+    )?;
+    let mut lines = Vec::new();
+    for e in replay_events(
+        TraceReader::new(bytes.as_slice(), "<memory>"),
+        ReplayOptions::default(),
+    ) {
+        if let ReplayEvent::Sweep(r) = e? {
+            lines.push((r.ball, r.outcome.kind, r.outcome_line()?));
+        }
+    }
+    let (_, kind, line) = lines.iter().find(|l| l.0 == 0).context("no ball 0")?;
+    ensure!(*kind == Kind::Edge, "ball 0 hits an edge: {line}");
+    let v: serde_json::Value = serde_json::from_str(line)?;
+    ensure!(v["edge_class"] == "boundary", "{line}");
+    let (_, kind, line) = lines.iter().find(|l| l.0 == 1).context("no ball 1")?;
+    ensure!(*kind == Kind::Face, "ball 1 hits a face: {line}");
+    let v: serde_json::Value = serde_json::from_str(line)?;
+    ensure!(v.get("edge_class").is_none(), "{line}");
+    Ok(())
+}
+
+fn sweep_explanation_names_the_edge_class() -> anyhow::Result<()> {
+    let args = [
+        "sweep", "--scene", "cube", "--radius", "0.5", "--from", "3,3,0", "--to", "0,0,0",
+    ];
+    let os: Vec<&std::ffi::OsStr> = args.iter().map(|a| a.as_ref()).collect();
+    let (code, out, err) = run_bin(&os)?;
+    ensure!(code == 0, "exit {code}\n{err}");
+    ensure!(
+        out.contains("\nedge 0.1: a convex edge shared with triangle 5\n"),
+        "{out}"
+    );
+    let mut json_args = os.clone();
+    json_args.push("--json".as_ref());
+    let (code, out, err) = run_bin(&json_args)?;
+    ensure!(code == 0, "exit {code}\n{err}");
+    let v: serde_json::Value = serde_json::from_str(&out)?;
+    ensure!(
+        v["outcome"]["edge_class"] == "convex"
+            && v["place"] == "edge 0.1: a convex edge shared with triangle 5",
+        "{v}"
+    );
+    // A vertex: the corner (1, 1, 1), where the edges are convex.
+    let args = [
+        "sweep", "--scene", "cube", "--radius", "0.5", "--from", "3,3,3", "--to", "0,0,0",
+    ];
+    let os: Vec<&std::ffi::OsStr> = args.iter().map(|a| a.as_ref()).collect();
+    let (_, out, _) = run_bin(&os)?;
+    ensure!(
+        out.contains(": a convex vertex (the most telling class of its"),
+        "{out}"
+    );
+    Ok(())
+}

@@ -47,7 +47,7 @@ fn replay_outcome_lines_name_the_edge_class() -> anyhow::Result<()> {
     let (_, kind, line) = lines.iter().find(|l| l.0 == 1).context("no ball 1")?;
     ensure!(*kind == Kind::Face, "ball 1 hits a face: {line}");
     let v: serde_json::Value = serde_json::from_str(line)?;
-    ensure!(v.get("edge_class").is_none(), "{line}");
+    ensure!(v["edge_class"].is_null(), "{line}");
     Ok(())
 }
 

@@ -145,7 +145,7 @@ impl SweepResult {
     /// when it is robust; see [`crate::core::FragileReason`]) and `tunnel`
     /// (the first of [`SweepResult::tunnels`], `null` when there is none),
     /// and for an edge or vertex hit `edge_class`, the class of the edge
-    /// (or vertex, [`feature_class`]) hit (absent otherwise).
+    /// (or vertex, [`feature_class`]) hit (`null` otherwise).
     pub fn outcome_line(&self) -> Result<String, serde_json::Error> {
         #[derive(serde::Serialize)]
         struct Line<'a> {
@@ -153,7 +153,6 @@ impl SweepResult {
             outcome: OutcomeMsg,
             fragile: crate::core::Fragility,
             tunnel: Option<&'a Tunnel>,
-            #[serde(skip_serializing_if = "Option::is_none")]
             edge_class: Option<EdgeClass>,
         }
         serde_json::to_string(&Line {

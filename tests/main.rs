@@ -31,6 +31,7 @@ mod prefetch;
 mod primary_skips;
 mod rapier;
 // The Rapier recorder example, run by `rapier` (its `main` is unused here).
+mod edge_class;
 mod ghost;
 #[allow(dead_code)]
 #[path = "../examples/rapier_record.rs"]
@@ -124,6 +125,7 @@ fn main() {
     trials.extend(outputs::tests());
     trials.extend(tunnel::tests());
     trials.extend(tunnel_through::tests());
+    trials.extend(edge_class::tests());
     trials.extend(ghost::tests());
     trials.extend(repro::tests());
     trials.extend(alt_engine::tests());

@@ -1144,8 +1144,17 @@ fn cli_writes_outcomes_and_rrd() -> anyhow::Result<()> {
         ensure!(
             sorted
                 == [
-                    "alpha", "ball", "contact", "feature", "fragile", "frame", "kind", "normal",
-                    "triangle", "tunnel"
+                    "alpha",
+                    "ball",
+                    "contact",
+                    "edge_class",
+                    "feature",
+                    "fragile",
+                    "frame",
+                    "kind",
+                    "normal",
+                    "triangle",
+                    "tunnel"
                 ],
             "fields {keys:?}"
         );
@@ -1156,6 +1165,7 @@ fn cli_writes_outcomes_and_rrd() -> anyhow::Result<()> {
             .and_then(|o| o.remove("fragile"))
             .context("no fragile field")?;
         value.as_object_mut().and_then(|o| o.remove("tunnel"));
+        value.as_object_mut().and_then(|o| o.remove("edge_class"));
         let o: OutcomeMsg = serde_json::from_value(value)?;
         let want = sweep_mesh(
             &mesh,

@@ -20,8 +20,8 @@ pub fn vec3(v: &[f64]) -> String {
     )
 }
 
-/// One line describing an outcome.
-pub fn outcome_line(o: &Outcome) -> String {
+/// A core outcome in words, for the `sweep` report (`outcome: ...`).
+pub fn outcome_text(o: &Outcome) -> String {
     let Some(hit) = o.hit else {
         return format!("no collision (alpha = {})", num(o.travelled()));
     };
@@ -238,7 +238,7 @@ pub fn sweep_text(r: &SweepReport) -> String {
     )
     .unwrap();
     writeln!(s, "inputs: {}", SweepInputs::of(r.sweep, r.options).text()).unwrap();
-    writeln!(s, "outcome: {}", outcome_line(r.outcome)).unwrap();
+    writeln!(s, "outcome: {}", outcome_text(r.outcome)).unwrap();
     if let Some(place) = &r.place {
         writeln!(s, "{}", place.text).unwrap();
     }

@@ -15,6 +15,7 @@ mod core_decisions;
 mod core_random;
 mod engine;
 mod error_messages;
+mod exact;
 mod expected_source;
 mod faults;
 mod first_hour;

@@ -26,6 +26,7 @@ use sweeptrace::trace::{TraceError, TraceEvent, TraceReader, TraceWriter};
 use sweeptrace::viz;
 
 use crate::ensure;
+use crate::support::scene_t;
 use crate::trial;
 use anyhow::Context as _;
 
@@ -74,10 +75,7 @@ fn cube_scene() -> SceneMsg {
 fn triangle_scene() -> SceneMsg {
     SceneMsg {
         name: Some("triangle".into()),
-        vertices: vec![[0.0, 0.0, 0.0], [4.0, 0.0, 0.0], [0.0, 4.0, 0.0]],
-        triangles: vec![[0, 1, 2]],
-        margin: 0.0,
-        facing: Facing::NonStrict,
+        ..scene_t(0.0)
     }
 }
 

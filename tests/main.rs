@@ -34,6 +34,7 @@ mod rapier;
 // The Rapier recorder example, run by `rapier` (its `main` is unused here).
 mod edge_class;
 mod ghost;
+mod ghost_marks;
 #[allow(dead_code)]
 #[path = "../examples/rapier_record.rs"]
 mod rapier_record;
@@ -128,6 +129,7 @@ fn main() {
     trials.extend(tunnel_through::tests());
     trials.extend(edge_class::tests());
     trials.extend(ghost::tests());
+    trials.extend(ghost_marks::tests());
     trials.extend(repro::tests());
     trials.extend(alt_engine::tests());
     trials.extend(scanned::tests());

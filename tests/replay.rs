@@ -741,7 +741,7 @@ impl Decoded {
     }
 
     /// The texts of `entity`'s `component` at `frame` (empty when none).
-    fn texts_at(&self, entity: &str, component: &str, frame: i64) -> Vec<String> {
+    pub(crate) fn texts_at(&self, entity: &str, component: &str, frame: i64) -> Vec<String> {
         self.texts
             .get(&(entity.to_string(), component.to_string()))
             .and_then(|m| m.get(&frame))
@@ -1149,6 +1149,7 @@ fn cli_writes_outcomes_and_rrd() -> anyhow::Result<()> {
                     "feature",
                     "fragile",
                     "frame",
+                    "ghost",
                     "kind",
                     "normal",
                     "triangle",
@@ -1164,6 +1165,9 @@ fn cli_writes_outcomes_and_rrd() -> anyhow::Result<()> {
             .context("no fragile field")?;
         value.as_object_mut().and_then(|o| o.remove("tunnel"));
         value.as_object_mut().and_then(|o| o.remove("edge_class"));
+        // No ghost contacts in this trace.
+        let ghost = value.as_object_mut().and_then(|o| o.remove("ghost"));
+        ensure!(ghost == Some(serde_json::Value::Null), "ghost {ghost:?}");
         let o: OutcomeMsg = serde_json::from_value(value)?;
         let want = sweep_mesh(
             &mesh,

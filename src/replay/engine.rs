@@ -141,7 +141,9 @@ impl SweepResult {
     /// when it is robust; see [`crate::core::FragileReason`]) and `tunnel`
     /// (the first of [`SweepResult::tunnels`], `null` when there is none),
     /// and for an edge or vertex hit `edge_class`, the class of the edge
-    /// (or vertex, [`feature_class`]) hit (`null` otherwise).
+    /// (or vertex, [`feature_class`]) hit (`null` otherwise), and `ghost`
+    /// ([`SweepResult::ghost`] as a [`crate::regress::GhostLine`], `null`
+    /// when the expected outcome is not a ghost contact).
     pub fn outcome_line(&self) -> Result<String, serde_json::Error> {
         #[derive(serde::Serialize)]
         struct Line<'a> {
@@ -150,13 +152,34 @@ impl SweepResult {
             fragile: crate::core::Fragility,
             tunnel: Option<&'a Tunnel>,
             edge_class: Option<EdgeClass>,
+            ghost: Option<crate::regress::GhostLine<'a>>,
         }
+        let ghost = self.ghost();
         serde_json::to_string(&Line {
             outcome: self.outcome_msg(),
             fragile: self.outcome.fragile,
             tunnel: self.tunnels.first(),
             edge_class: self.scene.hit_class(&self.outcome),
+            ghost: ghost.as_ref().map(|g| g.line()),
         })
+    }
+
+    /// The expected outcome as a ghost contact, when it is one: judged as
+    /// `check` judges it ([`crate::regress::judge_ghost`], with the core's
+    /// normal for the sweep as the rule's and the default threshold
+    /// [`crate::regress::GHOST_DEGREES`]).
+    pub fn ghost(&self) -> Option<crate::regress::GhostContact> {
+        let expected = self.expected.as_ref()?;
+        match crate::regress::judge_ghost(
+            &self.scene,
+            expected,
+            self.log_time_nanos,
+            self.outcome.hit.as_ref().map(|h| &h.normal),
+            crate::regress::GHOST_DEGREES,
+        ) {
+            crate::regress::GhostJudgement::Ghost(g) => Some(g),
+            _ => None,
+        }
     }
 
     /// The record that decided the sweep: the primary test when something is

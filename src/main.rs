@@ -6,7 +6,7 @@ mod cli;
 use std::process::ExitCode;
 
 use clap::Parser;
-use sweeptrace::run::RunOutcome;
+use cli::RunOutcome;
 
 fn main() -> ExitCode {
     // Like other command-line tools, stop quietly when the reader of our

@@ -2,7 +2,6 @@
 
 use clap::{Parser, Subcommand};
 use sweeptrace::replay::ReplayOptions;
-use sweeptrace::run::RunOutcome;
 
 pub mod bless;
 pub mod check;
@@ -12,11 +11,14 @@ pub mod diff;
 pub mod info;
 pub mod junit;
 pub mod mesh;
+mod outcome;
 pub mod record;
 pub mod replay;
 pub mod report;
 pub mod repro;
 pub mod sweep;
+
+pub use outcome::RunOutcome;
 
 /// Replay recorded ball trajectories through a swept-sphere vs triangle-mesh
 /// collision core and see, frame by frame, why each collision was or was not

@@ -13,6 +13,7 @@ use std::time::Instant;
 use anyhow::{Context, bail};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 
+use super::RunOutcome;
 use sweeptrace::atomic::PendingFile;
 use sweeptrace::core::Facing;
 use sweeptrace::foxglove::{FoxgloveFile, FoxgloveOptions};
@@ -22,7 +23,6 @@ use sweeptrace::replay::{
     Detail, FrameRange, PipelineOptions, ReplayError, ReplayEvent, ReplayOptions, Selection,
     replay_events_parallel, run_pipeline,
 };
-use sweeptrace::run::RunOutcome;
 use sweeptrace::trace::TraceReader;
 use sweeptrace::trace::prefetch::{self, prefetch};
 use sweeptrace::viz::{

@@ -23,7 +23,6 @@ use crate::core::{Facing, Feature, FragileReason, Kind};
 use crate::replay::{
     ReplayError, ReplayEvent, ReplayOptions, SweepResult, Tunnel, TunnelAt, TunnelKind,
 };
-use crate::run::RunOutcome;
 use crate::trace::messages::{EXPECTED_TOPIC, OutcomeMsg};
 use crate::trace::{TraceError, TraceEvent, TraceReader};
 
@@ -189,21 +188,6 @@ impl TraceReport {
     /// Whether ghost contacts were found and fail the check.
     pub fn fails_on_ghosts(&self) -> bool {
         self.ghosts > 0 && self.fail_on_ghost
-    }
-
-    /// What the check of this trace came to: a divergence is
-    /// [`RunOutcome::Differences`]; a trace that ends early
-    /// [`RunOutcome::IncompleteInput`]; any other error, or nothing to
-    /// compare, [`RunOutcome::Error`].
-    pub fn outcome(&self) -> RunOutcome {
-        match self.status() {
-            Status::Ok => RunOutcome::Success,
-            Status::Fail => RunOutcome::Differences,
-            Status::Error if self.incomplete && self.errors.len() == 1 => {
-                RunOutcome::IncompleteInput
-            }
-            Status::NoExpectations | Status::Error => RunOutcome::Error,
-        }
     }
 }
 

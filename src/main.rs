@@ -5,7 +5,6 @@ mod cli;
 
 use std::process::ExitCode;
 
-use clap::Parser;
 use cli::RunOutcome;
 
 fn main() -> ExitCode {
@@ -19,7 +18,7 @@ fn main() -> ExitCode {
     }
     #[cfg(unix)]
     interrupts::handle();
-    let args = cli::Cli::parse();
+    let args = cli::parse();
     let outcome = cli::run(args).unwrap_or_else(|err| {
         eprintln!("error: {err:#}");
         RunOutcome::Error

@@ -10,8 +10,10 @@
 
 mod cases;
 pub mod junit;
+mod rules;
 
-pub use cases::{Case, RULES, Rule, cases};
+pub use cases::{Case, cases};
+pub use rules::{RULES, Rule};
 
 use std::fmt::Write as _;
 

@@ -26,6 +26,16 @@
 //! (collision groups), like the balls of `sweeptrace record`. A ball is no
 //! longer recorded once it leaves the scene's play volume.
 //!
+//! `--fix-internal-edges` builds Rapier's mesh with
+//! `TriMeshFlags::FIX_INTERNAL_EDGES`. After each step the recorder judges
+//! the solver's contacts between each ball and the mesh (those touching, a
+//! point at distance ≤ 0) with `check`'s ghost-contact rule and prints how
+//! many are ghosts. `--expect contacts` writes those contacts as the
+//! expectations instead of the shape cast (for each sweep the contact whose
+//! normal leans furthest from its face, at `α = 0`): a trace to list ghost
+//! contacts with, not to compare (examples/rapier/README.md, "Ghost
+//! contacts on a floor and a ramp").
+//!
 //! The trace names its expectations' source (the `sweeptrace.expected_source`
 //! record): engine `rapier3d-f64`, the version linked, and the settings that
 //! bear on its answers ([`rapier_source`]: the mesh's `fix_internal_edges`
@@ -46,7 +56,10 @@ use std::process::ExitCode;
 use rapier3d_f64::parry::query::{ShapeCastOptions, ShapeCastStatus};
 use rapier3d_f64::parry::shape::{Ball, TriMeshFlags};
 use rapier3d_f64::prelude::*;
+use sweeptrace::Topology;
 use sweeptrace::core::Kind;
+use sweeptrace::regress::{GHOST_DEGREES, GhostJudgement, judge_ghost};
+use sweeptrace::replay::SceneState;
 use sweeptrace::sim::obj::load_obj;
 use sweeptrace::sim::scenes::SceneMesh;
 use sweeptrace::sim::{BuiltinScene, SimOptions, initial_states, play_volume, scene_message};
@@ -68,6 +81,14 @@ usage: rapier_record (--scene NAME | --mesh FILE.obj) -o OUT.mcap [options]
   --seed N            seed of the balls' jitter (default 0)
   --radius R          radius of the balls (default: the scene's)
   --position X,Y,Z    ball 0's starting centre (default: the scene's)
+  --velocity X,Y,Z    ball 0's starting velocity (default: the scene's)
+  --fix-internal-edges
+                      build the mesh with TriMeshFlags::FIX_INTERNAL_EDGES
+  --expect cast|contacts
+                      the expectations: Rapier's shape cast along each sweep
+                      (default), or the solver's contact at the step's start
+                      that leans furthest from its face (to list ghost
+                      contacts with `sweeptrace check`, not to compare)
 
 example: rapier_record --scene mini_golf --balls 2 --frames 240 -o rapier_mini_golf.mcap";
 
@@ -81,17 +102,79 @@ pub struct Args {
     pub output: PathBuf,
     /// Balls, frames, radius, time step, gravity, restitution.
     pub options: SimOptions,
+    /// Build Rapier's mesh with `TriMeshFlags::FIX_INTERNAL_EDGES`.
+    pub fix_internal_edges: bool,
+    /// What the expectations are.
+    pub expect: Expect,
+}
+
+/// What a sweep's expectation is.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Expect {
+    /// Rapier's shape cast of the ball along the sweep (`--expect cast`).
+    #[default]
+    Cast,
+    /// The solver's contact at the start of the step (`--expect
+    /// contacts`): of the contacts touching the mesh, the one whose normal
+    /// leans furthest from its triangle's face normal, at `α = 0`. Not a
+    /// first contact along the sweep: a trace to list ghost contacts with,
+    /// not to compare (see examples/rapier/README.md).
+    Contacts,
+}
+
+/// What the solver did at the seams, counted over the run: its contact
+/// manifolds against the mesh that touch (a point at distance ≤ 0), and
+/// those a `check` of them would call ghost contacts (an edge or vertex contact on an internal flat or concave place
+/// whose normal leans more than `GHOST_DEGREES` from the faces').
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct SolverContacts {
+    /// Touching manifolds (one per triangle) between a ball and the mesh,
+    /// summed over the steps.
+    pub manifolds: u64,
+    /// Of those, the ghost contacts.
+    pub ghosts: u64,
+}
+
+/// What [`run`] wrote and saw.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Counts {
+    /// Sweeps written.
+    pub sweeps: u64,
+    /// Rapier's shape-cast hits among them.
+    pub hits: u64,
+    /// Sweeps that start in contact (written without an expectation).
+    pub starting_in_contact: u64,
+    /// The solver's contacts.
+    pub solver: SolverContacts,
+}
+
+/// `X,Y,Z` as three finite numbers.
+fn triple(flag: &str, value: &str) -> Result<[f64; 3], String> {
+    let parts: Option<Vec<f64>> = value
+        .split(',')
+        .map(|p| p.trim().parse::<f64>().ok().filter(|v| v.is_finite()))
+        .collect();
+    match parts.as_deref() {
+        Some(&[x, y, z]) => Ok([x, y, z]),
+        _ => Err(format!("{flag}: expected X,Y,Z, got {value}")),
+    }
 }
 
 fn parse_args() -> Result<Args, String> {
     let mut raw = std::env::args().skip(1);
     let (mut scene, mut mesh, mut output) = (None, None, None);
-    let (mut balls, mut frames, mut seed, mut radius, mut position) =
-        (None, None, None, None, None);
+    let (mut balls, mut frames, mut seed, mut radius, mut position, mut velocity) =
+        (None, None, None, None, None, None);
+    let mut fix_internal_edges = false;
+    let mut expect = Expect::Cast;
     while let Some(flag) = raw.next() {
         if flag == "-h" || flag == "--help" {
             println!("{USAGE}");
             std::process::exit(0);
+        }
+        if flag == "--fix-internal-edges" {
+            fix_internal_edges = true;
+            continue;
         }
         let value = raw.next().ok_or_else(|| format!("{flag} needs a value"))?;
         let number = |what: &str| -> Result<f64, String> {
@@ -118,16 +201,14 @@ fn parse_args() -> Result<Args, String> {
             "--frames" => frames = Some(count("--frames")?),
             "--seed" => seed = Some(count("--seed")?),
             "--radius" => radius = Some(number("--radius")?),
-            "--position" => {
-                let parts: Vec<f64> = value
-                    .split(',')
-                    .map(|p| p.trim().parse::<f64>().ok().filter(|v| v.is_finite()))
-                    .collect::<Option<_>>()
-                    .ok_or_else(|| format!("--position: expected X,Y,Z, got {value}"))?;
-                let [x, y, z] = parts[..] else {
-                    return Err(format!("--position: expected X,Y,Z, got {value}"));
-                };
-                position = Some([x, y, z]);
+            "--position" => position = Some(triple("--position", &value)?),
+            "--velocity" => velocity = Some(triple("--velocity", &value)?),
+            "--expect" => {
+                expect = match value.as_str() {
+                    "cast" => Expect::Cast,
+                    "contacts" => Expect::Contacts,
+                    _ => return Err(format!("--expect: cast or contacts, got {value}")),
+                }
             }
             _ => return Err(format!("unknown option {flag}")),
         }
@@ -142,6 +223,7 @@ fn parse_args() -> Result<Args, String> {
     options.seed = seed.unwrap_or(options.seed);
     options.radius = radius.unwrap_or(options.radius);
     options.position = position.unwrap_or(options.position);
+    options.velocity = velocity.unwrap_or(options.velocity);
     // Rapier has no margin and no facing rule: the trace declares margin 0
     // and the default facing rule.
     options.margin = 0.0;
@@ -151,6 +233,8 @@ fn parse_args() -> Result<Args, String> {
         mesh,
         output,
         options,
+        fix_internal_edges,
+        expect,
     })
 }
 
@@ -193,10 +277,14 @@ fn classify(corners: [Vector; 3], witness: Vector, normal: Vector) -> (Kind, Opt
 
 /// The expectations' source: Rapier, its version, and the settings of this
 /// recording that bear on its answers.
+/// A trace of solver contacts (`--expect contacts`) says so in the setting
+/// `expectations = solver_contacts`; without it the expectations are shape
+/// casts.
 pub fn rapier_source(
     world: &PhysicsWorld,
     mesh: ColliderHandle,
     cast: &ShapeCastOptions,
+    expect: Expect,
 ) -> ExpectedSource {
     let collider = &world.colliders[mesh];
     let fix_internal_edges = collider
@@ -204,7 +292,12 @@ pub fn rapier_source(
         .as_trimesh()
         .is_some_and(|t| t.flags().contains(TriMeshFlags::FIX_INTERNAL_EDGES));
     let parameters = &world.integration_parameters;
-    ExpectedSource::new("rapier3d-f64", rapier3d_f64::VERSION)
+    let source = ExpectedSource::new("rapier3d-f64", rapier3d_f64::VERSION);
+    let source = match expect {
+        Expect::Cast => source,
+        Expect::Contacts => source.setting("expectations", "solver_contacts"),
+    };
+    source
         .setting("fix_internal_edges", fix_internal_edges)
         .setting("contact_skin", collider.contact_skin())
         .setting("dt", parameters.dt)
@@ -215,9 +308,83 @@ pub fn rapier_source(
         .setting("kind_tolerance", CLASSIFY_TOLERANCE)
 }
 
-/// Writes the trace; returns the sweeps, Rapier's hits, and the sweeps
-/// that start in contact (written without an expectation).
-pub fn run(args: Args) -> Result<(u64, u64, u64), String> {
+/// One of the solver's contacts between a ball and the mesh, as an
+/// outcome at `α = 0` (touching at the start of the step).
+struct SolverContact {
+    outcome: OutcomeMsg,
+    /// The angle between its normal and its triangle's face normal, degrees.
+    lean_degrees: f64,
+    /// Whether `check`'s rule (`judge_ghost`) calls it a ghost contact.
+    ghost: bool,
+}
+
+/// The solver's manifolds between the ball collider `ball` (of ball number
+/// `ball_number`, at `frame`) and the mesh after a step that touch (a point
+/// at distance ≤ 0; speculative points, still apart, are left out): each
+/// as an outcome with its triangle, the kind and feature read from its
+/// deepest point on the mesh (as for a shape cast's answer), its normal
+/// from the mesh toward the ball, judged by `check`'s ghost rule.
+fn solver_contacts(
+    world: &PhysicsWorld,
+    (ball, frame, ball_number): (ColliderHandle, u64, u32),
+    mesh: ColliderHandle,
+    scene: &SceneState,
+    corners_of: impl Fn(u32) -> Option<[Vector; 3]>,
+) -> Vec<SolverContact> {
+    let Some(pair) = world.contact_pair(ball, mesh) else {
+        return Vec::new();
+    };
+    let mesh_first = pair.collider1 == mesh;
+    let mut out = Vec::new();
+    for manifold in pair.manifolds() {
+        let Some(point) = manifold.find_deepest_contact().filter(|p| p.dist <= 0.0) else {
+            continue;
+        };
+        let (triangle, normal) = if mesh_first {
+            (manifold.subshape1, manifold.data.normal)
+        } else {
+            (manifold.subshape2, -manifold.data.normal)
+        };
+        // The mesh is fixed at the origin: its local frame is the world's.
+        let witness = if mesh_first {
+            point.local_p1
+        } else {
+            point.local_p2
+        };
+        let Some(corners) = corners_of(triangle) else {
+            continue;
+        };
+        let (kind, feature) = classify(corners, witness, normal);
+        let mut outcome = OutcomeMsg::hit(frame, ball_number, 0.0, kind)
+            .triangle(triangle)
+            .normal(array(normal))
+            .contact(array(witness));
+        if let Some(feature) = feature {
+            outcome = outcome.feature(feature);
+        }
+        let [a, b, c] = corners;
+        let face = (b - a).cross(c - a).normalize();
+        let lean_degrees = normal
+            .normalize()
+            .dot(face)
+            .clamp(-1.0, 1.0)
+            .acos()
+            .to_degrees();
+        let ghost = matches!(
+            judge_ghost(scene, &outcome, 0, None, GHOST_DEGREES),
+            GhostJudgement::Ghost(_)
+        );
+        out.push(SolverContact {
+            outcome,
+            lean_degrees,
+            ghost,
+        });
+    }
+    out
+}
+
+/// Writes the trace; returns what it wrote and what the solver did.
+pub fn run(args: Args) -> Result<Counts, String> {
     let scene: SceneMesh = match (&args.scene, &args.mesh) {
         (Some(builtin), _) => builtin.mesh(),
         (None, Some(path)) => load_obj(path).map_err(|e| e.to_string())?,
@@ -247,7 +414,12 @@ pub fn run(args: Args) -> Result<(u64, u64, u64), String> {
     let mesh_groups = InteractionGroups::new(Group::GROUP_1, Group::ALL, InteractionTestMode::And);
     let ball_groups =
         InteractionGroups::new(Group::GROUP_2, Group::GROUP_1, InteractionTestMode::And);
-    let mesh_collider = ColliderBuilder::trimesh(vertices, indices)
+    let builder = if args.fix_internal_edges {
+        ColliderBuilder::trimesh_with_flags(vertices, indices, TriMeshFlags::FIX_INTERNAL_EDGES)
+    } else {
+        ColliderBuilder::trimesh(vertices, indices)
+    };
+    let mesh_collider = builder
         .map_err(|e| format!("Rapier refuses the mesh {}: {e}", scene.name))?
         .collision_groups(mesh_groups)
         .restitution(options.restitution);
@@ -261,8 +433,8 @@ pub fn run(args: Args) -> Result<(u64, u64, u64), String> {
         let collider = ColliderBuilder::ball(options.radius)
             .restitution(options.restitution)
             .collision_groups(ball_groups);
-        let (handle, _) = world.insert(body, collider);
-        balls.push(Some(handle));
+        let (handle, collider) = world.insert(body, collider);
+        balls.push(Some((handle, collider)));
     }
 
     let shape = Ball::new(options.radius);
@@ -276,18 +448,36 @@ pub fn run(args: Args) -> Result<(u64, u64, u64), String> {
     };
     let step_nanos = options.time_step_nanos();
     let trimesh_triangles = &scene.triangles;
-    let source = rapier_source(&world, mesh_handle, &cast);
+    let source = rapier_source(&world, mesh_handle, &cast, args.expect);
+    let message = scene_message(&scene, options);
+    let scene_state = SceneState {
+        number: 0,
+        index: 0,
+        log_time_nanos: 0,
+        name: message.name.clone(),
+        mesh: core_mesh.clone(),
+        topology: Topology::new(&message.vertices, &message.triangles)
+            .map_err(|e| format!("scene {}: {e}", scene.name))?,
+        options: sweeptrace::core::Options {
+            margin: message.margin,
+            facing: message.facing,
+        },
+    };
+    let corners_of = |t: u32| {
+        let triangle = trimesh_triangles.get(t as usize)?;
+        Some(triangle.map(|i| vector(scene.vertices[i as usize])))
+    };
     let counts = write_trace_file(&args.output, |trace| {
         trace.expected_source(&source)?;
-        trace.scene(0, &scene_message(&scene, options))?;
-        let (mut sweeps, mut hits, mut starting_in_contact) = (0u64, 0u64, 0u64);
+        trace.scene(0, &message)?;
+        let mut counts = Counts::default();
         let gravity = vector(options.gravity);
         let dt = options.time_step;
         for frame in 0..options.frames {
             let log_time_nanos = frame * step_nanos;
             let pipeline = world.query_pipeline_with_filter(QueryFilter::only_fixed());
             for (ball, handle) in balls.iter_mut().enumerate() {
-                let Some(h) = *handle else {
+                let Some((h, _)) = *handle else {
                     continue;
                 };
                 // The step's motion before contacts: Rapier's integration
@@ -312,7 +502,7 @@ pub fn run(args: Args) -> Result<(u64, u64, u64), String> {
                         p1: array(p1),
                     },
                 )?;
-                sweeps += 1;
+                counts.sweeps += 1;
                 let answer =
                     pipeline.cast_shape(&Pose::from_translation(p0), p1 - p0, &shape, cast);
                 let outcome = match answer {
@@ -325,11 +515,11 @@ pub fn run(args: Args) -> Result<(u64, u64, u64), String> {
                     Some((_, hit))
                         if hit.status == ShapeCastStatus::PenetratingOrWithinTargetDist =>
                     {
-                        starting_in_contact += 1;
+                        counts.starting_in_contact += 1;
                         continue;
                     }
                     Some((collider, hit)) => {
-                        hits += 1;
+                        counts.hits += 1;
                         // The mesh is fixed at the origin: world = its frame.
                         let witness = hit.witness1;
                         let trimesh = world.colliders[collider]
@@ -341,23 +531,44 @@ pub fn run(args: Args) -> Result<(u64, u64, u64), String> {
                         let corners = trimesh_triangles[triangle as usize]
                             .map(|i| vector(scene.vertices[i as usize]));
                         let (kind, feature) = classify(corners, witness, hit.normal1);
-                        OutcomeMsg {
-                            frame,
-                            ball,
-                            alpha: hit.time_of_impact.clamp(0.0, 1.0),
-                            kind,
-                            triangle: Some(Some(triangle)),
-                            feature: Some(feature),
-                            normal: Some(Some(array(hit.normal1))),
-                            contact: Some(Some(array(witness))),
+                        let outcome =
+                            OutcomeMsg::hit(frame, ball, hit.time_of_impact.clamp(0.0, 1.0), kind)
+                                .triangle(triangle)
+                                .normal(array(hit.normal1))
+                                .contact(array(witness));
+                        match feature {
+                            Some(feature) => outcome.feature(feature),
+                            None => outcome,
                         }
                     }
                 };
-                trace.expected(log_time_nanos, &outcome)?;
+                if args.expect == Expect::Cast {
+                    trace.expected(log_time_nanos, &outcome)?;
+                }
             }
             world.step();
+            for (ball, handle) in balls.iter().enumerate() {
+                let Some((_, collider)) = *handle else {
+                    continue;
+                };
+                let contacts = solver_contacts(
+                    &world,
+                    (collider, frame, ball as u32),
+                    mesh_handle,
+                    &scene_state,
+                    corners_of,
+                );
+                counts.solver.manifolds += contacts.len() as u64;
+                counts.solver.ghosts += contacts.iter().filter(|c| c.ghost).count() as u64;
+                let leaning = contacts
+                    .into_iter()
+                    .max_by(|a, b| a.lean_degrees.total_cmp(&b.lean_degrees));
+                if let (Expect::Contacts, Some(contact)) = (args.expect, leaning) {
+                    trace.expected(log_time_nanos, &contact.outcome)?;
+                }
+            }
         }
-        Ok::<_, sweeptrace::trace::TraceError>((sweeps, hits, starting_in_contact))
+        Ok::<_, sweeptrace::trace::TraceError>(counts)
     })
     .map_err(|e| e.to_string())?;
     Ok(counts)
@@ -373,10 +584,17 @@ fn main() -> ExitCode {
     };
     let output = args.output.display().to_string();
     match run(args) {
-        Ok((sweeps, hits, starting_in_contact)) => {
+        Ok(c) => {
             println!(
-                "wrote {output}: {sweeps} sweeps, {hits} hits found by Rapier's shape cast, \
-                 {starting_in_contact} sweeps starting in contact (no expectation)"
+                "wrote {output}: {} sweeps, {} hits found by Rapier's shape cast, \
+                 {} sweeps starting in contact (no expectation)",
+                c.sweeps, c.hits, c.starting_in_contact
+            );
+            println!(
+                "Rapier's solver: {} ball-mesh contact manifolds over the steps, {} of them ghost contacts \
+                 (an edge or vertex contact on an internal flat or concave edge, normal more than {GHOST_DEGREES}° \
+                 from the faces')",
+                c.solver.manifolds, c.solver.ghosts
             );
             ExitCode::SUCCESS
         }

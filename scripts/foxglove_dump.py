@@ -24,10 +24,11 @@ CHANNELS = {
     "/sweeps": "foxglove.SceneUpdate",
     "/contacts": "foxglove.SceneUpdate",
     "/expected_outcome": "foxglove.SceneUpdate",
+    "/ghosts": "foxglove.SceneUpdate",
     "/decisions": "foxglove.Log",
     "/numbers": "sweeptrace.SweepNumbers",
 }
-PER_SWEEP = ["/balls", "/sweeps", "/contacts", "/expected_outcome", "/decisions", "/numbers"]
+PER_SWEEP = ["/balls", "/sweeps", "/contacts", "/expected_outcome", "/ghosts", "/decisions", "/numbers"]
 
 
 def main():

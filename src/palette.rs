@@ -46,3 +46,7 @@ pub const EXPECTED_COLOR: [u8; 4] = [230, 60, 230, 255];
 /// only).
 #[cfg_attr(not(feature = "viewer"), allow(dead_code))]
 pub const TUNNEL_COLOR: [u8; 4] = [255, 0, 90, 255];
+/// A ghost contact's mark: the point and its (tilted) normal.
+pub const GHOST_COLOR: [u8; 4] = [0, 215, 255, 255];
+/// The faces' normal drawn beside a ghost contact's normal.
+pub const FACE_NORMAL_COLOR: [u8; 4] = [245, 245, 245, 255];

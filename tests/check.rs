@@ -36,6 +36,7 @@ use sweeptrace::trace::{TraceReader, TraceWriter};
 use crate::ensure;
 use crate::os;
 use crate::support::run_bin;
+use crate::support::scene_t;
 use crate::trial;
 use anyhow::Context as _;
 
@@ -104,17 +105,6 @@ fn trace_trials() -> Vec<Trial> {
 }
 
 // ---------------------------------------------------------------- helpers
-
-/// Triangle T of SEMANTICS.md.
-fn scene_t(margin: f64) -> SceneMsg {
-    SceneMsg {
-        name: Some("triangle_t".into()),
-        vertices: vec![[0.0, 0.0, 0.0], [4.0, 0.0, 0.0], [0.0, 4.0, 0.0]],
-        triangles: vec![[0, 1, 2]],
-        margin,
-        facing: Facing::NonStrict,
-    }
-}
 
 fn sweep(frame: u64, p0: [f64; 3], p1: [f64; 3]) -> SweepMsg {
     SweepMsg {

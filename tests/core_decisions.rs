@@ -12,6 +12,7 @@ use sweeptrace::core::{
 
 use crate::core_random::{random_patch, random_sweep, random_triangle, uniform, unit};
 use crate::ensure;
+use crate::exact::{cross3, dot3, exact_tie_set, on_segment, rational_length_vectors, sub3};
 use crate::support::{close, mesh, run};
 use crate::trial;
 use anyhow::Context as _;
@@ -217,20 +218,6 @@ struct IntMesh {
     terrain: Option<(i64, i64, i64, i64)>,
 }
 
-pub(crate) fn sub3(a: [i64; 3], b: [i64; 3]) -> [i64; 3] {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-pub(crate) fn dot3(a: [i64; 3], b: [i64; 3]) -> i64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-pub(crate) fn cross3(a: [i64; 3], b: [i64; 3]) -> [i64; 3] {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
-}
-
 /// Shuffles the triangle order and rotates each index triple (orientation
 /// kept), so the tie order's triangle and feature numbers are arbitrary.
 fn shuffle_triangles(rng: &mut ChaCha8Rng, triangles: &mut [[usize; 3]]) {
@@ -304,60 +291,6 @@ fn int_terrain(rng: &mut ChaCha8Rng) -> IntMesh {
     }
 }
 
-/// Every integer vector of integer length 1..=11 (Pythagorean quadruples).
-fn rational_length_vectors() -> Vec<([i64; 3], i64)> {
-    let mut out = Vec::new();
-    for x in -11i64..=11 {
-        for y in -11i64..=11 {
-            for z in -11i64..=11 {
-                let s = x * x + y * y + z * z;
-                let r = (s as f64).sqrt().round() as i64;
-                if s > 0 && r * r == s && r <= 11 {
-                    out.push(([x, y, z], r));
-                }
-            }
-        }
-    }
-    out
-}
-
-/// Whether `x` lies on the closed segment `a b` (exact).
-pub(crate) fn on_segment(x: [i64; 3], a: [i64; 3], b: [i64; 3]) -> bool {
-    let (ab, ax) = (sub3(b, a), sub3(x, a));
-    cross3(ab, ax) == [0, 0, 0] && dot3(ax, ab) >= 0 && dot3(ax, ab) <= dot3(ab, ab)
-}
-
-/// The exact tie set at the contact point `x`, ball centre `x + w` with
-/// `ρ = |w|`, travelling along `d`, when `w` is in the normal cone at `x`:
-/// `(kind, triangle, feature)` of every test that touches at that moment.
-fn exact_tie_set(m: &IntMesh, x: [i64; 3], w: [i64; 3], d: [i64; 3]) -> Vec<(Kind, u32, u8)> {
-    let mut out = Vec::new();
-    for (t, tri) in m.triangles.iter().enumerate() {
-        let v = tri.map(|i| m.vertices[i]);
-        let normal = cross3(sub3(v[1], v[0]), sub3(v[2], v[0]));
-        if dot3(normal, d) > 0 {
-            continue; // back-facing (non-strict rule)
-        }
-        let contains = (0..3).any(|e| on_segment(x, v[e], v[(e + 1) % 3]));
-        if contains && cross3(normal, w) == [0, 0, 0] && dot3(normal, w) > 0 {
-            out.push((Kind::Face, t as u32, 0));
-        }
-        for e in 0..3 {
-            let (a, b) = (v[e], v[(e + 1) % 3]);
-            if on_segment(x, a, b) && dot3(sub3(b, a), w) == 0 {
-                out.push((Kind::Edge, t as u32, e as u8));
-            }
-        }
-        for (k, &p) in v.iter().enumerate() {
-            if p == x {
-                out.push((Kind::Vertex, t as u32, k as u8));
-            }
-        }
-    }
-    out.sort();
-    out
-}
-
 /// On closed boxes and convex height fields with shuffled triangles, balls
 /// sent at a vertex, a point of an edge or a face's boundary along a
 /// direction of its normal cone, all in small integers (exact in binary),
@@ -366,7 +299,7 @@ fn exact_tie_set(m: &IntMesh, x: [i64; 3], w: [i64; 3], d: [i64; 3]) -> Vec<(Kin
 /// the first of them in the rules' order, whatever rounding did.
 fn exact_ties_on_boxes_and_terrains_follow_the_rules() -> anyhow::Result<()> {
     let mut rng = ChaCha8Rng::seed_from_u64(0x7135);
-    let candidates = rational_length_vectors();
+    let candidates = rational_length_vectors(11);
     let (mut checked, mut multi, mut by_kind) = (0usize, 0usize, [0usize; 3]);
     let mut on_terrain = 0usize;
     for mesh_number in 0..200 {
@@ -430,7 +363,13 @@ fn exact_ties_on_boxes_and_terrains_follow_the_rules() -> anyhow::Result<()> {
                 if grazing {
                     continue;
                 }
-                let expected = exact_tie_set(&m, x, w, d);
+                let expected = exact_tie_set(
+                    &m.vertices,
+                    (0u32..).zip(m.triangles.iter().copied()),
+                    x,
+                    w,
+                    d,
+                );
                 let Some(&first) = expected.first() else {
                     continue;
                 };

@@ -7,11 +7,11 @@ use std::path::{Path, PathBuf};
 use std::time::Duration;
 
 use libtest_mimic::Trial;
-use sweeptrace::core::Facing;
 use sweeptrace::trace::TraceWriter;
-use sweeptrace::trace::messages::{SceneMsg, SweepMsg};
+use sweeptrace::trace::messages::SweepMsg;
 
 use crate::support::run_bin;
+use crate::support::scene_t;
 use crate::{ensure, os, trial};
 
 const LIMIT: Duration = Duration::from_secs(60);
@@ -57,13 +57,7 @@ pub fn example_engine_command(extra: &str) -> String {
 /// Triangle T of SEMANTICS.md with the sweeps of its worked examples 1 to 3
 /// (face, edge, vertex) and a miss.
 pub fn worked_examples_trace() -> Vec<u8> {
-    let scene = SceneMsg {
-        name: Some("triangle_t".into()),
-        vertices: vec![[0.0, 0.0, 0.0], [4.0, 0.0, 0.0], [0.0, 4.0, 0.0]],
-        triangles: vec![[0, 1, 2]],
-        margin: 0.0,
-        facing: Facing::NonStrict,
-    };
+    let scene = scene_t(0.0);
     let sweeps = [
         ([1.0, 1.0, 3.0], [1.0, 1.0, -3.0]),
         ([2.0, -0.3, 3.0], [2.0, -0.3, -3.0]),

@@ -10,7 +10,7 @@ use std::path::{Path, PathBuf};
 
 use libtest_mimic::{Completion, Trial};
 use mcap::records::{MessageHeader, Metadata};
-use sweeptrace::core::{Facing, Kind};
+use sweeptrace::core::Kind;
 use sweeptrace::regress::{CheckOptions, Status, check_file, render_json, render_text};
 use sweeptrace::trace::info::{self, collect};
 use sweeptrace::trace::messages::{OutcomeMsg, SceneMsg, SweepMsg};
@@ -21,6 +21,7 @@ use sweeptrace::trace::{
 
 use crate::engine::example_engine_command;
 use crate::support::run_bin;
+use crate::support::scene_t;
 use crate::{ensure, os, trial};
 use anyhow::Context as _;
 
@@ -47,11 +48,8 @@ const RAPIER_TEXT: &str = "rapier3d-f64 0.36.1 (fix_internal_edges = false)";
 
 fn scene() -> SceneMsg {
     SceneMsg {
-        name: Some("triangle".to_string()),
-        vertices: vec![[0.0, 0.0, 0.0], [4.0, 0.0, 0.0], [0.0, 4.0, 0.0]],
-        triangles: vec![[0, 1, 2]],
-        margin: 0.0,
-        facing: Facing::NonStrict,
+        name: Some("triangle".into()),
+        ..scene_t(0.0)
     }
 }
 

@@ -126,7 +126,7 @@ fn foxglove_bytes(trace: &[u8]) -> anyhow::Result<Vec<u8>> {
 }
 
 /// Every message: (topic, schema name, log_time, JSON).
-fn messages(bytes: &[u8]) -> anyhow::Result<Vec<(String, String, u64, Value)>> {
+pub(crate) fn messages(bytes: &[u8]) -> anyhow::Result<Vec<(String, String, u64, Value)>> {
     let mut out = Vec::new();
     for m in mcap::MessageStream::new(bytes)? {
         let m = m?;
@@ -143,7 +143,7 @@ fn messages(bytes: &[u8]) -> anyhow::Result<Vec<(String, String, u64, Value)>> {
     Ok(out)
 }
 
-fn on<'a>(all: &'a [(String, String, u64, Value)], topic: &str) -> Vec<&'a Value> {
+pub(crate) fn on<'a>(all: &'a [(String, String, u64, Value)], topic: &str) -> Vec<&'a Value> {
     all.iter()
         .filter(|(t, ..)| t == topic)
         .map(|(.., v)| v)
@@ -176,6 +176,7 @@ fn foxglove_file_reads_back_with_the_mcap_crate() -> anyhow::Result<()> {
         ("/sweeps", "foxglove.SceneUpdate"),
         ("/contacts", "foxglove.SceneUpdate"),
         ("/expected_outcome", "foxglove.SceneUpdate"),
+        ("/ghosts", "foxglove.SceneUpdate"),
         ("/decisions", "foxglove.Log"),
         ("/numbers", "sweeptrace.SweepNumbers"),
     ]
@@ -208,13 +209,14 @@ fn foxglove_file_reads_back_with_the_mcap_crate() -> anyhow::Result<()> {
         times.windows(2).all(|w| w[0] <= w[1]),
         "messages not in log_time order: {times:?}"
     );
-    // 5 sweeps; the second scene also clears the 4 per-sweep scene channels.
+    // 5 sweeps; the second scene also clears the 5 per-sweep scene channels.
     for (topic, n) in [
         ("/mesh", 2),
         ("/balls", 6),
         ("/sweeps", 6),
         ("/contacts", 6),
         ("/expected_outcome", 6),
+        ("/ghosts", 6),
         ("/decisions", 5),
         ("/numbers", 5),
     ] {
@@ -474,7 +476,18 @@ fn required(var: &str) -> bool {
     std::env::var_os(var).is_some_and(|v| v == "1")
 }
 
-fn python_and_node_read_and_validate_the_foxglove_file() -> anyhow::Result<Completion> {
+/// Reads `file` back with Python's `mcap` (scripts/foxglove_dump.py: the
+/// channels, and `scenes` scenes and `sweeps` sweeps), dumping its messages
+/// to `dump`, and validates every message against Foxglove's published
+/// schemas with Node (tests/foxglove/validate.mjs). Returns why a step
+/// was skipped (Python's `mcap`, or Node or its packages, missing and not
+/// required), `None` when everything ran; `dump` exists when Python ran.
+pub(crate) fn validate_foxglove_file(
+    file: &Path,
+    scenes: u64,
+    sweeps: u64,
+    dump: &Path,
+) -> anyhow::Result<Option<String>> {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
     let python_missing = match std::process::Command::new("python3")
         .args(["-c", "import mcap"])
@@ -488,35 +501,27 @@ fn python_and_node_read_and_validate_the_foxglove_file() -> anyhow::Result<Compl
         if required(REQUIRE_PYTHON) {
             anyhow::bail!("{missing}, and {REQUIRE_PYTHON}=1 requires it");
         }
-        return Ok(Completion::ignored_with(format!(
+        return Ok(Some(format!(
             "skipped: {missing}; {REQUIRE_PYTHON}=1 makes this a failure"
         )));
     }
-    let dir = tempfile::tempdir()?;
-    let file = dir.path().join("two_scenes.foxglove.mcap");
-    std::fs::write(&file, foxglove_bytes(&two_scene_trace()?)?)?;
-    let dump = dir.path().join("dump.jsonl");
     let script = root.join("scripts/foxglove_dump.py");
-    let python = |extra: &[&str]| {
-        run(std::process::Command::new("python3")
-            .arg(&script)
-            .arg(&file)
-            .args(extra))
-    };
-    let dump_arg = dump.display().to_string();
-    let ok = python(&["--scenes", "2", "--sweeps", "5", "--dump", &dump_arg])?;
+    let ok = run(std::process::Command::new("python3")
+        .arg(&script)
+        .arg(file)
+        .args([
+            "--scenes",
+            &scenes.to_string(),
+            "--sweeps",
+            &sweeps.to_string(),
+        ])
+        .arg("--dump")
+        .arg(dump))?;
     ensure!(
         ok.status.success(),
         "foxglove_dump.py: {}",
         output_text(&ok)
     );
-    let bad = python(&["--scenes", "2", "--sweeps", "6"])?;
-    ensure!(
-        !bad.status.success(),
-        "foxglove_dump.py accepted a wrong count"
-    );
-
-    // Node: every message against Foxglove's published schemas.
     let packages = root.join("tests/foxglove/node_modules/@foxglove/schemas");
     let node_missing = match std::process::Command::new("node").arg("--version").output() {
         Ok(o) if o.status.success() && packages.is_dir() => None,
@@ -529,18 +534,42 @@ fn python_and_node_read_and_validate_the_foxglove_file() -> anyhow::Result<Compl
         if required(REQUIRE_NODE) {
             anyhow::bail!("{missing}, and {REQUIRE_NODE}=1 requires it");
         }
-        return Ok(Completion::ignored_with(format!(
+        return Ok(Some(format!(
             "Python read the file; the schema validation was skipped: {missing}; \
              {REQUIRE_NODE}=1 makes this a failure"
         )));
     }
     let validate = root.join("tests/foxglove/validate.mjs");
-    let node = run(std::process::Command::new("node").arg(&validate).arg(&dump))?;
+    let node = run(std::process::Command::new("node").arg(&validate).arg(dump))?;
     ensure!(
         node.status.success(),
         "validate.mjs: {}",
         output_text(&node)
     );
+    Ok(None)
+}
+
+fn python_and_node_read_and_validate_the_foxglove_file() -> anyhow::Result<Completion> {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let dir = tempfile::tempdir()?;
+    let file = dir.path().join("two_scenes.foxglove.mcap");
+    std::fs::write(&file, foxglove_bytes(&two_scene_trace()?)?)?;
+    let dump = dir.path().join("dump.jsonl");
+    let skipped = validate_foxglove_file(&file, 2, 5, &dump)?;
+    if dump.is_file() {
+        let bad = run(std::process::Command::new("python3")
+            .arg(root.join("scripts/foxglove_dump.py"))
+            .arg(&file)
+            .args(["--scenes", "2", "--sweeps", "6"]))?;
+        ensure!(
+            !bad.status.success(),
+            "foxglove_dump.py accepted a wrong count"
+        );
+    }
+    if let Some(why) = skipped {
+        return Ok(Completion::ignored_with(why));
+    }
+    let validate = root.join("tests/foxglove/validate.mjs");
     // And it can fail: a Log level outside the schema's.
     let text = std::fs::read_to_string(&dump)?;
     let broken = dir.path().join("broken.jsonl");

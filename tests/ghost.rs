@@ -1,7 +1,8 @@
 //! Ghost contacts (issue 24): expected edge or vertex contacts on an
 //! internal flat or concave edge whose normal leans off the faces, listed by
 //! `check` apart from divergences; the same contacts on a ridge are not
-//! ghosts. The traces are built here with the library's writer.
+//! ghosts. The traces are built here with the library's writer (the
+//! fixtures are shared with `ghost_marks`).
 
 use std::io::Cursor;
 
@@ -24,7 +25,7 @@ pub fn tests() -> Vec<Trial> {
 
 /// A floor of two coplanar triangles, fronts `+z`, sharing the seam from
 /// vertex 0 `(-5, -5, 0)` to vertex 2 `(5, 5, 0)`: edge 2 of triangle 0.
-fn seam_floor() -> SceneMsg {
+pub(crate) fn seam_floor() -> SceneMsg {
     SceneMsg {
         name: Some("seam".into()),
         vertices: vec![
@@ -59,7 +60,7 @@ fn ridge() -> SceneMsg {
 }
 
 /// 10° off `+z`, toward `+x`.
-fn tilted() -> [f64; 3] {
+pub(crate) fn tilted() -> [f64; 3] {
     let a = 10f64.to_radians();
     [a.sin(), 0.0, a.cos()]
 }
@@ -67,7 +68,7 @@ fn tilted() -> [f64; 3] {
 /// A trace of `scene` whose balls fall onto the points `at` (frame, ball,
 /// x, y, top), each expectation the core's α with the contact named as
 /// edge `feature` of `triangle` and the normal `normal(frame, ball)`.
-fn trace(
+pub(crate) fn trace(
     scene: &SceneMsg,
     at: &[(u64, u32, f64, f64, f64)],
     triangle: u32,
@@ -104,11 +105,11 @@ fn trace(
 }
 
 /// Tilted at frames 1 and 3 of ball 0 and frame 2 of ball 2.
-fn is_tilted(frame: u64, ball: u32) -> bool {
+pub(crate) fn is_tilted(frame: u64, ball: u32) -> bool {
     matches!((frame, ball), (1, 0) | (3, 0) | (2, 2))
 }
 
-fn sweeps_along(y_of: impl Fn(f64) -> f64, top: f64) -> Vec<(u64, u32, f64, f64, f64)> {
+pub(crate) fn sweeps_along(y_of: impl Fn(f64) -> f64, top: f64) -> Vec<(u64, u32, f64, f64, f64)> {
     let mut v = Vec::new();
     for frame in 0..4u64 {
         for ball in 0..3u32 {
@@ -119,7 +120,11 @@ fn sweeps_along(y_of: impl Fn(f64) -> f64, top: f64) -> Vec<(u64, u32, f64, f64,
     v
 }
 
-fn write(bytes: &[u8], dir: &tempfile::TempDir, name: &str) -> anyhow::Result<std::path::PathBuf> {
+pub(crate) fn write(
+    bytes: &[u8],
+    dir: &tempfile::TempDir,
+    name: &str,
+) -> anyhow::Result<std::path::PathBuf> {
     let path = dir.path().join(name);
     std::fs::write(&path, bytes)?;
     Ok(path)

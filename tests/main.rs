@@ -15,6 +15,7 @@ mod core_decisions;
 mod core_random;
 mod engine;
 mod error_messages;
+mod exact;
 mod expected_source;
 mod faults;
 mod first_hour;
@@ -31,7 +32,9 @@ mod prefetch;
 mod primary_skips;
 mod rapier;
 // The Rapier recorder example, run by `rapier` (its `main` is unused here).
+mod edge_class;
 mod ghost;
+mod ghost_marks;
 #[allow(dead_code)]
 #[path = "../examples/rapier_record.rs"]
 mod rapier_record;
@@ -124,7 +127,9 @@ fn main() {
     trials.extend(outputs::tests());
     trials.extend(tunnel::tests());
     trials.extend(tunnel_through::tests());
+    trials.extend(edge_class::tests());
     trials.extend(ghost::tests());
+    trials.extend(ghost_marks::tests());
     trials.extend(repro::tests());
     trials.extend(alt_engine::tests());
     trials.extend(scanned::tests());

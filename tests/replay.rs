@@ -26,6 +26,7 @@ use sweeptrace::trace::{TraceError, TraceEvent, TraceReader, TraceWriter};
 use sweeptrace::viz;
 
 use crate::ensure;
+use crate::support::scene_t;
 use crate::trial;
 use anyhow::Context as _;
 
@@ -75,10 +76,7 @@ fn cube_scene() -> SceneMsg {
 fn triangle_scene() -> SceneMsg {
     SceneMsg {
         name: Some("triangle".into()),
-        vertices: vec![[0.0, 0.0, 0.0], [4.0, 0.0, 0.0], [0.0, 4.0, 0.0]],
-        triangles: vec![[0, 1, 2]],
-        margin: 0.0,
-        facing: Facing::NonStrict,
+        ..scene_t(0.0)
     }
 }
 
@@ -744,7 +742,7 @@ impl Decoded {
     }
 
     /// The texts of `entity`'s `component` at `frame` (empty when none).
-    fn texts_at(&self, entity: &str, component: &str, frame: i64) -> Vec<String> {
+    pub(crate) fn texts_at(&self, entity: &str, component: &str, frame: i64) -> Vec<String> {
         self.texts
             .get(&(entity.to_string(), component.to_string()))
             .and_then(|m| m.get(&frame))
@@ -1145,8 +1143,18 @@ fn cli_writes_outcomes_and_rrd() -> anyhow::Result<()> {
         ensure!(
             sorted
                 == [
-                    "alpha", "ball", "contact", "feature", "fragile", "frame", "kind", "normal",
-                    "triangle", "tunnel"
+                    "alpha",
+                    "ball",
+                    "contact",
+                    "edge_class",
+                    "feature",
+                    "fragile",
+                    "frame",
+                    "ghost",
+                    "kind",
+                    "normal",
+                    "triangle",
+                    "tunnel"
                 ],
             "fields {keys:?}"
         );
@@ -1157,6 +1165,10 @@ fn cli_writes_outcomes_and_rrd() -> anyhow::Result<()> {
             .and_then(|o| o.remove("fragile"))
             .context("no fragile field")?;
         value.as_object_mut().and_then(|o| o.remove("tunnel"));
+        value.as_object_mut().and_then(|o| o.remove("edge_class"));
+        // No ghost contacts in this trace.
+        let ghost = value.as_object_mut().and_then(|o| o.remove("ghost"));
+        ensure!(ghost == Some(serde_json::Value::Null), "ghost {ghost:?}");
         let o: OutcomeMsg = serde_json::from_value(value)?;
         let want = sweep_mesh(
             &mesh,

@@ -20,6 +20,7 @@ use sweeptrace::trace::{TraceReader, TraceWriter};
 use crate::ensure;
 use crate::os;
 use crate::support::run_bin;
+use crate::support::scene_t;
 use crate::trial;
 use anyhow::Context as _;
 
@@ -122,10 +123,7 @@ fn divergence_inputs() -> anyhow::Result<()> {
         // The pasted inputs make the same decision.
         let scene = SceneMsg {
             name: None,
-            vertices: vec![[0.0, 0.0, 0.0], [4.0, 0.0, 0.0], [0.0, 4.0, 0.0]],
-            triangles: vec![[0, 1, 2]],
-            margin: 0.1,
-            facing: Facing::NonStrict,
+            ..scene_t(0.1)
         };
         let mesh = Mesh::new(scene.vertices.clone(), &scene.triangles)?;
         let again = sweep_mesh(

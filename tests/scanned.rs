@@ -31,8 +31,11 @@ use sweeptrace::regress::{CheckOptions, Status, check_reader, render_text};
 use sweeptrace::sim::scenes::SceneMesh;
 use sweeptrace::trace::messages::{SceneMsg, SweepMsg};
 
-use crate::core_decisions::{cross3, dot3, on_segment, options, sub3};
+use crate::core_decisions::options;
 use crate::ensure;
+use crate::exact::{
+    I3, cross3, dot3, exact_sqrt, exact_tie_set, in_closed_triangle, rational_length_vectors, sub3,
+};
 use crate::support::close;
 use crate::trial;
 use anyhow::Context as _;
@@ -46,8 +49,6 @@ pub fn tests() -> Vec<Trial> {
 
 /// Units per metre of the snapped grid (2¹⁴).
 const UNITS: f64 = 16384.0;
-
-type I3 = [i64; 3];
 
 /// The scanned mesh as the core sees it (snapped) and as integers.
 struct Scanned {
@@ -111,75 +112,6 @@ fn load_scanned() -> anyhow::Result<Scanned> {
         triangles,
         used,
     })
-}
-
-/// Whether `x` lies in the closed triangle `v` of normal `n ≠ 0` (exact).
-fn in_closed_triangle(x: I3, v: [I3; 3], n: I3) -> bool {
-    let n = n.map(i128::from);
-    let dot = |a: I3, b: [i128; 3]| -> i128 { (0..3).map(|k| i128::from(a[k]) * b[k]).sum() };
-    dot(sub3(x, v[0]), n) == 0
-        && (0..3).all(|k| {
-            let (a, b) = (v[k], v[(k + 1) % 3]);
-            let c = cross3(sub3(b, a), sub3(x, a));
-            dot(c, n) >= 0
-        })
-}
-
-/// The exact tie set at `x` for the ball centred at `x + w` (radius `|w|`)
-/// travelling along `d`, `w` normal to a supporting plane at `x`:
-/// `(kind, triangle, feature)` of every test that touches at that moment,
-/// in the rules' order (kind, then triangle, then feature).
-fn exact_tie_set(m: &Scanned, x: I3, w: I3, d: I3) -> Vec<(Kind, u32, u8)> {
-    let mut out = Vec::new();
-    for (t, tri) in m.triangles.iter().enumerate() {
-        let Some(tri) = tri else { continue };
-        let v = tri.map(|i| m.vertices[i]);
-        let normal = cross3(sub3(v[1], v[0]), sub3(v[2], v[0]));
-        if dot3(normal, d) > 0 {
-            continue; // back-facing (non-strict rule)
-        }
-        if cross3(normal, w) == [0, 0, 0] && dot3(normal, w) > 0 && in_closed_triangle(x, v, normal)
-        {
-            out.push((Kind::Face, t as u32, 0));
-        }
-        for e in 0..3 {
-            let (a, b) = (v[e], v[(e + 1) % 3]);
-            if on_segment(x, a, b) && dot3(sub3(b, a), w) == 0 {
-                out.push((Kind::Edge, t as u32, e as u8));
-            }
-        }
-        for (k, &p) in v.iter().enumerate() {
-            if p == x {
-                out.push((Kind::Vertex, t as u32, k as u8));
-            }
-        }
-    }
-    out.sort();
-    out
-}
-
-/// Every integer vector of integer length `1..=max`, with its length.
-fn rational_length_vectors(max: i64) -> Vec<(I3, i64)> {
-    let mut out = Vec::new();
-    for x in -max..=max {
-        for y in -max..=max {
-            for z in -max..=max {
-                let s = x * x + y * y + z * z;
-                if let Some(r) = exact_sqrt(s)
-                    && r > 0
-                    && r <= max
-                {
-                    out.push(([x, y, z], r));
-                }
-            }
-        }
-    }
-    out
-}
-
-fn exact_sqrt(s: i64) -> Option<i64> {
-    let r = (s as f64).sqrt().round() as i64;
-    (r - 1..=r + 1).find(|&q| q >= 0 && q * q == s)
 }
 
 fn gcd(a: i64, b: i64) -> i64 {
@@ -327,7 +259,15 @@ fn contact(
     if grazing {
         return None;
     }
-    let expected = exact_tie_set(m, x, w, d);
+    let expected = exact_tie_set(
+        &m.vertices,
+        (0u32..)
+            .zip(&m.triangles)
+            .filter_map(|(t, tri)| tri.map(|tri| (t, tri))),
+        x,
+        w,
+        d,
+    );
     if expected.is_empty() {
         return None;
     }

@@ -223,12 +223,23 @@ pub fn mesh(vertices: &[[f64; 3]], triangles: &[[u64; 3]]) -> Mesh {
     Mesh::new(vertices.to_vec(), triangles).expect("test mesh is valid")
 }
 
-/// The triangle T of SEMANTICS.md's worked examples.
+/// The triangle T of SEMANTICS.md's worked examples, `(0, 0, 0)`,
+/// `(4, 0, 0)`, `(0, 4, 0)`, front `+z`, as a scene of margin `margin`
+/// under the non-strict facing rule.
+pub fn scene_t(margin: f64) -> sweeptrace::trace::messages::SceneMsg {
+    sweeptrace::trace::messages::SceneMsg {
+        name: Some("triangle_t".into()),
+        vertices: vec![[0.0, 0.0, 0.0], [4.0, 0.0, 0.0], [0.0, 4.0, 0.0]],
+        triangles: vec![[0, 1, 2]],
+        margin,
+        facing: sweeptrace::Facing::NonStrict,
+    }
+}
+
+/// The triangle T of SEMANTICS.md's worked examples, as a mesh.
 pub fn triangle_t() -> Mesh {
-    mesh(
-        &[[0.0, 0.0, 0.0], [4.0, 0.0, 0.0], [0.0, 4.0, 0.0]],
-        &[[0, 1, 2]],
-    )
+    let t = scene_t(0.0);
+    mesh(&t.vertices, &t.triangles)
 }
 
 /// Runs an exhaustive explained sweep.

@@ -17,6 +17,7 @@ use sweeptrace::trace::{
 };
 
 use crate::ensure;
+use crate::support::scene_t;
 use crate::trial;
 use anyhow::Context as _;
 
@@ -66,11 +67,8 @@ const FIXTURE: &str = "tests/fixtures/python_written.mcap";
 
 pub fn triangle_scene() -> SceneMsg {
     SceneMsg {
-        name: Some("triangle".to_string()),
-        vertices: vec![[0.0, 0.0, 0.0], [4.0, 0.0, 0.0], [0.0, 4.0, 0.0]],
-        triangles: vec![[0, 1, 2]],
-        margin: 0.0,
-        facing: Facing::NonStrict,
+        name: Some("triangle".into()),
+        ..scene_t(0.0)
     }
 }
 

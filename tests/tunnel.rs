@@ -28,7 +28,8 @@ use nalgebra::Point3;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use sweeptrace::core::{
-    Facing, Mesh, Options, Sweep, crossing_tolerance, first_crossing, sweep_mesh, triangle_crossing,
+    Facing, Mesh, Options, Sweep, crossing_tolerance, first_crossing, first_crossing_with_flipped,
+    sweep_mesh, triangle_crossing, triangle_crossing_back_to_front,
 };
 use sweeptrace::regress::{
     CheckOptions, Status, check_file, check_reader, render_json, render_text,
@@ -229,10 +230,54 @@ fn crossing_first_of_several() -> anyhow::Result<()> {
 /// The BVH query against every triangle tested in turn, on a terrain.
 fn crossing_bvh_matches_every_triangle() -> anyhow::Result<()> {
     let t = scenes::terrain(16);
-    let m = mesh(&t.vertices, &t.triangles);
+    let (found, back_to_front) = bvh_against_brute_force(&t.vertices, &t.triangles, &[], 7)?;
+    ensure!(found > 500, "only {found} segments cross");
+    ensure!(
+        back_to_front == 0,
+        "{back_to_front} back-to-front crossings"
+    );
+    // The same terrain with one triangle in eight wound the other way (the
+    // flipped triangles `Topology::flipped` finds): those are crossed in
+    // both directions, and the query must still be the brute force's.
+    let mut triangles = t.triangles.clone();
+    let mut rng = ChaCha8Rng::seed_from_u64(8);
+    let flipped: Vec<u32> = (0..triangles.len() as u32)
+        .filter(|_| rng.random_range(0..8) == 0)
+        .collect();
+    for &f in &flipped {
+        triangles[f as usize].swap(1, 2);
+    }
+    let topology = sweeptrace::Topology::new(&t.vertices, &triangles)?;
+    ensure!(
+        topology.flipped().iter().all(|f| flipped.contains(f)),
+        "topology flips {} triangles, some of them not flipped",
+        topology.flipped().len()
+    );
+    let (found, back_to_front) = bvh_against_brute_force(&t.vertices, &triangles, &flipped, 9)?;
+    ensure!(found > 500, "only {found} segments cross");
+    ensure!(
+        back_to_front > 50,
+        "only {back_to_front} back-to-front crossings"
+    );
+    Ok(())
+}
+
+/// `first_crossing_with_flipped` on 5000 random segments through the
+/// box of `vertices`, against every triangle tested in turn (front to
+/// back, and back to front for the `flipped`, ascending): the smallest
+/// fraction, the lowest triangle within the tie window of it. Returns how
+/// many segments cross, and how many of those first crossings are back to
+/// front.
+fn bvh_against_brute_force(
+    vertices: &[[f64; 3]],
+    triangles: &[[u64; 3]],
+    flipped: &[u32],
+    seed: u64,
+) -> anyhow::Result<(usize, usize)> {
+    let m = mesh(vertices, triangles);
     let (lo, hi) = m.bounds();
-    let mut rng = ChaCha8Rng::seed_from_u64(7);
-    let mut found = 0;
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let (mut found, mut back_to_front) = (0, 0);
     for i in 0..5000 {
         let mut point = || {
             p(
@@ -247,7 +292,14 @@ fn crossing_bvh_matches_every_triangle() -> anyhow::Result<()> {
         let all: Vec<_> = m
             .triangles()
             .iter()
-            .filter_map(|tr| triangle_crossing(tr, &a, &b, tau))
+            .filter_map(|tr| {
+                triangle_crossing(tr, &a, &b, tau).or_else(|| {
+                    flipped
+                        .contains(&tr.index)
+                        .then(|| triangle_crossing_back_to_front(tr, &a, &b, tau))
+                        .flatten()
+                })
+            })
             .collect();
         let want = all.iter().map(|c| c.fraction).fold(f64::INFINITY, f64::min);
         let want = all
@@ -255,12 +307,19 @@ fn crossing_bvh_matches_every_triangle() -> anyhow::Result<()> {
             .filter(|c| c.fraction <= want + window)
             .min_by_key(|c| c.triangle)
             .copied();
-        let got = first_crossing(&m, &a, &b);
+        let got = first_crossing_with_flipped(&m, flipped, &a, &b);
         ensure!(got == want, "segment {i}: {a} → {b}: {got:?} vs {want:?}");
+        if flipped.is_empty() {
+            let plain = first_crossing(&m, &a, &b);
+            ensure!(
+                plain == got,
+                "segment {i}: first_crossing {plain:?} vs {got:?}"
+            );
+        }
         found += usize::from(got.is_some());
+        back_to_front += usize::from(got.is_some_and(|c| c.back_to_front));
     }
-    ensure!(found > 500, "only {found} segments cross");
-    Ok(())
+    Ok((found, back_to_front))
 }
 
 // ---------------------------------------------------------------- fixtures

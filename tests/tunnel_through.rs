@@ -41,7 +41,7 @@ const RADIUS: f64 = 0.1;
 /// per square (`[a, b, c]`, `[a, c, d]` counter-clockwise from above),
 /// square `(i, j)` holding triangles `2 (3 j + i)` and `2 (3 j + i) + 1`;
 /// the triangles of `flipped` wound the other way.
-fn floor(n: u64, flipped: &[usize]) -> SceneMsg {
+pub(crate) fn floor(n: u64, flipped: &[usize]) -> SceneMsg {
     let mut vertices = Vec::new();
     for j in 0..=n {
         for i in 0..=n {
@@ -90,7 +90,7 @@ fn cracked_floor() -> SceneMsg {
     }
 }
 
-fn sweep(frame: u64, ball: u32, p0: [f64; 3], p1: [f64; 3]) -> SweepMsg {
+pub(crate) fn sweep(frame: u64, ball: u32, p0: [f64; 3], p1: [f64; 3]) -> SweepMsg {
     SweepMsg {
         frame,
         ball,
@@ -101,7 +101,7 @@ fn sweep(frame: u64, ball: u32, p0: [f64; 3], p1: [f64; 3]) -> SweepMsg {
 }
 
 /// A trace of `scene` and `sweeps`, each followed by the core's outcome.
-fn trace(scene: &SceneMsg, sweeps: &[SweepMsg]) -> anyhow::Result<Vec<u8>> {
+pub(crate) fn trace(scene: &SceneMsg, sweeps: &[SweepMsg]) -> anyhow::Result<Vec<u8>> {
     let m = mesh(&scene.vertices, &scene.triangles);
     let options = Options {
         margin: scene.margin,

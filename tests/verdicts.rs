@@ -18,6 +18,7 @@ use sweeptrace::trace::messages::{OutcomeMsg, SceneMsg, SweepMsg};
 use sweeptrace::trace::{TraceEvent, TraceWriter};
 
 use crate::support::run_bin;
+use crate::support::scene_t;
 use crate::{ensure, os, trial};
 use anyhow::Context as _;
 
@@ -271,13 +272,7 @@ fn against_expected_compares_the_tie_members_contact() -> anyhow::Result<()> {
 /// rounding unit higher: excused, and the report names that perturbation;
 /// a miss claimed with α = 0.5 is no rounding's answer.
 fn a_fragile_divergence_is_excused_only_by_a_named_perturbation() -> anyhow::Result<()> {
-    let scene = SceneMsg {
-        name: Some("triangle_t".into()),
-        vertices: vec![[0.0, 0.0, 0.0], [4.0, 0.0, 0.0], [0.0, 4.0, 0.0]],
-        triangles: vec![[0, 1, 2]],
-        margin: 0.0,
-        facing: Facing::NonStrict,
-    };
+    let scene = scene_t(0.0);
     let sweep = SweepMsg {
         frame: 0,
         ball: 0,
@@ -371,10 +366,7 @@ fn a_fragile_divergence_is_excused_only_by_a_named_perturbation() -> anyhow::Res
 fn a_robust_decision_is_never_excused() -> anyhow::Result<()> {
     let scene = SceneMsg {
         name: None,
-        vertices: vec![[0.0, 0.0, 0.0], [4.0, 0.0, 0.0], [0.0, 4.0, 0.0]],
-        triangles: vec![[0, 1, 2]],
-        margin: 0.0,
-        facing: Facing::NonStrict,
+        ..scene_t(0.0)
     };
     let sweep = SweepMsg {
         frame: 0,

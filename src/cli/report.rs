@@ -5,8 +5,11 @@ use std::fmt::Write;
 use serde_json::json;
 
 use sweeptrace::core::explain::{describe, miss_distance, num};
-use sweeptrace::core::{Options, Outcome, Sweep, TestRecord, Verdict};
+use sweeptrace::core::{
+    EdgeClass, Feature, Options, Outcome, Sweep, TestRecord, Topology, Verdict,
+};
 use sweeptrace::regress::SweepInputs;
+use sweeptrace::replay::feature_class;
 use sweeptrace::trace::messages::OutcomeMsg;
 
 /// Formats `[x, y, z]` compactly.
@@ -17,8 +20,8 @@ pub fn vec3(v: &[f64]) -> String {
     )
 }
 
-/// One line describing an outcome.
-pub fn outcome_line(o: &Outcome) -> String {
+/// A core outcome in words, for the `sweep` report (`outcome: ...`).
+pub fn outcome_text(o: &Outcome) -> String {
     let Some(hit) = o.hit else {
         return format!("no collision (alpha = {})", num(o.travelled()));
     };
@@ -161,6 +164,52 @@ pub struct SweepReport<'a> {
     pub records: &'a [TestRecord],
     /// Explain every test, not only those that came close.
     pub all: bool,
+    /// For an edge or vertex hit, its place in the mesh's topology
+    /// ([`hit_place`]).
+    pub place: Option<HitPlace>,
+}
+
+/// Where an edge or vertex hit is in the mesh's topology.
+pub struct HitPlace {
+    /// The class of the edge (or the vertex, `replay::feature_class`).
+    pub class: EdgeClass,
+    /// In words: `edge 17.2: an internal flat edge shared with triangle 18`.
+    pub text: String,
+}
+
+/// The place of `outcome`'s edge or vertex hit in `topology`; `None` for a
+/// face hit, a miss, or a feature the topology does not have.
+pub fn hit_place(topology: &Topology, outcome: &Outcome) -> Option<HitPlace> {
+    let hit = outcome.hit.as_ref()?;
+    let (triangle, feature) = (hit.triangle, hit.feature);
+    let class = feature_class(topology, triangle, feature)?;
+    let text = match feature {
+        Feature::Face => return None,
+        Feature::Edge(i) => {
+            let edge = topology.triangle_edge(triangle, i)?;
+            let other = edge.triangles().find(|&t| t != triangle);
+            let shared = other.map_or(String::new(), |o| format!(" shared with triangle {o}"));
+            let what = match class {
+                EdgeClass::Boundary => "a boundary edge (no other triangle has it)".to_string(),
+                EdgeClass::Flat => format!("an internal flat edge{shared}"),
+                EdgeClass::Convex => format!("a convex edge{shared}"),
+                EdgeClass::Concave => format!("a concave edge{shared}"),
+                EdgeClass::NonManifold => {
+                    "a non-manifold edge (three or more triangles have it)".to_string()
+                }
+            };
+            format!("edge {triangle}.{i}: {what}")
+        }
+        Feature::Vertex(i) => {
+            let v = topology.triangle_vertex(triangle, i)?;
+            let edges = topology.edges_at(v).count();
+            format!(
+                "vertex {triangle}.{i} (mesh vertex {v}): a {class} vertex (the most telling class of its {})",
+                sweeptrace::numbers::counted(edges as u64, "edge", "edges")
+            )
+        }
+    };
+    Some(HitPlace { class, text })
 }
 
 /// The `sweep` report as text.
@@ -189,7 +238,10 @@ pub fn sweep_text(r: &SweepReport) -> String {
     )
     .unwrap();
     writeln!(s, "inputs: {}", SweepInputs::of(r.sweep, r.options).text()).unwrap();
-    writeln!(s, "outcome: {}", outcome_line(r.outcome)).unwrap();
+    writeln!(s, "outcome: {}", outcome_text(r.outcome)).unwrap();
+    if let Some(place) = &r.place {
+        writeln!(s, "{}", place.text).unwrap();
+    }
     if let Some(e) = r.expected {
         writeln!(s, "expected (the trace's /expected): {}", expected_line(e)).unwrap();
     }
@@ -277,6 +329,12 @@ pub fn sweep_json(r: &SweepReport) -> String {
     if let Some(object) = value.as_object_mut() {
         if let Some(source) = r.source {
             object.insert("source".into(), json!(source));
+        }
+        if let Some(place) = &r.place {
+            if let Some(outcome) = object.get_mut("outcome").and_then(|o| o.as_object_mut()) {
+                outcome.insert("edge_class".into(), json!(place.class));
+            }
+            object.insert("place".into(), json!(place.text));
         }
         if let Some(e) = r.expected {
             object.insert("expected".into(), json!(e));

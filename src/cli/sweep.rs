@@ -73,6 +73,7 @@ pub struct Args {
 pub fn run(args: Args) -> anyhow::Result<RunOutcome> {
     let mut source: Option<String> = None;
     let mut expected: Option<OutcomeMsg> = None;
+    let topology: Option<sweeptrace::Topology>;
     let (name, mesh, sweep, options) = if let Some(path) = &args.trace {
         let frame = args.frame.context("--trace needs --frame")?;
         let shown = path.display().to_string();
@@ -81,6 +82,7 @@ pub fn run(args: Args) -> anyhow::Result<RunOutcome> {
         let found = find_sweep(reader, &shown, frame, args.ball)?;
         let mesh = sweeptrace::Mesh::new(found.scene.vertices.clone(), &found.scene.triangles)
             .with_context(|| format!("{shown}: building the scene of frame {frame}"))?;
+        topology = sweeptrace::Topology::new(&found.scene.vertices, &found.scene.triangles).ok();
         let mut options = found.options();
         options.margin = args.margin.unwrap_or(options.margin);
         options.facing = args.facing.unwrap_or(options.facing);
@@ -108,6 +110,7 @@ pub fn run(args: Args) -> anyhow::Result<RunOutcome> {
         let mesh = scene
             .to_mesh()
             .with_context(|| format!("building scene `{}`", scene.name))?;
+        topology = sweeptrace::Topology::new(&scene.vertices, &scene.triangles).ok();
         let (from, to) = args
             .from
             .zip(args.to)
@@ -142,6 +145,9 @@ pub fn run(args: Args) -> anyhow::Result<RunOutcome> {
         outcome: &outcome,
         records: &records.records,
         all: args.all,
+        place: topology
+            .as_ref()
+            .and_then(|t| report::hit_place(t, &outcome)),
     };
     if args.json {
         println!("{}", report::sweep_json(&explained));

@@ -52,7 +52,7 @@ pub use outcome::{Feature, Outcome, SweepHit};
 pub use path::{Sweep, SweptPath};
 pub use record::{
     CollectRecords, EdgeHit, EdgeRecord, FaceHit, FaceRecord, Kind, NoObserver, Observer, Skip,
-    SkipCounts, TestRecord, Verdict, VerdictCounts, VertexRecord,
+    SkipCounts, TestRecord, Verdict, VerdictCounts, VertexHit, VertexRecord,
 };
 pub use sweep_edge::sweep_edge;
 pub use sweep_face::{barycentric, barycentric_and_distance, sweep_face};

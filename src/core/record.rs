@@ -168,7 +168,14 @@ impl FromIterator<Verdict> for VerdictCounts {
 }
 
 /// Everything the face test computed.
+///
+/// Only the core builds records (the type is `#[non_exhaustive]`), so a
+/// `Hit` verdict always comes with the values it was decided on:
+/// [`FaceRecord::hit`] returns them typed. The `Option` fields are what the
+/// test computed before it stopped, whatever the verdict (a miss has them
+/// too, e.g. the roots of `before_start`).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+#[non_exhaustive]
 pub struct FaceRecord {
     /// Input index of the triangle.
     pub triangle: u32,
@@ -197,7 +204,14 @@ pub struct FaceRecord {
 }
 
 /// Everything the edge test computed.
+///
+/// Only the core builds records (the type is `#[non_exhaustive]`), so a
+/// `Hit` verdict always comes with the values it was decided on:
+/// [`EdgeRecord::hit`] returns them typed. The `Option` fields are what the
+/// test computed before it stopped, whatever the verdict (a miss has them
+/// too, e.g. the roots of `before_start`).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+#[non_exhaustive]
 pub struct EdgeRecord {
     /// Input index of the triangle.
     pub triangle: u32,
@@ -232,7 +246,14 @@ pub struct EdgeRecord {
 }
 
 /// Everything the vertex test computed.
+///
+/// Only the core builds records (the type is `#[non_exhaustive]`), so a
+/// `Hit` verdict always comes with the values it was decided on:
+/// [`VertexRecord::hit`] returns them typed. The `Option` fields are what the
+/// test computed before it stopped, whatever the verdict (a miss has them
+/// too, e.g. the roots of `before_start`).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+#[non_exhaustive]
 pub struct VertexRecord {
     /// Input index of the triangle.
     pub triangle: u32,
@@ -334,19 +355,37 @@ impl EdgeRecord {
     }
 }
 
+/// What a vertex test that hit found.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct VertexHit {
+    /// `α` of the collision (the smaller root `s0`).
+    pub alpha: f64,
+    /// The vertex the ball touches.
+    pub position: Point3<f64>,
+}
+
 impl VertexRecord {
-    /// `α` of the collision, if the verdict is a hit (a vertex test that
+    /// What the test found, if its verdict is a hit (a vertex test that
     /// hits has computed its roots; a record that says hit without them is
     /// not a hit).
     #[inline]
-    pub fn alpha(&self) -> Option<f64> {
+    pub fn hit(&self) -> Option<VertexHit> {
         match (self.verdict, self.roots) {
-            (Verdict::Hit, Some((s0, _))) => Some(s0),
+            (Verdict::Hit, Some((s0, _))) => Some(VertexHit {
+                alpha: s0,
+                position: self.position,
+            }),
             (verdict, _) => {
                 debug_assert!(verdict != Verdict::Hit, "vertex hit without its roots");
                 None
             }
         }
+    }
+
+    /// `α` of the collision, if the verdict is a hit.
+    #[inline]
+    pub fn alpha(&self) -> Option<f64> {
+        self.hit().map(|h| h.alpha)
     }
 }
 

@@ -16,11 +16,12 @@ use crate::core::explain::label;
 use crate::core::{DefectKind, EdgeClass, SweepHit, TestRecord};
 use crate::palette::{
     BOUNDARY_EDGE_COLOR, CONCAVE_EDGE_COLOR, CONTACT_BALL_COLOR, CONVEX_EDGE_COLOR, DEFECT_COLOR,
-    EXPECTED_COLOR, FLAT_EDGE_COLOR, HIT_COLOR, MAX_DRAWN_DEFECT_LABELS, MESH_COLOR,
-    NON_MANIFOLD_EDGE_COLOR, NORMAL_COLOR, P0_COLOR, P1_COLOR, SWEEP_COLOR,
+    EXPECTED_COLOR, FACE_NORMAL_COLOR, FLAT_EDGE_COLOR, GHOST_COLOR, HIT_COLOR,
+    MAX_DRAWN_DEFECT_LABELS, MESH_COLOR, NON_MANIFOLD_EDGE_COLOR, NORMAL_COLOR, P0_COLOR, P1_COLOR,
+    SWEEP_COLOR,
 };
 use crate::regress::decision::write_decision_line;
-use crate::regress::{FieldDiff, divergence_details, render_divergence};
+use crate::regress::{FieldDiff, divergence_details, ghost_point, render_divergence};
 use crate::replay::{SceneState, SweepResult};
 use strum::IntoEnumIterator as _;
 
@@ -478,6 +479,65 @@ pub fn expected_update(r: &SweepResult, diverges: bool) -> SceneUpdate {
             }
         }
     }
+    SceneUpdate {
+        deletions: Vec::new(),
+        entities: vec![entity],
+    }
+}
+
+/// Height of a ghost contact's label, in screen pixels.
+const GHOST_FONT_PIXELS: f64 = 14.0;
+
+/// The ghost contact of the sweep's expected outcome
+/// ([`SweepResult::ghost`]), on [`super::GHOSTS_TOPIC`]: entity
+/// `ghost/{ball}` with a marker where it is
+/// ([`crate::regress::ghost_point`]), two arrows from there, the expected
+/// (ghost) normal and the faces' normal, one label (`ghost contact 10.0°:
+/// edge 0.2 is internal and flat`) and `check`'s sentence in the metadata;
+/// otherwise the deletion of that entity.
+pub fn ghost_update(r: &SweepResult) -> SceneUpdate {
+    let time = Time::from_nanos(r.log_time_nanos);
+    let id = format!("ghost/{}", r.ball);
+    let Some(g) = r.ghost() else {
+        return SceneUpdate {
+            deletions: vec![delete(time, id)],
+            entities: Vec::new(),
+        };
+    };
+    let size = marker_size(r);
+    let at = nalgebra::Point3::from(ghost_point(r, &g));
+    let mut entity = SceneEntity::new(time, FRAME_ID, id);
+    entity.metadata = vec![
+        key_value("frame", r.frame),
+        key_value("ball", r.ball),
+        key_value("ghost contact", g),
+    ];
+    entity.spheres.push(sphere(&at, 0.15 * size, GHOST_COLOR));
+    for (n, rgba) in [(g.normal, GHOST_COLOR), (g.face_normal, FACE_NORMAL_COLOR)] {
+        let n = nalgebra::Vector3::from(n);
+        if n.norm() > 0.0 {
+            entity
+                .arrows
+                .push(arrow(&at, &n.normalize(), 2.0 * size, rgba));
+        }
+    }
+    let [x, y, z] = g.normal;
+    let n = nalgebra::Vector3::new(x, y, z).normalize() * (2.2 * size);
+    entity.texts.push(TextPrimitive {
+        pose: Pose {
+            position: Vector3 {
+                x: at.x + n.x,
+                y: at.y + n.y,
+                z: at.z + n.z,
+            },
+            orientation: Quaternion::IDENTITY,
+        },
+        billboard: true,
+        font_size: GHOST_FONT_PIXELS,
+        scale_invariant: true,
+        color: color(GHOST_COLOR),
+        text: g.label(),
+    });
     SceneUpdate {
         deletions: Vec::new(),
         entities: vec![entity],

@@ -13,6 +13,7 @@
 //! | [`SWEEPS_TOPIC`] | `foxglove.SceneUpdate` | per sweep, entity `sweep/{ball}`: the path, and the swept sphere (radius ρ) at the contact |
 //! | [`CONTACTS_TOPIC`] | `foxglove.SceneUpdate` | per sweep, entity `contact/{ball}`: the contact point and the reported normal (deleted at a miss) |
 //! | [`EXPECTED_TOPIC`] | `foxglove.SceneUpdate` | per sweep, entity `expected/{ball}`: the expected ball, contact and normal where the sweep diverges (deleted elsewhere) |
+//! | [`GHOSTS_TOPIC`] | `foxglove.SceneUpdate` | per sweep, entity `ghost/{ball}`: where the expected outcome is a ghost contact, a marker at it, the expected and the faces' normals and one label (deleted elsewhere) |
 //! | [`DECISIONS_TOPIC`] | `foxglove.Log` | per sweep, the decision in words; WARNING where `check` fails it |
 //! | [`NUMBERS_TOPIC`] | `sweeptrace.SweepNumbers` | per sweep, `α` and the decisive test's numbers, for the Plot panel |
 //!
@@ -46,6 +47,8 @@ pub const SWEEPS_TOPIC: &str = "/sweeps";
 pub const CONTACTS_TOPIC: &str = "/contacts";
 /// The expected outcomes where a sweep diverges.
 pub const EXPECTED_TOPIC: &str = "/expected_outcome";
+/// The ghost contacts of the expected outcomes.
+pub const GHOSTS_TOPIC: &str = "/ghosts";
 /// The decisions (Log).
 pub const DECISIONS_TOPIC: &str = "/decisions";
 /// The numbers (Plot).

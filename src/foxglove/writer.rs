@@ -14,8 +14,8 @@ use serde::Serialize;
 use thiserror::Error;
 
 use super::convert::{
-    ball_update, clear_update, contact_update, decision_log, expected_update, mesh_update,
-    sweep_numbers, sweep_update,
+    ball_update, clear_update, contact_update, decision_log, expected_update, ghost_update,
+    mesh_update, sweep_numbers, sweep_update,
 };
 use super::messages::Time;
 use super::schemas::{
@@ -23,8 +23,8 @@ use super::schemas::{
     SCHEMA_ENCODING, SWEEP_NUMBERS_SCHEMA, SWEEP_NUMBERS_SCHEMA_JSON,
 };
 use super::{
-    BALLS_TOPIC, CONTACTS_TOPIC, DECISIONS_TOPIC, EXPECTED_TOPIC, MESH_TOPIC, METADATA_NAME,
-    NUMBERS_TOPIC, SWEEPS_TOPIC,
+    BALLS_TOPIC, CONTACTS_TOPIC, DECISIONS_TOPIC, EXPECTED_TOPIC, GHOSTS_TOPIC, MESH_TOPIC,
+    METADATA_NAME, NUMBERS_TOPIC, SWEEPS_TOPIC,
 };
 use crate::atomic::PendingFile;
 use crate::regress::Tolerances;
@@ -96,6 +96,7 @@ struct Channels {
     sweeps: u16,
     contacts: u16,
     expected: u16,
+    ghosts: u16,
     decisions: u16,
     numbers: u16,
 }
@@ -167,6 +168,7 @@ impl<W: Write + Seek> FoxgloveWriter<W> {
             sweeps: channel(scene_update, SWEEPS_TOPIC)?,
             contacts: channel(scene_update, CONTACTS_TOPIC)?,
             expected: channel(scene_update, EXPECTED_TOPIC)?,
+            ghosts: channel(scene_update, GHOSTS_TOPIC)?,
             decisions: channel(log, DECISIONS_TOPIC)?,
             numbers: channel(numbers, NUMBERS_TOPIC)?,
         };
@@ -236,6 +238,7 @@ impl<W: Write + Seek> FoxgloveWriter<W> {
                 (c.sweeps, SWEEPS_TOPIC),
                 (c.contacts, CONTACTS_TOPIC),
                 (c.expected, EXPECTED_TOPIC),
+                (c.ghosts, GHOSTS_TOPIC),
             ] {
                 self.put(id, topic, 0, t, &clear)?;
             }
@@ -246,7 +249,8 @@ impl<W: Write + Seek> FoxgloveWriter<W> {
     }
 
     /// A sweep: the ball, the sweep, the contact and normal, the expected
-    /// outcome where it diverges, the decision and the numbers. The
+    /// outcome where it diverges, its ghost contact where it is one, the
+    /// decision and the numbers. The
     /// decisive test comes from the result's records (replay with
     /// `explain` on, or the decision line and numbers lack it).
     pub fn sweep(&mut self, r: &SweepResult) -> Result<(), FoxgloveError> {
@@ -265,6 +269,7 @@ impl<W: Write + Seek> FoxgloveWriter<W> {
             t,
             &expected_update(r, !diffs.is_empty()),
         )?;
+        self.put(c.ghosts, GHOSTS_TOPIC, f, t, &ghost_update(r))?;
         let log = decision_log(r, decisive, &diffs, &self.options.trace_name);
         self.put(c.decisions, DECISIONS_TOPIC, f, t, &log)?;
         let numbers = sweep_numbers(r, decisive, &diffs);

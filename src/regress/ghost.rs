@@ -237,3 +237,74 @@ impl fmt::Display for GhostContact {
         )
     }
 }
+
+impl GhostContact {
+    /// The short label the viewers draw at the contact: `ghost contact
+    /// 10.0°: edge 17.2 is internal and flat` (the rest of the story is in
+    /// [`GhostContact`]'s `Display`, the sentence `check` writes).
+    pub fn label(&self) -> String {
+        let (kind, what) = match self.place {
+            GhostPlace::Flat => ("edge", "is internal and flat"),
+            GhostPlace::Concave => ("edge", "is internal and concave"),
+            GhostPlace::Vertex => ("vertex", "has only flat or concave edges"),
+        };
+        format!(
+            "ghost contact {:.1}°: {kind} {}.{} {what}",
+            self.angle_degrees, self.triangle, self.feature
+        )
+    }
+
+    /// The `ghost` field of a `replay --outcomes` line (see
+    /// [`GhostLine`]).
+    pub fn line(&self) -> GhostLine<'_> {
+        GhostLine(self)
+    }
+}
+
+/// A ghost contact as the `ghost` field of a `replay --outcomes` line:
+/// its fields without those the line has already (`frame`, `ball`) or that
+/// say nothing there (`log_time_nanos`, `answer`), then `text`, the
+/// sentence `check` writes after `ghost contact: `.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct GhostLine<'a>(pub &'a GhostContact);
+
+impl Serialize for GhostLine<'_> {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        use serde::ser::SerializeMap as _;
+        let g = self.0;
+        let mut m = s.serialize_map(Some(9))?;
+        m.serialize_entry("triangle", &g.triangle)?;
+        m.serialize_entry("feature", &g.feature)?;
+        m.serialize_entry("kind", &g.kind)?;
+        m.serialize_entry("place", &g.place)?;
+        m.serialize_entry("angle_degrees", &g.angle_degrees)?;
+        m.serialize_entry("normal", &g.normal)?;
+        m.serialize_entry("face_normal", &g.face_normal)?;
+        m.serialize_entry("neighbour", &g.neighbour)?;
+        m.serialize_entry("text", &g.to_string())?;
+        m.end()
+    }
+}
+
+/// Where the viewers mark the ghost contact `g` of the sweep `r`: at the
+/// expected contact; without one, at the core's contact; without a hit, a
+/// detection radius from the ball's centre at the expected α, against the
+/// expected normal.
+pub fn ghost_point(r: &crate::replay::SweepResult, g: &GhostContact) -> [f64; 3] {
+    if let Some(Some(c)) = r.expected.as_ref().and_then(|e| e.contact) {
+        return c;
+    }
+    if let Some(h) = &r.outcome.hit {
+        return h.contact.coords.into();
+    }
+    let alpha = r.expected.as_ref().map_or(1.0, |e| {
+        if e.alpha.is_finite() {
+            e.alpha.clamp(0.0, 1.0)
+        } else {
+            1.0
+        }
+    });
+    let center = r.sweep.p0 + (r.sweep.p1 - r.sweep.p0) * alpha;
+    let n = Vector3::from(g.normal).normalize();
+    (center.coords - n * r.rho()).into()
+}

@@ -59,7 +59,9 @@ pub use engine_check::{
     Against, EngineCheck, check_file_with_engine, judge_answer_against_expected,
 };
 pub use explain::{ExpectedTest, expected_tests, explain_outcome, explained_records};
-pub use ghost::{GHOST_DEGREES, GhostContact, GhostJudgement, GhostPlace, judge_ghost};
+pub use ghost::{
+    GHOST_DEGREES, GhostContact, GhostJudgement, GhostLine, GhostPlace, ghost_point, judge_ghost,
+};
 pub use infer::{Inferred, Spread, infer};
 pub use judge::{Agreement, Perturbation, Reproduced, agreement, agreement_of, perturbations};
 pub use render::{

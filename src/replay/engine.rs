@@ -7,8 +7,8 @@ use std::time::{Duration, Instant};
 
 use crate::core::explain::nearest_miss;
 use crate::core::{
-    Broadphase, CollectRecords, Mesh, Observer, Options, Outcome, SkipCounts, Sweep, TestRecord,
-    Topology, VerdictCounts, sweep_mesh, sweep_mesh_with,
+    Broadphase, CollectRecords, EdgeClass, Feature, Mesh, Observer, Options, Outcome, SkipCounts,
+    Sweep, TestRecord, Topology, VerdictCounts, sweep_mesh, sweep_mesh_with,
 };
 use crate::trace::TraceEvent;
 use crate::trace::messages::{OutcomeMsg, SceneMsg, SweepMsg};
@@ -38,6 +38,14 @@ pub struct SceneState {
 }
 
 impl SceneState {
+    /// The class of the edge `outcome` hit, or for a vertex hit the class
+    /// of the vertex (see [`feature_class`]); `None` for a face hit or a
+    /// miss.
+    pub fn hit_class(&self, outcome: &Outcome) -> Option<EdgeClass> {
+        let hit = outcome.hit.as_ref()?;
+        feature_class(&self.topology, hit.triangle, hit.feature)
+    }
+
     /// What a tunnel of a ball of `radius` is judged against: the mesh, its
     /// topology and `ρ = radius − margin`.
     pub fn tunnel_scene(&self, radius: f64) -> TunnelScene<'_> {
@@ -45,6 +53,32 @@ impl SceneState {
             mesh: &self.mesh,
             topology: &self.topology,
             rho: radius - self.options.margin,
+        }
+    }
+}
+
+/// The class of feature `feature` of `triangle`: an edge's
+/// own class; for a vertex, the most telling class of its edges, in the
+/// order `non_manifold`, `boundary`, `convex`, `concave`, `flat` (a vertex
+/// is `flat` only when every edge at it is); `None` for a face, or a
+/// feature the topology does not have.
+pub fn feature_class(topology: &Topology, triangle: u32, feature: Feature) -> Option<EdgeClass> {
+    match feature {
+        Feature::Face => None,
+        Feature::Edge(i) => topology.triangle_edge_class(triangle, i),
+        Feature::Vertex(i) => {
+            let v = topology.triangle_vertex(triangle, i)?;
+            let rank = |c: EdgeClass| match c {
+                EdgeClass::NonManifold => 0,
+                EdgeClass::Boundary => 1,
+                EdgeClass::Convex => 2,
+                EdgeClass::Concave => 3,
+                EdgeClass::Flat => 4,
+            };
+            topology
+                .edges_at(v)
+                .map(|e| e.class)
+                .min_by_key(|&c| rank(c))
         }
     }
 }
@@ -105,7 +139,11 @@ impl SweepResult {
     /// The line `replay --outcomes` writes: the outcome record, then the
     /// additive fields `fragile` (the reasons the decision is fragile, `[]`
     /// when it is robust; see [`crate::core::FragileReason`]) and `tunnel`
-    /// (the first of [`SweepResult::tunnels`], `null` when there is none).
+    /// (the first of [`SweepResult::tunnels`], `null` when there is none),
+    /// and for an edge or vertex hit `edge_class`, the class of the edge
+    /// (or vertex, [`feature_class`]) hit (`null` otherwise), and `ghost`
+    /// ([`SweepResult::ghost`] as a [`crate::regress::GhostLine`], `null`
+    /// when the expected outcome is not a ghost contact).
     pub fn outcome_line(&self) -> Result<String, serde_json::Error> {
         #[derive(serde::Serialize)]
         struct Line<'a> {
@@ -113,12 +151,35 @@ impl SweepResult {
             outcome: OutcomeMsg,
             fragile: crate::core::Fragility,
             tunnel: Option<&'a Tunnel>,
+            edge_class: Option<EdgeClass>,
+            ghost: Option<crate::regress::GhostLine<'a>>,
         }
+        let ghost = self.ghost();
         serde_json::to_string(&Line {
             outcome: self.outcome_msg(),
             fragile: self.outcome.fragile,
             tunnel: self.tunnels.first(),
+            edge_class: self.scene.hit_class(&self.outcome),
+            ghost: ghost.as_ref().map(|g| g.line()),
         })
+    }
+
+    /// The expected outcome as a ghost contact, when it is one: judged as
+    /// `check` judges it ([`crate::regress::judge_ghost`], with the core's
+    /// normal for the sweep as the rule's and the default threshold
+    /// [`crate::regress::GHOST_DEGREES`]).
+    pub fn ghost(&self) -> Option<crate::regress::GhostContact> {
+        let expected = self.expected.as_ref()?;
+        match crate::regress::judge_ghost(
+            &self.scene,
+            expected,
+            self.log_time_nanos,
+            self.outcome.hit.as_ref().map(|h| &h.normal),
+            crate::regress::GHOST_DEGREES,
+        ) {
+            crate::regress::GhostJudgement::Ghost(g) => Some(g),
+            _ => None,
+        }
     }
 
     /// The record that decided the sweep: the primary test when something is

@@ -28,7 +28,9 @@ mod selection;
 mod summary;
 mod tunnel;
 
-pub use engine::{ComputedSweep, Replay, ReplayEvent, SceneState, SweepResult, compute_sweep};
+pub use engine::{
+    ComputedSweep, Replay, ReplayEvent, SceneState, SweepResult, compute_sweep, feature_class,
+};
 pub use error::ReplayError;
 pub use iter::{
     DEFAULT_BATCH_EVENTS, ParallelReplayIter, ReplayIter, replay_events, replay_events_parallel,

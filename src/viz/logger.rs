@@ -21,8 +21,8 @@ use super::convert::{
 use super::edge_frame::{choose_edges, edge_frame_rows};
 use super::paths;
 use super::rows::{
-    Out, PLOT_BITS, Shown, SweepLabels, ball_row, expected_rows, focus_rows, plot_entity,
-    plot_rows, plot_series, primary_rows, text_rows, transition_rows, tunnel_rows,
+    Out, PLOT_BITS, Shown, SweepLabels, ball_row, expected_rows, focus_rows, ghost_rows,
+    plot_entity, plot_rows, plot_series, primary_rows, text_rows, transition_rows, tunnel_rows,
 };
 use super::spill::Spill;
 use super::{MAX_EDGE_FRAMES, RecordError, TIMESTAMP_THRESHOLD_NANOS};
@@ -215,6 +215,7 @@ pub fn prepare_sweeps_into<'r>(
         }
         let slot0 = choose_edges(&mut p.edges, r, decisive.as_ref(), options.max_edge_frames);
         let expected = r.expected.filter(|_| !diffs.is_empty());
+        let ghost = r.ghost();
         let labels = SweepLabels::of(
             r,
             decisive.as_ref(),
@@ -222,19 +223,21 @@ pub fn prepare_sweeps_into<'r>(
             slot0,
             followed,
             expected.is_some(),
+            ghost.as_ref(),
         );
         let primary = primary_rows(&mut out, r, decisive.as_ref(), labels.primary);
         edge_frame_rows(&mut out, r, &p.edges, labels.slot0.as_deref());
         let plotted = plot_rows(&mut out, r, decisive.as_ref());
         if let Some(e) = &expected {
-            expected_rows(&mut out, r, e, labels.expected);
+            expected_rows(&mut out, r, e, labels.expected, ghost.as_ref());
         }
         let expected = expected.is_some();
         text_rows(&mut out, r, decisive.as_ref(), &diffs);
         let tunnel = tunnel_rows(&mut out, r);
+        let ghost = ghost_rows(&mut out, r, ghost.as_ref(), labels.ghost);
         // What this sweep drew (`Logger::shown_before` worked out the same
         // for the ball's next sweep).
-        let now = Shown::drawn(p.edges.len(), plotted, primary, expected, tunnel);
+        let now = Shown::drawn(p.edges.len(), plotted, primary, expected, tunnel, ghost);
         debug_assert!(
             Shown::of(r, options) == now,
             "Shown::of disagrees with the rows drawn"

@@ -38,6 +38,14 @@
 //! world/ball/{ball}/tunnel            Points3D: where the ball's centre went through a
 //!                                     triangle front to back (during this sweep or since
 //!                                     its previous one), labelled with the triangle
+//! world/ball/{ball}/ghost             a ghost contact, when the sweep's expected outcome is
+//!                                     one (see `regress::ghost`):
+//!                                       Points3D: the expected contact, labelled
+//!                                       (`ghost contact 10.0°: edge 0.2 is internal and
+//!                                       flat`; the label is the expected ball's instead
+//!                                       when that one is labelled, so they do not pile up)
+//!                                       Arrows3D: the expected (ghost) normal, then the
+//!                                       faces' normal, from that point
 //! world/ball/{ball}/edge/{slot}       one logged edge test in its standard frame:
 //!                                       Transform3D world_from_edge
 //!                                       AnyValues: test, verdict, length, a, b, c,
@@ -61,7 +69,7 @@
 //! status/ball/{ball}/fragile          Scalars: 1 at each fragile decision (absent elsewhere)
 //! log                                 TextLog: one line per sweep, the decision in words
 //! divergences                         TextLog: one line per divergent sweep and one
-//!                                     WARN line per tunnel
+//!                                     WARN line per tunnel and per ghost contact
 //! ```
 //!
 //! What one sweep shows of a ball is on few entities, each with the
@@ -135,6 +143,11 @@ pub fn tunnel(ball: u32) -> String {
     format!("world/ball/{ball}/tunnel")
 }
 
+/// A ghost contact of the ball's expected outcome.
+pub fn ghost(ball: u32) -> String {
+    format!("world/ball/{ball}/ghost")
+}
+
 /// The standard frame of the `slot`-th logged edge test and what is drawn
 /// in it.
 pub fn edge_frame(ball: u32, slot: usize) -> String {
@@ -182,6 +195,7 @@ pub(crate) enum Entity {
     EdgeFrame(u32, usize),
     Expected(u32),
     Tunnel(u32),
+    Ghost(u32),
     Status(u32),
     Fragile(u32),
     Divergences,
@@ -201,6 +215,7 @@ impl Entity {
             Entity::EdgeFrame(b, s) => edge_frame(b, s),
             Entity::Expected(b) => expected(b),
             Entity::Tunnel(b) => tunnel(b),
+            Entity::Ghost(b) => ghost(b),
             Entity::Status(b) => status(b),
             Entity::Fragile(b) => fragile(b),
             Entity::Divergences => DIVERGENCES.to_string(),

@@ -16,17 +16,17 @@ use rerun::{
 
 use super::columns::{self, Row};
 use super::convert::{
-    BOLD_EDGE_POINTS, CONTACT_BALL_COLOR, EXPECTED_COLOR, HIT_COLOR, MISS_COLOR, NORMAL_COLOR,
-    OUTLINE_POINTS, P0_COLOR, P1_COLOR, SWEEP_COLOR, TUNNEL_COLOR, VERTEX_POINTS, albedo,
-    any_value, capsule_pose, f32x3, rgba, ui_points,
+    BOLD_EDGE_POINTS, CONTACT_BALL_COLOR, EXPECTED_COLOR, FACE_NORMAL_COLOR, GHOST_COLOR,
+    HIT_COLOR, MISS_COLOR, NORMAL_COLOR, OUTLINE_POINTS, P0_COLOR, P1_COLOR, SWEEP_COLOR,
+    TUNNEL_COLOR, VERTEX_POINTS, albedo, any_value, capsule_pose, f32x3, rgba, ui_points,
 };
 use super::edge_frame::{Slot0, count_edges};
 use super::logger::PrepareOptions;
 use super::paths::{Entity, FACE_NAMES, QUADRATIC_NAMES};
 use crate::core::explain::Label;
 use crate::core::{EdgeRecord, Kind, TestRecord};
-use crate::regress::FieldDiff;
 use crate::regress::decision::{divergence, write_decision_line, write_divergence_line};
+use crate::regress::{FieldDiff, GhostContact, ghost_point};
 use crate::replay::SweepResult;
 use crate::trace::messages::OutcomeMsg;
 
@@ -49,11 +49,14 @@ pub(crate) mod set {
     pub const EDGE_FRAME_AXES: u8 = 17;
     pub const EXPECTED: u8 = 21;
     pub const TUNNEL: u8 = 22;
+    /// A ghost contact's mark: its point and two arrows.
+    pub const GHOST: u8 = 23;
 }
 
 /// What a sweep's rows leave shown for its ball, of the entities that are
 /// cleared when a sweep no longer logs them: the primary triangle, the edge
-/// frames, the plot series, the expected outcome, the tunnel marker. A
+/// frames, the plot series, the expected outcome, the tunnel marker, the
+/// ghost contact's mark. A
 /// ball's rows clear one of them only when the ball's previous sweep showed
 /// it, right after the sweep's own rows (so that a clear keeps its place
 /// among the sweeps of one frame). (The contact, the normal, the decisive
@@ -72,6 +75,7 @@ impl Shown {
     const PRIMARY: u8 = 1;
     const EXPECTED: u8 = 2;
     const TUNNEL: u8 = 4;
+    const GHOST: u8 = 8;
 
     /// What the rows of `r` show, as the logger with `options` draws them
     /// (worked out without drawing them or running any test).
@@ -89,6 +93,9 @@ impl Shown {
         if !r.tunnels.is_empty() {
             bits |= Shown::TUNNEL;
         }
+        if r.ghost().is_some() {
+            bits |= Shown::GHOST;
+        }
         let edges = count_edges(r, decisive, options.max_edge_frames);
         Shown {
             bits,
@@ -103,19 +110,21 @@ impl Shown {
 
     /// What the rows drawn for a sweep show: `edge_slots` edge frames, the
     /// `plotted` plot entities, whether the primary triangle, the expected
-    /// outcome and a tunnel marker were drawn.
+    /// outcome, a tunnel marker and a ghost contact's mark were drawn.
     pub(crate) fn drawn(
         edge_slots: usize,
         plotted: u16,
         primary: bool,
         expected: bool,
         tunnel: bool,
+        ghost: bool,
     ) -> Shown {
         let bit = |on: bool, b: u8| if on { b } else { 0 };
         Shown {
             bits: bit(primary, Shown::PRIMARY)
                 | bit(expected, Shown::EXPECTED)
-                | bit(tunnel, Shown::TUNNEL),
+                | bit(tunnel, Shown::TUNNEL)
+                | bit(ghost, Shown::GHOST),
             edge_slots: u8::try_from(edge_slots).unwrap_or(u8::MAX),
             plotted,
         }
@@ -124,7 +133,8 @@ impl Shown {
 
 /// Clears, at ball `b`'s sweep that shows `now`, what its previous sweep
 /// showed (`out.before`) and this one does not log: the primary triangle,
-/// edge frames, plot series, expected outcome and tunnel marker.
+/// edge frames, plot series, expected outcome, tunnel marker and ghost
+/// contact's mark.
 pub(crate) fn transition_rows(out: &mut Out<'_>, b: u32, now: Shown) {
     let before = out.before;
     if before.has(Shown::PRIMARY) && !now.has(Shown::PRIMARY) {
@@ -142,6 +152,9 @@ pub(crate) fn transition_rows(out: &mut Out<'_>, b: u32, now: Shown) {
     }
     if before.has(Shown::TUNNEL) && !now.has(Shown::TUNNEL) {
         out.clear(Entity::Tunnel(b), false);
+    }
+    if before.has(Shown::GHOST) && !now.has(Shown::GHOST) {
+        out.clear(Entity::Ghost(b), false);
     }
 }
 
@@ -304,7 +317,8 @@ pub(crate) fn focus_rows(
 
 /// Which of a sweep's archetypes carry a label, so that no two labels say
 /// the same thing in the same place: the primary feature's label, the
-/// expected ball's and slot 0's edge test's (see [`SweepLabels::of`]).
+/// expected ball's, slot 0's edge test's and the ghost contact's (see
+/// [`SweepLabels::of`]).
 #[derive(Clone, Debug, Default, PartialEq)]
 pub(crate) struct SweepLabels {
     /// The primary triangle's label is drawn on its decisive feature.
@@ -314,6 +328,10 @@ pub(crate) struct SweepLabels {
     /// Slot 0's edge test's label, on its edge (none for a decisive edge
     /// test, whose label is the primary edge's).
     pub(crate) slot0: Option<String>,
+    /// The ghost contact's mark carries its own label (when the expected
+    /// ball is drawn, its label, on the ball or folded into slot 0's, says
+    /// it instead).
+    pub(crate) ghost: bool,
 }
 
 impl SweepLabels {
@@ -332,6 +350,11 @@ impl SweepLabels {
     /// edge-frame view included): `face 0; nearest edge test: edge 0.1
     /// (parallel)`, `expected: edge; expected edge test: edge 0.0
     /// (no_real_roots)`.
+    ///
+    /// The ghost contact `ghost` is marked at the expected contact, which
+    /// the expected ball touches: when that ball is drawn its label says
+    /// both (`expected: edge; ghost contact 10.0°: edge 0.2 is internal
+    /// and flat`), else the mark has its own label.
     pub(crate) fn of(
         r: &SweepResult,
         decisive: Option<&TestRecord>,
@@ -339,12 +362,14 @@ impl SweepLabels {
         slot0: Slot0,
         followed: bool,
         expected: bool,
+        ghost: Option<&GhostContact>,
     ) -> SweepLabels {
         let shown = decisive.filter(|t| r.scene.mesh.triangle_by_index(t.triangle()).is_some());
         let mut labels = SweepLabels {
             primary: shown.is_some_and(|t| t.alpha().is_some() || followed),
             expected,
             slot0: None,
+            ghost: ghost.is_some() && !expected,
         };
         let Some(e) = edges.first().filter(|_| followed) else {
             return labels;
@@ -371,7 +396,7 @@ impl SweepLabels {
                     labels.expected = false;
                     Some(format!(
                         "{}; {}",
-                        expected_text(&x),
+                        expected_text(&x, ghost),
                         edge_test("expected edge test")
                     ))
                 }
@@ -393,9 +418,13 @@ fn primary_text(test: &TestRecord) -> String {
     format!("{prefix}{}", Label(test))
 }
 
-/// The expected ball's label.
-fn expected_text(e: &OutcomeMsg) -> String {
-    format!("expected: {}", e.kind)
+/// The expected ball's label, with the ghost contact's when the
+/// expectation is one.
+fn expected_text(e: &OutcomeMsg, ghost: Option<&GhostContact>) -> String {
+    match ghost {
+        Some(g) => format!("expected: {}; {}", e.kind, g.label()),
+        None => format!("expected: {}", e.kind),
+    }
 }
 
 /// The primary (or nearest-miss) triangle, in one row: filled, its three
@@ -472,8 +501,14 @@ pub(crate) fn primary_rows(
 /// one row: the ball at the expected α, the expected contact (when the
 /// expectation names one) and normal (when it names a contact and a normal
 /// of finite, non-zero length; else none); the ball labelled with the
-/// expected kind when `labelled`.
-pub(crate) fn expected_rows(out: &mut Out<'_>, r: &SweepResult, e: &OutcomeMsg, labelled: bool) {
+/// expected kind (and the ghost contact, `ghost`) when `labelled`.
+pub(crate) fn expected_rows(
+    out: &mut Out<'_>,
+    r: &SweepResult,
+    e: &OutcomeMsg,
+    labelled: bool,
+    ghost: Option<&GhostContact>,
+) {
     let b = r.ball;
     let p0 = r.sweep.p0;
     let d = r.sweep.p1 - p0;
@@ -510,7 +545,7 @@ pub(crate) fn expected_rows(out: &mut Out<'_>, r: &SweepResult, e: &OutcomeMsg, 
     )
     .put_texts(Ellipsoids3D::descriptor_labels, |t| {
         if labelled {
-            t.push_fmt(format_args!("{}", expected_text(e)));
+            t.push_fmt(format_args!("{}", expected_text(e, ghost)));
         }
     });
     // The contact point alone when the normal is missing or unusable.
@@ -666,5 +701,54 @@ pub(crate) fn tunnel_rows(out: &mut Out<'_>, r: &SweepResult) -> bool {
             })
             .put_strs(TextLog::descriptor_level, [TextLogLevel::WARN]);
     }
+    true
+}
+
+/// A ghost contact (`ghost`, the sweep's expected outcome as
+/// [`SweepResult::ghost`] judges it), in one row: a point where it is
+/// ([`ghost_point`]), labelled when `labelled`, and two arrows from it, the
+/// expected (ghost) normal and the faces' normal; and a WARN line in the
+/// divergences log. Returns whether it was drawn (the mark is cleared at
+/// the ball's next sweep without one).
+pub(crate) fn ghost_rows(
+    out: &mut Out<'_>,
+    r: &SweepResult,
+    ghost: Option<&GhostContact>,
+    labelled: bool,
+) -> bool {
+    let Some(g) = ghost else {
+        return false;
+    };
+    let at = ghost_point(r, g).map(|x| x as f32);
+    let length = r.sweep.radius.max(1e-3) * 3.0;
+    let arrow = |n: [f64; 3]| {
+        let v = nalgebra::Vector3::from(n);
+        let k = length / v.norm().max(f64::MIN_POSITIVE);
+        Vector3D::from(f32x3(v * k))
+    };
+    out.row(Entity::Ghost(r.ball), set::GHOST)
+        .put::<Position3D>(Points3D::descriptor_positions, [Position3D::from(at)])
+        .put::<Radius>(Points3D::descriptor_radii, [ui_points(7.0)])
+        .put::<Color>(Points3D::descriptor_colors, [rgba(GHOST_COLOR)])
+        .put_texts(Points3D::descriptor_labels, |t| {
+            if labelled {
+                t.push_fmt(format_args!("{}", g.label()));
+            }
+        })
+        .put::<Vector3D>(
+            Arrows3D::descriptor_vectors,
+            [arrow(g.normal), arrow(g.face_normal)],
+        )
+        .put::<Position3D>(Arrows3D::descriptor_origins, [Position3D::from(at)])
+        .put::<Radius>(Arrows3D::descriptor_radii, [ui_points(2.5)])
+        .put::<Color>(
+            Arrows3D::descriptor_colors,
+            [rgba(GHOST_COLOR), rgba(FACE_NORMAL_COLOR)],
+        );
+    out.row(Entity::Divergences, set::TEXT_LOG)
+        .put_texts(TextLog::descriptor_text, |t| {
+            t.push_fmt(format_args!("ghost contact: {g}"));
+        })
+        .put_strs(TextLog::descriptor_level, [TextLogLevel::WARN]);
     true
 }

@@ -73,7 +73,7 @@
 #![warn(missing_docs)]
 
 // Plumbing the command line shares with the library (atomic output files,
-// error texts, number checks, exit codes): public for the binary, not part
+// error texts, number checks): public for the binary, not part
 // of the library's API.
 #[doc(hidden)]
 pub mod atomic;
@@ -91,8 +91,6 @@ pub mod numbers;
 pub(crate) mod palette;
 pub mod regress;
 pub mod replay;
-#[doc(hidden)]
-pub mod run;
 pub mod sim;
 pub mod trace;
 #[cfg(feature = "viewer")]

@@ -5,8 +5,7 @@ mod cli;
 
 use std::process::ExitCode;
 
-use clap::Parser;
-use sweeptrace::run::RunOutcome;
+use cli::RunOutcome;
 
 fn main() -> ExitCode {
     // Like other command-line tools, stop quietly when the reader of our
@@ -19,7 +18,7 @@ fn main() -> ExitCode {
     }
     #[cfg(unix)]
     interrupts::handle();
-    let args = cli::Cli::parse();
+    let args = cli::parse();
     let outcome = cli::run(args).unwrap_or_else(|err| {
         eprintln!("error: {err:#}");
         RunOutcome::Error

@@ -478,7 +478,7 @@ fn wrong_engine_config_fixture_fails_with_frame_and_reason() -> anyhow::Result<(
     // The committed fixture is what the generator makes.
     let fresh = check_bytes(&fixture_bytes()?);
     check_fixture_report(&fresh)?;
-    let json: serde_json::Value = serde_json::from_str(&render_json(&[report]))?;
+    let json: serde_json::Value = serde_json::from_str(&render_json(&[report], 1))?;
     ensure!(json["exit_code"] == 1, "json exit code: {json}");
     ensure!(
         json["traces"][0]["divergences"][0]["frame"] == 2,
@@ -498,6 +498,7 @@ fn wrong_engine_config_fixture_binary_exit_1() -> anyhow::Result<()> {
     let json: serde_json::Value =
         serde_json::from_str(&out).map_err(|e| anyhow::anyhow!("{e}: {out}"))?;
     ensure!(json["traces"][0]["status"] == "fail", "json: {json}");
+    ensure!(json["exit_code"] == 1, "json exit code: {json}");
     // A tolerance wide enough for frame 3's α still fails on frame 2's kind.
     let (code, _, _) = run_bin(os!["check", fixture.as_os_str(), "--tolerance", "0.5"])?;
     ensure!(code == 1, "exit {code} with a wide α tolerance");

@@ -332,7 +332,7 @@ fn old_trace_without_it_reads_as_before() -> anyhow::Result<()> {
         !text.contains("expectations from") && text.lines().count() == 1,
         "{text}"
     );
-    let json: serde_json::Value = serde_json::from_str(&render_json(&[report]))?;
+    let json: serde_json::Value = serde_json::from_str(&render_json(&[report], 0))?;
     ensure!(
         json["traces"][0]
             .as_object()

@@ -45,6 +45,7 @@ pub fn tests() -> Vec<Trial> {
         trial!(through_an_mcap_trace),
         trial!(rrd_reads_back_through_rerun),
         trial!(cli_writes_outcomes_and_rrd),
+        trial!(detail_without_a_recording_warns),
         trial!(threads_do_not_change_the_outputs),
         trial!(blueprint_is_reproducible),
         trial!(parallel_iterator_equals_sequential),
@@ -1233,6 +1234,70 @@ fn cli_writes_outcomes_and_rrd() -> anyhow::Result<()> {
     );
     let stderr = String::from_utf8_lossy(&out.stderr);
     ensure!(stderr.contains("error"), "truncated trace: {stderr}");
+    Ok(())
+}
+
+/// `--detail` only changes what the recording shows: given without a
+/// recording output (`--outcomes` alone), the replay says so on stderr and
+/// still succeeds; with a recording (`--rrd`, `--foxglove`, or no output
+/// named at all, the default `.rrd`), or without `--detail`, it does not.
+fn detail_without_a_recording_warns() -> anyhow::Result<()> {
+    let dir = tempfile::tempdir()?;
+    let sweeps = random_sweeps(5, 4, 1);
+    std::fs::write(
+        dir.path().join("run.mcap"),
+        write_trace(&cube_scene(), &sweeps, false)?,
+    )?;
+    let warning = "warning: --detail only changes what the recording shows, and no \
+                   recording output was asked for (--rrd, --spawn, --connect or --foxglove \
+                   give one)\n";
+    let cases: [(&[&str], bool); 7] = [
+        (&["--outcomes", "out.jsonl", "--detail", "all"], true),
+        (&["--outcomes", "-", "--detail=candidates"], true),
+        // Given, even at its default value.
+        (&["--outcomes", "out.jsonl", "--detail", "primary"], true),
+        (&["--outcomes", "out.jsonl"], false),
+        (
+            &[
+                "--outcomes",
+                "out.jsonl",
+                "--rrd",
+                "run.rrd",
+                "--detail",
+                "all",
+            ],
+            false,
+        ),
+        (&["--foxglove", "run.fg.mcap", "--detail", "all"], false),
+        (&["--detail", "all"], false),
+    ];
+    for (extra, warns) in cases {
+        let mut args = vec!["replay", "run.mcap"];
+        args.extend(extra);
+        let out = std::process::Command::new(env!("CARGO_BIN_EXE_sweeptrace"))
+            .current_dir(dir.path())
+            .args(&args)
+            .output()?;
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        ensure!(
+            out.status.success(),
+            "{extra:?}: exit {:?}: {stderr}",
+            out.status.code()
+        );
+        ensure!(
+            stderr.contains(warning) == warns,
+            "{extra:?}: the warning should {}be on stderr:\n{stderr}",
+            if warns { "" } else { "not " }
+        );
+        ensure!(
+            stderr.matches("--detail").count() <= 1,
+            "{extra:?}: warned more than once:\n{stderr}"
+        );
+    }
+    ensure!(
+        dir.path().join("run.rrd").is_file(),
+        "default recording missing"
+    );
     Ok(())
 }
 

@@ -145,7 +145,7 @@ fn divergence_inputs() -> anyhow::Result<()> {
             d.got
         );
     }
-    let json: serde_json::Value = serde_json::from_str(&render_json(&[report]))?;
+    let json: serde_json::Value = serde_json::from_str(&render_json(&[report], 1))?;
     let inputs = &json["traces"][0]["divergences"][0]["inputs"];
     let p0: Vec<f64> = serde_json::from_value(inputs["p0"].clone())?;
     same_bits("json p0", &p0, &[2.0, -0.45, 3.0])?;
@@ -593,7 +593,7 @@ fn infer_wrong_engine_config() -> anyhow::Result<()> {
             && text.contains("expectations match with margin 0 and facing non_strict: 5 of 5"),
         "text:\n{text}"
     );
-    let json: serde_json::Value = serde_json::from_str(&render_json(&[report]))?;
+    let json: serde_json::Value = serde_json::from_str(&render_json(&[report], 1))?;
     ensure!(
         json["traces"][0]["inferred"]["margin"] == 0.0
             && json["traces"][0]["inferred"]["matches"] == 5,

@@ -491,7 +491,7 @@ fn floor_fixture_check() -> anyhow::Result<()> {
         &CheckOptions::default(),
     );
     check_floor_report(&fresh)?;
-    let json: serde_json::Value = serde_json::from_str(&render_json(&[report]))?;
+    let json: serde_json::Value = serde_json::from_str(&render_json(&[report], 1))?;
     let t = &json["traces"][0];
     ensure!(json["exit_code"] == 1 && t["status"] == "fail", "{json}");
     ensure!(

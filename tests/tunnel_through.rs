@@ -165,7 +165,7 @@ fn flipped_floor_tunnel_names_the_flipped_triangle() -> anyhow::Result<()> {
             && text.contains("through the flipped triangle 8"),
         "text:\n{text}"
     );
-    let json: serde_json::Value = serde_json::from_str(&render_json(&[report]))?;
+    let json: serde_json::Value = serde_json::from_str(&render_json(&[report], 1))?;
     let d = json["traces"][0]["tunnel_details"]
         .as_array()
         .and_then(|a| a.iter().find(|d| d["ball"] == 0))
@@ -200,7 +200,7 @@ fn ordinary_tunnel_names_nothing() -> anyhow::Result<()> {
     ensure!(t.tunnel.through.is_none(), "{t:?}");
     let line = t.line();
     ensure!(!line.contains(", through the"), "{line}");
-    let json: serde_json::Value = serde_json::from_str(&render_json(&[report]))?;
+    let json: serde_json::Value = serde_json::from_str(&render_json(&[report], 1))?;
     let d = json["traces"][0]["tunnel_details"]
         .as_array()
         .and_then(|a| a.iter().find(|d| d["ball"] == 1))

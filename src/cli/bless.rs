@@ -7,10 +7,10 @@ use std::path::PathBuf;
 
 use anyhow::bail;
 
+use super::RunOutcome;
 use sweeptrace::numbers::counted;
 use sweeptrace::regress::bless_file;
 use sweeptrace::replay::ReplayOptions;
-use sweeptrace::run::RunOutcome;
 
 /// Arguments of `bless`.
 #[derive(Debug, clap::Args)]

@@ -6,6 +6,7 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context, bail};
 
+use super::RunOutcome;
 use sweeptrace::engine::{EngineCommand, EngineOptions};
 use sweeptrace::regress::{Against, check_file_with_engine};
 use sweeptrace::regress::{
@@ -13,7 +14,6 @@ use sweeptrace::regress::{
     render_json, render_text,
 };
 use sweeptrace::replay::{Detail, ReplayError, ReplayEvent, ReplayOptions, replay_events};
-use sweeptrace::run::RunOutcome;
 use sweeptrace::trace::TraceReader;
 use sweeptrace::viz;
 
@@ -257,8 +257,9 @@ pub fn run(args: Args) -> anyhow::Result<RunOutcome> {
         }
         reports.push(report);
     }
+    let outcome = RunOutcome::worst(reports.iter().map(outcome_of));
     if args.json {
-        print!("{}", render_json(&reports));
+        print!("{}", render_json(&reports, outcome.exit_code()));
     } else if traces.len() > 1 {
         let count = |s: Status| reports.iter().filter(|r| r.status() == s).count();
         println!(
@@ -271,12 +272,26 @@ pub fn run(args: Args) -> anyhow::Result<RunOutcome> {
         );
     }
     super::junit::finish_check(junit, &reports, &times)?;
-    let outcome = RunOutcome::worst(reports.iter().map(TraceReport::outcome));
     Ok(if rrd_error {
         RunOutcome::Error
     } else {
         outcome
     })
+}
+
+/// What the check of one trace came to: a divergence is
+/// [`RunOutcome::Differences`]; a trace that ends early (its only error)
+/// [`RunOutcome::IncompleteInput`]; any other error, or nothing to
+/// compare, [`RunOutcome::Error`].
+fn outcome_of(report: &TraceReport) -> RunOutcome {
+    match report.status() {
+        Status::Ok => RunOutcome::Success,
+        Status::Fail => RunOutcome::Differences,
+        Status::Error if report.incomplete && report.errors.len() == 1 => {
+            RunOutcome::IncompleteInput
+        }
+        Status::NoExpectations | Status::Error => RunOutcome::Error,
+    }
 }
 
 /// The engine's options from `--engine-timeout`.

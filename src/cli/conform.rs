@@ -3,9 +3,9 @@
 
 use anyhow::{Context, bail};
 
-use sweeptrace::conform::{self, ConformOptions, RULES};
+use super::RunOutcome;
+use sweeptrace::conform::{self, ConformOptions, ConformStatus, RULES};
 use sweeptrace::engine::EngineCommand;
-use sweeptrace::run::RunOutcome;
 use sweeptrace::trace::TraceEvent;
 
 /// Arguments of `conform`.
@@ -135,8 +135,9 @@ pub fn run(args: Args) -> anyhow::Result<RunOutcome> {
             return Ok(RunOutcome::EngineUnavailable);
         }
     };
+    let outcome = outcome_of(report.status());
     if args.json {
-        print!("{}", conform::render_json(&report));
+        print!("{}", conform::render_json(&report, outcome.exit_code()));
     } else {
         print!("{}", conform::render_text(&report));
     }
@@ -149,7 +150,17 @@ pub fn run(args: Args) -> anyhow::Result<RunOutcome> {
         );
         junit.finish(&xml)?;
     }
-    Ok(report.outcome())
+    Ok(outcome)
+}
+
+/// What a conformance run came to: a fault of the engine is an error, a
+/// failed case a difference.
+fn outcome_of(status: ConformStatus) -> RunOutcome {
+    match status {
+        ConformStatus::Ok => RunOutcome::Success,
+        ConformStatus::Fail => RunOutcome::Differences,
+        ConformStatus::Error => RunOutcome::Error,
+    }
 }
 
 /// The rules and their cases, one line each.

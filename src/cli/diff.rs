@@ -8,12 +8,12 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context, bail};
 
+use super::RunOutcome;
 use sweeptrace::core::Facing;
 use sweeptrace::numbers::{self, Rule};
 use sweeptrace::regress::diff::{render_json, render_text};
 use sweeptrace::regress::{Side, diff};
 use sweeptrace::replay::{FrameRange, ReplayOptions, Selection};
-use sweeptrace::run::RunOutcome;
 use sweeptrace::trace::TraceReader;
 
 /// Arguments of `diff`.

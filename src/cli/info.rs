@@ -7,7 +7,7 @@ use std::path::PathBuf;
 
 use anyhow::Context;
 
-use sweeptrace::run::RunOutcome;
+use super::RunOutcome;
 use sweeptrace::trace::TraceReader;
 use sweeptrace::trace::info::{collect, render_json, render_text};
 

@@ -9,8 +9,8 @@ use std::path::PathBuf;
 use anyhow::Context;
 use serde::Serialize;
 
+use super::RunOutcome;
 use sweeptrace::core::{Defect, DefectKind, EdgeClass, EdgeCounts, Topology};
-use sweeptrace::run::RunOutcome;
 use sweeptrace::sim::load_obj;
 use sweeptrace::trace::{TraceEvent, TraceReader};
 

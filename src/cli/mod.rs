@@ -1,8 +1,8 @@
 //! Argument structs (kept dumb) and dispatch to one file per subcommand.
 
-use clap::{Parser, Subcommand};
+use clap::parser::ValueSource;
+use clap::{CommandFactory, FromArgMatches, Parser, Subcommand};
 use sweeptrace::replay::ReplayOptions;
-use sweeptrace::run::RunOutcome;
 
 pub mod bless;
 pub mod check;
@@ -12,11 +12,14 @@ pub mod diff;
 pub mod info;
 pub mod junit;
 pub mod mesh;
+mod outcome;
 pub mod record;
 pub mod replay;
 pub mod report;
 pub mod repro;
 pub mod sweep;
+
+pub use outcome::RunOutcome;
 
 /// Replay recorded ball trajectories through a swept-sphere vs triangle-mesh
 /// collision core and see, frame by frame, why each collision was or was not
@@ -50,6 +53,23 @@ pub enum Command {
     Repro(repro::Args),
     /// Simulate balls through a scene and record their sweeps and expected outcomes as a trace.
     Record(record::Args),
+}
+
+/// Parses the command line (as [`Parser::parse`] does: a bad argument
+/// prints clap's error and exits), noting what only the parsed matches
+/// know: whether `replay --detail` was given on the command line.
+pub fn parse() -> Cli {
+    let matches = Cli::command().get_matches();
+    let mut cli = Cli::from_arg_matches(&matches)
+        .map_err(|e| e.format(&mut Cli::command()))
+        .unwrap_or_else(|e| e.exit());
+    if let Command::Replay(args) = &mut cli.command {
+        args.detail_given = matches
+            .subcommand_matches("replay")
+            .and_then(|m| m.value_source("detail"))
+            == Some(ValueSource::CommandLine);
+    }
+    cli
 }
 
 /// Runs the chosen subcommand; `main` turns what it came to into the exit

@@ -7,8 +7,8 @@ use std::path::PathBuf;
 use anyhow::Context;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 
+use super::RunOutcome;
 use sweeptrace::core::Facing;
-use sweeptrace::run::RunOutcome;
 use sweeptrace::sim::scenes::{self, BuiltinScene, SceneMesh};
 use sweeptrace::sim::{self, SimOptions, SimSummary, StopReason};
 use sweeptrace::trace::source::sweeptrace_source;

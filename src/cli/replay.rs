@@ -13,6 +13,7 @@ use std::time::Instant;
 use anyhow::{Context, bail};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 
+use super::RunOutcome;
 use sweeptrace::atomic::PendingFile;
 use sweeptrace::core::Facing;
 use sweeptrace::foxglove::{FoxgloveFile, FoxgloveOptions};
@@ -22,7 +23,6 @@ use sweeptrace::replay::{
     Detail, FrameRange, PipelineOptions, ReplayError, ReplayEvent, ReplayOptions, Selection,
     replay_events_parallel, run_pipeline,
 };
-use sweeptrace::run::RunOutcome;
 use sweeptrace::trace::TraceReader;
 use sweeptrace::trace::prefetch::{self, prefetch};
 use sweeptrace::viz::{
@@ -96,6 +96,10 @@ pub struct Args {
     /// visited) or `all` (every test of every triangle).
     #[arg(long, default_value = "primary", value_name = "LEVEL")]
     pub detail: Detail,
+    /// Whether `--detail` was given on the command line (not its default):
+    /// set by [`super::parse`].
+    #[arg(skip)]
+    pub detail_given: bool,
     /// Override every scene's margin ε (tests use ρ = r - ε).
     #[arg(long, value_name = "EPSILON")]
     pub margin: Option<f64>,
@@ -146,6 +150,12 @@ pub fn run(args: Args) -> anyhow::Result<RunOutcome> {
         numbers::check(m, Rule::NonNegative).map_err(|e| anyhow::anyhow!("--margin {e}"))?;
     }
     let target = recording_target(&args);
+    if args.detail_given && target.is_none() && args.foxglove.is_none() {
+        eprintln!(
+            "warning: --detail only changes what the recording shows, and no recording \
+             output was asked for (--rrd, --spawn, --connect or --foxglove give one)"
+        );
+    }
     let options = ReplayOptions {
         frames: args.frames.unwrap_or_default(),
         ball: args.ball,

@@ -6,8 +6,8 @@ use std::path::PathBuf;
 
 use anyhow::Context;
 
+use super::RunOutcome;
 use sweeptrace::regress::{ReproCase, find_sweep};
-use sweeptrace::run::RunOutcome;
 use sweeptrace::trace::{TraceReader, write_trace_file};
 
 /// Arguments of `repro`.

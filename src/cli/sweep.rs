@@ -5,10 +5,10 @@ use std::path::PathBuf;
 
 use anyhow::Context;
 
+use super::RunOutcome;
 use super::report;
 use sweeptrace::core::{Broadphase, CollectRecords, Facing, Options, Sweep, sweep_mesh_with};
 use sweeptrace::regress::find_sweep;
-use sweeptrace::run::RunOutcome;
 use sweeptrace::sim::{BuiltinScene, load_obj};
 use sweeptrace::trace::TraceReader;
 use sweeptrace::trace::messages::OutcomeMsg;

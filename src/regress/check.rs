@@ -23,13 +23,15 @@ use crate::core::{Facing, Feature, FragileReason, Kind};
 use crate::replay::{
     ReplayError, ReplayEvent, ReplayOptions, SweepResult, Tunnel, TunnelAt, TunnelKind,
 };
-use crate::run::RunOutcome;
 use crate::trace::messages::{EXPECTED_TOPIC, OutcomeMsg};
 use crate::trace::{TraceError, TraceEvent, TraceReader};
 
 use super::compare::{FieldDiff, Tolerances};
+pub use super::discovery::find_traces;
 use super::explain::{ExpectedTest, expected_tests, explain_outcome, explained_records};
-use super::ghost::{GhostContact, GhostJudgement, judge_ghost};
+use super::ghost::GhostContact;
+pub use super::ghost_count::MAX_LISTED_GHOSTS;
+use super::ghost_count::count_ghosts;
 use super::infer::{ComparedSweep, Inferred, infer};
 use super::judge::{Agreement, agreement};
 use super::repro::{HexInputs, SweepInputs};
@@ -38,8 +40,6 @@ use super::repro::{HexInputs, SweepInputs};
 pub const DEFAULT_MAX_DETAILS: usize = 3;
 /// How many tunnels a report lists, one line each.
 pub const MAX_LISTED_TUNNELS: usize = 10;
-/// How many ghost contacts a report lists, one line each.
-pub const MAX_LISTED_GHOSTS: usize = 10;
 
 /// A tunnel found in a trace: a ball's centre went through a triangle from
 /// its front to its back, during a sweep or between two of its sweeps (see
@@ -188,21 +188,6 @@ impl TraceReport {
     /// Whether ghost contacts were found and fail the check.
     pub fn fails_on_ghosts(&self) -> bool {
         self.ghosts > 0 && self.fail_on_ghost
-    }
-
-    /// What the check of this trace came to: a divergence is
-    /// [`RunOutcome::Differences`]; a trace that ends early
-    /// [`RunOutcome::IncompleteInput`]; any other error, or nothing to
-    /// compare, [`RunOutcome::Error`].
-    pub fn outcome(&self) -> RunOutcome {
-        match self.status() {
-            Status::Ok => RunOutcome::Success,
-            Status::Fail => RunOutcome::Differences,
-            Status::Error if self.incomplete && self.errors.len() == 1 => {
-                RunOutcome::IncompleteInput
-            }
-            Status::NoExpectations | Status::Error => RunOutcome::Error,
-        }
     }
 }
 
@@ -675,30 +660,7 @@ where
                 };
                 let expected = &judged.expected;
                 report.compared += 1;
-                // The expectation, and an engine's answer when it is not
-                // the core's outcome, judged for ghost contacts whatever
-                // the compared fields.
-                let answer = (!judged.got_is_core).then_some(&judged.got);
-                for (outcome, is_answer) in [(Some(expected), false), (answer, true)] {
-                    let Some(outcome) = outcome else { continue };
-                    match judge_ghost(
-                        &result.scene,
-                        outcome,
-                        result.log_time_nanos,
-                        result.outcome.hit.as_ref().map(|h| &h.normal),
-                        options.ghost_degrees,
-                    ) {
-                        GhostJudgement::Ghost(mut g) => {
-                            report.ghosts += 1;
-                            if report.ghost_contacts.len() < MAX_LISTED_GHOSTS {
-                                g.answer = is_answer;
-                                report.ghost_contacts.push(g);
-                            }
-                        }
-                        GhostJudgement::NoNormal => report.ghosts_unjudged += 1,
-                        GhostJudgement::Fine | GhostJudgement::NotApplicable => {}
-                    }
-                }
+                count_ghosts(&mut report, &result, &judged, options.ghost_degrees);
                 // Kept for the inference of the engine's configuration; the
                 // first ones only, so memory stays bounded on long traces.
                 if judged.got_is_core && compared.len() < MAX_INFERENCE_SWEEPS {
@@ -854,40 +816,4 @@ pub fn check_file(path: &std::path::Path, options: &CheckOptions) -> TraceReport
             report
         }
     }
-}
-
-/// The traces named by `paths`: files as given, directories searched
-/// recursively for `*.mcap` files (sorted by path, hidden entries skipped).
-/// Errors name the path that could not be read.
-pub fn find_traces(paths: &[std::path::PathBuf]) -> Result<Vec<std::path::PathBuf>, String> {
-    let mut out = Vec::new();
-    for p in paths {
-        if !p.is_dir() {
-            out.push(p.clone());
-            continue;
-        }
-        let walk = walkdir::WalkDir::new(p)
-            .follow_links(true)
-            .sort_by_file_name()
-            .into_iter()
-            .filter_entry(|e| e.depth() == 0 || !e.file_name().to_string_lossy().starts_with('.'));
-        for entry in walk {
-            let entry = entry.map_err(|e| {
-                let dir = e.path().unwrap_or(p).display().to_string();
-                let cause = e
-                    .io_error()
-                    .map_or_else(|| e.to_string(), std::io::Error::to_string);
-                format!("{dir}: cannot list the directory: {cause}")
-            })?;
-            if !entry.file_type().is_dir()
-                && entry
-                    .path()
-                    .extension()
-                    .is_some_and(|e| e.eq_ignore_ascii_case("mcap"))
-            {
-                out.push(entry.into_path());
-            }
-        }
-    }
-    Ok(out)
 }

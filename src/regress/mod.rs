@@ -11,11 +11,12 @@
 //! - [`decision`](mod@decision): the decision line of a sweep in words, and
 //!   whether it diverges (used by the viewer and the Foxglove output);
 //! - [`explain`](mod@explain): why a divergent sweep came out as it did;
-//! - [`check`](mod@check): a whole trace checked ([`check_file`]), and
+//! - [`check`](mod@check): a whole trace checked ([`check_file`]; the
+//!   traces of a suite found by [`find_traces`]), and
 //!   [`render_text`] / [`render_json`] for its report;
 //! - [`ghost`](mod@ghost): ghost contacts, edge or vertex contacts on an
 //!   internal flat or concave place whose normal leans off the faces
-//!   ([`judge_ghost`]);
+//!   ([`judge_ghost`]), counted into `check`'s report beside it;
 //! - [`junit`](mod@junit): check's reports as JUnit XML and GitHub Actions
 //!   annotations, for CI systems;
 //! - [`config`]: `check`'s suite configuration, the `sweeptrace.toml`
@@ -32,9 +33,11 @@ pub mod compare;
 pub mod config;
 pub mod decision;
 pub mod diff;
+mod discovery;
 pub mod engine_check;
 pub mod explain;
 pub mod ghost;
+mod ghost_count;
 pub mod infer;
 pub mod judge;
 pub mod junit;

@@ -6,7 +6,6 @@ use serde_json::{Value, json};
 
 use crate::core::Kind;
 use crate::core::explain::num;
-use crate::run::RunOutcome;
 
 use super::check::{Divergence, Status, TraceReport, counts_by_name};
 
@@ -469,9 +468,10 @@ fn tunnel_words(n: u64) -> &'static str {
     if n == 1 { "tunnel" } else { "tunnels" }
 }
 
-/// The reports as one JSON document: `{"status": ..., "traces": [...]}`
-/// (pretty-printed, ending with a newline).
-pub fn render_json(reports: &[TraceReport]) -> String {
+/// The reports as one JSON document: `{"status": ..., "exit_code": ...,
+/// "traces": [...]}` (pretty-printed, ending with a newline); `exit_code`
+/// is the command's exit code for these reports, as its caller maps them.
+pub fn render_json(reports: &[TraceReport], exit_code: u8) -> String {
     let overall = reports
         .iter()
         .map(|r| r.status())
@@ -479,7 +479,7 @@ pub fn render_json(reports: &[TraceReport]) -> String {
         .unwrap_or(Status::Ok);
     let doc = json!({
         "status": overall,
-        "exit_code": RunOutcome::worst(reports.iter().map(TraceReport::outcome)).exit_code(),
+        "exit_code": exit_code,
         "traces": reports,
     });
     let mut s = serde_json::to_string_pretty(&doc).unwrap_or_else(|e| {

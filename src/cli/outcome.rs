@@ -1,6 +1,8 @@
 //! What a command came to, as one value; [`RunOutcome::exit_code`] is the
 //! one place that turns it into the process's exit code (the README's
-//! table lists the same codes).
+//! table lists the same codes). The library's reports give their own
+//! status (`regress::Status`, `conform::ConformStatus`); the commands map
+//! it to a `RunOutcome`.
 
 use serde::Serialize;
 

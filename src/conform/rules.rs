@@ -1,0 +1,164 @@
+//! The rules the conformance cases exercise, in the order of
+//! docs/SEMANTICS.md: each one's name (what `conform --case` and the
+//! reports call it) and what it checks.
+
+/// A rule and what it checks.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Rule {
+    /// Its name.
+    pub name: &'static str,
+    /// What it checks, in words (with the SEMANTICS.md step).
+    pub description: &'static str,
+}
+
+/// Every rule, in the order of docs/SEMANTICS.md.
+pub const RULES: &[Rule] = &[
+    Rule {
+        name: "face.hit",
+        description: "the ball reaches the plane at ρ with its touch point inside the triangle: a face collision at β (face, step 5)",
+    },
+    Rule {
+        name: "face.miss.outside-triangle",
+        description: "the touch point falls outside the triangle and no edge or vertex is within ρ: no collision (face, step 4)",
+    },
+    Rule {
+        name: "face.miss.beyond-end",
+        description: "the path ends before the ball reaches the plane at ρ: β > 1 (face, step 3)",
+    },
+    Rule {
+        name: "face.miss.parallel",
+        description: "the path runs parallel to the plane, farther than ρ: no collision (face, step 2)",
+    },
+    Rule {
+        name: "face.miss.back-facing",
+        description: "the ball comes from behind the triangle: the facing rule rejects every test",
+    },
+    Rule {
+        name: "start.inside",
+        description: "the ball starts within ρ of the plane (h0 < ρ) and moves through it: the face test ignores it (face, step 1)",
+    },
+    Rule {
+        name: "start.touching",
+        description: "the ball starts exactly ρ from the plane (h0 = ρ) moving toward it: a face collision at α = 0",
+    },
+    Rule {
+        name: "path.zero-length",
+        description: "p0 = p1: nothing moves, nothing is hit (vertex: not moving; face and edge: parallel)",
+    },
+    Rule {
+        name: "edge.hit",
+        description: "the path comes within ρ of an edge, between its ends, facing it: an edge collision at s0 (edge, step 7; each of the three edges)",
+    },
+    Rule {
+        name: "edge.miss.no-real-roots",
+        description: "the path never comes within ρ of the edge's line: B² - 4AC < 0 (edge, step 2)",
+    },
+    Rule {
+        name: "edge.miss.before-start",
+        description: "the ball starts within ρ of the edge's line and moves away: s0 < 0 (edge, step 4)",
+    },
+    Rule {
+        name: "edge.miss.beyond-end",
+        description: "the path ends before the ball comes within ρ of the edge: s0 > 1 (edge, step 4)",
+    },
+    Rule {
+        name: "edge.miss.beyond-v1",
+        description: "the contact on the edge's line lies beyond v1 (xc > L): not an edge collision, the vertex test finds it (edge, step 5)",
+    },
+    Rule {
+        name: "edge.miss.before-v0",
+        description: "the contact on the edge's line lies before v0 (xc < 0): the vertex test finds it (edge, step 5)",
+    },
+    Rule {
+        name: "edge.miss.parallel",
+        description: "the path runs parallel to the edge (A = 0): no edge collision (edge, step 1)",
+    },
+    Rule {
+        name: "edge.miss.back-facing",
+        description: "the ball comes at the edge from behind the triangle: back-facing (edge, step 6)",
+    },
+    Rule {
+        name: "vertex.hit",
+        description: "the path comes within ρ of a vertex, facing it: a vertex collision at the smaller root",
+    },
+    Rule {
+        name: "vertex.miss.no-real-roots",
+        description: "the path never comes within ρ of the vertex: no collision",
+    },
+    Rule {
+        name: "vertex.miss.before-start",
+        description: "the ball starts within ρ of the vertex and moves away: s0 < 0",
+    },
+    Rule {
+        name: "vertex.miss.beyond-end",
+        description: "the path ends before the ball comes within ρ of the vertex: s0 > 1",
+    },
+    Rule {
+        name: "end.exact-hit",
+        description: "the ball touches exactly at the end of the path: a collision at α = 1 with its kind set (worked example 4)",
+    },
+    Rule {
+        name: "tie.edge-end",
+        description: "a contact exactly at an edge's end is found by the edge and the vertex test at the same α: the tie order makes it an edge collision",
+    },
+    Rule {
+        name: "tie.shared-edge.planar",
+        description: "a touch point on the edge shared by two coplanar triangles: both faces tie, the lower triangle is primary",
+    },
+    Rule {
+        name: "tie.shared-edge.cube",
+        description: "a cube edge hit by both of its triangles at the same α: the lower triangle is primary, the normal the average of both faces' normals (worked example 5)",
+    },
+    Rule {
+        name: "tie.shared-vertex",
+        description: "the apex of a pyramid hit head-on: the vertex of four triangles ties, the normal averages their four normals",
+    },
+    Rule {
+        name: "tie.kind-order",
+        description: "straight down onto a triangle's vertex: the face, both edges that end there and the vertex all touch at one α: the kind order face < edge < vertex makes it a face collision",
+    },
+    Rule {
+        name: "tie.across-kinds",
+        description: "the face of triangle 1 and an edge of triangle 0 touch at one α: the kind order comes before the triangle index, so the face of the higher triangle is primary",
+    },
+    Rule {
+        name: "tie.feature-order",
+        description: "a ball inside the plane's band (no face test) moving to a vertex along its bisector touches the triangle's two edges there at one α: the lower feature (edge 0) is primary",
+    },
+    Rule {
+        name: "tie.cube-corner",
+        description: "a ball coming diagonally at a cube's corner: a vertex collision shared by the corner's triangles, averaged normal",
+    },
+    Rule {
+        name: "grazing.face-hit",
+        description: "a path descending onto the face at a grazing angle (cosine below 1e-3): still a face collision at β",
+    },
+    Rule {
+        name: "grazing.edge-tangent",
+        description: "a path that passes exactly ρ from an edge's line (a double root): a tangent edge collision",
+    },
+    Rule {
+        name: "margin.face-hit",
+        description: "with margin ε the face test detects at ρ = r - ε: α moves accordingly",
+    },
+    Rule {
+        name: "margin.edge-miss",
+        description: "a path that passes within r but farther than ρ = r - ε from an edge: no collision",
+    },
+    Rule {
+        name: "margin.vertex-hit",
+        description: "with margin ε the vertex test detects at ρ = r - ε",
+    },
+    Rule {
+        name: "facing.non-strict",
+        description: "a path in the triangle's plane (n·d = 0) toward an edge: the non-strict rule n·d ≤ 0 lets it hit",
+    },
+    Rule {
+        name: "facing.strict",
+        description: "the strict rule n·d < 0: the same in-plane path hits nothing; an ordinary approach still hits",
+    },
+    Rule {
+        name: "degenerate.skipped",
+        description: "degenerate triangles (a repeated index, zero area) are left out of every test; the others keep their indices",
+    },
+];

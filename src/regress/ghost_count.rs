@@ -1,0 +1,46 @@
+//! `check`'s ghost contacts: each judged sweep's expectation, and an
+//! engine's answer when it is not the core's outcome, judged with
+//! [`judge_ghost`] and counted into the trace's report.
+
+use crate::replay::SweepResult;
+
+use super::check::{Judged, TraceReport};
+use super::ghost::{GhostJudgement, judge_ghost};
+
+/// How many ghost contacts a report lists, one line each.
+pub const MAX_LISTED_GHOSTS: usize = 10;
+
+/// Counts the ghost contacts of one judged sweep into `report` (the first
+/// [`MAX_LISTED_GHOSTS`] kept in detail), with the threshold
+/// `ghost_degrees`.
+pub(super) fn count_ghosts(
+    report: &mut TraceReport,
+    result: &SweepResult,
+    judged: &Judged,
+    ghost_degrees: f64,
+) {
+    // The expectation, and an engine's answer when it is not
+    // the core's outcome, judged for ghost contacts whatever
+    // the compared fields.
+    let answer = (!judged.got_is_core).then_some(&judged.got);
+    for (outcome, is_answer) in [(Some(&judged.expected), false), (answer, true)] {
+        let Some(outcome) = outcome else { continue };
+        match judge_ghost(
+            &result.scene,
+            outcome,
+            result.log_time_nanos,
+            result.outcome.hit.as_ref().map(|h| &h.normal),
+            ghost_degrees,
+        ) {
+            GhostJudgement::Ghost(mut g) => {
+                report.ghosts += 1;
+                if report.ghost_contacts.len() < MAX_LISTED_GHOSTS {
+                    g.answer = is_answer;
+                    report.ghost_contacts.push(g);
+                }
+            }
+            GhostJudgement::NoNormal => report.ghosts_unjudged += 1,
+            GhostJudgement::Fine | GhostJudgement::NotApplicable => {}
+        }
+    }
+}

@@ -5,7 +5,7 @@ mod cli;
 
 use std::process::ExitCode;
 
-use cli::RunOutcome;
+use cli::Exit;
 
 fn main() -> ExitCode {
     // Like other command-line tools, stop quietly when the reader of our
@@ -21,7 +21,7 @@ fn main() -> ExitCode {
     let args = cli::parse();
     let outcome = cli::run(args).unwrap_or_else(|err| {
         eprintln!("error: {err:#}");
-        RunOutcome::Error
+        Exit::Error
     });
     ExitCode::from(outcome.exit_code())
 }

@@ -7,7 +7,7 @@ use std::path::PathBuf;
 
 use anyhow::bail;
 
-use super::RunOutcome;
+use super::Exit;
 use sweeptrace::numbers::counted;
 use sweeptrace::regress::bless_file;
 use sweeptrace::replay::ReplayOptions;
@@ -40,7 +40,7 @@ pub struct Args {
 }
 
 /// Blesses the trace.
-pub fn run(args: Args) -> anyhow::Result<RunOutcome> {
+pub fn run(args: Args) -> anyhow::Result<Exit> {
     let output = match (&args.output, args.in_place) {
         (Some(out), false) => out.clone(),
         (None, true) => args.trace.clone(),
@@ -69,5 +69,5 @@ pub fn run(args: Args) -> anyhow::Result<RunOutcome> {
         ),
         counted(summary.attachments_copied, "attachment", "attachments"),
     );
-    Ok(RunOutcome::Success)
+    Ok(Exit::Success)
 }

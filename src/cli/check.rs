@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context, bail};
 
-use super::RunOutcome;
+use super::Exit;
 use sweeptrace::engine::{EngineCommand, EngineOptions};
 use sweeptrace::regress::{Against, check_file_with_engine};
 use sweeptrace::regress::{
@@ -172,7 +172,7 @@ pub enum AgainstArg {
 }
 
 /// Checks every trace, prints the reports, returns the exit code.
-pub fn run(args: Args) -> anyhow::Result<RunOutcome> {
+pub fn run(args: Args) -> anyhow::Result<Exit> {
     let overrides = sweeptrace::regress::config::Overrides {
         strict: args.strict,
         allow_tunnels: args.allow_tunnels,
@@ -195,7 +195,7 @@ pub fn run(args: Args) -> anyhow::Result<RunOutcome> {
             "{}",
             super::check_config::render(&traces, &settings, args.json)
         );
-        return Ok(RunOutcome::Success);
+        return Ok(Exit::Success);
     }
     if !(args.ghost_degrees.is_finite() && (0.0..=180.0).contains(&args.ghost_degrees)) {
         bail!(
@@ -234,7 +234,7 @@ pub fn run(args: Args) -> anyhow::Result<RunOutcome> {
                     Ok(report) => report,
                     Err(err) => {
                         eprintln!("error: {}: {err}", path.display());
-                        return Ok(RunOutcome::EngineUnavailable);
+                        return Ok(Exit::EngineUnavailable);
                     }
                 }
             }
@@ -257,7 +257,7 @@ pub fn run(args: Args) -> anyhow::Result<RunOutcome> {
         }
         reports.push(report);
     }
-    let outcome = RunOutcome::worst(reports.iter().map(outcome_of));
+    let outcome = Exit::worst(reports.iter().map(outcome_of));
     if args.json {
         print!("{}", render_json(&reports, outcome.exit_code()));
     } else if traces.len() > 1 {
@@ -272,25 +272,19 @@ pub fn run(args: Args) -> anyhow::Result<RunOutcome> {
         );
     }
     super::junit::finish_check(junit, &reports, &times)?;
-    Ok(if rrd_error {
-        RunOutcome::Error
-    } else {
-        outcome
-    })
+    Ok(if rrd_error { Exit::Error } else { outcome })
 }
 
 /// What the check of one trace came to: a divergence is
-/// [`RunOutcome::Differences`]; a trace that ends early (its only error)
-/// [`RunOutcome::IncompleteInput`]; any other error, or nothing to
-/// compare, [`RunOutcome::Error`].
-fn outcome_of(report: &TraceReport) -> RunOutcome {
+/// [`Exit::Differences`]; a trace that ends early (its only error)
+/// [`Exit::IncompleteInput`]; any other error, or nothing to
+/// compare, [`Exit::Error`].
+fn outcome_of(report: &TraceReport) -> Exit {
     match report.status() {
-        Status::Ok => RunOutcome::Success,
-        Status::Fail => RunOutcome::Differences,
-        Status::Error if report.incomplete && report.errors.len() == 1 => {
-            RunOutcome::IncompleteInput
-        }
-        Status::NoExpectations | Status::Error => RunOutcome::Error,
+        Status::Ok => Exit::Success,
+        Status::Fail => Exit::Differences,
+        Status::Error if report.incomplete && report.errors.len() == 1 => Exit::IncompleteInput,
+        Status::NoExpectations | Status::Error => Exit::Error,
     }
 }
 

@@ -3,7 +3,7 @@
 
 use anyhow::{Context, bail};
 
-use super::RunOutcome;
+use super::Exit;
 use sweeptrace::conform::{self, ConformOptions, ConformStatus, RULES};
 use sweeptrace::engine::EngineCommand;
 use sweeptrace::trace::TraceEvent;
@@ -76,11 +76,11 @@ pub struct Args {
 }
 
 /// Runs the suite, prints the report, returns the exit code.
-pub fn run(args: Args) -> anyhow::Result<RunOutcome> {
+pub fn run(args: Args) -> anyhow::Result<Exit> {
     let cases = conform::select(args.case.as_deref()).map_err(anyhow::Error::msg)?;
     if args.list {
         print!("{}", list_text(&cases));
-        return Ok(RunOutcome::Success);
+        return Ok(Exit::Success);
     }
     if let Some(path) = &args.write_trace {
         super::warn_unfinished(path);
@@ -114,7 +114,7 @@ pub fn run(args: Args) -> anyhow::Result<RunOutcome> {
                 .join(", ")
         );
         if args.engine.is_none() {
-            return Ok(RunOutcome::Success);
+            return Ok(Exit::Success);
         }
     }
     let Some(text) = &args.engine else {
@@ -132,7 +132,7 @@ pub fn run(args: Args) -> anyhow::Result<RunOutcome> {
         Ok(report) => report,
         Err(err) => {
             eprintln!("error: {err}");
-            return Ok(RunOutcome::EngineUnavailable);
+            return Ok(Exit::EngineUnavailable);
         }
     };
     let outcome = outcome_of(report.status());
@@ -155,11 +155,11 @@ pub fn run(args: Args) -> anyhow::Result<RunOutcome> {
 
 /// What a conformance run came to: a fault of the engine is an error, a
 /// failed case a difference.
-fn outcome_of(status: ConformStatus) -> RunOutcome {
+fn outcome_of(status: ConformStatus) -> Exit {
     match status {
-        ConformStatus::Ok => RunOutcome::Success,
-        ConformStatus::Fail => RunOutcome::Differences,
-        ConformStatus::Error => RunOutcome::Error,
+        ConformStatus::Ok => Exit::Success,
+        ConformStatus::Fail => Exit::Differences,
+        ConformStatus::Error => Exit::Error,
     }
 }
 

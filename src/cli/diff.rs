@@ -8,7 +8,7 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context, bail};
 
-use super::RunOutcome;
+use super::Exit;
 use sweeptrace::core::Facing;
 use sweeptrace::numbers::{self, Rule};
 use sweeptrace::regress::diff::{render_json, render_text};
@@ -78,7 +78,7 @@ fn side(path: &Path, options: ReplayOptions) -> anyhow::Result<Side> {
 }
 
 /// Compares the two replays.
-pub fn run(args: Args) -> anyhow::Result<RunOutcome> {
+pub fn run(args: Args) -> anyhow::Result<Exit> {
     let tolerances = args.tolerances.to_tolerances()?;
     for (flag, m) in [("--margin-a", args.margin_a), ("--margin-b", args.margin_b)] {
         if let Some(m) = m {
@@ -146,8 +146,8 @@ pub fn run(args: Args) -> anyhow::Result<RunOutcome> {
         print!("{}", render_text(&report));
     }
     Ok(if report.is_same() {
-        RunOutcome::Success
+        Exit::Success
     } else {
-        RunOutcome::Differences
+        Exit::Differences
     })
 }

@@ -7,7 +7,7 @@ use std::path::PathBuf;
 
 use anyhow::Context;
 
-use super::RunOutcome;
+use super::Exit;
 use sweeptrace::trace::TraceReader;
 use sweeptrace::trace::info::{collect, render_json, render_text};
 
@@ -26,7 +26,7 @@ pub struct Args {
 /// report of what came before the error, then the error; an input that is
 /// not an MCAP file at all (it cannot be read, is empty, has no MCAP
 /// header) gets only the error, and nothing on stdout.
-pub fn run(args: Args) -> anyhow::Result<RunOutcome> {
+pub fn run(args: Args) -> anyhow::Result<Exit> {
     let name = args.trace.display().to_string();
     let file = File::open(&args.trace).with_context(|| format!("cannot open trace {name}"))?;
     let file_bytes = file
@@ -53,10 +53,10 @@ pub fn run(args: Args) -> anyhow::Result<RunOutcome> {
         println!();
     }
     match error {
-        None => Ok(RunOutcome::Success),
+        None => Ok(Exit::Success),
         Some(err) if err.is_truncation() => {
             eprintln!("error: {err}");
-            Ok(RunOutcome::IncompleteInput)
+            Ok(Exit::IncompleteInput)
         }
         Some(err) => Err(err).name_file_once("reading the trace", &name),
     }

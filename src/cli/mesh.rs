@@ -9,7 +9,7 @@ use std::path::PathBuf;
 use anyhow::Context;
 use serde::Serialize;
 
-use super::RunOutcome;
+use super::Exit;
 use sweeptrace::core::{Defect, DefectKind, EdgeClass, EdgeCounts, Topology};
 use sweeptrace::sim::load_obj;
 use sweeptrace::trace::{TraceEvent, TraceReader};
@@ -234,7 +234,7 @@ pub fn render_json(file: &str, reports: &[MeshReport]) -> String {
 const MCAP_MAGIC: &[u8] = b"\x89MCAP0\r\n";
 
 /// Reads the file's meshes and prints the report.
-pub fn run(args: Args) -> anyhow::Result<RunOutcome> {
+pub fn run(args: Args) -> anyhow::Result<Exit> {
     let name = args.file.display().to_string();
     let mut head = [0u8; 8];
     let n = {
@@ -287,8 +287,8 @@ pub fn run(args: Args) -> anyhow::Result<RunOutcome> {
         println!();
     }
     Ok(if reports.iter().any(MeshReport::changes_collisions) {
-        RunOutcome::Differences
+        Exit::Differences
     } else {
-        RunOutcome::Success
+        Exit::Success
     })
 }

@@ -9,17 +9,17 @@ pub mod check;
 pub mod check_config;
 pub mod conform;
 pub mod diff;
+mod exit;
 pub mod info;
 pub mod junit;
 pub mod mesh;
-mod outcome;
 pub mod record;
 pub mod replay;
 pub mod report;
 pub mod repro;
 pub mod sweep;
 
-pub use outcome::RunOutcome;
+pub use exit::Exit;
 
 /// Replay recorded ball trajectories through a swept-sphere vs triangle-mesh
 /// collision core and see, frame by frame, why each collision was or was not
@@ -73,9 +73,9 @@ pub fn parse() -> Cli {
 }
 
 /// Runs the chosen subcommand; `main` turns what it came to into the exit
-/// code ([`RunOutcome::exit_code`]), an error into
-/// [`RunOutcome::Error`]'s.
-pub fn run(cli: Cli) -> anyhow::Result<RunOutcome> {
+/// code ([`Exit::exit_code`]), an error into
+/// [`Exit::Error`]'s.
+pub fn run(cli: Cli) -> anyhow::Result<Exit> {
     match cli.command {
         Command::Sweep(args) => sweep::run(args),
         Command::Record(args) => record::run(args),

@@ -7,7 +7,7 @@ use std::path::PathBuf;
 use anyhow::Context;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 
-use super::RunOutcome;
+use super::Exit;
 use sweeptrace::core::Facing;
 use sweeptrace::sim::scenes::{self, BuiltinScene, SceneMesh};
 use sweeptrace::sim::{self, SimOptions, SimSummary, StopReason};
@@ -121,7 +121,7 @@ impl Args {
 }
 
 /// Simulates, writes the trace and prints a summary.
-pub fn run(args: Args) -> anyhow::Result<RunOutcome> {
+pub fn run(args: Args) -> anyhow::Result<Exit> {
     let scene: SceneMesh = match &args.mesh {
         Some(path) => sim::load_obj(path)?,
         None => args.scene.mesh_with_terrain_cells(args.terrain_cells),
@@ -206,7 +206,7 @@ pub fn run(args: Args) -> anyhow::Result<RunOutcome> {
             &output.display().to_string()
         )
     );
-    Ok(RunOutcome::Success)
+    Ok(Exit::Success)
 }
 
 /// The closing summary of a recording, one paragraph.

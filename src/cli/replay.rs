@@ -13,7 +13,7 @@ use std::time::Instant;
 use anyhow::{Context, bail};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 
-use super::RunOutcome;
+use super::Exit;
 use sweeptrace::atomic::PendingFile;
 use sweeptrace::core::Facing;
 use sweeptrace::foxglove::{FoxgloveFile, FoxgloveOptions};
@@ -139,7 +139,7 @@ impl<R: Read> Read for CountingReader<R> {
 
 /// Runs the replay: the options in, the outputs opened, the pipeline, the
 /// outputs finished, the summary printed.
-pub fn run(args: Args) -> anyhow::Result<RunOutcome> {
+pub fn run(args: Args) -> anyhow::Result<Exit> {
     let started = Instant::now();
     let trace_path = &args.trace;
     let file =
@@ -261,9 +261,9 @@ pub fn run(args: Args) -> anyhow::Result<RunOutcome> {
             numbers::counted(summary.sweeps, "sweep", "sweeps"),
             last_frame.map_or(String::new(), |f| format!(" (up to frame {f})"))
         );
-        return Ok(RunOutcome::IncompleteInput);
+        return Ok(Exit::IncompleteInput);
     }
-    Ok(RunOutcome::Success)
+    Ok(Exit::Success)
 }
 
 /// Where the recording goes, if anywhere: `--rrd`, `--spawn`,

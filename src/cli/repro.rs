@@ -6,7 +6,7 @@ use std::path::PathBuf;
 
 use anyhow::Context;
 
-use super::RunOutcome;
+use super::Exit;
 use sweeptrace::regress::{ReproCase, find_sweep};
 use sweeptrace::trace::{TraceReader, write_trace_file};
 
@@ -41,7 +41,7 @@ pub struct Args {
 }
 
 /// Writes the case and prints the test.
-pub fn run(args: Args) -> anyhow::Result<RunOutcome> {
+pub fn run(args: Args) -> anyhow::Result<Exit> {
     let tolerances = args.tolerances.to_tolerances()?;
     let shown = args.trace.display().to_string();
     let file = std::fs::File::open(&args.trace).with_context(|| format!("cannot open {shown}"))?;
@@ -54,8 +54,8 @@ pub fn run(args: Args) -> anyhow::Result<RunOutcome> {
     eprintln!("wrote {}", args.output.display());
     print!("{}", case.rust_test(&tolerances));
     Ok(if case.reproduces() {
-        RunOutcome::Success
+        Exit::Success
     } else {
-        RunOutcome::Error
+        Exit::Error
     })
 }

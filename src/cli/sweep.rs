@@ -5,7 +5,7 @@ use std::path::PathBuf;
 
 use anyhow::Context;
 
-use super::RunOutcome;
+use super::Exit;
 use super::report;
 use sweeptrace::core::{Broadphase, CollectRecords, Facing, Options, Sweep, sweep_mesh_with};
 use sweeptrace::regress::find_sweep;
@@ -70,7 +70,7 @@ pub struct Args {
 }
 
 /// Runs the sweep and prints the outcome and explanations.
-pub fn run(args: Args) -> anyhow::Result<RunOutcome> {
+pub fn run(args: Args) -> anyhow::Result<Exit> {
     let mut source: Option<String> = None;
     let mut expected: Option<OutcomeMsg> = None;
     let topology: Option<sweeptrace::Topology>;
@@ -154,5 +154,5 @@ pub fn run(args: Args) -> anyhow::Result<RunOutcome> {
     } else {
         print!("{}", report::sweep_text(&explained));
     }
-    Ok(RunOutcome::Success)
+    Ok(Exit::Success)
 }

@@ -1,17 +1,17 @@
-//! What a command came to, as one value; [`RunOutcome::exit_code`] is the
+//! How a command ended, as one value; [`Exit::exit_code`] is the
 //! one place that turns it into the process's exit code (the README's
 //! table lists the same codes). The library's reports give their own
 //! status (`regress::Status`, `conform::ConformStatus`); the commands map
-//! it to a `RunOutcome`.
+//! it to an `Exit`.
 
 use serde::Serialize;
 
 /// What a command came to. Ordered by severity: when a command handles
 /// several inputs, the most severe outcome is the command's
-/// ([`RunOutcome::worst`]).
+/// ([`Exit::worst`]).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize)]
 #[serde(rename_all = "snake_case")]
-pub enum RunOutcome {
+pub enum Exit {
     /// Everything was processed and nothing differs. Exit code 0.
     Success,
     /// Everything was processed and differences were found (`check`: a
@@ -30,21 +30,21 @@ pub enum RunOutcome {
     EngineUnavailable,
 }
 
-impl RunOutcome {
+impl Exit {
     /// The process exit code: 0 success, 1 differences found, 2 error,
     /// 3 incomplete input, 125 the engine cannot be started.
     pub const fn exit_code(self) -> u8 {
         match self {
-            RunOutcome::Success => 0,
-            RunOutcome::Differences => 1,
-            RunOutcome::Error => 2,
-            RunOutcome::IncompleteInput => 3,
-            RunOutcome::EngineUnavailable => 125,
+            Exit::Success => 0,
+            Exit::Differences => 1,
+            Exit::Error => 2,
+            Exit::IncompleteInput => 3,
+            Exit::EngineUnavailable => 125,
         }
     }
 
-    /// The most severe of `outcomes` ([`RunOutcome::Success`] when empty).
-    pub fn worst(outcomes: impl IntoIterator<Item = RunOutcome>) -> RunOutcome {
-        outcomes.into_iter().max().unwrap_or(RunOutcome::Success)
+    /// The most severe of `outcomes` ([`Exit::Success`] when empty).
+    pub fn worst(outcomes: impl IntoIterator<Item = Exit>) -> Exit {
+        outcomes.into_iter().max().unwrap_or(Exit::Success)
     }
 }

@@ -1,8 +1,9 @@
 //! The weld (vertices at one position are one vertex) and the undirected
 //! edges between welded vertices: their triangles, windings and classes.
 
-use std::collections::{HashMap, HashSet};
+use std::collections::HashMap;
 
+use nalgebra::Vector3;
 use serde::Serialize;
 
 use super::defects::{Defect, DefectKind};
@@ -179,6 +180,32 @@ impl ParityForest {
     }
 }
 
+/// `half` sorted (by undirected key, then triangle, then slot): placed by
+/// the key's lower vertex (a counting sort over the `vertex_count` welded
+/// vertices), then each vertex's few half-edges sorted. The same order as
+/// sorting the whole, in time linear in the half-edges.
+fn sort_half_edges(half: Vec<(u64, u32, u8)>, vertex_count: usize) -> Vec<(u64, u32, u8)> {
+    let lower = |h: &(u64, u32, u8)| (h.0 >> 32) as usize;
+    let mut start = vec![0u32; vertex_count + 1];
+    for h in &half {
+        start[lower(h) + 1] += 1;
+    }
+    for v in 0..vertex_count {
+        start[v + 1] += start[v];
+    }
+    let mut next = start.clone();
+    let mut sorted = vec![(0u64, 0u32, 0u8); half.len()];
+    for h in half {
+        let v = lower(&h);
+        sorted[next[v] as usize] = h;
+        next[v] += 1;
+    }
+    for v in 0..vertex_count {
+        sorted[start[v] as usize..start[v + 1] as usize].sort_unstable();
+    }
+    sorted
+}
+
 /// The ranges of equal keys in sorted half-edges.
 fn runs(half: &[(u64, u32, u8)]) -> impl Iterator<Item = std::ops::Range<usize>> + '_ {
     let mut start = 0;
@@ -206,18 +233,25 @@ pub(super) struct BoundaryEdge {
 
 impl Builder<'_> {
     fn weld(&mut self) {
-        let mut order: Vec<u32> = (0..self.vertices.len() as u32).collect();
-        order.sort_unstable_by_key(|&i| (position_key(&self.vertices[i as usize]), i));
+        // Keys computed once, then sorted with their index: equal positions
+        // side by side, the lowest index first.
+        let mut order: Vec<([u64; 3], u32)> = self
+            .vertices
+            .iter()
+            .enumerate()
+            .map(|(i, v)| (position_key(v), i as u32))
+            .collect();
+        order.sort_unstable();
         self.weld = vec![0; self.vertices.len()];
         let mut start = 0;
         while start < order.len() {
-            let key = position_key(&self.vertices[order[start] as usize]);
+            let key = order[start].0;
             let mut end = start + 1;
-            while end < order.len() && position_key(&self.vertices[order[end] as usize]) == key {
+            while end < order.len() && order[end].0 == key {
                 end += 1;
             }
-            for &i in &order[start..end] {
-                self.weld[i as usize] = order[start];
+            for &(_, i) in &order[start..end] {
+                self.weld[i as usize] = order[start].1;
             }
             self.welded_vertex_count += 1;
             start = end;
@@ -247,7 +281,7 @@ impl Builder<'_> {
                 ));
             }
         }
-        half.sort_unstable();
+        let half = sort_half_edges(half, self.vertices.len());
         // Windings: unite the two triangles of every manifold edge.
         let mut forest = ParityForest::new(n);
         for run in runs(&half) {
@@ -257,10 +291,12 @@ impl Builder<'_> {
                 forest.union(x.1, y.1, u8::from(same_direction));
             }
         }
-        let flipped_set = self.flipped(&mut forest);
+        let is_flipped = self.flipped(&mut forest);
         drop(forest);
 
-        // Edges and their classes.
+        // Edges and their classes, from each triangle's unit normal
+        // (computed once, not once per edge).
+        let normals: Vec<Vector3<f64>> = (0..n as u32).map(|t| self.cross(t).normalize()).collect();
         let mut edges = Vec::with_capacity(half.len() / 2 + 1);
         let mut counts = EdgeCounts::default();
         let mut neighbours_of: Vec<(u32, u32)> = Vec::new();
@@ -283,7 +319,7 @@ impl Builder<'_> {
                 }
                 2 => {
                     let (x, y) = (half[run.start], half[run.start + 1]);
-                    let (fx, fy) = (flipped_set.contains(&x.1), flipped_set.contains(&y.1));
+                    let (fx, fy) = (is_flipped[x.1 as usize], is_flipped[y.1 as usize]);
                     if (x.2 >> 2) == (y.2 >> 2) {
                         if fx && !fy {
                             neighbours_of.push((x.1, y.1));
@@ -291,7 +327,7 @@ impl Builder<'_> {
                             neighbours_of.push((y.1, x.1));
                         }
                     }
-                    self.dihedral(x.1, fx, y.1, (y.2 & 3) as usize, fy)
+                    self.dihedral(&normals, (x.1, fx), (y.1, (y.2 & 3) as usize, fy))
                 }
                 _ => {
                     let triangles: Vec<u32> = half[run.clone()].iter().map(|h| h.1).collect();
@@ -324,10 +360,11 @@ impl Builder<'_> {
             });
         }
         drop(half);
+        drop(normals);
 
         // Flipped triangles with the neighbours they contradict.
-        let mut flipped: Vec<u32> = flipped_set.into_iter().collect();
-        flipped.sort_unstable();
+        let flipped: Vec<u32> = (0..n as u32).filter(|&t| is_flipped[t as usize]).collect();
+        drop(is_flipped);
         neighbours_of.sort_unstable();
         for &t in &flipped {
             let lo = neighbours_of.partition_point(|p| p.0 < t);
@@ -396,12 +433,14 @@ impl Builder<'_> {
 
     /// The minority winding of each connected piece: the triangles whose
     /// flip makes the piece consistent (on a tie, the side without the
-    /// piece's lowest triangle).
-    fn flipped(&self, forest: &mut ParityForest) -> HashSet<u32> {
+    /// piece's lowest triangle), as a flag per triangle. Counted in vectors
+    /// indexed by the piece's root.
+    fn flipped(&self, forest: &mut ParityForest) -> Vec<bool> {
+        const UNSET: u8 = u8::MAX;
         let n = self.triangles.len();
         // Per root: triangles of parity 0 and 1, and the lowest's parity.
-        let mut count: HashMap<u32, [u32; 2]> = HashMap::new();
-        let mut lowest: HashMap<u32, u8> = HashMap::new();
+        let mut count = vec![[0u32; 2]; n];
+        let mut lowest = vec![UNSET; n];
         let mut parity_of = vec![(0u32, 0u8); n];
         for t in 0..n as u32 {
             if !self.usable[t as usize] {
@@ -412,33 +451,38 @@ impl Builder<'_> {
             if forest.size[root as usize] == 1 {
                 continue;
             }
-            count.entry(root).or_default()[p as usize] += 1;
-            lowest.entry(root).or_insert(p);
+            count[root as usize][p as usize] += 1;
+            if lowest[root as usize] == UNSET {
+                lowest[root as usize] = p;
+            }
         }
-        let minority: HashMap<u32, u8> = count
-            .iter()
-            .map(|(&root, c)| match c[0].cmp(&c[1]) {
-                std::cmp::Ordering::Less => (root, 0),
-                std::cmp::Ordering::Greater => (root, 1),
-                std::cmp::Ordering::Equal => (root, 1 - lowest.get(&root).copied().unwrap_or(0)),
-            })
-            .collect();
-        (0..n as u32)
-            .filter(|&t| {
-                self.usable[t as usize] && {
-                    let (root, p) = parity_of[t as usize];
-                    minority.get(&root) == Some(&p)
-                }
+        (0..n)
+            .map(|t| {
+                let (root, p) = parity_of[t];
+                let c = count[root as usize];
+                self.usable[t]
+                    && c != [0, 0]
+                    && p == match c[0].cmp(&c[1]) {
+                        std::cmp::Ordering::Less => 0,
+                        std::cmp::Ordering::Greater => 1,
+                        std::cmp::Ordering::Equal => 1 - lowest[root as usize],
+                    }
             })
             .collect()
     }
 
     /// The class of the manifold edge between `x` and `y` (`y`'s edge in
     /// slot `y_slot`), with the flipped ones turned over first.
-    fn dihedral(&self, x: u32, fx: bool, y: u32, y_slot: usize, fy: bool) -> EdgeClass {
+    /// `normals` are the triangles' unit normals by their own winding.
+    fn dihedral(
+        &self,
+        normals: &[Vector3<f64>],
+        (x, fx): (u32, bool),
+        (y, y_slot, fy): (u32, usize, bool),
+    ) -> EdgeClass {
         let sign = |f: bool| if f { -1.0 } else { 1.0 };
-        let nx = self.cross(x).normalize() * sign(fx);
-        let ny = self.cross(y).normalize() * sign(fy);
+        let nx = normals[x as usize] * sign(fx);
+        let ny = normals[y as usize] * sign(fy);
         let sine = nx.cross(&ny).norm();
         if nx.dot(&ny) > 0.0 && sine <= FLAT_DIHEDRAL_SINE {
             return EdgeClass::Flat;

@@ -30,8 +30,7 @@ use sweeptrace::regress::{
 };
 use sweeptrace::regress::{Side, diff};
 use sweeptrace::replay::ReplayOptions;
-use sweeptrace::trace::messages::{OutcomeMsg, SceneMsg, SweepMsg};
-use sweeptrace::trace::{TraceReader, TraceWriter};
+use sweeptrace::trace::{OutcomeMsg, SceneMsg, SweepMsg, TraceReader, TraceWriter};
 
 use crate::ensure;
 use crate::os;
@@ -665,7 +664,7 @@ fn foreign_trace() -> anyhow::Result<Vec<u8>> {
 
 /// [`foreign_trace`], with or without its `/expected` channel.
 fn foreign_trace_with(with_expected: bool) -> anyhow::Result<Vec<u8>> {
-    use sweeptrace::trace::schemas::{OUTCOME_SCHEMA_JSON, SCENE_SCHEMA_JSON, SWEEP_SCHEMA_JSON};
+    use sweeptrace::trace::{OUTCOME_SCHEMA_JSON, SCENE_SCHEMA_JSON, SWEEP_SCHEMA_JSON};
     let e = |e: mcap::McapError| anyhow::Error::from(e);
     let mut w = mcap::WriteOptions::new()
         .library("some-engine 3.1")

@@ -18,8 +18,7 @@ use sweeptrace::foxglove::schemas::{
 };
 use sweeptrace::foxglove::{FoxgloveOptions, FoxgloveWriter};
 use sweeptrace::replay::{Detail, ReplayOptions, replay_events};
-use sweeptrace::trace::messages::{OutcomeMsg, SceneMsg, SweepMsg};
-use sweeptrace::trace::{TraceReader, TraceWriter};
+use sweeptrace::trace::{OutcomeMsg, SceneMsg, SweepMsg, TraceReader, TraceWriter};
 
 use crate::support::run_bin;
 use crate::{ensure, os, trial};

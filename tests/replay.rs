@@ -21,8 +21,9 @@ use sweeptrace::replay::{
     Detail, FrameRange, ReplayEvent, ReplayOptions, ReplaySummary, SweepResult, replay_events,
 };
 use sweeptrace::sim::scenes;
-use sweeptrace::trace::messages::{OutcomeMsg, SceneMsg, SweepMsg};
-use sweeptrace::trace::{TraceError, TraceEvent, TraceReader, TraceWriter};
+use sweeptrace::trace::{
+    OutcomeMsg, SceneMsg, SweepMsg, TraceError, TraceEvent, TraceReader, TraceWriter,
+};
 use sweeptrace::viz;
 
 use crate::ensure;

@@ -30,7 +30,7 @@ use crate::atomic::PendingFile;
 use crate::regress::Tolerances;
 use crate::regress::decision::divergence;
 use crate::replay::{ReplayEvent, SceneState, SweepResult};
-use crate::trace::write::library_string;
+use crate::trace::library_string;
 
 /// Writing the Foxglove file failed.
 #[derive(Debug, Error)]

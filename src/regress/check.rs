@@ -23,8 +23,7 @@ use crate::core::{Facing, Feature, FragileReason, Kind};
 use crate::replay::{
     ReplayError, ReplayEvent, ReplayOptions, SweepResult, Tunnel, TunnelAt, TunnelKind,
 };
-use crate::trace::messages::{EXPECTED_TOPIC, OutcomeMsg};
-use crate::trace::{TraceError, TraceEvent, TraceReader};
+use crate::trace::{EXPECTED_TOPIC, OutcomeMsg, TraceError, TraceEvent, TraceReader};
 
 use super::compare::{FieldDiff, Tolerances};
 pub use super::discovery::find_traces;

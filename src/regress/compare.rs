@@ -15,7 +15,7 @@ use serde_json::{Value, json};
 use crate::core::Kind;
 use crate::core::explain::num;
 use crate::numbers::{self, Rule};
-use crate::trace::messages::OutcomeMsg;
+use crate::trace::OutcomeMsg;
 
 /// Default absolute tolerance on `α` (a fraction of the path, unitless).
 pub const DEFAULT_ALPHA_TOLERANCE: f64 = 1e-6;

@@ -23,8 +23,7 @@ use crate::regress::{
 use crate::replay::{
     ReplayError, ReplayEvent, ReplayOptions, ReplaySummary, SceneState, SweepResult, replay_events,
 };
-use crate::trace::messages::OutcomeMsg;
-use crate::trace::{TraceError, TraceEvent};
+use crate::trace::{OutcomeMsg, TraceError, TraceEvent};
 use std::sync::Arc;
 
 /// One side's replayed sweeps, by `(frame, ball)`.

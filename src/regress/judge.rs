@@ -33,7 +33,7 @@ use crate::core::{
     Sweep, SweptPath, TestRecord, Tie, VertexRecord, sweep_mesh_with,
 };
 use crate::replay::SweepResult;
-use crate::trace::messages::OutcomeMsg;
+use crate::trace::OutcomeMsg;
 
 use super::compare::{Field, FieldDiff, Tolerances, compare};
 

@@ -18,7 +18,7 @@
 //!   expected outcome, plots, status, text); `edge_frame`: its edge tests in
 //!   their standard frames;
 //! - the decision line, and whether a sweep diverges, are
-//!   [`crate::regress::decision`] (shared with the Foxglove output);
+//!   [`crate::regress::decision_line`] (shared with the Foxglove output);
 //! - `convert`: conversions to Rerun types, colors and sizes;
 //! - [`blueprint`]: the default layouts, with fixed ids; `columns`: rows
 //!   buffered as typed columns and sent as chunks (both use SDK internals
@@ -41,7 +41,7 @@ mod spill;
 
 use rerun::RecordingStreamBuilder;
 
-pub use crate::regress::decision::{decision_line, divergence};
+pub use crate::regress::{decision_line, divergence};
 pub use ids::{IdHasher, recording_id};
 pub use logger::{
     DEFAULT_FLUSH_BYTES, DEFAULT_FLUSH_ROWS, Logger, LoggerOptions, PREPARE_GROUP_SWEEPS,

@@ -291,7 +291,7 @@ fn recording_target(args: &Args) -> Option<RecordingTarget> {
     };
     (file.is_some() || viewer.is_some()).then_some(RecordingTarget {
         file,
-        file_options: viz::rrd_file::RrdFileOptions {
+        file_options: viz::RrdFileOptions {
             footer: !args.no_rrd_footer,
         },
         viewer,

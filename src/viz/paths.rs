@@ -95,8 +95,6 @@ use crate::core::{DefectKind, EdgeClass};
 pub const WORLD: &str = "world";
 /// The text log.
 pub const LOG: &str = "log";
-/// Root of the time-series plots.
-pub const PLOTS: &str = "plots";
 /// Root of the per-ball divergence status series.
 pub const STATUS: &str = "status";
 /// The log of divergent sweeps.

@@ -18,8 +18,7 @@ use sweeptrace::replay::{
     DEFAULT_BATCH_EVENTS, Detail, PipelineOptions, ReplayEvent, ReplayOptions,
     replay_events_parallel, run_pipeline_unrecorded,
 };
-use sweeptrace::trace::TraceReader;
-use sweeptrace::trace::prefetch::{self, prefetch};
+use sweeptrace::trace::{DEFAULT_PREFETCH_CHUNK, DEFAULT_PREFETCH_DEPTH, TraceReader, prefetch};
 
 #[path = "../examples/long_trace.rs"]
 mod long_trace;
@@ -56,8 +55,8 @@ fn outcomes(bytes: &[u8]) -> u64 {
     // bytes, a memcpy, lets the reader thread own them).
     let read_ahead = prefetch(
         TraceReader::new(std::io::Cursor::new(bytes.to_vec()), "bench.mcap"),
-        prefetch::DEFAULT_CHUNK,
-        prefetch::DEFAULT_DEPTH,
+        DEFAULT_PREFETCH_CHUNK,
+        DEFAULT_PREFETCH_DEPTH,
     )
     .expect("reader thread");
     let mut events = replay_events_parallel(read_ahead, options, DEFAULT_BATCH_EVENTS, None);
@@ -101,8 +100,8 @@ fn rrd(bytes: &[u8], detail: Detail, path: &std::path::Path) -> u64 {
         .expect("recording");
     let read_ahead = prefetch(
         TraceReader::new(std::io::Cursor::new(bytes.to_vec()), "bench.mcap"),
-        prefetch::DEFAULT_CHUNK,
-        prefetch::DEFAULT_DEPTH,
+        DEFAULT_PREFETCH_CHUNK,
+        DEFAULT_PREFETCH_DEPTH,
     )
     .expect("reader thread");
     let mut events = replay_events_parallel(read_ahead, options, DEFAULT_BATCH_EVENTS, None);

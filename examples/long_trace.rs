@@ -22,8 +22,7 @@ use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use sweeptrace::core::Facing;
 use sweeptrace::sim::scenes;
-use sweeptrace::trace::messages::{SceneMsg, SweepMsg};
-use sweeptrace::trace::{TraceError, TraceWriter};
+use sweeptrace::{SceneMsg, SweepMsg, TraceError, TraceWriter};
 
 /// Balls per frame.
 pub const BALLS: u32 = 8;

@@ -56,15 +56,13 @@ use std::process::ExitCode;
 use rapier3d_f64::parry::query::{ShapeCastOptions, ShapeCastStatus};
 use rapier3d_f64::parry::shape::{Ball, TriMeshFlags};
 use rapier3d_f64::prelude::*;
-use sweeptrace::Topology;
 use sweeptrace::core::Kind;
 use sweeptrace::regress::{GHOST_DEGREES, GhostJudgement, judge_ghost};
 use sweeptrace::replay::SceneState;
 use sweeptrace::sim::obj::load_obj;
 use sweeptrace::sim::scenes::SceneMesh;
 use sweeptrace::sim::{BuiltinScene, SimOptions, initial_states, play_volume, scene_message};
-use sweeptrace::trace::messages::{OutcomeMsg, SweepMsg};
-use sweeptrace::trace::{ExpectedSource, write_trace_file};
+use sweeptrace::{ExpectedSource, OutcomeMsg, SweepMsg, Topology, write_trace_file};
 
 /// Relative tolerance of the kind read from Rapier's answer (see the module
 /// documentation).
@@ -568,7 +566,7 @@ pub fn run(args: Args) -> Result<Counts, String> {
                 }
             }
         }
-        Ok::<_, sweeptrace::trace::TraceError>(counts)
+        Ok::<_, sweeptrace::TraceError>(counts)
     })
     .map_err(|e| e.to_string())?;
     Ok(counts)

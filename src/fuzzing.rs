@@ -10,9 +10,10 @@ use crate::core::{
     Broadphase, CollectRecords, Facing, Mesh, MeshError, Options, Outcome, Sweep, SweptPath,
     TestRecord, sweep_edge, sweep_face, sweep_mesh, sweep_mesh_with, sweep_vertex,
 };
-use crate::trace::messages::{OutcomeMsg, SceneMsg, SweepMsg};
-use crate::trace::validate::{parse_message_as, validate_outcome, validate_scene, validate_sweep};
-use crate::trace::{Encoding, MessageAt, ReadLimits, TraceEvent, TraceReader};
+use crate::trace::{
+    Encoding, MessageAt, OutcomeMsg, ReadLimits, SceneMsg, SweepMsg, TraceEvent, TraceReader,
+    parse_message_as, validate_outcome, validate_scene, validate_sweep,
+};
 
 /// The source name the reader is given; every error must name it.
 const SOURCE_NAME: &str = "fuzz-input.mcap";

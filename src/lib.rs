@@ -106,10 +106,9 @@ pub use crate::regress::{
     compare,
 };
 pub use crate::replay::{ReplayOptions, replay_events};
-pub use crate::trace::messages::{OutcomeMsg, SceneMsg, SweepMsg};
 pub use crate::trace::{
-    Encoding, ExpectedSource, TraceError, TraceEvent, TraceReader, TraceWriter, write_trace_file,
-    write_trace_file_with_encoding,
+    Encoding, ExpectedSource, OutcomeMsg, SceneMsg, SweepMsg, TraceError, TraceEvent, TraceReader,
+    TraceWriter, write_trace_file, write_trace_file_with_encoding,
 };
 
 /// The README's Rust examples, compiled and run as doctests.

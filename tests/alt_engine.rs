@@ -31,8 +31,7 @@ use libtest_mimic::Trial;
 use sweeptrace::core::{Facing, Kind};
 use sweeptrace::regress::{CheckOptions, Status, check_reader, render_text};
 use sweeptrace::sim::scenes;
-use sweeptrace::trace::TraceWriter;
-use sweeptrace::trace::messages::{OutcomeMsg, SceneMsg, SweepMsg};
+use sweeptrace::trace::{OutcomeMsg, SceneMsg, SweepMsg, TraceWriter};
 
 use crate::ensure;
 use crate::trial;

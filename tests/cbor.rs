@@ -11,9 +11,10 @@ use libtest_mimic::{Completion, Trial};
 use mcap::WriteOptions;
 use mcap::records::MessageHeader;
 use rand::{Rng, SeedableRng};
-use sweeptrace::trace::info::{collect, render_text};
-use sweeptrace::trace::messages::{OutcomeMsg, SceneMsg, SweepMsg};
-use sweeptrace::trace::{Encoding, TraceError, TraceEvent, TraceReader, TraceWriter};
+use sweeptrace::trace::{
+    Encoding, OutcomeMsg, SceneMsg, SweepMsg, TraceError, TraceEvent, TraceReader, TraceWriter,
+    collect_info, render_info_text,
+};
 
 use crate::support::run_bin;
 use crate::trace_io::{
@@ -280,8 +281,8 @@ fn cbor_and_json_channels_mixed_in_one_file() -> anyhow::Result<()> {
         "{:?}",
         stats.channels
     );
-    let (info, _) = collect(TraceReader::new(bytes.as_slice(), "mixed.mcap"));
-    let text = render_text(&info);
+    let (info, _) = collect_info(TraceReader::new(bytes.as_slice(), "mixed.mcap"));
+    let text = render_info_text(&info);
     ensure!(
         text.contains("encoding:    cbor (/sweep), json (/expected, /scene)")
             && text.contains("  /sweep  s [jsonschema / cbor]  2 messages"),
@@ -289,11 +290,11 @@ fn cbor_and_json_channels_mixed_in_one_file() -> anyhow::Result<()> {
     );
     // One encoding: said once.
     let only = write_events_as(&sample_events(2), default_opts(), Encoding::Cbor)?;
-    let (info, _) = collect(TraceReader::new(only.as_slice(), "only.mcap"));
+    let (info, _) = collect_info(TraceReader::new(only.as_slice(), "only.mcap"));
     ensure!(
-        render_text(&info).contains("encoding:    cbor\n"),
+        render_info_text(&info).contains("encoding:    cbor\n"),
         "{}",
-        render_text(&info)
+        render_info_text(&info)
     );
     Ok(())
 }

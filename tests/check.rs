@@ -22,16 +22,12 @@ use std::path::{Path, PathBuf};
 
 use libtest_mimic::Trial;
 use sweeptrace::core::{Facing, Kind};
-use sweeptrace::regress::bless_bytes;
-use sweeptrace::regress::config;
 use sweeptrace::regress::{
-    CheckOptions, Field, FieldSet, Status, Tolerances, check_file, check_reader, compare,
-    find_traces, render_json, render_text,
+    CheckOptions, Field, FieldSet, Overrides, Side, Source, Status, Tolerances, bless_bytes,
+    check_file, check_reader, compare, diff, find_traces, render_json, render_text, settings_for,
 };
-use sweeptrace::regress::{Side, diff};
 use sweeptrace::replay::ReplayOptions;
-use sweeptrace::trace::messages::{OutcomeMsg, SceneMsg, SweepMsg};
-use sweeptrace::trace::{TraceReader, TraceWriter};
+use sweeptrace::trace::{OutcomeMsg, SceneMsg, SweepMsg, TraceReader, TraceWriter};
 
 use crate::ensure;
 use crate::os;
@@ -92,7 +88,7 @@ fn trace_trials() -> Vec<Trial> {
                     .display()
                     .to_string();
                 trial(&format!("check::trace::{name}"), move || {
-                    let settings = config::settings_for(&path, &config::Overrides::default())?;
+                    let settings = settings_for(&path, &Overrides::default())?;
                     let report =
                         check_file(&path, &settings.check_options(CheckOptions::default()));
                     ensure!(report.status() == Status::Ok, "{}", render_text(&report));
@@ -342,7 +338,7 @@ fn check_fields_option_binary() -> anyhow::Result<()> {
 /// needed and the test of the sample can fail.
 fn rapier_sample_needs_its_settings_file() -> anyhow::Result<()> {
     let trace = rapier_sample();
-    let settings = config::settings_for(&trace, &config::Overrides::default())?;
+    let settings = settings_for(&trace, &Overrides::default())?;
     let tolerances = settings.tolerances();
     ensure!(
         tolerances.fields.names() == "kind,triangle,feature,alpha,contact"
@@ -355,7 +351,7 @@ fn rapier_sample_needs_its_settings_file() -> anyhow::Result<()> {
     );
     for source in [&settings.fields.source, &settings.alpha.source] {
         ensure!(
-            matches!(source, config::Source::File { file, .. } if file == "examples/sweeptrace.toml"),
+            matches!(source, Source::File { file, .. } if file == "examples/sweeptrace.toml"),
             "{source:?}"
         );
     }
@@ -665,7 +661,7 @@ fn foreign_trace() -> anyhow::Result<Vec<u8>> {
 
 /// [`foreign_trace`], with or without its `/expected` channel.
 fn foreign_trace_with(with_expected: bool) -> anyhow::Result<Vec<u8>> {
-    use sweeptrace::trace::schemas::{OUTCOME_SCHEMA_JSON, SCENE_SCHEMA_JSON, SWEEP_SCHEMA_JSON};
+    use sweeptrace::trace::{OUTCOME_SCHEMA_JSON, SCENE_SCHEMA_JSON, SWEEP_SCHEMA_JSON};
     let e = |e: mcap::McapError| anyhow::Error::from(e);
     let mut w = mcap::WriteOptions::new()
         .library("some-engine 3.1")
@@ -959,7 +955,7 @@ fn diff_strict_facing_reports_first_divergence() -> anyhow::Result<()> {
         ..ReplayOptions::default()
     })?;
     let r = diff(&a, &b, &Tolerances::default());
-    let text = sweeptrace::regress::diff::render_text(&r);
+    let text = sweeptrace::regress::render_diff_text(&r);
     ensure!(!r.is_same() && r.different == 1, "{text}");
     let first = r.first.as_ref().context("no first divergence")?;
     ensure!(first.frame == 5, "first divergence at frame 5: {text}");

@@ -5,8 +5,7 @@
 use libtest_mimic::Trial;
 use sweeptrace::core::{Facing, Kind};
 use sweeptrace::replay::{ReplayEvent, ReplayOptions, replay_events};
-use sweeptrace::trace::TraceReader;
-use sweeptrace::trace::messages::SceneMsg;
+use sweeptrace::trace::{SceneMsg, TraceReader};
 
 use crate::ensure;
 use crate::support::run_bin;

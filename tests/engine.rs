@@ -7,8 +7,7 @@ use std::path::{Path, PathBuf};
 use std::time::Duration;
 
 use libtest_mimic::Trial;
-use sweeptrace::trace::TraceWriter;
-use sweeptrace::trace::messages::SweepMsg;
+use sweeptrace::trace::{SweepMsg, TraceWriter};
 
 use crate::support::run_bin;
 use crate::support::scene_t;

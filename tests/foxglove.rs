@@ -12,14 +12,12 @@ use libtest_mimic::{Completion, Trial};
 use serde_json::Value;
 
 use sweeptrace::core::{Facing, Kind};
-use sweeptrace::foxglove::convert::rotation_from_x;
-use sweeptrace::foxglove::schemas::{
-    LOG_SCHEMA_JSON, SCENE_UPDATE_SCHEMA_JSON, SWEEP_NUMBERS_SCHEMA_JSON,
+use sweeptrace::foxglove::{
+    FoxgloveOptions, FoxgloveWriter, LOG_SCHEMA_JSON, SCENE_UPDATE_SCHEMA_JSON,
+    SWEEP_NUMBERS_SCHEMA_JSON, rotation_from_x,
 };
-use sweeptrace::foxglove::{FoxgloveOptions, FoxgloveWriter};
 use sweeptrace::replay::{Detail, ReplayOptions, replay_events};
-use sweeptrace::trace::messages::{OutcomeMsg, SceneMsg, SweepMsg};
-use sweeptrace::trace::{TraceReader, TraceWriter};
+use sweeptrace::trace::{OutcomeMsg, SceneMsg, SweepMsg, TraceReader, TraceWriter};
 
 use crate::support::run_bin;
 use crate::{ensure, os, trial};

@@ -8,8 +8,7 @@ use std::io::Cursor;
 
 use libtest_mimic::Trial;
 use sweeptrace::core::{Facing, Kind, Options, Sweep, sweep_mesh};
-use sweeptrace::trace::TraceWriter;
-use sweeptrace::trace::messages::{OutcomeMsg, SceneMsg, SweepMsg};
+use sweeptrace::trace::{OutcomeMsg, SceneMsg, SweepMsg, TraceWriter};
 
 use crate::ensure;
 use crate::support::{mesh, run_bin};

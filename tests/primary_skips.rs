@@ -9,11 +9,11 @@ use std::path::Path;
 use libtest_mimic::Trial;
 use sweeptrace::core::{Skip, Verdict};
 use sweeptrace::regress::Tolerances;
+use sweeptrace::regress::decision_line;
 use sweeptrace::replay::{
     Detail, ReplayEvent, ReplayOptions, ReplaySummary, SweepResult, replay_events,
 };
 use sweeptrace::trace::TraceReader;
-use sweeptrace::viz::decision_line;
 
 use crate::{ensure, trial};
 

@@ -11,8 +11,7 @@ use nalgebra::{Point3, Vector3};
 use sweeptrace::core::{Facing, Kind, Mesh, Options, Sweep, sweep_mesh};
 use sweeptrace::sim::scenes::{self, BuiltinScene, SceneMesh};
 use sweeptrace::sim::{self, SimError, SimOptions};
-use sweeptrace::trace::messages::{OutcomeMsg, SceneMsg, SweepMsg};
-use sweeptrace::trace::{TraceEvent, TraceReader, TraceWriter};
+use sweeptrace::trace::{OutcomeMsg, SceneMsg, SweepMsg, TraceEvent, TraceReader, TraceWriter};
 
 use crate::{ensure, trial};
 use anyhow::Context as _;

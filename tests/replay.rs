@@ -21,8 +21,9 @@ use sweeptrace::replay::{
     Detail, FrameRange, ReplayEvent, ReplayOptions, ReplaySummary, SweepResult, replay_events,
 };
 use sweeptrace::sim::scenes;
-use sweeptrace::trace::messages::{OutcomeMsg, SceneMsg, SweepMsg};
-use sweeptrace::trace::{TraceError, TraceEvent, TraceReader, TraceWriter};
+use sweeptrace::trace::{
+    OutcomeMsg, SceneMsg, SweepMsg, TraceError, TraceEvent, TraceReader, TraceWriter,
+};
 use sweeptrace::viz;
 
 use crate::ensure;
@@ -506,7 +507,7 @@ fn expected_attached_before_and_after() -> anyhow::Result<()> {
         summary.expected_matched == 2 && summary.expected_unmatched == 1,
         "summary {summary:?}"
     );
-    let (line, mismatch) = viz::decision_line(
+    let (line, mismatch) = sweeptrace::regress::decision_line(
         &results[0],
         results[0].decisive_record(),
         &sweeptrace::regress::Tolerances::default(),
@@ -1893,7 +1894,9 @@ fn viewer_and_check_agree_on_divergences() -> anyhow::Result<()> {
 
     let line_frames: BTreeSet<i64> = results
         .iter()
-        .filter(|r| viz::decision_line(r, r.decisive_record(), &Tolerances::default()).1)
+        .filter(|r| {
+            sweeptrace::regress::decision_line(r, r.decisive_record(), &Tolerances::default()).1
+        })
         .map(|r| r.frame as i64)
         .collect();
     ensure!(
@@ -2139,8 +2142,7 @@ fn spilled_recording_holds_the_same_rows() -> anyhow::Result<()> {
     let dir = tempfile::tempdir()?;
     let sweeps = random_sweeps(14, 60, 5);
     let write = |path: &std::path::Path, spill: bool| -> anyhow::Result<()> {
-        let (sink, writer) =
-            viz::rrd_file::create(path, viz::rrd_file::RrdFileOptions { footer: true })?;
+        let (sink, writer) = viz::create_rrd_file(path, viz::RrdFileOptions { footer: true })?;
         let id = viz::recording_id(&[b"spill"]);
         let rec = viz::builder(&id, "test")
             .set_sinks(vec![Box::new(sink) as Box<dyn rerun::sink::LogSink>])?;
@@ -2214,7 +2216,7 @@ fn rrd_footer_only_when_asked() -> anyhow::Result<()> {
     let dir = tempfile::tempdir()?;
     let sweeps = random_sweeps(13, 30, 2);
     let write = |path: &std::path::Path, footer: bool| -> anyhow::Result<u64> {
-        let (sink, writer) = viz::rrd_file::create(path, viz::rrd_file::RrdFileOptions { footer })?;
+        let (sink, writer) = viz::create_rrd_file(path, viz::RrdFileOptions { footer })?;
         let id = viz::recording_id(&[b"footer"]);
         let rec = viz::builder(&id, "test")
             .set_sinks(vec![Box::new(sink) as Box<dyn rerun::sink::LogSink>])?;

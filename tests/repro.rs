@@ -14,8 +14,7 @@ use sweeptrace::regress::{
     compare, find_sweep, render_json, render_text,
 };
 use sweeptrace::replay::ReplayOptions;
-use sweeptrace::trace::messages::{OutcomeMsg, SceneMsg, SweepMsg};
-use sweeptrace::trace::{TraceReader, TraceWriter};
+use sweeptrace::trace::{OutcomeMsg, SceneMsg, SweepMsg, TraceReader, TraceWriter};
 
 use crate::ensure;
 use crate::os;

@@ -29,7 +29,7 @@ use rand_chacha::ChaCha8Rng;
 use sweeptrace::core::{Broadphase, FragileReason, Kind, NoObserver, Sweep, sweep_mesh_with};
 use sweeptrace::regress::{CheckOptions, Status, check_reader, render_text};
 use sweeptrace::sim::scenes::SceneMesh;
-use sweeptrace::trace::messages::{SceneMsg, SweepMsg};
+use sweeptrace::trace::{SceneMsg, SweepMsg};
 
 use crate::core_decisions::options;
 use crate::ensure;

@@ -13,8 +13,7 @@ use crate::os;
 use crate::support::run_bin_in;
 use crate::trial;
 use anyhow::Context as _;
-use sweeptrace::regress::config::{ConfigFile, Overrides, Source, resolve};
-use sweeptrace::regress::{Field, FieldSet, Tolerances};
+use sweeptrace::regress::{ConfigFile, Field, FieldSet, Overrides, Source, Tolerances, resolve};
 
 pub fn tests() -> Vec<Trial> {
     vec![

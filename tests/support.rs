@@ -226,8 +226,8 @@ pub fn mesh(vertices: &[[f64; 3]], triangles: &[[u64; 3]]) -> Mesh {
 /// The triangle T of SEMANTICS.md's worked examples, `(0, 0, 0)`,
 /// `(4, 0, 0)`, `(0, 4, 0)`, front `+z`, as a scene of margin `margin`
 /// under the non-strict facing rule.
-pub fn scene_t(margin: f64) -> sweeptrace::trace::messages::SceneMsg {
-    sweeptrace::trace::messages::SceneMsg {
+pub fn scene_t(margin: f64) -> sweeptrace::trace::SceneMsg {
+    sweeptrace::trace::SceneMsg {
         name: Some("triangle_t".into()),
         vertices: vec![[0.0, 0.0, 0.0], [4.0, 0.0, 0.0], [0.0, 4.0, 0.0]],
         triangles: vec![[0, 1, 2]],
@@ -300,7 +300,7 @@ pub fn vertex(records: &[TestRecord], t: u32, v: u8) -> VertexRecord {
 /// with triangle 9 wound the other way (flipped): 12 boundary edges and 21
 /// flat ones (the turned triangle's edges are classified as if it were
 /// turned back), one defect.
-pub fn flipped_floor() -> sweeptrace::trace::messages::SceneMsg {
+pub fn flipped_floor() -> sweeptrace::trace::SceneMsg {
     let mut vertices = Vec::new();
     for j in 0..4 {
         for i in 0..4 {
@@ -316,7 +316,7 @@ pub fn flipped_floor() -> sweeptrace::trace::messages::SceneMsg {
         }
     }
     triangles[9].swap(1, 2);
-    sweeptrace::trace::messages::SceneMsg {
+    sweeptrace::trace::SceneMsg {
         name: Some("flipped floor".into()),
         vertices,
         triangles,

@@ -10,10 +10,9 @@ use mcap::records::MessageHeader;
 use mcap::{Compression, WriteOptions};
 use rand::{Rng, SeedableRng};
 use sweeptrace::core::{Facing, Kind};
-use sweeptrace::trace::info::{collect, render_json, render_text};
-use sweeptrace::trace::messages::{OutcomeMsg, SceneMsg, SweepMsg};
 use sweeptrace::trace::{
-    ReadLimits, ReadStats, TraceError, TraceEvent, TraceReader, TraceWriter, write_trace_file,
+    OutcomeMsg, ReadLimits, ReadStats, SceneMsg, SweepMsg, TraceError, TraceEvent, TraceReader,
+    TraceWriter, collect_info, render_info_json, render_info_text, write_trace_file,
 };
 
 use crate::ensure;
@@ -142,7 +141,7 @@ pub fn sample_events(frames: u64) -> Vec<TraceEvent> {
 }
 
 pub fn default_opts() -> WriteOptions {
-    sweeptrace::trace::write::default_write_options()
+    sweeptrace::trace::default_write_options()
 }
 pub fn unchunked() -> WriteOptions {
     default_opts().use_chunks(false)
@@ -1211,9 +1210,9 @@ fn write_trace_file_is_atomic() -> anyhow::Result<()> {
 
 fn info_renders_python_fixture() -> anyhow::Result<()> {
     let bytes = std::fs::read(FIXTURE).map_err(|e| anyhow::anyhow!("{FIXTURE}: {e}"))?;
-    let (info, error) = collect(TraceReader::new(bytes.as_slice(), "python_written.mcap"));
+    let (info, error) = collect_info(TraceReader::new(bytes.as_slice(), "python_written.mcap"));
     ensure!(error.is_none(), "{error:?}");
-    let text = render_text(&info);
+    let text = render_info_text(&info);
     for needle in [
         "trace:       python_written.mcap",
         &format!(
@@ -1234,7 +1233,7 @@ fn info_renders_python_fixture() -> anyhow::Result<()> {
         ensure!(text.contains(needle), "report lacks `{needle}`:\n{text}");
     }
     ensure!(!text.contains("incomplete"), "{text}");
-    let json: serde_json::Value = serde_json::from_str(&render_json(&info))?;
+    let json: serde_json::Value = serde_json::from_str(&render_info_json(&info))?;
     ensure!(json["sweeps"] == 5 && json["expected"] == 4, "{json}");
     ensure!(json["stats"]["skipped_by_topic"]["/debug"] == 4, "{json}");
     ensure!(json["scenes"][0]["triangles"] == 1, "{json}");
@@ -1247,8 +1246,8 @@ fn info_renders_python_fixture() -> anyhow::Result<()> {
     let mut w = TraceWriter::with_options(Cursor::new(Vec::new()), default_opts())?;
     w.scene(0, &scene)?;
     let bytes = w.finish()?.into_inner();
-    let (info, _) = collect(TraceReader::new(bytes.as_slice(), "d.mcap"));
-    let text = render_text(&info);
+    let (info, _) = collect_info(TraceReader::new(bytes.as_slice(), "d.mcap"));
+    let text = render_info_text(&info);
     ensure!(
         text.contains("4 vertices, 3 triangles, 2 degenerate"),
         "{text}"
@@ -1266,10 +1265,10 @@ fn info_renders_python_fixture() -> anyhow::Result<()> {
 fn info_reports_partial_trace() -> anyhow::Result<()> {
     let bytes = write_events(&sample_events(10), unchunked())?;
     let cut = &bytes[..bytes.len() / 2];
-    let (info, error) = collect(TraceReader::new(cut, "cut.mcap"));
+    let (info, error) = collect_info(TraceReader::new(cut, "cut.mcap"));
     let error = error.context("no error")?;
     ensure!(matches!(error, TraceError::Truncated { .. }), "{error}");
-    let text = render_text(&info);
+    let text = render_info_text(&info);
     ensure!(
         text.contains("incomplete:  cut.mcap: the file is truncated"),
         "{text}"

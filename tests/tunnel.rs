@@ -38,8 +38,7 @@ use sweeptrace::replay::{
     ReplayEvent, ReplayOptions, SweepResult, TunnelKind, replay_events, replay_events_parallel,
 };
 use sweeptrace::sim::scenes;
-use sweeptrace::trace::messages::{OutcomeMsg, SceneMsg, SweepMsg};
-use sweeptrace::trace::{TraceReader, TraceWriter};
+use sweeptrace::trace::{OutcomeMsg, SceneMsg, SweepMsg, TraceReader, TraceWriter};
 
 use crate::ensure;
 use crate::support::mesh;

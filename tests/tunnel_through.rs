@@ -19,8 +19,7 @@ use libtest_mimic::Trial;
 use sweeptrace::core::{Facing, Options, Sweep, sweep_mesh};
 use sweeptrace::regress::{CheckOptions, check_reader, render_json, render_text};
 use sweeptrace::replay::TunnelKind;
-use sweeptrace::trace::TraceWriter;
-use sweeptrace::trace::messages::{OutcomeMsg, SceneMsg, SweepMsg};
+use sweeptrace::trace::{OutcomeMsg, SceneMsg, SweepMsg, TraceWriter};
 
 use crate::ensure;
 use crate::support::mesh;

@@ -14,8 +14,7 @@ use sweeptrace::core::{Facing, Kind, Mesh, Options, Sweep, sweep_ties};
 use sweeptrace::regress::{Agreement, Tolerances, agreement, agreement_of};
 use sweeptrace::replay::{ReplayEvent, ReplayOptions, SweepResult, replay_events};
 use sweeptrace::sim::scenes;
-use sweeptrace::trace::messages::{OutcomeMsg, SceneMsg, SweepMsg};
-use sweeptrace::trace::{TraceEvent, TraceWriter};
+use sweeptrace::trace::{OutcomeMsg, SceneMsg, SweepMsg, TraceEvent, TraceWriter};
 
 use crate::support::run_bin;
 use crate::support::scene_t;

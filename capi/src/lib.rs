@@ -33,9 +33,8 @@ use std::panic::{AssertUnwindSafe, catch_unwind};
 use std::path::PathBuf;
 
 use sweeptrace::core::{Facing, Kind};
-use sweeptrace::trace::messages::{OutcomeMsg, SceneMsg, SweepMsg};
-use sweeptrace::trace::source::MAX_SETTINGS;
-use sweeptrace::trace::{Encoding, ExpectedSource, PendingTrace, TraceError};
+use sweeptrace::trace::{MAX_SETTINGS, PendingTrace};
+use sweeptrace::{Encoding, ExpectedSource, OutcomeMsg, SceneMsg, SweepMsg, TraceError};
 
 /// What a call came to.
 #[repr(C)]
@@ -951,7 +950,7 @@ unsafe fn serve(
     output: &mut impl std::io::Write,
 ) -> Result<(), Stop> {
     use sweeptrace::engine::protocol::{Request, answer_line, parse_request};
-    use sweeptrace::trace::validate::{validate_outcome, validate_scene, validate_sweep};
+    use sweeptrace::trace::{validate_outcome, validate_scene, validate_sweep};
 
     let mut scene: Option<SceneData> = None;
     let mut line = Vec::new();

@@ -26,7 +26,7 @@ use sweeptrace::engine::protocol::{parse_answer, scene_line, sweep_line};
 use sweeptrace::engine::{EngineCommand, EngineOptions};
 use sweeptrace::regress::{Against, CheckOptions, Status, check_file_with_engine, render_text};
 use sweeptrace::trace::PendingTrace;
-use sweeptrace::trace::messages::{SceneMsg, SweepMsg};
+use sweeptrace::{SceneMsg, SweepMsg};
 
 /// Set to `1` to make the tests that need a C (or C++) compiler fail,
 /// instead of being skipped, when there is none.
@@ -360,7 +360,7 @@ fn a_scene_without_triangles_is_passed_and_a_miss_answered() {
     let answer = parse_answer(text(&output.stdout).trim().as_bytes()).expect("an outcome");
     assert_eq!(
         answer,
-        sweeptrace::trace::messages::OutcomeMsg::miss(0, 2),
+        sweeptrace::OutcomeMsg::miss(0, 2),
         "every field given, null"
     );
     assert!(text(&output.stderr).contains("scene (none) with 0 triangles"));

@@ -5,8 +5,8 @@
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
+use sweeptrace::ExpectedSource;
 use sweeptrace::regress::{CheckOptions, Status, check_file, render_text};
-use sweeptrace::trace::ExpectedSource;
 
 /// The repository's root.
 fn root() -> PathBuf {

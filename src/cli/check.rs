@@ -8,10 +8,9 @@ use anyhow::{Context, bail};
 
 use super::Exit;
 use sweeptrace::engine::{EngineCommand, EngineOptions};
-use sweeptrace::regress::{Against, check_file_with_engine};
 use sweeptrace::regress::{
-    CheckOptions, DEFAULT_MAX_DETAILS, Status, TraceReport, check_file, find_traces, frames_around,
-    render_json, render_text,
+    Against, CheckOptions, DEFAULT_MAX_DETAILS, Status, TraceReport, check_file,
+    check_file_with_engine, find_traces, frames_around, render_json, render_text,
 };
 use sweeptrace::replay::{Detail, ReplayError, ReplayEvent, ReplayOptions, replay_events};
 use sweeptrace::trace::TraceReader;
@@ -173,7 +172,7 @@ pub enum AgainstArg {
 
 /// Checks every trace, prints the reports, returns the exit code.
 pub fn run(args: Args) -> anyhow::Result<Exit> {
-    let overrides = sweeptrace::regress::config::Overrides {
+    let overrides = sweeptrace::regress::Overrides {
         strict: args.strict,
         allow_tunnels: args.allow_tunnels,
         ..args.tolerances.to_overrides()?

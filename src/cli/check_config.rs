@@ -1,10 +1,10 @@
 //! `check`'s settings for each trace: the `sweeptrace.toml` files found
 //! beside and above it, then the command line (the library's
-//! [`sweeptrace::regress::config`] does the resolution).
+//! [`sweeptrace::regress::settings_for`] does the resolution).
 
 use std::path::PathBuf;
 
-use sweeptrace::regress::config::{self, Overrides, Settings};
+use sweeptrace::regress::{self, Overrides, Settings};
 
 /// Each trace's settings, in the order of `traces`; with `no_config`, the
 /// defaults and the command line only. A configuration file that cannot be
@@ -18,9 +18,9 @@ pub fn settings(
         .iter()
         .map(|trace| {
             if no_config {
-                Ok(config::resolve(&[], trace, command_line))
+                Ok(regress::resolve(&[], trace, command_line))
             } else {
-                Ok(config::settings_for(trace, command_line)?)
+                Ok(regress::settings_for(trace, command_line)?)
             }
         })
         .collect()
@@ -34,8 +34,8 @@ pub fn render(traces: &[PathBuf], settings: &[Settings], json: bool) -> String {
         .map(|(t, s)| (t.display().to_string(), s.clone()))
         .collect();
     if json {
-        config::render_settings_json(&named)
+        regress::render_settings_json(&named)
     } else {
-        config::render_settings_text(&named)
+        regress::render_settings_text(&named)
     }
 }

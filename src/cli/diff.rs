@@ -11,8 +11,7 @@ use anyhow::{Context, bail};
 use super::Exit;
 use sweeptrace::core::Facing;
 use sweeptrace::numbers::{self, Rule};
-use sweeptrace::regress::diff::{render_json, render_text};
-use sweeptrace::regress::{Side, diff};
+use sweeptrace::regress::{Side, diff, render_diff_json, render_diff_text};
 use sweeptrace::replay::{FrameRange, ReplayOptions, Selection};
 use sweeptrace::trace::TraceReader;
 
@@ -141,9 +140,9 @@ pub fn run(args: Args) -> anyhow::Result<Exit> {
         eprintln!("{line}");
     }
     if args.json {
-        print!("{}", render_json(&report));
+        print!("{}", render_diff_json(&report));
     } else {
-        print!("{}", render_text(&report));
+        print!("{}", render_diff_text(&report));
     }
     Ok(if report.is_same() {
         Exit::Success

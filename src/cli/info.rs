@@ -8,8 +8,7 @@ use std::path::PathBuf;
 use anyhow::Context;
 
 use super::Exit;
-use sweeptrace::trace::TraceReader;
-use sweeptrace::trace::info::{collect, render_json, render_text};
+use sweeptrace::trace::{TraceReader, collect_info, render_info_json, render_info_text};
 
 /// Arguments of `info`.
 #[derive(Debug, clap::Args)]
@@ -34,7 +33,7 @@ pub fn run(args: Args) -> anyhow::Result<Exit> {
         .ok()
         .filter(|m| m.is_file())
         .map(|m| m.len());
-    let (mut info, error) = collect(TraceReader::new_indexed(BufReader::new(file), &name));
+    let (mut info, error) = collect_info(TraceReader::new_indexed(BufReader::new(file), &name));
     info.file_bytes = file_bytes;
     let (error, not_mcap) = match error {
         Some(err) if !info.stats.header_read => (None, Some(err)),
@@ -44,9 +43,9 @@ pub fn run(args: Args) -> anyhow::Result<Exit> {
         return Err(err).name_file_once("reading the trace", &name);
     }
     let report = if args.json {
-        render_json(&info)
+        render_info_json(&info)
     } else {
-        render_text(&info)
+        render_info_text(&info)
     };
     print!("{report}");
     if args.json {

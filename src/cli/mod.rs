@@ -134,9 +134,9 @@ impl ToleranceArgs {
 
     /// The values given, as the command line's layer of `check`'s settings
     /// (validated).
-    pub fn to_overrides(&self) -> anyhow::Result<sweeptrace::regress::config::Overrides> {
+    pub fn to_overrides(&self) -> anyhow::Result<sweeptrace::regress::Overrides> {
         self.to_tolerances()?;
-        Ok(sweeptrace::regress::config::Overrides {
+        Ok(sweeptrace::regress::Overrides {
             alpha: self.tolerance,
             normal_degrees: self.normal_tolerance,
             contact: self.contact_tolerance,

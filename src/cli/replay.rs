@@ -23,8 +23,7 @@ use sweeptrace::replay::{
     Detail, FrameRange, PipelineOptions, ReplayError, ReplayEvent, ReplayOptions, Selection,
     replay_events_parallel, run_pipeline,
 };
-use sweeptrace::trace::TraceReader;
-use sweeptrace::trace::prefetch::{self, prefetch};
+use sweeptrace::trace::{DEFAULT_PREFETCH_CHUNK, DEFAULT_PREFETCH_DEPTH, TraceReader, prefetch};
 use sweeptrace::viz::{
     self, FinishedRecording, Recording, RecordingError, RecordingTarget, Viewer,
 };
@@ -184,8 +183,8 @@ pub fn run(args: Args) -> anyhow::Result<Exit> {
     // Decode on a thread of its own, so reading overlaps the core's work.
     let read_ahead = prefetch(
         TraceReader::new_indexed(reader, &source_name),
-        prefetch::DEFAULT_CHUNK,
-        prefetch::DEFAULT_DEPTH,
+        DEFAULT_PREFETCH_CHUNK,
+        DEFAULT_PREFETCH_DEPTH,
     )
     .context("starting the trace reader thread")?;
     let batch_events = options.batch_events();
@@ -292,7 +291,7 @@ fn recording_target(args: &Args) -> Option<RecordingTarget> {
     };
     (file.is_some() || viewer.is_some()).then_some(RecordingTarget {
         file,
-        file_options: viz::rrd_file::RrdFileOptions {
+        file_options: viz::RrdFileOptions {
             footer: !args.no_rrd_footer,
         },
         viewer,

@@ -10,7 +10,7 @@ use sweeptrace::core::{
 };
 use sweeptrace::regress::SweepInputs;
 use sweeptrace::replay::feature_class;
-use sweeptrace::trace::messages::OutcomeMsg;
+use sweeptrace::trace::OutcomeMsg;
 
 /// Formats `[x, y, z]` compactly.
 pub fn vec3(v: &[f64]) -> String {

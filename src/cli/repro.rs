@@ -1,5 +1,5 @@
 //! `sweeptrace repro`: one sweep of a trace as a minimal trace and a
-//! ready-to-paste Rust test (the library's [`sweeptrace::regress::repro`]).
+//! ready-to-paste Rust test (the library's [`sweeptrace::regress::ReproCase`]).
 
 use super::NameFileOnce;
 use std::path::PathBuf;

@@ -10,8 +10,7 @@ use super::report;
 use sweeptrace::core::{Broadphase, CollectRecords, Facing, Options, Sweep, sweep_mesh_with};
 use sweeptrace::regress::find_sweep;
 use sweeptrace::sim::{BuiltinScene, load_obj};
-use sweeptrace::trace::TraceReader;
-use sweeptrace::trace::messages::OutcomeMsg;
+use sweeptrace::trace::{OutcomeMsg, TraceReader};
 
 /// Arguments of `sweep`.
 #[derive(Debug, clap::Args)]

@@ -5,7 +5,7 @@
 
 use crate::core::{Facing, Kind};
 use crate::sim::scenes;
-use crate::trace::messages::{SceneMsg, SweepMsg};
+use crate::trace::{SceneMsg, SweepMsg};
 
 /// One case: a scene, a sweep, and the kind the core decides (checked by
 /// the test suite, so a case cannot silently stop testing its rule).

@@ -27,8 +27,7 @@ use crate::regress::{
     render_divergence_as,
 };
 use crate::replay::{ReplayEvent, ReplayOptions, replay_events};
-use crate::trace::TraceEvent;
-use crate::trace::messages::OutcomeMsg;
+use crate::trace::{OutcomeMsg, TraceEvent};
 
 /// The first failing case of a rule, explained.
 #[derive(Clone, Debug, PartialEq, Serialize)]

@@ -4,7 +4,7 @@ use std::cell::RefCell;
 use std::collections::{HashMap, VecDeque};
 use std::rc::Rc;
 
-use crate::trace::messages::OutcomeMsg;
+use crate::trace::OutcomeMsg;
 
 use crate::trace::{TraceError, TraceEvent};
 

@@ -9,7 +9,7 @@ use std::sync::mpsc::{self, Receiver, RecvTimeoutError, Sender};
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
-use crate::trace::messages::{OutcomeMsg, SceneMsg, SweepMsg};
+use crate::trace::{OutcomeMsg, SceneMsg, SweepMsg};
 
 use super::protocol::{MAX_ANSWER_BYTES, parse_answer, scene_line, sweep_line};
 use super::{EngineCommand, EngineError, EngineOptions, STDERR_TAIL_LINES};

@@ -20,8 +20,9 @@ use crate::palette::{
     MAX_DRAWN_DEFECT_LABELS, MESH_COLOR, NON_MANIFOLD_EDGE_COLOR, NORMAL_COLOR, P0_COLOR, P1_COLOR,
     SWEEP_COLOR,
 };
-use crate::regress::decision::write_decision_line;
-use crate::regress::{FieldDiff, divergence_details, ghost_point, render_divergence};
+use crate::regress::{
+    FieldDiff, divergence_details, ghost_point, render_divergence, write_decision_line,
+};
 use crate::replay::{SceneState, SweepResult};
 use strum::IntoEnumIterator as _;
 
@@ -546,7 +547,7 @@ pub fn ghost_update(r: &SweepResult) -> SceneUpdate {
 
 /// The decision of a sweep as a Log line, on [`super::DECISIONS_TOPIC`]:
 /// the viewer's decision line; for a sweep that `check` counts as a
-/// divergence (`diffs`, from [`crate::regress::decision::divergence`]) also
+/// divergence (`diffs`, from [`crate::regress::divergence`]) also
 /// `check`'s report of it ([`render_divergence`]). Level WARNING when
 /// `check` fails the sweep (a divergence or a tunnel), INFO otherwise.
 /// `name` is `ball N`, `file` the trace's file name.

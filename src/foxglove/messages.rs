@@ -139,12 +139,15 @@ pub struct ArrowPrimitive {
     pub color: Color,
 }
 
-/// `foxglove.LineType`.
+/// `foxglove.LineType` (the variants are named as in the schema).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[allow(clippy::enum_variant_names)]
 pub enum LineType {
     /// Connected segments 0-1, 1-2, ...
     LineStrip = 0,
-    /// A closed polygon.
+    /// A closed polygon (never written; kept so that the values are the
+    /// schema's).
+    #[allow(dead_code)]
     LineLoop = 1,
     /// Separate segments 0-1, 2-3, ...
     LineList = 2,

@@ -17,19 +17,28 @@
 //! | [`DECISIONS_TOPIC`] | `foxglove.Log` | per sweep, the decision in words; WARNING where `check` fails it |
 //! | [`NUMBERS_TOPIC`] | `sweeptrace.SweepNumbers` | per sweep, `α` and the decisive test's numbers, for the Plot panel |
 //!
-//! - `schemas`: the embedded JSON Schemas;
+//! Inside (the submodules are private; every public item is named once,
+//! here):
+//! - `schemas`: the embedded JSON Schemas ([`SCENE_UPDATE_SCHEMA_JSON`],
+//!   [`LOG_SCHEMA_JSON`], [`SWEEP_NUMBERS_SCHEMA_JSON`]);
 //! - `messages`: the messages as serde types;
 //! - `convert`: pure functions from a scene or a sweep's result to each
 //!   channel's message (the decision text is
-//!   [`crate::regress::decision`]'s and `check`'s, shared with the viewer);
+//!   [`crate::regress::decision_line`]'s and `check`'s, shared with the viewer);
 //! - `writer`: [`FoxgloveWriter`] over any `Write + Seek`, and
 //!   [`FoxgloveFile`], written under a temporary name and renamed.
 
-pub mod convert;
-pub mod messages;
-pub mod schemas;
+mod convert;
+mod messages;
+mod schemas;
 mod writer;
 
+pub use convert::rotation_from_x;
+pub use messages::Quaternion;
+pub use schemas::{
+    LOG_SCHEMA, LOG_SCHEMA_JSON, SCENE_UPDATE_SCHEMA, SCENE_UPDATE_SCHEMA_JSON,
+    SWEEP_NUMBERS_SCHEMA, SWEEP_NUMBERS_SCHEMA_JSON,
+};
 pub use writer::{
     FoxgloveCounts, FoxgloveError, FoxgloveFile, FoxgloveOptions, FoxgloveWriter, write_options,
 };

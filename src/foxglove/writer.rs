@@ -27,10 +27,9 @@ use super::{
     METADATA_NAME, NUMBERS_TOPIC, SWEEPS_TOPIC,
 };
 use crate::atomic::PendingFile;
-use crate::regress::Tolerances;
-use crate::regress::decision::divergence;
+use crate::regress::{Tolerances, divergence};
 use crate::replay::{ReplayEvent, SceneState, SweepResult};
-use crate::trace::write::library_string;
+use crate::trace::library_string;
 
 /// Writing the Foxglove file failed.
 #[derive(Debug, Error)]

@@ -38,12 +38,11 @@ use thiserror::Error;
 use crate::atomic::{FinishStep, PendingFile};
 use crate::error_text::full_text;
 use crate::replay::{ReplayError, ReplayEvent, ReplayOptions, replay_events};
-use crate::trace::messages::{EXPECTED_TOPIC, OUTCOME_SCHEMA, OutcomeMsg, SWEEP_TOPIC};
-use crate::trace::schemas::{OUTCOME_SCHEMA_JSON, SCHEMA_ENCODING};
-use crate::trace::source::{EXPECTED_SOURCE_METADATA, ExpectedSource, sweeptrace_source};
-use crate::trace::validate::frame_of_message;
-use crate::trace::write::default_write_options;
-use crate::trace::{Encoding, TraceError, TraceReader};
+use crate::trace::{
+    EXPECTED_SOURCE_METADATA, EXPECTED_TOPIC, Encoding, ExpectedSource, OUTCOME_SCHEMA,
+    OUTCOME_SCHEMA_JSON, OutcomeMsg, SCHEMA_ENCODING, SWEEP_TOPIC, TraceError, TraceReader,
+    default_write_options, frame_of_message, sweeptrace_source,
+};
 
 /// What went wrong while blessing.
 #[derive(Debug, Error)]
@@ -136,7 +135,7 @@ struct Replayed {
 }
 
 /// Values in words, the first few of many only (a setting's value is
-/// bounded: [`crate::trace::source::MAX_SETTING_VALUE_BYTES`]).
+/// bounded: [`crate::trace::MAX_SETTING_VALUE_BYTES`]).
 fn listed(values: &[String]) -> String {
     const SHOWN: usize = 8;
     let text = values
@@ -447,7 +446,7 @@ fn ball_of(data: &[u8], encoding: Encoding) -> u32 {
     use serde::Deserialize;
     match encoding {
         Encoding::Cbor => {
-            BallOnly::deserialize(&mut crate::trace::cbor::Deserializer::from_slice(data)).ok()
+            BallOnly::deserialize(&mut crate::trace::CborDeserializer::from_slice(data)).ok()
         }
         Encoding::Json => serde_json::from_slice::<BallOnly>(data).ok(),
     }

@@ -23,8 +23,7 @@ use crate::core::{Facing, Feature, FragileReason, Kind};
 use crate::replay::{
     ReplayError, ReplayEvent, ReplayOptions, SweepResult, Tunnel, TunnelAt, TunnelKind,
 };
-use crate::trace::messages::{EXPECTED_TOPIC, OutcomeMsg};
-use crate::trace::{TraceError, TraceEvent, TraceReader};
+use crate::trace::{EXPECTED_TOPIC, OutcomeMsg, TraceError, TraceEvent, TraceReader};
 
 use super::compare::{FieldDiff, Tolerances};
 pub use super::discovery::find_traces;
@@ -204,7 +203,7 @@ pub struct CheckOptions {
     /// recording engine, whatever the expectations say).
     pub fail_on_tunnel: bool,
     /// Whether a ghost contact fails the check (the default; see
-    /// [`super::ghost`]).
+    /// [`judge_ghost`](super::judge_ghost)).
     pub fail_on_ghost: bool,
     /// The angle, in degrees, above which an edge or vertex contact on an
     /// internal flat or concave place is a ghost contact
@@ -278,7 +277,7 @@ pub struct TraceReport {
     /// Ghost contacts found: expectations (or an engine's answers) that are
     /// edge or vertex contacts on an internal flat or concave place with a
     /// normal more than `ghost_degrees` from the faces' there
-    /// ([`super::ghost`]), whatever the compared fields. They fail the
+    /// ([`judge_ghost`](super::judge_ghost)), whatever the compared fields. They fail the
     /// check unless `fail_on_ghost` is off.
     pub ghosts: u64,
     /// The first ghost contacts (at most [`MAX_LISTED_GHOSTS`]), in trace

@@ -1,12 +1,5 @@
 //! The field-by-field comparison of an outcome with its expectation, on
-//! which the one judgement ([`super::judge`]) rests.
-//!
-//! [`compare`] compares one outcome with one expectation, field by field,
-//! **only over the fields the expectation holds** (an absent field is `None`
-//! in [`OutcomeMsg`] and is not compared; a `null` field is `Some(None)` and
-//! is compared: it must be null in the outcome too). Discrete fields
-//! (`kind`, `triangle`, `feature`) must be equal; the continuous ones are
-//! compared within the [`Tolerances`], whose defaults are listed there.
+//! which the one judgement ([`super::agreement`]) rests: [`compare`].
 
 use nalgebra::Vector3;
 use serde::Serialize;
@@ -15,7 +8,7 @@ use serde_json::{Value, json};
 use crate::core::Kind;
 use crate::core::explain::num;
 use crate::numbers::{self, Rule};
-use crate::trace::messages::OutcomeMsg;
+use crate::trace::OutcomeMsg;
 
 /// Default absolute tolerance on `α` (a fraction of the path, unitless).
 pub const DEFAULT_ALPHA_TOLERANCE: f64 = 1e-6;
@@ -200,12 +193,16 @@ fn distance(a: [f64; 3], b: [f64; 3]) -> f64 {
     (Vector3::from(a) - Vector3::from(b)).norm()
 }
 
-/// Compares `got` with `expected` over the fields `expected` holds (see the
-/// [module documentation](self)). Returns the fields that differ, in the
-/// order kind, triangle, feature, alpha, normal, contact; empty when they
-/// match. `frame` and `ball` are not compared (they are the matching key).
-/// A NaN anywhere counts as a difference, never as a match. Fields outside
-/// `tol.fields` are not compared.
+/// Compares `got` with `expected`, field by field, **only over the fields
+/// `expected` holds** (an absent field is `None` in [`OutcomeMsg`] and is
+/// not compared; a `null` field is `Some(None)` and is compared: it must be
+/// null in the outcome too). Discrete fields (`kind`, `triangle`,
+/// `feature`) must be equal; the continuous ones are compared within the
+/// [`Tolerances`], whose defaults are listed there. Returns the fields that
+/// differ, in the order kind, triangle, feature, alpha, normal, contact;
+/// empty when they match. `frame` and `ball` are not compared (they are the
+/// matching key). A NaN anywhere counts as a difference, never as a match.
+/// Fields outside `tol.fields` are not compared.
 pub fn compare(expected: &OutcomeMsg, got: &OutcomeMsg, tol: &Tolerances) -> Vec<FieldDiff> {
     let mut out = compare_all(expected, got, tol);
     out.retain(|d| tol.fields.contains(d.field));

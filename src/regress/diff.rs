@@ -23,8 +23,7 @@ use crate::regress::{
 use crate::replay::{
     ReplayError, ReplayEvent, ReplayOptions, ReplaySummary, SceneState, SweepResult, replay_events,
 };
-use crate::trace::messages::OutcomeMsg;
-use crate::trace::{TraceError, TraceEvent};
+use crate::trace::{OutcomeMsg, TraceError, TraceEvent};
 use std::sync::Arc;
 
 /// One side's replayed sweeps, by `(frame, ball)`.
@@ -340,7 +339,7 @@ pub fn diff(a: &Side, b: &Side, tolerances: &Tolerances) -> DiffReport {
 }
 
 /// The report in words.
-pub fn render_text(r: &DiffReport) -> String {
+pub fn render_diff_text(r: &DiffReport) -> String {
     let mut s = String::new();
     let _ = writeln!(s, "A: {}\nB: {}", r.a, r.b);
     if !r.scene_differences.is_empty() {
@@ -424,7 +423,7 @@ pub fn render_text(r: &DiffReport) -> String {
 }
 
 /// The report as pretty JSON, ending with a newline.
-pub fn render_json(r: &DiffReport) -> String {
+pub fn render_diff_json(r: &DiffReport) -> String {
     let mut v = serde_json::to_value(r).unwrap_or_else(|e| json!({ "error": e.to_string() }));
     if let Some(obj) = v.as_object_mut() {
         obj.insert("same_outcomes".into(), json!(r.is_same()));

@@ -12,8 +12,7 @@ use crate::engine::{
     AnswerSink, EngineAnswers, EngineCommand, EngineError, EngineOptions, EngineSession,
 };
 use crate::replay::SweepResult;
-use crate::trace::TraceReader;
-use crate::trace::messages::{EXPECTED_TOPIC, OutcomeMsg};
+use crate::trace::{EXPECTED_TOPIC, OutcomeMsg, TraceReader};
 
 use super::check::{
     CheckOptions, Judged, TraceReport, check_file, check_stream, judge_against_core,

@@ -8,7 +8,7 @@ use crate::core::{
     Broadphase, CollectRecords, Kind, Outcome, TestRecord, Verdict, sweep_mesh_with,
 };
 use crate::replay::{SceneState, SweepResult, primary_records};
-use crate::trace::messages::OutcomeMsg;
+use crate::trace::OutcomeMsg;
 
 /// The test that would have produced the expected result, and why it did not.
 #[derive(Clone, Debug, PartialEq, Serialize)]

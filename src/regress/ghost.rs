@@ -20,7 +20,7 @@ use serde::Serialize;
 use crate::core::explain::num;
 use crate::core::{EdgeClass, Kind, Topology};
 use crate::replay::SceneState;
-use crate::trace::messages::OutcomeMsg;
+use crate::trace::OutcomeMsg;
 
 /// The default angle, in degrees, between an edge or vertex contact's
 /// normal and the nearest adjacent face's normal above which the contact

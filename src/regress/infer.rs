@@ -27,7 +27,7 @@ use serde::Serialize;
 use crate::core::explain::num;
 use crate::core::{Facing, Kind, Options, Sweep, sweep_mesh};
 use crate::replay::{SceneState, SweepResult};
-use crate::trace::messages::OutcomeMsg;
+use crate::trace::OutcomeMsg;
 
 use super::compare::Tolerances;
 use super::judge::{Agreement, agreement};

@@ -1,27 +1,5 @@
-//! The one judgement of an answer against an expectation for one sweep,
-//! used by `check`, `check --engine` (both `--against` modes), `diff`,
-//! `conform` and the viewer's divergence marks.
-//!
-//! Three outcomes ([`Agreement`]):
-//! - **match**: [`compare`] finds no field that differs;
-//! - **tie**: each side is an answer the core's decision accepts: its
-//!   primary, or another member of its tie set with that member's own
-//!   kind, triangle, feature and contact (α and the averaged normal are the
-//!   decision's);
-//! - **divergence**, which is *excused as fragile* only when the core's
-//!   decision is fragile **and** a named perturbation of the sweep's inputs
-//!   within the rounding budget the fragility reasons are defined by makes
-//!   the core give each side's answer ([`Reproduced`]). Any other
-//!   divergence fails, whatever the decision's fragility: a fragile
-//!   decision does not excuse an answer no rounding gives.
-//!
-//! The perturbations ([`perturbations`]) move one input at a time by
-//! `k · u`, where `u = ε · S` is the sweep's rounding unit (`S` the scale of
-//! [`SweptPath`], ε the machine epsilon) and `k` runs over 1, 2⁴, 2⁸, 2¹²
-//! and 2¹⁶ = [`FRAGILE_ULPS`] (the fragility band), both signs: each
-//! coordinate of `p0`, of `p1`, of both together (the path moved, which is
-//! the mesh moved the other way), and the radius. The first one that
-//! reproduces an answer, smallest first, is the one reported.
+//! The one judgement of an answer against an expectation for one sweep
+//! ([`agreement`], whose documentation says how it judges).
 
 use std::fmt;
 
@@ -33,7 +11,7 @@ use crate::core::{
     Sweep, SweptPath, TestRecord, Tie, VertexRecord, sweep_mesh_with,
 };
 use crate::replay::SweepResult;
-use crate::trace::messages::OutcomeMsg;
+use crate::trace::OutcomeMsg;
 
 use super::compare::{Field, FieldDiff, Tolerances, compare};
 
@@ -308,7 +286,28 @@ impl Decision {
 }
 
 /// Judges the expectation against the core's outcome of `result` (`check`,
-/// `diff`, `conform`, the viewer): see the [module documentation](self).
+/// `diff`, `conform`, the viewer).
+///
+/// Three outcomes ([`Agreement`]):
+/// - **match**: [`compare`] finds no field that differs;
+/// - **tie**: each side is an answer the core's decision accepts: its
+///   primary, or another member of its tie set with that member's own
+///   kind, triangle, feature and contact (α and the averaged normal are the
+///   decision's);
+/// - **divergence**, which is *excused as fragile* only when the core's
+///   decision is fragile **and** a named perturbation of the sweep's inputs
+///   within the rounding budget the fragility reasons are defined by makes
+///   the core give each side's answer ([`Reproduced`]). Any other
+///   divergence fails, whatever the decision's fragility: a fragile
+///   decision does not excuse an answer no rounding gives.
+///
+/// The perturbations ([`perturbations`]) move one input at a time by
+/// `k · u`, where `u = ε · S` is the sweep's rounding unit (`S` the scale of
+/// [`SweptPath`], ε the machine epsilon) and `k` runs over 1, 2⁴, 2⁸, 2¹²
+/// and 2¹⁶ = [`FRAGILE_ULPS`] (the fragility band), both signs: each
+/// coordinate of `p0`, of `p1`, of both together (the path moved, which is
+/// the mesh moved the other way), and the radius. The first one that
+/// reproduces an answer, smallest first, is the one reported.
 pub fn agreement(expected: &OutcomeMsg, result: &SweepResult, tol: &Tolerances) -> Agreement {
     judge(expected, &result.outcome_msg(), true, result, tol)
 }

@@ -1,60 +1,72 @@
 //! Regression testing on top of replay: a trace's `/expected` outcomes are
 //! the test case.
 //!
-//! - [`compare`](mod@compare): an outcome against its expectation, field
-//!   by field ([`compare()`], [`Tolerances`]);
-//! - [`judge`](mod@judge): the one judgement of a sweep's answer against its
+//! - comparison: an outcome against its expectation, field by field
+//!   ([`compare()`], [`Tolerances`]);
+//! - judgement: the one judgement of a sweep's answer against its
 //!   expectation ([`agreement`], [`agreement_of`]): match, tie, or
 //!   divergence, excused only when a named perturbation within the
 //!   rounding budget reproduces it; shared by `check`, `check --engine`,
 //!   `diff`, `conform` and the viewer;
-//! - [`decision`](mod@decision): the decision line of a sweep in words, and
-//!   whether it diverges (used by the viewer and the Foxglove output);
-//! - [`explain`](mod@explain): why a divergent sweep came out as it did;
-//! - [`check`](mod@check): a whole trace checked ([`check_file`]; the
-//!   traces of a suite found by [`find_traces`]), and
-//!   [`render_text`] / [`render_json`] for its report;
-//! - [`ghost`](mod@ghost): ghost contacts, edge or vertex contacts on an
-//!   internal flat or concave place whose normal leans off the faces
-//!   ([`judge_ghost`]), counted into `check`'s report beside it;
-//! - [`junit`](mod@junit): check's reports as JUnit XML and GitHub Actions
-//!   annotations, for CI systems;
-//! - [`config`]: `check`'s suite configuration, the `sweeptrace.toml`
-//!   files beside the traces, resolved key by key with where each setting
-//!   came from ([`config::resolve`]);
-//! - [`diff`](mod@diff): two traces, or one under two configurations;
-//! - [`bless`](mod@bless): a trace's expectations rewritten from the core;
-//! - [`repro`]: one sweep taken out of its trace, bit-exactly: a minimal
-//!   trace and a Rust test.
+//! - the decision line of a sweep in words, and whether it diverges
+//!   ([`decision_line`], [`divergence`]; used by the viewer and the
+//!   Foxglove output);
+//! - why a divergent sweep came out as it did ([`explain_outcome`]);
+//! - a whole trace checked ([`check_file`]; the traces of a suite found by
+//!   [`find_traces`]), and [`render_text`] / [`render_json`] for its report;
+//! - ghost contacts, edge or vertex contacts on an internal flat or concave
+//!   place whose normal leans off the faces ([`judge_ghost`]), counted into
+//!   `check`'s report beside it;
+//! - check's reports as JUnit XML and GitHub Actions annotations, for CI
+//!   systems ([`check_junit`], [`github_annotations`]);
+//! - `check`'s suite configuration, the `sweeptrace.toml` files beside the
+//!   traces, resolved key by key with where each setting came from
+//!   ([`resolve`], [`settings_for`]);
+//! - two traces, or one under two configurations ([`diff()`],
+//!   [`render_diff_text`]);
+//! - a trace's expectations rewritten from the core ([`bless_file`]);
+//! - one sweep taken out of its trace, bit-exactly: a minimal trace and a
+//!   Rust test ([`find_sweep`], [`ReproCase`]).
+//!
+//! The submodules are private: every public item is named once, here.
 
-pub mod bless;
-pub mod check;
-pub mod compare;
-pub mod config;
-pub mod decision;
-pub mod diff;
+mod bless;
+mod check;
+mod compare;
+mod config;
+mod decision;
+mod diff;
 mod discovery;
-pub mod engine_check;
-pub mod explain;
-pub mod ghost;
+mod engine_check;
+mod explain;
+mod ghost;
 mod ghost_count;
-pub mod infer;
-pub mod judge;
-pub mod junit;
+mod infer;
+mod judge;
+mod junit;
 mod render;
-pub mod repro;
+mod repro;
 
 pub use bless::{BlessError, BlessSummary, bless_bytes, bless_file};
 pub use check::{
-    CheckOptions, DEFAULT_MAX_DETAILS, Divergence, Judged, KindChange, MAX_LISTED_TUNNELS, Status,
-    TraceReport, TunnelReport, check_events, check_events_judged, check_file, check_reader,
-    divergence_details, find_traces, frames_around, judge_against_core,
+    CheckOptions, DEFAULT_MAX_DETAILS, Divergence, Judged, KindChange, MAX_INFERENCE_SWEEPS,
+    MAX_LISTED_GHOSTS, MAX_LISTED_TUNNELS, Status, TraceReport, TunnelReport, check_events,
+    check_events_judged, check_file, check_reader, divergence_details, find_traces, frames_around,
+    judge_against_core,
 };
 pub use compare::{
     DEFAULT_ALPHA_TOLERANCE, DEFAULT_CONTACT_TOLERANCE, DEFAULT_NORMAL_TOLERANCE_DEGREES, Field,
     FieldDiff, FieldSet, Tolerances, angle_degrees, compare,
 };
-pub use diff::{DiffReport, FirstDifference, Side, diff};
+pub use config::{
+    CONFIG_FILE_NAME, ConfigError, ConfigFile, Overrides, Setting, Settings, Source,
+    find_config_files, load_config_files, normalize, render_settings_json, render_settings_text,
+    resolve, settings_for,
+};
+pub use decision::{decision_line, divergence, write_decision_line, write_divergence_line};
+pub use diff::{
+    DiffReport, FirstDifference, Side, diff, render_diff_json, render_diff_text, scene_differences,
+};
 pub use engine_check::{
     Against, EngineCheck, check_file_with_engine, judge_answer_against_expected,
 };
@@ -62,10 +74,13 @@ pub use explain::{ExpectedTest, expected_tests, explain_outcome, explained_recor
 pub use ghost::{
     GHOST_DEGREES, GhostContact, GhostJudgement, GhostLine, GhostPlace, ghost_point, judge_ghost,
 };
-pub use infer::{Inferred, Spread, infer};
+pub use infer::{ComparedSweep, Inferred, Spread, infer};
 pub use judge::{Agreement, Perturbation, Reproduced, agreement, agreement_of, perturbations};
+pub use junit::{check_junit, first_problem, github_annotations, github_data, github_property};
 pub use render::{
     Sides, divergence_line, render_divergence, render_divergence_as, render_json, render_text,
     sides_of, value_text, value_text_exact, values_text,
 };
-pub use repro::{HexInputs, ReproCase, ReproError, SweepInputs, TraceSweep, find_sweep};
+pub use repro::{
+    HexInputs, ReproCase, ReproError, SweepInputs, TraceSweep, agreement_text, find_sweep,
+};

@@ -185,7 +185,7 @@ pub fn render_divergence_as(d: &Divergence, indent: &str, sides: Sides) -> Strin
 /// One divergence on one line: the sweep, each differing field's two
 /// sides, and what rounding explains when it does (`frame 2, ball 0: kind
 /// expected edge, got none; alpha expected 0.4, got 1`). The summary CI
-/// reports show ([`super::junit`]).
+/// reports show ([`github_annotations`](super::github_annotations)).
 pub fn divergence_line(d: &Divergence, sides: Sides) -> String {
     let fields = d
         .fields

@@ -10,8 +10,7 @@ use crate::core::{
     Broadphase, CollectRecords, EdgeClass, Feature, Mesh, Observer, Options, Outcome, SkipCounts,
     Sweep, TestRecord, Topology, VerdictCounts, sweep_mesh, sweep_mesh_with,
 };
-use crate::trace::TraceEvent;
-use crate::trace::messages::{OutcomeMsg, SceneMsg, SweepMsg};
+use crate::trace::{OutcomeMsg, SceneMsg, SweepMsg, TraceEvent};
 
 use super::primary::CollectPrimary;
 use super::tunnel::{BallEnds, Tunnel, TunnelScene, sweep_end, tunnel_during_sweep};

@@ -38,7 +38,7 @@ use crate::numbers::{self, Rule};
 pub mod obj;
 pub mod scenes;
 
-use crate::trace::messages::{OutcomeMsg, SceneMsg, SweepMsg};
+use crate::trace::{OutcomeMsg, SceneMsg, SweepMsg};
 pub use obj::{ObjError, load_obj, obj_from_reader};
 pub use scenes::{BuiltinScene, SceneMesh};
 

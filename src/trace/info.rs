@@ -1,7 +1,7 @@
 //! What `sweeptrace info` reports about a trace, and its rendering.
 //!
-//! [`collect`] reads a whole trace (streaming) into a [`TraceInfo`];
-//! [`render_text`] and [`render_json`] are pure functions of it.
+//! [`collect_info`] reads a whole trace (streaming) into a [`TraceInfo`];
+//! [`render_info_text`] and [`render_info_json`] are pure functions of it.
 
 use std::collections::{BTreeMap, BTreeSet};
 use std::fmt::Write as _;
@@ -94,7 +94,7 @@ fn widen(range: &mut Option<(u64, u64)>, v: u64) {
 
 /// Reads a whole trace and summarises it. On an error the summary covers
 /// the messages before it, and the error is returned alongside.
-pub fn collect<R: Read>(mut reader: TraceReader<R>) -> (TraceInfo, Option<TraceError>) {
+pub fn collect_info<R: Read>(mut reader: TraceReader<R>) -> (TraceInfo, Option<TraceError>) {
     let mut info = TraceInfo {
         file: reader.source_name().to_string(),
         scenes: Vec::new(),
@@ -187,7 +187,7 @@ fn seconds(nanos: u64) -> String {
 }
 
 /// The human-readable report.
-pub fn render_text(info: &TraceInfo) -> String {
+pub fn render_info_text(info: &TraceInfo) -> String {
     let mut out = String::new();
     let s = &info.stats;
     let compression = if s.compression.is_empty() && info.error.is_some() {
@@ -398,7 +398,7 @@ fn encoding_line(stats: &ReadStats) -> Option<String> {
 }
 
 /// The report as one pretty-printed JSON object.
-pub fn render_json(info: &TraceInfo) -> String {
+pub fn render_info_json(info: &TraceInfo) -> String {
     serde_json::to_string_pretty(info)
         .unwrap_or_else(|e| format!("{{\"error\": {:?}}}", e.to_string()))
 }

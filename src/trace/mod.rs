@@ -1,27 +1,59 @@
 //! Traces: MCAP files holding a scene, ball sweeps and expected outcomes.
 //!
-//! [`read`] streams a trace from any `Read`, [`write`](mod@write) records one,
-//! in either message [`encoding`] (JSON, or CBOR through [`cbor`]),
-//! [`validate`] holds the message checks both share, [`source`] the record
-//! of who computed the expectations, and [`info`] summarises
-//! a trace for `sweeptrace info`. The format is described in
-//! `docs/TRACE_FORMAT.md`.
+//! The messages are [`SceneMsg`], [`SweepMsg`] and [`OutcomeMsg`] (their
+//! JSON Schemas [`SCENE_SCHEMA_JSON`], [`SWEEP_SCHEMA_JSON`],
+//! [`OUTCOME_SCHEMA_JSON`]). [`TraceReader`] streams a trace from any
+//! `Read`, [`TraceWriter`] (or [`write_trace_file`], [`PendingTrace`])
+//! records one, in either message [`Encoding`] (JSON or CBOR);
+//! [`validate_scene`], [`validate_sweep`] and [`validate_outcome`] are the
+//! message checks both share, [`ExpectedSource`] the record of who computed
+//! the expectations, [`collect_info`] summarises a trace for
+//! `sweeptrace info`, and [`prefetch`] moves a reader to a thread of its
+//! own. The format is described in `docs/TRACE_FORMAT.md`.
+//!
+//! The submodules are private: every public item is named once, here.
 
-pub mod cbor;
-pub mod encoding;
-pub mod error;
-pub mod info;
+mod cbor;
+mod encoding;
+mod error;
+mod info;
 mod lengths;
-pub mod messages;
-pub mod prefetch;
-pub mod read;
-pub mod schemas;
-pub mod source;
-pub mod validate;
-pub mod write;
+mod messages;
+mod prefetch;
+mod read;
+mod schemas;
+mod source;
+mod validate;
+mod write;
 
+pub(crate) use cbor::Deserializer as CborDeserializer;
 pub use encoding::Encoding;
 pub use error::{MessageAt, TraceError};
-pub use read::{ReadLimits, ReadStats, TraceEvent, TraceReader};
-pub use source::{EXPECTED_SOURCE_METADATA, ExpectedSource};
-pub use write::{PendingTrace, TraceWriter, write_trace_file, write_trace_file_with_encoding};
+pub use info::{
+    MAX_LISTED_BALLS, MAX_LISTED_SCENES, SceneSummary, TraceInfo, collect_info, render_info_json,
+    render_info_text,
+};
+pub use messages::{
+    EXPECTED_TOPIC, OUTCOME_SCHEMA, OutcomeMsg, SCENE_SCHEMA, SCENE_TOPIC, SWEEP_SCHEMA,
+    SWEEP_TOPIC, SceneMsg, SweepMsg,
+};
+pub use prefetch::{DEFAULT_PREFETCH_CHUNK, DEFAULT_PREFETCH_DEPTH, Prefetched, prefetch};
+pub use read::{
+    ChannelStats, MAX_RECORD_BYTES, MAX_SCENE_BYTES, MAX_SMALL_MESSAGE_BYTES, ReadLimits,
+    ReadStats, TraceEvent, TraceReader,
+};
+pub(crate) use schemas::SCHEMA_ENCODING;
+pub use schemas::{OUTCOME_SCHEMA_JSON, SCENE_SCHEMA_JSON, SWEEP_SCHEMA_JSON};
+pub use source::{
+    EXPECTED_SOURCE_METADATA, ExpectedSource, MAX_SETTING_VALUE_BYTES, MAX_SETTINGS,
+    sweeptrace_source,
+};
+pub use validate::{
+    FieldProblem, frame_of_message, parse_message, parse_message_as, validate_outcome,
+    validate_scene, validate_sweep,
+};
+pub(crate) use write::library_string;
+pub use write::{
+    PendingTrace, TraceWriter, default_write_options, write_trace_file,
+    write_trace_file_with_encoding,
+};

@@ -12,9 +12,9 @@ use std::sync::mpsc::{Receiver, SyncSender, sync_channel};
 use std::thread;
 
 /// Items read ahead per message on the channel.
-pub const DEFAULT_CHUNK: usize = 1024;
+pub const DEFAULT_PREFETCH_CHUNK: usize = 1024;
 /// Chunks that may wait in the channel.
-pub const DEFAULT_DEPTH: usize = 4;
+pub const DEFAULT_PREFETCH_DEPTH: usize = 4;
 
 /// Runs `source` on a background thread, `chunk` items at a time, with at
 /// most `depth` chunks waiting; the result yields the same items in the

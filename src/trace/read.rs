@@ -1,42 +1,5 @@
-//! A streaming trace reader over any [`Read`].
-//!
-//! The reader walks the file once from start to end with the `mcap` crate's
-//! sans-io linear reader, so it needs neither the summary nor the indexes
-//! (a file without them is read in full, never refused or read as empty)
-//! and never holds more than one chunk in memory. Chunked or not, zstd, lz4
-//! or uncompressed: all are read.
-//!
-//! # Ordering
-//! Events come in file order. The messages of the three trace channels must
-//! be written in non-decreasing `log_time` order (the format says `log_time`
-//! grows with `frame`); a message whose `log_time` is smaller than that of an
-//! earlier trace message is an error ([`TraceError::OutOfOrder`]) rather
-//! than being reordered, which keeps memory bounded. Messages with equal
-//! `log_time` keep their file order, so a scene must be written before the
-//! sweeps that share its `log_time`.
-//!
-//! A file whose chunks overlap in log time (written by a multi-threaded
-//! recorder) cannot be read this way without reordering. When it has a
-//! summary with chunk indexes, [`TraceReader::new_indexed`] reads its
-//! messages in log-time order through the indexes instead, holding only the
-//! chunks that overlap at once (`info` says so); without a summary it gives
-//! the error above.
-//!
-//! # Limits
-//! Sizes declared by the file are checked before anything is allocated for
-//! them (see [`ReadLimits`]): any record, and any chunk compressed or
-//! uncompressed, is refused above [`MAX_RECORD_BYTES`]; a `/scene` message
-//! above [`MAX_SCENE_BYTES`]; a `/sweep` or `/expected` message above
-//! [`MAX_SMALL_MESSAGE_BYTES`]. A scene's vertex and triangle counts are
-//! bounded by its byte size (a JSON number takes at least one byte), so a
-//! scene "claiming" a billion triangles is refused by its size.
-//!
-//! # Errors
-//! Every message of the trace channels is parsed and validated; the first
-//! error ends the iteration (the iterator returns `None` afterwards). The
-//! events before it have already been yielded, so a truncated file still
-//! gives every complete message before the cut, and the error says how many
-//! complete messages were read.
+//! The streaming trace reader, [`TraceReader`] (its documentation says
+//! how it orders, bounds and fails).
 
 use std::collections::{BTreeMap, BTreeSet, HashMap};
 use std::io::{ErrorKind, Read};
@@ -211,7 +174,45 @@ struct State {
 }
 
 /// Reads a trace from any [`Read`], yielding the messages of the three trace
-/// channels in file order. See the [module documentation](self).
+/// channels in file order.
+///
+/// The reader walks the file once from start to end with the `mcap` crate's
+/// sans-io linear reader, so it needs neither the summary nor the indexes
+/// (a file without them is read in full, never refused or read as empty)
+/// and never holds more than one chunk in memory. Chunked or not, zstd, lz4
+/// or uncompressed: all are read.
+///
+/// # Ordering
+/// Events come in file order. The messages of the three trace channels must
+/// be written in non-decreasing `log_time` order (the format says `log_time`
+/// grows with `frame`); a message whose `log_time` is smaller than that of an
+/// earlier trace message is an error ([`TraceError::OutOfOrder`]) rather
+/// than being reordered, which keeps memory bounded. Messages with equal
+/// `log_time` keep their file order, so a scene must be written before the
+/// sweeps that share its `log_time`.
+///
+/// A file whose chunks overlap in log time (written by a multi-threaded
+/// recorder) cannot be read this way without reordering. When it has a
+/// summary with chunk indexes, [`TraceReader::new_indexed`] reads its
+/// messages in log-time order through the indexes instead, holding only the
+/// chunks that overlap at once (`info` says so); without a summary it gives
+/// the error above.
+///
+/// # Limits
+/// Sizes declared by the file are checked before anything is allocated for
+/// them (see [`ReadLimits`]): any record, and any chunk compressed or
+/// uncompressed, is refused above [`MAX_RECORD_BYTES`]; a `/scene` message
+/// above [`MAX_SCENE_BYTES`]; a `/sweep` or `/expected` message above
+/// [`MAX_SMALL_MESSAGE_BYTES`]. A scene's vertex and triangle counts are
+/// bounded by its byte size (a JSON number takes at least one byte), so a
+/// scene "claiming" a billion triangles is refused by its size.
+///
+/// # Errors
+/// Every message of the trace channels is parsed and validated; the first
+/// error ends the iteration (the iterator returns `None` afterwards). The
+/// events before it have already been yielded, so a truncated file still
+/// gives every complete message before the cut, and the error says how many
+/// complete messages were read.
 pub struct TraceReader<R: Read> {
     input: R,
     file: LinearReader,

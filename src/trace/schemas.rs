@@ -9,9 +9,6 @@ pub const OUTCOME_SCHEMA_JSON: &str = include_str!("../../schemas/outcome.schema
 /// Schema encoding of the three channels, in either message encoding (the
 /// JSON Schemas describe the CBOR messages too: the same maps and fields).
 pub const SCHEMA_ENCODING: &str = "jsonschema";
-/// Message encoding of the three channels written by default (the reader
-/// also reads `cbor`: [`Encoding`](super::Encoding)).
-pub const MESSAGE_ENCODING: &str = "json";
 /// Value of `format_version` in the `sweeptrace` metadata record.
 pub const FORMAT_VERSION: &str = "1";
 /// Name of the metadata record written by this crate.

@@ -50,11 +50,6 @@ struct FrameOnly {
     frame: Option<u64>,
 }
 
-/// The frame of a JSON message, if one can be read from it.
-pub fn frame_of(data: &[u8]) -> Option<u64> {
-    frame_of_message(data, Encoding::Json)
-}
-
 /// The frame of a message in `encoding`, if one can be read from it.
 pub fn frame_of_message(data: &[u8], encoding: Encoding) -> Option<u64> {
     match encoding {

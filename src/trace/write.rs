@@ -88,7 +88,7 @@ impl<W: Write + Seek> TraceWriter<W> {
     /// the project's own).
     ///
     /// ```
-    /// use sweeptrace::trace::write::default_write_options;
+    /// use sweeptrace::trace::default_write_options;
     /// use sweeptrace::{Encoding, SceneMsg, TraceReader, TraceWriter};
     /// let mut w = TraceWriter::with_encoding(
     ///     std::io::Cursor::new(Vec::new()),

@@ -28,8 +28,7 @@ use super::spill::Spill;
 use super::{MAX_EDGE_FRAMES, RecordError, TIMESTAMP_THRESHOLD_NANOS};
 use crate::core::{DefectKind, EdgeClass, EdgeRecord, Triangle};
 use crate::palette::MAX_DRAWN_DEFECT_LABELS;
-use crate::regress::Tolerances;
-use crate::regress::decision::divergence;
+use crate::regress::{Tolerances, divergence};
 use crate::replay::{ReplayEvent, SceneState, SweepResult};
 
 /// Rows buffered before the logger sends them (see [`Logger`]); with

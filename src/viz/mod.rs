@@ -1,7 +1,7 @@
 //! The Rerun recording of a replay: the only module that imports `rerun`.
 //!
 //! [`Logger`] turns [`crate::replay::ReplayEvent`]s into entities (see
-//! [`paths`] for every path) on two timelines: `frame` (sequence, the
+//! `paths` for every path) on two timelines: `frame` (sequence, the
 //! sweep's frame) and `time` (the trace's `log_time`; never the wall clock).
 //! The default timelines `log_time` and `log_tick` of the SDK are switched
 //! off, and the recording id is derived from the trace and the options
@@ -18,30 +18,29 @@
 //!   expected outcome, plots, status, text); `edge_frame`: its edge tests in
 //!   their standard frames;
 //! - the decision line, and whether a sweep diverges, are
-//!   [`crate::regress::decision`] (shared with the Foxglove output);
+//!   [`crate::regress::decision_line`] (shared with the Foxglove output);
 //! - `convert`: conversions to Rerun types, colors and sizes;
-//! - [`blueprint`]: the default layouts, with fixed ids; `columns`: rows
+//! - `blueprint`: the default layouts, with fixed ids; `columns`: rows
 //!   buffered as typed columns and sent as chunks (both use SDK internals
 //!   pinned to Rerun 0.36.3); `spill`: for a recording file, the buffered
 //!   rows kept in a temporary file and sent in long chunks;
-//! - [`paths`]: every entity path.
+//! - `paths`: every entity path.
 
-pub mod blueprint;
+mod blueprint;
 mod columns;
 mod convert;
 mod edge_frame;
 mod ids;
 mod logger;
-pub mod paths;
+mod paths;
 mod pipeline;
 mod recording;
 mod rows;
-pub mod rrd_file;
+mod rrd_file;
 mod spill;
 
 use rerun::RecordingStreamBuilder;
 
-pub use crate::regress::decision::{decision_line, divergence};
 pub use ids::{IdHasher, recording_id};
 pub use logger::{
     DEFAULT_FLUSH_BYTES, DEFAULT_FLUSH_ROWS, Logger, LoggerOptions, PREPARE_GROUP_SWEEPS,
@@ -53,6 +52,7 @@ pub use recording::{
 };
 pub use rerun::RecordingStreamError;
 pub use rows::Shown;
+pub use rrd_file::{RrdFileError, RrdFileOptions, RrdFileSink, RrdFileWriter, create_rrd_file};
 pub use spill::{MAX_CHUNK_BYTES, MAX_CHUNK_ROWS};
 
 /// Application id of every recording.

@@ -39,7 +39,7 @@
 //!                                     triangle front to back (during this sweep or since
 //!                                     its previous one), labelled with the triangle
 //! world/ball/{ball}/ghost             a ghost contact, when the sweep's expected outcome is
-//!                                     one (see `regress::ghost`):
+//!                                     one (see `regress::judge_ghost`):
 //!                                       Points3D: the expected contact, labelled
 //!                                       (`ghost contact 10.0°: edge 0.2 is internal and
 //!                                       flat`; the label is the expected ball's instead
@@ -95,8 +95,6 @@ use crate::core::{DefectKind, EdgeClass};
 pub const WORLD: &str = "world";
 /// The text log.
 pub const LOG: &str = "log";
-/// Root of the time-series plots.
-pub const PLOTS: &str = "plots";
 /// Root of the per-ball divergence status series.
 pub const STATUS: &str = "status";
 /// The log of divergent sweeps.

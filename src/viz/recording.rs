@@ -190,12 +190,10 @@ impl Recording {
                 target: path.clone(),
                 cause,
             })?;
-            let (sink, writer) =
-                rrd_file::create(pending.path(), target.file_options).map_err(|e| {
-                    RecordingError::File {
-                        target: path.clone(),
-                        reason: e.reason,
-                    }
+            let (sink, writer) = rrd_file::create_rrd_file(pending.path(), target.file_options)
+                .map_err(|e| RecordingError::File {
+                    target: path.clone(),
+                    reason: e.reason,
                 })?;
             sinks.push(Box::new(sink));
             file = Some((pending, writer));

@@ -25,10 +25,11 @@ use super::logger::PrepareOptions;
 use super::paths::{Entity, FACE_NAMES, QUADRATIC_NAMES};
 use crate::core::explain::Label;
 use crate::core::{EdgeRecord, Kind, TestRecord};
-use crate::regress::decision::{divergence, write_decision_line, write_divergence_line};
-use crate::regress::{FieldDiff, GhostContact, ghost_point};
+use crate::regress::{
+    FieldDiff, GhostContact, divergence, ghost_point, write_decision_line, write_divergence_line,
+};
 use crate::replay::SweepResult;
-use crate::trace::messages::OutcomeMsg;
+use crate::trace::OutcomeMsg;
 
 /// Component sets: the rows of one entity with the same set number have the
 /// same components (see `columns::Columns::row`).

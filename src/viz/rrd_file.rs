@@ -75,7 +75,7 @@ pub struct RrdFileWriter {
 
 /// Creates `path` and starts an `.rrd` stream in it (compressed; with the
 /// footer when `options` ask for it).
-pub fn create(
+pub fn create_rrd_file(
     path: &Path,
     options: RrdFileOptions,
 ) -> Result<(RrdFileSink, RrdFileWriter), RrdFileError> {

@@ -6,8 +6,7 @@ use std::fmt::Write as _;
 
 use crate::core::explain::num;
 use crate::core::{Mesh, Options, Outcome, Sweep, SweptPath, sweep_ties};
-use crate::trace::messages::{OutcomeMsg, SceneMsg, SweepMsg};
-use crate::trace::{TraceError, TraceWriter};
+use crate::trace::{OutcomeMsg, SceneMsg, SweepMsg, TraceError, TraceWriter};
 
 use crate::regress::compare::{Field, FieldSet, Tolerances};
 use crate::regress::judge::{Agreement, agreement};

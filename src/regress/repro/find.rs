@@ -3,8 +3,7 @@
 
 use crate::core::{MeshError, Options, Sweep, SweepError};
 use crate::replay::SweepExtent;
-use crate::trace::messages::{OutcomeMsg, SceneMsg, SweepMsg};
-use crate::trace::{TraceError, TraceEvent};
+use crate::trace::{OutcomeMsg, SceneMsg, SweepMsg, TraceError, TraceEvent};
 
 /// Why a sweep could not be taken out of a trace.
 #[derive(Debug, thiserror::Error)]

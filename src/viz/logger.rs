@@ -496,7 +496,7 @@ impl Logger {
     /// Logs a scene's mesh (static, one Mesh3D, flat-shaded), its edges
     /// (static, one LineStrips3D per class, every edge once) and its
     /// defects (static, one Points3D per kind, a label each, drawn when the
-    /// scene has at most [`MAX_DRAWN_DEFECT_LABELS`]), from the scene's
+    /// scene has at most `MAX_DRAWN_DEFECT_LABELS` of them), from the scene's
     /// topology.
     pub fn log_scene(&mut self, scene: &Arc<SceneState>) -> Result<(), RecordingStreamError> {
         let mut triangles: Vec<&Triangle> = scene.mesh.triangles().iter().collect();

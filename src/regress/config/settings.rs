@@ -20,7 +20,7 @@ pub enum Source {
     Default,
     /// A line of a configuration file.
     File {
-        /// The file, as [`ConfigFile::name`] gives it.
+        /// The file, as written in the report (its name as given to `check`).
         file: String,
         /// The line of the key (1-based).
         line: usize,

@@ -166,6 +166,7 @@ impl RuleReport {
 
 /// The conformance of one engine.
 #[derive(Clone, Debug, PartialEq, Serialize)]
+#[non_exhaustive]
 pub struct ConformReport {
     /// The engine's command.
     pub engine: String,

@@ -36,6 +36,7 @@ use super::sweep_face::barycentric_and_distance;
 
 /// A front-to-back crossing of a triangle by a segment.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+#[non_exhaustive]
 pub struct Crossing {
     /// Input index of the triangle crossed.
     pub triangle: u32,

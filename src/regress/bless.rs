@@ -104,6 +104,7 @@ fn replay_error_text(file: &str, cause: &ReplayError) -> String {
 
 /// Counts of a bless.
 #[derive(Clone, Debug, Default, PartialEq, Eq)]
+#[non_exhaustive]
 pub struct BlessSummary {
     /// Expectations written (one per sweep).
     pub expected_written: u64,

@@ -236,6 +236,7 @@ impl Default for CheckOptions {
 /// The result of checking one trace. Its verdict is [`TraceReport::status`]
 /// (in the JSON, `status` after `trace`).
 #[derive(Clone, Debug, PartialEq)]
+#[non_exhaustive]
 pub struct TraceReport {
     /// The trace's name (its path as given).
     pub trace: String,

@@ -118,6 +118,7 @@ pub struct FirstDifference {
 
 /// The comparison of two replays.
 #[derive(Clone, Debug, PartialEq, Serialize)]
+#[non_exhaustive]
 pub struct DiffReport {
     /// Side A's name and options in words.
     pub a: String,

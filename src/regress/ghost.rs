@@ -45,6 +45,7 @@ pub enum GhostPlace {
 
 /// One ghost contact: which outcome, where, and how far its normal leans.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+#[non_exhaustive]
 pub struct GhostContact {
     /// Frame of the sweep.
     pub frame: u64,

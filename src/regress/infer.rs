@@ -63,6 +63,7 @@ pub struct Spread {
 
 /// What `check` inferred about the recording engine's configuration.
 #[derive(Clone, Debug, PartialEq, Serialize)]
+#[non_exhaustive]
 pub struct Inferred {
     /// Expected face hits whose triangle is known: one margin estimate each.
     pub face_hits: u64,

@@ -96,6 +96,7 @@ impl PartialEq for SceneState {
 
 /// The result of one sweep.
 #[derive(Clone, Debug, PartialEq)]
+#[non_exhaustive]
 pub struct SweepResult {
     /// Frame number.
     pub frame: u64,

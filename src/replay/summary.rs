@@ -58,6 +58,7 @@ impl std::fmt::Display for TunnelAt {
 
 /// Counts of a replay.
 #[derive(Clone, Debug, Default, PartialEq)]
+#[non_exhaustive]
 pub struct ReplaySummary {
     /// Scenes read.
     pub scenes: usize,

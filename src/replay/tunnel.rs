@@ -113,6 +113,7 @@ fn through_words(d: &Defect) -> String {
 /// A ball's centre through a triangle, front to back (or a flipped triangle
 /// back to front).
 #[derive(Clone, Debug, PartialEq, Serialize)]
+#[non_exhaustive]
 pub struct Tunnel {
     /// During the sweep or between sweeps.
     pub kind: TunnelKind,

@@ -78,6 +78,7 @@ impl DefectKind {
 
 /// One defect of a mesh.
 #[derive(Clone, Debug, PartialEq, Serialize)]
+#[non_exhaustive]
 pub struct Defect {
     /// What is wrong.
     pub kind: DefectKind,

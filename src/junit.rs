@@ -5,7 +5,7 @@
 //! `error` / `skipped`, `system-out`).
 //!
 //! `check` ([`crate::regress::check_junit`]) and `conform`
-//! ([`crate::conform::junit`]) build a [`Report`] from their reports;
+//! ([`crate::conform::conform_junit`]) build a [`Report`] from their reports;
 //! [`render`] writes it, counting `tests`, `failures`, `errors` and
 //! `skipped` on every suite and on the root. Text is escaped for XML 1.0,
 //! and characters XML 1.0 cannot hold at all (control characters other

@@ -142,7 +142,7 @@ pub fn run(args: Args) -> anyhow::Result<Exit> {
         print!("{}", conform::render_text(&report));
     }
     if let Some(junit) = junit {
-        let xml = conform::junit::conform_junit(
+        let xml = conform::conform_junit(
             &report,
             &options.tolerances,
             Some(junit.elapsed()),

@@ -2,7 +2,7 @@
 //! GitHub Actions annotations: the file is created (under a temporary
 //! name) before the run, so an unwritable place fails at once, and renamed
 //! into place when the report is complete; rendering is the library's
-//! ([`sweeptrace::regress::check_junit`], [`sweeptrace::conform::junit`]).
+//! ([`sweeptrace::regress::check_junit`], [`sweeptrace::conform::conform_junit`]).
 
 use std::io::Write as _;
 use std::path::PathBuf;

@@ -9,10 +9,11 @@
 //! [`render_text`] and [`render_json`] are pure functions of it.
 
 mod cases;
-pub mod junit;
+mod junit;
 mod rules;
 
 pub use cases::{Case, cases};
+pub use junit::{conform_junit, rule_group};
 pub use rules::{RULES, Rule};
 
 use std::fmt::Write as _;

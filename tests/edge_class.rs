@@ -8,9 +8,10 @@ use sweeptrace::replay::{ReplayEvent, ReplayOptions, replay_events};
 use sweeptrace::trace::{SceneMsg, TraceReader};
 
 use crate::ensure;
+use crate::support::core_trace;
 use crate::support::run_bin;
 use crate::trial;
-use crate::tunnel_through::{floor, sweep, trace};
+use crate::tunnel_through::{floor, sweep};
 use anyhow::Context as _;
 
 pub fn tests() -> Vec<Trial> {
@@ -25,7 +26,7 @@ pub fn tests() -> Vec<Trial> {
 /// `x = 0` (a boundary edge), ball 1 falls onto the middle of triangle 4 (a
 /// face: no class).
 fn replay_outcome_lines_name_the_edge_class() -> anyhow::Result<()> {
-    let bytes = trace(
+    let bytes = core_trace(
         &floor(3, &[]),
         &[
             sweep(0, 0, [-0.05, 1.5, 1.0], [-0.05, 1.5, -1.0]),
@@ -105,7 +106,7 @@ fn sweep_explanation_names_a_flat_internal_edge() -> anyhow::Result<()> {
         margin: 0.0,
         facing: Facing::NonStrict,
     };
-    let bytes = trace(&scene, &[sweep(0, 0, [0.5, 0.5, 1.0], [0.5, 0.5, -1.0])])?;
+    let bytes = core_trace(&scene, &[sweep(0, 0, [0.5, 0.5, 1.0], [0.5, 0.5, -1.0])])?;
     let dir = tempfile::tempdir()?;
     let path = dir.path().join("folded.mcap");
     std::fs::write(&path, &bytes)?;

@@ -324,3 +324,30 @@ pub fn flipped_floor() -> sweeptrace::trace::SceneMsg {
         facing: Facing::NonStrict,
     }
 }
+
+/// A trace of `scene` and `sweeps`, each sweep logged at
+/// `1_000_000 (frame + 1)` ns and followed by the core's outcome for it as
+/// its `/expected` message.
+pub fn core_trace(
+    scene: &sweeptrace::trace::SceneMsg,
+    sweeps: &[sweeptrace::trace::SweepMsg],
+) -> anyhow::Result<Vec<u8>> {
+    let m = mesh(&scene.vertices, &scene.triangles);
+    let options = sweeptrace::Options {
+        margin: scene.margin,
+        facing: scene.facing,
+    };
+    let mut w = sweeptrace::trace::TraceWriter::new(std::io::Cursor::new(Vec::new()))?;
+    w.scene(0, scene)?;
+    for s in sweeps {
+        let t = 1_000_000 * (s.frame + 1);
+        w.sweep(t, s)?;
+        let o =
+            sweeptrace::sweep_mesh(&m, &sweeptrace::Sweep::new(s.p0, s.p1, s.radius), &options)?;
+        w.expected(
+            t,
+            &sweeptrace::trace::OutcomeMsg::from_outcome(s.frame, s.ball, &o),
+        )?;
+    }
+    Ok(w.finish()?.into_inner())
+}

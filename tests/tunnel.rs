@@ -28,8 +28,8 @@ use nalgebra::Point3;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use sweeptrace::core::{
-    Facing, Mesh, Options, Sweep, crossing_tolerance, first_crossing, first_crossing_with_flipped,
-    sweep_mesh, triangle_crossing, triangle_crossing_back_to_front,
+    Facing, Mesh, crossing_tolerance, first_crossing, first_crossing_with_flipped,
+    triangle_crossing, triangle_crossing_back_to_front,
 };
 use sweeptrace::regress::{
     CheckOptions, Status, check_file, check_reader, render_json, render_text,
@@ -38,11 +38,11 @@ use sweeptrace::replay::{
     ReplayEvent, ReplayOptions, SweepResult, TunnelKind, replay_events, replay_events_parallel,
 };
 use sweeptrace::sim::scenes;
-use sweeptrace::trace::{OutcomeMsg, SceneMsg, SweepMsg, TraceReader, TraceWriter};
+use sweeptrace::trace::{SceneMsg, SweepMsg, TraceReader, TraceWriter};
 
 use crate::ensure;
-use crate::support::mesh;
 use crate::support::run_bin;
+use crate::support::{core_trace, mesh};
 use crate::trial;
 use anyhow::Context as _;
 
@@ -394,31 +394,12 @@ fn wall_sweeps() -> Vec<SweepMsg> {
     ]
 }
 
-/// A trace of `scene` and `sweeps`, each followed by the core's outcome as
-/// its `/expected` message.
-fn write_trace(scene: &SceneMsg, sweeps: &[SweepMsg]) -> anyhow::Result<Vec<u8>> {
-    let m = mesh(&scene.vertices, &scene.triangles);
-    let options = Options {
-        margin: scene.margin,
-        facing: scene.facing,
-    };
-    let mut w = TraceWriter::new(Cursor::new(Vec::new()))?;
-    w.scene(0, scene)?;
-    for s in sweeps {
-        let t = 1_000_000 * (s.frame + 1);
-        w.sweep(t, s)?;
-        let o = sweep_mesh(&m, &Sweep::new(s.p0, s.p1, s.radius), &options)?;
-        w.expected(t, &OutcomeMsg::from_outcome(s.frame, s.ball, &o))?;
-    }
-    Ok(w.finish()?.into_inner())
-}
-
 fn floor_bytes() -> anyhow::Result<Vec<u8>> {
-    write_trace(&floor_scene(), &floor_sweeps())
+    core_trace(&floor_scene(), &floor_sweeps())
 }
 
 fn wall_bytes() -> anyhow::Result<Vec<u8>> {
-    write_trace(&wall_scene(), &wall_sweeps())
+    core_trace(&wall_scene(), &wall_sweeps())
 }
 
 fn root() -> &'static Path {

@@ -13,16 +13,14 @@
 //!   (a crack between triangles 0 and 3): a ball moved from above the
 //!   floor to below it between two sweeps, 0.05 from the crack.
 
-use std::io::Cursor;
-
 use libtest_mimic::Trial;
-use sweeptrace::core::{Facing, Options, Sweep, sweep_mesh};
+use sweeptrace::core::Facing;
 use sweeptrace::regress::{CheckOptions, check_reader, render_json, render_text};
 use sweeptrace::replay::TunnelKind;
-use sweeptrace::trace::{OutcomeMsg, SceneMsg, SweepMsg, TraceWriter};
+use sweeptrace::trace::{SceneMsg, SweepMsg};
 
 use crate::ensure;
-use crate::support::mesh;
+use crate::support::core_trace;
 use crate::trial;
 use anyhow::Context as _;
 
@@ -99,31 +97,13 @@ pub(crate) fn sweep(frame: u64, ball: u32, p0: [f64; 3], p1: [f64; 3]) -> SweepM
     }
 }
 
-/// A trace of `scene` and `sweeps`, each followed by the core's outcome.
-pub(crate) fn trace(scene: &SceneMsg, sweeps: &[SweepMsg]) -> anyhow::Result<Vec<u8>> {
-    let m = mesh(&scene.vertices, &scene.triangles);
-    let options = Options {
-        margin: scene.margin,
-        facing: scene.facing,
-    };
-    let mut w = TraceWriter::new(Cursor::new(Vec::new()))?;
-    w.scene(0, scene)?;
-    for s in sweeps {
-        let t = 1_000_000 * (s.frame + 1);
-        w.sweep(t, s)?;
-        let o = sweep_mesh(&m, &Sweep::new(s.p0, s.p1, s.radius), &options)?;
-        w.expected(t, &OutcomeMsg::from_outcome(s.frame, s.ball, &o))?;
-    }
-    Ok(w.finish()?.into_inner())
-}
-
 /// The flipped floor's trace: ball 0 through the middle of the flipped
 /// triangle 8 (centroid `(5/3, 4/3)`), ball 1 through triangle 0 from 0.05
 /// over it (centroid `(2/3, 1/3)`).
 fn flipped_trace() -> anyhow::Result<Vec<u8>> {
     let (x0, y0) = (5.0 / 3.0, 4.0 / 3.0);
     let (x1, y1) = (2.0 / 3.0, 1.0 / 3.0);
-    trace(
+    core_trace(
         &floor(3, &[8]),
         &[
             sweep(0, 0, [x0, y0, 1.0], [x0, y0, 0.5]),
@@ -212,7 +192,7 @@ fn ordinary_tunnel_names_nothing() -> anyhow::Result<()> {
 }
 
 fn tunnel_near_a_crack_names_the_crack() -> anyhow::Result<()> {
-    let bytes = trace(
+    let bytes = core_trace(
         &cracked_floor(),
         &[
             sweep(0, 0, [0.5, 0.5, 0.3], [0.95, 0.5, 0.3]),

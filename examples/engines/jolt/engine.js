@@ -10,6 +10,8 @@
 //
 // A deliberate mistake for sweeptrace to find: JOLT_VARIANT=NAME in the
 // environment or `--variant NAME` (see VARIANTS and README.md).
+// `--honour-margin` (or JOLT_HONOUR_MARGIN=1), for measurements only: cast a
+// sphere of radius r - margin (the rules' rho) instead of Jolt's r.
 import initJolt from 'jolt-physics';
 import { createInterface } from 'node:readline';
 
@@ -17,6 +19,7 @@ const VARIANTS = ['clean', 'late', 'no_vertex', 'next_triangle', 'back_faces', '
 const flag = process.argv.indexOf('--variant');
 const variant = (flag >= 0 ? process.argv[flag + 1] : process.env.JOLT_VARIANT) || 'clean';
 if (!VARIANTS.includes(variant)) fail(`unknown variant \`${variant}\` (one of ${VARIANTS.join(', ')})`);
+const honourMargin = process.argv.includes('--honour-margin') || process.env.JOLT_HONOUR_MARGIN === '1';
 
 // A barycentric weight at most this counts as 0 when the contact point is
 // classified (face / edge / vertex). It is relative to the triangle (a
@@ -63,7 +66,7 @@ function loadScene(msg) {
     bodies.RemoveBody(scene.body);
     bodies.DestroyBody(scene.body);
   }
-  scene = { vertices: msg.vertices, triangles: msg.triangles, body: null, mesh: null };
+  scene = { vertices: msg.vertices, triangles: msg.triangles, margin: msg.margin ?? 0, body: null, mesh: null };
   const vertices = new Jolt.VertexList(), triangles = new Jolt.IndexedTriangleList();
   for (const [x, y, z] of msg.vertices) {
     const v = new Jolt.Float3(x, y, z);
@@ -114,11 +117,12 @@ function sweep(msg) {
   const none = { frame: msg.frame, ball: msg.ball, alpha: 1, kind: 'none' };
   if (!scene) fail(`the sweep of frame ${msg.frame}, ball ${msg.ball} arrived before any scene`);
   if (!scene.body) return none;
-  let sphere = spheres.get(msg.radius);
+  const radius = honourMargin ? msg.radius - scene.margin : msg.radius;
+  let sphere = spheres.get(radius);
   if (!sphere) {
-    sphere = new Jolt.SphereShape(msg.radius);
+    sphere = new Jolt.SphereShape(radius);
     sphere.AddRef();
-    spheres.set(msg.radius, sphere);
+    spheres.set(radius, sphere);
   }
   const [p0, p1] = [msg.p0, msg.p1], d = sub(p1, p0);
   const start = new Jolt.RVec3(...p0), direction = new Jolt.Vec3(...d);

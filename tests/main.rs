@@ -23,11 +23,13 @@ mod foxglove;
 mod fuzz_corpus;
 mod help;
 mod interrupts;
+mod jolt;
 mod junit;
 mod mesh;
 mod oracle;
 mod out_of_order;
 mod outputs;
+mod precision;
 mod prefetch;
 mod primary_skips;
 mod rapier;
@@ -149,6 +151,8 @@ fn main() {
     trials.extend(help::tests());
     trials.extend(first_hour::tests());
     trials.extend(mesh::tests());
+    trials.extend(jolt::tests());
+    trials.extend(precision::tests());
     let trials = mark_slow(trials);
     libtest_mimic::run(&args, trials).exit();
 }
@@ -165,6 +169,10 @@ const SLOW: &[&str] = &[
     "replay::threads_do_not_change_the_outputs",
     "replay::spilled_recording_holds_the_same_rows",
     "replay::flush_by_bytes_keeps_the_content",
+    "jolt::clean_jolt_passes_check_under_its_inferred_config",
+    "jolt::broken_jolt_variants_fail_check_naming_the_difference",
+    "jolt::jolt_conforms_under_its_config_and_its_broken_variants_do_not",
+    "jolt::jolt_config_is_what_infer_config_prints",
 ];
 
 fn mark_slow(trials: Vec<Trial>) -> Vec<Trial> {

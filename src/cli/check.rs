@@ -125,6 +125,11 @@ pub struct Args {
     /// Ignore the sweeptrace.toml files: the defaults and the command line only.
     #[arg(long)]
     pub no_config: bool,
+    /// Settings from this `sweeptrace.toml` instead of the ones found beside
+    /// and above each trace (an engine's `[engine]` table kept with the
+    /// engine, say: `--config examples/engines/jolt/sweeptrace.toml`).
+    #[arg(long, value_name = "FILE", conflicts_with = "no_config")]
+    pub config: Option<PathBuf>,
     /// Print each trace's settings and where each came from (`default`,
     /// `FILE:LINE`, `command line`), and exit without checking (with
     /// --json, as JSON).
@@ -199,7 +204,8 @@ pub fn run(args: Args) -> anyhow::Result<Exit> {
                 .join(", ")
         );
     }
-    let settings = super::check_config::settings(&traces, &overrides, args.no_config)?;
+    let settings =
+        super::check_config::settings(&traces, &overrides, args.no_config, args.config.as_deref())?;
     if args.print_config {
         print!(
             "{}",

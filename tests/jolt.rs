@@ -1,0 +1,248 @@
+//! A real single-precision engine judged fairly and strictly: Jolt Physics
+//! (`examples/engines/jolt/`, the npm package `jolt-physics` 1.1.0 in
+//! Node) over the engine protocol, with the `[engine]` table `check
+//! --infer-config` wrote for it (`examples/engines/jolt/sweeptrace.toml`).
+//! The clean engine passes `check` on every sample trace and `conform`;
+//! each deliberately broken variant fails, and its failure names what is
+//! wrong. Needs `node` and the package (`npm ci --prefix
+//! examples/engines/jolt`): skipped without them, a failure when
+//! `SWEEPTRACE_REQUIRE_NODE=1` (CI).
+
+use anyhow::ensure;
+use libtest_mimic::{Completion, Trial};
+
+use crate::support::run_bin;
+use crate::{os, trial};
+
+pub fn tests() -> Vec<Trial> {
+    vec![
+        trial!(clean_jolt_passes_check_under_its_inferred_config),
+        trial!(broken_jolt_variants_fail_check_naming_the_difference),
+        trial!(jolt_conforms_under_its_config_and_its_broken_variants_do_not),
+        trial!(jolt_config_is_what_infer_config_prints),
+    ]
+}
+
+const REQUIRE_NODE: &str = "SWEEPTRACE_REQUIRE_NODE";
+
+fn root() -> std::path::PathBuf {
+    std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+}
+
+/// The engine command, or the reason to skip.
+fn jolt() -> anyhow::Result<Result<String, Completion>> {
+    let dir = root().join("examples/engines/jolt");
+    let installed = dir.join("node_modules/jolt-physics").is_dir();
+    let missing = match std::process::Command::new("node").arg("--version").output() {
+        Ok(o) if o.status.success() && installed => None,
+        Ok(o) if o.status.success() => Some(
+            "examples/engines/jolt has no node_modules (run `npm ci --prefix \
+             examples/engines/jolt`)"
+                .to_string(),
+        ),
+        _ => Some("node cannot be run".to_string()),
+    };
+    match missing {
+        None => Ok(Ok(format!("node {}", dir.join("engine.js").display()))),
+        Some(m) if std::env::var_os(REQUIRE_NODE).is_some_and(|v| v == "1") => {
+            anyhow::bail!("{m}, and {REQUIRE_NODE}=1 requires it")
+        }
+        Some(m) => Ok(Err(Completion::ignored_with(format!(
+            "skipped: {m}; {REQUIRE_NODE}=1 makes this a failure"
+        )))),
+    }
+}
+
+fn config() -> String {
+    root()
+        .join("examples/engines/jolt/sweeptrace.toml")
+        .display()
+        .to_string()
+}
+
+fn traces() -> String {
+    root().join("traces").display().to_string()
+}
+
+/// `check traces/ --engine JOLT --config its table --json`, with
+/// `JOLT_VARIANT=variant`: exit code and the parsed report.
+fn check(engine: &str, variant: &str) -> anyhow::Result<(i32, serde_json::Value)> {
+    // The variant reaches the engine through the environment sweeptrace
+    // passes on.
+    let out = crate::support::bin()
+        .env("JOLT_VARIANT", variant)
+        .args([
+            "check",
+            &traces(),
+            "--engine",
+            engine,
+            "--config",
+            &config(),
+            "--json",
+        ])
+        .output()?;
+    let report: serde_json::Value = serde_json::from_slice(&out.stdout).map_err(|e| {
+        anyhow::anyhow!(
+            "check --json: {e}: {}",
+            String::from_utf8_lossy(&out.stderr)
+        )
+    })?;
+    Ok((out.status.code().unwrap_or(-1), report))
+}
+
+fn traces_of(report: &serde_json::Value) -> Vec<serde_json::Value> {
+    report["traces"].as_array().cloned().unwrap_or_default()
+}
+
+fn clean_jolt_passes_check_under_its_inferred_config() -> anyhow::Result<Completion> {
+    let engine = match jolt()? {
+        Ok(e) => e,
+        Err(skip) => return Ok(skip),
+    };
+    let (code, report) = check(&engine, "")?;
+    let traces = traces_of(&report);
+    ensure!(traces.len() == 5, "{report}");
+    ensure!(code == 0, "the clean engine fails: {report}");
+    let precision: u64 = traces
+        .iter()
+        .map(|t| t["precision_divergent"].as_u64().unwrap_or(0))
+        .sum();
+    let largest = traces
+        .iter()
+        .map(|t| t["max_backward_error"].as_f64().unwrap_or(0.0))
+        .fold(0.0, f64::max);
+    // Jolt rounds: most differences are within single precision, and
+    // every one of them within the budget of 16 units.
+    ensure!(
+        precision > 500,
+        "{precision} differences within single precision"
+    );
+    ensure!(
+        largest > 0.0 && largest <= 16.0,
+        "largest backward error {largest}"
+    );
+    ensure!(
+        traces.iter().all(|t| t["conventions"]["precision"] == "f32"
+            && t["conventions"]["normal"] == "active_edges"),
+        "the reports name the conventions: {report}"
+    );
+    Ok(Completion::Completed)
+}
+
+fn broken_jolt_variants_fail_check_naming_the_difference() -> anyhow::Result<Completion> {
+    let engine = match jolt()? {
+        Ok(e) => e,
+        Err(skip) => return Ok(skip),
+    };
+    // Each variant and a word its first divergence must show.
+    let variants = [
+        ("late", "beyond the f32 backward-error bound"),
+        ("no_vertex", "\"vertex\""),
+        ("next_triangle", "\"triangle\""),
+        ("back_faces", "back_facing"),
+        ("centre_contact", "\"contact\""),
+        ("flipped_edge_normal", "\"normal\""),
+    ];
+    for (variant, shows) in variants {
+        let (code, report) = check(&engine, variant)?;
+        ensure!(code == 1, "{variant}: exit {code}");
+        let shown: Vec<serde_json::Value> = traces_of(&report)
+            .into_iter()
+            .flat_map(|t| t["divergences"].as_array().cloned().unwrap_or_default())
+            .collect();
+        ensure!(!shown.is_empty(), "{variant}: no divergence in {report}");
+        let text = serde_json::Value::from(shown).to_string();
+        ensure!(
+            text.contains(shows),
+            "{variant}: no divergence shows {shows}: {text}"
+        );
+    }
+    Ok(Completion::Completed)
+}
+
+fn jolt_conforms_under_its_config_and_its_broken_variants_do_not() -> anyhow::Result<Completion> {
+    let engine = match jolt()? {
+        Ok(e) => e,
+        Err(skip) => return Ok(skip),
+    };
+    let conform = |variant: &str| -> anyhow::Result<(i32, serde_json::Value)> {
+        let out = crate::support::bin()
+            .env("JOLT_VARIANT", variant)
+            .args([
+                "conform",
+                "--engine",
+                &engine,
+                "--config",
+                &config(),
+                "--json",
+            ])
+            .output()?;
+        Ok((
+            out.status.code().unwrap_or(-1),
+            serde_json::from_slice(&out.stdout)?,
+        ))
+    };
+    let failing = |report: &serde_json::Value| -> Vec<String> {
+        report["rules"]
+            .as_array()
+            .into_iter()
+            .flatten()
+            .filter(|r| r["failed"].as_u64().unwrap_or(0) > 0)
+            .filter_map(|r| r["rule"].as_str().map(str::to_string))
+            .collect()
+    };
+    let (code, report) = conform("")?;
+    ensure!(code == 0, "clean Jolt fails rules {:?}", failing(&report));
+    let not_applicable: Vec<&str> = report["rules"]
+        .as_array()
+        .into_iter()
+        .flatten()
+        .filter(|r| r["not_applicable"].is_string())
+        .filter_map(|r| r["rule"].as_str())
+        .collect();
+    ensure!(
+        not_applicable.contains(&"margin.face-hit") && not_applicable.contains(&"start.inside"),
+        "the rules its conventions replace are listed: {not_applicable:?}"
+    );
+    let (code, report) = conform("back_faces")?;
+    let fails = failing(&report);
+    ensure!(
+        code == 1 && fails.iter().any(|r| r == "face.miss.back-facing"),
+        "back_faces fails {fails:?}"
+    );
+    let (code, report) = conform("no_vertex")?;
+    let fails = failing(&report);
+    ensure!(
+        code == 1 && fails.iter().any(|r| r == "vertex.hit"),
+        "no_vertex fails {fails:?}"
+    );
+    Ok(Completion::Completed)
+}
+
+fn jolt_config_is_what_infer_config_prints() -> anyhow::Result<Completion> {
+    let engine = match jolt()? {
+        Ok(e) => e,
+        Err(skip) => return Ok(skip),
+    };
+    let (code, stdout, stderr) = run_bin(os![
+        "check",
+        &traces(),
+        "--engine",
+        &engine,
+        "--infer-config"
+    ])?;
+    ensure!(code == 0, "{stderr}");
+    let parsed: toml::Table = toml::from_str(&stdout)?;
+    let committed: toml::Table = toml::from_str(&std::fs::read_to_string(
+        root().join("examples/engines/jolt/sweeptrace.toml"),
+    )?)?;
+    ensure!(
+        parsed["engine"] == committed["engine"],
+        "the committed table is not what --infer-config prints now:\n{stdout}"
+    );
+    ensure!(
+        stderr.contains("tried the rules"),
+        "progress on stderr: {stderr}"
+    );
+    Ok(Completion::Completed)
+}

@@ -1,0 +1,187 @@
+//! Single precision in the judgement, against an independent single-
+//! precision computation: the core's answers for inputs rounded to `f32`
+//! (what an exact engine fed `f32` coordinates answers) are accepted at
+//! `precision = "f32"` and mostly refused at `f64`; the same answers with
+//! `α` moved by ten times the sweep's reported bound are refused. Seeded
+//! random sweeps over a bumpy height field (faces, edges and vertices hit).
+
+use anyhow::ensure;
+use libtest_mimic::Trial;
+use rand::{Rng, SeedableRng};
+use sweeptrace::regress::{F32_OPERATIONS, Precision, Sensitivity, Tolerances};
+use sweeptrace::replay::ReplayEvent;
+use sweeptrace::trace::{OutcomeMsg, SceneMsg, SweepMsg, TraceReader, TraceWriter};
+use sweeptrace::{Agreement, Facing, Mesh, Options, ReplayOptions, Sweep};
+
+use crate::trial;
+
+pub fn tests() -> Vec<Trial> {
+    vec![
+        trial!(answers_for_inputs_rounded_to_f32_are_accepted_at_f32),
+        trial!(alpha_moved_by_ten_bounds_is_refused_at_f32),
+    ]
+}
+
+/// A 6 × 6 height field with bumps, fronts up, in coordinates around 1000
+/// (so that `f32` rounding is visible).
+fn terrain() -> SceneMsg {
+    let n = 7;
+    let mut vertices = Vec::new();
+    for j in 0..n {
+        for i in 0..n {
+            let (x, y) = (1000.0 + f64::from(i), 1000.0 + f64::from(j));
+            vertices.push([x, y, 0.3 * (x * 1.3).sin() * (y * 0.7).cos()]);
+        }
+    }
+    let mut triangles = Vec::new();
+    for j in 0..(n - 1) as u64 {
+        for i in 0..(n - 1) as u64 {
+            let a = j * n as u64 + i;
+            triangles.push([a, a + 1, a + n as u64 + 1]);
+            triangles.push([a, a + n as u64 + 1, a + n as u64]);
+        }
+    }
+    SceneMsg {
+        name: Some("bumps".into()),
+        vertices,
+        triangles,
+        margin: 0.0,
+        facing: Facing::NonStrict,
+    }
+}
+
+/// `x` rounded to the nearest `f32`.
+fn f32_of(x: f64) -> f64 {
+    f64::from(x as f32)
+}
+
+/// Seeded sweeps falling onto the terrain at assorted angles.
+fn sweeps(count: u64) -> Vec<SweepMsg> {
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(32);
+    (0..count)
+        .map(|frame| {
+            let x = 1000.0 + rng.random_range(1.0..5.0);
+            let y = 1000.0 + rng.random_range(1.0..5.0);
+            let p0 = [x, y, rng.random_range(0.8..2.0)];
+            let p1 = [
+                x + rng.random_range(-1.0..1.0),
+                y + rng.random_range(-1.0..1.0),
+                rng.random_range(-1.5..0.0),
+            ];
+            SweepMsg {
+                frame,
+                ball: 0,
+                radius: 0.25,
+                p0,
+                p1,
+            }
+        })
+        .collect()
+}
+
+/// The answer of an exact engine fed `f32` inputs: the core's outcome for
+/// the scene and the sweep with every coordinate rounded to `f32`.
+fn f32_answer(scene: &SceneMsg, s: &SweepMsg) -> anyhow::Result<OutcomeMsg> {
+    let round = |p: [f64; 3]| p.map(f32_of);
+    let vertices: Vec<[f64; 3]> = scene.vertices.iter().copied().map(round).collect();
+    let mesh = Mesh::new(vertices, &scene.triangles)?;
+    let sweep = Sweep::new(round(s.p0), round(s.p1), f32_of(s.radius));
+    let o = sweeptrace::sweep_mesh(&mesh, &sweep, &Options::default())?;
+    Ok(OutcomeMsg::from_outcome(s.frame, s.ball, &o))
+}
+
+/// The replayed results of `sweeps` over `scene`, each with `answer` of it
+/// as its expectation.
+fn results(
+    scene: &SceneMsg,
+    sweeps: &[SweepMsg],
+    answer: impl Fn(&SweepMsg) -> anyhow::Result<OutcomeMsg>,
+) -> anyhow::Result<Vec<sweeptrace::replay::SweepResult>> {
+    let mut w = TraceWriter::new(std::io::Cursor::new(Vec::new()))?;
+    w.scene(0, scene)?;
+    for s in sweeps {
+        let t = 1_000 * (s.frame + 1);
+        w.sweep(t, s)?;
+        w.expected(t, &answer(s)?)?;
+    }
+    let bytes = w.finish()?.into_inner();
+    let mut out = Vec::new();
+    for event in sweeptrace::replay_events(
+        TraceReader::new(bytes.as_slice(), "precision.mcap"),
+        ReplayOptions::default(),
+    ) {
+        if let ReplayEvent::Sweep(r) = event? {
+            out.push(*r);
+        }
+    }
+    Ok(out)
+}
+
+fn tolerances(precision: Precision) -> Tolerances {
+    Tolerances {
+        precision,
+        ..Tolerances::default()
+    }
+}
+
+fn answers_for_inputs_rounded_to_f32_are_accepted_at_f32() -> anyhow::Result<()> {
+    let scene = terrain();
+    let sweeps = sweeps(400);
+    let results = results(&scene, &sweeps, |s| f32_answer(&scene, s))?;
+    let (mut hits, mut refused_at_f64, mut refused_at_f32) = (0, 0, Vec::new());
+    for r in &results {
+        let expected = r.expected.expect("every sweep has its answer");
+        hits += u32::from(r.outcome.is_hit());
+        if sweeptrace::agreement(&expected, r, &tolerances(Precision::F64)).fails(false) {
+            refused_at_f64 += 1;
+        }
+        if sweeptrace::agreement(&expected, r, &tolerances(Precision::F32)).fails(false) {
+            refused_at_f32.push(r.frame);
+        }
+    }
+    ensure!(hits > 300, "{hits} hits: the sweeps must reach the terrain");
+    // The rounding is visible at the fixed tolerances...
+    ensure!(refused_at_f64 > 50, "only {refused_at_f64} refused at f64");
+    // ...and every one of those answers is within single precision.
+    ensure!(
+        refused_at_f32.is_empty(),
+        "refused at f32: frames {refused_at_f32:?}"
+    );
+    Ok(())
+}
+
+fn alpha_moved_by_ten_bounds_is_refused_at_f32() -> anyhow::Result<()> {
+    let scene = terrain();
+    let sweeps = sweeps(400);
+    let exact = results(&scene, &sweeps, |s| f32_answer(&scene, s))?;
+    let (mut tried, mut refused) = (0, 0);
+    for r in &exact {
+        let Some(s) = Sensitivity::of(r) else {
+            continue;
+        };
+        let Some(hit) = r.outcome.hit else { continue };
+        let bound = F32_OPERATIONS * s.alpha;
+        // Only where ten bounds keep α inside [0, 1] (and the sweep away
+        // from a grazing contact, where the bound is the whole path).
+        let moved = hit.alpha + 10.0 * bound;
+        if !(moved <= 1.0 && bound < 0.01) {
+            continue;
+        }
+        let mut expected = r.expected.expect("every sweep has its answer");
+        expected.alpha = moved;
+        tried += 1;
+        let agreement = sweeptrace::agreement(&expected, r, &tolerances(Precision::F32));
+        if agreement.fails(false) {
+            refused += 1;
+        } else {
+            ensure!(
+                !matches!(agreement, Agreement::Precision { .. }),
+                "frame {}: α moved by 10 bounds ({bound}) is called rounding",
+                r.frame
+            );
+        }
+    }
+    ensure!(tried > 200, "only {tried} sweeps tried");
+    ensure!(refused == tried, "{refused} of {tried} refused");
+    Ok(())
+}

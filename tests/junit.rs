@@ -374,7 +374,7 @@ fn check_junit_detail_sweeps_adds_divergences_and_tunnels() -> anyhow::Result<()
 fn check_junit_fragile_divergences_are_skipped_unless_strict() -> anyhow::Result<()> {
     // Recorded with the strict facing rule, the scene declares non_strict:
     // they differ only on a path parallel to the floor, a divergence
-    // rounding explains (tests/repro.rs, infer_strict_by_replay).
+    // rounding explains (tests/repro.rs, infer_strict_facing_by_replaying_both).
     let (scene, sweeps) = crate::repro::floor_and_sweeps(0.0, Facing::NonStrict);
     let bytes = crate::repro::recorded_by(&scene, &sweeps, 0.0, Facing::Strict)?;
     let dir = tempdir()?;

@@ -53,6 +53,7 @@ pub fn tests() -> Vec<Trial> {
         trial!(error_bad_outcome_alpha),
         trial!(random_corruption_never_panics),
         trial!(writer_refuses_invalid_messages),
+        trial!(writer_refuses_a_triangle_the_scene_does_not_have),
         trial!(write_trace_file_is_atomic),
         trial!(info_renders_python_fixture),
         trial!(info_reports_partial_trace),
@@ -1138,6 +1139,33 @@ fn writer_refuses_invalid_messages() -> anyhow::Result<()> {
     let bytes = w.finish()?.into_inner();
     let (events, error, _) = read_all(&bytes);
     ensure!(error.is_none() && events.len() == 2, "{events:?} {error:?}");
+    Ok(())
+}
+
+/// The C writer refused an `/expected` triangle beyond the scene's that the
+/// Rust writer wrote; both check it now (`validate_triangle`). The reader
+/// still reads such a trace: a recording engine's bad index is judged.
+fn writer_refuses_a_triangle_the_scene_does_not_have() -> anyhow::Result<()> {
+    let mut w = TraceWriter::new(Cursor::new(Vec::new()))?;
+    // Before any scene there is nothing to check it against.
+    w.expected(0, &OutcomeMsg::hit(0, 0, 0.5, Kind::Face).triangle(7))?;
+    w.scene(1, &triangle_scene())?;
+    w.expected(1, &OutcomeMsg::hit(1, 0, 0.5, Kind::Face).triangle(0))?;
+    let e = w
+        .expected(1, &OutcomeMsg::hit(2, 0, 0.5, Kind::Face).triangle(1))
+        .err()
+        .context("triangle 1 of a 1-triangle scene accepted")?;
+    ensure!(
+        matches!(e, TraceError::Invalid { .. })
+            && e.to_string().contains("`triangle`")
+            && e.to_string()
+                .contains("index 1 is out of range (the scene has 1 triangles)")
+            && e.to_string().contains("frame 2"),
+        "{e}"
+    );
+    let bytes = w.finish()?.into_inner();
+    let (events, error, _) = read_all(&bytes);
+    ensure!(error.is_none() && events.len() == 3, "{events:?} {error:?}");
     Ok(())
 }
 

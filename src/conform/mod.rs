@@ -28,7 +28,7 @@ use crate::regress::{
     render_divergence_as,
 };
 use crate::replay::{ReplayEvent, ReplayOptions, replay_events};
-use crate::trace::{OutcomeMsg, TraceEvent};
+use crate::trace::{EventBody, EventHeader, OutcomeMsg, TraceEvent};
 
 /// The first failing case of a rule, explained.
 #[derive(Clone, Debug, PartialEq, Serialize)]
@@ -258,15 +258,17 @@ pub fn case_events(cases: &[Case]) -> Vec<TraceEvent> {
     let mut events = Vec::with_capacity(2 * cases.len());
     for (i, case) in cases.iter().enumerate() {
         let i = i as u64;
-        events.push(TraceEvent::Scene {
-            log_time_nanos: 2 * i,
-            index: 2 * i,
-            scene: case.scene.clone(),
+        let at = |n: u64| EventHeader {
+            log_time_nanos: n,
+            index: n,
+        };
+        events.push(TraceEvent {
+            header: at(2 * i),
+            body: EventBody::Scene(case.scene.clone()),
         });
-        events.push(TraceEvent::Sweep {
-            log_time_nanos: 2 * i + 1,
-            index: 2 * i + 1,
-            sweep: case.sweep,
+        events.push(TraceEvent {
+            header: at(2 * i + 1),
+            body: EventBody::Sweep(case.sweep),
         });
     }
     events

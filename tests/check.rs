@@ -96,7 +96,9 @@ fn trace_trials() -> Vec<Trial> {
                 })
             })
             .collect(),
-        Err(e) => vec![trial("check::trace::discovery", move || Err::<(), _>(e))],
+        Err(e) => vec![trial("check::trace::discovery", move || {
+            Err::<(), _>(anyhow::Error::from(e))
+        })],
     }
 }
 
@@ -594,7 +596,7 @@ fn trace_discovery_in_directories() -> anyhow::Result<()> {
     std::fs::write(dir.path().join("a.mcap"), &good)?;
     std::fs::write(sub.join("c.mcap"), &good)?;
     std::fs::write(sub.join("notes.txt"), b"x")?;
-    let found = find_traces(&[dir.path().to_path_buf()]).map_err(anyhow::Error::msg)?;
+    let found = find_traces(&[dir.path().to_path_buf()])?;
     let names: Vec<String> = found
         .iter()
         .map(|p| {

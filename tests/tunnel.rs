@@ -742,7 +742,7 @@ fn recording_marks_the_tunnel() -> anyhow::Result<()> {
 
 fn sample_traces_have_none() -> anyhow::Result<()> {
     let dir = root().join("traces");
-    let traces = sweeptrace::regress::find_traces(&[dir]).map_err(anyhow::Error::msg)?;
+    let traces = sweeptrace::regress::find_traces(&[dir])?;
     ensure!(!traces.is_empty(), "no sample trace");
     for path in traces {
         let bytes = std::fs::read(&path)?;

@@ -177,7 +177,7 @@ pub fn run(args: Args) -> anyhow::Result<Exit> {
         allow_tunnels: args.allow_tunnels,
         ..args.tolerances.to_overrides()?
     };
-    let traces = find_traces(&args.paths).map_err(anyhow::Error::msg)?;
+    let traces = find_traces(&args.paths)?;
     if traces.is_empty() {
         bail!(
             "no trace found (directories are searched for *.mcap): {}",

@@ -77,7 +77,7 @@ pub struct Args {
 
 /// Runs the suite, prints the report, returns the exit code.
 pub fn run(args: Args) -> anyhow::Result<Exit> {
-    let cases = conform::select(args.case.as_deref()).map_err(anyhow::Error::msg)?;
+    let cases = conform::select(args.case.as_deref())?;
     if args.list {
         print!("{}", list_text(&cases));
         return Ok(Exit::Success);

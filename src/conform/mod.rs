@@ -226,10 +226,23 @@ pub struct ConformOptions {
     pub only: Option<String>,
 }
 
+/// `conform --case` named no case, rule or group of rules; the message
+/// lists the rules ([`RULES`]).
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error(
+    "no conformance case or rule `{name}`; the rules are: {}",
+    RULES.iter().map(|r| r.name).collect::<Vec<_>>().join(", ")
+)]
+#[non_exhaustive]
+pub struct UnknownCase {
+    /// What was asked for.
+    pub name: String,
+}
+
 /// The cases `only` selects (every case when `None`): a case
 /// (`edge.hit/2`), a rule (`edge.hit`) or a group of rules (`edge`,
 /// `edge.miss`); an error names the rules when nothing matches.
-pub fn select(only: Option<&str>) -> Result<Vec<Case>, String> {
+pub fn select(only: Option<&str>) -> Result<Vec<Case>, UnknownCase> {
     let all = cases();
     let Some(only) = only else {
         return Ok(all);
@@ -245,10 +258,9 @@ pub fn select(only: Option<&str>) -> Result<Vec<Case>, String> {
         })
         .collect();
     if chosen.is_empty() {
-        return Err(format!(
-            "no conformance case or rule `{only}`; the rules are: {}",
-            RULES.iter().map(|r| r.name).collect::<Vec<_>>().join(", ")
-        ));
+        return Err(UnknownCase {
+            name: only.to_string(),
+        });
     }
     Ok(chosen)
 }

@@ -1,4 +1,4 @@
-//! The replay engine and its Rerun recording: outcomes equal the core's,
+//! Replay and its Rerun recording: outcomes equal the core's,
 //! filters, detail levels, expected outcomes, and the written `.rrd` read
 //! back through Rerun's own decoder.
 

@@ -1,5 +1,5 @@
-//! The push-based replay engine: scenes built into meshes, each sweep run
-//! through the core, `/expected` outcomes attached to their sweep.
+//! The push-based replay state machine: scenes built into meshes, each
+//! sweep run through the core, `/expected` outcomes attached to their sweep.
 
 use std::collections::{HashMap, VecDeque};
 use std::sync::Arc;
@@ -212,7 +212,7 @@ pub enum ReplayEvent {
     Sweep(Box<SweepResult>),
 }
 
-/// The replay engine (push-based; see the module documentation).
+/// The replay state machine (push-based; see the module documentation).
 #[derive(Debug)]
 pub struct Replay {
     options: ReplayOptions,

@@ -20,7 +20,7 @@ use std::time::{Duration, Instant};
 
 use sweeptrace::engine::{EngineAnswers, EngineCommand, EngineOptions, EngineSession};
 use sweeptrace::regress::{CheckOptions, check_events};
-use sweeptrace::trace::{TraceEvent, TraceReader};
+use sweeptrace::trace::{EventBody, TraceEvent, TraceReader};
 
 #[path = "../examples/long_trace.rs"]
 mod long_trace;
@@ -38,7 +38,11 @@ fn pipe_only(bytes: &[u8], command: &EngineCommand, options: EngineOptions) -> u
     );
     let mut answered = 0;
     for event in answers.by_ref() {
-        if let Ok(TraceEvent::Expected { .. }) = event {
+        if let Ok(TraceEvent {
+            body: EventBody::Expected(_),
+            ..
+        }) = event
+        {
             answered += 1;
         }
     }
@@ -79,7 +83,15 @@ fn median(mut f: impl FnMut() -> u64) -> Duration {
 /// The floor: reading and decoding the trace alone.
 fn read_only(bytes: &[u8]) -> u64 {
     TraceReader::new(bytes, "bench.mcap")
-        .filter(|e| matches!(e, Ok(TraceEvent::Sweep { .. })))
+        .filter(|e| {
+            matches!(
+                e,
+                Ok(TraceEvent {
+                    body: EventBody::Sweep(_),
+                    ..
+                })
+            )
+        })
         .count() as u64
 }
 

@@ -13,7 +13,7 @@ use crate::core::{
     TestRecord, sweep_edge, sweep_face, sweep_mesh, sweep_mesh_with, sweep_vertex,
 };
 use crate::trace::{
-    Encoding, MessageAt, OutcomeMsg, ReadLimits, SceneMsg, SweepMsg, TraceEvent, TraceReader,
+    Encoding, EventBody, MessageAt, OutcomeMsg, ReadLimits, SceneMsg, SweepMsg, TraceReader,
     parse_message_as, validate_outcome, validate_scene, validate_sweep,
 };
 
@@ -70,7 +70,7 @@ fn check_reading<R: std::io::Read>(mut reader: TraceReader<R>, input: &[u8]) -> 
             }
         };
         events += 1;
-        let order = (event.log_time_nanos(), event.index());
+        let order = (event.header.log_time_nanos, event.header.index);
         if let Some(previous) = last
             && (order.0 < previous.0 || order.1 <= previous.1)
         {
@@ -79,13 +79,13 @@ fn check_reading<R: std::io::Read>(mut reader: TraceReader<R>, input: &[u8]) -> 
             ));
         }
         last = Some(order);
-        match event {
-            TraceEvent::Scene { scene: msg, .. } => {
+        match event.body {
+            EventBody::Scene(msg) => {
                 validate_scene(&msg).map_err(|p| format!("a yielded scene is invalid: {p:?}"))?;
                 let mesh = build_mesh(msg.vertices.clone(), &msg.triangles)?;
                 scene = Some((mesh, msg.margin, msg.facing));
             }
-            TraceEvent::Sweep { sweep, .. } => {
+            EventBody::Sweep(sweep) => {
                 let Some((mesh, margin, facing)) = &scene else {
                     return Err("a sweep was yielded before any scene".into());
                 };
@@ -106,7 +106,7 @@ fn check_reading<R: std::io::Read>(mut reader: TraceReader<R>, input: &[u8]) -> 
                     check_outcome(mesh, &outcome)?;
                 }
             }
-            TraceEvent::Expected { outcome, .. } => {
+            EventBody::Expected(outcome) => {
                 validate_outcome(&outcome)
                     .map_err(|p| format!("a yielded outcome is invalid: {p:?}"))?;
             }

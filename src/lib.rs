@@ -10,7 +10,7 @@
 //!
 //! ```
 //! use sweeptrace::{
-//!     CheckOptions, Facing, Kind, OutcomeMsg, SceneMsg, Status, SweepMsg, TraceEvent,
+//!     CheckOptions, EventBody, Facing, Kind, OutcomeMsg, SceneMsg, Status, SweepMsg,
 //!     TraceReader, TraceWriter, check_reader,
 //! };
 //!
@@ -37,7 +37,7 @@
 //!
 //! let mut sweeps = 0;
 //! for event in TraceReader::new(bytes.as_slice(), "example.mcap") {
-//!     if let TraceEvent::Sweep { sweep, .. } = event? {
+//!     if let EventBody::Sweep(sweep) = event?.body {
 //!         assert_eq!(sweep.radius, 0.5);
 //!         sweeps += 1;
 //!     }
@@ -100,8 +100,8 @@ pub use crate::regress::{
 };
 pub use crate::replay::{ReplayOptions, replay_events};
 pub use crate::trace::{
-    Encoding, ExpectedSource, OutcomeMsg, SceneMsg, SweepMsg, TraceError, TraceEvent, TraceReader,
-    TraceWriter, write_trace_file, write_trace_file_with_encoding,
+    Encoding, EventBody, ExpectedSource, OutcomeMsg, SceneMsg, SweepMsg, TraceError, TraceEvent,
+    TraceReader, TraceWriter, write_trace_file, write_trace_file_with_encoding,
 };
 
 /// The README's Rust examples, compiled and run as doctests.

@@ -38,14 +38,8 @@ use crate::trial;
 
 pub fn tests() -> Vec<Trial> {
     vec![
-        trial(
-            "alt_engine::differently_rounding_engine_gives_ties_not_divergences",
-            differently_rounding_engine,
-        ),
-        trial(
-            "alt_engine::tie_member_is_judged_with_its_own_contact",
-            valley_tie_contact,
-        ),
+        trial!(differently_rounding_engine_gives_ties_not_divergences),
+        trial!(tie_member_is_judged_with_its_own_contact),
     ]
 }
 
@@ -505,7 +499,7 @@ fn scenes() -> Vec<(SceneMsg, Vec<SweepMsg>)> {
     out
 }
 
-fn differently_rounding_engine() -> anyhow::Result<()> {
+fn differently_rounding_engine_gives_ties_not_divergences() -> anyhow::Result<()> {
     let mut totals = [0u64; 4];
     let mut lines = Vec::new();
     for (scene, sweeps) in scenes() {
@@ -556,7 +550,7 @@ fn differently_rounding_engine() -> anyhow::Result<()> {
 /// it touches both at once, at two points. An engine reporting the second
 /// face with its own contact point is a tie; the same with the first
 /// face's contact is a divergence.
-fn valley_tie_contact() -> anyhow::Result<()> {
+fn tie_member_is_judged_with_its_own_contact() -> anyhow::Result<()> {
     let scene = SceneMsg {
         name: Some("valley".into()),
         vertices: vec![

@@ -12,11 +12,12 @@ use mcap::WriteOptions;
 use mcap::records::MessageHeader;
 use rand::{Rng, SeedableRng};
 use sweeptrace::trace::{
-    Encoding, OutcomeMsg, SceneMsg, SweepMsg, TraceError, TraceEvent, TraceReader, TraceWriter,
-    collect_info, render_info_text,
+    Encoding, EventBody, OutcomeMsg, SceneMsg, SweepMsg, TraceError, TraceEvent, TraceReader,
+    TraceWriter, collect_info, render_info_text,
 };
 
 use crate::support::run_bin;
+use crate::support::{event, write_event};
 use crate::trace_io::{
     default_opts, error_names_where, lz4, read_all, same, sample_events, triangle_scene, unchunked,
     variant_name,
@@ -53,23 +54,7 @@ fn write_events_as(
         w.encoding()
     );
     for e in events {
-        match e {
-            TraceEvent::Scene {
-                log_time_nanos,
-                scene,
-                ..
-            } => w.scene(*log_time_nanos, scene),
-            TraceEvent::Sweep {
-                log_time_nanos,
-                sweep,
-                ..
-            } => w.sweep(*log_time_nanos, sweep),
-            TraceEvent::Expected {
-                log_time_nanos,
-                outcome,
-                ..
-            } => w.expected(*log_time_nanos, outcome),
-        }?;
+        write_event(&mut w, e)?;
     }
     Ok(w.finish()?.into_inner())
 }
@@ -157,29 +142,29 @@ fn cbor_floats_round_trip_bit_for_bit() -> anyhow::Result<()> {
             return x;
         }
     };
-    let mut events = vec![TraceEvent::Scene {
-        log_time_nanos: 0,
-        index: 0,
-        scene: SceneMsg {
+    let mut events = vec![event(
+        0,
+        0,
+        EventBody::Scene(SceneMsg {
             name: Some("random".to_string()),
             vertices: (0..300).map(|_| [any(), any(), any()]).collect(),
             triangles: vec![[0, 1, 2], [297, 298, 299]],
             margin: 0.0,
             facing: Default::default(),
-        },
-    }];
+        }),
+    )];
     for frame in 0..500u64 {
-        events.push(TraceEvent::Sweep {
-            log_time_nanos: frame,
-            index: frame + 1,
-            sweep: SweepMsg {
+        events.push(event(
+            frame,
+            frame + 1,
+            EventBody::Sweep(SweepMsg {
                 frame,
                 ball: 3,
                 radius: any().abs().max(f64::MIN_POSITIVE),
                 p0: [any(), any(), any()],
                 p1: [any(), any(), any()],
-            },
-        });
+            }),
+        ));
     }
     let bytes = write_events_as(&events, default_opts(), Encoding::Cbor)?;
     let (got, error, _) = read_all(&bytes);
@@ -188,15 +173,15 @@ fn cbor_floats_round_trip_bit_for_bit() -> anyhow::Result<()> {
     let bits = |events: &[TraceEvent]| -> Vec<u64> {
         let mut out = Vec::new();
         for e in events {
-            match e {
-                TraceEvent::Scene { scene, .. } => {
+            match &e.body {
+                EventBody::Scene(scene) => {
                     out.extend(scene.vertices.iter().flatten().map(|x| x.to_bits()))
                 }
-                TraceEvent::Sweep { sweep, .. } => {
+                EventBody::Sweep(sweep) => {
                     out.push(sweep.radius.to_bits());
                     out.extend(sweep.p0.iter().chain(&sweep.p1).map(|x| x.to_bits()));
                 }
-                TraceEvent::Expected { .. } => {}
+                EventBody::Expected(_) => {}
             }
         }
         out
@@ -253,26 +238,10 @@ fn cbor_and_json_channels_mixed_in_one_file() -> anyhow::Result<()> {
     let (got, error, stats) = read_all(&bytes);
     ensure!(error.is_none(), "{error:?}");
     let want = vec![
-        TraceEvent::Scene {
-            log_time_nanos: 0,
-            index: 0,
-            scene,
-        },
-        TraceEvent::Sweep {
-            log_time_nanos: 1,
-            index: 1,
-            sweep: sweep(1),
-        },
-        TraceEvent::Expected {
-            log_time_nanos: 1,
-            index: 2,
-            outcome,
-        },
-        TraceEvent::Sweep {
-            log_time_nanos: 2,
-            index: 3,
-            sweep: sweep(2),
-        },
+        event(0, 0, EventBody::Scene(scene)),
+        event(1, 1, EventBody::Sweep(sweep(1))),
+        event(1, 2, EventBody::Expected(outcome)),
+        event(2, 3, EventBody::Sweep(sweep(2))),
     ];
     same(&got, &want)?;
     ensure!(
@@ -633,8 +602,8 @@ fn cbor_bless_keeps_the_encoding() -> anyhow::Result<()> {
             ensure!(error.is_none(), "{error:?}");
             Ok(events
                 .into_iter()
-                .filter_map(|e| match e {
-                    TraceEvent::Expected { outcome, .. } => Some(outcome),
+                .filter_map(|e| match e.body {
+                    EventBody::Expected(outcome) => Some(outcome),
                     _ => None,
                 })
                 .collect())

@@ -96,7 +96,9 @@ fn trace_trials() -> Vec<Trial> {
                 })
             })
             .collect(),
-        Err(e) => vec![trial("check::trace::discovery", move || Err::<(), _>(e))],
+        Err(e) => vec![trial("check::trace::discovery", move || {
+            Err::<(), _>(anyhow::Error::from(e))
+        })],
     }
 }
 
@@ -594,7 +596,7 @@ fn trace_discovery_in_directories() -> anyhow::Result<()> {
     std::fs::write(dir.path().join("a.mcap"), &good)?;
     std::fs::write(sub.join("c.mcap"), &good)?;
     std::fs::write(sub.join("notes.txt"), b"x")?;
-    let found = find_traces(&[dir.path().to_path_buf()]).map_err(anyhow::Error::msg)?;
+    let found = find_traces(&[dir.path().to_path_buf()])?;
     let names: Vec<String> = found
         .iter()
         .map(|p| {
@@ -662,55 +664,41 @@ fn foreign_trace() -> anyhow::Result<Vec<u8>> {
 /// [`foreign_trace`], with or without its `/expected` channel.
 fn foreign_trace_with(with_expected: bool) -> anyhow::Result<Vec<u8>> {
     use sweeptrace::trace::{OUTCOME_SCHEMA_JSON, SCENE_SCHEMA_JSON, SWEEP_SCHEMA_JSON};
-    let e = |e: mcap::McapError| anyhow::Error::from(e);
     let mut w = mcap::WriteOptions::new()
         .library("some-engine 3.1")
         .profile("game")
-        .create(Cursor::new(Vec::new()))
-        .map_err(e)?;
+        .create(Cursor::new(Vec::new()))?;
     let none = BTreeMap::new();
-    let scene_s = w
-        .add_schema(
-            "sweeptrace.Scene",
-            "jsonschema",
-            SCENE_SCHEMA_JSON.as_bytes(),
-        )
-        .map_err(e)?;
-    let sweep_s = w
-        .add_schema(
-            "sweeptrace.Sweep",
-            "jsonschema",
-            SWEEP_SCHEMA_JSON.as_bytes(),
-        )
-        .map_err(e)?;
-    let out_s = w
-        .add_schema(
-            "sweeptrace.Outcome",
-            "jsonschema",
-            OUTCOME_SCHEMA_JSON.as_bytes(),
-        )
-        .map_err(e)?;
-    let cam_s = w
-        .add_schema("game.Camera", "protobuf", b"\x0a\x05hello")
-        .map_err(e)?;
-    let scene_c = w.add_channel(scene_s, "/scene", "json", &none).map_err(e)?;
-    let sweep_c = w.add_channel(sweep_s, "/sweep", "json", &none).map_err(e)?;
+    let scene_s = w.add_schema(
+        "sweeptrace.Scene",
+        "jsonschema",
+        SCENE_SCHEMA_JSON.as_bytes(),
+    )?;
+    let sweep_s = w.add_schema(
+        "sweeptrace.Sweep",
+        "jsonschema",
+        SWEEP_SCHEMA_JSON.as_bytes(),
+    )?;
+    let out_s = w.add_schema(
+        "sweeptrace.Outcome",
+        "jsonschema",
+        OUTCOME_SCHEMA_JSON.as_bytes(),
+    )?;
+    let cam_s = w.add_schema("game.Camera", "protobuf", b"\x0a\x05hello")?;
+    let scene_c = w.add_channel(scene_s, "/scene", "json", &none)?;
+    let sweep_c = w.add_channel(sweep_s, "/sweep", "json", &none)?;
     let out_c = if with_expected {
-        w.add_channel(out_s, "/expected", "json", &none)
-            .map_err(e)?
+        w.add_channel(out_s, "/expected", "json", &none)?
     } else {
         0
     };
     let cam_meta = BTreeMap::from([("fps".to_string(), "60".to_string())]);
-    let cam_c = w
-        .add_channel(cam_s, "/camera", "protobuf", &cam_meta)
-        .map_err(e)?;
-    let log_c = w.add_channel(0, "/log", "text", &none).map_err(e)?;
+    let cam_c = w.add_channel(cam_s, "/camera", "protobuf", &cam_meta)?;
+    let log_c = w.add_channel(0, "/log", "text", &none)?;
     w.write_metadata(&mcap::records::Metadata {
         name: "engine".into(),
         metadata: BTreeMap::from([("gravity".to_string(), "-9.81".to_string())]),
-    })
-    .map_err(e)?;
+    })?;
     let put = |w: &mut mcap::Writer<Cursor<Vec<u8>>>, c: u16, t: u64, data: &[u8]| {
         w.write_to_known_channel(
             &mcap::records::MessageHeader {
@@ -756,9 +744,8 @@ fn foreign_trace_with(with_expected: bool) -> anyhow::Result<Vec<u8>> {
         name: "calibration.txt".into(),
         media_type: "text/plain".into(),
         data: Cow::Borrowed(b"k = 1.5"),
-    })
-    .map_err(e)?;
-    w.finish().map_err(e)?;
+    })?;
+    w.finish()?;
     Ok(w.into_inner().into_inner())
 }
 

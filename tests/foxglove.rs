@@ -81,25 +81,22 @@ fn expected(frame: u64, ball: u32, alpha: f64, kind: Kind) -> OutcomeMsg {
 /// Two scenes; ball 0 hits the triangle's face at α = 5/12 each frame,
 /// ball 1 misses. Frame 1's expectation for ball 0 (α = 0.3) diverges.
 fn two_scene_trace() -> anyhow::Result<Vec<u8>> {
-    let e = |e: sweeptrace::trace::TraceError| anyhow::Error::from(e);
-    let mut w = TraceWriter::new(Cursor::new(Vec::new())).map_err(e)?;
-    w.scene(0, &triangle("first", 4.0)).map_err(e)?;
+    let mut w = TraceWriter::new(Cursor::new(Vec::new()))?;
+    w.scene(0, &triangle("first", 4.0))?;
     for frame in 0..3u64 {
         let t = 1_000_000_000 + frame * 500_000_000;
         if frame == 2 {
-            w.scene(t, &triangle("second", 8.0)).map_err(e)?;
+            w.scene(t, &triangle("second", 8.0))?;
         }
-        w.sweep(t, &down(frame, 0, 1.0)).map_err(e)?;
+        w.sweep(t, &down(frame, 0, 1.0))?;
         let alpha = if frame == 1 { 0.3 } else { 5.0 / 12.0 };
-        w.expected(t, &expected(frame, 0, alpha, Kind::Face))
-            .map_err(e)?;
+        w.expected(t, &expected(frame, 0, alpha, Kind::Face))?;
         if frame < 2 {
-            w.sweep(t, &down(frame, 1, 10.0)).map_err(e)?;
-            w.expected(t, &expected(frame, 1, 1.0, Kind::None))
-                .map_err(e)?;
+            w.sweep(t, &down(frame, 1, 10.0))?;
+            w.expected(t, &expected(frame, 1, 1.0, Kind::None))?;
         }
     }
-    Ok(w.finish().map_err(e)?.into_inner())
+    Ok(w.finish()?.into_inner())
 }
 
 /// The Foxglove file of `trace`, through the library.
@@ -379,10 +376,9 @@ fn foxglove_file_reads_back_with_the_mcap_crate() -> anyhow::Result<()> {
 /// (a line list, two indices per edge, in the class's colour) and one per
 /// defect kind with one text per defect.
 fn foxglove_mesh_has_edge_classes_and_defects() -> anyhow::Result<()> {
-    let e = |e: sweeptrace::trace::TraceError| anyhow::Error::from(e);
-    let mut w = TraceWriter::new(Cursor::new(Vec::new())).map_err(e)?;
-    w.scene(0, &crate::support::flipped_floor()).map_err(e)?;
-    let trace = w.finish().map_err(e)?.into_inner();
+    let mut w = TraceWriter::new(Cursor::new(Vec::new()))?;
+    w.scene(0, &crate::support::flipped_floor())?;
+    let trace = w.finish()?.into_inner();
     let all = messages(&foxglove_bytes(&trace)?)?;
     let meshes = on(&all, "/mesh");
     ensure!(meshes.len() == 1, "{} mesh updates", meshes.len());

@@ -168,7 +168,7 @@ fn check_junit_of_passing_traces_has_one_suite_per_trace() -> anyhow::Result<()>
     let report = dir.path().join("r.xml");
     let (code, stdout, stderr) = run_bin(os!["check", s(&at("traces")), "--junit", s(&report)])?;
     ensure!(code == 0, "exit {code}\n{stdout}{stderr}");
-    let traces = sweeptrace::regress::find_traces(&[at("traces")]).map_err(anyhow::Error::msg)?;
+    let traces = sweeptrace::regress::find_traces(&[at("traces")])?;
     let xml = read(&report)?;
     let doc = parse(&xml)?;
     counts_add_up(&doc)?;
@@ -374,7 +374,7 @@ fn check_junit_detail_sweeps_adds_divergences_and_tunnels() -> anyhow::Result<()
 fn check_junit_fragile_divergences_are_skipped_unless_strict() -> anyhow::Result<()> {
     // Recorded with the strict facing rule, the scene declares non_strict:
     // they differ only on a path parallel to the floor, a divergence
-    // rounding explains (tests/repro.rs, infer_strict_by_replay).
+    // rounding explains (tests/repro.rs, infer_strict_facing_by_replaying_both).
     let (scene, sweeps) = crate::repro::floor_and_sweeps(0.0, Facing::NonStrict);
     let bytes = crate::repro::recorded_by(&scene, &sweeps, 0.0, Facing::Strict)?;
     let dir = tempdir()?;

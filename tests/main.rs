@@ -6,6 +6,7 @@
 use libtest_mimic::{Arguments, Completion, Failed, Trial};
 
 mod alt_engine;
+mod architecture;
 mod bisect;
 mod cbor;
 mod check;
@@ -153,6 +154,7 @@ fn main() {
     trials.extend(mesh::tests());
     trials.extend(jolt::tests());
     trials.extend(precision::tests());
+    trials.extend(architecture::tests());
     let trials = mark_slow(trials);
     libtest_mimic::run(&args, trials).exit();
 }

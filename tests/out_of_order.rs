@@ -31,11 +31,7 @@ fn events_of<R: std::io::Read>(
     for item in reader.by_ref() {
         match item {
             Ok(mut event) => {
-                match &mut event {
-                    TraceEvent::Scene { index, .. }
-                    | TraceEvent::Sweep { index, .. }
-                    | TraceEvent::Expected { index, .. } => *index = 0,
-                }
+                event.header.index = 0;
                 events.push(event);
             }
             Err(err) => error = Some(err),

@@ -11,7 +11,9 @@ use nalgebra::{Point3, Vector3};
 use sweeptrace::core::{Facing, Kind, Mesh, Options, Sweep, sweep_mesh};
 use sweeptrace::sim::scenes::{self, BuiltinScene, SceneMesh};
 use sweeptrace::sim::{self, SimError, SimOptions};
-use sweeptrace::trace::{OutcomeMsg, SceneMsg, SweepMsg, TraceEvent, TraceReader, TraceWriter};
+use sweeptrace::trace::{
+    EventBody, OutcomeMsg, SceneMsg, SweepMsg, TraceEvent, TraceReader, TraceWriter,
+};
 
 use crate::{ensure, trial};
 use anyhow::Context as _;
@@ -81,14 +83,11 @@ fn read(bytes: &[u8], name: &str) -> anyhow::Result<Read> {
         expected: Vec::new(),
     };
     for event in TraceReader::new(Cursor::new(bytes), name) {
-        match event? {
-            TraceEvent::Scene { scene, .. } => r.scenes.push(scene),
-            TraceEvent::Sweep {
-                sweep,
-                log_time_nanos,
-                ..
-            } => r.sweeps.push((log_time_nanos, sweep)),
-            TraceEvent::Expected { outcome, .. } => r.expected.push(outcome),
+        let event = event?;
+        match event.body {
+            EventBody::Scene(scene) => r.scenes.push(scene),
+            EventBody::Sweep(sweep) => r.sweeps.push((event.header.log_time_nanos, sweep)),
+            EventBody::Expected(outcome) => r.expected.push(outcome),
         }
     }
     Ok(r)

@@ -1,4 +1,4 @@
-//! The replay engine and its Rerun recording: outcomes equal the core's,
+//! Replay and its Rerun recording: outcomes equal the core's,
 //! filters, detail levels, expected outcomes, and the written `.rrd` read
 //! back through Rerun's own decoder.
 
@@ -22,11 +22,12 @@ use sweeptrace::replay::{
 };
 use sweeptrace::sim::scenes;
 use sweeptrace::trace::{
-    OutcomeMsg, SceneMsg, SweepMsg, TraceError, TraceEvent, TraceReader, TraceWriter,
+    EventBody, OutcomeMsg, SceneMsg, SweepMsg, TraceError, TraceEvent, TraceReader, TraceWriter,
 };
 use sweeptrace::viz;
 
 use crate::ensure;
+use crate::support::event;
 use crate::support::scene_t;
 use crate::trial;
 use anyhow::Context as _;
@@ -115,17 +116,13 @@ fn random_sweeps(seed: u64, frames: u64, balls: u32) -> Vec<SweepMsg> {
 }
 
 fn events_for(scene: SceneMsg, sweeps: &[SweepMsg]) -> Events {
-    let mut ev = vec![Ok(TraceEvent::Scene {
-        log_time_nanos: 0,
-        index: 0,
-        scene,
-    })];
+    let mut ev = vec![Ok(event(0, 0, EventBody::Scene(scene)))];
     for (i, s) in sweeps.iter().enumerate() {
-        ev.push(Ok(TraceEvent::Sweep {
-            log_time_nanos: 1_000_000 * (s.frame + 1),
-            index: i as u64 + 1,
-            sweep: *s,
-        }));
+        ev.push(Ok(event(
+            1_000_000 * (s.frame + 1),
+            i as u64 + 1,
+            EventBody::Sweep(*s),
+        )));
     }
     ev
 }
@@ -455,44 +452,16 @@ fn expected_attached_before_and_after() -> anyhow::Result<()> {
         contact: None,
     };
     let ev: Events = vec![
-        Ok(TraceEvent::Scene {
-            log_time_nanos: 0,
-            index: 0,
-            scene,
-        }),
+        Ok(event(0, 0, EventBody::Scene(scene))),
         // Before its sweep.
-        Ok(TraceEvent::Expected {
-            log_time_nanos: 1,
-            index: 1,
-            outcome: expected(0, 0.1),
-        }),
-        Ok(TraceEvent::Sweep {
-            log_time_nanos: 1,
-            index: 2,
-            sweep: sweep(0),
-        }),
+        Ok(event(1, 1, EventBody::Expected(expected(0, 0.1)))),
+        Ok(event(1, 2, EventBody::Sweep(sweep(0)))),
         // After its sweep.
-        Ok(TraceEvent::Sweep {
-            log_time_nanos: 2,
-            index: 3,
-            sweep: sweep(1),
-        }),
-        Ok(TraceEvent::Expected {
-            log_time_nanos: 2,
-            index: 4,
-            outcome: expected(1, 0.2),
-        }),
+        Ok(event(2, 3, EventBody::Sweep(sweep(1)))),
+        Ok(event(2, 4, EventBody::Expected(expected(1, 0.2)))),
         // None for frame 2; one that matches nothing.
-        Ok(TraceEvent::Sweep {
-            log_time_nanos: 3,
-            index: 5,
-            sweep: sweep(2),
-        }),
-        Ok(TraceEvent::Expected {
-            log_time_nanos: 4,
-            index: 6,
-            outcome: expected(99, 0.3),
-        }),
+        Ok(event(3, 5, EventBody::Sweep(sweep(2)))),
+        Ok(event(4, 6, EventBody::Expected(expected(99, 0.3)))),
     ];
     let (results, summary) = run(ev, explained(Detail::Primary))?;
     let got: Vec<Option<f64>> = results
@@ -562,11 +531,7 @@ fn sweep_before_scene_is_an_error() -> anyhow::Result<()> {
         p0: [0.0; 3],
         p1: [1.0; 3],
     };
-    let ev: Events = vec![Ok(TraceEvent::Sweep {
-        log_time_nanos: 0,
-        index: 0,
-        sweep,
-    })];
+    let ev: Events = vec![Ok(event(0, 0, EventBody::Sweep(sweep)))];
     let errors: Vec<String> = replay_events(ev.into_iter(), ReplayOptions::default())
         .filter_map(|e| e.err())
         .map(|e| e.to_string())
@@ -1538,31 +1503,23 @@ fn parallel_iterator_equals_sequential() -> anyhow::Result<()> {
     use sweeptrace::replay::replay_events_parallel;
     let sweeps = random_sweeps(9, 40, 3);
     let mesh = mesh_of(&cube_scene());
-    let mut events: Vec<TraceEvent> = vec![TraceEvent::Scene {
-        log_time_nanos: 0,
-        index: 0,
-        scene: cube_scene(),
-    }];
+    let mut events: Vec<TraceEvent> = vec![event(0, 0, EventBody::Scene(cube_scene()))];
     for (i, s) in sweeps.iter().enumerate() {
         let o = sweep_mesh(
             &mesh,
             &Sweep::new(s.p0, s.p1, s.radius),
             &Options::default(),
         )?;
-        let expected = TraceEvent::Expected {
-            log_time_nanos: s.frame,
-            index: 0,
-            outcome: OutcomeMsg::from_outcome(s.frame, s.ball, &o),
-        };
+        let expected = event(
+            s.frame,
+            0,
+            EventBody::Expected(OutcomeMsg::from_outcome(s.frame, s.ball, &o)),
+        );
         let mut sweep = *s;
         if i == 50 {
             sweep.radius = -1.0;
         }
-        let sweep = TraceEvent::Sweep {
-            log_time_nanos: s.frame,
-            index: i as u64 + 1,
-            sweep,
-        };
+        let sweep = event(s.frame, i as u64 + 1, EventBody::Sweep(sweep));
         if i % 2 == 0 {
             events.push(expected);
             events.push(sweep);
@@ -2339,22 +2296,18 @@ fn expected_edge_test_only_of_an_existing_triangle() -> anyhow::Result<()> {
         normal: None,
         contact: None,
     };
-    let mut ev: Events = vec![Ok(TraceEvent::Scene {
-        log_time_nanos: 0,
-        index: 0,
-        scene: triangle_scene(),
-    })];
+    let mut ev: Events = vec![Ok(event(0, 0, EventBody::Scene(triangle_scene())))];
     for (frame, triangle) in [(0, 0), (1, 7), (2, 0)] {
-        ev.push(Ok(TraceEvent::Expected {
-            log_time_nanos: 1 + frame,
-            index: ev.len() as u64,
-            outcome: expected(frame, triangle),
-        }));
-        ev.push(Ok(TraceEvent::Sweep {
-            log_time_nanos: 1 + frame,
-            index: ev.len() as u64,
-            sweep: sweep(frame),
-        }));
+        ev.push(Ok(event(
+            1 + frame,
+            ev.len() as u64,
+            EventBody::Expected(expected(frame, triangle)),
+        )));
+        ev.push(Ok(event(
+            1 + frame,
+            ev.len() as u64,
+            EventBody::Sweep(sweep(frame)),
+        )));
     }
     let results = write_rrd(ev, Detail::Primary, &path)?;
     ensure!(
@@ -2399,11 +2352,7 @@ fn rrd_draws_edges_by_class_and_labels_each_defect() -> anyhow::Result<()> {
     let path = dir.path().join("classes.rrd");
     let floor = crate::support::flipped_floor();
     let mut events = events_for(cube_scene(), &[]);
-    events.push(Ok(TraceEvent::Scene {
-        log_time_nanos: 1,
-        index: 1,
-        scene: floor.clone(),
-    }));
+    events.push(Ok(event(1, 1, EventBody::Scene(floor.clone()))));
     let sweep = SweepMsg {
         frame: 0,
         ball: 0,
@@ -2411,11 +2360,7 @@ fn rrd_draws_edges_by_class_and_labels_each_defect() -> anyhow::Result<()> {
         p0: [1.5, 1.5, 1.0],
         p1: [1.5, 1.5, -1.0],
     };
-    events.push(Ok(TraceEvent::Sweep {
-        log_time_nanos: 2,
-        index: 2,
-        sweep,
-    }));
+    events.push(Ok(event(2, 2, EventBody::Sweep(sweep))));
     write_rrd(events, Detail::Primary, &path)?;
     let d = decode_rrd(&path)?;
     let segments = |entity: &str| -> Option<usize> {

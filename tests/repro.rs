@@ -25,31 +25,16 @@ use anyhow::Context as _;
 
 pub fn tests() -> Vec<Trial> {
     vec![
-        trial(
-            "repro::divergence_inputs_read_back_bit_exactly",
-            divergence_inputs,
-        ),
-        trial("repro::check_hex_binary", check_hex_binary),
-        trial("repro::fixture_case_gives_the_same_verdict", fixture_case),
-        trial(
-            "repro::sample_trace_cases_reproduce_and_their_tests_hold",
-            sample_cases,
-        ),
-        trial("repro::binary_writes_case_and_test", repro_binary),
-        trial("repro::sweep_from_trace_and_obj", sweep_sources),
-        trial("repro::sweep_flag_errors", sweep_flag_errors),
-        trial(
-            "repro::infer_wrong_engine_config_margin_0",
-            infer_wrong_engine_config,
-        ),
-        trial(
-            "repro::infer_margin_and_facing_implied_by_a_parallel_hit",
-            infer_parallel_hit,
-        ),
-        trial(
-            "repro::infer_strict_facing_by_replaying_both",
-            infer_strict_by_replay,
-        ),
+        trial!(divergence_inputs_read_back_bit_exactly),
+        trial!(check_hex_binary),
+        trial!(fixture_case_gives_the_same_verdict),
+        trial!(sample_trace_cases_reproduce_and_their_tests_hold),
+        trial!(binary_writes_case_and_test),
+        trial!(sweep_from_trace_and_obj),
+        trial!(sweep_flag_errors),
+        trial!(infer_wrong_engine_config_margin_0),
+        trial!(infer_margin_and_facing_implied_by_a_parallel_hit),
+        trial!(infer_strict_facing_by_replaying_both),
     ]
 }
 
@@ -88,7 +73,7 @@ fn same_bits(what: &str, got: &[f64], want: &[f64]) -> anyhow::Result<()> {
     Ok(())
 }
 
-fn divergence_inputs() -> anyhow::Result<()> {
+fn divergence_inputs_read_back_bit_exactly() -> anyhow::Result<()> {
     let options = CheckOptions {
         hex: true,
         ..CheckOptions::default()
@@ -311,7 +296,7 @@ fn check_generated_test(case: &ReproCase) -> anyhow::Result<()> {
     Ok(())
 }
 
-fn fixture_case() -> anyhow::Result<()> {
+fn fixture_case_gives_the_same_verdict() -> anyhow::Result<()> {
     let full = check_file(&fixture(), &CheckOptions::default());
     for frame in [2u64, 3] {
         let case = case_of(&fixture(), frame, 0)?;
@@ -345,7 +330,7 @@ fn fixture_case() -> anyhow::Result<()> {
 
 /// For every sample trace, a few sweeps of each kind (and fragile ones):
 /// the reduced case makes the same decision and checks `ok` on its own.
-fn sample_cases() -> anyhow::Result<()> {
+fn sample_trace_cases_reproduce_and_their_tests_hold() -> anyhow::Result<()> {
     let mut cases = 0;
     for name in [
         "record_mini_golf.mcap",
@@ -401,7 +386,7 @@ fn sample_cases() -> anyhow::Result<()> {
     Ok(())
 }
 
-fn repro_binary() -> anyhow::Result<()> {
+fn binary_writes_case_and_test() -> anyhow::Result<()> {
     let dir = tempfile::tempdir()?;
     let out = dir.path().join("case.mcap");
     let f = fixture();
@@ -452,7 +437,7 @@ fn repro_binary() -> anyhow::Result<()> {
     Ok(())
 }
 
-fn sweep_sources() -> anyhow::Result<()> {
+fn sweep_from_trace_and_obj() -> anyhow::Result<()> {
     let f = fixture();
     let (code, out, err) = run_bin(os!["sweep", "--trace", f.as_os_str(), "--frame", "3"])?;
     ensure!(code == 0, "exit {code}\n{out}\n{err}");
@@ -583,7 +568,7 @@ fn sweep_flag_errors() -> anyhow::Result<()> {
     Ok(())
 }
 
-fn infer_wrong_engine_config() -> anyhow::Result<()> {
+fn infer_wrong_engine_config_margin_0() -> anyhow::Result<()> {
     let report = check_file(&fixture(), &CheckOptions::default());
     let inferred = report.inferred.as_ref().context("nothing inferred")?;
     ensure!(inferred.margin == Some(0.0), "margin: {inferred:?}");
@@ -675,7 +660,7 @@ pub(crate) fn floor_and_sweeps(margin: f64, facing: Facing) -> (SceneMsg, Vec<Sw
     (scene, sweeps)
 }
 
-fn infer_parallel_hit() -> anyhow::Result<()> {
+fn infer_margin_and_facing_implied_by_a_parallel_hit() -> anyhow::Result<()> {
     // The engine: margin 0.05, non_strict; the scene declares margin 0, strict.
     let (scene, sweeps) = floor_and_sweeps(0.0, Facing::Strict);
     let bytes = recorded_by(&scene, &sweeps, 0.05, Facing::NonStrict)?;
@@ -707,7 +692,7 @@ fn infer_parallel_hit() -> anyhow::Result<()> {
     Ok(())
 }
 
-fn infer_strict_by_replay() -> anyhow::Result<()> {
+fn infer_strict_facing_by_replaying_both() -> anyhow::Result<()> {
     // The engine: margin 0, strict; the scene declares non_strict. The
     // parallel path then finds nothing: no hit implies a rule, replaying
     // both finds strict.

@@ -356,3 +356,32 @@ pub fn core_trace(
     }
     Ok(w.finish()?.into_inner())
 }
+
+/// A trace event: `body` logged at `log_time_nanos`, message `index` of its file.
+pub fn event(
+    log_time_nanos: u64,
+    index: u64,
+    body: sweeptrace::trace::EventBody,
+) -> sweeptrace::trace::TraceEvent {
+    sweeptrace::trace::TraceEvent {
+        header: sweeptrace::trace::EventHeader {
+            log_time_nanos,
+            index,
+        },
+        body,
+    }
+}
+
+/// Writes `event` through `w` at its `log_time` (its index is the writer's).
+pub fn write_event<W: std::io::Write + std::io::Seek>(
+    w: &mut sweeptrace::trace::TraceWriter<W>,
+    event: &sweeptrace::trace::TraceEvent,
+) -> Result<(), sweeptrace::trace::TraceError> {
+    use sweeptrace::trace::EventBody;
+    let log_time_nanos = event.header.log_time_nanos;
+    match &event.body {
+        EventBody::Scene(scene) => w.scene(log_time_nanos, scene),
+        EventBody::Sweep(sweep) => w.sweep(log_time_nanos, sweep),
+        EventBody::Expected(outcome) => w.expected(log_time_nanos, outcome),
+    }
+}

@@ -11,12 +11,14 @@ use mcap::{Compression, WriteOptions};
 use rand::{Rng, SeedableRng};
 use sweeptrace::core::{Facing, Kind};
 use sweeptrace::trace::{
-    OutcomeMsg, ReadLimits, ReadStats, SceneMsg, SweepMsg, TraceError, TraceEvent, TraceReader,
-    TraceWriter, collect_info, render_info_json, render_info_text, write_trace_file,
+    EventBody, EventHeader, OutcomeMsg, ReadLimits, ReadStats, SceneMsg, SweepMsg, TraceError,
+    TraceEvent, TraceReader, TraceWriter, collect_info, render_info_json, render_info_text,
+    write_trace_file,
 };
 
 use crate::ensure;
 use crate::support::scene_t;
+use crate::support::{event, write_event};
 use crate::trial;
 use anyhow::Context as _;
 
@@ -53,6 +55,7 @@ pub fn tests() -> Vec<Trial> {
         trial!(error_bad_outcome_alpha),
         trial!(random_corruption_never_panics),
         trial!(writer_refuses_invalid_messages),
+        trial!(writer_refuses_a_triangle_the_scene_does_not_have),
         trial!(write_trace_file_is_atomic),
         trial!(info_renders_python_fixture),
         trial!(info_reports_partial_trace),
@@ -102,11 +105,7 @@ pub fn sample_events(frames: u64) -> Vec<TraceEvent> {
     let mut push = |e: TraceEvent| {
         events.push(e);
     };
-    push(TraceEvent::Scene {
-        log_time_nanos: 0,
-        index,
-        scene: triangle_scene(),
-    });
+    push(event(0, index, EventBody::Scene(triangle_scene())));
     index += 1;
     for frame in 0..frames {
         let t = 1_000 + frame * 1_000_000;
@@ -115,26 +114,14 @@ pub fn sample_events(frames: u64) -> Vec<TraceEvent> {
             scene.name = Some("second".to_string());
             scene.margin = 0.125;
             scene.facing = Facing::Strict;
-            push(TraceEvent::Scene {
-                log_time_nanos: t,
-                index,
-                scene,
-            });
+            push(event(t, index, EventBody::Scene(scene)));
             index += 1;
         }
         for ball in 0..2 {
-            push(TraceEvent::Sweep {
-                log_time_nanos: t,
-                index,
-                sweep: sweep(frame, ball),
-            });
+            push(event(t, index, EventBody::Sweep(sweep(frame, ball))));
             index += 1;
         }
-        push(TraceEvent::Expected {
-            log_time_nanos: t,
-            index,
-            outcome: outcome(frame),
-        });
+        push(event(t, index, EventBody::Expected(outcome(frame))));
         index += 1;
     }
     events
@@ -170,23 +157,7 @@ fn no_summary() -> WriteOptions {
 pub fn write_events(events: &[TraceEvent], opts: WriteOptions) -> anyhow::Result<Vec<u8>> {
     let mut w = TraceWriter::with_options(Cursor::new(Vec::new()), opts)?;
     for e in events {
-        match e {
-            TraceEvent::Scene {
-                log_time_nanos,
-                scene,
-                ..
-            } => w.scene(*log_time_nanos, scene),
-            TraceEvent::Sweep {
-                log_time_nanos,
-                sweep,
-                ..
-            } => w.sweep(*log_time_nanos, sweep),
-            TraceEvent::Expected {
-                log_time_nanos,
-                outcome,
-                ..
-            } => w.expected(*log_time_nanos, outcome),
-        }?;
+        write_event(&mut w, e)?;
     }
     Ok(w.finish()?.into_inner())
 }
@@ -431,10 +402,12 @@ pub fn check_python_fixture(bytes: &[u8]) -> anyhow::Result<()> {
     let (events, error, stats) = read_all(bytes);
     ensure!(error.is_none(), "error: {error:?}");
     ensure!(events.len() == 10, "{} events", events.len());
-    let TraceEvent::Scene {
-        log_time_nanos: 0,
-        index: 0,
-        scene,
+    let TraceEvent {
+        header: EventHeader {
+            log_time_nanos: 0,
+            index: 0,
+        },
+        body: EventBody::Scene(scene),
     } = &events[0]
     else {
         anyhow::bail!("first event {:?}", events[0]);
@@ -444,11 +417,10 @@ pub fn check_python_fixture(bytes: &[u8]) -> anyhow::Result<()> {
     let sweeps: Vec<_> = events
         .iter()
         .filter_map(|e| match e {
-            TraceEvent::Sweep {
-                log_time_nanos,
-                index,
-                sweep,
-            } => Some((*log_time_nanos, *index, *sweep)),
+            TraceEvent {
+                header,
+                body: EventBody::Sweep(sweep),
+            } => Some((header.log_time_nanos, header.index, *sweep)),
             _ => None,
         })
         .collect();
@@ -512,8 +484,8 @@ pub fn check_python_fixture(bytes: &[u8]) -> anyhow::Result<()> {
     ensure!(sweeps == want, "sweeps {sweeps:?}");
     let outcomes: Vec<_> = events
         .iter()
-        .filter_map(|e| match e {
-            TraceEvent::Expected { outcome, .. } => Some(*outcome),
+        .filter_map(|e| match &e.body {
+            EventBody::Expected(outcome) => Some(*outcome),
             _ => None,
         })
         .collect();
@@ -590,7 +562,7 @@ fn foreign_channels_skipped_and_counted() -> anyhow::Result<()> {
     ensure!(error.is_none(), "error: {error:?}");
     ensure!(events.len() == 2, "{} events", events.len());
     ensure!(
-        events[0].index() == 1 && events[1].index() == 3,
+        events[0].header.index == 1 && events[1].header.index == 3,
         "indices {events:?}"
     );
     ensure!(stats.messages == 5, "messages {}", stats.messages);
@@ -1141,29 +1113,40 @@ fn writer_refuses_invalid_messages() -> anyhow::Result<()> {
     Ok(())
 }
 
+/// The C writer refused an `/expected` triangle beyond the scene's that the
+/// Rust writer wrote; both check it now (`validate_triangle`). The reader
+/// still reads such a trace: a recording engine's bad index is judged.
+fn writer_refuses_a_triangle_the_scene_does_not_have() -> anyhow::Result<()> {
+    let mut w = TraceWriter::new(Cursor::new(Vec::new()))?;
+    // Before any scene there is nothing to check it against.
+    w.expected(0, &OutcomeMsg::hit(0, 0, 0.5, Kind::Face).triangle(7))?;
+    w.scene(1, &triangle_scene())?;
+    w.expected(1, &OutcomeMsg::hit(1, 0, 0.5, Kind::Face).triangle(0))?;
+    let e = w
+        .expected(1, &OutcomeMsg::hit(2, 0, 0.5, Kind::Face).triangle(1))
+        .err()
+        .context("triangle 1 of a 1-triangle scene accepted")?;
+    ensure!(
+        matches!(e, TraceError::Invalid { .. })
+            && e.to_string().contains("`triangle`")
+            && e.to_string()
+                .contains("index 1 is out of range (the scene has 1 triangles)")
+            && e.to_string().contains("frame 2"),
+        "{e}"
+    );
+    let bytes = w.finish()?.into_inner();
+    let (events, error, _) = read_all(&bytes);
+    ensure!(error.is_none() && events.len() == 3, "{events:?} {error:?}");
+    Ok(())
+}
+
 fn write_trace_file_is_atomic() -> anyhow::Result<()> {
     let dir = tempfile::tempdir()?;
     let path = dir.path().join("run.mcap");
     let events = sample_events(5);
     write_trace_file(&path, |w| -> Result<(), TraceError> {
         for e in &events {
-            match e {
-                TraceEvent::Scene {
-                    log_time_nanos,
-                    scene,
-                    ..
-                } => w.scene(*log_time_nanos, scene)?,
-                TraceEvent::Sweep {
-                    log_time_nanos,
-                    sweep,
-                    ..
-                } => w.sweep(*log_time_nanos, sweep)?,
-                TraceEvent::Expected {
-                    log_time_nanos,
-                    outcome,
-                    ..
-                } => w.expected(*log_time_nanos, outcome)?,
-            }
+            write_event(w, e)?;
         }
         Ok(())
     })?;

@@ -742,7 +742,7 @@ fn recording_marks_the_tunnel() -> anyhow::Result<()> {
 
 fn sample_traces_have_none() -> anyhow::Result<()> {
     let dir = root().join("traces");
-    let traces = sweeptrace::regress::find_traces(&[dir]).map_err(anyhow::Error::msg)?;
+    let traces = sweeptrace::regress::find_traces(&[dir])?;
     ensure!(!traces.is_empty(), "no sample trace");
     for path in traces {
         let bytes = std::fs::read(&path)?;
@@ -757,9 +757,10 @@ fn sample_traces_have_none() -> anyhow::Result<()> {
 /// ball through a surface, and no sweep starts where the tests let it
 /// through.
 fn simulation_has_none() -> anyhow::Result<()> {
+    use crate::support::event;
     use sweeptrace::sim::scenes::BuiltinScene;
     use sweeptrace::sim::{SimError, SimOptions, scene_message, simulate};
-    use sweeptrace::trace::{TraceError, TraceEvent};
+    use sweeptrace::trace::{EventBody, TraceError, TraceEvent};
     let (mut sweeps, mut hits) = (0u64, 0u64);
     for scene in BuiltinScene::all() {
         let shape = scene.mesh_with_terrain_cells(12);
@@ -791,17 +792,17 @@ fn simulation_has_none() -> anyhow::Result<()> {
                 facing,
                 ..SimOptions::default()
             };
-            let mut events: Vec<Result<TraceEvent, TraceError>> = vec![Ok(TraceEvent::Scene {
-                log_time_nanos: 0,
-                index: 0,
-                scene: scene_message(&shape, &options),
-            })];
+            let mut events: Vec<Result<TraceEvent, TraceError>> = vec![Ok(event(
+                0,
+                0,
+                EventBody::Scene(scene_message(&shape, &options)),
+            ))];
             simulate::<SimError>(&m, &options, |e| {
-                events.push(Ok(TraceEvent::Sweep {
-                    log_time_nanos: e.log_time_nanos,
-                    index: events.len() as u64,
-                    sweep: e.sweep,
-                }));
+                events.push(Ok(event(
+                    e.log_time_nanos,
+                    events.len() as u64,
+                    EventBody::Sweep(e.sweep),
+                )));
                 Ok(())
             })?;
             sweeps += events.len() as u64 - 1;

@@ -32,7 +32,7 @@ use std::ffi::{CStr, CString, c_char, c_int, c_void};
 use std::panic::{AssertUnwindSafe, catch_unwind};
 use std::path::PathBuf;
 
-use sweeptrace::trace::{MAX_SETTINGS, PendingTrace};
+use sweeptrace::trace::{MAX_SETTINGS, PendingTrace, validate_triangle};
 use sweeptrace::{Encoding, ExpectedSource, OutcomeMsg, SceneMsg, SweepMsg, TraceError};
 use sweeptrace::{Facing, Kind};
 
@@ -669,19 +669,34 @@ fn outcome_message(
     let given = |bit: u32| outcome.fields & bit != 0;
     let hit = kind != Kind::None;
     let on_feature = matches!(kind, Kind::Edge | Kind::Vertex);
-    if hit && given(SWEEPTRACE_FIELD_TRIANGLE) {
+    fn field<T>(given: bool, meaningful: bool, value: T) -> Option<Option<T>> {
+        given.then_some(meaningful.then_some(value))
+    }
+    let message = OutcomeMsg {
+        frame: outcome.frame,
+        ball: outcome.ball,
+        alpha: outcome.alpha,
+        kind,
+        triangle: field(given(SWEEPTRACE_FIELD_TRIANGLE), hit, outcome.triangle),
+        // Above 255 it stays above 2, which is refused below.
+        feature: field(
+            given(SWEEPTRACE_FIELD_FEATURE),
+            on_feature,
+            u8::try_from(outcome.feature).unwrap_or(u8::MAX),
+        ),
+        normal: field(given(SWEEPTRACE_FIELD_NORMAL), hit, outcome.normal),
+        contact: field(given(SWEEPTRACE_FIELD_CONTACT), hit, outcome.contact),
+    };
+    if let Some(Some(_)) = message.triangle {
         let Some(count) = scene_triangles else {
             return Err(Failure::new(
                 SweeptraceStatus::WrongOrder,
                 format!("{at}: `triangle` is given but no scene was added yet"),
             ));
         };
-        if outcome.triangle as usize >= count {
-            return Err(Failure::invalid(format!(
-                "{at}: field `triangle`: index {} is out of range (the scene has {count} triangles)",
-                outcome.triangle
-            )));
-        }
+        // The Rust writer's rule (`TraceWriter::expected`).
+        validate_triangle(&message, count)
+            .map_err(|p| Failure::invalid(format!("{at}: field `{}`: {}", p.field, p.problem)))?;
     }
     if on_feature && given(SWEEPTRACE_FIELD_FEATURE) && outcome.feature > 2 {
         return Err(Failure::invalid(format!(
@@ -689,24 +704,7 @@ fn outcome_message(
             outcome.feature
         )));
     }
-    fn field<T>(given: bool, meaningful: bool, value: T) -> Option<Option<T>> {
-        given.then_some(meaningful.then_some(value))
-    }
-    Ok(OutcomeMsg {
-        frame: outcome.frame,
-        ball: outcome.ball,
-        alpha: outcome.alpha,
-        kind,
-        triangle: field(given(SWEEPTRACE_FIELD_TRIANGLE), hit, outcome.triangle),
-        // Checked above to be at most 2.
-        feature: field(
-            given(SWEEPTRACE_FIELD_FEATURE),
-            on_feature,
-            outcome.feature as u8,
-        ),
-        normal: field(given(SWEEPTRACE_FIELD_NORMAL), hit, outcome.normal),
-        contact: field(given(SWEEPTRACE_FIELD_CONTACT), hit, outcome.contact),
-    })
+    Ok(message)
 }
 
 /// Finishes the trace and renames it to its target path. After it (success

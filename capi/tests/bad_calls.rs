@@ -416,8 +416,8 @@ fn outcome_fields_for_a_kind_without_them_are_written_as_null() {
     let bytes = std::fs::read(&target).expect("the trace");
     let expected = sweeptrace::TraceReader::new(bytes.as_slice(), "none.mcap")
         .filter_map(Result::ok)
-        .find_map(|event| match event {
-            sweeptrace::TraceEvent::Expected { outcome, .. } => Some(outcome),
+        .find_map(|event| match event.body {
+            sweeptrace::EventBody::Expected(outcome) => Some(outcome),
             _ => None,
         })
         .expect("one expected outcome");
@@ -617,8 +617,8 @@ fn open_with_encoding_writes_cbor_and_refuses_an_unknown_encoding() {
         for topic in ["/scene", "/sweep", "/expected"] {
             assert_eq!(reader.stats().channels[topic].message_encoding, name);
         }
-        match &events[1] {
-            sweeptrace::TraceEvent::Sweep { sweep, .. } => assert_eq!(sweep.p0, P0),
+        match &events[1].body {
+            sweeptrace::EventBody::Sweep(sweep) => assert_eq!(sweep.p0, P0),
             other => panic!("not a sweep: {other:?}"),
         }
     }

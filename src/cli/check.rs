@@ -193,7 +193,7 @@ pub fn run(args: Args) -> anyhow::Result<Exit> {
         engine: args.conventions.to_overrides(),
         ..args.tolerances.to_overrides()?
     };
-    let traces = find_traces(&args.paths).map_err(anyhow::Error::msg)?;
+    let traces = find_traces(&args.paths)?;
     if traces.is_empty() {
         bail!(
             "no trace found (directories are searched for *.mcap): {}",

@@ -6,7 +6,7 @@ use anyhow::{Context, bail};
 use super::Exit;
 use sweeptrace::conform::{self, ConformOptions, ConformStatus, RULES};
 use sweeptrace::engine::EngineCommand;
-use sweeptrace::trace::TraceEvent;
+use sweeptrace::trace::EventBody;
 
 /// Arguments of `conform`.
 #[derive(Debug, clap::Args)]
@@ -109,7 +109,7 @@ fn conventions(args: &Args) -> anyhow::Result<sweeptrace::regress::EngineConvent
 
 /// Runs the suite, prints the report, returns the exit code.
 pub fn run(args: Args) -> anyhow::Result<Exit> {
-    let cases = conform::select(args.case.as_deref()).map_err(anyhow::Error::msg)?;
+    let cases = conform::select(args.case.as_deref())?;
     if args.list {
         print!("{}", list_text(&cases));
         return Ok(Exit::Success);
@@ -118,18 +118,11 @@ pub fn run(args: Args) -> anyhow::Result<Exit> {
         super::warn_unfinished(path);
         sweeptrace::trace::write_trace_file(path, |w| {
             for event in conform::case_events(&cases) {
-                match event {
-                    TraceEvent::Scene {
-                        log_time_nanos,
-                        scene,
-                        ..
-                    } => w.scene(log_time_nanos, &scene)?,
-                    TraceEvent::Sweep {
-                        log_time_nanos,
-                        sweep,
-                        ..
-                    } => w.sweep(log_time_nanos, &sweep)?,
-                    TraceEvent::Expected { .. } => {}
+                let log_time_nanos = event.header.log_time_nanos;
+                match event.body {
+                    EventBody::Scene(scene) => w.scene(log_time_nanos, &scene)?,
+                    EventBody::Sweep(sweep) => w.sweep(log_time_nanos, &sweep)?,
+                    EventBody::Expected(_) => {}
                 }
             }
             Ok::<_, sweeptrace::trace::TraceError>(())

@@ -12,7 +12,7 @@ use serde::Serialize;
 use super::Exit;
 use sweeptrace::core::{Defect, DefectKind, EdgeClass, EdgeCounts, Topology};
 use sweeptrace::sim::load_obj;
-use sweeptrace::trace::{TraceEvent, TraceReader};
+use sweeptrace::trace::{EventBody, TraceReader};
 
 /// How many defects of each kind the text report lists.
 const LISTED_PER_KIND: usize = 3;
@@ -259,7 +259,8 @@ pub fn run(args: Args) -> anyhow::Result<Exit> {
         let reader = TraceReader::new_indexed(std::io::BufReader::new(file), &name);
         for event in reader {
             let event = event.name_file_once("reading the trace", &name)?;
-            if let TraceEvent::Scene { index, scene, .. } = event {
+            if let EventBody::Scene(scene) = event.body {
+                let index = event.header.index;
                 let topology = Topology::new(&scene.vertices, &scene.triangles)
                     .with_context(|| format!("{name}: the scene of message {index}"))?;
                 let shown = scene.name.unwrap_or_else(|| format!("scene {index}"));

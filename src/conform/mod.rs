@@ -28,7 +28,7 @@ use crate::regress::{
     divergence_details, render_divergence_as,
 };
 use crate::replay::{ReplayEvent, ReplayOptions, replay_events};
-use crate::trace::{OutcomeMsg, TraceEvent};
+use crate::trace::{EventBody, EventHeader, OutcomeMsg, TraceEvent};
 
 /// The first failing case of a rule, explained.
 #[derive(Clone, Debug, PartialEq, Serialize)]
@@ -237,10 +237,23 @@ pub struct ConformOptions {
     pub conventions: EngineConventions,
 }
 
+/// `conform --case` named no case, rule or group of rules; the message
+/// lists the rules ([`RULES`]).
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error(
+    "no conformance case or rule `{name}`; the rules are: {}",
+    RULES.iter().map(|r| r.name).collect::<Vec<_>>().join(", ")
+)]
+#[non_exhaustive]
+pub struct UnknownCase {
+    /// What was asked for.
+    pub name: String,
+}
+
 /// The cases `only` selects (every case when `None`): a case
 /// (`edge.hit/2`), a rule (`edge.hit`) or a group of rules (`edge`,
 /// `edge.miss`); an error names the rules when nothing matches.
-pub fn select(only: Option<&str>) -> Result<Vec<Case>, String> {
+pub fn select(only: Option<&str>) -> Result<Vec<Case>, UnknownCase> {
     let all = cases();
     let Some(only) = only else {
         return Ok(all);
@@ -256,10 +269,9 @@ pub fn select(only: Option<&str>) -> Result<Vec<Case>, String> {
         })
         .collect();
     if chosen.is_empty() {
-        return Err(format!(
-            "no conformance case or rule `{only}`; the rules are: {}",
-            RULES.iter().map(|r| r.name).collect::<Vec<_>>().join(", ")
-        ));
+        return Err(UnknownCase {
+            name: only.to_string(),
+        });
     }
     Ok(chosen)
 }
@@ -269,15 +281,17 @@ pub fn case_events(cases: &[Case]) -> Vec<TraceEvent> {
     let mut events = Vec::with_capacity(2 * cases.len());
     for (i, case) in cases.iter().enumerate() {
         let i = i as u64;
-        events.push(TraceEvent::Scene {
-            log_time_nanos: 2 * i,
-            index: 2 * i,
-            scene: case.scene.clone(),
+        let at = |n: u64| EventHeader {
+            log_time_nanos: n,
+            index: n,
+        };
+        events.push(TraceEvent {
+            header: at(2 * i),
+            body: EventBody::Scene(case.scene.clone()),
         });
-        events.push(TraceEvent::Sweep {
-            log_time_nanos: 2 * i + 1,
-            index: 2 * i + 1,
-            sweep: case.sweep,
+        events.push(TraceEvent {
+            header: at(2 * i + 1),
+            body: EventBody::Sweep(case.sweep),
         });
     }
     events

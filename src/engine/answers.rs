@@ -6,7 +6,7 @@ use std::rc::Rc;
 
 use crate::trace::OutcomeMsg;
 
-use crate::trace::{TraceError, TraceEvent};
+use crate::trace::{EventBody, TraceError, TraceEvent};
 
 use super::{EngineError, EngineSession};
 
@@ -20,7 +20,7 @@ enum Queued {
 
 /// The events of a trace, with the trace's own `/expected` messages left
 /// out and each sweep preceded by the engine's answer to it, as an
-/// [`TraceEvent::Expected`] of that sweep. Scenes and sweeps go to the
+/// [`EventBody::Expected`] of that sweep. Scenes and sweeps go to the
 /// engine as they are read, up to `window` sweeps ahead of the answers.
 ///
 /// A fault of the engine ends the events (what came before stays valid);
@@ -127,26 +127,24 @@ where
         while !self.input_done && self.in_flight < self.window {
             match self.input.next() {
                 None => self.input_done = true,
-                Some(Ok(event @ TraceEvent::Expected { .. })) => {
-                    self.trace_expectations += 1;
-                    if self.sink.is_some() {
+                Some(Ok(event)) => match &event.body {
+                    EventBody::Expected(_) => {
+                        self.trace_expectations += 1;
+                        if self.sink.is_some() {
+                            self.queue.push_back(Queued::Ready(Ok(event)));
+                        }
+                    }
+                    EventBody::Scene(scene) => {
+                        session.send_scene(scene)?;
                         self.queue.push_back(Queued::Ready(Ok(event)));
                     }
-                }
-                Some(Ok(event @ TraceEvent::Scene { .. })) => {
-                    if let TraceEvent::Scene { scene, .. } = &event {
-                        session.send_scene(scene)?;
-                    }
-                    self.queue.push_back(Queued::Ready(Ok(event)));
-                }
-                Some(Ok(event @ TraceEvent::Sweep { .. })) => {
-                    if let TraceEvent::Sweep { sweep, .. } = &event {
+                    EventBody::Sweep(sweep) => {
                         session.send_sweep(sweep)?;
                         let key = (sweep.frame, sweep.ball);
                         self.queue.push_back(Queued::Sweep(event, key));
                         self.in_flight += 1;
                     }
-                }
+                },
                 Some(Err(e)) => self.queue.push_back(Queued::Ready(Err(e))),
             }
         }
@@ -180,7 +178,7 @@ where
                     self.queue.pop_front();
                     return Some(Ok(event));
                 }
-                let (key, log_time_nanos, index) = (*key, event.log_time_nanos(), event.index());
+                let (key, header) = (*key, event.header);
                 let session = self.session.as_mut()?;
                 match session.next_answer(key) {
                     Ok(outcome) if self.sink.is_some() => {
@@ -197,10 +195,9 @@ where
                     Ok(outcome) => {
                         self.front_answered = true;
                         self.answered += 1;
-                        Some(Ok(TraceEvent::Expected {
-                            log_time_nanos,
-                            index,
-                            outcome,
+                        Some(Ok(TraceEvent {
+                            header,
+                            body: EventBody::Expected(outcome),
                         }))
                     }
                     Err(e) => self.fail(e),

@@ -18,7 +18,7 @@ use std::collections::BTreeMap;
 
 use crate::core::Feature;
 use crate::replay::{ReplayError, ReplayEvent, ReplayOptions, SweepResult};
-use crate::trace::{EXPECTED_TOPIC, OutcomeMsg, TraceError, TraceEvent, TraceReader};
+use crate::trace::{EXPECTED_TOPIC, EventBody, OutcomeMsg, TraceError, TraceEvent, TraceReader};
 
 use super::compare::{FieldDiff, Tolerances};
 use super::conventions::EngineConventions;
@@ -159,7 +159,13 @@ where
 {
     let mut saw_expected = false;
     let events = events.inspect(|e| {
-        if matches!(e, Ok(TraceEvent::Expected { .. })) {
+        if matches!(
+            e,
+            Ok(TraceEvent {
+                body: EventBody::Expected(_),
+                ..
+            })
+        ) {
             saw_expected = true;
         }
     });

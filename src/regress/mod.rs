@@ -70,7 +70,7 @@ pub use decision::{decision_line, divergence};
 pub use diff::{
     DiffReport, FirstDifference, Side, diff, render_diff_json, render_diff_text, scene_differences,
 };
-pub use discovery::find_traces;
+pub use discovery::{DiscoveryError, find_traces};
 pub use engine_check::check_file_with_engine;
 pub use explain::ExpectedTest;
 pub(crate) use explain::{expected_tests, explain_outcome, explained_records};

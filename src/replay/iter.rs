@@ -4,7 +4,7 @@
 use std::collections::VecDeque;
 use std::sync::Arc;
 
-use crate::trace::{TraceError, TraceEvent};
+use crate::trace::{EventBody, TraceError, TraceEvent};
 
 use super::replayer::{ComputedSweep, compute_sweep};
 use super::{Replay, ReplayError, ReplayEvent, ReplayOptions, ReplaySummary};
@@ -163,8 +163,8 @@ where
         while batch.len() < self.batch_events {
             match self.events.next() {
                 Some(Ok(event)) => {
-                    let is_scene = matches!(event, TraceEvent::Scene { .. });
-                    if is_scene && batch.iter().any(|e| !matches!(e, TraceEvent::Scene { .. })) {
+                    let is_scene = |e: &TraceEvent| matches!(e.body, EventBody::Scene(_));
+                    if is_scene(&event) && batch.iter().any(|e| !is_scene(e)) {
                         self.held_scene = Some(event);
                         break;
                     }
@@ -184,7 +184,7 @@ where
         // Leading scenes first, so the sweeps see the scene in force.
         let scenes = batch
             .iter()
-            .take_while(|e| matches!(e, TraceEvent::Scene { .. }))
+            .take_while(|e| matches!(e.body, EventBody::Scene(_)))
             .count();
         let rest = batch.split_off(scenes);
         for event in batch {
@@ -194,11 +194,9 @@ where
 
         let scene = replay.current_scene().cloned();
         let options = *replay.options();
-        let compute = |event: &TraceEvent| match (event, &scene) {
-            (TraceEvent::Sweep { index, sweep, .. }, Some(scene))
-                if options.wants(sweep.frame, sweep.ball) =>
-            {
-                Some(compute_sweep(scene, sweep, *index, &options))
+        let compute = |event: &TraceEvent| match (&event.body, &scene) {
+            (EventBody::Sweep(sweep), Some(scene)) if options.wants(sweep.frame, sweep.ball) => {
+                Some(compute_sweep(scene, sweep, event.header.index, &options))
             }
             _ => None,
         };
@@ -211,13 +209,12 @@ where
             }
         };
         for (event, computed) in rest.into_iter().zip(computed) {
-            let result = match event {
-                TraceEvent::Sweep {
-                    log_time_nanos,
-                    index,
-                    sweep,
-                } => replay.sweep_computed(log_time_nanos, index, sweep, computed),
-                other => replay.push(other),
+            let result = match event.body {
+                EventBody::Sweep(sweep) => replay.sweep_computed(event.header, sweep, computed),
+                body => replay.push(TraceEvent {
+                    header: event.header,
+                    body,
+                }),
             };
             drain(replay, result, &mut self.out);
         }

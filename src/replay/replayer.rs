@@ -1,5 +1,5 @@
-//! The push-based replay engine: scenes built into meshes, each sweep run
-//! through the core, `/expected` outcomes attached to their sweep.
+//! The push-based replay state machine: scenes built into meshes, each
+//! sweep run through the core, `/expected` outcomes attached to their sweep.
 
 use std::collections::{HashMap, VecDeque};
 use std::sync::Arc;
@@ -10,7 +10,7 @@ use crate::core::{
     Broadphase, CollectRecords, EdgeClass, Feature, Mesh, Observer, Options, Outcome, SkipCounts,
     Sweep, TestRecord, Topology, VerdictCounts, sweep_mesh, sweep_mesh_with,
 };
-use crate::trace::{OutcomeMsg, SceneMsg, SweepMsg, TraceEvent};
+use crate::trace::{EventBody, EventHeader, OutcomeMsg, SceneMsg, SweepMsg, TraceEvent};
 
 use super::options::{ACTIVE_EDGE_DEGREES, NormalRule};
 use super::primary::CollectPrimary;
@@ -334,7 +334,7 @@ pub enum ReplayEvent {
     Sweep(Box<SweepResult>),
 }
 
-/// The replay engine (push-based; see the module documentation).
+/// The replay state machine (push-based; see the module documentation).
 #[derive(Debug)]
 pub struct Replay {
     options: ReplayOptions,
@@ -374,12 +374,11 @@ impl Replay {
     }
 
     /// A `/scene` message.
-    pub fn scene(
-        &mut self,
-        log_time_nanos: u64,
-        index: u64,
-        scene: SceneMsg,
-    ) -> Result<(), ReplayError> {
+    pub fn scene(&mut self, header: EventHeader, scene: SceneMsg) -> Result<(), ReplayError> {
+        let EventHeader {
+            log_time_nanos,
+            index,
+        } = header;
         let start = Instant::now();
         self.release_pending();
         let SceneMsg {
@@ -423,12 +422,7 @@ impl Replay {
     }
 
     /// A `/sweep` message.
-    pub fn sweep(
-        &mut self,
-        log_time_nanos: u64,
-        index: u64,
-        msg: SweepMsg,
-    ) -> Result<(), ReplayError> {
+    pub fn sweep(&mut self, header: EventHeader, msg: SweepMsg) -> Result<(), ReplayError> {
         self.summary.seen.add(msg.frame, msg.ball);
         if self.pending.first().is_some_and(|p| p.frame != msg.frame) {
             self.release_pending();
@@ -443,11 +437,11 @@ impl Replay {
         let Some(scene) = self.scene.clone() else {
             return Err(ReplayError::NoScene {
                 frame: msg.frame,
-                index,
+                index: header.index,
             });
         };
-        let computed = compute_sweep(&scene, &msg, index, &self.options);
-        self.commit(log_time_nanos, index, msg, &scene, computed?);
+        let computed = compute_sweep(&scene, &msg, header.index, &self.options);
+        self.commit(header, msg, &scene, computed?);
         Ok(())
     }
 
@@ -457,13 +451,12 @@ impl Replay {
     /// [`Replay::sweep`] without the query. Used by [`super::replay_events_parallel`].
     pub(crate) fn sweep_computed(
         &mut self,
-        log_time_nanos: u64,
-        index: u64,
+        header: EventHeader,
         msg: SweepMsg,
         computed: Option<Result<ComputedSweep, ReplayError>>,
     ) -> Result<(), ReplayError> {
         let Some(computed) = computed else {
-            return self.sweep(log_time_nanos, index, msg);
+            return self.sweep(header, msg);
         };
         self.summary.seen.add(msg.frame, msg.ball);
         if self.pending.first().is_some_and(|p| p.frame != msg.frame) {
@@ -472,10 +465,10 @@ impl Replay {
         let Some(scene) = self.scene.clone() else {
             return Err(ReplayError::NoScene {
                 frame: msg.frame,
-                index,
+                index: header.index,
             });
         };
-        self.commit(log_time_nanos, index, msg, &scene, computed?);
+        self.commit(header, msg, &scene, computed?);
         Ok(())
     }
 
@@ -486,8 +479,7 @@ impl Replay {
 
     fn commit(
         &mut self,
-        log_time_nanos: u64,
-        index: u64,
+        header: EventHeader,
         msg: SweepMsg,
         scene: &Arc<SceneState>,
         computed: ComputedSweep,
@@ -537,8 +529,8 @@ impl Replay {
         self.pending.push(SweepResult {
             frame: msg.frame,
             ball: msg.ball,
-            log_time_nanos,
-            index,
+            log_time_nanos: header.log_time_nanos,
+            index: header.index,
             scene: Arc::clone(scene),
             sweep,
             outcome,
@@ -551,18 +543,10 @@ impl Replay {
 
     /// Any trace event.
     pub fn push(&mut self, event: TraceEvent) -> Result<(), ReplayError> {
-        match event {
-            TraceEvent::Scene {
-                log_time_nanos,
-                index,
-                scene,
-            } => self.scene(log_time_nanos, index, scene),
-            TraceEvent::Sweep {
-                log_time_nanos,
-                index,
-                sweep,
-            } => self.sweep(log_time_nanos, index, sweep),
-            TraceEvent::Expected { outcome, .. } => {
+        match event.body {
+            EventBody::Scene(scene) => self.scene(event.header, scene),
+            EventBody::Sweep(sweep) => self.sweep(event.header, sweep),
+            EventBody::Expected(outcome) => {
                 self.expected(outcome);
                 Ok(())
             }

@@ -11,7 +11,7 @@ use serde::Serialize;
 
 use super::error::TraceError;
 use super::messages::{EXPECTED_TOPIC, SCENE_TOPIC, SWEEP_TOPIC};
-use super::read::{ReadStats, TraceEvent, TraceReader};
+use super::read::{EventBody, EventHeader, ReadStats, TraceReader};
 use crate::core::{EdgeCounts, Mesh, MeshError, Topology};
 use crate::numbers::counted;
 
@@ -122,13 +122,13 @@ pub fn collect_info<R: Read>(mut reader: TraceReader<R>) -> (TraceInfo, Option<T
                 break;
             }
         };
-        widen(&mut info.log_time_nanos, event.log_time_nanos());
-        match event {
-            TraceEvent::Scene {
-                log_time_nanos,
-                index,
-                scene,
-            } => {
+        let EventHeader {
+            log_time_nanos,
+            index,
+        } = event.header;
+        widen(&mut info.log_time_nanos, log_time_nanos);
+        match event.body {
+            EventBody::Scene(scene) => {
                 info.scene_count += 1;
                 if info.scenes.len() < MAX_LISTED_SCENES {
                     let vertices = scene.vertices.len();
@@ -157,7 +157,7 @@ pub fn collect_info<R: Read>(mut reader: TraceReader<R>) -> (TraceInfo, Option<T
                     });
                 }
             }
-            TraceEvent::Sweep { sweep, .. } => {
+            EventBody::Sweep(sweep) => {
                 info.sweeps += 1;
                 widen(&mut info.frames, sweep.frame);
                 if info.balls.len() < MAX_LISTED_BALLS || info.balls.contains(&sweep.ball) {
@@ -166,7 +166,7 @@ pub fn collect_info<R: Read>(mut reader: TraceReader<R>) -> (TraceInfo, Option<T
                     info.balls_truncated = true;
                 }
             }
-            TraceEvent::Expected { outcome, .. } => {
+            EventBody::Expected(outcome) => {
                 info.expected += 1;
                 widen(&mut info.frames, outcome.frame);
                 *info

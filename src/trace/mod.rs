@@ -35,11 +35,16 @@ pub use messages::{
     SWEEP_TOPIC, SceneMsg, SweepMsg,
 };
 pub use prefetch::{DEFAULT_PREFETCH_CHUNK, DEFAULT_PREFETCH_DEPTH, Prefetched, prefetch};
-pub use read::{ChannelStats, ReadLimits, ReadStats, TraceEvent, TraceReader};
+pub use read::{
+    ChannelStats, EventBody, EventHeader, ReadLimits, ReadStats, TraceEvent, TraceReader,
+};
 pub(crate) use schemas::SCHEMA_ENCODING;
 pub use schemas::{OUTCOME_SCHEMA_JSON, SCENE_SCHEMA_JSON, SWEEP_SCHEMA_JSON};
 pub use source::{EXPECTED_SOURCE_METADATA, ExpectedSource, MAX_SETTINGS, sweeptrace_source};
-pub use validate::{FieldProblem, parse_message, validate_outcome, validate_scene, validate_sweep};
+pub use validate::{
+    FieldProblem, parse_message, validate_outcome, validate_scene, validate_sweep,
+    validate_triangle,
+};
 pub(crate) use validate::{frame_of_message, parse_message_as};
 pub(crate) use write::library_string;
 pub use write::{

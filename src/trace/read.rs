@@ -44,56 +44,34 @@ impl Default for ReadLimits {
     }
 }
 
-/// One message of a trace channel, parsed and validated.
+/// One message of a trace channel, parsed and validated: where it sits in
+/// the file, and what it says.
 #[derive(Debug, Clone, PartialEq)]
-pub enum TraceEvent {
-    /// A `/scene` message.
-    Scene {
-        /// Its `log_time`.
-        log_time_nanos: u64,
-        /// Its index among all messages of the file, from 0.
-        index: u64,
-        /// The scene.
-        scene: SceneMsg,
-    },
-    /// A `/sweep` message.
-    Sweep {
-        /// Its `log_time`.
-        log_time_nanos: u64,
-        /// Its index among all messages of the file, from 0.
-        index: u64,
-        /// The sweep.
-        sweep: SweepMsg,
-    },
-    /// An `/expected` message.
-    Expected {
-        /// Its `log_time`.
-        log_time_nanos: u64,
-        /// Its index among all messages of the file, from 0.
-        index: u64,
-        /// The expected outcome.
-        outcome: OutcomeMsg,
-    },
+pub struct TraceEvent {
+    /// Its `log_time` and its index in the file.
+    pub header: EventHeader,
+    /// The message.
+    pub body: EventBody,
 }
 
-impl TraceEvent {
-    /// The message's `log_time` in nanoseconds.
-    pub fn log_time_nanos(&self) -> u64 {
-        match self {
-            TraceEvent::Scene { log_time_nanos, .. }
-            | TraceEvent::Sweep { log_time_nanos, .. }
-            | TraceEvent::Expected { log_time_nanos, .. } => *log_time_nanos,
-        }
-    }
+/// Where a message sits in its trace.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub struct EventHeader {
+    /// Its `log_time`.
+    pub log_time_nanos: u64,
+    /// Its index among all messages of the file, from 0.
+    pub index: u64,
+}
 
-    /// The message's index in the file.
-    pub fn index(&self) -> u64 {
-        match self {
-            TraceEvent::Scene { index, .. }
-            | TraceEvent::Sweep { index, .. }
-            | TraceEvent::Expected { index, .. } => *index,
-        }
-    }
+/// The message of a [`TraceEvent`], by channel.
+#[derive(Debug, Clone, PartialEq)]
+pub enum EventBody {
+    /// A `/scene` message.
+    Scene(SceneMsg),
+    /// A `/sweep` message.
+    Sweep(SweepMsg),
+    /// An `/expected` message.
+    Expected(OutcomeMsg),
 }
 
 /// One channel (or several sharing a topic) as seen in the file.

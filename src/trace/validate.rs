@@ -269,3 +269,18 @@ pub fn validate_outcome(outcome: &OutcomeMsg) -> Result<(), FieldProblem> {
     }
     Ok(())
 }
+
+/// Checks an outcome's `triangle` against its scene: an index below
+/// `scene_triangles`. The writers check it ([`TraceWriter::expected`](super::TraceWriter::expected)
+/// and the C API's); the reader does not, so that a recording engine that
+/// names a triangle the scene does not have is judged (a divergence), not
+/// refused with the file.
+pub fn validate_triangle(outcome: &OutcomeMsg, scene_triangles: usize) -> Result<(), FieldProblem> {
+    match outcome.triangle {
+        Some(Some(triangle)) if triangle as usize >= scene_triangles => Err(FieldProblem::new(
+            "triangle",
+            format!("index {triangle} is out of range (the scene has {scene_triangles} triangles)"),
+        )),
+        _ => Ok(()),
+    }
+}

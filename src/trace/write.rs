@@ -36,7 +36,7 @@ use super::schemas::{
     SWEEP_SCHEMA_JSON,
 };
 use super::source::{EXPECTED_SOURCE_METADATA, ExpectedSource};
-use super::validate::{validate_outcome, validate_scene, validate_sweep};
+use super::validate::{validate_outcome, validate_scene, validate_sweep, validate_triangle};
 use crate::atomic::PendingFile;
 
 /// The library string written into every trace: `sweeptrace <version>`.
@@ -65,6 +65,9 @@ pub struct TraceWriter<W: Write + Seek> {
     messages: u64,
     last_log_time: Option<u64>,
     scene_margin: Option<f64>,
+    /// The current scene's triangle count, against which an `/expected`
+    /// triangle is checked; `None` before the first scene.
+    scene_triangles: Option<usize>,
     /// Whether the `sweeptrace.expected_source` record was written.
     wrote_expected_source: bool,
 }
@@ -164,6 +167,7 @@ impl<W: Write + Seek> TraceWriter<W> {
             messages: 0,
             last_log_time: None,
             scene_margin: None,
+            scene_triangles: None,
             wrote_expected_source: false,
         })
     }
@@ -315,6 +319,7 @@ impl<W: Write + Seek> TraceWriter<W> {
         validate_scene(scene).map_err(|p| p.at(self.at(SCENE_TOPIC, None)))?;
         self.put(self.scene_channel, SCENE_TOPIC, None, log_time_nanos, scene)?;
         self.scene_margin = Some(scene.margin);
+        self.scene_triangles = Some(scene.triangles.len());
         Ok(())
     }
 
@@ -337,7 +342,8 @@ impl<W: Write + Seek> TraceWriter<W> {
         )
     }
 
-    /// Writes an `/expected` message.
+    /// Writes an `/expected` message. Its triangle must be one of the
+    /// current scene's ([`validate_triangle`]), when a scene was written.
     pub fn expected(
         &mut self,
         log_time_nanos: u64,
@@ -345,7 +351,12 @@ impl<W: Write + Seek> TraceWriter<W> {
     ) -> Result<(), TraceError> {
         let frame = Some(outcome.frame);
         self.check_time(EXPECTED_TOPIC, frame, log_time_nanos)?;
-        validate_outcome(outcome).map_err(|p| p.at(self.at(EXPECTED_TOPIC, frame)))?;
+        validate_outcome(outcome)
+            .and_then(|()| match self.scene_triangles {
+                Some(count) => validate_triangle(outcome, count),
+                None => Ok(()),
+            })
+            .map_err(|p| p.at(self.at(EXPECTED_TOPIC, frame)))?;
         self.put(
             self.expected_channel,
             EXPECTED_TOPIC,

@@ -3,7 +3,7 @@
 
 use crate::core::{MeshError, Options, Sweep, SweepError};
 use crate::replay::SweepExtent;
-use crate::trace::{OutcomeMsg, SceneMsg, SweepMsg, TraceError, TraceEvent};
+use crate::trace::{EventBody, OutcomeMsg, SceneMsg, SweepMsg, TraceError, TraceEvent};
 
 /// Why a sweep could not be taken out of a trace.
 #[derive(Debug, thiserror::Error)]
@@ -111,18 +111,14 @@ where
             Err(_) if found.is_some() => break,
             Err(e) => return Err(e.into()),
         };
-        match event {
-            TraceEvent::Scene { scene: s, .. } => {
+        match event.body {
+            EventBody::Scene(s) => {
                 if found.is_some() {
                     break;
                 }
                 scene = Some(s);
             }
-            TraceEvent::Sweep {
-                sweep,
-                log_time_nanos,
-                ..
-            } => {
+            EventBody::Sweep(sweep) => {
                 seen.add(sweep.frame, sweep.ball);
                 if let Some(f) = &found {
                     if sweep.frame != f.sweep.frame {
@@ -141,12 +137,12 @@ where
                     found = Some(TraceSweep {
                         scene: s,
                         sweep,
-                        log_time_nanos,
+                        log_time_nanos: event.header.log_time_nanos,
                         expected: early.take(),
                     });
                 }
             }
-            TraceEvent::Expected { outcome, .. } => {
+            EventBody::Expected(outcome) => {
                 if outcome.frame != frame || outcome.ball != ball {
                     continue;
                 }

@@ -9,7 +9,7 @@ use mcap::McapError;
 use mcap::records::{Record, op};
 use mcap::sans_io::{LinearReader, LinearReaderOptions};
 
-use super::{ChannelInfo, State, TraceError, TraceEvent, clamp};
+use super::{ChannelInfo, EventBody, EventHeader, State, TraceError, TraceEvent, clamp};
 use crate::trace::encoding::Encoding;
 use crate::trace::error::MessageAt;
 use crate::trace::messages::{
@@ -256,16 +256,12 @@ impl State {
                 previous_nanos,
             });
         }
-        let event = match topic {
+        let body = match topic {
             SCENE_TOPIC => {
                 let scene: SceneMsg = parse_message_as(data, encoding, || at(None))?;
                 validate_scene(&scene).map_err(|p| p.at(at(None)))?;
                 self.scene_margin = Some(scene.margin);
-                TraceEvent::Scene {
-                    log_time_nanos,
-                    index,
-                    scene,
-                }
+                EventBody::Scene(scene)
             }
             SWEEP_TOPIC => {
                 let sweep: SweepMsg = parse_message_as(data, encoding, || at(None))?;
@@ -276,20 +272,12 @@ impl State {
                 }
                 validate_sweep(&sweep, self.scene_margin)
                     .map_err(|p| p.at(at(Some(sweep.frame))))?;
-                TraceEvent::Sweep {
-                    log_time_nanos,
-                    index,
-                    sweep,
-                }
+                EventBody::Sweep(sweep)
             }
             _ => {
                 let outcome: OutcomeMsg = parse_message_as(data, encoding, || at(None))?;
                 validate_outcome(&outcome).map_err(|p| p.at(at(Some(outcome.frame))))?;
-                TraceEvent::Expected {
-                    log_time_nanos,
-                    index,
-                    outcome,
-                }
+                EventBody::Expected(outcome)
             }
         };
         if let Some(c) = self.stats.channels.get_mut(topic) {
@@ -297,6 +285,12 @@ impl State {
         }
         self.last_log_time = Some(log_time_nanos);
         self.stats.messages += 1;
-        Ok(Some(event))
+        Ok(Some(TraceEvent {
+            header: EventHeader {
+                log_time_nanos,
+                index,
+            },
+            body,
+        }))
     }
 }

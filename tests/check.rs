@@ -441,7 +441,7 @@ fn blessed_trace_passes() -> anyhow::Result<()> {
     let report = check_bytes(&blessed);
     ensure!(report.status() == Status::Ok, "{}", render_text(&report));
     ensure!(
-        report.compared == 5 && report.sweeps_without_expectation == 0,
+        report.compared == 5 && report.expectations.missing == 0,
         "counts: {report:?}"
     );
     ensure!(
@@ -463,7 +463,11 @@ fn check_fixture_report(report: &sweeptrace::regress::TraceReport) -> anyhow::Re
         report.divergent == 2,
         "two sweeps diverge (2 and 3):\n{text}"
     );
-    let first = report.divergences.first().context("no divergence detail")?;
+    let first = report
+        .divergences
+        .details
+        .first()
+        .context("no divergence detail")?;
     ensure!(
         first.frame == 2,
         "first divergent frame is 2, got {}",
@@ -671,7 +675,7 @@ fn bless_round_trip_fixes_wrong_expectations() -> anyhow::Result<()> {
     let report = check_bytes(&blessed);
     ensure!(report.status() == Status::Ok, "{}", render_text(&report));
     ensure!(
-        report.compared == 5 && report.expectations_without_sweep == 0,
+        report.compared == 5 && report.expectations.unmatched == 0,
         "one expectation per sweep, old ones gone: {report:?}"
     );
     // Blessing twice gives the same bytes (deterministic writer).

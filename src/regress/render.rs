@@ -234,8 +234,8 @@ pub fn render_text(r: &TraceReport) -> String {
         "{}, {} compared, {} without expectation, {} without a sweep",
         crate::numbers::counted(r.sweeps, "sweep", "sweeps"),
         r.compared,
-        r.sweeps_without_expectation,
-        crate::numbers::counted(r.expectations_without_sweep, "expectation", "expectations"),
+        r.expectations.missing,
+        crate::numbers::counted(r.expectations.unmatched, "expectation", "expectations"),
     );
     if !r.tolerances.fields.is_all() {
         let _ = write!(counts, ", fields compared: {}", r.tolerances.fields.names());
@@ -247,8 +247,8 @@ pub fn render_text(r: &TraceReport) -> String {
             crate::numbers::counted(r.ties, "tie", "ties")
         );
     }
-    if r.fragile_divergent > 0 {
-        let reasons = counts_by_name(&r.fragile_by_reason)
+    if r.fragile.count > 0 {
+        let reasons = counts_by_name(&r.fragile.by_reason)
             .iter()
             .map(|(k, n)| format!("{k}: {n}"))
             .collect::<Vec<_>>()
@@ -256,53 +256,53 @@ pub fn render_text(r: &TraceReport) -> String {
         let _ = write!(
             counts,
             ", {} fragile divergences ({reasons}){}",
-            r.fragile_divergent,
-            if r.strict {
+            r.fragile.count,
+            if r.fragile.strict {
                 ", failures under --strict"
             } else {
                 ", not failures without --strict"
             }
         );
     }
-    if r.tunnels > 0 && !r.fail_on_tunnel {
+    if r.tunnels.count > 0 && !r.tunnels.fail {
         let _ = write!(
             counts,
             ", {} {} (not failures: tunnels allowed)",
-            r.tunnels,
-            tunnel_words(r.tunnels)
+            r.tunnels.count,
+            tunnel_words(r.tunnels.count)
         );
     }
-    if r.ghosts > 0 && !r.fail_on_ghost {
+    if r.ghosts.count > 0 && !r.ghosts.fail {
         let _ = write!(
             counts,
             ", {} (not failures: ghost contacts allowed)",
-            ghost_words(r.ghosts)
+            ghost_words(r.ghosts.count)
         );
     }
     let tunnel_lines = |s: &mut String| {
-        for t in &r.tunnel_details {
+        for t in &r.tunnels.details {
             let _ = writeln!(s, "  tunnel: {}", t.line());
         }
-        if r.tunnels as usize > r.tunnel_details.len() {
+        if r.tunnels.count as usize > r.tunnels.details.len() {
             let _ = writeln!(
                 s,
                 "  ... {} more tunnels",
-                r.tunnels as usize - r.tunnel_details.len()
+                r.tunnels.count as usize - r.tunnels.details.len()
             );
         }
-        for g in &r.ghost_contacts {
+        for g in &r.ghosts.contacts {
             let _ = writeln!(s, "  ghost contact: {g}");
         }
-        if r.ghosts as usize > r.ghost_contacts.len() {
+        if r.ghosts.count as usize > r.ghosts.contacts.len() {
             let _ = writeln!(
                 s,
                 "  ... {} more ghost contacts",
-                r.ghosts as usize - r.ghost_contacts.len()
+                r.ghosts.count as usize - r.ghosts.contacts.len()
             );
         }
     };
     let fragile_details = |s: &mut String| {
-        for d in &r.fragile_divergences {
+        for d in &r.fragile.details {
             let _ = writeln!(
                 s,
                 "  fragile divergence (not a failure; rounding could change this decision):"
@@ -319,7 +319,7 @@ pub fn render_text(r: &TraceReport) -> String {
         Status::Fail => {
             let mut failures: Vec<String> = Vec::new();
             if r.divergent > 0 || !(r.fails_on_tunnels() || r.fails_on_ghosts()) {
-                let kinds = counts_by_name(&r.by_kind)
+                let kinds = counts_by_name(&r.divergences.by_kind)
                     .iter()
                     .map(|(k, n)| format!("{k}: {n}"))
                     .collect::<Vec<_>>()
@@ -332,9 +332,9 @@ pub fn render_text(r: &TraceReport) -> String {
             if r.fails_on_tunnels() {
                 failures.push(format!(
                     "{} {} (a ball's centre went through a triangle from its front to its back: {})",
-                    r.tunnels,
-                    tunnel_words(r.tunnels),
-                    counts_by_name(&r.tunnels_by_kind)
+                    r.tunnels.count,
+                    tunnel_words(r.tunnels.count),
+                    counts_by_name(&r.tunnels.by_kind)
                         .iter()
                         .map(|(k, n)| format!("{k}: {n}"))
                         .collect::<Vec<_>>()
@@ -345,18 +345,18 @@ pub fn render_text(r: &TraceReport) -> String {
                 failures.push(format!(
                     "{} (an edge or vertex contact on an internal flat or concave place \
                      with a normal more than {}° off the faces')",
-                    ghost_words(r.ghosts),
-                    crate::core::explain::num(r.ghost_degrees)
+                    ghost_words(r.ghosts.count),
+                    crate::core::explain::num(r.ghosts.degrees)
                 ));
             }
             let _ = writeln!(s, "FAIL {}: {}; {counts}", r.trace, failures.join("; "));
             tunnel_lines(&mut s);
-            if r.divergences.is_empty()
-                && let Some(frame) = r.divergent_frames.first()
+            if r.divergences.details.is_empty()
+                && let Some(frame) = r.divergences.frames.first()
             {
                 let _ = writeln!(s, "  first divergence: frame {frame}");
             }
-            if let Some(first) = r.divergences.first() {
+            if let Some(first) = r.divergences.details.first() {
                 let _ = writeln!(
                     s,
                     "  first divergence: frame {}, ball {} ({})",
@@ -370,22 +370,23 @@ pub fn render_text(r: &TraceReport) -> String {
                         .join(", ")
                 );
             }
-            for d in &r.divergences {
+            for d in &r.divergences.details {
                 s.push_str(&render_divergence_as(d, "  ", sides));
             }
-            if r.divergent as usize > r.divergences.len() {
+            if r.divergent as usize > r.divergences.details.len() {
                 let _ = writeln!(
                     s,
                     "  ... {} more divergent sweeps (frames {}{})",
-                    r.divergent as usize - r.divergences.len(),
-                    r.divergent_frames
+                    r.divergent as usize - r.divergences.details.len(),
+                    r.divergences
+                        .frames
                         .iter()
-                        .skip(r.divergences.len())
+                        .skip(r.divergences.details.len())
                         .take(20)
                         .map(u64::to_string)
                         .collect::<Vec<_>>()
                         .join(", "),
-                    if r.divergent as usize > r.divergences.len() + 20 {
+                    if r.divergent as usize > r.divergences.details.len() + 20 {
                         ", ..."
                     } else {
                         ""
@@ -394,14 +395,14 @@ pub fn render_text(r: &TraceReport) -> String {
             }
         }
         Status::NoExpectations => {
-            let why = if !r.has_expected_channel {
+            let why = if !r.expectations.has_channel {
                 "no /expected channel".to_string()
-            } else if r.expectations == 0 {
+            } else if r.expectations.read == 0 {
                 "the /expected channel holds no message".to_string()
             } else {
                 format!(
                     "none of the {} /expected messages matches a sweep",
-                    r.expectations
+                    r.expectations.read
                 )
             };
             let _ = writeln!(s, "NO EXPECTATIONS {}: {why}; {counts}", r.trace);
@@ -427,7 +428,7 @@ pub fn render_text(r: &TraceReport) -> String {
                 let _ = writeln!(s, "  also: {}", unnamed(e));
             }
             tunnel_lines(&mut s);
-            for d in &r.divergences {
+            for d in &r.divergences.details {
                 s.push_str(&render_divergence_as(d, "  ", sides));
             }
         }

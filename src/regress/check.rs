@@ -19,13 +19,14 @@ use crate::replay::{ReplayError, ReplayEvent, ReplayOptions, ReplaySummary, Swee
 use crate::trace::{EXPECTED_TOPIC, OutcomeMsg, TraceError, TraceEvent, TraceReader};
 
 use super::compare::{FieldDiff, Tolerances};
+use super::conventions::EngineConventions;
 use super::explain::{expected_tests, explain_outcome, explained_records};
 use super::ghost_count::count_ghosts;
 use super::infer::{ComparedSweep, MAX_INFERENCE_SWEEPS, infer};
 use super::judge::{Agreement, agreement};
 use super::report::{
     Divergence, Judged, KindChange, MAX_DIVERGENT_FRAMES, MAX_ERRORS, MAX_LISTED_TUNNELS,
-    TraceReport, TunnelReport,
+    TraceReport, TunnelReport, WithinPrecision,
 };
 use super::repro::SweepInputs;
 
@@ -200,6 +201,9 @@ impl<'a> ReportBuilder<'a> {
             ..TraceReport::default()
         };
         report.fragile.strict = options.strict;
+        report.within_precision =
+            (!options.tolerances.precision.is_f64()).then(WithinPrecision::default);
+        report.conventions = EngineConventions::of(&options.tolerances, &options.replay);
         report.tunnels.fail = options.fail_on_tunnel;
         report.ghosts.fail = options.fail_on_ghost;
         report.ghosts.degrees = options.ghost_degrees;
@@ -255,51 +259,82 @@ impl<'a> ReportBuilder<'a> {
         match judged.agreement {
             Agreement::Match => {}
             Agreement::Tie => self.report.ties += 1,
+            Agreement::Precision { .. } | Agreement::Diverges { .. } => {
+                self.diverges(result, judged);
+            }
+        }
+    }
+
+    /// A sweep whose answers differ: within single precision (a backward
+    /// error), fragile and explained by rounding (`reproduced`), or a
+    /// divergence; the first of each kind in detail.
+    fn diverges(&mut self, result: &SweepResult, judged: Judged) {
+        let (fields, fragile, reproduced, backward_error) = match judged.agreement {
+            Agreement::Match | Agreement::Tie => return,
+            Agreement::Precision {
+                fields,
+                backward_error,
+                reproduced,
+            } => (
+                fields,
+                result.outcome.fragile,
+                reproduced,
+                Some(backward_error),
+            ),
             Agreement::Diverges {
                 fields,
                 fragile,
                 reproduced,
-            } => {
-                let details = |fields| {
-                    let mut d = divergence_details(
-                        result,
-                        judged.expected,
-                        judged.got,
-                        fields,
-                        self.options.hex,
-                    );
-                    d.reproduced = reproduced;
-                    d
-                };
-                let report = &mut self.report;
-                if reproduced.is_some() {
-                    report.fragile.count += 1;
-                    for reason in fragile.iter() {
-                        *report.fragile.by_reason.entry(reason).or_default() += 1;
-                    }
-                    if !self.options.strict {
-                        if report.fragile.details.len() < self.options.max_details {
-                            report.fragile.details.push(details(fields));
-                        }
-                        return;
-                    }
-                }
-                report.divergent += 1;
-                let divergences = &mut report.divergences;
-                *divergences
-                    .by_kind
-                    .entry(KindChange {
-                        expected: judged.expected.kind,
-                        got: judged.got.kind,
-                    })
-                    .or_default() += 1;
-                if divergences.frames.len() < MAX_DIVERGENT_FRAMES {
-                    divergences.frames.push(result.frame);
-                }
-                if divergences.details.len() < self.options.max_details {
-                    divergences.details.push(details(fields));
-                }
+            } => (fields, fragile, reproduced, None),
+        };
+        let details = |fields| {
+            let mut d = divergence_details(
+                result,
+                judged.expected,
+                judged.got,
+                fields,
+                self.options.hex,
+            );
+            d.reproduced = reproduced;
+            d.backward_error = backward_error;
+            d
+        };
+        let report = &mut self.report;
+        if let Some(error) = backward_error {
+            let within = report
+                .within_precision
+                .get_or_insert_with(WithinPrecision::default);
+            within.count += 1;
+            within.max_backward_error = within.max_backward_error.max(error);
+            if !self.options.strict {
+                return;
             }
+        } else if reproduced.is_some() {
+            report.fragile.count += 1;
+            for reason in fragile.iter() {
+                *report.fragile.by_reason.entry(reason).or_default() += 1;
+            }
+            if !self.options.strict {
+                if report.fragile.details.len() < self.options.max_details {
+                    report.fragile.details.push(details(fields));
+                }
+                return;
+            }
+        }
+        report.divergent += 1;
+        let divergences = &mut report.divergences;
+        *divergences
+            .by_kind
+            .entry(KindChange {
+                expected: judged.expected.kind,
+                got: judged.got.kind,
+            })
+            .or_default() += 1;
+        if divergences.frames.len() < MAX_DIVERGENT_FRAMES {
+            divergences.frames.push(result.frame);
+        }
+        if divergences.details.len() < self.options.max_details {
+            divergences.details.push(details(fields));
         }
     }
 
@@ -351,6 +386,7 @@ pub fn divergence_details(
         fragile: result.outcome.fragile,
         reproduced: None,
         names_tie_member: false,
+        backward_error: None,
         margin: result.options().margin,
         facing: result.options().facing,
         got_explanation: explain_outcome(&result.outcome, &records),

@@ -33,6 +33,7 @@ mod bless;
 mod check;
 mod compare;
 mod config;
+mod conventions;
 mod decision;
 mod diff;
 mod discovery;
@@ -42,6 +43,7 @@ mod ghost_count;
 mod infer;
 mod judge;
 mod junit;
+mod precision;
 mod render;
 mod report;
 mod repro;
@@ -53,12 +55,13 @@ pub use check::{
 };
 pub use compare::{
     DEFAULT_ALPHA_TOLERANCE, DEFAULT_CONTACT_TOLERANCE, DEFAULT_NORMAL_TOLERANCE_DEGREES, Field,
-    FieldDiff, FieldSet, Tolerances, angle_degrees, compare,
+    FieldDiff, FieldSet, TieRule, Tolerances, angle_degrees, compare,
 };
 pub use config::{
-    ConfigError, ConfigFile, Overrides, Setting, Settings, Source, normalize, render_settings_json,
-    render_settings_text, resolve, settings_for,
+    ConfigError, ConfigFile, EngineOverrides, EngineSettings, Overrides, Setting, Settings, Source,
+    normalize, render_settings_json, render_settings_text, resolve, settings_for,
 };
+pub use conventions::{EngineConventions, FacingRule, MarginRule};
 pub(crate) use decision::write_decision_line;
 #[cfg(feature = "viewer")]
 pub(crate) use decision::write_divergence_line;
@@ -73,10 +76,11 @@ pub(crate) use explain::{expected_tests, explain_outcome, explained_records};
 pub use infer::{Inferred, Spread};
 pub use judge::{Agreement, Perturbation, Reproduced, agreement, agreement_of};
 pub use junit::{check_junit, github_annotations};
+pub use precision::{F32_OPERATIONS, F32_UNIT, Precision, Sensitivity};
 pub use render::{Sides, render_divergence, render_json, render_text};
 pub(crate) use render::{divergence_line, render_divergence_as, values_text};
 pub use report::{
     Against, Divergence, Divergences, EngineCheck, Expectations, Fragile, Ghosts, KindChange,
-    MAX_LISTED_TUNNELS, Status, TraceReport, TunnelReport, Tunnels,
+    MAX_LISTED_TUNNELS, Status, TraceReport, TunnelReport, Tunnels, WithinPrecision,
 };
 pub use repro::{HexInputs, ReproCase, ReproError, SweepInputs, TraceSweep, find_sweep};

@@ -235,11 +235,13 @@ pub fn render_text(r: &TraceReport) -> String {
     match r.status() {
         Status::Ok => {
             let _ = writeln!(s, "ok {}: {counts}", r.trace);
+            write_conventions(&mut s, r);
             write_tunnels_and_ghosts(&mut s, r);
             write_fragile_divergences(&mut s, r, sides);
         }
         Status::Fail => {
             let _ = writeln!(s, "FAIL {}: {}; {counts}", r.trace, failures(r).join("; "));
+            write_conventions(&mut s, r);
             write_tunnels_and_ghosts(&mut s, r);
             write_divergences(&mut s, r, sides);
         }
@@ -295,6 +297,22 @@ fn counts_text(r: &TraceReport) -> String {
             ", {} fragile divergences ({}){}",
             r.fragile.count,
             names_and_counts(&r.fragile.by_reason),
+            if r.fragile.strict {
+                ", failures under --strict"
+            } else {
+                ", not failures without --strict"
+            }
+        );
+    }
+    if let Some(within) = &r.within_precision
+        && within.count > 0
+    {
+        let _ = write!(
+            counts,
+            ", {} within single precision (largest backward error {} u32 units of the \
+             sweep's scale){}",
+            crate::numbers::counted(within.count, "difference", "differences"),
+            crate::core::num(within.max_backward_error),
             if r.fragile.strict {
                 ", failures under --strict"
             } else {
@@ -358,6 +376,17 @@ fn failures(r: &TraceReport) -> Vec<String> {
         ));
     }
     failures
+}
+
+/// The engine conventions the trace was judged by, when some are declared.
+fn write_conventions(s: &mut String, r: &TraceReport) {
+    if !r.conventions.is_rules() {
+        let _ = writeln!(
+            s,
+            "  judged under the engine's declared conventions: {}",
+            r.conventions.summary()
+        );
+    }
 }
 
 /// The listed tunnels and ghost contacts, one line each, and how many

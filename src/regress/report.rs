@@ -13,6 +13,7 @@ use crate::replay::{GhostContact, Tunnel, TunnelAt, TunnelKind};
 use crate::trace::OutcomeMsg;
 
 use super::compare::{FieldDiff, Tolerances};
+use super::conventions::EngineConventions;
 use super::explain::ExpectedTest;
 use super::infer::Inferred;
 use super::judge::Agreement;
@@ -77,6 +78,11 @@ pub struct Divergence {
     /// `conform`). Only in the JSON when true.
     #[serde(skip_serializing_if = "std::ops::Not::not")]
     pub names_tie_member: bool,
+    /// At single precision, when the difference is within what it
+    /// explains: its backward error, in units of `u₃₂ · S` (see
+    /// [`super::Sensitivity`]). Absent otherwise.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub backward_error: Option<f64>,
     /// The sweep's inputs, exactly (shortest round-trip decimals in the
     /// JSON): with them the core makes the same decision.
     pub inputs: SweepInputs,
@@ -245,6 +251,15 @@ pub struct TraceReport {
     /// Divergences on fragile decisions that rounding explains.
     #[serde(flatten)]
     pub fragile: Fragile,
+    /// At single precision (`precision = "f32"`; `None` otherwise, and
+    /// then not in the JSON): the differences single-precision rounding
+    /// explains.
+    #[serde(flatten)]
+    pub within_precision: Option<WithinPrecision>,
+    /// The engine conventions the check judged by (the `[engine]` table;
+    /// only in the JSON when some are declared).
+    #[serde(skip_serializing_if = "EngineConventions::is_rules")]
+    pub conventions: EngineConventions,
     /// Tunnels found.
     #[serde(flatten)]
     pub tunnels: Tunnels,
@@ -302,6 +317,20 @@ pub struct Fragile {
     pub details: Vec<Divergence>,
     /// Whether they fail the check (`--strict`).
     pub strict: bool,
+}
+
+/// A report's sweeps whose answers differ by no more than single-precision
+/// rounding explains ([`super::Agreement::Precision`]). Failures only with
+/// `strict`, where they are also counted in [`TraceReport::divergent`].
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+#[non_exhaustive]
+pub struct WithinPrecision {
+    /// How many (`precision_divergent` in the JSON).
+    #[serde(rename = "precision_divergent")]
+    pub count: u64,
+    /// The largest backward error among them, in units of `u₃₂ · S`
+    /// (`max_backward_error`).
+    pub max_backward_error: f64,
 }
 
 /// A report's tunnels: a ball's centre through a triangle, front to back,

@@ -166,7 +166,7 @@ impl ReproCase {
         };
         let _ = writeln!(
             s,
-            "    let options = Options {{ margin: {}, facing: Facing::{facing} }};",
+            "    let options = Options {{ margin: {}, facing: Facing::{facing}, ..Options::default() }};",
             literal(self.inputs.margin)
         );
     }

@@ -52,6 +52,7 @@ pub fn tests() -> Vec<Trial> {
         trial!(wrong_engine_config_fixture_fails_with_frame_and_reason),
         trial!(wrong_engine_config_fixture_binary_exit_1),
         trial!(wrong_engine_config_fixture_is_what_its_generator_makes),
+        trial!(report_json_fixture_is_what_check_makes),
         trial!(no_expected_channel_is_not_a_pass),
         trial!(binary_errors_exit_2),
         trial!(trace_discovery_in_directories),
@@ -161,6 +162,33 @@ fn fixture_bytes() -> anyhow::Result<Vec<u8>> {
             ..ReplayOptions::default()
         },
     )
+}
+
+/// The fixtures whose report's JSON is pinned under `tests/fixtures/report/`:
+/// between them divergences, an inference, ghost contacts and a tunnel.
+const REPORT_FIXTURES: [&str; 3] = [
+    "wrong_engine_config",
+    "rapier_floor_contacts",
+    "tunnel_floor",
+];
+
+/// The JSON of a report, its keys in the order the report serializes them
+/// (`check --json` sorts them), is the committed one: a change of the
+/// report's shape changes no key, no value and no order. Rewritten with
+/// `SWEEPTRACE_BLESS=1 cargo test --test integration -- fixture`.
+fn report_json_fixture_is_what_check_makes() -> anyhow::Result<()> {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures");
+    for name in REPORT_FIXTURES {
+        let file = std::fs::File::open(dir.join(format!("{name}.mcap")))?;
+        let report = check_reader(file, &format!("{name}.mcap"), &CheckOptions::default());
+        let mut json = serde_json::to_string_pretty(&report)?;
+        json.push('\n');
+        crate::support::compare_or_bless(
+            &dir.join(format!("report/{name}.json")),
+            json.as_bytes(),
+        )?;
+    }
+    Ok(())
 }
 
 fn check_bytes(bytes: &[u8]) -> sweeptrace::regress::TraceReport {
@@ -415,7 +443,7 @@ fn blessed_trace_passes() -> anyhow::Result<()> {
     let report = check_bytes(&blessed);
     ensure!(report.status() == Status::Ok, "{}", render_text(&report));
     ensure!(
-        report.compared == 5 && report.sweeps_without_expectation == 0,
+        report.compared == 5 && report.expectations.missing == 0,
         "counts: {report:?}"
     );
     ensure!(
@@ -437,7 +465,11 @@ fn check_fixture_report(report: &sweeptrace::regress::TraceReport) -> anyhow::Re
         report.divergent == 2,
         "two sweeps diverge (2 and 3):\n{text}"
     );
-    let first = report.divergences.first().context("no divergence detail")?;
+    let first = report
+        .divergences
+        .details
+        .first()
+        .context("no divergence detail")?;
     ensure!(
         first.frame == 2,
         "first divergent frame is 2, got {}",
@@ -645,7 +677,7 @@ fn bless_round_trip_fixes_wrong_expectations() -> anyhow::Result<()> {
     let report = check_bytes(&blessed);
     ensure!(report.status() == Status::Ok, "{}", render_text(&report));
     ensure!(
-        report.compared == 5 && report.expectations_without_sweep == 0,
+        report.compared == 5 && report.expectations.unmatched == 0,
         "one expectation per sweep, old ones gone: {report:?}"
     );
     // Blessing twice gives the same bytes (deterministic writer).

@@ -60,7 +60,7 @@ fn rapier_ghosts_on_a_floor_go_with_fix_internal_edges() -> anyhow::Result<()> {
         let counts = run(floor_args(&output, fix, Expect::Cast)).map_err(anyhow::Error::msg)?;
         let report = check_file(&output, &CheckOptions::default());
         ensure!(
-            report.ghosts == 0 && report.compared > 0,
+            report.ghosts.count == 0 && report.compared > 0,
             "fix {fix}: the shape cast's answers hold ghosts\n{}",
             render_text(&report)
         );
@@ -76,9 +76,9 @@ fn rapier_ghosts_on_a_floor_go_with_fix_internal_edges() -> anyhow::Result<()> {
     let counts = run(floor_args(&output, false, Expect::Contacts)).map_err(anyhow::Error::msg)?;
     let report = check_file(&output, &CheckOptions::default());
     ensure!(
-        report.ghosts > 0 && report.ghosts <= counts.solver.ghosts,
+        report.ghosts.count > 0 && report.ghosts.count <= counts.solver.ghosts,
         "check lists {} ghosts, the solver made {}\n{}",
-        report.ghosts,
+        report.ghosts.count,
         counts.solver.ghosts,
         render_text(&report)
     );
@@ -94,7 +94,8 @@ fn rapier_floor_contacts_trace_lists_its_ghosts() -> anyhow::Result<()> {
     let path = root().join("tests/fixtures/rapier_floor_contacts.mcap");
     let report = check_file(&path, &CheckOptions::default());
     let listed: Vec<(u64, u32, u8)> = report
-        .ghost_contacts
+        .ghosts
+        .contacts
         .iter()
         .map(|g| (g.frame, g.triangle, g.feature))
         .collect();
@@ -110,9 +111,10 @@ fn rapier_floor_contacts_trace_lists_its_ghosts() -> anyhow::Result<()> {
                 (174, 41, 1),
                 (175, 41, 1)
             ]
-            && report.ghosts == 8
+            && report.ghosts.count == 8
             && report
-                .ghost_contacts
+                .ghosts
+                .contacts
                 .iter()
                 .all(|g| g.place == sweeptrace::replay::GhostPlace::Flat && g.angle_degrees > 1.0)
             && report.status() == Status::Fail,
@@ -160,8 +162,8 @@ fn rapier_recording_passes_check_with_the_readme_options() -> anyhow::Result<()>
     let report = check_file(&output, &readme);
     ensure!(
         report.status() == Status::Ok
-            && report.compared + report.sweeps_without_expectation == sweeps
-            && report.sweeps_without_expectation == starting_in_contact,
+            && report.compared + report.expectations.missing == sweeps
+            && report.expectations.missing == starting_in_contact,
         "{}",
         render_text(&report)
     );

@@ -1837,7 +1837,12 @@ fn viewer_and_check_agree_on_divergences() -> anyhow::Result<()> {
         "the fixture has {} divergent sweeps",
         report.divergent
     );
-    let check_frames: BTreeSet<i64> = report.divergent_frames.iter().map(|&f| f as i64).collect();
+    let check_frames: BTreeSet<i64> = report
+        .divergences
+        .frames
+        .iter()
+        .map(|&f| f as i64)
+        .collect();
 
     let bytes = std::fs::read(&fixture)?;
     let dir = tempfile::tempdir()?;

@@ -79,7 +79,11 @@ fn divergence_inputs_read_back_bit_exactly() -> anyhow::Result<()> {
         ..CheckOptions::default()
     };
     let report = check_file(&fixture(), &options);
-    let d = report.divergences.first().context("no divergence")?;
+    let d = report
+        .divergences
+        .details
+        .first()
+        .context("no divergence")?;
     // Frame 2 of the fixture: p0 (2, -0.45, 3), p1 (2, -0.45, -3), r 0.5, margin 0.1.
     same_bits("p0", &d.inputs.p0, &[2.0, -0.45, 3.0])?;
     same_bits("p1", &d.inputs.p1, &[2.0, -0.45, -3.0])?;
@@ -96,7 +100,7 @@ fn divergence_inputs_read_back_bit_exactly() -> anyhow::Result<()> {
         ),
         "text:\n{text}"
     );
-    for d in &report.divergences {
+    for d in &report.divergences.details {
         let block = sweeptrace::regress::render_divergence(d, "");
         let inputs = &block[block.find("inputs: ").context("inputs line")?..];
         same_bits("decimal p0", &numbers_after(inputs, "p0 ")?, &d.inputs.p0)?;
@@ -310,10 +314,11 @@ fn fixture_case_gives_the_same_verdict() -> anyhow::Result<()> {
         );
         let want = full
             .divergences
+            .details
             .iter()
             .find(|d| d.frame == frame)
             .context("frame in the full report")?;
-        let got = &report.divergences[0];
+        let got = &report.divergences.details[0];
         ensure!(
             got.fields
                 .iter()
@@ -702,7 +707,7 @@ fn infer_strict_facing_by_replaying_both() -> anyhow::Result<()> {
     let text = render_text(&report);
     // The two rules differ only on a path parallel to the plane: a
     // fragile (grazing) divergence, not a failure; still inferred.
-    ensure!(report.fragile_divergent == 1, "{text}");
+    ensure!(report.fragile.count == 1, "{text}");
     let inferred = report.inferred.as_ref().context("nothing inferred")?;
     ensure!(
         inferred.facing == Facing::Strict

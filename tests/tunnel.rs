@@ -440,8 +440,8 @@ fn check_floor_report(report: &sweeptrace::regress::TraceReport) -> anyhow::Resu
         report.divergent == 0 && report.compared == 10,
         "the expectations all match:\n{text}"
     );
-    ensure!(report.tunnels == 1, "one tunnel:\n{text}");
-    let t = report.tunnel_details.first().context("no tunnel detail")?;
+    ensure!(report.tunnels.count == 1, "one tunnel:\n{text}");
+    let t = report.tunnels.details.first().context("no tunnel detail")?;
     ensure!(
         t.frame == 4 && t.ball == 0 && t.tunnel.kind == TunnelKind::DuringSweep,
         "{t:?}"
@@ -511,8 +511,8 @@ fn check_wall_report(report: &sweeptrace::regress::TraceReport) -> anyhow::Resul
     let text = render_text(report);
     ensure!(report.status() == Status::Fail, "status\n{text}");
     ensure!(report.divergent == 0, "the expectations all match:\n{text}");
-    ensure!(report.tunnels == 1, "one tunnel:\n{text}");
-    let t = report.tunnel_details.first().context("no tunnel detail")?;
+    ensure!(report.tunnels.count == 1, "one tunnel:\n{text}");
+    let t = report.tunnels.details.first().context("no tunnel detail")?;
     ensure!(
         t.frame == 2
             && t.ball == 0

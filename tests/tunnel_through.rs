@@ -122,11 +122,12 @@ fn flipped_floor_tunnel_names_the_flipped_triangle() -> anyhow::Result<()> {
     );
     let text = render_text(&report);
     ensure!(
-        report.divergent == 0 && report.tunnels == 2,
+        report.divergent == 0 && report.tunnels.count == 2,
         "two tunnels, no divergence:\n{text}"
     );
     let t = report
-        .tunnel_details
+        .tunnels
+        .details
         .iter()
         .find(|t| t.ball == 0)
         .context("no tunnel of ball 0")?;
@@ -168,7 +169,8 @@ fn ordinary_tunnel_names_nothing() -> anyhow::Result<()> {
     );
     let text = render_text(&report);
     let t = report
-        .tunnel_details
+        .tunnels
+        .details
         .iter()
         .find(|t| t.ball == 1)
         .context(format!("no tunnel of ball 1:\n{text}"))?;
@@ -204,10 +206,10 @@ fn tunnel_near_a_crack_names_the_crack() -> anyhow::Result<()> {
     let report = check_reader(bytes.as_slice(), "<memory>", &CheckOptions::default());
     let text = render_text(&report);
     ensure!(
-        report.divergent == 0 && report.tunnels == 1,
+        report.divergent == 0 && report.tunnels.count == 1,
         "one tunnel:\n{text}"
     );
-    let t = report.tunnel_details.first().context("no tunnel")?;
+    let t = report.tunnels.details.first().context("no tunnel")?;
     ensure!(
         t.tunnel.kind == TunnelKind::BetweenSweeps && t.tunnel.triangle == 0,
         "{t:?}"

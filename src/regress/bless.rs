@@ -216,28 +216,83 @@ fn bless_into<W: Write + Seek>(
     options: ReplayOptions,
 ) -> Result<(BlessSummary, W), BlessError> {
     let Replayed {
-        mut outcomes,
+        outcomes,
         source,
         replaced,
     } = outcomes_of(input, name, options)?;
-    let read_err = |cause| BlessError::Mcap {
+    let (write_options, expected_only) = scan(input, name)?;
+    let mut writer = write_options
+        .create(output)
+        .map_err(write_error(output_name))?;
+    source.validate().map_err(|problem| BlessError::Trace {
+        cause: TraceError::ExpectedSource {
+            file: output_name.to_string(),
+            problem,
+        },
+    })?;
+    writer
+        .write_metadata(&mcap::records::Metadata {
+            name: EXPECTED_SOURCE_METADATA.to_string(),
+            metadata: source.to_metadata(),
+        })
+        .map_err(write_error(output_name))?;
+    let mut copier = Copier {
+        name,
+        output_name,
+        writer,
+        outcomes,
+        expected_only,
+        schema_ids: HashMap::new(),
+        channel_ids: HashMap::new(),
+        channel_topics: HashMap::new(),
+        channel_encodings: HashMap::new(),
+        expected_channels: BTreeMap::new(),
+        index: 0,
+        sequence: 0,
+        summary: BlessSummary {
+            expected_source: source,
+            replaced_expected_source: replaced,
+            ..BlessSummary::default()
+        },
+    };
+    for record in ChunkFlattener::new(input).map_err(read_error(name))? {
+        match record.map_err(read_error(name))? {
+            // The summary section is rebuilt by the writer.
+            Record::DataEnd(_) => break,
+            record => copier.record(record)?,
+        }
+    }
+    copier.writer.finish().map_err(write_error(output_name))?;
+    Ok((copier.summary, copier.writer.into_inner()))
+}
+
+/// An error reading the input `name`'s container.
+fn read_error(name: &str) -> impl Fn(McapError) -> BlessError + '_ {
+    move |cause| BlessError::Mcap {
         file: name.to_string(),
         what: "reading the container".to_string(),
         cause,
-    };
-    let write_err = |cause| BlessError::Mcap {
+    }
+}
+
+/// An error writing the blessed trace `output_name`.
+fn write_error(output_name: &str) -> impl Fn(McapError) -> BlessError + '_ {
+    move |cause| BlessError::Mcap {
         file: output_name.to_string(),
         what: "writing the blessed trace".to_string(),
         cause,
-    };
+    }
+}
 
-    // Pass 2 (cheap; pass 1 was the replay): the header, and which schemas
-    // only `/expected` uses.
+/// Pass 2 (cheap; pass 1 was the replay): the writer's options with the
+/// input's header (profile, library), and the schemas only `/expected`
+/// channels use (not copied).
+fn scan(input: &[u8], name: &str) -> Result<(mcap::WriteOptions, HashSet<u16>), BlessError> {
     let mut write_options = default_write_options();
     let mut used_by_others: HashSet<u16> = HashSet::new();
     let mut used_by_expected: HashSet<u16> = HashSet::new();
-    for record in ChunkFlattener::new(input).map_err(read_err)? {
-        match record.map_err(read_err)? {
+    for record in ChunkFlattener::new(input).map_err(read_error(name))? {
+        match record.map_err(read_error(name))? {
             Record::Header(h) => {
                 write_options = write_options.profile(h.profile).library(h.library);
             }
@@ -251,171 +306,73 @@ fn bless_into<W: Write + Seek>(
             _ => {}
         }
     }
+    let expected_only = used_by_expected
+        .difference(&used_by_others)
+        .copied()
+        .collect();
+    Ok((write_options, expected_only))
+}
 
-    // Pass 3: the copy.
-    let mut writer = write_options.create(output).map_err(write_err)?;
-    source.validate().map_err(|problem| BlessError::Trace {
-        cause: TraceError::ExpectedSource {
-            file: output_name.to_string(),
-            problem,
-        },
-    })?;
-    writer
-        .write_metadata(&mcap::records::Metadata {
-            name: EXPECTED_SOURCE_METADATA.to_string(),
-            metadata: source.to_metadata(),
-        })
-        .map_err(write_err)?;
-    let mut summary = BlessSummary {
-        expected_source: source,
-        replaced_expected_source: replaced,
-        ..BlessSummary::default()
-    };
-    let mut schema_ids: HashMap<u16, u16> = HashMap::new();
-    let mut channel_ids: HashMap<u16, u16> = HashMap::new();
-    let mut channel_topics: HashMap<u16, String> = HashMap::new();
-    // The message encoding of each input channel (trace channels: the
-    // replay pass checked they are `json` or `cbor`).
-    let mut channel_encodings: HashMap<u16, Encoding> = HashMap::new();
-    let mut expected_channels: BTreeMap<Encoding, u16> = BTreeMap::new();
-    let mut index: u64 = 0;
-    let mut sequence: u32 = 0;
-    for record in ChunkFlattener::new(input).map_err(read_err)? {
-        match record.map_err(read_err)? {
+/// Pass 3: the copy of the input's records, record by record, with each
+/// sweep's new expectation after it.
+struct Copier<'a, W: Write + Seek> {
+    /// The input's name.
+    name: &'a str,
+    /// The output's name.
+    output_name: &'a str,
+    writer: mcap::Writer<W>,
+    /// The replayed outcomes by `(frame, ball)`, in trace order.
+    outcomes: HashMap<(u64, u32), VecDeque<OutcomeMsg>>,
+    /// The input's schemas that only `/expected` channels use.
+    expected_only: HashSet<u16>,
+    /// Input schema id to output schema id.
+    schema_ids: HashMap<u16, u16>,
+    /// Input channel id to output channel id (`/expected` channels have none).
+    channel_ids: HashMap<u16, u16>,
+    /// Every input channel's topic.
+    channel_topics: HashMap<u16, String>,
+    /// The message encoding of each input channel (trace channels: the
+    /// replay pass checked they are `json` or `cbor`).
+    channel_encodings: HashMap<u16, Encoding>,
+    /// The output's `/expected` channel for each encoding.
+    expected_channels: BTreeMap<Encoding, u16>,
+    /// The index of the next input message.
+    index: u64,
+    /// The sequence number of the next output message.
+    sequence: u32,
+    summary: BlessSummary,
+}
+
+impl<W: Write + Seek> Copier<'_, W> {
+    /// Copies one record (or drops it: `/expected`'s own, the old
+    /// `sweeptrace.expected_source` record).
+    fn record(&mut self, record: Record<'_>) -> Result<(), BlessError> {
+        match record {
             Record::Schema { header, data } => {
-                if schema_ids.contains_key(&header.id)
-                    || (used_by_expected.contains(&header.id)
-                        && !used_by_others.contains(&header.id))
+                if self.schema_ids.contains_key(&header.id)
+                    || self.expected_only.contains(&header.id)
                 {
-                    continue;
+                    return Ok(());
                 }
-                let id = writer
+                let id = self
+                    .writer
                     .add_schema(&header.name, &header.encoding, &data)
-                    .map_err(write_err)?;
-                schema_ids.insert(header.id, id);
-                summary.schemas_copied += 1;
+                    .map_err(write_error(self.output_name))?;
+                self.schema_ids.insert(header.id, id);
+                self.summary.schemas_copied += 1;
             }
-            Record::Channel(c) => {
-                if channel_topics.contains_key(&c.id) {
-                    continue;
-                }
-                channel_topics.insert(c.id, c.topic.clone());
-                if let Some(encoding) = Encoding::from_message_encoding(&c.message_encoding) {
-                    channel_encodings.insert(c.id, encoding);
-                }
-                if c.topic == EXPECTED_TOPIC {
-                    continue;
-                }
-                let schema_id = if c.schema_id == 0 {
-                    0
-                } else {
-                    *schema_ids
-                        .get(&c.schema_id)
-                        .ok_or_else(|| BlessError::Mcap {
-                            file: name.to_string(),
-                            what: format!("channel `{}`", c.topic),
-                            cause: McapError::UnknownSchema(c.topic.clone(), c.schema_id),
-                        })?
-                };
-                let id = writer
-                    .add_channel(schema_id, &c.topic, &c.message_encoding, &c.metadata)
-                    .map_err(write_err)?;
-                channel_ids.insert(c.id, id);
-                summary.channels_copied += 1;
-            }
-            Record::Message { header, data } => {
-                let this = index;
-                index += 1;
-                let topic = channel_topics.get(&header.channel_id).map(String::as_str);
-                if topic == Some(EXPECTED_TOPIC) {
-                    summary.expected_dropped += 1;
-                    continue;
-                }
-                let Some(&channel_id) = channel_ids.get(&header.channel_id) else {
-                    return Err(BlessError::Mcap {
-                        file: name.to_string(),
-                        what: format!("message {this}"),
-                        cause: McapError::UnknownChannel(header.sequence, header.channel_id),
-                    });
-                };
-                writer
-                    .write_to_known_channel(
-                        &MessageHeader {
-                            channel_id,
-                            sequence,
-                            ..header
-                        },
-                        &data,
-                    )
-                    .map_err(write_err)?;
-                sequence = sequence.wrapping_add(1);
-                summary.messages_copied += 1;
-                if topic != Some(SWEEP_TOPIC) {
-                    continue;
-                }
-                let encoding = channel_encodings
-                    .get(&header.channel_id)
-                    .copied()
-                    .unwrap_or_default();
-                let ball = ball_of(&data, encoding);
-                let Some(outcome) = frame_of_message(&data, encoding)
-                    .and_then(|frame| outcomes.get_mut(&(frame, ball)))
-                    .and_then(VecDeque::pop_front)
-                else {
-                    return Err(BlessError::Unmatched {
-                        file: name.to_string(),
-                        index: this,
-                    });
-                };
-                let channel_id = match expected_channels.get(&encoding) {
-                    Some(&id) => id,
-                    None => {
-                        let schema = writer
-                            .add_schema(
-                                OUTCOME_SCHEMA,
-                                SCHEMA_ENCODING,
-                                OUTCOME_SCHEMA_JSON.as_bytes(),
-                            )
-                            .map_err(write_err)?;
-                        let id = writer
-                            .add_channel(
-                                schema,
-                                EXPECTED_TOPIC,
-                                encoding.as_str(),
-                                &BTreeMap::new(),
-                            )
-                            .map_err(write_err)?;
-                        expected_channels.insert(encoding, id);
-                        id
-                    }
-                };
-                let encoded = encoding.encode(&outcome).map_err(|e| BlessError::Io {
-                    file: name.to_string(),
-                    what: format!("serializing the outcome of frame {}", outcome.frame),
-                    cause: std::io::Error::other(e),
-                })?;
-                writer
-                    .write_to_known_channel(
-                        &MessageHeader {
-                            channel_id,
-                            sequence,
-                            log_time: header.log_time,
-                            publish_time: header.log_time,
-                        },
-                        &encoded,
-                    )
-                    .map_err(write_err)?;
-                sequence = sequence.wrapping_add(1);
-                summary.expected_written += 1;
-            }
+            Record::Channel(c) => self.channel(&c)?,
+            Record::Message { header, data } => self.message(header, &data)?,
             // Replaced by the record written first.
             Record::Metadata(m) if m.name == EXPECTED_SOURCE_METADATA => {}
             Record::Metadata(m) => {
-                writer.write_metadata(&m).map_err(write_err)?;
-                summary.metadata_copied += 1;
+                self.writer
+                    .write_metadata(&m)
+                    .map_err(write_error(self.output_name))?;
+                self.summary.metadata_copied += 1;
             }
             Record::Attachment { header, data, .. } => {
-                writer
+                self.writer
                     .attach(&Attachment {
                         log_time: header.log_time,
                         create_time: header.create_time,
@@ -423,16 +380,157 @@ fn bless_into<W: Write + Seek>(
                         media_type: header.media_type,
                         data: Cow::Borrowed(&data),
                     })
-                    .map_err(write_err)?;
-                summary.attachments_copied += 1;
+                    .map_err(write_error(self.output_name))?;
+                self.summary.attachments_copied += 1;
             }
-            // The summary section is rebuilt by the writer.
-            Record::DataEnd(_) => break,
             _ => {}
         }
+        Ok(())
     }
-    writer.finish().map_err(write_err)?;
-    Ok((summary, writer.into_inner()))
+
+    /// Copies a channel, except an `/expected` one (its topic and
+    /// encoding are kept either way).
+    fn channel(&mut self, c: &mcap::records::Channel) -> Result<(), BlessError> {
+        if self.channel_topics.contains_key(&c.id) {
+            return Ok(());
+        }
+        self.channel_topics.insert(c.id, c.topic.clone());
+        if let Some(encoding) = Encoding::from_message_encoding(&c.message_encoding) {
+            self.channel_encodings.insert(c.id, encoding);
+        }
+        if c.topic == EXPECTED_TOPIC {
+            return Ok(());
+        }
+        let schema_id = if c.schema_id == 0 {
+            0
+        } else {
+            *self
+                .schema_ids
+                .get(&c.schema_id)
+                .ok_or_else(|| BlessError::Mcap {
+                    file: self.name.to_string(),
+                    what: format!("channel `{}`", c.topic),
+                    cause: McapError::UnknownSchema(c.topic.clone(), c.schema_id),
+                })?
+        };
+        let id = self
+            .writer
+            .add_channel(schema_id, &c.topic, &c.message_encoding, &c.metadata)
+            .map_err(write_error(self.output_name))?;
+        self.channel_ids.insert(c.id, id);
+        self.summary.channels_copied += 1;
+        Ok(())
+    }
+
+    /// Copies a message, except an `/expected` one; after a `/sweep`
+    /// message, writes its new expectation.
+    fn message(&mut self, header: MessageHeader, data: &[u8]) -> Result<(), BlessError> {
+        let this = self.index;
+        self.index += 1;
+        let topic = self
+            .channel_topics
+            .get(&header.channel_id)
+            .map(String::as_str);
+        if topic == Some(EXPECTED_TOPIC) {
+            self.summary.expected_dropped += 1;
+            return Ok(());
+        }
+        let is_sweep = topic == Some(SWEEP_TOPIC);
+        let Some(&channel_id) = self.channel_ids.get(&header.channel_id) else {
+            return Err(BlessError::Mcap {
+                file: self.name.to_string(),
+                what: format!("message {this}"),
+                cause: McapError::UnknownChannel(header.sequence, header.channel_id),
+            });
+        };
+        self.write(
+            &MessageHeader {
+                channel_id,
+                sequence: self.sequence,
+                ..header
+            },
+            data,
+        )?;
+        self.summary.messages_copied += 1;
+        if is_sweep {
+            self.expectation(this, &header, data)?;
+        }
+        Ok(())
+    }
+
+    /// Writes the expectation of the sweep message `index` (`header`,
+    /// `data`): the next replayed outcome of its frame and ball, on the
+    /// `/expected` channel of its encoding, at its `log_time`.
+    fn expectation(
+        &mut self,
+        index: u64,
+        header: &MessageHeader,
+        data: &[u8],
+    ) -> Result<(), BlessError> {
+        let encoding = self
+            .channel_encodings
+            .get(&header.channel_id)
+            .copied()
+            .unwrap_or_default();
+        let ball = ball_of(data, encoding);
+        let Some(outcome) = frame_of_message(data, encoding)
+            .and_then(|frame| self.outcomes.get_mut(&(frame, ball)))
+            .and_then(VecDeque::pop_front)
+        else {
+            return Err(BlessError::Unmatched {
+                file: self.name.to_string(),
+                index,
+            });
+        };
+        let channel_id = self.expected_channel(encoding)?;
+        let encoded = encoding.encode(&outcome).map_err(|e| BlessError::Io {
+            file: self.name.to_string(),
+            what: format!("serializing the outcome of frame {}", outcome.frame),
+            cause: std::io::Error::other(e),
+        })?;
+        self.write(
+            &MessageHeader {
+                channel_id,
+                sequence: self.sequence,
+                log_time: header.log_time,
+                publish_time: header.log_time,
+            },
+            &encoded,
+        )?;
+        self.summary.expected_written += 1;
+        Ok(())
+    }
+
+    /// The output's `/expected` channel for `encoding`, added the first
+    /// time.
+    fn expected_channel(&mut self, encoding: Encoding) -> Result<u16, BlessError> {
+        if let Some(&id) = self.expected_channels.get(&encoding) {
+            return Ok(id);
+        }
+        let schema = self
+            .writer
+            .add_schema(
+                OUTCOME_SCHEMA,
+                SCHEMA_ENCODING,
+                OUTCOME_SCHEMA_JSON.as_bytes(),
+            )
+            .map_err(write_error(self.output_name))?;
+        let id = self
+            .writer
+            .add_channel(schema, EXPECTED_TOPIC, encoding.as_str(), &BTreeMap::new())
+            .map_err(write_error(self.output_name))?;
+        self.expected_channels.insert(encoding, id);
+        Ok(id)
+    }
+
+    /// Writes one message and advances the sequence number.
+    fn write(&mut self, header: &MessageHeader, data: &[u8]) -> Result<(), BlessError> {
+        self.writer
+            .write_to_known_channel(header, data)
+            .map_err(write_error(self.output_name))?;
+        self.sequence = self.sequence.wrapping_add(1);
+        Ok(())
+    }
 }
 
 #[derive(serde::Deserialize)]

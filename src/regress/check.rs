@@ -14,10 +14,8 @@
 //! ([`crate::core::Broadphase::Exhaustive`]): the fast path stays fast on
 //! passing traces.
 
-use std::collections::BTreeMap;
-
 use crate::core::Feature;
-use crate::replay::{ReplayError, ReplayEvent, ReplayOptions, SweepResult};
+use crate::replay::{ReplayError, ReplayEvent, ReplayOptions, ReplaySummary, SweepResult};
 use crate::trace::{EXPECTED_TOPIC, EventBody, OutcomeMsg, TraceError, TraceEvent, TraceReader};
 
 use super::compare::{FieldDiff, Tolerances};
@@ -28,7 +26,7 @@ use super::infer::{ComparedSweep, MAX_INFERENCE_SWEEPS, infer};
 use super::judge::{Agreement, agreement};
 use super::report::{
     Divergence, Judged, KindChange, MAX_DIVERGENT_FRAMES, MAX_ERRORS, MAX_LISTED_TUNNELS,
-    TraceReport, TunnelReport,
+    TraceReport, TunnelReport, WithinPrecision,
 };
 use super::repro::SweepInputs;
 
@@ -96,7 +94,7 @@ fn check_trace<R: std::io::Read>(
     let (mut report, _) = check_stream(reader.by_ref(), name, options, |result| {
         judge_against_core(result, &options.tolerances)
     });
-    report.has_expected_channel = reader.stats().channels.contains_key(EXPECTED_TOPIC);
+    report.expectations.has_channel = reader.stats().channels.contains_key(EXPECTED_TOPIC);
     report.expected_source = reader.expected_source().cloned();
     report
 }
@@ -113,8 +111,8 @@ pub fn judge_against_core(result: &SweepResult, tolerances: &Tolerances) -> Opti
     })
 }
 
-/// Checks a trace given as a stream of events. `has_expected_channel` is
-/// set from the events (true when any `/expected` message was seen);
+/// Checks a trace given as a stream of events. Whether it has an
+/// `/expected` channel ([`super::Expectations::has_channel`]) is set from the events (true when any `/expected` message was seen);
 /// [`check_reader`] sets it from the file's channels instead.
 pub fn check_events<I>(events: I, name: &str, options: &CheckOptions) -> TraceReport
 where
@@ -139,14 +137,14 @@ where
     J: FnMut(&SweepResult) -> Option<Judged>,
 {
     let (mut report, saw_expected) = check_stream(events, name, options, judge);
-    report.has_expected_channel = saw_expected;
+    report.expectations.has_channel = saw_expected;
     report
 }
 
 /// The check of a stream of events with `judge`, except whether the trace
-/// has an `/expected` channel (`has_expected_channel` is left false: each
-/// caller sets it once, from what it knows); returns the report and whether
-/// any `/expected` message was seen.
+/// has an `/expected` channel (`has_channel` is left false: each caller
+/// sets it once, from what it knows); returns the report and whether any
+/// `/expected` message was seen.
 pub(crate) fn check_stream<I, J>(
     events: I,
     name: &str,
@@ -173,164 +171,200 @@ where
         explain: None,
         ..options.replay
     };
-    let mut report = TraceReport {
-        trace: name.to_string(),
-        sweeps: 0,
-        compared: 0,
-        divergent: 0,
-        ties: 0,
-        fragile_divergent: 0,
-        fragile_by_reason: BTreeMap::new(),
-        fragile_divergences: Vec::new(),
-        strict: options.strict,
-        precision_divergent: 0,
-        max_backward_error: 0.0,
-        conventions: EngineConventions::of(&options.tolerances, &options.replay),
-        tunnels: 0,
-        tunnels_by_kind: BTreeMap::new(),
-        tunnel_details: Vec::new(),
-        fail_on_tunnel: options.fail_on_tunnel,
-        ghosts: 0,
-        ghost_contacts: Vec::new(),
-        ghosts_unjudged: 0,
-        fail_on_ghost: options.fail_on_ghost,
-        ghost_degrees: options.ghost_degrees,
-        sweeps_without_expectation: 0,
-        expectations_without_sweep: 0,
-        expectations: 0,
-        has_expected_channel: false,
-        by_kind: BTreeMap::new(),
-        divergences: Vec::new(),
-        divergent_frames: Vec::new(),
-        errors: Vec::new(),
-        incomplete: false,
-        tolerances: options.tolerances,
-        inferred: None,
-        engine: None,
-        expected_source: None,
-    };
-    let mut compared: Vec<ComparedSweep> = Vec::new();
+    let mut report = ReportBuilder::new(name, options);
     let mut replay = crate::replay::replay_events(events, replay_options);
     for event in replay.by_ref() {
         match event {
             Ok(ReplayEvent::Scene(_)) => {}
             Ok(ReplayEvent::Sweep(result)) => {
-                report.sweeps += 1;
-                for t in &result.tunnels {
-                    report.tunnels += 1;
-                    *report.tunnels_by_kind.entry(t.kind).or_default() += 1;
-                    if report.tunnel_details.len() < MAX_LISTED_TUNNELS {
-                        report.tunnel_details.push(TunnelReport {
-                            frame: result.frame,
-                            ball: result.ball,
-                            log_time_nanos: result.log_time_nanos,
-                            tunnel: t.clone(),
-                        });
-                    }
-                }
-                let Some(judged) = judge(&result) else {
-                    report.sweeps_without_expectation += 1;
-                    continue;
-                };
-                let expected = &judged.expected;
-                report.compared += 1;
-                count_ghosts(&mut report, &result, &judged, options.ghost_degrees);
-                // Kept for the inference of the engine's configuration; the
-                // first ones only, so memory stays bounded on long traces.
-                if judged.got_is_core && compared.len() < MAX_INFERENCE_SWEEPS {
-                    compared.push(ComparedSweep {
-                        scene: result.scene.clone(),
-                        frame: result.frame,
-                        ball: result.ball,
-                        sweep: result.sweep,
-                        expected: *expected,
-                        replayed_face: result
-                            .outcome
-                            .hit
-                            .filter(|h| h.feature == Feature::Face)
-                            .map(|h| h.triangle),
-                    });
-                }
-                let (fields, fragile, reproduced, backward_error) = match judged.agreement {
-                    Agreement::Match => continue,
-                    Agreement::Tie => {
-                        report.ties += 1;
-                        continue;
-                    }
-                    Agreement::Precision {
-                        fields,
-                        backward_error,
-                        reproduced,
-                    } => (
-                        fields,
-                        result.outcome.fragile,
-                        reproduced,
-                        Some(backward_error),
-                    ),
-                    Agreement::Diverges {
-                        fields,
-                        fragile,
-                        reproduced,
-                    } => (fields, fragile, reproduced, None),
-                };
-                let got = judged.got;
-                let details = |fields| {
-                    let mut d = divergence_details(&result, *expected, got, fields, options.hex);
-                    d.reproduced = reproduced;
-                    d.backward_error = backward_error;
-                    d
-                };
-                if let Some(error) = backward_error {
-                    report.precision_divergent += 1;
-                    report.max_backward_error = report.max_backward_error.max(error);
-                    if !options.strict {
-                        continue;
-                    }
-                } else if reproduced.is_some() {
-                    report.fragile_divergent += 1;
-                    for reason in fragile.iter() {
-                        *report.fragile_by_reason.entry(reason).or_default() += 1;
-                    }
-                    if !options.strict {
-                        if report.fragile_divergences.len() < options.max_details {
-                            report.fragile_divergences.push(details(fields));
-                        }
-                        continue;
-                    }
-                }
-                report.divergent += 1;
-                *report
-                    .by_kind
-                    .entry(KindChange {
-                        expected: expected.kind,
-                        got: got.kind,
-                    })
-                    .or_default() += 1;
-                if report.divergent_frames.len() < MAX_DIVERGENT_FRAMES {
-                    report.divergent_frames.push(result.frame);
-                }
-                if report.divergences.len() < options.max_details {
-                    report.divergences.push(details(fields));
-                }
+                let judged = judge(&result);
+                report.sweep(&result, judged);
             }
-            Err(err) => {
-                if matches!(&err, ReplayError::Trace(e) if e.is_truncation()) {
-                    report.incomplete = true;
-                }
-                if report.errors.len() < MAX_ERRORS {
-                    report.errors.push(crate::error_text::full_text(&err));
-                }
-            }
+            Err(err) => report.error(&err),
         }
     }
     let summary = replay.summary();
     drop(replay);
-    report.expectations_without_sweep = summary.expected_unmatched;
-    report.expectations = summary.expected_matched + summary.expected_unmatched;
-    if report.divergent + report.fragile_divergent > 0 {
-        report.inferred = infer(&compared, &options.tolerances);
+    (report.finish(&summary), saw_expected)
+}
+
+/// `check`'s fold: one trace's report, built sweep by sweep.
+struct ReportBuilder<'a> {
+    report: TraceReport,
+    options: &'a CheckOptions,
+    /// The first sweeps compared with the core's outcome, kept for the
+    /// inference of the engine's configuration (the first ones only, so
+    /// memory stays bounded on long traces).
+    compared: Vec<ComparedSweep>,
+}
+
+impl<'a> ReportBuilder<'a> {
+    /// A report of nothing yet, with the check's options in it.
+    fn new(name: &str, options: &'a CheckOptions) -> Self {
+        let mut report = TraceReport {
+            trace: name.to_string(),
+            tolerances: options.tolerances,
+            ..TraceReport::default()
+        };
+        report.fragile.strict = options.strict;
+        report.within_precision =
+            (!options.tolerances.precision.is_f64()).then(WithinPrecision::default);
+        report.conventions = EngineConventions::of(&options.tolerances, &options.replay);
+        report.tunnels.fail = options.fail_on_tunnel;
+        report.ghosts.fail = options.fail_on_ghost;
+        report.ghosts.degrees = options.ghost_degrees;
+        ReportBuilder {
+            report,
+            options,
+            compared: Vec::new(),
+        }
     }
-    (report, saw_expected)
+
+    /// One replayed sweep: its tunnels, and its judgement (`None` when it
+    /// has no expectation).
+    fn sweep(&mut self, result: &SweepResult, judged: Option<Judged>) {
+        self.report.sweeps += 1;
+        let tunnels = &mut self.report.tunnels;
+        for t in &result.tunnels {
+            tunnels.count += 1;
+            *tunnels.by_kind.entry(t.kind).or_default() += 1;
+            if tunnels.details.len() < MAX_LISTED_TUNNELS {
+                tunnels.details.push(TunnelReport {
+                    frame: result.frame,
+                    ball: result.ball,
+                    log_time_nanos: result.log_time_nanos,
+                    tunnel: t.clone(),
+                });
+            }
+        }
+        match judged {
+            Some(judged) => self.judged(result, judged),
+            None => self.report.expectations.missing += 1,
+        }
+    }
+
+    /// A sweep compared with its expectation: its ghost contacts, and a
+    /// match, a tie or a divergence.
+    fn judged(&mut self, result: &SweepResult, judged: Judged) {
+        self.report.compared += 1;
+        count_ghosts(&mut self.report.ghosts, result, &judged);
+        if judged.got_is_core && self.compared.len() < MAX_INFERENCE_SWEEPS {
+            self.compared.push(ComparedSweep {
+                scene: result.scene.clone(),
+                frame: result.frame,
+                ball: result.ball,
+                sweep: result.sweep,
+                expected: judged.expected,
+                replayed_face: result
+                    .outcome
+                    .hit
+                    .filter(|h| h.feature == Feature::Face)
+                    .map(|h| h.triangle),
+            });
+        }
+        match judged.agreement {
+            Agreement::Match => {}
+            Agreement::Tie => self.report.ties += 1,
+            Agreement::Precision { .. } | Agreement::Diverges { .. } => {
+                self.diverges(result, judged);
+            }
+        }
+    }
+
+    /// A sweep whose answers differ: within single precision (a backward
+    /// error), fragile and explained by rounding (`reproduced`), or a
+    /// divergence; the first of each kind in detail.
+    fn diverges(&mut self, result: &SweepResult, judged: Judged) {
+        let (fields, fragile, reproduced, backward_error) = match judged.agreement {
+            Agreement::Match | Agreement::Tie => return,
+            Agreement::Precision {
+                fields,
+                backward_error,
+                reproduced,
+            } => (
+                fields,
+                result.outcome.fragile,
+                reproduced,
+                Some(backward_error),
+            ),
+            Agreement::Diverges {
+                fields,
+                fragile,
+                reproduced,
+            } => (fields, fragile, reproduced, None),
+        };
+        let details = |fields| {
+            let mut d = divergence_details(
+                result,
+                judged.expected,
+                judged.got,
+                fields,
+                self.options.hex,
+            );
+            d.reproduced = reproduced;
+            d.backward_error = backward_error;
+            d
+        };
+        let report = &mut self.report;
+        if let Some(error) = backward_error {
+            let within = report
+                .within_precision
+                .get_or_insert_with(WithinPrecision::default);
+            within.count += 1;
+            within.max_backward_error = within.max_backward_error.max(error);
+            if !self.options.strict {
+                return;
+            }
+        } else if reproduced.is_some() {
+            report.fragile.count += 1;
+            for reason in fragile.iter() {
+                *report.fragile.by_reason.entry(reason).or_default() += 1;
+            }
+            if !self.options.strict {
+                if report.fragile.details.len() < self.options.max_details {
+                    report.fragile.details.push(details(fields));
+                }
+                return;
+            }
+        }
+        report.divergent += 1;
+        let divergences = &mut report.divergences;
+        *divergences
+            .by_kind
+            .entry(KindChange {
+                expected: judged.expected.kind,
+                got: judged.got.kind,
+            })
+            .or_default() += 1;
+        if divergences.frames.len() < MAX_DIVERGENT_FRAMES {
+            divergences.frames.push(result.frame);
+        }
+        if divergences.details.len() < self.options.max_details {
+            divergences.details.push(details(fields));
+        }
+    }
+
+    /// What the replay could not do.
+    fn error(&mut self, err: &ReplayError) {
+        if matches!(err, ReplayError::Trace(e) if e.is_truncation()) {
+            self.report.incomplete = true;
+        }
+        if self.report.errors.len() < MAX_ERRORS {
+            self.report.errors.push(crate::error_text::full_text(err));
+        }
+    }
+
+    /// The report, with the replay's count of expectations and, when any
+    /// sweep diverged, the inference of the engine's configuration.
+    fn finish(mut self, summary: &ReplaySummary) -> TraceReport {
+        let report = &mut self.report;
+        report.expectations.unmatched = summary.expected_unmatched;
+        report.expectations.read = summary.expected_matched + summary.expected_unmatched;
+        if report.divergent + report.fragile.count > 0 {
+            report.inferred = infer(&self.compared, &self.options.tolerances);
+        }
+        self.report
+    }
 }
 
 /// A divergent sweep explained as `check` reports it (render it with
@@ -376,13 +410,20 @@ pub fn frames_around(
     before: u64,
     after: u64,
 ) -> Option<crate::replay::FrameRange> {
-    let kept = r.divergences.len().max(1);
-    let divergent = r.divergent_frames.iter().take(kept).copied();
-    let tunnel = r.tunnel_details.first().map(|t| t.frame).into_iter().chain(
-        r.tunnel_details
-            .first()
-            .and_then(|t| t.tunnel.previous_frame),
-    );
+    let kept = r.divergences.details.len().max(1);
+    let divergent = r.divergences.frames.iter().take(kept).copied();
+    let tunnel = r
+        .tunnels
+        .details
+        .first()
+        .map(|t| t.frame)
+        .into_iter()
+        .chain(
+            r.tunnels
+                .details
+                .first()
+                .and_then(|t| t.tunnel.previous_frame),
+        );
     let frames: Vec<u64> = divergent.chain(tunnel).collect();
     let first = frames.iter().copied().min()?;
     let last = frames.iter().copied().max().unwrap_or(first);

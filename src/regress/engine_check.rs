@@ -77,7 +77,7 @@ pub fn check_file_with_engine(
     };
     report.engine = Some(engine_check);
     report.expected_source = reader.expected_source().cloned();
-    report.has_expected_channel = match against {
+    report.expectations.has_channel = match against {
         Against::Core => true,
         Against::Expected => reader.stats().channels.contains_key(EXPECTED_TOPIC),
     };

@@ -4,21 +4,16 @@
 
 use crate::replay::SweepResult;
 
-use super::report::{Judged, TraceReport};
+use super::report::{Ghosts, Judged};
 use crate::replay::{GhostJudgement, judge_ghost};
 
 /// How many ghost contacts a report lists, one line each.
 pub const MAX_LISTED_GHOSTS: usize = 10;
 
-/// Counts the ghost contacts of one judged sweep into `report` (the first
-/// [`MAX_LISTED_GHOSTS`] kept in detail), with the threshold
-/// `ghost_degrees`.
-pub(super) fn count_ghosts(
-    report: &mut TraceReport,
-    result: &SweepResult,
-    judged: &Judged,
-    ghost_degrees: f64,
-) {
+/// Counts the ghost contacts of one judged sweep into `ghosts` (the first
+/// [`MAX_LISTED_GHOSTS`] kept in detail), with its threshold
+/// [`Ghosts::degrees`].
+pub(super) fn count_ghosts(ghosts: &mut Ghosts, result: &SweepResult, judged: &Judged) {
     // The expectation, and an engine's answer when it is not
     // the core's outcome, judged for ghost contacts whatever
     // the compared fields.
@@ -30,16 +25,16 @@ pub(super) fn count_ghosts(
             outcome,
             result.log_time_nanos,
             result.outcome.hit.as_ref().map(|h| &h.normal),
-            ghost_degrees,
+            ghosts.degrees,
         ) {
             GhostJudgement::Ghost(mut g) => {
-                report.ghosts += 1;
-                if report.ghost_contacts.len() < MAX_LISTED_GHOSTS {
+                ghosts.count += 1;
+                if ghosts.contacts.len() < MAX_LISTED_GHOSTS {
                     g.answer = is_answer;
-                    report.ghost_contacts.push(g);
+                    ghosts.contacts.push(g);
                 }
             }
-            GhostJudgement::NoNormal => report.ghosts_unjudged += 1,
+            GhostJudgement::NoNormal => ghosts.unjudged += 1,
             GhostJudgement::Fine | GhostJudgement::NotApplicable => {}
         }
     }

@@ -49,8 +49,10 @@ impl Trial {
         for r in reports {
             t.failing += r.divergent;
             t.compared += r.compared;
-            t.precision += r.precision_divergent;
-            t.max_backward_error = t.max_backward_error.max(r.max_backward_error);
+            if let Some(within) = &r.within_precision {
+                t.precision += within.count;
+                t.max_backward_error = t.max_backward_error.max(within.max_backward_error);
+            }
             t.ties += r.ties;
             if let Some(m) = r.inferred.as_ref().and_then(|i| i.margin) {
                 t.margins.push(m);

@@ -60,7 +60,7 @@ pub fn first_problem(r: &TraceReport) -> Option<String> {
         Status::Fail => {
             let mut parts: Vec<String> = Vec::new();
             if r.divergent > 0 {
-                let first = match (r.divergences.first(), r.divergent_frames.first()) {
+                let first = match (r.divergences.details.first(), r.divergences.frames.first()) {
                     (Some(d), _) => divergence_line(d, sides),
                     (None, Some(frame)) => format!("frame {frame}"),
                     (None, None) => "not kept".to_string(),
@@ -72,23 +72,25 @@ pub fn first_problem(r: &TraceReport) -> Option<String> {
             }
             if r.fails_on_tunnels() {
                 let first = r
-                    .tunnel_details
+                    .tunnels
+                    .details
                     .first()
                     .map_or_else(String::new, |t| format!("; first tunnel: {}", t.line()));
                 parts.push(format!(
                     "{} {} (a ball's centre went through a triangle from its front to its back){first}",
-                    r.tunnels,
-                    if r.tunnels == 1 { "tunnel" } else { "tunnels" }
+                    r.tunnels.count,
+                    if r.tunnels.count == 1 { "tunnel" } else { "tunnels" }
                 ));
             }
             if r.fails_on_ghosts() {
                 let first = r
-                    .ghost_contacts
+                    .ghosts
+                    .contacts
                     .first()
                     .map_or_else(String::new, |g| format!("; first ghost contact: {g}"));
                 parts.push(format!(
                     "{}{first}",
-                    crate::numbers::counted(r.ghosts, "ghost contact", "ghost contacts")
+                    crate::numbers::counted(r.ghosts.count, "ghost contact", "ghost contacts")
                 ));
             }
             Some(crate::junit::one_line(&parts.join("; ")))
@@ -121,8 +123,8 @@ fn properties(r: &TraceReport) -> Vec<(String, String)> {
         ),
         ("tolerance.contact".to_string(), t.contact.to_string()),
         ("fields".to_string(), t.fields.names()),
-        ("strict".to_string(), r.strict.to_string()),
-        ("fail_on_tunnel".to_string(), r.fail_on_tunnel.to_string()),
+        ("strict".to_string(), r.fragile.strict.to_string()),
+        ("fail_on_tunnel".to_string(), r.tunnels.fail.to_string()),
     ];
     if let Some(engine) = &r.engine {
         p.push(("engine".to_string(), engine.command.clone()));
@@ -179,7 +181,7 @@ fn trace_suite(r: &TraceReport, time: Option<Duration>, options: &JunitOptions) 
         system_out: passed.then(|| text.clone()),
     }];
     if options.detail == Detail::Sweeps {
-        for d in &r.divergences {
+        for d in &r.divergences.details {
             cases.push(Case {
                 name: format!("{}: frame {}, ball {}", r.trace, d.frame, d.ball),
                 classname: SWEEP_CLASS.to_string(),
@@ -194,7 +196,7 @@ fn trace_suite(r: &TraceReport, time: Option<Duration>, options: &JunitOptions) 
             });
         }
         if r.fails_on_tunnels() {
-            for t in &r.tunnel_details {
+            for t in &r.tunnels.details {
                 cases.push(Case {
                     name: format!("{}: tunnel, frame {}, ball {}", r.trace, t.frame, t.ball),
                     classname: TUNNEL_CLASS.to_string(),
@@ -213,7 +215,7 @@ fn trace_suite(r: &TraceReport, time: Option<Duration>, options: &JunitOptions) 
             }
         }
         if r.fails_on_ghosts() {
-            for g in &r.ghost_contacts {
+            for g in &r.ghosts.contacts {
                 cases.push(Case {
                     name: format!(
                         "{}: ghost contact, frame {}, ball {}",
@@ -232,7 +234,7 @@ fn trace_suite(r: &TraceReport, time: Option<Duration>, options: &JunitOptions) 
             }
         }
     }
-    for d in &r.fragile_divergences {
+    for d in &r.fragile.details {
         cases.push(Case {
             name: format!("{}: frame {}, ball {} (fragile)", r.trace, d.frame, d.ball),
             classname: FRAGILE_CLASS.to_string(),
@@ -267,7 +269,7 @@ pub fn github_annotations(r: &TraceReport) -> String {
     match r.status() {
         Status::Ok => {}
         Status::Fail => {
-            for d in &r.divergences {
+            for d in &r.divergences.details {
                 lines.push((
                     format!(
                         "sweeptrace check: frame {}, ball {} diverges",
@@ -276,14 +278,14 @@ pub fn github_annotations(r: &TraceReport) -> String {
                     divergence_line(d, sides),
                 ));
             }
-            if r.divergences.is_empty()
+            if r.divergences.details.is_empty()
                 && r.divergent > 0
                 && let Some(message) = first_problem(r)
             {
                 lines.push(("sweeptrace check: FAIL".to_string(), message));
             }
             if r.fails_on_tunnels() {
-                for t in &r.tunnel_details {
+                for t in &r.tunnels.details {
                     lines.push((
                         format!("sweeptrace check: tunnel, frame {}, ball {}", t.frame, t.ball),
                         format!(
@@ -294,7 +296,7 @@ pub fn github_annotations(r: &TraceReport) -> String {
                 }
             }
             if r.fails_on_ghosts() {
-                for g in &r.ghost_contacts {
+                for g in &r.ghosts.contacts {
                     lines.push((
                         format!(
                             "sweeptrace check: ghost contact, frame {}, ball {}",

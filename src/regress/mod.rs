@@ -82,7 +82,7 @@ pub use precision::{F32_OPERATIONS, F32_UNIT, Precision, Sensitivity};
 pub use render::{Sides, render_divergence, render_json, render_text};
 pub(crate) use render::{divergence_line, render_divergence_as, values_text};
 pub use report::{
-    Against, Divergence, EngineCheck, KindChange, MAX_LISTED_TUNNELS, Status, TraceReport,
-    TunnelReport,
+    Against, Divergence, Divergences, EngineCheck, Expectations, Fragile, Ghosts, KindChange,
+    MAX_LISTED_TUNNELS, Status, TraceReport, TunnelReport, Tunnels, WithinPrecision,
 };
 pub use repro::{HexInputs, ReproCase, ReproError, SweepInputs, TraceSweep, find_sweep};

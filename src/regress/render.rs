@@ -1,5 +1,6 @@
 //! `check` reports in words and as JSON: pure functions of a report.
 
+use std::collections::BTreeMap;
 use std::fmt::Write as _;
 
 use serde_json::{Value, json};
@@ -230,229 +231,29 @@ pub fn sides_of(r: &TraceReport) -> Sides {
 pub fn render_text(r: &TraceReport) -> String {
     let mut s = String::new();
     let sides = sides_of(r);
-    let mut counts = format!(
-        "{}, {} compared, {} without expectation, {} without a sweep",
-        crate::numbers::counted(r.sweeps, "sweep", "sweeps"),
-        r.compared,
-        r.sweeps_without_expectation,
-        crate::numbers::counted(r.expectations_without_sweep, "expectation", "expectations"),
-    );
-    if !r.tolerances.fields.is_all() {
-        let _ = write!(counts, ", fields compared: {}", r.tolerances.fields.names());
-    }
-    if r.ties > 0 {
-        let _ = write!(
-            counts,
-            ", {} (the expectation names another member of the tie set: a match)",
-            crate::numbers::counted(r.ties, "tie", "ties")
-        );
-    }
-    if r.fragile_divergent > 0 {
-        let reasons = counts_by_name(&r.fragile_by_reason)
-            .iter()
-            .map(|(k, n)| format!("{k}: {n}"))
-            .collect::<Vec<_>>()
-            .join(", ");
-        let _ = write!(
-            counts,
-            ", {} fragile divergences ({reasons}){}",
-            r.fragile_divergent,
-            if r.strict {
-                ", failures under --strict"
-            } else {
-                ", not failures without --strict"
-            }
-        );
-    }
-    if r.precision_divergent > 0 {
-        let _ = write!(
-            counts,
-            ", {} within single precision (largest backward error {} u32 units of the \
-             sweep's scale){}",
-            crate::numbers::counted(r.precision_divergent, "difference", "differences"),
-            crate::core::num(r.max_backward_error),
-            if r.strict {
-                ", failures under --strict"
-            } else {
-                ", not failures without --strict"
-            }
-        );
-    }
-    if r.tunnels > 0 && !r.fail_on_tunnel {
-        let _ = write!(
-            counts,
-            ", {} {} (not failures: tunnels allowed)",
-            r.tunnels,
-            tunnel_words(r.tunnels)
-        );
-    }
-    if r.ghosts > 0 && !r.fail_on_ghost {
-        let _ = write!(
-            counts,
-            ", {} (not failures: ghost contacts allowed)",
-            ghost_words(r.ghosts)
-        );
-    }
-    let tunnel_lines = |s: &mut String| {
-        for t in &r.tunnel_details {
-            let _ = writeln!(s, "  tunnel: {}", t.line());
-        }
-        if r.tunnels as usize > r.tunnel_details.len() {
-            let _ = writeln!(
-                s,
-                "  ... {} more tunnels",
-                r.tunnels as usize - r.tunnel_details.len()
-            );
-        }
-        for g in &r.ghost_contacts {
-            let _ = writeln!(s, "  ghost contact: {g}");
-        }
-        if r.ghosts as usize > r.ghost_contacts.len() {
-            let _ = writeln!(
-                s,
-                "  ... {} more ghost contacts",
-                r.ghosts as usize - r.ghost_contacts.len()
-            );
-        }
-    };
-    let conventions_line = |s: &mut String| {
-        if !r.conventions.is_rules() {
-            let _ = writeln!(
-                s,
-                "  judged under the engine's declared conventions: {}",
-                r.conventions.summary()
-            );
-        }
-    };
-    let fragile_details = |s: &mut String| {
-        for d in &r.fragile_divergences {
-            let _ = writeln!(
-                s,
-                "  fragile divergence (not a failure; rounding could change this decision):"
-            );
-            s.push_str(&render_divergence_as(d, "    ", sides));
-        }
-    };
+    let counts = counts_text(r);
     match r.status() {
         Status::Ok => {
             let _ = writeln!(s, "ok {}: {counts}", r.trace);
-            conventions_line(&mut s);
-            tunnel_lines(&mut s);
-            fragile_details(&mut s);
+            write_conventions(&mut s, r);
+            write_tunnels_and_ghosts(&mut s, r);
+            write_fragile_divergences(&mut s, r, sides);
         }
         Status::Fail => {
-            let mut failures: Vec<String> = Vec::new();
-            if r.divergent > 0 || !(r.fails_on_tunnels() || r.fails_on_ghosts()) {
-                let kinds = counts_by_name(&r.by_kind)
-                    .iter()
-                    .map(|(k, n)| format!("{k}: {n}"))
-                    .collect::<Vec<_>>()
-                    .join(", ");
-                failures.push(format!(
-                    "{} of {} compared sweeps diverge ({kinds})",
-                    r.divergent, r.compared
-                ));
-            }
-            if r.fails_on_tunnels() {
-                failures.push(format!(
-                    "{} {} (a ball's centre went through a triangle from its front to its back: {})",
-                    r.tunnels,
-                    tunnel_words(r.tunnels),
-                    counts_by_name(&r.tunnels_by_kind)
-                        .iter()
-                        .map(|(k, n)| format!("{k}: {n}"))
-                        .collect::<Vec<_>>()
-                        .join(", ")
-                ));
-            }
-            if r.fails_on_ghosts() {
-                failures.push(format!(
-                    "{} (an edge or vertex contact on an internal flat or concave place \
-                     with a normal more than {}° off the faces')",
-                    ghost_words(r.ghosts),
-                    crate::core::explain::num(r.ghost_degrees)
-                ));
-            }
-            let _ = writeln!(s, "FAIL {}: {}; {counts}", r.trace, failures.join("; "));
-            conventions_line(&mut s);
-            tunnel_lines(&mut s);
-            if r.divergences.is_empty()
-                && let Some(frame) = r.divergent_frames.first()
-            {
-                let _ = writeln!(s, "  first divergence: frame {frame}");
-            }
-            if let Some(first) = r.divergences.first() {
-                let _ = writeln!(
-                    s,
-                    "  first divergence: frame {}, ball {} ({})",
-                    first.frame,
-                    first.ball,
-                    first
-                        .fields
-                        .iter()
-                        .map(|f| f.field.as_str())
-                        .collect::<Vec<_>>()
-                        .join(", ")
-                );
-            }
-            for d in &r.divergences {
-                s.push_str(&render_divergence_as(d, "  ", sides));
-            }
-            if r.divergent as usize > r.divergences.len() {
-                let _ = writeln!(
-                    s,
-                    "  ... {} more divergent sweeps (frames {}{})",
-                    r.divergent as usize - r.divergences.len(),
-                    r.divergent_frames
-                        .iter()
-                        .skip(r.divergences.len())
-                        .take(20)
-                        .map(u64::to_string)
-                        .collect::<Vec<_>>()
-                        .join(", "),
-                    if r.divergent as usize > r.divergences.len() + 20 {
-                        ", ..."
-                    } else {
-                        ""
-                    }
-                );
-            }
+            let _ = writeln!(s, "FAIL {}: {}; {counts}", r.trace, failures(r).join("; "));
+            write_conventions(&mut s, r);
+            write_tunnels_and_ghosts(&mut s, r);
+            write_divergences(&mut s, r, sides);
         }
         Status::NoExpectations => {
-            let why = if !r.has_expected_channel {
-                "no /expected channel".to_string()
-            } else if r.expectations == 0 {
-                "the /expected channel holds no message".to_string()
-            } else {
-                format!(
-                    "none of the {} /expected messages matches a sweep",
-                    r.expectations
-                )
-            };
+            let why = no_expectations_reason(r);
             let _ = writeln!(s, "NO EXPECTATIONS {}: {why}; {counts}", r.trace);
-            tunnel_lines(&mut s);
+            write_tunnels_and_ghosts(&mut s, r);
         }
         Status::Error => {
-            // The errors name the trace; the line names it once. A message
-            // of several lines (an engine's last stderr lines) keeps its
-            // first line with the counts, the rest below.
-            let prefix = format!("{}: ", r.trace);
-            let unnamed = |e: &str| e.strip_prefix(&prefix).unwrap_or(e).to_string();
-            let first = r.errors.first().map_or("error".to_string(), |e| unnamed(e));
-            let (head, below) = first.split_once('\n').unwrap_or((first.as_str(), ""));
-            let _ = writeln!(
-                s,
-                "ERROR {}: {head}; {counts}, {} diverge",
-                r.trace, r.divergent
-            );
-            for line in below.lines() {
-                let _ = writeln!(s, "{line}");
-            }
-            for e in r.errors.iter().skip(1) {
-                let _ = writeln!(s, "  also: {}", unnamed(e));
-            }
-            tunnel_lines(&mut s);
-            for d in &r.divergences {
+            write_errors(&mut s, r, &counts);
+            write_tunnels_and_ghosts(&mut s, r);
+            for d in &r.divergences.details {
                 s.push_str(&render_divergence_as(d, "  ", sides));
             }
         }
@@ -468,6 +269,245 @@ pub fn render_text(r: &TraceReport) -> String {
         s.insert_str(at, &line);
     }
     s
+}
+
+/// The counts of the status line: sweeps, comparisons, the fields
+/// compared, ties, and what was found but does not fail the check.
+fn counts_text(r: &TraceReport) -> String {
+    let mut counts = format!(
+        "{}, {} compared, {} without expectation, {} without a sweep",
+        crate::numbers::counted(r.sweeps, "sweep", "sweeps"),
+        r.compared,
+        r.expectations.missing,
+        crate::numbers::counted(r.expectations.unmatched, "expectation", "expectations"),
+    );
+    if !r.tolerances.fields.is_all() {
+        let _ = write!(counts, ", fields compared: {}", r.tolerances.fields.names());
+    }
+    if r.ties > 0 {
+        let _ = write!(
+            counts,
+            ", {} (the expectation names another member of the tie set: a match)",
+            crate::numbers::counted(r.ties, "tie", "ties")
+        );
+    }
+    if r.fragile.count > 0 {
+        let _ = write!(
+            counts,
+            ", {} fragile divergences ({}){}",
+            r.fragile.count,
+            names_and_counts(&r.fragile.by_reason),
+            if r.fragile.strict {
+                ", failures under --strict"
+            } else {
+                ", not failures without --strict"
+            }
+        );
+    }
+    if let Some(within) = &r.within_precision
+        && within.count > 0
+    {
+        let _ = write!(
+            counts,
+            ", {} within single precision (largest backward error {} u32 units of the \
+             sweep's scale){}",
+            crate::numbers::counted(within.count, "difference", "differences"),
+            crate::core::num(within.max_backward_error),
+            if r.fragile.strict {
+                ", failures under --strict"
+            } else {
+                ", not failures without --strict"
+            }
+        );
+    }
+    if r.tunnels.count > 0 && !r.tunnels.fail {
+        let _ = write!(
+            counts,
+            ", {} {} (not failures: tunnels allowed)",
+            r.tunnels.count,
+            tunnel_words(r.tunnels.count)
+        );
+    }
+    if r.ghosts.count > 0 && !r.ghosts.fail {
+        let _ = write!(
+            counts,
+            ", {} (not failures: ghost contacts allowed)",
+            ghost_words(r.ghosts.count)
+        );
+    }
+    counts
+}
+
+/// `key: n, key: n` in the keys' alphabetical order.
+fn names_and_counts<K: std::fmt::Display>(counts: &BTreeMap<K, u64>) -> String {
+    counts_by_name(counts)
+        .iter()
+        .map(|(k, n)| format!("{k}: {n}"))
+        .collect::<Vec<_>>()
+        .join(", ")
+}
+
+/// Why a trace failed, one phrase a cause: divergences, tunnels, ghost
+/// contacts.
+fn failures(r: &TraceReport) -> Vec<String> {
+    let mut failures: Vec<String> = Vec::new();
+    if r.divergent > 0 || !(r.fails_on_tunnels() || r.fails_on_ghosts()) {
+        failures.push(format!(
+            "{} of {} compared sweeps diverge ({})",
+            r.divergent,
+            r.compared,
+            names_and_counts(&r.divergences.by_kind)
+        ));
+    }
+    if r.fails_on_tunnels() {
+        failures.push(format!(
+            "{} {} (a ball's centre went through a triangle from its front to its back: {})",
+            r.tunnels.count,
+            tunnel_words(r.tunnels.count),
+            names_and_counts(&r.tunnels.by_kind)
+        ));
+    }
+    if r.fails_on_ghosts() {
+        failures.push(format!(
+            "{} (an edge or vertex contact on an internal flat or concave place \
+             with a normal more than {}° off the faces')",
+            ghost_words(r.ghosts.count),
+            crate::core::explain::num(r.ghosts.degrees)
+        ));
+    }
+    failures
+}
+
+/// The engine conventions the trace was judged by, when some are declared.
+fn write_conventions(s: &mut String, r: &TraceReport) {
+    if !r.conventions.is_rules() {
+        let _ = writeln!(
+            s,
+            "  judged under the engine's declared conventions: {}",
+            r.conventions.summary()
+        );
+    }
+}
+
+/// The listed tunnels and ghost contacts, one line each, and how many
+/// more there are.
+fn write_tunnels_and_ghosts(s: &mut String, r: &TraceReport) {
+    for t in &r.tunnels.details {
+        let _ = writeln!(s, "  tunnel: {}", t.line());
+    }
+    if r.tunnels.count as usize > r.tunnels.details.len() {
+        let _ = writeln!(
+            s,
+            "  ... {} more tunnels",
+            r.tunnels.count as usize - r.tunnels.details.len()
+        );
+    }
+    for g in &r.ghosts.contacts {
+        let _ = writeln!(s, "  ghost contact: {g}");
+    }
+    if r.ghosts.count as usize > r.ghosts.contacts.len() {
+        let _ = writeln!(
+            s,
+            "  ... {} more ghost contacts",
+            r.ghosts.count as usize - r.ghosts.contacts.len()
+        );
+    }
+}
+
+/// The fragile divergences kept in detail (a passing trace's).
+fn write_fragile_divergences(s: &mut String, r: &TraceReport, sides: Sides) {
+    for d in &r.fragile.details {
+        let _ = writeln!(
+            s,
+            "  fragile divergence (not a failure; rounding could change this decision):"
+        );
+        s.push_str(&render_divergence_as(d, "    ", sides));
+    }
+}
+
+/// A failed trace's divergences: the first one, those kept in detail,
+/// then the frames of the next ones.
+fn write_divergences(s: &mut String, r: &TraceReport, sides: Sides) {
+    let divergences = &r.divergences;
+    if divergences.details.is_empty()
+        && let Some(frame) = divergences.frames.first()
+    {
+        let _ = writeln!(s, "  first divergence: frame {frame}");
+    }
+    if let Some(first) = divergences.details.first() {
+        let _ = writeln!(
+            s,
+            "  first divergence: frame {}, ball {} ({})",
+            first.frame,
+            first.ball,
+            first
+                .fields
+                .iter()
+                .map(|f| f.field.as_str())
+                .collect::<Vec<_>>()
+                .join(", ")
+        );
+    }
+    for d in &divergences.details {
+        s.push_str(&render_divergence_as(d, "  ", sides));
+    }
+    let kept = divergences.details.len();
+    if r.divergent as usize > kept {
+        let _ = writeln!(
+            s,
+            "  ... {} more divergent sweeps (frames {}{})",
+            r.divergent as usize - kept,
+            divergences
+                .frames
+                .iter()
+                .skip(kept)
+                .take(20)
+                .map(u64::to_string)
+                .collect::<Vec<_>>()
+                .join(", "),
+            if r.divergent as usize > kept + 20 {
+                ", ..."
+            } else {
+                ""
+            }
+        );
+    }
+}
+
+/// Why nothing was compared.
+fn no_expectations_reason(r: &TraceReport) -> String {
+    if !r.expectations.has_channel {
+        "no /expected channel".to_string()
+    } else if r.expectations.read == 0 {
+        "the /expected channel holds no message".to_string()
+    } else {
+        format!(
+            "none of the {} /expected messages matches a sweep",
+            r.expectations.read
+        )
+    }
+}
+
+/// The status line of a trace that could not be checked, and its errors.
+fn write_errors(s: &mut String, r: &TraceReport, counts: &str) {
+    // The errors name the trace; the line names it once. A message of
+    // several lines (an engine's last stderr lines) keeps its first line
+    // with the counts, the rest below.
+    let prefix = format!("{}: ", r.trace);
+    let unnamed = |e: &str| e.strip_prefix(&prefix).unwrap_or(e).to_string();
+    let first = r.errors.first().map_or("error".to_string(), |e| unnamed(e));
+    let (head, below) = first.split_once('\n').unwrap_or((first.as_str(), ""));
+    let _ = writeln!(
+        s,
+        "ERROR {}: {head}; {counts}, {} diverge",
+        r.trace, r.divergent
+    );
+    for line in below.lines() {
+        let _ = writeln!(s, "{line}");
+    }
+    for e in r.errors.iter().skip(1) {
+        let _ = writeln!(s, "  also: {}", unnamed(e));
+    }
 }
 
 /// Who computed the expectations the report compared with, one line: the

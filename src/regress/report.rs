@@ -167,12 +167,12 @@ impl TraceReport {
 
     /// Whether tunnels were found and fail the check.
     pub fn fails_on_tunnels(&self) -> bool {
-        self.tunnels > 0 && self.fail_on_tunnel
+        self.tunnels.count > 0 && self.tunnels.fail
     }
 
     /// Whether ghost contacts were found and fail the check.
     pub fn fails_on_ghosts(&self) -> bool {
-        self.ghosts > 0 && self.fail_on_ghost
+        self.ghosts.count > 0 && self.ghosts.fail
     }
 }
 
@@ -221,10 +221,20 @@ pub struct EngineCheck {
 
 /// The result of checking one trace. Its verdict is [`TraceReport::status`]
 /// (in the JSON, `status` after `trace`).
-#[derive(Clone, Debug, PartialEq)]
+///
+/// Its JSON is flat: each part ([`Fragile`], [`Tunnels`], [`Ghosts`],
+/// [`Expectations`], [`Divergences`]) writes its fields beside the
+/// report's own, under the names each field's `serde(rename)` gives, in
+/// declaration order.
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+// The derive writes every field but `trace` into an inherent
+// `TraceReport::serialize`; the `Serialize` impl below puts `trace` and
+// the computed `status` first.
+#[serde(remote = "Self")]
 #[non_exhaustive]
 pub struct TraceReport {
     /// The trace's name (its path as given).
+    #[serde(skip)]
     pub trace: String,
     /// Sweeps replayed.
     pub sweeps: u64,
@@ -232,97 +242,183 @@ pub struct TraceReport {
     pub compared: u64,
     /// Sweeps whose outcome differs from its expectation (on a robust
     /// decision; with `strict`, on any decision). These fail the check.
+    /// The first of them are in [`TraceReport::divergences`].
     pub divergent: u64,
     /// Sweeps whose expectation names another member of the replayed
     /// decision's tie set: an equally valid answer to the rules, counted
     /// as a match.
     pub ties: u64,
-    /// Sweeps that diverge on a fragile decision in a way rounding
-    /// explains: a perturbation of the inputs within the rounding budget
-    /// makes the core give the expected answer
-    /// ([`Divergence::reproduced`]). They fail the check only with
-    /// `strict`, where they are also counted in `divergent`. A divergence
-    /// on a fragile decision that no perturbation reproduces is counted in
-    /// `divergent`.
-    pub fragile_divergent: u64,
-    /// Fragile divergences by reason (one sweep can have several).
-    pub fragile_by_reason: BTreeMap<FragileReason, u64>,
-    /// The first fragile divergences, in detail (without `strict`).
-    pub fragile_divergences: Vec<Divergence>,
-    /// Whether fragile divergences fail the check (`--strict`).
-    pub strict: bool,
-    /// At single precision (`precision = "f32"`): sweeps whose answers
-    /// differ by no more than single-precision rounding explains
-    /// ([`super::Agreement::Precision`]). Failures only with `strict`,
-    /// where they are also counted in `divergent`. Only in the JSON at
-    /// `f32`.
-    pub precision_divergent: u64,
-    /// The largest backward error among them, in units of `u₃₂ · S`.
-    pub max_backward_error: f64,
+    /// Divergences on fragile decisions that rounding explains.
+    #[serde(flatten)]
+    pub fragile: Fragile,
+    /// At single precision (`precision = "f32"`; `None` otherwise, and
+    /// then not in the JSON): the differences single-precision rounding
+    /// explains.
+    #[serde(flatten)]
+    pub within_precision: Option<WithinPrecision>,
     /// The engine conventions the check judged by (the `[engine]` table;
     /// only in the JSON when some are declared).
+    #[serde(skip_serializing_if = "EngineConventions::is_rules")]
     pub conventions: EngineConventions,
-    /// Tunnels found: a ball's centre through a triangle, front to back,
-    /// during a sweep or between two sweeps of the ball. They fail the
-    /// check unless `fail_on_tunnel` is off.
-    pub tunnels: u64,
-    /// Tunnels by kind.
-    pub tunnels_by_kind: BTreeMap<TunnelKind, u64>,
-    /// The first tunnels (at most [`MAX_LISTED_TUNNELS`]), in trace order.
-    pub tunnel_details: Vec<TunnelReport>,
-    /// Whether tunnels fail the check.
-    pub fail_on_tunnel: bool,
-    /// Ghost contacts found: expectations (or an engine's answers) that are
-    /// edge or vertex contacts on an internal flat or concave place with a
-    /// normal more than `ghost_degrees` from the faces' there
-    /// ([`judge_ghost`](crate::replay::judge_ghost)), whatever the compared fields. They fail the
-    /// check unless `fail_on_ghost` is off.
-    pub ghosts: u64,
-    /// The first ghost contacts (at most [`MAX_LISTED_GHOSTS`]), in trace
-    /// order.
-    pub ghost_contacts: Vec<GhostContact>,
-    /// Edge or vertex contacts on such a place that give no normal, so
-    /// cannot be judged.
-    pub ghosts_unjudged: u64,
-    /// Whether ghost contacts fail the check.
-    pub fail_on_ghost: bool,
-    /// The ghost contacts' threshold, in degrees.
-    pub ghost_degrees: f64,
-    /// Replayed sweeps without an expectation.
-    pub sweeps_without_expectation: u64,
-    /// Expectations that match no replayed sweep (or arrived after theirs was
-    /// complete, or repeat one).
-    pub expectations_without_sweep: u64,
-    /// `/expected` messages read (matched or not).
-    pub expectations: u64,
-    /// Whether the trace has an `/expected` channel at all.
-    pub has_expected_channel: bool,
-    /// Divergent sweeps by the kinds of the expectation and of the outcome
-    /// it is compared with.
-    pub by_kind: BTreeMap<KindChange, u64>,
-    /// The first divergences, in detail (at most `max_details`).
-    pub divergences: Vec<Divergence>,
-    /// Frames of the first divergent sweeps (up to 100), in trace order.
-    pub divergent_frames: Vec<u64>,
+    /// Tunnels found.
+    #[serde(flatten)]
+    pub tunnels: Tunnels,
+    /// Ghost contacts found.
+    #[serde(flatten)]
+    pub ghosts: Ghosts,
+    /// The expectations and the sweeps, matched.
+    #[serde(flatten)]
+    pub expectations: Expectations,
+    /// The divergent sweeps (counted in [`TraceReport::divergent`]).
+    #[serde(flatten)]
+    pub divergences: Divergences,
     /// What could not be checked: read errors, invalid scenes or sweeps.
     pub errors: Vec<String>,
     /// Whether the trace ends early (it is truncated): the sweeps before
     /// the end were checked. Only in the JSON when true.
+    #[serde(skip_serializing_if = "std::ops::Not::not")]
     pub incomplete: bool,
     /// The tolerances used.
     pub tolerances: Tolerances,
     /// When expectations fail: the recording engine's margin and facing
     /// rule as its expectations imply them, and how many expectations
     /// match when the trace is replayed with them ([`Inferred`]).
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub inferred: Option<Inferred>,
     /// When a running engine was checked (`check --engine`): its command
     /// and what its answers were compared with.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub engine: Option<EngineCheck>,
     /// Who computed the trace's `/expected` outcomes, as its
     /// `sweeptrace.expected_source` record says (`null` when it does not).
     /// With `check --engine` and `against` `core` the report's
     /// expectations are the engine's answers instead (`engine`).
     pub expected_source: Option<crate::trace::ExpectedSource>,
+}
+
+/// A report's divergences on fragile decisions that rounding explains: a
+/// perturbation of the inputs within the rounding budget makes the core
+/// give the expected answer ([`Divergence::reproduced`]). They fail the
+/// check only with `strict`, where they are also counted in
+/// [`TraceReport::divergent`]. A divergence on a fragile decision that no
+/// perturbation reproduces is counted in [`TraceReport::divergent`] only.
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+#[non_exhaustive]
+pub struct Fragile {
+    /// How many (`fragile_divergent` in the JSON).
+    #[serde(rename = "fragile_divergent")]
+    pub count: u64,
+    /// How many by reason; one sweep can have several (`fragile_by_reason`).
+    #[serde(rename = "fragile_by_reason", serialize_with = "serialize_by_name")]
+    pub by_reason: BTreeMap<FragileReason, u64>,
+    /// The first of them, in detail, without `strict`
+    /// (`fragile_divergences`).
+    #[serde(rename = "fragile_divergences")]
+    pub details: Vec<Divergence>,
+    /// Whether they fail the check (`--strict`).
+    pub strict: bool,
+}
+
+/// A report's sweeps whose answers differ by no more than single-precision
+/// rounding explains ([`super::Agreement::Precision`]). Failures only with
+/// `strict`, where they are also counted in [`TraceReport::divergent`].
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+#[non_exhaustive]
+pub struct WithinPrecision {
+    /// How many (`precision_divergent` in the JSON).
+    #[serde(rename = "precision_divergent")]
+    pub count: u64,
+    /// The largest backward error among them, in units of `u₃₂ · S`
+    /// (`max_backward_error`).
+    pub max_backward_error: f64,
+}
+
+/// A report's tunnels: a ball's centre through a triangle, front to back,
+/// during a sweep or between two sweeps of the ball. They fail the check
+/// unless `fail` is off.
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+#[non_exhaustive]
+pub struct Tunnels {
+    /// How many (`tunnels` in the JSON).
+    #[serde(rename = "tunnels")]
+    pub count: u64,
+    /// How many by kind (`tunnels_by_kind`).
+    #[serde(rename = "tunnels_by_kind", serialize_with = "serialize_by_name")]
+    pub by_kind: BTreeMap<TunnelKind, u64>,
+    /// The first of them (at most [`MAX_LISTED_TUNNELS`]), in trace order
+    /// (`tunnel_details`).
+    #[serde(rename = "tunnel_details")]
+    pub details: Vec<TunnelReport>,
+    /// Whether they fail the check (`fail_on_tunnel`).
+    #[serde(rename = "fail_on_tunnel")]
+    pub fail: bool,
+}
+
+/// A report's ghost contacts: expectations (or an engine's answers) that
+/// are edge or vertex contacts on an internal flat or concave place with a
+/// normal more than `degrees` from the faces' there
+/// ([`judge_ghost`](crate::replay::judge_ghost)), whatever the compared
+/// fields. They fail the check unless `fail` is off.
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+#[non_exhaustive]
+pub struct Ghosts {
+    /// How many (`ghosts` in the JSON).
+    #[serde(rename = "ghosts")]
+    pub count: u64,
+    /// The first of them (at most ten), in trace order
+    /// (`ghost_contacts`).
+    #[serde(rename = "ghost_contacts")]
+    pub contacts: Vec<GhostContact>,
+    /// Edge or vertex contacts on such a place that give no normal, so
+    /// cannot be judged (`ghosts_unjudged`).
+    #[serde(rename = "ghosts_unjudged")]
+    pub unjudged: u64,
+    /// Whether they fail the check (`fail_on_ghost`).
+    #[serde(rename = "fail_on_ghost")]
+    pub fail: bool,
+    /// The threshold, in degrees (`ghost_degrees`).
+    #[serde(rename = "ghost_degrees")]
+    pub degrees: f64,
+}
+
+/// A report's expectations and replayed sweeps, matched.
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+#[non_exhaustive]
+pub struct Expectations {
+    /// Replayed sweeps without an expectation
+    /// (`sweeps_without_expectation` in the JSON).
+    #[serde(rename = "sweeps_without_expectation")]
+    pub missing: u64,
+    /// Expectations that match no replayed sweep (or arrived after theirs
+    /// was complete, or repeat one) (`expectations_without_sweep`).
+    #[serde(rename = "expectations_without_sweep")]
+    pub unmatched: u64,
+    /// `/expected` messages read, matched or not (`expectations`).
+    #[serde(rename = "expectations")]
+    pub read: u64,
+    /// Whether the trace has an `/expected` channel at all
+    /// (`has_expected_channel`).
+    #[serde(rename = "has_expected_channel")]
+    pub has_channel: bool,
+}
+
+/// A report's divergent sweeps (their count is
+/// [`TraceReport::divergent`]).
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+#[non_exhaustive]
+pub struct Divergences {
+    /// How many by the kinds of the expectation and of the outcome it is
+    /// compared with (`by_kind` in the JSON).
+    #[serde(serialize_with = "serialize_by_name")]
+    pub by_kind: BTreeMap<KindChange, u64>,
+    /// The first of them, in detail (at most `max_details`)
+    /// (`divergences`).
+    #[serde(rename = "divergences")]
+    pub details: Vec<Divergence>,
+    /// Frames of the first of them (up to 100), in trace order
+    /// (`divergent_frames`).
+    #[serde(rename = "divergent_frames")]
+    pub frames: Vec<u64>,
 }
 
 /// The kinds of a divergent sweep's expectation and of the outcome it is
@@ -367,131 +463,28 @@ where
     serializer.collect_map(counts_by_name(counts))
 }
 
-/// The JSON of a report: its fields in declaration order, with the
-/// computed [`TraceReport::status`] after `trace`.
+/// The JSON of a report: `trace`, the computed [`TraceReport::status`],
+/// then the other fields in declaration order, each part's flattened in.
 impl Serialize for TraceReport {
     fn serialize<S: Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        /// The report's fields but `trace`, as the derive writes them.
+        struct Fields<'a>(&'a TraceReport);
+        impl Serialize for Fields<'_> {
+            fn serialize<S: Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+                TraceReport::serialize(self.0, serializer)
+            }
+        }
         #[derive(Serialize)]
         struct Json<'a> {
             trace: &'a str,
             status: Status,
-            sweeps: u64,
-            compared: u64,
-            divergent: u64,
-            ties: u64,
-            fragile_divergent: u64,
-            #[serde(serialize_with = "serialize_by_name")]
-            fragile_by_reason: &'a BTreeMap<FragileReason, u64>,
-            fragile_divergences: &'a [Divergence],
-            strict: bool,
-            #[serde(skip_serializing_if = "Option::is_none")]
-            precision_divergent: Option<u64>,
-            #[serde(skip_serializing_if = "Option::is_none")]
-            max_backward_error: Option<f64>,
-            #[serde(skip_serializing_if = "EngineConventions::is_rules")]
-            conventions: &'a EngineConventions,
-            tunnels: u64,
-            #[serde(serialize_with = "serialize_by_name")]
-            tunnels_by_kind: &'a BTreeMap<TunnelKind, u64>,
-            tunnel_details: &'a [TunnelReport],
-            fail_on_tunnel: bool,
-            ghosts: u64,
-            ghost_contacts: &'a [GhostContact],
-            ghosts_unjudged: u64,
-            fail_on_ghost: bool,
-            ghost_degrees: f64,
-            sweeps_without_expectation: u64,
-            expectations_without_sweep: u64,
-            expectations: u64,
-            has_expected_channel: bool,
-            #[serde(serialize_with = "serialize_by_name")]
-            by_kind: &'a BTreeMap<KindChange, u64>,
-            divergences: &'a [Divergence],
-            divergent_frames: &'a [u64],
-            errors: &'a [String],
-            #[serde(skip_serializing_if = "std::ops::Not::not")]
-            incomplete: bool,
-            tolerances: &'a Tolerances,
-            #[serde(skip_serializing_if = "Option::is_none")]
-            inferred: &'a Option<Inferred>,
-            #[serde(skip_serializing_if = "Option::is_none")]
-            engine: &'a Option<EngineCheck>,
-            expected_source: &'a Option<crate::trace::ExpectedSource>,
+            #[serde(flatten)]
+            fields: Fields<'a>,
         }
-        // Every field, named: a new field does not compile until it is
-        // written here too.
-        let TraceReport {
-            trace,
-            sweeps,
-            compared,
-            divergent,
-            ties,
-            fragile_divergent,
-            fragile_by_reason,
-            fragile_divergences,
-            strict,
-            precision_divergent,
-            max_backward_error,
-            conventions,
-            tunnels,
-            tunnels_by_kind,
-            tunnel_details,
-            fail_on_tunnel,
-            ghosts,
-            ghost_contacts,
-            ghosts_unjudged,
-            fail_on_ghost,
-            ghost_degrees,
-            sweeps_without_expectation,
-            expectations_without_sweep,
-            expectations,
-            has_expected_channel,
-            by_kind,
-            divergences,
-            divergent_frames,
-            errors,
-            incomplete,
-            tolerances,
-            inferred,
-            engine,
-            expected_source,
-        } = self;
         Json {
-            trace,
+            trace: &self.trace,
             status: self.status(),
-            sweeps: *sweeps,
-            compared: *compared,
-            divergent: *divergent,
-            ties: *ties,
-            fragile_divergent: *fragile_divergent,
-            fragile_by_reason,
-            fragile_divergences,
-            strict: *strict,
-            precision_divergent: (!tolerances.precision.is_f64()).then_some(*precision_divergent),
-            max_backward_error: (!tolerances.precision.is_f64()).then_some(*max_backward_error),
-            conventions,
-            tunnels: *tunnels,
-            tunnels_by_kind,
-            tunnel_details,
-            fail_on_tunnel: *fail_on_tunnel,
-            ghosts: *ghosts,
-            ghost_contacts,
-            ghosts_unjudged: *ghosts_unjudged,
-            fail_on_ghost: *fail_on_ghost,
-            ghost_degrees: *ghost_degrees,
-            sweeps_without_expectation: *sweeps_without_expectation,
-            expectations_without_sweep: *expectations_without_sweep,
-            expectations: *expectations,
-            has_expected_channel: *has_expected_channel,
-            by_kind,
-            divergences,
-            divergent_frames,
-            errors,
-            incomplete: *incomplete,
-            tolerances,
-            inferred,
-            engine,
-            expected_source,
+            fields: Fields(self),
         }
         .serialize(serializer)
     }

@@ -189,6 +189,20 @@ fn seconds(nanos: u64) -> String {
 /// The human-readable report.
 pub fn render_info_text(info: &TraceInfo) -> String {
     let mut out = String::new();
+    write_container(&mut out, info);
+    write_scenes(&mut out, info);
+    write_sweeps(&mut out, info);
+    write_expected(&mut out, info);
+    write_channels(&mut out, &info.stats);
+    if let Some(err) = &info.error {
+        let _ = writeln!(out, "incomplete:  {err}");
+    }
+    out
+}
+
+/// The file: its name, size, chunks and summary, the reading order and
+/// the writing library.
+fn write_container(out: &mut String, info: &TraceInfo) {
     let s = &info.stats;
     let compression = if s.compression.is_empty() && info.error.is_some() {
         // Reading stopped before a complete chunk: whether the rest of the
@@ -230,6 +244,10 @@ pub fn render_info_text(info: &TraceInfo) -> String {
         s.library.as_str()
     };
     let _ = writeln!(out, "library:     {library}");
+}
+
+/// The scenes, one line each (two with the mesh's edges).
+fn write_scenes(out: &mut String, info: &TraceInfo) {
     let _ = writeln!(out, "scenes:      {}", info.scene_count);
     for scene in &info.scenes {
         let name = scene
@@ -272,6 +290,10 @@ pub fn render_info_text(info: &TraceInfo) -> String {
             info.scene_count - info.scenes.len() as u64
         );
     }
+}
+
+/// The sweeps and their balls, and the frames and `log_time`s they span.
+fn write_sweeps(out: &mut String, info: &TraceInfo) {
     let balls: Vec<String> = info.balls.iter().map(u32::to_string).collect();
     let more = if info.balls_truncated { ", ..." } else { "" };
     let _ = writeln!(
@@ -310,6 +332,10 @@ pub fn render_info_text(info: &TraceInfo) -> String {
             let _ = writeln!(out, "log_time:    (no messages)");
         }
     }
+}
+
+/// The `/expected` outcomes by kind, and who computed them.
+fn write_expected(out: &mut String, info: &TraceInfo) {
     if info.expected_present {
         let kinds: Vec<String> = info
             .expected_by_kind
@@ -332,6 +358,10 @@ pub fn render_info_text(info: &TraceInfo) -> String {
     if let Some(source) = &info.expected_source {
         let _ = writeln!(out, "expected by: {source}");
     }
+}
+
+/// The trace channels' encoding, every channel, and the metadata records.
+fn write_channels(out: &mut String, s: &ReadStats) {
     if let Some(line) = encoding_line(s) {
         let _ = writeln!(out, "encoding:    {line}");
     }
@@ -365,10 +395,6 @@ pub fn render_info_text(info: &TraceInfo) -> String {
             let _ = writeln!(out, "  {name}: {}", pairs.join(", "));
         }
     }
-    if let Some(err) = &info.error {
-        let _ = writeln!(out, "incomplete:  {err}");
-    }
-    out
 }
 
 /// The message encodings of the trace channels: `cbor` when they all use

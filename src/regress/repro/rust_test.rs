@@ -6,6 +6,7 @@ use crate::regress::compare::Tolerances;
 use crate::regress::judge::Agreement;
 
 use crate::core::{Facing, Kind};
+use crate::trace::OutcomeMsg;
 
 use super::case::{ReproCase, agreement_text, list_commas};
 
@@ -45,14 +46,42 @@ impl ReproCase {
     /// shortest decimal that reads back to the same bits.
     pub fn rust_test(&self, tol: &Tolerances) -> String {
         let mut s = String::new();
-        let f = |x: f64| format!("{x:?}");
-        let v3 = |p: &[f64; 3]| format!("[{}, {}, {}]", f(p[0]), f(p[1]), f(p[2]));
         let a = self.asserted_within(tol.fields);
-        let stem = std::path::Path::new(&self.source)
+        self.write_test_doc(&mut s);
+        let _ = writeln!(s, "#[test]");
+        let _ = writeln!(
+            s,
+            "fn repro_{}_frame_{}_ball_{}() {{",
+            self.test_ident(),
+            self.frame,
+            self.ball
+        );
+        let _ = writeln!(
+            s,
+            "    use sweeptrace::{{Facing, Kind, Mesh, Options, Sweep}};"
+        );
+        self.write_test_inputs(&mut s);
+        if self.asserts_tie() {
+            write_tie_assertion(&mut s, &a);
+        } else {
+            self.write_primary_assertions(&mut s, &a);
+        }
+        write_number_assertions(&mut s, &a, tol);
+        let _ = writeln!(s, "}}");
+        s
+    }
+
+    /// The file stem of the trace the case comes from.
+    fn source_stem(&self) -> String {
+        std::path::Path::new(&self.source)
             .file_stem()
             .map(|s| s.to_string_lossy().into_owned())
-            .unwrap_or_else(|| "trace".into());
-        let ident: String = stem
+            .unwrap_or_else(|| "trace".into())
+    }
+
+    /// [`ReproCase::source_stem`] as part of a Rust identifier.
+    fn test_ident(&self) -> String {
+        self.source_stem()
             .chars()
             .map(|c| {
                 if c.is_ascii_alphanumeric() {
@@ -61,7 +90,12 @@ impl ReproCase {
                     '_'
                 }
             })
-            .collect();
+            .collect()
+    }
+
+    /// The test's doc comment: where the sweep comes from, which triangles
+    /// are kept, and what the core gives on the whole scene.
+    fn write_test_doc(&self, s: &mut String) {
         let what = if self.expected.is_some() {
             "the outcome the trace expects"
         } else {
@@ -72,7 +106,7 @@ impl ReproCase {
             "/// Frame {}, ball {} of `{}` (scene `{}`): {what}.",
             self.frame,
             self.ball,
-            stem,
+            self.source_stem(),
             self.scene_name.as_deref().unwrap_or("unnamed")
         );
         let _ = writeln!(
@@ -93,20 +127,14 @@ impl ReproCase {
                 agreement_text(agreement)
             );
         }
-        let _ = writeln!(s, "#[test]");
-        let _ = writeln!(
-            s,
-            "fn repro_{ident}_frame_{}_ball_{}() {{",
-            self.frame, self.ball
-        );
-        let _ = writeln!(
-            s,
-            "    use sweeptrace::{{Facing, Kind, Mesh, Options, Sweep}};"
-        );
+    }
+
+    /// The test's `mesh`, `sweep` and `options`.
+    fn write_test_inputs(&self, s: &mut String) {
         let _ = writeln!(s, "    let mesh = Mesh::new(");
         let _ = writeln!(s, "        vec![");
         for v in &self.vertices {
-            let _ = writeln!(s, "            {},", v3(v));
+            let _ = writeln!(s, "            {},", vec3_literal(v));
         }
         let _ = writeln!(s, "        ],");
         let _ = writeln!(s, "        &[");
@@ -128,9 +156,9 @@ impl ReproCase {
         let _ = writeln!(
             s,
             "    let sweep = Sweep::new({}, {}, {});",
-            v3(&self.inputs.p0),
-            v3(&self.inputs.p1),
-            f(self.inputs.radius)
+            vec3_literal(&self.inputs.p0),
+            vec3_literal(&self.inputs.p1),
+            literal(self.inputs.radius)
         );
         let facing = match self.inputs.facing {
             Facing::NonStrict => "NonStrict",
@@ -139,149 +167,168 @@ impl ReproCase {
         let _ = writeln!(
             s,
             "    let options = Options {{ margin: {}, facing: Facing::{facing}, ..Options::default() }};",
-            f(self.inputs.margin)
+            literal(self.inputs.margin)
         );
-        let kind = match a.kind {
-            Kind::None => "None",
-            Kind::Face => "Face",
-            Kind::Edge => "Edge",
-            Kind::Vertex => "Vertex",
-        };
-        let triangle_note = |t: u32| match self.original_triangle(t) {
-            Some(o) => format!(" // triangle {o} of the trace's scene"),
-            None => " // not a triangle of the trace's scene".to_string(),
-        };
-        if self.asserts_tie() {
-            let _ = writeln!(
-                s,
-                "    let (outcome, ties) = sweeptrace::core::sweep_ties(&mesh, &sweep, &options).expect(\"valid sweep\");"
-            );
-            let _ = writeln!(
-                s,
-                "    // The expectation names a member of the tie set (an equally valid answer to the tie order)."
-            );
-            let triangle = match a.triangle.flatten() {
-                Some(t) => format!("Some({t})"),
-                None => "None".into(),
-            };
-            let feature = match a.feature.flatten() {
-                Some(f) => format!("Some({f})"),
-                None => "None".into(),
-            };
-            let _ = writeln!(
-                s,
-                "    assert!(ties.iter().any(|t| t.matches(Kind::{kind}, {triangle}, {feature})), \"tie set {{ties:?}}\");"
-            );
-        } else {
-            let _ = writeln!(
-                s,
-                "    let outcome = sweeptrace::sweep_mesh(&mesh, &sweep, &options).expect(\"valid sweep\");"
-            );
-            let _ = writeln!(s, "    assert_eq!(outcome.kind(), Kind::{kind});");
-            if let Some(t) = a.triangle {
-                match t {
-                    Some(t) => {
-                        let _ = writeln!(
-                            s,
-                            "    assert_eq!(outcome.hit.map(|h| h.triangle), Some({t})); {}",
-                            triangle_note(t).trim_start()
-                        );
-                    }
-                    None => {
-                        let _ =
-                            writeln!(s, "    assert_eq!(outcome.hit.map(|h| h.triangle), None);");
-                    }
-                }
-            }
-            if let Some(feature) = a.feature
-                && a.kind != Kind::Face
-            {
-                match feature {
-                    Some(x) => {
-                        let _ = writeln!(
-                            s,
-                            "    assert_eq!(outcome.hit.and_then(|h| h.feature.index()), Some({x}));"
-                        );
-                    }
-                    None => {
-                        let _ = writeln!(
-                            s,
-                            "    assert_eq!(outcome.hit.and_then(|h| h.feature.index()), None);"
-                        );
-                    }
-                }
-            }
-        }
+    }
+
+    /// The core's primary outcome: its kind, triangle and feature, as `a`
+    /// asserts them.
+    fn write_primary_assertions(&self, s: &mut String, a: &OutcomeMsg) {
         let _ = writeln!(
             s,
-            "    let (alpha, tolerance) = ({}, {});",
-            f(a.alpha),
-            f(tol.alpha)
+            "    let outcome = sweeptrace::sweep_mesh(&mesh, &sweep, &options).expect(\"valid sweep\");"
         );
         let _ = writeln!(
             s,
-            "    assert!((outcome.travelled() - alpha).abs() <= tolerance, \"α = {{}}, expected {{alpha}}\", outcome.travelled());"
+            "    assert_eq!(outcome.kind(), Kind::{});",
+            kind_name(a.kind)
         );
-        match a.normal {
-            Some(Some(n)) => {
+        match a.triangle {
+            Some(Some(t)) => {
+                let note = match self.original_triangle(t) {
+                    Some(o) => format!("// triangle {o} of the trace's scene"),
+                    None => "// not a triangle of the trace's scene".to_string(),
+                };
                 let _ = writeln!(
                     s,
-                    "    let (want, degrees) = ({}, {});",
-                    v3(&n),
-                    f(tol.normal_degrees)
-                );
-                let _ = writeln!(
-                    s,
-                    "    let n = outcome.hit.expect(\"a hit with a normal\").normal;"
-                );
-                let _ = writeln!(
-                    s,
-                    "    let cross = [n.y * want[2] - n.z * want[1], n.z * want[0] - n.x * want[2], n.x * want[1] - n.y * want[0]];"
-                );
-                let _ = writeln!(
-                    s,
-                    "    let angle = cross[0].hypot(cross[1]).hypot(cross[2]).atan2(n.x * want[0] + n.y * want[1] + n.z * want[2]).to_degrees();"
-                );
-                let _ = writeln!(
-                    s,
-                    "    assert!(angle <= degrees, \"normal {{n:?}} is {{angle}}° from {{want:?}}\");"
+                    "    assert_eq!(outcome.hit.map(|h| h.triangle), Some({t})); {note}"
                 );
             }
             Some(None) => {
-                let _ = writeln!(s, "    assert!(outcome.hit.is_none(), \"no normal\");");
+                let _ = writeln!(s, "    assert_eq!(outcome.hit.map(|h| h.triangle), None);");
             }
             None => {}
         }
-        match a.contact {
-            Some(Some(c)) => {
-                let _ = writeln!(
-                    s,
-                    "    let (want, distance) = ({}, {});",
-                    v3(&c),
-                    f(tol.contact)
-                );
-                let _ = writeln!(
-                    s,
-                    "    let c = outcome.hit.expect(\"a hit with a contact point\").contact;"
-                );
-                let _ = writeln!(
-                    s,
-                    "    let d = (c.x - want[0]).hypot(c.y - want[1]).hypot(c.z - want[2]);"
-                );
-                let _ = writeln!(
-                    s,
-                    "    assert!(d <= distance, \"contact {{c:?}} is {{d}} from {{want:?}}\");"
-                );
-            }
-            Some(None) => {
-                let _ = writeln!(
-                    s,
-                    "    assert!(outcome.hit.is_none(), \"no contact point\");"
-                );
-            }
-            None => {}
+        if let Some(feature) = a.feature
+            && a.kind != Kind::Face
+        {
+            let _ = writeln!(
+                s,
+                "    assert_eq!(outcome.hit.and_then(|h| h.feature.index()), {});",
+                option_literal(feature)
+            );
         }
-        let _ = writeln!(s, "}}");
-        s
+    }
+}
+
+/// The shortest decimal that reads back to the same `f64`, as Rust.
+fn literal(x: f64) -> String {
+    format!("{x:?}")
+}
+
+/// A point or vector as a Rust array of [`literal`]s.
+fn vec3_literal(p: &[f64; 3]) -> String {
+    format!("[{}, {}, {}]", literal(p[0]), literal(p[1]), literal(p[2]))
+}
+
+/// `Some(x)` or `None`, as Rust.
+fn option_literal<T: std::fmt::Display>(x: Option<T>) -> String {
+    match x {
+        Some(x) => format!("Some({x})"),
+        None => "None".into(),
+    }
+}
+
+/// The name of a [`Kind`] variant.
+fn kind_name(kind: Kind) -> &'static str {
+    match kind {
+        Kind::None => "None",
+        Kind::Face => "Face",
+        Kind::Edge => "Edge",
+        Kind::Vertex => "Vertex",
+    }
+}
+
+/// The tie set's membership of `a`: the expectation names a member of
+/// the tie set other than the primary.
+fn write_tie_assertion(s: &mut String, a: &OutcomeMsg) {
+    let _ = writeln!(
+        s,
+        "    let (outcome, ties) = sweeptrace::core::sweep_ties(&mesh, &sweep, &options).expect(\"valid sweep\");"
+    );
+    let _ = writeln!(
+        s,
+        "    // The expectation names a member of the tie set (an equally valid answer to the tie order)."
+    );
+    let _ = writeln!(
+        s,
+        "    assert!(ties.iter().any(|t| t.matches(Kind::{}, {}, {})), \"tie set {{ties:?}}\");",
+        kind_name(a.kind),
+        option_literal(a.triangle.flatten()),
+        option_literal(a.feature.flatten())
+    );
+}
+
+/// `α`, and the normal and contact point when `a` asserts them, each
+/// within its tolerance in `tol`.
+fn write_number_assertions(s: &mut String, a: &OutcomeMsg, tol: &Tolerances) {
+    let _ = writeln!(
+        s,
+        "    let (alpha, tolerance) = ({}, {});",
+        literal(a.alpha),
+        literal(tol.alpha)
+    );
+    let _ = writeln!(
+        s,
+        "    assert!((outcome.travelled() - alpha).abs() <= tolerance, \"α = {{}}, expected {{alpha}}\", outcome.travelled());"
+    );
+    match a.normal {
+        Some(Some(n)) => {
+            let _ = writeln!(
+                s,
+                "    let (want, degrees) = ({}, {});",
+                vec3_literal(&n),
+                literal(tol.normal_degrees)
+            );
+            let _ = writeln!(
+                s,
+                "    let n = outcome.hit.expect(\"a hit with a normal\").normal;"
+            );
+            let _ = writeln!(
+                s,
+                "    let cross = [n.y * want[2] - n.z * want[1], n.z * want[0] - n.x * want[2], n.x * want[1] - n.y * want[0]];"
+            );
+            let _ = writeln!(
+                s,
+                "    let angle = cross[0].hypot(cross[1]).hypot(cross[2]).atan2(n.x * want[0] + n.y * want[1] + n.z * want[2]).to_degrees();"
+            );
+            let _ = writeln!(
+                s,
+                "    assert!(angle <= degrees, \"normal {{n:?}} is {{angle}}° from {{want:?}}\");"
+            );
+        }
+        Some(None) => {
+            let _ = writeln!(s, "    assert!(outcome.hit.is_none(), \"no normal\");");
+        }
+        None => {}
+    }
+    match a.contact {
+        Some(Some(c)) => {
+            let _ = writeln!(
+                s,
+                "    let (want, distance) = ({}, {});",
+                vec3_literal(&c),
+                literal(tol.contact)
+            );
+            let _ = writeln!(
+                s,
+                "    let c = outcome.hit.expect(\"a hit with a contact point\").contact;"
+            );
+            let _ = writeln!(
+                s,
+                "    let d = (c.x - want[0]).hypot(c.y - want[1]).hypot(c.z - want[2]);"
+            );
+            let _ = writeln!(
+                s,
+                "    assert!(d <= distance, \"contact {{c:?}} is {{d}} from {{want:?}}\");"
+            );
+        }
+        Some(None) => {
+            let _ = writeln!(
+                s,
+                "    assert!(outcome.hit.is_none(), \"no contact point\");"
+            );
+        }
+        None => {}
     }
 }

@@ -19,6 +19,7 @@ mod exact;
 mod expected_source;
 mod faults;
 mod first_hour;
+mod first_hour_again;
 mod foxglove;
 mod fuzz_corpus;
 mod help;
@@ -148,6 +149,7 @@ fn main() {
     trials.extend(interrupts::tests());
     trials.extend(help::tests());
     trials.extend(first_hour::tests());
+    trials.extend(first_hour_again::tests());
     trials.extend(mesh::tests());
     let trials = mark_slow(trials);
     libtest_mimic::run(&args, trials).exit();

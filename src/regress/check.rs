@@ -734,6 +734,12 @@ where
     }
     let summary = replay.summary();
     drop(replay);
+    // A --frames or --ball filter that keeps no sweep compares nothing: an
+    // error naming what the trace has, as `replay` gives.
+    let selection = summary.selection(&options.replay);
+    if selection.is_nothing() && report.errors.len() < MAX_ERRORS {
+        report.errors.push(selection.to_string());
+    }
     report.expectations_without_sweep = summary.expected_unmatched;
     report.expectations = summary.expected_matched + summary.expected_unmatched;
     if report.divergent + report.fragile_divergent > 0 {

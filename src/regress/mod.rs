@@ -58,6 +58,7 @@ pub use compare::{
     DEFAULT_ALPHA_TOLERANCE, DEFAULT_CONTACT_TOLERANCE, DEFAULT_NORMAL_TOLERANCE_DEGREES, Field,
     FieldDiff, FieldSet, Tolerances, angle_degrees, compare,
 };
+pub use config::excluded_by;
 pub use config::{
     CONFIG_FILE_NAME, ConfigError, ConfigFile, Overrides, Setting, Settings, Source,
     find_config_files, load_config_files, normalize, render_settings_json, render_settings_text,
@@ -67,6 +68,7 @@ pub use decision::{decision_line, divergence, write_decision_line, write_diverge
 pub use diff::{
     DiffReport, FirstDifference, Side, diff, render_diff_json, render_diff_text, scene_differences,
 };
+pub use discovery::foxglove_output;
 pub use engine_check::{
     Against, EngineCheck, check_file_with_engine, judge_answer_against_expected,
 };

@@ -8,7 +8,7 @@ use std::ffi::OsStr;
 use std::path::{Path, PathBuf};
 
 use anyhow::Context as _;
-use libtest_mimic::Trial;
+use libtest_mimic::{Completion, Trial};
 
 use crate::support::run_bin_in;
 use crate::trial;
@@ -21,6 +21,15 @@ pub fn tests() -> Vec<Trial> {
         trial!(bad_exclude_glob_is_an_error_with_file_and_line),
         trial!(check_takes_frames_and_ball_like_replay),
         trial!(replay_json_prints_the_summary_as_one_object),
+        trial!(truncated_trace_exits_3_in_bless_and_mesh_too),
+        trial!(info_of_a_truncated_trace_gives_the_message_once),
+        trial!(trace_cut_before_its_first_sweep_writes_nothing),
+        trial!(missing_file_has_one_wording_in_every_command),
+        trial!(obj_file_given_for_a_trace_says_what_takes_one),
+        trial!(dash_frame_range_suggests_the_dots),
+        trial!(counts_are_grammatical),
+        trial!(unjudged_ghost_candidates_are_mentioned),
+        trial!(gitignore_covers_what_the_documented_commands_write),
     ]
 }
 
@@ -303,4 +312,458 @@ fn replay_json_prints_the_summary_as_one_object() -> anyhow::Result<()> {
         "refused, yet wrote something"
     );
     Ok(())
+}
+
+/// The mini-golf sample (one chunk) cut at `num/den` of its length, as
+/// `cut.mcap` in `dir`.
+fn cut_golf(dir: &Path, num: usize, den: usize) -> anyhow::Result<()> {
+    let bytes = std::fs::read(golf())?;
+    std::fs::write(dir.join("cut.mcap"), &bytes[..bytes.len() * num / den])?;
+    Ok(())
+}
+
+/// Every file in `dir`, sorted.
+fn entries(dir: &Path) -> anyhow::Result<Vec<String>> {
+    let mut names: Vec<String> = std::fs::read_dir(dir)?
+        .filter_map(Result::ok)
+        .map(|e| e.file_name().to_string_lossy().into_owned())
+        .collect();
+    names.sort();
+    Ok(names)
+}
+
+/// A trace that ends early is exit 3 in `bless` and `mesh` as in the other
+/// commands. `bless` writes nothing (in place, the trace is left as it
+/// was): a blessed trace would lose the sweeps after the cut. `mesh`
+/// reports the scenes it read before the end, and says how many.
+fn truncated_trace_exits_3_in_bless_and_mesh_too() -> anyhow::Result<()> {
+    let dir = tempfile::tempdir()?;
+    cut_golf(dir.path(), 2, 3)?;
+    let before = std::fs::read(dir.path().join("cut.mcap"))?;
+    for args in [
+        os!["bless", "cut.mcap", "-o", "blessed.mcap"].to_vec(),
+        os!["bless", "cut.mcap", "--in-place"].to_vec(),
+    ] {
+        let (code, out, err) = run(dir.path(), &args)?;
+        ensure!(
+            code == 3 && err.contains("truncated") && err.contains("nothing written"),
+            "{args:?}: exit {code}\n{out}{err}"
+        );
+        ensure!(
+            entries(dir.path())? == ["cut.mcap"],
+            "{args:?} left {:?}",
+            entries(dir.path())?
+        );
+        ensure!(
+            std::fs::read(dir.path().join("cut.mcap"))? == before,
+            "{args:?} changed the trace"
+        );
+    }
+    let (code, out, err) = run(dir.path(), os!["mesh", "cut.mcap"])?;
+    ensure!(
+        code == 3
+            && out.contains("mesh `mini_golf` (cut.mcap)")
+            && out.contains("verdict:")
+            && err.contains("truncated")
+            && err.contains("the report covers the 1 scene read before the end"),
+        "mesh: exit {code}\n{out}{err}"
+    );
+    let (code, out, err) = run(dir.path(), os!["mesh", "cut.mcap", "--json"])?;
+    let value: serde_json::Value = serde_json::from_str(&out)?;
+    ensure!(
+        code == 3 && value["meshes"].as_array().map(Vec::len) == Some(1),
+        "mesh --json: exit {code}\n{out}{err}"
+    );
+    // Cut before the scene's end: no mesh, still exit 3.
+    cut_golf(dir.path(), 1, 2)?;
+    let (code, out, err) = run(dir.path(), os!["mesh", "cut.mcap"])?;
+    ensure!(
+        code == 3 && out.is_empty() && err.contains("0 scenes read before the end"),
+        "mesh of a trace cut in its first chunk: exit {code}\n{out}{err}"
+    );
+    Ok(())
+}
+
+/// `info` of a truncated trace gives the truncation message once (the
+/// report's `incomplete:` line), with exit 3.
+fn info_of_a_truncated_trace_gives_the_message_once() -> anyhow::Result<()> {
+    let dir = tempfile::tempdir()?;
+    cut_golf(dir.path(), 2, 3)?;
+    let (code, out, err) = run(dir.path(), os!["info", "cut.mcap"])?;
+    let both = format!("{out}{err}");
+    ensure!(
+        code == 3 && both.matches("the file is truncated").count() == 1,
+        "exit {code}\n{out}{err}"
+    );
+    ensure!(out.contains("incomplete:"), "no `incomplete:` line: {out}");
+    Ok(())
+}
+
+/// A one-chunk trace cut in half holds no complete message: `replay` says
+/// `0 sweeps read before the end`, exit 3, and leaves no empty outcome
+/// file or recording (with `--json`, `incomplete` gives the error).
+fn trace_cut_before_its_first_sweep_writes_nothing() -> anyhow::Result<()> {
+    let dir = tempfile::tempdir()?;
+    cut_golf(dir.path(), 1, 2)?;
+    let (code, out, err) = run(
+        dir.path(),
+        os![
+            "replay",
+            "cut.mcap",
+            "--outcomes",
+            "cut.jsonl",
+            "--rrd",
+            "cut.rrd",
+            "--json"
+        ],
+    )?;
+    ensure!(
+        code == 3 && err.contains("0 sweeps read before the end: nothing written"),
+        "exit {code}\n{out}{err}"
+    );
+    ensure!(!err.contains("wrote"), "says it wrote: {err}");
+    let value: serde_json::Value = serde_json::from_str(&out)?;
+    ensure!(
+        value["sweeps"] == 0
+            && value["incomplete"]
+                .as_str()
+                .is_some_and(|e| e.contains("truncated")),
+        "{value}"
+    );
+    ensure!(
+        entries(dir.path())? == ["cut.mcap"],
+        "left {:?}",
+        entries(dir.path())?
+    );
+    // Cut later, the sweeps read are written, and said.
+    cut_golf(dir.path(), 2, 3)?;
+    let (code, out, err) = run(
+        dir.path(),
+        os!["replay", "cut.mcap", "--outcomes", "cut.jsonl"],
+    )?;
+    let lines = std::fs::read_to_string(dir.path().join("cut.jsonl"))?
+        .lines()
+        .count();
+    ensure!(
+        code == 3 && lines > 0 && err.contains(&format!("{lines} sweeps read before the end")),
+        "exit {code}, {lines} lines\n{out}{err}"
+    );
+    Ok(())
+}
+
+/// Every command that reads a file says the same for one that does not
+/// exist: `FILE: cannot open: REASON` (`check` on its `ERROR` line).
+fn missing_file_has_one_wording_in_every_command() -> anyhow::Result<()> {
+    let dir = tempfile::tempdir()?;
+    let want = "nope.mcap: cannot open: ";
+    let cases: Vec<Vec<&OsStr>> = vec![
+        os!["info", "nope.mcap"].to_vec(),
+        os!["mesh", "nope.mcap"].to_vec(),
+        os!["replay", "nope.mcap"].to_vec(),
+        os!["check", "nope.mcap"].to_vec(),
+        os!["bless", "nope.mcap", "-o", "b.mcap"].to_vec(),
+        os!["diff", "nope.mcap", "nope.mcap"].to_vec(),
+        os!["repro", "nope.mcap", "--frame", "1", "-o", "c.mcap"].to_vec(),
+        os!["sweep", "--trace", "nope.mcap", "--frame", "1"].to_vec(),
+    ];
+    for args in cases {
+        let (code, out, err) = run(dir.path(), &args)?;
+        let said = if args[0] == "check" { &out } else { &err };
+        ensure!(
+            code == 2 && said.contains(want) && said.contains("No such file"),
+            "{args:?}: exit {code}\n{out}{err}"
+        );
+    }
+    for args in [
+        os![
+            "sweep", "--mesh", "nope.obj", "--from", "0,0,1", "--to", "0,0,0"
+        ]
+        .to_vec(),
+        os!["record", "--mesh", "nope.obj", "-o", "r.mcap"].to_vec(),
+    ] {
+        let (code, out, err) = run(dir.path(), &args)?;
+        ensure!(
+            code == 2 && err.contains("nope.obj: cannot open: "),
+            "{args:?}: exit {code}\n{out}{err}"
+        );
+    }
+    ensure!(
+        entries(dir.path())?.is_empty(),
+        "left {:?}",
+        entries(dir.path())?
+    );
+    Ok(())
+}
+
+/// An OBJ file given where a trace is expected (`info`, `check`, `replay`)
+/// is an error saying what it is and what takes one; a text file that is
+/// not OBJ is not called one.
+fn obj_file_given_for_a_trace_says_what_takes_one() -> anyhow::Result<()> {
+    let dir = tempfile::tempdir()?;
+    std::fs::copy(
+        root().join("tests/fixtures/scanned/bunny_res4.obj"),
+        dir.path().join("bunny.obj"),
+    )?;
+    let want = "bunny.obj: this is an OBJ file: use `mesh` or `--mesh`";
+    for command in ["info", "check", "replay"] {
+        let (code, out, err) = run(dir.path(), os![command, "bunny.obj"])?;
+        let said = if command == "check" { &out } else { &err };
+        ensure!(
+            code == 2 && said.contains(want) && !said.contains("Bad magic"),
+            "{command}: exit {code}\n{out}{err}"
+        );
+    }
+    let (code, out, err) = run(dir.path(), os!["mesh", "bunny.obj"])?;
+    ensure!(
+        code <= 1 && out.contains("mesh `bunny`"),
+        "mesh: exit {code}\n{out}{err}"
+    );
+    let readme = root().join("README.md");
+    let (code, _, err) = run(dir.path(), os!["info", readme.as_os_str()])?;
+    ensure!(
+        code == 2 && !err.contains("OBJ"),
+        "README.md called an OBJ file: {err}"
+    );
+    ensure!(
+        entries(dir.path())? == ["bunny.obj"],
+        "left {:?}",
+        entries(dir.path())?
+    );
+    Ok(())
+}
+
+/// `--frames 10-20` (or `10:20`) is refused with the range it likely
+/// meant, in every command that takes `--frames`.
+fn dash_frame_range_suggests_the_dots() -> anyhow::Result<()> {
+    let dir = tempfile::tempdir()?;
+    let trace = cube();
+    let t = trace.as_os_str();
+    for args in [
+        os!["replay", t, "--frames", "10-20"].to_vec(),
+        os!["check", t, "--frames", "10-20"].to_vec(),
+        os!["diff", t, t, "--frames", "10:20"].to_vec(),
+    ] {
+        let (code, out, err) = run(dir.path(), &args)?;
+        ensure!(
+            code == 2 && err.contains("did you mean `10..20`"),
+            "{args:?}: exit {code}\n{out}{err}"
+        );
+    }
+    Ok(())
+}
+
+/// Counts agree with their nouns and verbs where a count can be 1: a
+/// divergence whose one field differs, a trace with one divergence, one
+/// fragile divergence, one back-facing expected hit.
+fn counts_are_grammatical() -> anyhow::Result<()> {
+    use sweeptrace::trace::{OutcomeMsg, SweepMsg, TraceWriter};
+    let dir = tempfile::tempdir()?;
+    let scene = crate::support::scene_t(0.0);
+    // Ball 0 comes down onto the face at α = 0.25; its expectation says
+    // 0.3 (alpha alone differs). Ball 1's expectation is a back-facing hit
+    // on the triangle from below.
+    let sweeps = [
+        SweepMsg {
+            frame: 0,
+            ball: 0,
+            p0: [1.0, 1.0, 2.0],
+            p1: [1.0, 1.0, -2.0],
+            radius: 0.5,
+        },
+        SweepMsg {
+            frame: 0,
+            ball: 1,
+            p0: [1.0, 1.0, -2.0],
+            p1: [1.0, 1.0, -1.0],
+            radius: 0.5,
+        },
+    ];
+    let m = crate::support::mesh(&scene.vertices, &scene.triangles);
+    let mut w = TraceWriter::new(std::io::Cursor::new(Vec::new()))?;
+    w.scene(0, &scene)?;
+    for (i, s) in sweeps.iter().enumerate() {
+        let t = 1_000_000 * (i as u64 + 1);
+        w.sweep(t, s)?;
+        let o = sweeptrace::sweep_mesh(
+            &m,
+            &sweeptrace::Sweep::new(s.p0, s.p1, s.radius),
+            &Default::default(),
+        )?;
+        let mut e = OutcomeMsg::from_outcome(s.frame, s.ball, &o);
+        if s.ball == 0 {
+            e.alpha = 0.3;
+        } else {
+            e = OutcomeMsg::from_outcome(
+                s.frame,
+                s.ball,
+                &sweeptrace::sweep_mesh(
+                    &m,
+                    &sweeptrace::Sweep::new([1.0, 1.0, 2.0], [1.0, 1.0, -2.0], 0.5),
+                    &Default::default(),
+                )?,
+            );
+            e.ball = 1;
+        }
+        w.expected(t, &e)?;
+    }
+    std::fs::write(dir.path().join("t.mcap"), w.finish()?.into_inner())?;
+    let (code, out, err) = run(dir.path(), os!["check", "t.mcap", "--fields", "alpha"])?;
+    ensure!(code == 1, "exit {code}\n{out}{err}");
+    ensure!(
+        out.contains("2 of 2 compared sweeps diverge (")
+            && out.contains("1 expected hit is back-facing")
+            && out.contains("no facing rule allows it")
+            && !out.contains("1 expected hits are"),
+        "{out}"
+    );
+    let (code, out, err) = run(
+        dir.path(),
+        os!["check", "t.mcap", "--fields", "alpha", "--ball", "0"],
+    )?;
+    ensure!(code == 1, "--ball 0: exit {code}\n{out}{err}");
+    ensure!(
+        out.contains("1 of 1 compared sweep diverges (")
+            && out.contains("frame 0, ball 0: alpha differs (")
+            && !out.contains("alpha differ "),
+        "--ball 0:\n{out}"
+    );
+    Ok(())
+}
+
+/// An expected edge contact that does not say its triangle or feature
+/// cannot be judged for a ghost contact: the text report says how many
+/// were not judged, instead of passing over them in silence.
+fn unjudged_ghost_candidates_are_mentioned() -> anyhow::Result<()> {
+    use sweeptrace::trace::{OutcomeMsg, SweepMsg};
+    let dir = tempfile::tempdir()?;
+    let scene = crate::support::scene_t(0.0);
+    let sweep = SweepMsg {
+        frame: 0,
+        ball: 0,
+        p0: [2.0, -0.3, 3.0],
+        p1: [2.0, -0.3, -3.0],
+        radius: 0.5,
+    };
+    let bytes = crate::support::core_trace(&scene, std::slice::from_ref(&sweep))?;
+    // The same trace, its expectation without triangle and feature.
+    let m = crate::support::mesh(&scene.vertices, &scene.triangles);
+    let o = sweeptrace::sweep_mesh(
+        &m,
+        &sweeptrace::Sweep::new(sweep.p0, sweep.p1, sweep.radius),
+        &Default::default(),
+    )?;
+    let mut e = OutcomeMsg::from_outcome(0, 0, &o);
+    ensure!(e.kind == sweeptrace::Kind::Edge, "not an edge hit: {e:?}");
+    e.triangle = None;
+    e.feature = None;
+    let mut w = sweeptrace::trace::TraceWriter::new(std::io::Cursor::new(Vec::new()))?;
+    w.scene(0, &scene)?;
+    w.sweep(1_000_000, &sweep)?;
+    w.expected(1_000_000, &e)?;
+    std::fs::write(dir.path().join("placed.mcap"), bytes)?;
+    std::fs::write(dir.path().join("unplaced.mcap"), w.finish()?.into_inner())?;
+    let (code, out, err) = run(dir.path(), os!["check", "unplaced.mcap"])?;
+    ensure!(
+        code == 0 && out.contains("1 edge or vertex contact not judged for ghost contacts"),
+        "exit {code}\n{out}{err}"
+    );
+    let (code, out, err) = run(dir.path(), os!["check", "placed.mcap"])?;
+    ensure!(
+        code == 0 && !out.contains("not judged"),
+        "exit {code}\n{out}{err}"
+    );
+    Ok(())
+}
+
+/// What the commands of the README and docs/ write at the repository's
+/// root (`-o`, `--rrd`, `--outcomes`, `--foxglove`, `--junit`,
+/// `--rrd-on-failure`, `> FILE`, the C examples' `-o engine`) is ignored
+/// by git, so that trying the docs leaves `git status` clean.
+fn gitignore_covers_what_the_documented_commands_write() -> anyhow::Result<Completion> {
+    const FLAGS: &[&str] = &[
+        "-o",
+        "--output",
+        "--rrd",
+        "--outcomes",
+        "--foxglove",
+        "--junit",
+        "--rrd-on-failure",
+        ">",
+    ];
+    let git = std::process::Command::new("git")
+        .args(["rev-parse", "--is-inside-work-tree"])
+        .current_dir(root())
+        .output();
+    if !git.is_ok_and(|o| o.status.success()) {
+        return Ok(Completion::ignored_with(
+            "skipped: not a git work tree (or no git): nothing to ignore files",
+        ));
+    }
+    let mut docs = vec![root().join("README.md"), root().join("capi/README.md")];
+    for entry in std::fs::read_dir(root().join("docs"))? {
+        let path = entry?.path();
+        if path.extension().is_some_and(|e| e == "md") {
+            docs.push(path);
+        }
+    }
+    let mut written = std::collections::BTreeSet::new();
+    for doc in &docs {
+        let text = std::fs::read_to_string(doc)?;
+        for line in text.lines() {
+            let words: Vec<&str> = line
+                .split(|c: char| c.is_whitespace() || c == '`')
+                .filter(|w| !w.is_empty())
+                .collect();
+            for pair in words.windows(2) {
+                if !FLAGS.contains(&pair[0]) {
+                    continue;
+                }
+                let target = pair[1].trim_end_matches([',', ')', '.', ';']);
+                let looks_like_a_file = target.contains('.')
+                    || target.ends_with('/')
+                    || ["engine", "write_trace"].contains(&target);
+                let placeholder = target.chars().all(|c| !c.is_lowercase());
+                if looks_like_a_file
+                    && !placeholder
+                    && !target.starts_with(['-', '/', '$'])
+                    && !target.contains("..")
+                    && target.chars().next().is_some_and(char::is_alphanumeric)
+                {
+                    written.insert(target.to_string());
+                }
+            }
+        }
+    }
+    ensure!(
+        [
+            "engine",
+            "write_trace",
+            "report.xml",
+            "conform.xml",
+            "repro_test.rs"
+        ]
+        .iter()
+        .all(|f| written.contains(*f)),
+        "the scan misses documented outputs: {written:?}"
+    );
+    let mut not_ignored = Vec::new();
+    for target in &written {
+        // A directory's contents: a file in it.
+        let path = match target.strip_suffix('/') {
+            Some(dir) => format!("{dir}/trace.rrd"),
+            None => target.clone(),
+        };
+        let status = std::process::Command::new("git")
+            .args(["check-ignore", "-q", "--no-index", &path])
+            .current_dir(root())
+            .status()?;
+        if !status.success() {
+            not_ignored.push(path);
+        }
+    }
+    ensure!(
+        not_ignored.is_empty(),
+        "written by documented commands at the root, not in .gitignore: {not_ignored:?}"
+    );
+    Ok(Completion::Completed)
 }

@@ -50,7 +50,9 @@ written to <trace stem>.rrd in the current directory. The outputs combine:
 one replay can write outcomes, a Rerun recording and a Foxglove file. Files
 are written under a temporary name next to the target and renamed once
 complete: an error (or Ctrl-C, SIGTERM) leaves none of them, only a trace
-that ends early (exit 3) keeps what was read before its end.")]
+that ends early (exit 3) keeps what was read before its end, unless that
+is no sweep at all (\"0 sweeps read before the end\"): an empty outcome file
+or a recording without a sweep would pass for a replay, so none is written.")]
 pub struct Args {
     /// The trace (an MCAP file).
     #[arg(value_name = "TRACE")]
@@ -147,8 +149,7 @@ impl<R: Read> Read for CountingReader<R> {
 pub fn run(args: Args) -> anyhow::Result<Exit> {
     let started = Instant::now();
     let trace_path = &args.trace;
-    let file =
-        File::open(trace_path).with_context(|| format!("opening {}", trace_path.display()))?;
+    let file = super::open_trace(trace_path)?;
     let total_bytes = file.metadata().map(|m| m.len()).unwrap_or(0);
     let source_name = trace_path.display().to_string();
     if args.json && args.outcomes.as_deref() == Some(Path::new("-")) {
@@ -461,8 +462,7 @@ impl Outputs {
         let recording = match target {
             None => None,
             Some(target) => {
-                let trace = File::open(trace_path)
-                    .with_context(|| format!("opening {}", trace_path.display()))?;
+                let trace = super::open_trace(trace_path)?;
                 let id = super::recording_id(BufReader::new(trace), "replay", options)
                     .with_context(|| format!("reading {}", trace_path.display()))?;
                 if let Some(path) = &target.file {

@@ -284,8 +284,9 @@ pub struct TraceReport {
     /// The first ghost contacts (at most [`MAX_LISTED_GHOSTS`]), in trace
     /// order.
     pub ghost_contacts: Vec<GhostContact>,
-    /// Edge or vertex contacts on such a place that give no normal, so
-    /// cannot be judged.
+    /// Edge or vertex contacts that cannot be judged for ghost contacts:
+    /// on such a place but without a normal, or without the triangle or
+    /// feature that places them.
     pub ghosts_unjudged: u64,
     /// Whether ghost contacts fail the check.
     pub fail_on_ghost: bool,
@@ -810,6 +811,11 @@ pub fn frames_around(
 /// report with [`Status::Error`].
 pub fn check_file(path: &std::path::Path, options: &CheckOptions) -> TraceReport {
     let name = path.display().to_string();
+    if let Some(text) = crate::sim::obj_instead_of_trace(path) {
+        let mut report = check_events(std::iter::empty(), &name, options);
+        report.add_error(text);
+        return report;
+    }
     match std::fs::File::open(path) {
         Ok(file) => check_trace(
             TraceReader::new_indexed(std::io::BufReader::with_capacity(1 << 16, file), &name),

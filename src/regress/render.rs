@@ -105,7 +105,7 @@ pub fn render_divergence_as(d: &Divergence, indent: &str, sides: Sides) -> Strin
     let mut s = String::new();
     let _ = writeln!(
         s,
-        "{indent}frame {}, ball {}: {} differ (margin {}, facing {}{})",
+        "{indent}frame {}, ball {}: {} {} (margin {}, facing {}{})",
         d.frame,
         d.ball,
         d.fields
@@ -113,6 +113,7 @@ pub fn render_divergence_as(d: &Divergence, indent: &str, sides: Sides) -> Strin
             .map(|f| f.field.as_str())
             .collect::<Vec<_>>()
             .join(", "),
+        crate::numbers::verb(d.fields.len() as u64, "differs", "differ"),
         num(d.margin),
         d.facing,
         if d.fragile.is_robust() {
@@ -255,8 +256,12 @@ pub fn render_text(r: &TraceReport) -> String {
             .join(", ");
         let _ = write!(
             counts,
-            ", {} fragile divergences ({reasons}){}",
-            r.fragile_divergent,
+            ", {} ({reasons}){}",
+            crate::numbers::counted(
+                r.fragile_divergent,
+                "fragile divergence",
+                "fragile divergences"
+            ),
             if r.strict {
                 ", failures under --strict"
             } else {
@@ -279,6 +284,17 @@ pub fn render_text(r: &TraceReport) -> String {
             ghost_words(r.ghosts)
         );
     }
+    if r.ghosts_unjudged > 0 {
+        let _ = write!(
+            counts,
+            ", {} not judged for ghost contacts (without a triangle, feature or normal)",
+            crate::numbers::counted(
+                r.ghosts_unjudged,
+                "edge or vertex contact",
+                "edge or vertex contacts"
+            )
+        );
+    }
     let tunnel_lines = |s: &mut String| {
         for t in &r.tunnel_details {
             let _ = writeln!(s, "  tunnel: {}", t.line());
@@ -286,8 +302,9 @@ pub fn render_text(r: &TraceReport) -> String {
         if r.tunnels as usize > r.tunnel_details.len() {
             let _ = writeln!(
                 s,
-                "  ... {} more tunnels",
-                r.tunnels as usize - r.tunnel_details.len()
+                "  ... {} more {}",
+                r.tunnels as usize - r.tunnel_details.len(),
+                tunnel_words(r.tunnels - r.tunnel_details.len() as u64)
             );
         }
         for g in &r.ghost_contacts {
@@ -296,8 +313,8 @@ pub fn render_text(r: &TraceReport) -> String {
         if r.ghosts as usize > r.ghost_contacts.len() {
             let _ = writeln!(
                 s,
-                "  ... {} more ghost contacts",
-                r.ghosts as usize - r.ghost_contacts.len()
+                "  ... {} more",
+                ghost_words(r.ghosts - r.ghost_contacts.len() as u64)
             );
         }
     };
@@ -325,8 +342,11 @@ pub fn render_text(r: &TraceReport) -> String {
                     .collect::<Vec<_>>()
                     .join(", ");
                 failures.push(format!(
-                    "{} of {} compared sweeps diverge ({kinds})",
-                    r.divergent, r.compared
+                    "{} of {} compared {} {} ({kinds})",
+                    r.divergent,
+                    r.compared,
+                    crate::numbers::plural(r.compared, "sweep"),
+                    crate::numbers::verb(r.divergent, "diverges", "diverge")
                 ));
             }
             if r.fails_on_tunnels() {
@@ -376,8 +396,9 @@ pub fn render_text(r: &TraceReport) -> String {
             if r.divergent as usize > r.divergences.len() {
                 let _ = writeln!(
                     s,
-                    "  ... {} more divergent sweeps (frames {}{})",
+                    "  ... {} more divergent {} (frames {}{})",
                     r.divergent as usize - r.divergences.len(),
+                    crate::numbers::plural(r.divergent - r.divergences.len() as u64, "sweep"),
                     r.divergent_frames
                         .iter()
                         .skip(r.divergences.len())
@@ -417,8 +438,10 @@ pub fn render_text(r: &TraceReport) -> String {
             let (head, below) = first.split_once('\n').unwrap_or((first.as_str(), ""));
             let _ = writeln!(
                 s,
-                "ERROR {}: {head}; {counts}, {} diverge",
-                r.trace, r.divergent
+                "ERROR {}: {head}; {counts}, {} {}",
+                r.trace,
+                r.divergent,
+                crate::numbers::verb(r.divergent, "diverges", "diverge")
             );
             for line in below.lines() {
                 let _ = writeln!(s, "{line}");

@@ -151,7 +151,7 @@ fn tie_set_lists_every_tied_hit_primary_first() -> anyhow::Result<()> {
     for t in &ties {
         ensure!(o.ties_with(t.alpha), "{t:?} is in the window");
         ensure!(
-            t.matches(t.kind(), Some(Some(t.triangle)), Some(t.feature.index())),
+            t.matches(t.kind(), Some(t.triangle), t.feature.index()),
             "{t:?} matches itself"
         );
         ensure!(
@@ -181,15 +181,15 @@ fn clear_hit_is_robust_with_a_single_member_tie_set() -> anyhow::Result<()> {
         "tie set {ties:?}"
     );
     ensure!(
-        ties[0].matches(Kind::Face, Some(Some(0)), Some(Some(0))),
+        ties[0].matches(Kind::Face, Some(0), Some(0)),
         "an expected face with feature 0 (older recordings) matches"
     );
     ensure!(
-        ties[0].matches(Kind::Face, Some(Some(0)), Some(None)),
-        "an expected face with feature null matches"
+        ties[0].matches(Kind::Face, Some(0), None),
+        "an expected face with no feature matches"
     );
     ensure!(
-        !ties[0].matches(Kind::Edge, Some(Some(0)), Some(Some(0))),
+        !ties[0].matches(Kind::Edge, Some(0), Some(0)),
         "another kind does not match"
     );
     Ok(())

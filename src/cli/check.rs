@@ -127,7 +127,7 @@ pub struct Args {
     /// The angle, in degrees, between an edge or vertex contact's normal and
     /// the nearest adjacent face's normal above which it is a ghost contact
     /// (docs/SEMANTICS.md), e.g. `--ghost-degrees 5`.
-    #[arg(long, value_name = "DEGREES", default_value_t = sweeptrace::regress::GHOST_DEGREES)]
+    #[arg(long, value_name = "DEGREES", default_value_t = sweeptrace::replay::GHOST_DEGREES)]
     pub ghost_degrees: f64,
     /// Ignore the sweeptrace.toml files: the defaults and the command line only.
     #[arg(long)]

@@ -23,6 +23,7 @@ mod bvh;
 mod crossing;
 mod error;
 pub mod explain;
+mod feature;
 mod fragility;
 mod mesh;
 mod options;
@@ -42,23 +43,24 @@ pub use crossing::{
     triangle_crossing_back_to_front,
 };
 pub use error::{MeshError, SweepError};
+pub use feature::{Feature, Kind};
 pub use fragility::{FragileReason, Fragility};
 pub use mesh::{DegenerateReason, DegenerateTriangle, Mesh, StandardFrame, Triangle};
 pub use options::{
     ALPHA_SENSITIVITY, BROADPHASE_MARGIN, DEGENERATE_TOLERANCE, FRAGILE_ULPS, Facing,
     GRAZING_COSINE, Options, PARALLEL_TOLERANCE, TIE_WINDOW_ULPS,
 };
-pub use outcome::{Feature, Outcome, SweepHit};
+pub use outcome::{Outcome, SweepHit, Tie, in_tie_window};
 pub use path::{Sweep, SweptPath};
 pub use record::{
-    CollectRecords, EdgeHit, EdgeRecord, FaceHit, FaceRecord, Kind, NoObserver, Observer, Skip,
+    CollectRecords, EdgeHit, EdgeRecord, FaceHit, FaceRecord, NoObserver, Observer, Skip,
     SkipCounts, TestRecord, Verdict, VerdictCounts, VertexHit, VertexRecord,
 };
 pub use sweep_edge::sweep_edge;
 pub use sweep_face::{barycentric, barycentric_and_distance, sweep_face};
 pub use sweep_mesh::{Broadphase, sweep_mesh, sweep_mesh_with};
 pub use sweep_vertex::sweep_vertex;
-pub use ties::{CollectTies, Tie, in_tie_window, sweep_ties};
+pub use ties::{CollectTies, sweep_ties};
 pub use topology::{
     Defect, DefectKind, Edge, EdgeClass, EdgeCounts, FLAT_DIHEDRAL_SINE, NEAR_FRACTION,
     SLIVER_RATIO, Topology,

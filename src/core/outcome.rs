@@ -1,80 +1,12 @@
-//! What a sweep reports: a hit or no hit ([`Outcome`]), and the feature a
-//! hit touches ([`Feature`]).
+//! What a sweep reports: a hit or no hit ([`Outcome`]), and the hits tied
+//! with it ([`Tie`], [`in_tie_window`]: the one definition of "tied").
 
 use nalgebra::{Point3, Vector3};
 use serde::{Serialize, Serializer};
 
+use super::feature::{Feature, Kind};
 use super::fragility::Fragility;
-use super::record::{Kind, TestRecord};
-use super::ties::{Tie, in_tie_window};
-
-/// The part of a triangle a test touches: its face, one of its edges or one
-/// of its vertices, with the edge or vertex index (0..3) in the variant, the
-/// way parry's `FeatureId` carries it.
-///
-/// Edge `i` runs from vertex `i` to vertex `(i + 1) % 3`. The order is the
-/// tie order within one triangle: face < edge < vertex, then the index.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
-pub enum Feature {
-    /// The face (its interior).
-    Face,
-    /// Edge `i`.
-    Edge(u8),
-    /// Vertex `i`.
-    Vertex(u8),
-}
-
-impl Feature {
-    /// The kind of the feature, the word traces and reports use.
-    #[inline]
-    pub fn kind(self) -> Kind {
-        match self {
-            Feature::Face => Kind::Face,
-            Feature::Edge(_) => Kind::Edge,
-            Feature::Vertex(_) => Kind::Vertex,
-        }
-    }
-
-    /// The edge or vertex index, as an outcome reports it; `None` for the
-    /// face (a face has no feature index).
-    #[inline]
-    pub fn index(self) -> Option<u8> {
-        match self {
-            Feature::Face => None,
-            Feature::Edge(i) | Feature::Vertex(i) => Some(i),
-        }
-    }
-
-    /// The feature a trace's `kind` and `feature` fields name: `None` for
-    /// [`Kind::None`], for an edge or a vertex without an index, or for an
-    /// index past 2. A face ignores the index.
-    pub fn from_parts(kind: Kind, index: Option<u8>) -> Option<Feature> {
-        match (kind, index) {
-            (Kind::Face, _) => Some(Feature::Face),
-            (Kind::Edge, Some(i)) if i < 3 => Some(Feature::Edge(i)),
-            (Kind::Vertex, Some(i)) if i < 3 => Some(Feature::Vertex(i)),
-            _ => None,
-        }
-    }
-
-    /// The key of the tie order within one triangle's tests: face < edge <
-    /// vertex, then the index.
-    #[inline]
-    pub(crate) fn order_key(self) -> (Kind, u8) {
-        (self.kind(), self.index().unwrap_or(0))
-    }
-}
-
-impl std::fmt::Display for Feature {
-    /// `face`, `edge 2`, `vertex 0`.
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        match self {
-            Feature::Face => f.write_str("face"),
-            Feature::Edge(i) => write!(f, "edge {i}"),
-            Feature::Vertex(i) => write!(f, "vertex {i}"),
-        }
-    }
-}
+use super::record::TestRecord;
 
 /// The primary collision of a sweep that hits something.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -257,5 +189,79 @@ mod tests {
         assert_eq!(json["kind"], "none");
         assert!(json["triangle"].is_null() && json["feature"].is_null());
         assert!(json["normal"].is_null() && json["contact"].is_null());
+    }
+}
+
+/// Whether a hit at `alpha` lies in the tie window `window` of the minimum
+/// `min_alpha`: `alpha ≤ min_alpha + window`. The one definition of "tied"
+/// (the combiner, [`Outcome::ties_with`] and every consumer use it).
+#[inline]
+pub fn in_tie_window(alpha: f64, min_alpha: f64, window: f64) -> bool {
+    alpha <= min_alpha + window
+}
+
+/// One member of a decision's tie set: a hit, named as an outcome names it.
+///
+/// Serialised as `{kind, triangle, feature, alpha}` (the feature index,
+/// `null` for a face).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Tie {
+    /// Input index of its triangle.
+    pub triangle: u32,
+    /// The feature it touches.
+    pub feature: Feature,
+    /// Its own `α`.
+    pub alpha: f64,
+}
+
+impl Tie {
+    /// The tie-set entry of a record, if it is a hit.
+    pub fn of(record: &TestRecord) -> Option<Tie> {
+        Some(Tie {
+            triangle: record.triangle(),
+            feature: record.feature(),
+            alpha: record.alpha()?,
+        })
+    }
+
+    /// Its kind.
+    #[inline]
+    pub fn kind(&self) -> Kind {
+        self.feature.kind()
+    }
+
+    /// The tie order: face < edge < vertex, then triangle, then feature.
+    pub fn order(&self) -> (Kind, u32, Option<u8>) {
+        (self.feature.kind(), self.triangle, self.feature.index())
+    }
+
+    /// Whether an answer naming `kind` and, when given, `triangle` and
+    /// `feature` (the edge or vertex index) names this hit. `None` names
+    /// any triangle or feature. A face has no feature index: any index an
+    /// answer gives with a face is accepted.
+    pub fn matches(&self, kind: Kind, triangle: Option<u32>, feature: Option<u8>) -> bool {
+        kind == self.kind()
+            && triangle.is_none_or(|t| t == self.triangle)
+            && (self.feature == Feature::Face
+                || feature.is_none_or(|f| Some(f) == self.feature.index()))
+    }
+}
+
+impl Serialize for Tie {
+    fn serialize<S: Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        #[derive(Serialize)]
+        struct Flat {
+            kind: Kind,
+            triangle: u32,
+            feature: Option<u8>,
+            alpha: f64,
+        }
+        Flat {
+            kind: self.kind(),
+            triangle: self.triangle,
+            feature: self.feature.index(),
+            alpha: self.alpha,
+        }
+        .serialize(serializer)
     }
 }

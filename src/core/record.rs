@@ -3,43 +3,8 @@
 use nalgebra::{Point3, Vector3};
 use serde::Serialize;
 
+use super::feature::{Feature, Kind};
 use super::mesh::StandardFrame;
-use super::outcome::Feature;
-
-/// The kind of a collision.
-#[derive(
-    Clone, Copy, Debug, Default, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, serde::Deserialize,
-)]
-#[serde(rename_all = "snake_case")]
-pub enum Kind {
-    /// Ties between kinds go in this order: face first.
-    Face,
-    /// An edge.
-    Edge,
-    /// A vertex.
-    Vertex,
-    /// Nothing touched.
-    #[default]
-    None,
-}
-
-impl Kind {
-    /// Name used in outcomes.
-    pub fn as_str(self) -> &'static str {
-        match self {
-            Kind::Face => "face",
-            Kind::Edge => "edge",
-            Kind::Vertex => "vertex",
-            Kind::None => "none",
-        }
-    }
-}
-
-impl std::fmt::Display for Kind {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str(self.as_str())
-    }
-}
 
 /// The verdict of one test.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize)]

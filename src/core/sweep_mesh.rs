@@ -4,16 +4,16 @@
 use nalgebra::{Point3, Vector3};
 
 use super::error::SweepError;
+use super::feature::{Feature, Kind};
 use super::fragility::{FragileReason, Fragility};
 use super::mesh::{Mesh, Triangle};
 use super::options::{ALPHA_SENSITIVITY, Facing, GRAZING_COSINE, Options};
-use super::outcome::{Feature, Outcome, SweepHit};
+use super::outcome::{Outcome, SweepHit, in_tie_window};
 use super::path::{Sweep, SweptPath};
-use super::record::{Kind, NoObserver, Observer, Skip, Verdict};
+use super::record::{NoObserver, Observer, Skip, Verdict};
 use super::sweep_edge::sweep_edge;
 use super::sweep_face::{barycentric_and_distance, sweep_face};
 use super::sweep_vertex::sweep_vertex;
-use super::ties::in_tie_window;
 
 /// How the candidate triangles are chosen.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

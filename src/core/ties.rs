@@ -3,93 +3,13 @@
 //! (face < edge < vertex, then triangle, then feature). `check` and `diff`
 //! accept an expectation that names any member of it.
 
-use serde::{Serialize, Serializer};
-
 use super::error::SweepError;
 use super::mesh::Mesh;
 use super::options::Options;
-use super::outcome::{Feature, Outcome};
+use super::outcome::{Outcome, Tie};
 use super::path::Sweep;
-use super::record::{Kind, Observer, TestRecord};
+use super::record::{Observer, TestRecord};
 use super::sweep_mesh::{Broadphase, sweep_mesh_with};
-
-/// Whether a hit at `alpha` lies in the tie window `window` of the minimum
-/// `min_alpha`: `alpha ≤ min_alpha + window`. The one definition of "tied"
-/// (the combiner, [`Outcome::ties_with`] and every consumer use it).
-#[inline]
-pub fn in_tie_window(alpha: f64, min_alpha: f64, window: f64) -> bool {
-    alpha <= min_alpha + window
-}
-
-/// One member of a decision's tie set: a hit, named as an outcome names it.
-///
-/// Serialised as `{kind, triangle, feature, alpha}` (the feature index,
-/// `null` for a face).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Tie {
-    /// Input index of its triangle.
-    pub triangle: u32,
-    /// The feature it touches.
-    pub feature: Feature,
-    /// Its own `α`.
-    pub alpha: f64,
-}
-
-impl Tie {
-    /// The tie-set entry of a record, if it is a hit.
-    pub fn of(record: &TestRecord) -> Option<Tie> {
-        Some(Tie {
-            triangle: record.triangle(),
-            feature: record.feature(),
-            alpha: record.alpha()?,
-        })
-    }
-
-    /// Its kind.
-    #[inline]
-    pub fn kind(&self) -> Kind {
-        self.feature.kind()
-    }
-
-    /// The tie order: face < edge < vertex, then triangle, then feature.
-    pub fn order(&self) -> (Kind, u32, Option<u8>) {
-        (self.feature.kind(), self.triangle, self.feature.index())
-    }
-
-    /// Whether an expectation naming `kind` and, when known, `triangle`
-    /// and `feature` names this hit (`None`: not named, so any value;
-    /// `Some(None)`: null). A face has no feature: any feature an expected
-    /// face names is accepted.
-    pub fn matches(
-        &self,
-        kind: Kind,
-        triangle: Option<Option<u32>>,
-        feature: Option<Option<u8>>,
-    ) -> bool {
-        kind == self.kind()
-            && triangle.is_none_or(|t| t == Some(self.triangle))
-            && (self.feature == Feature::Face || feature.is_none_or(|f| f == self.feature.index()))
-    }
-}
-
-impl Serialize for Tie {
-    fn serialize<S: Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
-        #[derive(Serialize)]
-        struct Flat {
-            kind: Kind,
-            triangle: u32,
-            feature: Option<u8>,
-            alpha: f64,
-        }
-        Flat {
-            kind: self.kind(),
-            triangle: self.triangle,
-            feature: self.feature.index(),
-            alpha: self.alpha,
-        }
-        .serialize(serializer)
-    }
-}
 
 /// An observer that keeps the hits of an explained sweep, from which
 /// [`CollectTies::tie_set`] gives the decision's tie set. Cheaper than

@@ -20,10 +20,8 @@ use crate::palette::{
     MAX_DRAWN_DEFECT_LABELS, MESH_COLOR, NON_MANIFOLD_EDGE_COLOR, NORMAL_COLOR, P0_COLOR, P1_COLOR,
     SWEEP_COLOR,
 };
-use crate::regress::{
-    FieldDiff, divergence_details, ghost_point, render_divergence, write_decision_line,
-};
-use crate::replay::{SceneState, SweepResult};
+use crate::regress::{FieldDiff, divergence_details, render_divergence, write_decision_line};
+use crate::replay::{SceneState, SweepResult, ghost_point};
 use strum::IntoEnumIterator as _;
 
 /// The id of the mesh entity on [`super::MESH_TOPIC`]: one id for every
@@ -492,7 +490,7 @@ const GHOST_FONT_PIXELS: f64 = 14.0;
 /// The ghost contact of the sweep's expected outcome
 /// ([`SweepResult::ghost`]), on [`super::GHOSTS_TOPIC`]: entity
 /// `ghost/{ball}` with a marker where it is
-/// ([`crate::regress::ghost_point`]), two arrows from there, the expected
+/// ([`crate::replay::ghost_point`]), two arrows from there, the expected
 /// (ghost) normal and the faces' normal, one label (`ghost contact 10.0°:
 /// edge 0.2 is internal and flat`) and `check`'s sentence in the metadata;
 /// otherwise the deletion of that entity.

@@ -6,47 +6,16 @@
 // lines; it happens once per run, so its size does not matter.
 #![allow(clippy::result_large_err)]
 
-use serde::Serialize;
-
 use crate::engine::{
     AnswerSink, EngineAnswers, EngineCommand, EngineError, EngineOptions, EngineSession,
 };
 use crate::replay::SweepResult;
 use crate::trace::{EXPECTED_TOPIC, OutcomeMsg, TraceReader};
 
-use super::check::{
-    CheckOptions, Judged, TraceReport, check_file, check_stream, judge_against_core,
-};
+use super::check::{CheckOptions, check_file, check_stream, judge_against_core};
 use super::compare::Tolerances;
 use super::judge::agreement_of;
-
-/// What an engine's answers are compared with.
-#[derive(
-    Clone, Copy, Debug, PartialEq, Eq, Default, Serialize, strum::IntoStaticStr, strum::Display,
-)]
-#[serde(rename_all = "snake_case")]
-#[strum(serialize_all = "snake_case")]
-pub enum Against {
-    /// The core's outcomes: the answers are the sweeps' expectations.
-    #[default]
-    Core,
-    /// The trace's `/expected` channel: the answers are compared with it
-    /// (ties and fragility are the core's decision's).
-    Expected,
-}
-
-/// A running engine's part in a check.
-#[derive(Clone, Debug, PartialEq, Eq, Serialize)]
-pub struct EngineCheck {
-    /// The engine's command.
-    pub command: String,
-    /// [`Against::Core`]: the engine's answers are the expectations and the
-    /// core's outcomes are compared with them ("expected" is the engine's
-    /// answer, "got" the core's); [`Against::Expected`]: the trace's
-    /// `/expected` is the expectation and the engine's answers are compared
-    /// with it ("got" is the engine's answer).
-    pub against: Against,
-}
+use super::report::{Against, EngineCheck, Judged, TraceReport};
 
 /// Checks the trace at `path` against a running engine: the engine answers
 /// every sweep ([`EngineAnswers`]) and the answers are judged by an

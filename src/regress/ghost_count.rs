@@ -4,8 +4,8 @@
 
 use crate::replay::SweepResult;
 
-use super::check::{Judged, TraceReport};
-use super::ghost::{GhostJudgement, judge_ghost};
+use super::report::{Judged, TraceReport};
+use crate::replay::{GhostJudgement, judge_ghost};
 
 /// How many ghost contacts a report lists, one line each.
 pub const MAX_LISTED_GHOSTS: usize = 10;

@@ -32,6 +32,11 @@ use crate::trace::OutcomeMsg;
 use super::compare::Tolerances;
 use super::judge::{Agreement, agreement};
 
+/// How many compared sweeps (the first ones) the inference of the
+/// recording engine's configuration looks at and replays, so that a
+/// check's memory stays bounded whatever the trace's length.
+pub const MAX_INFERENCE_SWEEPS: usize = 100_000;
+
 /// One compared sweep, kept by `check` for the inference.
 #[derive(Clone, Debug)]
 pub struct ComparedSweep {
@@ -94,7 +99,7 @@ pub struct Inferred {
     /// trace is replayed with what was inferred.
     pub matches: u64,
     /// Expectations compared: the first
-    /// [`MAX_INFERENCE_SWEEPS`](super::check::MAX_INFERENCE_SWEEPS) of the
+    /// [`MAX_INFERENCE_SWEEPS`](MAX_INFERENCE_SWEEPS) of the
     /// trace at most.
     pub compared: u64,
     /// With the other facing rule, when both were replayed: how many match.
@@ -163,7 +168,7 @@ impl Inferred {
             self.facing,
             self.matches,
             self.compared,
-            if self.compared as usize >= super::check::MAX_INFERENCE_SWEEPS {
+            if self.compared as usize >= MAX_INFERENCE_SWEEPS {
                 " (the first ones of the trace)"
             } else {
                 ""

@@ -7,8 +7,8 @@ use serde::Serialize;
 
 use crate::core::explain::num;
 use crate::core::{
-    Broadphase, EdgeRecord, FRAGILE_ULPS, FaceRecord, Fragility, Mesh, Observer, Options, Outcome,
-    Sweep, SweptPath, TestRecord, Tie, VertexRecord, sweep_mesh_with,
+    Broadphase, EdgeRecord, FRAGILE_ULPS, FaceRecord, Feature, Fragility, Mesh, Observer, Options,
+    Outcome, Sweep, SweptPath, TestRecord, Tie, VertexRecord, sweep_mesh_with,
 };
 use crate::replay::SweepResult;
 use crate::trace::OutcomeMsg;
@@ -277,12 +277,29 @@ impl Decision {
             if d.is_empty() {
                 return None;
             }
-            if tie.matches(answer.kind, answer.triangle, answer.feature) {
+            if names_tie(answer, &tie) {
                 named.get_or_insert(d);
             }
         }
         Some(named.unwrap_or(differ))
     }
+}
+
+/// Whether `answer` names `tie`. The trace spells "not given" as an absent
+/// field (`None`) and "given as null" as `Some(None)`: a tie is a hit, so a
+/// null triangle never names it, nor a null feature an edge or a vertex.
+fn names_tie(answer: &OutcomeMsg, tie: &Tie) -> bool {
+    let triangle = match answer.triangle {
+        None => None,
+        Some(None) => return false,
+        Some(Some(t)) => Some(t),
+    };
+    let feature = match answer.feature {
+        None => None,
+        Some(None) if tie.feature != Feature::Face => return false,
+        Some(f) => f,
+    };
+    tie.matches(answer.kind, triangle, feature)
 }
 
 /// Judges the expectation against the core's outcome of `result` (`check`,

@@ -14,9 +14,8 @@
 //! - why a divergent sweep came out as it did ([`explain_outcome`]);
 //! - a whole trace checked ([`check_file`]; the traces of a suite found by
 //!   [`find_traces`]), and [`render_text`] / [`render_json`] for its report;
-//! - ghost contacts, edge or vertex contacts on an internal flat or concave
-//!   place whose normal leans off the faces ([`judge_ghost`]), counted into
-//!   `check`'s report beside it;
+//! - ghost contacts (judged by [`crate::replay::judge_ghost`]) counted into
+//!   `check`'s report;
 //! - check's reports as JUnit XML and GitHub Actions annotations, for CI
 //!   systems ([`check_junit`], [`github_annotations`]);
 //! - `check`'s suite configuration, the `sweeptrace.toml` files beside the
@@ -39,20 +38,18 @@ mod diff;
 mod discovery;
 mod engine_check;
 mod explain;
-mod ghost;
 mod ghost_count;
 mod infer;
 mod judge;
 mod junit;
 mod render;
+mod report;
 mod repro;
 
 pub use bless::{BlessError, BlessSummary, bless_bytes, bless_file};
 pub use check::{
-    CheckOptions, DEFAULT_MAX_DETAILS, Divergence, Judged, KindChange, MAX_INFERENCE_SWEEPS,
-    MAX_LISTED_GHOSTS, MAX_LISTED_TUNNELS, Status, TraceReport, TunnelReport, check_events,
-    check_events_judged, check_file, check_reader, divergence_details, find_traces, frames_around,
-    judge_against_core,
+    CheckOptions, DEFAULT_MAX_DETAILS, check_events, check_events_judged, check_file, check_reader,
+    divergence_details, frames_around, judge_against_core,
 };
 pub use compare::{
     DEFAULT_ALPHA_TOLERANCE, DEFAULT_CONTACT_TOLERANCE, DEFAULT_NORMAL_TOLERANCE_DEGREES, Field,
@@ -68,20 +65,22 @@ pub use decision::{decision_line, divergence, write_decision_line, write_diverge
 pub use diff::{
     DiffReport, FirstDifference, Side, diff, render_diff_json, render_diff_text, scene_differences,
 };
+pub use discovery::find_traces;
 pub use discovery::foxglove_output;
-pub use engine_check::{
-    Against, EngineCheck, check_file_with_engine, judge_answer_against_expected,
-};
+pub use engine_check::{check_file_with_engine, judge_answer_against_expected};
 pub use explain::{ExpectedTest, expected_tests, explain_outcome, explained_records};
-pub use ghost::{
-    GHOST_DEGREES, GhostContact, GhostJudgement, GhostLine, GhostPlace, ghost_point, judge_ghost,
-};
+pub use ghost_count::MAX_LISTED_GHOSTS;
+pub use infer::MAX_INFERENCE_SWEEPS;
 pub use infer::{ComparedSweep, Inferred, Spread, infer};
 pub use judge::{Agreement, Perturbation, Reproduced, agreement, agreement_of, perturbations};
 pub use junit::{check_junit, first_problem, github_annotations, github_data, github_property};
 pub use render::{
     Sides, divergence_line, render_divergence, render_divergence_as, render_json, render_text,
     sides_of, value_text, value_text_exact, values_text,
+};
+pub use report::{
+    Against, Divergence, EngineCheck, Judged, KindChange, MAX_LISTED_TUNNELS, Status, TraceReport,
+    TunnelReport,
 };
 pub use repro::{
     HexInputs, ReproCase, ReproError, SweepInputs, TraceSweep, agreement_text, find_sweep,

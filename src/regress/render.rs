@@ -7,7 +7,7 @@ use serde_json::{Value, json};
 use crate::core::Kind;
 use crate::core::explain::num;
 
-use super::check::{Divergence, Status, TraceReport, counts_by_name};
+use super::report::{Divergence, Status, TraceReport, counts_by_name};
 
 /// A JSON value in words: numbers as [`num`], null as `null`.
 pub fn value_text(v: &Value) -> String {

@@ -6,7 +6,7 @@ use std::sync::Arc;
 
 use crate::trace::{TraceError, TraceEvent};
 
-use super::engine::{ComputedSweep, compute_sweep};
+use super::replayer::{ComputedSweep, compute_sweep};
 use super::{Replay, ReplayError, ReplayEvent, ReplayOptions, ReplaySummary};
 
 /// Replays a stream of trace events (a [`crate::trace::TraceReader`], or

@@ -1,4 +1,4 @@
-//! The replay engine: trace events in, one explained result per sweep out.
+//! Replay: trace events in, one explained result per sweep out.
 //!
 //! [`Replay`] is push-based: feed it the events of a trace in order
 //! ([`Replay::scene`], [`Replay::sweep`], [`Replay::expected`]) and take the
@@ -12,26 +12,30 @@
 //!
 //! Each result also says whether the ball's centre went through a triangle
 //! front to back ([`Tunnel`]): during the sweep, or since the ball's
-//! previous sweep (the engine keeps where each ball's last sweep left it).
+//! previous sweep ([`Replay`] keeps where each ball's last sweep left it),
+//! and whether its contact is a ghost contact: an edge or vertex contact
+//! on an internal flat or concave place whose normal leans off the faces
+//! ([`judge_ghost`]).
 //!
 //! Nothing here knows about the viewer: `viz` turns results into a Rerun
 //! recording, `check`-like commands compare [`SweepResult::outcome_msg`]
 //! with [`SweepResult::expected`].
 
-mod engine;
 mod error;
+mod ghost;
 mod iter;
 mod options;
 mod pipeline;
 mod primary;
+mod replayer;
 mod selection;
 mod summary;
 mod tunnel;
 
-pub use engine::{
-    ComputedSweep, Replay, ReplayEvent, SceneState, SweepResult, compute_sweep, feature_class,
-};
 pub use error::ReplayError;
+pub use ghost::{
+    GHOST_DEGREES, GhostContact, GhostJudgement, GhostLine, GhostPlace, ghost_point, judge_ghost,
+};
 pub use iter::{
     DEFAULT_BATCH_EVENTS, ParallelReplayIter, ReplayIter, replay_events, replay_events_parallel,
 };
@@ -43,6 +47,9 @@ pub use pipeline::{
     run_pipeline_unrecorded,
 };
 pub use primary::{CollectPrimary, primary_records};
+pub use replayer::{
+    ComputedSweep, Replay, ReplayEvent, SceneState, SweepResult, compute_sweep, feature_class,
+};
 pub use selection::{Selection, SweepExtent};
 pub use summary::{LISTED_TUNNELS, ReplaySummary, TunnelAt};
 pub use tunnel::{Through, Tunnel, TunnelKind, TunnelScene, sweep_end, tunnel_during_sweep};

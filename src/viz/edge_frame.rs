@@ -22,8 +22,8 @@ use super::convert::{
     AXIS_COLORS, CYLINDER_COLOR, EDGE_COLOR, HIT_COLOR, MISS_COLOR, PATH_COLOR, any_value, f32x3,
     quaternion, rgba, ui_points,
 };
+use super::out::{Out, set};
 use super::paths::Entity;
-use super::rows::{Out, set};
 use crate::core::explain::miss_distance;
 use crate::core::{EdgeRecord, Kind, SweptPath, TestRecord, sweep_edge};
 use crate::replay::SweepResult;

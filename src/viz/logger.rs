@@ -19,16 +19,17 @@ use super::convert::{
     ui_points,
 };
 use super::edge_frame::{choose_edges, edge_frame_rows};
+use super::out::{Out, PrepareOptions, Shown};
 use super::paths;
 use super::rows::{
-    Out, PLOT_BITS, Shown, SweepLabels, ball_row, expected_rows, focus_rows, ghost_rows,
-    plot_entity, plot_rows, plot_series, primary_rows, text_rows, transition_rows, tunnel_rows,
+    self, PLOT_BITS, SweepLabels, ball_row, expected_rows, focus_rows, ghost_rows, plot_entity,
+    plot_rows, plot_series, primary_rows, text_rows, transition_rows, tunnel_rows,
 };
 use super::spill::Spill;
-use super::{MAX_EDGE_FRAMES, RecordError, TIMESTAMP_THRESHOLD_NANOS};
+use super::{RecordError, TIMESTAMP_THRESHOLD_NANOS};
 use crate::core::{DefectKind, EdgeClass, EdgeRecord, Triangle};
 use crate::palette::MAX_DRAWN_DEFECT_LABELS;
-use crate::regress::{Tolerances, divergence};
+use crate::regress::divergence;
 use crate::replay::{ReplayEvent, SceneState, SweepResult};
 
 /// Rows buffered before the logger sends them (see [`Logger`]); with
@@ -60,29 +61,6 @@ pub const PREPARE_GROUP_SWEEPS: usize = 1024;
 
 /// At most this many emptied [`PreparedSweeps`] are kept for reuse.
 const MAX_SPARE_PREPARED: usize = 16;
-
-/// What the rows of a sweep depend on besides the sweep: the same for every
-/// sweep of a recording ([`Logger::prepare_options`]).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct PrepareOptions {
-    /// At most this many edge tests per sweep get an edge frame.
-    pub max_edge_frames: usize,
-    /// When a sweep diverges from its expectation: `check`'s comparison
-    /// with these tolerances.
-    pub tolerances: Tolerances,
-    /// The ball the "follow" view follows: only it gets a focus transform.
-    pub follow_ball: u32,
-}
-
-impl Default for PrepareOptions {
-    fn default() -> Self {
-        PrepareOptions {
-            max_edge_frames: MAX_EDGE_FRAMES,
-            tolerances: Tolerances::default(),
-            follow_ball: 0,
-        }
-    }
-}
 
 /// Options of a [`Logger`].
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -238,8 +216,8 @@ pub fn prepare_sweeps_into<'r>(
         // for the ball's next sweep).
         let now = Shown::drawn(p.edges.len(), plotted, primary, expected, tunnel, ghost);
         debug_assert!(
-            Shown::of(r, options) == now,
-            "Shown::of disagrees with the rows drawn"
+            rows::shown_of(r, options) == now,
+            "shown_of disagrees with the rows drawn"
         );
         transition_rows(&mut out, r.ball, now);
         p.divergent += u64::from(!diffs.is_empty());
@@ -565,14 +543,14 @@ impl Logger {
     ) -> Vec<Shown> {
         let nows: Vec<(u32, Shown)> = results
             .into_iter()
-            .map(|r| (r.ball, Shown::of(r, &self.options.prepare)))
+            .map(|r| (r.ball, rows::shown_of(r, &self.options.prepare)))
             .collect();
         self.shown_before_given(nows)
     }
 
     /// [`Logger::shown_before`] of sweeps of the balls `balls` whose rows
     /// show `now` (worked out elsewhere, for example in parallel, with
-    /// `Shown::of`).
+    /// `rows::shown_of`).
     pub(crate) fn shown_before_given(
         &mut self,
         balls_now: impl IntoIterator<Item = (u32, Shown)>,

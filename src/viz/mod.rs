@@ -32,6 +32,7 @@ mod convert;
 mod edge_frame;
 mod ids;
 mod logger;
+mod out;
 mod paths;
 mod pipeline;
 mod recording;
@@ -44,14 +45,14 @@ use rerun::RecordingStreamBuilder;
 pub use ids::{IdHasher, recording_id};
 pub use logger::{
     DEFAULT_FLUSH_BYTES, DEFAULT_FLUSH_ROWS, Logger, LoggerOptions, PREPARE_GROUP_SWEEPS,
-    PrepareOptions, PreparedSweeps, SPILL_FLUSH_BYTES, prepare_sweeps, prepare_sweeps_into,
+    PreparedSweeps, SPILL_FLUSH_BYTES, prepare_sweeps, prepare_sweeps_into,
 };
+pub use out::{PrepareOptions, Shown};
 pub use pipeline::LogError;
 pub use recording::{
     FinishedRecording, Recording, RecordingError, RecordingTarget, VIEWER_FLUSH_TIMEOUT, Viewer,
 };
 pub use rerun::RecordingStreamError;
-pub use rows::Shown;
 pub use rrd_file::{RrdFileError, RrdFileOptions, RrdFileSink, RrdFileWriter, create_rrd_file};
 pub use spill::{MAX_CHUNK_BYTES, MAX_CHUNK_ROWS};
 

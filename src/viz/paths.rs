@@ -39,7 +39,7 @@
 //!                                     triangle front to back (during this sweep or since
 //!                                     its previous one), labelled with the triangle
 //! world/ball/{ball}/ghost             a ghost contact, when the sweep's expected outcome is
-//!                                     one (see `regress::judge_ghost`):
+//!                                     one (see `replay::judge_ghost`):
 //!                                       Points3D: the expected contact, labelled
 //!                                       (`ghost contact 10.0°: edge 0.2 is internal and
 //!                                       flat`; the label is the expected ball's instead

@@ -15,7 +15,7 @@ use crate::replay::{BatchRecorder, PipelineEvent as Event, ReplayEvent, sweep_of
 
 use super::{
     Logger, PREPARE_GROUP_SWEEPS, PrepareOptions, PreparedSweeps, RecordError,
-    RecordingStreamError, Shown, prepare_sweeps_into,
+    RecordingStreamError, Shown, prepare_sweeps_into, rows,
 };
 
 /// Logging to the recording failed.
@@ -68,7 +68,7 @@ impl BatchRecorder for Logger {
             batch
                 .par_iter()
                 .filter_map(sweep_of)
-                .map(|r| (r.ball, Shown::of(r, &options)))
+                .map(|r| (r.ball, rows::shown_of(r, &options)))
                 .collect()
         });
         let mut shown = self.shown_before_given(nows).into_iter();

@@ -6,130 +6,57 @@
 use std::iter::once;
 
 use rerun::components::{
-    AlbedoFactor, ClearIsRecursive, FillMode, HalfSize3D, Length, Position3D, Radius, RotationQuat,
-    Scalar, Scale3D, Text, TextLogLevel, Translation3D, TriangleIndices, Vector3D,
+    AlbedoFactor, FillMode, HalfSize3D, Length, Position3D, Radius, RotationQuat, Scalar, Scale3D,
+    Text, TextLogLevel, Translation3D, TriangleIndices, Vector3D,
 };
 use rerun::{
-    Arrows3D, Capsules3D, Clear, Color, Ellipsoids3D, LineStrips3D, Mesh3D, Points3D, Scalars,
-    TextLog, Transform3D,
+    Arrows3D, Capsules3D, Color, Ellipsoids3D, LineStrips3D, Mesh3D, Points3D, Scalars, TextLog,
+    Transform3D,
 };
 
-use super::columns::{self, Row};
+use super::columns::Row;
 use super::convert::{
     BOLD_EDGE_POINTS, CONTACT_BALL_COLOR, EXPECTED_COLOR, FACE_NORMAL_COLOR, GHOST_COLOR,
     HIT_COLOR, MISS_COLOR, NORMAL_COLOR, OUTLINE_POINTS, P0_COLOR, P1_COLOR, SWEEP_COLOR,
     TUNNEL_COLOR, VERTEX_POINTS, albedo, any_value, capsule_pose, f32x3, rgba, ui_points,
 };
 use super::edge_frame::{Slot0, count_edges};
-use super::logger::PrepareOptions;
+use super::out::{Out, PrepareOptions, Shown, set};
 use super::paths::{Entity, FACE_NAMES, QUADRATIC_NAMES};
 use crate::core::explain::Label;
 use crate::core::{EdgeRecord, Kind, TestRecord};
-use crate::regress::{
-    FieldDiff, GhostContact, divergence, ghost_point, write_decision_line, write_divergence_line,
-};
-use crate::replay::SweepResult;
+use crate::regress::{FieldDiff, divergence, write_decision_line, write_divergence_line};
+use crate::replay::{GhostContact, SweepResult, ghost_point};
 use crate::trace::OutcomeMsg;
 
-/// Component sets: the rows of one entity with the same set number have the
-/// same components (see `columns::Columns::row`).
-pub(crate) mod set {
-    /// A ball's sweep: balls, swept volume, contact, normal.
-    pub const BALL: u8 = 0;
-    pub const CLEAR: u8 = 4;
-    /// The primary triangle, its outline and decisive edge, its vertex.
-    pub const PRIMARY: u8 = 5;
-    pub const SCALAR: u8 = 12;
-    pub const KIND: u8 = 13;
-    pub const TEXT_LOG: u8 = 14;
-    pub const FOCUS: u8 = 15;
-    /// An edge frame: its transform, its test's numbers and what is drawn
-    /// in it.
-    pub const EDGE_FRAME: u8 = 16;
-    /// [`EDGE_FRAME`] with the frame's axes (slot 0).
-    pub const EDGE_FRAME_AXES: u8 = 17;
-    pub const EXPECTED: u8 = 21;
-    pub const TUNNEL: u8 = 22;
-    /// A ghost contact's mark: its point and two arrows.
-    pub const GHOST: u8 = 23;
-}
-
-/// What a sweep's rows leave shown for its ball, of the entities that are
-/// cleared when a sweep no longer logs them: the primary triangle, the edge
-/// frames, the plot series, the expected outcome, the tunnel marker, the
-/// ghost contact's mark. A
-/// ball's rows clear one of them only when the ball's previous sweep showed
-/// it, right after the sweep's own rows (so that a clear keeps its place
-/// among the sweeps of one frame). (The contact, the normal, the decisive
-/// edge and vertex are parts of rows logged at every sweep that can show
-/// them, logged empty when not shown.)
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub struct Shown {
-    bits: u8,
-    /// Edge slots logged.
-    edge_slots: u8,
-    /// Plot entities that got a value (bits of [`plot_entity`]).
-    plotted: u16,
-}
-
-impl Shown {
-    const PRIMARY: u8 = 1;
-    const EXPECTED: u8 = 2;
-    const TUNNEL: u8 = 4;
-    const GHOST: u8 = 8;
-
-    /// What the rows of `r` show, as the logger with `options` draws them
-    /// (worked out without drawing them or running any test).
-    pub(crate) fn of(r: &SweepResult, options: &PrepareOptions) -> Shown {
-        let mut bits = 0;
-        let decisive = r.decisive_record();
-        if let Some(t) = decisive
-            && r.scene.mesh.triangle_by_index(t.triangle()).is_some()
-        {
-            bits |= Shown::PRIMARY;
-        }
-        if r.expected.is_some() && !divergence(r, &options.tolerances).is_empty() {
-            bits |= Shown::EXPECTED;
-        }
-        if !r.tunnels.is_empty() {
-            bits |= Shown::TUNNEL;
-        }
-        if r.ghost().is_some() {
-            bits |= Shown::GHOST;
-        }
-        let edges = count_edges(r, decisive, options.max_edge_frames);
-        Shown {
-            bits,
-            edge_slots: u8::try_from(edges).unwrap_or(u8::MAX),
-            plotted: plot_bits(decisive),
-        }
+/// What the rows of `r` show, as the logger with `options` draws them
+/// (worked out without drawing them or running any test).
+pub(crate) fn shown_of(r: &SweepResult, options: &PrepareOptions) -> Shown {
+    let mut bits = 0;
+    let decisive = r.decisive_record();
+    if let Some(t) = decisive
+        && r.scene.mesh.triangle_by_index(t.triangle()).is_some()
+    {
+        bits |= Shown::PRIMARY;
     }
-
-    fn has(self, bit: u8) -> bool {
-        self.bits & bit != 0
+    if r.expected.is_some() && !divergence(r, &options.tolerances).is_empty() {
+        bits |= Shown::EXPECTED;
     }
-
-    /// What the rows drawn for a sweep show: `edge_slots` edge frames, the
-    /// `plotted` plot entities, whether the primary triangle, the expected
-    /// outcome, a tunnel marker and a ghost contact's mark were drawn.
-    pub(crate) fn drawn(
-        edge_slots: usize,
-        plotted: u16,
-        primary: bool,
-        expected: bool,
-        tunnel: bool,
-        ghost: bool,
-    ) -> Shown {
-        let bit = |on: bool, b: u8| if on { b } else { 0 };
-        Shown {
-            bits: bit(primary, Shown::PRIMARY)
-                | bit(expected, Shown::EXPECTED)
-                | bit(tunnel, Shown::TUNNEL)
-                | bit(ghost, Shown::GHOST),
-            edge_slots: u8::try_from(edge_slots).unwrap_or(u8::MAX),
-            plotted,
-        }
+    if !r.tunnels.is_empty() {
+        bits |= Shown::TUNNEL;
     }
+    if r.ghost().is_some() {
+        bits |= Shown::GHOST;
+    }
+    let edges = count_edges(r, decisive, options.max_edge_frames);
+    Shown::drawn(
+        edges,
+        plot_bits(decisive),
+        bits & Shown::PRIMARY != 0,
+        bits & Shown::EXPECTED != 0,
+        bits & Shown::TUNNEL != 0,
+        bits & Shown::GHOST != 0,
+    )
 }
 
 /// Clears, at ball `b`'s sweep that shows `now`, what its previous sweep
@@ -156,26 +83,6 @@ pub(crate) fn transition_rows(out: &mut Out<'_>, b: u32, now: Shown) {
     }
     if before.has(Shown::GHOST) && !now.has(Shown::GHOST) {
         out.clear(Entity::Ghost(b), false);
-    }
-}
-
-/// Where the rows of one sweep go.
-pub(crate) struct Out<'a> {
-    pub(crate) columns: &'a mut columns::Columns,
-    pub(crate) frame: i64,
-    pub(crate) time: columns::Time,
-    /// What the ball's previous sweep left shown ([`Shown`]).
-    pub(crate) before: Shown,
-}
-
-impl Out<'_> {
-    pub(crate) fn row(&mut self, entity: Entity, set: u8) -> Row<'_> {
-        self.columns.row(entity, set, self.frame, self.time)
-    }
-
-    fn clear(&mut self, entity: Entity, recursive: bool) {
-        self.row(entity, set::CLEAR)
-            .put::<ClearIsRecursive>(Clear::descriptor_is_recursive, [recursive.into()]);
     }
 }
 

@@ -160,12 +160,12 @@ impl ReproCase {
                 s,
                 "    // The expectation names a member of the tie set (an equally valid answer to the tie order)."
             );
-            let triangle = match a.triangle {
-                Some(t) => format!("Some({t:?})"),
+            let triangle = match a.triangle.flatten() {
+                Some(t) => format!("Some({t})"),
                 None => "None".into(),
             };
-            let feature = match a.feature {
-                Some(f) => format!("Some({f:?})"),
+            let feature = match a.feature.flatten() {
+                Some(f) => format!("Some({f})"),
                 None => "None".into(),
             };
             let _ = writeln!(

@@ -17,9 +17,9 @@ use std::fmt;
 use nalgebra::Vector3;
 use serde::Serialize;
 
+use super::replayer::SceneState;
 use crate::core::explain::num;
 use crate::core::{EdgeClass, Kind, Topology};
-use crate::replay::SceneState;
 use crate::trace::OutcomeMsg;
 
 /// The default angle, in degrees, between an edge or vertex contact's

@@ -142,7 +142,7 @@ impl SweepResult {
     /// (the first of [`SweepResult::tunnels`], `null` when there is none),
     /// and for an edge or vertex hit `edge_class`, the class of the edge
     /// (or vertex, [`feature_class`]) hit (`null` otherwise), and `ghost`
-    /// ([`SweepResult::ghost`] as a [`crate::regress::GhostLine`], `null`
+    /// ([`SweepResult::ghost`] as a [`super::GhostLine`], `null`
     /// when the expected outcome is not a ghost contact).
     pub fn outcome_line(&self) -> Result<String, serde_json::Error> {
         #[derive(serde::Serialize)]
@@ -152,7 +152,7 @@ impl SweepResult {
             fragile: crate::core::Fragility,
             tunnel: Option<&'a Tunnel>,
             edge_class: Option<EdgeClass>,
-            ghost: Option<crate::regress::GhostLine<'a>>,
+            ghost: Option<super::GhostLine<'a>>,
         }
         let ghost = self.ghost();
         serde_json::to_string(&Line {
@@ -165,19 +165,19 @@ impl SweepResult {
     }
 
     /// The expected outcome as a ghost contact, when it is one: judged as
-    /// `check` judges it ([`crate::regress::judge_ghost`], with the core's
+    /// `check` judges it ([`crate::replay::judge_ghost`], with the core's
     /// normal for the sweep as the rule's and the default threshold
-    /// [`crate::regress::GHOST_DEGREES`]).
-    pub fn ghost(&self) -> Option<crate::regress::GhostContact> {
+    /// [`super::GHOST_DEGREES`]).
+    pub fn ghost(&self) -> Option<crate::replay::GhostContact> {
         let expected = self.expected.as_ref()?;
-        match crate::regress::judge_ghost(
+        match crate::replay::judge_ghost(
             &self.scene,
             expected,
             self.log_time_nanos,
             self.outcome.hit.as_ref().map(|h| &h.normal),
-            crate::regress::GHOST_DEGREES,
+            super::GHOST_DEGREES,
         ) {
-            crate::regress::GhostJudgement::Ghost(g) => Some(g),
+            super::GhostJudgement::Ghost(g) => Some(g),
             _ => None,
         }
     }

@@ -1,0 +1,475 @@
+//! What `check` reports of one trace ([`TraceReport`], its [`Status`]) and
+//! of one sweep ([`Judged`], [`Divergence`], [`TunnelReport`]): the types
+//! that the check's fold ([`super::check`]), `check --engine`, the ghost
+//! count, the inference, the renderers and JUnit share. Nothing here runs
+//! a replay.
+
+use std::collections::BTreeMap;
+
+use serde::{Serialize, Serializer};
+
+use crate::core::{Facing, FragileReason, Kind};
+use crate::replay::{GhostContact, Tunnel, TunnelAt, TunnelKind};
+use crate::trace::OutcomeMsg;
+
+use super::compare::{FieldDiff, Tolerances};
+use super::explain::ExpectedTest;
+use super::infer::Inferred;
+use super::judge::Agreement;
+use super::repro::{HexInputs, SweepInputs};
+
+/// How many tunnels a report lists, one line each.
+pub const MAX_LISTED_TUNNELS: usize = 10;
+/// A tunnel found in a trace: a ball's centre went through a triangle from
+/// its front to its back, during a sweep or between two of its sweeps (see
+/// [`crate::replay::Tunnel`]).
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct TunnelReport {
+    /// Frame of the sweep.
+    pub frame: u64,
+    /// Ball.
+    pub ball: u32,
+    /// `log_time` of the sweep, in nanoseconds.
+    pub log_time_nanos: u64,
+    /// The tunnel: kind, triangle, point, fraction, from, to,
+    /// previous_frame.
+    #[serde(flatten)]
+    pub tunnel: Tunnel,
+}
+
+impl TunnelReport {
+    /// One line for people: frame, ball, triangle, where.
+    pub fn line(&self) -> String {
+        TunnelAt {
+            frame: self.frame,
+            ball: self.ball,
+            tunnel: self.tunnel.clone(),
+        }
+        .to_string()
+    }
+}
+
+/// One sweep whose outcome differs from its expectation.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Divergence {
+    /// Frame.
+    pub frame: u64,
+    /// Ball.
+    pub ball: u32,
+    /// `log_time` of the sweep, in nanoseconds.
+    pub log_time_nanos: u64,
+    /// The fields that differ.
+    pub fields: Vec<FieldDiff>,
+    /// The expectation.
+    pub expected: OutcomeMsg,
+    /// The core's outcome.
+    pub got: OutcomeMsg,
+    /// Why the core's decision is fragile (empty when robust).
+    pub fragile: crate::core::Fragility,
+    /// When the decision is fragile and rounding explains the divergence:
+    /// the perturbation of the inputs under which the core gives each
+    /// side's answer (absent otherwise: a fragile decision does not excuse
+    /// an answer no rounding gives).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub reproduced: Option<super::judge::Reproduced>,
+    /// Whether the expectation names another member of the core's tie set
+    /// (a failure only where the tie order must be followed exactly:
+    /// `conform`). Only in the JSON when true.
+    #[serde(skip_serializing_if = "std::ops::Not::not")]
+    pub names_tie_member: bool,
+    /// The sweep's inputs, exactly (shortest round-trip decimals in the
+    /// JSON): with them the core makes the same decision.
+    pub inputs: SweepInputs,
+    /// The inputs as hexadecimal floating point (`check --hex`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub inputs_hex: Option<HexInputs>,
+    /// The margin and facing rule the core used.
+    pub margin: f64,
+    /// The facing rule the core used.
+    pub facing: Facing,
+    /// The tests that decided the core's outcome, in words: the primary
+    /// test and the other hits at the same `α`, or the nearest miss.
+    pub got_explanation: Vec<String>,
+    /// The tests that would have produced the expected result (none when the
+    /// expectation is `none`, or names no triangle).
+    pub expected_tests: Vec<ExpectedTest>,
+}
+
+/// The status of one trace.
+#[derive(
+    Clone,
+    Copy,
+    Debug,
+    PartialEq,
+    Eq,
+    Hash,
+    PartialOrd,
+    Ord,
+    Serialize,
+    strum::IntoStaticStr,
+    strum::Display,
+)]
+#[serde(rename_all = "snake_case")]
+pub enum Status {
+    /// Every expectation matched, and no tunnel was found (or tunnels do
+    /// not fail the check).
+    #[strum(serialize = "ok")]
+    Ok,
+    /// At least one sweep diverged, or a tunnel was found.
+    #[strum(serialize = "FAIL")]
+    Fail,
+    /// Nothing to compare: no `/expected` channel, or no expectation matches
+    /// a sweep. Never a pass.
+    #[strum(serialize = "NO EXPECTATIONS")]
+    NoExpectations,
+    /// The trace could not be (fully) checked.
+    #[strum(serialize = "ERROR")]
+    Error,
+}
+
+impl Status {
+    /// `ok`, `FAIL`, `NO EXPECTATIONS`, `ERROR`.
+    pub fn as_str(self) -> &'static str {
+        self.into()
+    }
+}
+
+impl TraceReport {
+    /// Records something that could not be checked (the report becomes
+    /// [`Status::Error`]).
+    pub fn add_error(&mut self, message: String) {
+        if self.errors.len() < MAX_ERRORS {
+            self.errors.push(message);
+        }
+    }
+
+    /// The verdict, from the counts: [`Status::Error`] when anything could
+    /// not be checked; [`Status::Fail`] on a divergence (or a tunnel that
+    /// fails the check); [`Status::NoExpectations`] when nothing was
+    /// compared; otherwise [`Status::Ok`].
+    pub fn status(&self) -> Status {
+        if !self.errors.is_empty() {
+            Status::Error
+        } else if self.divergent > 0 || self.fails_on_tunnels() || self.fails_on_ghosts() {
+            Status::Fail
+        } else if self.compared == 0 {
+            Status::NoExpectations
+        } else {
+            Status::Ok
+        }
+    }
+
+    /// Whether tunnels were found and fail the check.
+    pub fn fails_on_tunnels(&self) -> bool {
+        self.tunnels > 0 && self.fail_on_tunnel
+    }
+
+    /// Whether ghost contacts were found and fail the check.
+    pub fn fails_on_ghosts(&self) -> bool {
+        self.ghosts > 0 && self.fail_on_ghost
+    }
+}
+
+/// One sweep judged: its expectation, the outcome it is compared with,
+/// and how they agree.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Judged {
+    /// The expectation.
+    pub expected: OutcomeMsg,
+    /// What it is compared with (the core's outcome, or an engine's answer).
+    pub got: OutcomeMsg,
+    /// How they agree.
+    pub agreement: Agreement,
+    /// Whether `got` is the core's outcome (the inference of the recording
+    /// engine's configuration replays the core, so it runs only then).
+    pub got_is_core: bool,
+}
+
+/// What an engine's answers are compared with.
+#[derive(
+    Clone, Copy, Debug, PartialEq, Eq, Default, Serialize, strum::IntoStaticStr, strum::Display,
+)]
+#[serde(rename_all = "snake_case")]
+#[strum(serialize_all = "snake_case")]
+pub enum Against {
+    /// The core's outcomes: the answers are the sweeps' expectations.
+    #[default]
+    Core,
+    /// The trace's `/expected` channel: the answers are compared with it
+    /// (ties and fragility are the core's decision's).
+    Expected,
+}
+
+/// A running engine's part in a check.
+#[derive(Clone, Debug, PartialEq, Eq, Serialize)]
+pub struct EngineCheck {
+    /// The engine's command.
+    pub command: String,
+    /// [`Against::Core`]: the engine's answers are the expectations and the
+    /// core's outcomes are compared with them ("expected" is the engine's
+    /// answer, "got" the core's); [`Against::Expected`]: the trace's
+    /// `/expected` is the expectation and the engine's answers are compared
+    /// with it ("got" is the engine's answer).
+    pub against: Against,
+}
+
+/// The result of checking one trace. Its verdict is [`TraceReport::status`]
+/// (in the JSON, `status` after `trace`).
+#[derive(Clone, Debug, PartialEq)]
+#[non_exhaustive]
+pub struct TraceReport {
+    /// The trace's name (its path as given).
+    pub trace: String,
+    /// Sweeps replayed.
+    pub sweeps: u64,
+    /// Sweeps compared with an expectation.
+    pub compared: u64,
+    /// Sweeps whose outcome differs from its expectation (on a robust
+    /// decision; with `strict`, on any decision). These fail the check.
+    pub divergent: u64,
+    /// Sweeps whose expectation names another member of the replayed
+    /// decision's tie set: an equally valid answer to the rules, counted
+    /// as a match.
+    pub ties: u64,
+    /// Sweeps that diverge on a fragile decision in a way rounding
+    /// explains: a perturbation of the inputs within the rounding budget
+    /// makes the core give the expected answer
+    /// ([`Divergence::reproduced`]). They fail the check only with
+    /// `strict`, where they are also counted in `divergent`. A divergence
+    /// on a fragile decision that no perturbation reproduces is counted in
+    /// `divergent`.
+    pub fragile_divergent: u64,
+    /// Fragile divergences by reason (one sweep can have several).
+    pub fragile_by_reason: BTreeMap<FragileReason, u64>,
+    /// The first fragile divergences, in detail (without `strict`).
+    pub fragile_divergences: Vec<Divergence>,
+    /// Whether fragile divergences fail the check (`--strict`).
+    pub strict: bool,
+    /// Tunnels found: a ball's centre through a triangle, front to back,
+    /// during a sweep or between two sweeps of the ball. They fail the
+    /// check unless `fail_on_tunnel` is off.
+    pub tunnels: u64,
+    /// Tunnels by kind.
+    pub tunnels_by_kind: BTreeMap<TunnelKind, u64>,
+    /// The first tunnels (at most [`MAX_LISTED_TUNNELS`]), in trace order.
+    pub tunnel_details: Vec<TunnelReport>,
+    /// Whether tunnels fail the check.
+    pub fail_on_tunnel: bool,
+    /// Ghost contacts found: expectations (or an engine's answers) that are
+    /// edge or vertex contacts on an internal flat or concave place with a
+    /// normal more than `ghost_degrees` from the faces' there
+    /// ([`judge_ghost`](crate::replay::judge_ghost)), whatever the compared fields. They fail the
+    /// check unless `fail_on_ghost` is off.
+    pub ghosts: u64,
+    /// The first ghost contacts (at most [`MAX_LISTED_GHOSTS`]), in trace
+    /// order.
+    pub ghost_contacts: Vec<GhostContact>,
+    /// Edge or vertex contacts that cannot be judged for ghost contacts:
+    /// on such a place but without a normal, or without the triangle or
+    /// feature that places them.
+    pub ghosts_unjudged: u64,
+    /// Whether ghost contacts fail the check.
+    pub fail_on_ghost: bool,
+    /// The ghost contacts' threshold, in degrees.
+    pub ghost_degrees: f64,
+    /// Replayed sweeps without an expectation.
+    pub sweeps_without_expectation: u64,
+    /// Expectations that match no replayed sweep (or arrived after theirs was
+    /// complete, or repeat one).
+    pub expectations_without_sweep: u64,
+    /// `/expected` messages read (matched or not).
+    pub expectations: u64,
+    /// Whether the trace has an `/expected` channel at all.
+    pub has_expected_channel: bool,
+    /// Divergent sweeps by the kinds of the expectation and of the outcome
+    /// it is compared with.
+    pub by_kind: BTreeMap<KindChange, u64>,
+    /// The first divergences, in detail (at most `max_details`).
+    pub divergences: Vec<Divergence>,
+    /// Frames of the first divergent sweeps (up to 100), in trace order.
+    pub divergent_frames: Vec<u64>,
+    /// What could not be checked: read errors, invalid scenes or sweeps.
+    pub errors: Vec<String>,
+    /// Whether the trace ends early (it is truncated): the sweeps before
+    /// the end were checked. Only in the JSON when true.
+    pub incomplete: bool,
+    /// The tolerances used.
+    pub tolerances: Tolerances,
+    /// When expectations fail: the recording engine's margin and facing
+    /// rule as its expectations imply them, and how many expectations
+    /// match when the trace is replayed with them ([`Inferred`]).
+    pub inferred: Option<Inferred>,
+    /// When a running engine was checked (`check --engine`): its command
+    /// and what its answers were compared with.
+    pub engine: Option<EngineCheck>,
+    /// Who computed the trace's `/expected` outcomes, as its
+    /// `sweeptrace.expected_source` record says (`null` when it does not).
+    /// With `check --engine` and `against` `core` the report's
+    /// expectations are the engine's answers instead (`engine`).
+    pub expected_source: Option<crate::trace::ExpectedSource>,
+}
+
+/// The kinds of a divergent sweep's expectation and of the outcome it is
+/// compared with; written `expected -> got` (`face -> edge`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub struct KindChange {
+    /// The expectation's kind.
+    pub expected: Kind,
+    /// The compared outcome's kind.
+    pub got: Kind,
+}
+
+impl std::fmt::Display for KindChange {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{} -> {}", self.expected, self.got)
+    }
+}
+
+impl Serialize for KindChange {
+    fn serialize<S: Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        serializer.collect_str(self)
+    }
+}
+
+/// Counts by key, listed by the keys' names in alphabetical order: the
+/// order of the report's text and of its JSON objects.
+pub(crate) fn counts_by_name<K: std::fmt::Display>(
+    counts: &BTreeMap<K, u64>,
+) -> Vec<(String, u64)> {
+    let mut named: Vec<(String, u64)> = counts.iter().map(|(k, n)| (k.to_string(), *n)).collect();
+    named.sort();
+    named
+}
+
+/// A count map written as a JSON object whose keys are the names, in
+/// alphabetical order.
+fn serialize_by_name<K, S>(counts: &BTreeMap<K, u64>, serializer: S) -> Result<S::Ok, S::Error>
+where
+    K: std::fmt::Display,
+    S: Serializer,
+{
+    serializer.collect_map(counts_by_name(counts))
+}
+
+/// The JSON of a report: its fields in declaration order, with the
+/// computed [`TraceReport::status`] after `trace`.
+impl Serialize for TraceReport {
+    fn serialize<S: Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        #[derive(Serialize)]
+        struct Json<'a> {
+            trace: &'a str,
+            status: Status,
+            sweeps: u64,
+            compared: u64,
+            divergent: u64,
+            ties: u64,
+            fragile_divergent: u64,
+            #[serde(serialize_with = "serialize_by_name")]
+            fragile_by_reason: &'a BTreeMap<FragileReason, u64>,
+            fragile_divergences: &'a [Divergence],
+            strict: bool,
+            tunnels: u64,
+            #[serde(serialize_with = "serialize_by_name")]
+            tunnels_by_kind: &'a BTreeMap<TunnelKind, u64>,
+            tunnel_details: &'a [TunnelReport],
+            fail_on_tunnel: bool,
+            ghosts: u64,
+            ghost_contacts: &'a [GhostContact],
+            ghosts_unjudged: u64,
+            fail_on_ghost: bool,
+            ghost_degrees: f64,
+            sweeps_without_expectation: u64,
+            expectations_without_sweep: u64,
+            expectations: u64,
+            has_expected_channel: bool,
+            #[serde(serialize_with = "serialize_by_name")]
+            by_kind: &'a BTreeMap<KindChange, u64>,
+            divergences: &'a [Divergence],
+            divergent_frames: &'a [u64],
+            errors: &'a [String],
+            #[serde(skip_serializing_if = "std::ops::Not::not")]
+            incomplete: bool,
+            tolerances: &'a Tolerances,
+            #[serde(skip_serializing_if = "Option::is_none")]
+            inferred: &'a Option<Inferred>,
+            #[serde(skip_serializing_if = "Option::is_none")]
+            engine: &'a Option<EngineCheck>,
+            expected_source: &'a Option<crate::trace::ExpectedSource>,
+        }
+        // Every field, named: a new field does not compile until it is
+        // written here too.
+        let TraceReport {
+            trace,
+            sweeps,
+            compared,
+            divergent,
+            ties,
+            fragile_divergent,
+            fragile_by_reason,
+            fragile_divergences,
+            strict,
+            tunnels,
+            tunnels_by_kind,
+            tunnel_details,
+            fail_on_tunnel,
+            ghosts,
+            ghost_contacts,
+            ghosts_unjudged,
+            fail_on_ghost,
+            ghost_degrees,
+            sweeps_without_expectation,
+            expectations_without_sweep,
+            expectations,
+            has_expected_channel,
+            by_kind,
+            divergences,
+            divergent_frames,
+            errors,
+            incomplete,
+            tolerances,
+            inferred,
+            engine,
+            expected_source,
+        } = self;
+        Json {
+            trace,
+            status: self.status(),
+            sweeps: *sweeps,
+            compared: *compared,
+            divergent: *divergent,
+            ties: *ties,
+            fragile_divergent: *fragile_divergent,
+            fragile_by_reason,
+            fragile_divergences,
+            strict: *strict,
+            tunnels: *tunnels,
+            tunnels_by_kind,
+            tunnel_details,
+            fail_on_tunnel: *fail_on_tunnel,
+            ghosts: *ghosts,
+            ghost_contacts,
+            ghosts_unjudged: *ghosts_unjudged,
+            fail_on_ghost: *fail_on_ghost,
+            ghost_degrees: *ghost_degrees,
+            sweeps_without_expectation: *sweeps_without_expectation,
+            expectations_without_sweep: *expectations_without_sweep,
+            expectations: *expectations,
+            has_expected_channel: *has_expected_channel,
+            by_kind,
+            divergences,
+            divergent_frames,
+            errors,
+            incomplete: *incomplete,
+            tolerances,
+            inferred,
+            engine,
+            expected_source,
+        }
+        .serialize(serializer)
+    }
+}
+
+/// How many divergent frames a report lists.
+pub(crate) const MAX_DIVERGENT_FRAMES: usize = 100;
+/// How many errors a report keeps.
+pub(crate) const MAX_ERRORS: usize = 20;

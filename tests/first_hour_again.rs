@@ -30,6 +30,7 @@ pub fn tests() -> Vec<Trial> {
         trial!(counts_are_grammatical),
         trial!(unjudged_ghost_candidates_are_mentioned),
         trial!(gitignore_covers_what_the_documented_commands_write),
+        trial!(record_help_gives_the_defaults_and_says_where_the_ball_starts),
     ]
 }
 
@@ -766,4 +767,84 @@ fn gitignore_covers_what_the_documented_commands_write() -> anyhow::Result<Compl
         "written by documented commands at the root, not in .gitignore: {not_ignored:?}"
     );
     Ok(Completion::Completed)
+}
+
+/// `record --help` gives each scene's defaults, and they are what `record`
+/// does with no option (the triangle scene's balls, radius and frames, as
+/// its summary says); it says where ball 0 starts with `--mesh` (above the
+/// middle of the mesh's bounding box, two radii above its top), which a
+/// recording over an OBJ file confirms, and what "left the play volume"
+/// means.
+fn record_help_gives_the_defaults_and_says_where_the_ball_starts() -> anyhow::Result<()> {
+    let dir = tempfile::tempdir()?;
+    let (code, help, err) = run(dir.path(), os!["record", "--help"])?;
+    ensure!(code == 0, "--help: exit {code}: {err}");
+    let line = help
+        .lines()
+        .find(|l| l.trim_start().starts_with("--scene triangle:"))
+        .with_context(|| format!("no defaults of the triangle scene in:\n{help}"))?;
+    let value = |name: &str| -> anyhow::Result<String> {
+        let at = line
+            .find(&format!("{name} "))
+            .with_context(|| format!("no {name} in `{line}`"))?;
+        Ok(line[at + name.len() + 1..]
+            .split(',')
+            .next()
+            .unwrap_or("")
+            .trim()
+            .to_string())
+    };
+    let (frames, balls, radius) = (value("--frames")?, value("--balls")?, value("--radius")?);
+    ensure!(
+        help.contains("every scene: --seed 0")
+            && help.contains("--mesh FILE: --frames")
+            && help.contains("With --mesh, ball 0 starts above the middle of the mesh")
+            && help.contains("two radii above its top")
+            && help.contains("The play volume is the mesh's bounding box grown on every side")
+            && help.contains("\"left the play volume\""),
+        "{help}"
+    );
+    let (code, out, err) = run(
+        dir.path(),
+        os!["record", "--scene", "triangle", "-o", "t.mcap"],
+    )?;
+    ensure!(code == 0, "record: exit {code}\n{out}{err}");
+    let said = format!("of {balls} balls of radius {radius} over {frames} frames");
+    ensure!(
+        out.contains(&said),
+        "the help says `{said}`, record did:\n{out}"
+    );
+    // An OBJ: a unit square at z = 1 over [0, 4] × [0, 2].
+    std::fs::write(
+        dir.path().join("floor.obj"),
+        "v 0 0 1\nv 4 0 1\nv 4 2 1\nv 0 2 1\nf 1 2 3\nf 1 3 4\n",
+    )?;
+    let (code, out, err) = run(
+        dir.path(),
+        os![
+            "record",
+            "--mesh",
+            "floor.obj",
+            "--radius",
+            "0.5",
+            "--frames",
+            "2",
+            "-o",
+            "f.mcap"
+        ],
+    )?;
+    ensure!(code == 0, "record --mesh: exit {code}\n{out}{err}");
+    let file = std::fs::File::open(dir.path().join("f.mcap"))?;
+    let first = sweeptrace::TraceReader::new(std::io::BufReader::new(file), "f.mcap")
+        .find_map(|e| match e {
+            Ok(sweeptrace::TraceEvent::Sweep { sweep, .. }) if sweep.ball == 0 => Some(sweep),
+            _ => None,
+        })
+        .context("no sweep of ball 0")?;
+    ensure!(
+        first.p0 == [2.0, 1.0, 2.0],
+        "ball 0 starts at {:?}, not (2, 1, 2)",
+        first.p0
+    );
+    Ok(())
 }

@@ -31,6 +31,7 @@ pub fn tests() -> Vec<Trial> {
         trial!(unjudged_ghost_candidates_are_mentioned),
         trial!(gitignore_covers_what_the_documented_commands_write),
         trial!(record_help_gives_the_defaults_and_says_where_the_ball_starts),
+        trial!(spawn_notices_a_viewer_that_exits_at_once),
     ]
 }
 
@@ -847,4 +848,75 @@ fn record_help_gives_the_defaults_and_says_where_the_ball_starts() -> anyhow::Re
         first.p0
     );
     Ok(())
+}
+
+/// `replay --spawn` where the viewer cannot open a window: a `rerun` on
+/// PATH that exits at once (with a failure, or with success and nothing
+/// listening, as a launcher whose viewer failed) is noticed within a
+/// couple of seconds instead of the 9 s of the stream's timeouts; the
+/// error says the viewer exited and how, not "at the spawned viewer", and
+/// leaves no file (`--rrd` given too).
+#[cfg(unix)]
+fn spawn_notices_a_viewer_that_exits_at_once() -> anyhow::Result<()> {
+    use std::os::unix::fs::PermissionsExt as _;
+    for (code, status, limit) in [(1, "exit status 1", 1.0), (0, "exit status 0", 4.0)] {
+        let dir = tempfile::tempdir()?;
+        let bin = dir.path().join("bin");
+        std::fs::create_dir(&bin)?;
+        let fake = bin.join("rerun");
+        std::fs::write(
+            &fake,
+            format!(
+                "#!/bin/sh\n[ \"$1\" = --version ] && exit 0\n\
+                 echo 'fake viewer: no display' >&2\nexit {code}\n"
+            ),
+        )?;
+        std::fs::set_permissions(&fake, std::fs::Permissions::from_mode(0o755))?;
+        let path = std::env::join_paths(std::iter::once(bin.clone()).chain(
+            std::env::split_paths(&std::env::var_os("PATH").unwrap_or_default()),
+        ))?;
+        let work = dir.path().join("work");
+        std::fs::create_dir(&work)?;
+        let started = std::time::Instant::now();
+        let out = crate::support::bin()
+            .args([
+                OsStr::new("replay"),
+                cube().as_os_str(),
+                OsStr::new("--spawn"),
+                OsStr::new("--rrd"),
+                OsStr::new("r.rrd"),
+            ])
+            .arg("--threads")
+            .arg("1")
+            .env("PATH", path)
+            .env_remove("DISPLAY")
+            .env_remove("WAYLAND_DISPLAY")
+            .env_remove("CARGO_TARGET_DIR")
+            .current_dir(&work)
+            .output()?;
+        let took = started.elapsed().as_secs_f64();
+        let err = String::from_utf8_lossy(&out.stderr);
+        ensure!(
+            out.status.code() == Some(2)
+                && err.contains(&format!(
+                    "the Rerun viewer that --spawn started exited ({status})"
+                ))
+                && !err.contains("at the spawned viewer"),
+            "viewer exiting with {code}: {:?}\n{err}",
+            out.status
+        );
+        ensure!(
+            took < limit,
+            "viewer exiting with {code}: noticed after {took:.1} s"
+        );
+        ensure!(entries(&work)?.is_empty(), "left {:?}", entries(&work)?);
+    }
+    Ok(())
+}
+
+#[cfg(not(unix))]
+fn spawn_notices_a_viewer_that_exits_at_once() -> anyhow::Result<Completion> {
+    Ok(Completion::ignored_with(
+        "skipped: the viewer's exit is looked for on Unix only",
+    ))
 }

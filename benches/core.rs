@@ -42,7 +42,7 @@ use sweeptrace::core::{
     sweep_mesh_with,
 };
 use sweeptrace::replay::{CollectPrimary, primary_records};
-use sweeptrace::sim::{self, BuiltinScene};
+use sweeptrace::sim::{self, scenes::BuiltinScene};
 
 use parry3d_f64::math::{Pose, Vector};
 use parry3d_f64::query::{ShapeCastOptions, cast_shapes};

@@ -57,11 +57,11 @@ use rapier3d_f64::parry::query::{ShapeCastOptions, ShapeCastStatus};
 use rapier3d_f64::parry::shape::{Ball, TriMeshFlags};
 use rapier3d_f64::prelude::*;
 use sweeptrace::core::Kind;
-use sweeptrace::replay::SceneState;
-use sweeptrace::replay::{GHOST_DEGREES, GhostJudgement, judge_ghost};
-use sweeptrace::sim::obj::load_obj;
+use sweeptrace::replay::{GHOST_DEGREES, GhostJudgement, SceneState, judge_ghost};
+use sweeptrace::sim::load_obj;
+use sweeptrace::sim::scenes::BuiltinScene;
 use sweeptrace::sim::scenes::SceneMesh;
-use sweeptrace::sim::{BuiltinScene, SimOptions, initial_states, play_volume, scene_message};
+use sweeptrace::sim::{SimOptions, initial_states, play_volume, scene_message};
 use sweeptrace::{ExpectedSource, OutcomeMsg, SweepMsg, Topology, write_trace_file};
 
 /// Relative tolerance of the kind read from Rapier's answer (see the module

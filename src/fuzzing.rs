@@ -4,7 +4,9 @@
 //!
 //! Each `check_*` function takes arbitrary bytes and returns `Err` with the
 //! broken property in words; a panic inside the library is a finding too.
-//! Not part of the public API.
+//! Public so that the fuzz targets, a separate crate, call the same code;
+//! [`repeated_segment`] is the property of every error message the tests
+//! assert too.
 
 use crate::core::{
     Broadphase, CollectRecords, Facing, Mesh, MeshError, Options, Outcome, Sweep, SweptPath,
@@ -14,6 +16,8 @@ use crate::trace::{
     Encoding, MessageAt, OutcomeMsg, ReadLimits, SceneMsg, SweepMsg, TraceEvent, TraceReader,
     parse_message_as, validate_outcome, validate_scene, validate_sweep,
 };
+
+pub use crate::error_text::repeated_segment;
 
 /// The source name the reader is given; every error must name it.
 const SOURCE_NAME: &str = "fuzz-input.mcap";

@@ -72,21 +72,14 @@
 
 #![warn(missing_docs)]
 
-// Plumbing the command line shares with the library (atomic output files,
-// error texts, number checks): public for the binary, not part
-// of the library's API.
-#[doc(hidden)]
 pub mod atomic;
 pub mod conform;
 pub mod core;
 pub mod engine;
-#[doc(hidden)]
-pub mod error_text;
+pub(crate) mod error_text;
 pub mod foxglove;
-#[doc(hidden)]
 pub mod fuzzing;
 pub mod junit;
-#[doc(hidden)]
 pub mod numbers;
 pub(crate) mod palette;
 pub mod regress;

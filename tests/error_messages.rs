@@ -1,7 +1,7 @@
 //! Error messages in one style: a representative set of failing commands,
 //! each of whose messages names the file (and the channel, frame and field
 //! where there is one) and says no part of itself twice
-//! (`sweeptrace::error_text::repeated_segment`).
+//! (`sweeptrace::fuzzing::repeated_segment`).
 
 use std::path::Path;
 
@@ -193,7 +193,7 @@ fn failing_commands_say_each_thing_once() -> anyhow::Result<()> {
                 "{what}: the message does not say `{needle}`: {message}"
             );
         }
-        if let Some(repeated) = sweeptrace::error_text::repeated_segment(message) {
+        if let Some(repeated) = sweeptrace::fuzzing::repeated_segment(message) {
             anyhow::bail!("{what}: the message repeats `{repeated}`: {message}");
         }
     }

@@ -198,7 +198,7 @@ fn check_error(
         error.matches(reason).count() == 1,
         "{what}: the error does not say `{reason}` exactly once: {error}"
     );
-    if let Some(repeated) = sweeptrace::error_text::repeated_segment(error) {
+    if let Some(repeated) = sweeptrace::fuzzing::repeated_segment(error) {
         anyhow::bail!("{what}: the error repeats `{repeated}`: {error}");
     }
     Ok(())

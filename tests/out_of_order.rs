@@ -141,7 +141,7 @@ fn overlapping_chunks_written_by_python() -> anyhow::Result<Completion> {
             && stdout.contains("is earlier than the previous message's"),
         "check without a summary: exit {code}: {stdout}{stderr}"
     );
-    if let Some(repeated) = sweeptrace::error_text::repeated_segment(&stdout) {
+    if let Some(repeated) = sweeptrace::fuzzing::repeated_segment(&stdout) {
         anyhow::bail!("check repeats `{repeated}`: {stdout}");
     }
     Ok(Completion::Completed)

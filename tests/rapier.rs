@@ -7,7 +7,7 @@ use libtest_mimic::Trial;
 use sweeptrace::regress::{
     CheckOptions, Field, FieldSet, Status, Tolerances, check_file, render_text,
 };
-use sweeptrace::sim::BuiltinScene;
+use sweeptrace::sim::scenes::BuiltinScene;
 
 use crate::ensure;
 use crate::rapier_record::{Args, Expect, run};

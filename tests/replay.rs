@@ -12,7 +12,7 @@ use libtest_mimic::Trial;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
-use sweeptrace::core::explain::miss_distance;
+use sweeptrace::core::miss_distance;
 use sweeptrace::core::{
     Broadphase, CollectRecords, EdgeRecord, FaceRecord, Facing, Kind, Mesh, Observer, Options,
     Sweep, TestRecord, VertexRecord, sweep_mesh, sweep_mesh_with,

@@ -757,7 +757,8 @@ fn sample_traces_have_none() -> anyhow::Result<()> {
 /// ball through a surface, and no sweep starts where the tests let it
 /// through.
 fn simulation_has_none() -> anyhow::Result<()> {
-    use sweeptrace::sim::{BuiltinScene, SimError, SimOptions, scene_message, simulate};
+    use sweeptrace::sim::scenes::BuiltinScene;
+    use sweeptrace::sim::{SimError, SimOptions, scene_message, simulate};
     use sweeptrace::trace::{TraceError, TraceEvent};
     let (mut sweeps, mut hits) = (0u64, 0u64);
     for scene in BuiltinScene::all() {

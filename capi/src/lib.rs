@@ -32,9 +32,9 @@ use std::ffi::{CStr, CString, c_char, c_int, c_void};
 use std::panic::{AssertUnwindSafe, catch_unwind};
 use std::path::PathBuf;
 
-use sweeptrace::core::{Facing, Kind};
 use sweeptrace::trace::{MAX_SETTINGS, PendingTrace};
 use sweeptrace::{Encoding, ExpectedSource, OutcomeMsg, SceneMsg, SweepMsg, TraceError};
+use sweeptrace::{Facing, Kind};
 
 /// What a call came to.
 #[repr(C)]

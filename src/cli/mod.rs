@@ -218,13 +218,8 @@ impl<T, E: Into<anyhow::Error>> NameFileOnce<T> for Result<T, E> {
 /// library's errors: `run.mcap: cannot open: No such file or directory
 /// (os error 2)` (`check` says the same on its `ERROR` line).
 pub fn open_input(path: &std::path::Path) -> anyhow::Result<std::fs::File> {
-    std::fs::File::open(path).map_err(|e| {
-        anyhow::anyhow!(
-            "{}: cannot open: {}",
-            path.display(),
-            sweeptrace::error_text::full_text(&e)
-        )
-    })
+    use anyhow::Context as _;
+    std::fs::File::open(path).with_context(|| format!("{}: cannot open", path.display()))
 }
 
 /// Opens the trace `path` ([`open_input`]); an OBJ file given instead is

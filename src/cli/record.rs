@@ -14,7 +14,7 @@ use sweeptrace::sim::{self, SimOptions, SimSummary, StopReason};
 use sweeptrace::trace::{Encoding, sweeptrace_source, write_trace_file_with_encoding};
 
 /// Arguments of `record`. Every simulation option defaults to the scene's
-/// own choice (`sweeptrace::sim::BuiltinScene::sim_options`).
+/// own choice (`sweeptrace::sim::scenes::BuiltinScene::sim_options`).
 #[derive(Debug, clap::Args)]
 #[command(after_help = after_help())]
 pub struct Args {

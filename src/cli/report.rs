@@ -4,10 +4,10 @@ use std::fmt::Write;
 
 use serde_json::json;
 
-use sweeptrace::core::explain::{describe, miss_distance, num};
 use sweeptrace::core::{
     EdgeClass, Feature, Options, Outcome, Sweep, TestRecord, Topology, Verdict,
 };
+use sweeptrace::core::{describe, miss_distance, num};
 use sweeptrace::regress::SweepInputs;
 use sweeptrace::replay::feature_class;
 use sweeptrace::trace::OutcomeMsg;

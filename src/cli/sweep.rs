@@ -9,7 +9,8 @@ use super::Exit;
 use super::report;
 use sweeptrace::core::{Broadphase, CollectRecords, Facing, Options, Sweep, sweep_mesh_with};
 use sweeptrace::regress::find_sweep;
-use sweeptrace::sim::{BuiltinScene, load_obj};
+use sweeptrace::sim::load_obj;
+use sweeptrace::sim::scenes::BuiltinScene;
 use sweeptrace::trace::{OutcomeMsg, TraceReader};
 
 /// Arguments of `sweep`.

@@ -13,7 +13,7 @@ mod junit;
 mod rules;
 
 pub use cases::{Case, cases};
-pub use junit::{conform_junit, rule_group};
+pub use junit::conform_junit;
 pub use rules::{RULES, Rule};
 
 use std::fmt::Write as _;

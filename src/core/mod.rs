@@ -22,14 +22,14 @@
 mod bvh;
 mod crossing;
 mod error;
-pub mod explain;
+pub(crate) mod explain;
 mod feature;
 mod fragility;
 mod mesh;
 mod options;
 mod outcome;
 mod path;
-pub mod quadratic;
+mod quadratic;
 mod record;
 mod sweep_edge;
 mod sweep_face;
@@ -43,23 +43,24 @@ pub use crossing::{
     triangle_crossing_back_to_front,
 };
 pub use error::{MeshError, SweepError};
+pub use explain::{describe, miss_distance, num};
 pub use feature::{Feature, Kind};
 pub use fragility::{FragileReason, Fragility};
 pub use mesh::{DegenerateReason, DegenerateTriangle, Mesh, StandardFrame, Triangle};
 pub use options::{
-    ALPHA_SENSITIVITY, BROADPHASE_MARGIN, DEGENERATE_TOLERANCE, FRAGILE_ULPS, Facing,
-    GRAZING_COSINE, Options, PARALLEL_TOLERANCE, TIE_WINDOW_ULPS,
+    ALPHA_SENSITIVITY, DEGENERATE_TOLERANCE, FRAGILE_ULPS, Facing, GRAZING_COSINE, Options,
+    PARALLEL_TOLERANCE, TIE_WINDOW_ULPS,
 };
-pub use outcome::{Outcome, SweepHit, Tie, in_tie_window};
+pub use outcome::{Outcome, SweepHit, Tie};
 pub use path::{Sweep, SweptPath};
 pub use record::{
     CollectRecords, EdgeHit, EdgeRecord, FaceHit, FaceRecord, NoObserver, Observer, Skip,
     SkipCounts, TestRecord, Verdict, VerdictCounts, VertexHit, VertexRecord,
 };
-pub use sweep_edge::sweep_edge;
-pub use sweep_face::{barycentric, barycentric_and_distance, sweep_face};
+pub(crate) use sweep_edge::sweep_edge;
+pub use sweep_face::{barycentric, sweep_face};
 pub use sweep_mesh::{Broadphase, sweep_mesh, sweep_mesh_with};
-pub use sweep_vertex::sweep_vertex;
+pub(crate) use sweep_vertex::sweep_vertex;
 pub use ties::{CollectTies, sweep_ties};
 pub use topology::{
     Defect, DefectKind, Edge, EdgeClass, EdgeCounts, FLAT_DIHEDRAL_SINE, NEAR_FRACTION,

@@ -27,7 +27,8 @@ mod error;
 mod process;
 pub mod protocol;
 
-pub use answers::{AnswerSink, EngineAnswers, EngineRun};
+pub(crate) use answers::AnswerSink;
+pub use answers::{EngineAnswers, EngineRun};
 pub use command::EngineCommand;
 pub use error::EngineError;
 pub use process::EngineSession;

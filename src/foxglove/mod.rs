@@ -35,10 +35,7 @@ mod writer;
 
 pub use convert::rotation_from_x;
 pub use messages::Quaternion;
-pub use schemas::{
-    LOG_SCHEMA, LOG_SCHEMA_JSON, SCENE_UPDATE_SCHEMA, SCENE_UPDATE_SCHEMA_JSON,
-    SWEEP_NUMBERS_SCHEMA, SWEEP_NUMBERS_SCHEMA_JSON,
-};
+pub use schemas::{LOG_SCHEMA_JSON, SCENE_UPDATE_SCHEMA_JSON, SWEEP_NUMBERS_SCHEMA_JSON};
 pub use writer::{
     FoxgloveCounts, FoxgloveError, FoxgloveFile, FoxgloveOptions, FoxgloveWriter, write_options,
 };

@@ -103,6 +103,7 @@ pub fn write_decision_line(
 
 /// The line of the `divergences` log: what was expected, what was found,
 /// which fields differ.
+#[cfg(feature = "viewer")]
 pub fn write_divergence_line(s: &mut String, r: &SweepResult, diffs: &[FieldDiff]) {
     let o = &r.outcome;
     let _ = write!(s, "frame {} ball {}: ", r.frame, r.ball);

@@ -47,9 +47,9 @@ mod report;
 mod repro;
 
 pub use bless::{BlessError, BlessSummary, bless_bytes, bless_file};
+pub(crate) use check::divergence_details;
 pub use check::{
-    CheckOptions, DEFAULT_MAX_DETAILS, check_events, check_events_judged, check_file, check_reader,
-    divergence_details, frames_around, judge_against_core,
+    CheckOptions, DEFAULT_MAX_DETAILS, check_events, check_file, check_reader, frames_around,
 };
 pub use compare::{
     DEFAULT_ALPHA_TOLERANCE, DEFAULT_CONTACT_TOLERANCE, DEFAULT_NORMAL_TOLERANCE_DEGREES, Field,
@@ -57,31 +57,28 @@ pub use compare::{
 };
 pub use config::excluded_by;
 pub use config::{
-    CONFIG_FILE_NAME, ConfigError, ConfigFile, Overrides, Setting, Settings, Source,
-    find_config_files, load_config_files, normalize, render_settings_json, render_settings_text,
-    resolve, settings_for,
+    ConfigError, ConfigFile, Overrides, Setting, Settings, Source, normalize, render_settings_json,
+    render_settings_text, resolve, settings_for,
 };
-pub use decision::{decision_line, divergence, write_decision_line, write_divergence_line};
+pub(crate) use decision::write_decision_line;
+#[cfg(feature = "viewer")]
+pub(crate) use decision::write_divergence_line;
+pub use decision::{decision_line, divergence};
 pub use diff::{
     DiffReport, FirstDifference, Side, diff, render_diff_json, render_diff_text, scene_differences,
 };
 pub use discovery::find_traces;
 pub use discovery::foxglove_output;
-pub use engine_check::{check_file_with_engine, judge_answer_against_expected};
-pub use explain::{ExpectedTest, expected_tests, explain_outcome, explained_records};
-pub use ghost_count::MAX_LISTED_GHOSTS;
-pub use infer::MAX_INFERENCE_SWEEPS;
-pub use infer::{ComparedSweep, Inferred, Spread, infer};
-pub use judge::{Agreement, Perturbation, Reproduced, agreement, agreement_of, perturbations};
-pub use junit::{check_junit, first_problem, github_annotations, github_data, github_property};
-pub use render::{
-    Sides, divergence_line, render_divergence, render_divergence_as, render_json, render_text,
-    sides_of, value_text, value_text_exact, values_text,
-};
+pub use engine_check::check_file_with_engine;
+pub use explain::ExpectedTest;
+pub(crate) use explain::{expected_tests, explain_outcome, explained_records};
+pub use infer::{Inferred, Spread};
+pub use judge::{Agreement, Perturbation, Reproduced, agreement, agreement_of};
+pub use junit::{check_junit, github_annotations};
+pub use render::{Sides, render_divergence, render_json, render_text};
+pub(crate) use render::{divergence_line, render_divergence_as, values_text};
 pub use report::{
-    Against, Divergence, EngineCheck, Judged, KindChange, MAX_LISTED_TUNNELS, Status, TraceReport,
+    Against, Divergence, EngineCheck, KindChange, MAX_LISTED_TUNNELS, Status, TraceReport,
     TunnelReport,
 };
-pub use repro::{
-    HexInputs, ReproCase, ReproError, SweepInputs, TraceSweep, agreement_text, find_sweep,
-};
+pub use repro::{HexInputs, ReproCase, ReproError, SweepInputs, TraceSweep, find_sweep};

@@ -257,7 +257,7 @@ impl GhostContact {
 
     /// The `ghost` field of a `replay --outcomes` line (see
     /// [`GhostLine`]).
-    pub fn line(&self) -> GhostLine<'_> {
+    pub(crate) fn line(&self) -> GhostLine<'_> {
         GhostLine(self)
     }
 }

@@ -33,9 +33,8 @@ mod summary;
 mod tunnel;
 
 pub use error::ReplayError;
-pub use ghost::{
-    GHOST_DEGREES, GhostContact, GhostJudgement, GhostLine, GhostPlace, ghost_point, judge_ghost,
-};
+pub use ghost::{GHOST_DEGREES, GhostContact, GhostJudgement, GhostPlace, judge_ghost};
+pub(crate) use ghost::{GhostLine, ghost_point};
 pub use iter::{
     DEFAULT_BATCH_EVENTS, ParallelReplayIter, ReplayIter, replay_events, replay_events_parallel,
 };
@@ -47,9 +46,7 @@ pub use pipeline::{
     run_pipeline_unrecorded,
 };
 pub use primary::{CollectPrimary, primary_records};
-pub use replayer::{
-    ComputedSweep, Replay, ReplayEvent, SceneState, SweepResult, compute_sweep, feature_class,
-};
+pub use replayer::{Replay, ReplayEvent, SceneState, SweepResult, feature_class};
 pub use selection::{Selection, SweepExtent};
-pub use summary::{LISTED_TUNNELS, ReplaySummary, TunnelAt};
-pub use tunnel::{Through, Tunnel, TunnelKind, TunnelScene, sweep_end, tunnel_during_sweep};
+pub use summary::{ReplaySummary, TunnelAt};
+pub use tunnel::{Through, Tunnel, TunnelKind};

@@ -47,7 +47,7 @@ impl SceneState {
 
     /// What a tunnel of a ball of `radius` is judged against: the mesh, its
     /// topology and `ρ = radius − margin`.
-    pub fn tunnel_scene(&self, radius: f64) -> TunnelScene<'_> {
+    pub(crate) fn tunnel_scene(&self, radius: f64) -> TunnelScene<'_> {
         TunnelScene {
             mesh: &self.mesh,
             topology: &self.topology,
@@ -330,7 +330,7 @@ impl Replay {
     /// against [`Replay::current_scene`], or `None` when the sweep is
     /// filtered out or comes before any scene): the same as
     /// [`Replay::sweep`] without the query. Used by [`super::replay_events_parallel`].
-    pub fn sweep_computed(
+    pub(crate) fn sweep_computed(
         &mut self,
         log_time_nanos: u64,
         index: u64,

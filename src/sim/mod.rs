@@ -35,12 +35,12 @@ use thiserror::Error;
 
 use crate::core::{Facing, Kind, Mesh, Options, Sweep, SweepError, SweepHit, sweep_mesh};
 use crate::numbers::{self, Rule};
-pub mod obj;
+mod obj;
 pub mod scenes;
 
 use crate::trace::{OutcomeMsg, SceneMsg, SweepMsg};
 pub use obj::{ObjError, load_obj, obj_from_reader, obj_instead_of_trace};
-pub use scenes::{BuiltinScene, SceneMesh};
+use scenes::SceneMesh;
 
 /// Largest number of simulation frames.
 pub const MAX_FRAMES: u64 = 100_000_000;

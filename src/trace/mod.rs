@@ -29,29 +29,18 @@ mod write;
 pub(crate) use cbor::Deserializer as CborDeserializer;
 pub use encoding::Encoding;
 pub use error::{MessageAt, TraceError};
-pub use info::{
-    MAX_LISTED_BALLS, MAX_LISTED_SCENES, SceneSummary, TraceInfo, collect_info, render_info_json,
-    render_info_text,
-};
+pub use info::{SceneSummary, TraceInfo, collect_info, render_info_json, render_info_text};
 pub use messages::{
     EXPECTED_TOPIC, OUTCOME_SCHEMA, OutcomeMsg, SCENE_SCHEMA, SCENE_TOPIC, SWEEP_SCHEMA,
     SWEEP_TOPIC, SceneMsg, SweepMsg,
 };
 pub use prefetch::{DEFAULT_PREFETCH_CHUNK, DEFAULT_PREFETCH_DEPTH, Prefetched, prefetch};
-pub use read::{
-    ChannelStats, MAX_RECORD_BYTES, MAX_SCENE_BYTES, MAX_SMALL_MESSAGE_BYTES, ReadLimits,
-    ReadStats, TraceEvent, TraceReader,
-};
+pub use read::{ChannelStats, ReadLimits, ReadStats, TraceEvent, TraceReader};
 pub(crate) use schemas::SCHEMA_ENCODING;
 pub use schemas::{OUTCOME_SCHEMA_JSON, SCENE_SCHEMA_JSON, SWEEP_SCHEMA_JSON};
-pub use source::{
-    EXPECTED_SOURCE_METADATA, ExpectedSource, MAX_SETTING_VALUE_BYTES, MAX_SETTINGS,
-    sweeptrace_source,
-};
-pub use validate::{
-    FieldProblem, frame_of_message, parse_message, parse_message_as, validate_outcome,
-    validate_scene, validate_sweep,
-};
+pub use source::{EXPECTED_SOURCE_METADATA, ExpectedSource, MAX_SETTINGS, sweeptrace_source};
+pub use validate::{FieldProblem, parse_message, validate_outcome, validate_scene, validate_sweep};
+pub(crate) use validate::{frame_of_message, parse_message_as};
 pub(crate) use write::library_string;
 pub use write::{
     PendingTrace, TraceWriter, default_write_options, write_trace_file,

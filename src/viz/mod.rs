@@ -44,14 +44,13 @@ use rerun::RecordingStreamBuilder;
 
 pub use ids::{IdHasher, recording_id};
 pub use logger::{
-    DEFAULT_FLUSH_BYTES, DEFAULT_FLUSH_ROWS, Logger, LoggerOptions, PREPARE_GROUP_SWEEPS,
-    PreparedSweeps, SPILL_FLUSH_BYTES, prepare_sweeps, prepare_sweeps_into,
+    DEFAULT_FLUSH_BYTES, DEFAULT_FLUSH_ROWS, Logger, LoggerOptions, PreparedSweeps,
+    SPILL_FLUSH_BYTES, prepare_sweeps,
 };
+pub(crate) use logger::{PREPARE_GROUP_SWEEPS, prepare_sweeps_into};
 pub use out::{PrepareOptions, Shown};
 pub use pipeline::LogError;
-pub use recording::{
-    FinishedRecording, Recording, RecordingError, RecordingTarget, VIEWER_FLUSH_TIMEOUT, Viewer,
-};
+pub use recording::{FinishedRecording, Recording, RecordingError, RecordingTarget, Viewer};
 pub use rerun::RecordingStreamError;
 pub use rrd_file::{RrdFileError, RrdFileOptions, RrdFileSink, RrdFileWriter, create_rrd_file};
 pub use spill::{MAX_CHUNK_BYTES, MAX_CHUNK_ROWS};

@@ -13,6 +13,6 @@ mod find;
 mod inputs;
 mod rust_test;
 
-pub use case::{ReproCase, agreement_text};
+pub use case::ReproCase;
 pub use find::{ReproError, TraceSweep, find_sweep};
 pub use inputs::{HexInputs, SweepInputs};

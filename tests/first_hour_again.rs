@@ -32,6 +32,7 @@ pub fn tests() -> Vec<Trial> {
         trial!(gitignore_covers_what_the_documented_commands_write),
         trial!(record_help_gives_the_defaults_and_says_where_the_ball_starts),
         trial!(spawn_notices_a_viewer_that_exits_at_once),
+        trial!(known_mistakes_are_named_in_words),
     ]
 }
 
@@ -919,4 +920,103 @@ fn spawn_notices_a_viewer_that_exits_at_once() -> anyhow::Result<Completion> {
     Ok(Completion::ignored_with(
         "skipped: the viewer's exit is looked for on Unix only",
     ))
+}
+
+/// An expectation whose α is what a known mistake gives on the test that
+/// decides the sweep is named as that mistake, in words: the radius
+/// forgotten (α = h0/|n·d|), the later root (a face's and an edge's), α
+/// measured from p1, a back-facing hit accepted (the two-sided rule); an
+/// α no mistake explains keeps the generic words. The expected result's
+/// test, when it is the primary test, is named, not described again.
+fn known_mistakes_are_named_in_words() -> anyhow::Result<()> {
+    use sweeptrace::trace::{OutcomeMsg, SweepMsg, TraceWriter};
+    let dir = tempfile::tempdir()?;
+    let scene = crate::support::scene_t(0.0);
+    let m = crate::support::mesh(&scene.vertices, &scene.triangles);
+    // Down onto the face: h0 = 2, n·d = -5, ρ = 0.5: α = 0.3; the radius
+    // ignored gives 0.4, the later root 0.5, α from p1 0.7.
+    let down = ([1.0, 1.0, 2.0], [1.0, 1.0, -3.0]);
+    // Up through it from below (back-facing): the two-sided rule gives 0.3.
+    let up = ([1.0, 1.0, -2.0], [1.0, 1.0, 3.0]);
+    // Onto edge 0 (README's example): its later root s1.
+    let edge = ([2.0, -0.3, 3.0], [2.0, -0.3, -3.0]);
+    let (_, records) =
+        crate::support::run(&m, edge.0, edge.1, 0.5, 0.0, sweeptrace::Facing::NonStrict);
+    let (_, s1) = crate::support::edge(&records, 0, 0)
+        .roots
+        .context("edge 0.0 has roots")?;
+    let cases: [(([f64; 3], [f64; 3]), f64, &str); 7] = [
+        (down, 0.4, "ρ = 0, the radius ignored: α = h0/|n·d|"),
+        (down, 0.5, "the later root s1 instead of s0"),
+        (down, 0.7, "α measured from p1 instead of p0"),
+        (up, 0.3, "the two-sided rule: a back-facing contact"),
+        (edge, s1, "the later root s1 instead of s0"),
+        (
+            down,
+            0.35,
+            "the same test with other numbers (a computation less precise",
+        ),
+        (down, 0.3, ""),
+    ];
+    let mut w = TraceWriter::new(std::io::Cursor::new(Vec::new()))?;
+    w.scene(0, &scene)?;
+    for (ball, ((p0, p1), alpha, _)) in cases.iter().enumerate() {
+        let sweep = SweepMsg {
+            frame: 0,
+            ball: ball as u32,
+            p0: *p0,
+            p1: *p1,
+            radius: 0.5,
+        };
+        let t = 1_000_000 * (ball as u64 + 1);
+        w.sweep(t, &sweep)?;
+        let hit = if *p0 == up.0 { down } else { (*p0, *p1) };
+        let o = sweeptrace::sweep_mesh(
+            &m,
+            &sweeptrace::Sweep::new(hit.0, hit.1, 0.5),
+            &Default::default(),
+        )?;
+        let mut e = OutcomeMsg::from_outcome(0, ball as u32, &o);
+        e.alpha = *alpha;
+        w.expected(t, &e)?;
+    }
+    std::fs::write(dir.path().join("m.mcap"), w.finish()?.into_inner())?;
+    for (ball, (_, _, words)) in cases.iter().enumerate() {
+        let b = ball.to_string();
+        let (code, out, err) = run(
+            dir.path(),
+            os![
+                "check",
+                "m.mcap",
+                "--ball",
+                &b,
+                "--fields",
+                "kind,triangle,feature,alpha"
+            ],
+        )?;
+        if words.is_empty() {
+            ensure!(code == 0, "ball {ball}: exit {code}\n{out}{err}");
+            continue;
+        }
+        ensure!(code == 1, "ball {ball}: exit {code}\n{out}{err}");
+        let why = out
+            .lines()
+            .find(|l| l.trim_start().starts_with("why not:"))
+            .with_context(|| format!("ball {ball}: no `why not`:\n{out}"))?;
+        ensure!(
+            why.contains(words),
+            "ball {ball}: `{why}` does not say `{words}`:\n{out}"
+        );
+        if words.contains("other numbers") {
+            ensure!(!why.contains("known mistake"), "ball {ball}: {why}");
+        }
+        if *words != "the two-sided rule: a back-facing contact" {
+            ensure!(
+                out.contains("expected result's test: the same test, ")
+                    && out.matches("in [0, 1]").count() == 1,
+                "ball {ball}: the primary test described twice:\n{out}"
+            );
+        }
+    }
+    Ok(())
 }

@@ -114,8 +114,8 @@ fn rule_case(rule: &RuleReport, classname: &str) -> Case {
                 "{} of {} {} {}; first failing case: {first}",
                 rule.failed,
                 rule.cases,
-                crate::numbers::plural(rule.cases as u64, "case"),
-                crate::numbers::verb(rule.failed as u64, "fails", "fail")
+                crate::numbers::plural(rule.cases, "case"),
+                crate::numbers::verb(rule.failed, "fails", "fail")
             ),
             kind: if rule
                 .first_failure

@@ -340,7 +340,13 @@ pub fn divergence_details(
         margin: result.options().margin,
         facing: result.options().facing,
         got_explanation: explain_outcome(&result.outcome, &records),
-        expected_tests: expected_tests(&expected, &result.outcome, &records, Some(&result.scene)),
+        expected_tests: expected_tests(
+            &expected,
+            &result.outcome,
+            &records,
+            Some(&result.scene),
+            result.sweep.radius - result.options().margin,
+        ),
     }
 }
 

@@ -119,6 +119,11 @@ impl Inferred {
                 num(s.median),
                 num(s.max)
             ),
+            (None, Some(s)) if self.face_hits == 1 => format!(
+                "no valid margin (the 1 expected face hit gives ε = {}: not 0 ≤ ε < r; the \
+                 scenes' margins kept)",
+                num(s.median)
+            ),
             (None, Some(s)) => format!(
                 "no valid margin (the {} expected face hits give ε from {} to {}, median {}: \
                  not 0 ≤ ε < r; the scenes' margins kept)",

@@ -42,6 +42,7 @@ mod ghost_count;
 mod infer;
 mod judge;
 mod junit;
+mod mistakes;
 mod render;
 mod report;
 mod repro;
@@ -75,6 +76,7 @@ pub(crate) use explain::{expected_tests, explain_outcome, explained_records};
 pub use infer::{Inferred, Spread};
 pub use judge::{Agreement, Perturbation, Reproduced, agreement, agreement_of};
 pub use junit::{check_junit, github_annotations};
+pub use mistakes::{KNOWN_MISTAKES, Mistake, known_mistake};
 pub use render::{Sides, render_divergence, render_json, render_text};
 pub(crate) use render::{divergence_line, render_divergence_as, values_text};
 pub use report::{

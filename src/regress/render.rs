@@ -176,7 +176,18 @@ pub fn render_divergence_as(d: &Divergence, indent: &str, sides: Sides) -> Strin
         );
     } else {
         for t in &d.expected_tests {
-            let _ = writeln!(s, "{indent}  {whose} test: {}", t.description);
+            // The test that decided the sweep, described just above: named,
+            // not described again.
+            let primary = format!("primary: {}", t.description);
+            if d.got_explanation.contains(&primary) {
+                let _ = writeln!(
+                    s,
+                    "{indent}  {whose} test: the same test, {} (the primary above)",
+                    t.test
+                );
+            } else {
+                let _ = writeln!(s, "{indent}  {whose} test: {}", t.description);
+            }
             let _ = writeln!(s, "{indent}    why not: {}", t.why_not);
         }
     }

@@ -945,7 +945,8 @@ fn known_mistakes_are_named_in_words() -> anyhow::Result<()> {
     let (_, s1) = crate::support::edge(&records, 0, 0)
         .roots
         .context("edge 0.0 has roots")?;
-    let cases: [(([f64; 3], [f64; 3]), f64, &str); 7] = [
+    type Path = ([f64; 3], [f64; 3]);
+    let cases: [(Path, f64, &str); 7] = [
         (down, 0.4, "ρ = 0, the radius ignored: α = h0/|n·d|"),
         (down, 0.5, "the later root s1 instead of s0"),
         (down, 0.7, "α measured from p1 instead of p0"),

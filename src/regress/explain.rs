@@ -22,7 +22,7 @@ pub struct ExpectedTest {
     /// Why it did not decide the sweep, in words.
     pub why_not: String,
     /// The known mistake whose α is the expected one on this test
-    /// ([`super::mistakes::KNOWN_MISTAKES`]'s name), if any; `why_not`
+    /// ([`super::KNOWN_MISTAKES`]'s name), if any; `why_not`
     /// says it in words.
     pub mistake: Option<&'static str>,
 }

@@ -144,7 +144,8 @@ pub fn settings_for(trace: &Path, command_line: &Overrides) -> Result<Settings, 
 }
 
 /// The `exclude` glob that leaves `trace` out of a search of a folder, and
-/// the configuration file that has it (as [`load_config_files`] names it):
+/// the configuration file that has it (named relative to the working
+/// directory when under it):
 /// the nearest file's globs first, then the farther ones'. Globs are
 /// relative to their file's folder.
 pub fn excluded_by(trace: &Path) -> Result<Option<(String, String)>, ConfigError> {

@@ -459,7 +459,9 @@ pub fn run(args: Args) -> Result<Counts, String> {
         options: sweeptrace::core::Options {
             margin: message.margin,
             facing: message.facing,
+            ..Default::default()
         },
+        normals: Default::default(),
     };
     let corners_of = |t: u32| {
         let triangle = trimesh_triangles.get(t as usize)?;

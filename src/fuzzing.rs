@@ -95,6 +95,7 @@ fn check_reading<R: std::io::Read>(mut reader: TraceReader<R>, input: &[u8]) -> 
                     let options = Options {
                         margin: *margin,
                         facing: *facing,
+                        ..Options::default()
                     };
                     let outcome = sweep_mesh(
                         mesh,
@@ -232,7 +233,11 @@ pub fn check_core(data: &[u8]) -> Result<(), String> {
     }
 
     let sweep = Sweep::new(p0, p1, radius);
-    let options = Options { margin, facing };
+    let options = Options {
+        margin,
+        facing,
+        ..Options::default()
+    };
     let path_is_measurable = (0..3)
         .map(|k| p1[k] - p0[k])
         .map(|d| d * d)

@@ -90,9 +90,9 @@ pub mod trace;
 pub mod viz;
 
 pub use crate::core::{
-    CollectRecords, Defect, DefectKind, EdgeClass, EdgeCounts, Facing, Feature, Kind, Mesh,
-    MeshError, NoObserver, Observer, Options, Outcome, Sweep, SweepError, SweepHit, Tie, Topology,
-    sweep_mesh, sweep_mesh_with, sweep_ties,
+    CollectRecords, Defect, DefectKind, EdgeClass, EdgeCounts, Facing, Feature, InitialOverlap,
+    Kind, Mesh, MeshError, NoObserver, Observer, Options, Outcome, Sweep, SweepError, SweepHit,
+    Tie, Topology, sweep_mesh, sweep_mesh_with, sweep_ties,
 };
 pub use crate::regress::{
     Agreement, CheckOptions, Status, Tolerances, TraceReport, agreement, check_file, check_reader,

@@ -71,6 +71,7 @@ fn every_case_decides_the_kind_of_its_rule() -> anyhow::Result<()> {
         let options = Options {
             margin: case.scene.margin,
             facing: case.scene.facing,
+            ..Options::default()
         };
         let s = &case.sweep;
         let outcome = sweep_mesh(&mesh, &Sweep::new(s.p0, s.p1, s.radius), &options)

@@ -35,6 +35,7 @@ pub(crate) fn options() -> Options {
     Options {
         margin: 0.0,
         facing: NS,
+        ..Options::default()
     }
 }
 
@@ -511,7 +512,11 @@ fn unflagged_decisions_survive_one_ulp_changes() -> anyhow::Result<()> {
             let (p0, p1, r) = aimed_sweep(&mut rng, &vertices, &triangles);
             (p0, p1, r, 0.0, Facing::NonStrict)
         };
-        let options = Options { margin, facing };
+        let options = Options {
+            margin,
+            facing,
+            ..Options::default()
+        };
         let o = sweep_mesh(m, &Sweep::new(p0, p1, radius), &options)?;
         let flagged = !o.fragile.is_robust();
         if flagged {

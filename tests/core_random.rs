@@ -177,6 +177,7 @@ fn run_core(case: &Case) -> anyhow::Result<(Mesh, Outcome)> {
     let options = Options {
         margin: case.margin,
         facing: case.facing,
+        ..Options::default()
     };
     let o = sweep_mesh(&mesh, &Sweep::new(case.p0, case.p1, case.radius), &options)?;
     Ok((mesh, o))
@@ -459,7 +460,11 @@ fn primary_collector_equals_collecting_every_record() -> anyhow::Result<()> {
         for _ in 0..800 {
             let (p0, p1, radius, margin, facing) = random_sweep(&mut rng, &vertices, &usable);
             let sweep = Sweep::new(p0, p1, radius);
-            let options = Options { margin, facing };
+            let options = Options {
+                margin,
+                facing,
+                ..Options::default()
+            };
             for broadphase in [Broadphase::Bvh, Broadphase::Exhaustive] {
                 let at = || format!("{p0:?} -> {p1:?} ({broadphase:?})");
                 let mut every = CollectRecords::default();
@@ -552,7 +557,11 @@ fn bvh_equals_exhaustive() -> anyhow::Result<()> {
         for _ in 0..2_000 {
             let (p0, p1, radius, margin, facing) = random_sweep(&mut rng, &vertices, &usable);
             let sweep = Sweep::new(p0, p1, radius);
-            let options = Options { margin, facing };
+            let options = Options {
+                margin,
+                facing,
+                ..Options::default()
+            };
             let fast = sweep_mesh(&mesh, &sweep, &options)?;
             let all = sweep_mesh_with(
                 &mesh,

@@ -78,6 +78,7 @@ pub(crate) fn trace(
     let options = Options {
         margin: scene.margin,
         facing: scene.facing,
+        ..Options::default()
     };
     let mut w = TraceWriter::new(Cursor::new(Vec::new()))?;
     w.scene(0, scene)?;

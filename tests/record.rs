@@ -157,6 +157,7 @@ fn expected_equals_sweep_mesh_rerun_on_recorded_sweeps() -> anyhow::Result<()> {
         let core = Options {
             margin: scene_msg.margin,
             facing: scene_msg.facing,
+            ..Options::default()
         };
         ensure!(!trace.sweeps.is_empty(), "{name}: no sweeps");
         ensure!(

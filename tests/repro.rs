@@ -267,6 +267,7 @@ fn check_generated_test(case: &ReproCase) -> anyhow::Result<()> {
     let options = sweeptrace::Options {
         margin,
         facing: case.inputs.facing,
+        ..sweeptrace::Options::default()
     };
     let outcome = sweep_mesh(&mesh, &Sweep::new(p0, p1, radius), &options)?;
     ensure!(

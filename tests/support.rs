@@ -255,7 +255,11 @@ pub fn run(
     let o = sweep_mesh_with(
         mesh,
         &Sweep::new(p0, p1, radius),
-        &Options { margin, facing },
+        &Options {
+            margin,
+            facing,
+            ..Options::default()
+        },
         Broadphase::Exhaustive,
         &mut obs,
     )
@@ -336,6 +340,7 @@ pub fn core_trace(
     let options = sweeptrace::Options {
         margin: scene.margin,
         facing: scene.facing,
+        ..Options::default()
     };
     let mut w = sweeptrace::trace::TraceWriter::new(std::io::Cursor::new(Vec::new()))?;
     w.scene(0, scene)?;

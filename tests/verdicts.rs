@@ -72,6 +72,7 @@ fn core_answers(
     let options = Options {
         margin: scene.margin,
         facing: scene.facing,
+        ..Options::default()
     };
     let s = Sweep::new(sweep.p0, sweep.p1, sweep.radius);
     let (outcome, ties) = sweep_ties(&mesh, &s, &options)?;
@@ -337,6 +338,7 @@ fn a_fragile_divergence_is_excused_only_by_a_named_perturbation() -> anyhow::Res
     let options = Options {
         margin: 0.0,
         facing: Facing::NonStrict,
+        ..Options::default()
     };
     let outcome = sweeptrace::core::sweep_mesh(&mesh, &moved, &options)?;
     ensure!(

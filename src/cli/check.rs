@@ -174,6 +174,16 @@ pub struct Args {
     pub ball: Option<u32>,
     #[command(flatten)]
     pub junit: super::junit::JunitArgs,
+    #[command(flatten)]
+    pub conventions: super::ConventionArgs,
+    /// With --engine: run the engine, then print only a `sweeptrace.toml`
+    /// whose `[engine]` table declares the conventions its answers imply,
+    /// each with its evidence in a comment (`check TRACES --engine CMD
+    /// --infer-config > suite/sweeptrace.toml`). Without --engine, infers
+    /// from the traces' own /expected (traces recorded from an engine).
+    /// Never makes a run pass by itself: check again with the file.
+    #[arg(long)]
+    pub infer_config: bool,
 }
 
 /// `--against`.
@@ -190,6 +200,7 @@ pub fn run(args: Args) -> anyhow::Result<Exit> {
     let overrides = sweeptrace::regress::Overrides {
         strict: args.strict,
         allow_tunnels: args.allow_tunnels,
+        engine: args.conventions.to_overrides(),
         ..args.tolerances.to_overrides()?
     };
     let found = find_traces(&args.paths).map_err(anyhow::Error::msg)?;

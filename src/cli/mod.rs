@@ -127,6 +127,7 @@ impl ToleranceArgs {
             fields: self
                 .field_set()
                 .unwrap_or(sweeptrace::regress::FieldSet::ALL),
+            ..sweeptrace::regress::Tolerances::default()
         };
         tolerances.validate().map_err(anyhow::Error::msg)?;
         Ok(tolerances)
@@ -147,6 +148,65 @@ impl ToleranceArgs {
 
     fn field_set(&self) -> Option<sweeptrace::regress::FieldSet> {
         (!self.fields.is_empty()).then(|| sweeptrace::regress::FieldSet::of(&self.fields))
+    }
+}
+
+/// The engine's conventions on the command line: the keys of
+/// `sweeptrace.toml`'s `[engine]` table, above the files (docs/ENGINES.md,
+/// "Conventions"). Each changes the reference answer or how an answer is
+/// judged; none is a tolerance.
+#[derive(clap::Args, Clone, Debug, Default)]
+pub struct ConventionArgs {
+    /// The engine's arithmetic: `f64` (fixed tolerances) or `f32` (each
+    /// difference judged by backward error: passes when the exact rules
+    /// give it for inputs moved by at most 16 u32 units of the sweep's
+    /// scale) [default: f64].
+    #[arg(long, value_name = "f64|f32", help_heading = "Engine conventions")]
+    pub precision: Option<sweeptrace::regress::Precision>,
+    /// The engine's margin: `scene` (each scene's) or a number it always
+    /// uses [default: scene].
+    #[arg(
+        long = "engine-margin",
+        value_name = "scene|NUMBER",
+        help_heading = "Engine conventions"
+    )]
+    pub margin: Option<sweeptrace::regress::MarginRule>,
+    /// The engine's facing rule: `scene`, `strict` or `non_strict`
+    /// [default: scene].
+    #[arg(
+        long = "engine-facing",
+        value_name = "RULE",
+        help_heading = "Engine conventions"
+    )]
+    pub facing: Option<sweeptrace::regress::FacingRule>,
+    /// A ball that starts within its radius of the mesh: `none` (the
+    /// rules: no collision) or `alpha0` (a hit at α = 0 with the nearest
+    /// feature) [default: none].
+    #[arg(long, value_name = "none|alpha0", help_heading = "Engine conventions")]
+    pub initial_overlap: Option<sweeptrace::InitialOverlap>,
+    /// The normal of a hit: `face` (the rules: the triangle's),
+    /// `contact` (centre minus contact, normalised, at edges and
+    /// vertices) or `active_edges` (the contact normal at active edges
+    /// only, as Jolt) [default: face].
+    #[arg(long, value_name = "RULE", help_heading = "Engine conventions")]
+    pub normal: Option<sweeptrace::replay::NormalRule>,
+    /// A tie: `rule` (the decision's α and normal) or `any` (any member
+    /// with its own contact and normal) [default: rule].
+    #[arg(long, value_name = "rule|any", help_heading = "Engine conventions")]
+    pub ties: Option<sweeptrace::regress::TieRule>,
+}
+
+impl ConventionArgs {
+    /// The conventions given, as the command line's layer.
+    pub fn to_overrides(&self) -> sweeptrace::regress::EngineOverrides {
+        sweeptrace::regress::EngineOverrides {
+            precision: self.precision,
+            margin: self.margin,
+            facing: self.facing,
+            initial_overlap: self.initial_overlap,
+            normal: self.normal,
+            ties: self.ties,
+        }
     }
 }
 

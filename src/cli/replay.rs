@@ -173,6 +173,7 @@ pub fn run(args: Args) -> anyhow::Result<Exit> {
         explain: (target.is_some() || args.foxglove.is_some()).then_some(args.detail),
         margin: args.margin,
         facing: args.facing,
+        ..ReplayOptions::default()
     };
     let mut outputs = Outputs::open(&args, target, &options)?;
     if args.threads == Some(0) {

@@ -118,6 +118,7 @@ pub fn run(args: Args) -> anyhow::Result<Exit> {
         let options = Options {
             margin: args.margin.unwrap_or(0.0),
             facing: args.facing.unwrap_or_default(),
+            ..Options::default()
         };
         (
             scene.name,

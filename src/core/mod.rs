@@ -25,6 +25,7 @@ mod error;
 pub(crate) mod explain;
 mod feature;
 mod fragility;
+mod initial;
 mod mesh;
 mod options;
 mod outcome;
@@ -46,10 +47,11 @@ pub use error::{MeshError, SweepError};
 pub use explain::{describe, miss_distance, num};
 pub use feature::{Feature, Kind};
 pub use fragility::{FragileReason, Fragility};
+pub use initial::initial_contacts;
 pub use mesh::{DegenerateReason, DegenerateTriangle, Mesh, StandardFrame, Triangle};
 pub use options::{
-    ALPHA_SENSITIVITY, DEGENERATE_TOLERANCE, FRAGILE_ULPS, Facing, GRAZING_COSINE, Options,
-    PARALLEL_TOLERANCE, TIE_WINDOW_ULPS,
+    ALPHA_SENSITIVITY, DEGENERATE_TOLERANCE, FRAGILE_ULPS, Facing, GRAZING_COSINE, InitialOverlap,
+    Options, PARALLEL_TOLERANCE, TIE_WINDOW_ULPS,
 };
 pub use outcome::{Outcome, SweepHit, Tie};
 pub use path::{Sweep, SweptPath};

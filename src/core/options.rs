@@ -56,6 +56,44 @@ impl std::str::FromStr for Facing {
     }
 }
 
+/// What a ball that starts within `ρ` of the mesh gets: an engine
+/// convention (docs/ENGINES.md, "Conventions").
+#[derive(
+    Clone,
+    Copy,
+    Debug,
+    Default,
+    PartialEq,
+    Eq,
+    Hash,
+    Serialize,
+    Deserialize,
+    strum::IntoStaticStr,
+    strum::Display,
+    strum::EnumString,
+    strum::VariantNames,
+)]
+#[serde(rename_all = "snake_case")]
+#[strum(serialize_all = "snake_case")]
+pub enum InitialOverlap {
+    /// The rules: no collision from the tests that start within `ρ` (a
+    /// later hit, if any, is the answer).
+    #[default]
+    None,
+    /// A hit at `α = 0` with the nearest feature of a triangle the facing
+    /// rule lets the path through, the contact at its nearest point (Jolt,
+    /// PhysX without `eASSUME_NO_INITIAL_OVERLAP`, parry with
+    /// `stop_at_penetration`).
+    Alpha0,
+}
+
+impl InitialOverlap {
+    /// Whether this is the rules' choice (the default).
+    pub fn is_rules(&self) -> bool {
+        *self == InitialOverlap::None
+    }
+}
+
 /// Options of the collision core.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct Options {
@@ -64,6 +102,10 @@ pub struct Options {
     pub margin: f64,
     /// The facing rule.
     pub facing: Facing,
+    /// What a ball that starts within `ρ` of the mesh gets (the rules: no
+    /// collision from those tests).
+    #[serde(default, skip_serializing_if = "InitialOverlap::is_rules")]
+    pub initial_overlap: InitialOverlap,
 }
 
 /// A path is *parallel* to a plane or an edge when the component of `d`

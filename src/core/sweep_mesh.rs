@@ -6,8 +6,9 @@ use nalgebra::{Point3, Vector3};
 use super::error::SweepError;
 use super::feature::{Feature, Kind};
 use super::fragility::{FragileReason, Fragility};
+use super::initial::initial_contact;
 use super::mesh::{Mesh, Triangle};
-use super::options::{ALPHA_SENSITIVITY, Facing, GRAZING_COSINE, Options};
+use super::options::{ALPHA_SENSITIVITY, Facing, GRAZING_COSINE, InitialOverlap, Options};
 use super::outcome::{Outcome, SweepHit, in_tie_window};
 use super::path::{Sweep, SweptPath};
 use super::record::{NoObserver, Observer, Skip, Verdict};
@@ -401,13 +402,22 @@ pub fn sweep_mesh_with<O: Observer>(
 ) -> Result<Outcome, SweepError> {
     let (lo, hi) = mesh.bounds();
     let path = SweptPath::new(sweep, options)?.with_mesh_scale(&lo, &hi);
-    Ok(sweep_path(
-        mesh,
-        &path,
-        options.facing,
-        broadphase,
-        observer,
-    ))
+    let outcome = sweep_path(mesh, &path, options.facing, broadphase, observer);
+    if options.initial_overlap == InitialOverlap::Alpha0
+        && let Some((hit, distance)) = initial_contact(mesh, &path, options.facing)
+    {
+        // The tests ran for the observer; the answer is the start's contact.
+        let mut fragile = Fragility::ROBUST;
+        if path.rho - distance <= path.fragile_distance() {
+            fragile.insert(FragileReason::StartTouching);
+        }
+        return Ok(Outcome {
+            hit: Some(hit),
+            tie_window: path.tie_window(),
+            fragile,
+        });
+    }
+    Ok(outcome)
 }
 
 /// Why the fast query may skip a triangle without testing it (`None`: it

@@ -21,6 +21,7 @@ use crate::replay::{ReplayError, ReplayEvent, ReplayOptions, SweepResult};
 use crate::trace::{EXPECTED_TOPIC, OutcomeMsg, TraceError, TraceEvent, TraceReader};
 
 use super::compare::{FieldDiff, Tolerances};
+use super::conventions::EngineConventions;
 use super::explain::{expected_tests, explain_outcome, explained_records};
 use super::ghost_count::count_ghosts;
 use super::infer::{ComparedSweep, MAX_INFERENCE_SWEEPS, infer};
@@ -176,6 +177,9 @@ where
         fragile_by_reason: BTreeMap::new(),
         fragile_divergences: Vec::new(),
         strict: options.strict,
+        precision_divergent: 0,
+        max_backward_error: 0.0,
+        conventions: EngineConventions::of(&options.tolerances, &options.replay),
         tunnels: 0,
         tunnels_by_kind: BTreeMap::new(),
         tunnel_details: Vec::new(),
@@ -241,25 +245,42 @@ where
                             .map(|h| h.triangle),
                     });
                 }
-                let (fields, fragile, reproduced) = match judged.agreement {
+                let (fields, fragile, reproduced, backward_error) = match judged.agreement {
                     Agreement::Match => continue,
                     Agreement::Tie => {
                         report.ties += 1;
                         continue;
                     }
+                    Agreement::Precision {
+                        fields,
+                        backward_error,
+                        reproduced,
+                    } => (
+                        fields,
+                        result.outcome.fragile,
+                        reproduced,
+                        Some(backward_error),
+                    ),
                     Agreement::Diverges {
                         fields,
                         fragile,
                         reproduced,
-                    } => (fields, fragile, reproduced),
+                    } => (fields, fragile, reproduced, None),
                 };
                 let got = judged.got;
                 let details = |fields| {
                     let mut d = divergence_details(&result, *expected, got, fields, options.hex);
                     d.reproduced = reproduced;
+                    d.backward_error = backward_error;
                     d
                 };
-                if reproduced.is_some() {
+                if let Some(error) = backward_error {
+                    report.precision_divergent += 1;
+                    report.max_backward_error = report.max_backward_error.max(error);
+                    if !options.strict {
+                        continue;
+                    }
+                } else if reproduced.is_some() {
                     report.fragile_divergent += 1;
                     for reason in fragile.iter() {
                         *report.fragile_by_reason.entry(reason).or_default() += 1;
@@ -337,6 +358,7 @@ pub fn divergence_details(
         fragile: result.outcome.fragile,
         reproduced: None,
         names_tie_member: false,
+        backward_error: None,
         margin: result.options().margin,
         facing: result.options().facing,
         got_explanation: explain_outcome(&result.outcome, &records),

@@ -10,6 +10,8 @@ use crate::core::explain::num;
 use crate::numbers::{self, Rule};
 use crate::trace::OutcomeMsg;
 
+use super::precision::Precision;
+
 /// Default absolute tolerance on `α` (a fraction of the path, unitless).
 pub const DEFAULT_ALPHA_TOLERANCE: f64 = 1e-6;
 /// Default angular tolerance on the normal, in **degrees**.
@@ -42,6 +44,52 @@ pub struct Tolerances {
     pub contact: f64,
     /// The fields compared (those the expectation holds among them).
     pub fields: FieldSet,
+    /// The arithmetic of the engine judged (`f64`: these tolerances as
+    /// they are; `f32`: widened per sweep to the backward-error bound,
+    /// [`super::Precision`]). Only in the JSON when not `f64`.
+    #[serde(skip_serializing_if = "Precision::is_f64")]
+    pub precision: Precision,
+    /// Which member of a tie an answer may name. Only in the JSON when not
+    /// `rule`.
+    #[serde(skip_serializing_if = "TieRule::is_rule")]
+    pub ties: TieRule,
+}
+
+/// Which member of a tie an answer may name: an engine convention (`ties`
+/// in `sweeptrace.toml`'s `[engine]` table).
+#[derive(
+    Clone,
+    Copy,
+    Debug,
+    Default,
+    PartialEq,
+    Eq,
+    Hash,
+    Serialize,
+    serde::Deserialize,
+    strum::IntoStaticStr,
+    strum::Display,
+    strum::EnumString,
+    strum::VariantNames,
+)]
+#[serde(rename_all = "snake_case")]
+#[strum(serialize_all = "snake_case")]
+pub enum TieRule {
+    /// Any member of the tie set, with the decision's `α` and normal (the
+    /// averaged normal under the rules) and the member's own contact:
+    /// `check` accepts it as a tie, `conform` asks for the tie order's.
+    #[default]
+    Rule,
+    /// Any member of the tie set with its own contact and its own normal
+    /// (an engine that keeps the first hit it meets, as most do).
+    Any,
+}
+
+impl TieRule {
+    /// Whether this is the default, `rule`.
+    pub fn is_rule(&self) -> bool {
+        *self == TieRule::Rule
+    }
 }
 
 impl Default for Tolerances {
@@ -51,6 +99,8 @@ impl Default for Tolerances {
             normal_degrees: DEFAULT_NORMAL_TOLERANCE_DEGREES,
             contact: DEFAULT_CONTACT_TOLERANCE,
             fields: FieldSet::ALL,
+            precision: Precision::F64,
+            ties: TieRule::Rule,
         }
     }
 }

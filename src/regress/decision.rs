@@ -24,7 +24,10 @@ pub fn divergence(r: &SweepResult, tolerances: &Tolerances) -> Vec<FieldDiff> {
             reproduced: None,
             ..
         } => fields,
-        Agreement::Diverges { .. } | Agreement::Match | Agreement::Tie => Vec::new(),
+        Agreement::Diverges { .. }
+        | Agreement::Precision { .. }
+        | Agreement::Match
+        | Agreement::Tie => Vec::new(),
     }
 }
 

@@ -228,6 +228,7 @@ fn count_matches(
                     let options = Options {
                         margin: margin.unwrap_or(c.scene.options.margin),
                         facing,
+                        ..c.scene.options
                     };
                     let replayed = Arc::new(SceneState {
                         options,

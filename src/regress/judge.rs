@@ -3,17 +3,21 @@
 
 use std::fmt;
 
+use nalgebra::Point3;
+
 use serde::Serialize;
 
 use crate::core::explain::num;
 use crate::core::{
-    Broadphase, EdgeRecord, FRAGILE_ULPS, FaceRecord, Feature, Fragility, Mesh, Observer, Options,
-    Outcome, Sweep, SweptPath, TestRecord, Tie, VertexRecord, sweep_mesh_with,
+    Broadphase, EdgeRecord, FRAGILE_ULPS, FaceRecord, Feature, Fragility, InitialOverlap, Mesh,
+    Observer, Options, Outcome, Sweep, SweepHit, SweptPath, TestRecord, Tie, VertexRecord,
+    initial_contacts, sweep_mesh_with,
 };
-use crate::replay::SweepResult;
+use crate::replay::{SceneState, SweepResult};
 use crate::trace::OutcomeMsg;
 
-use super::compare::{Field, FieldDiff, Tolerances, compare};
+use super::compare::{Field, FieldDiff, TieRule, Tolerances, compare};
+use super::precision::{F32_OPERATIONS, F32_UNIT, Precision, Sensitivity};
 
 /// How an answer stands against an expectation: the one judgement.
 #[derive(Clone, Debug, PartialEq)]
@@ -28,6 +32,22 @@ pub enum Agreement {
     /// a divergence (except in `conform`, where the cases are exact and the
     /// rule's choice is the only right answer).
     Tie,
+    /// Fields differ, by no more than single-precision arithmetic explains
+    /// (declared `precision = "f32"`): the continuous fields within their
+    /// backward-error bound ([`super::Sensitivity`]), and any other
+    /// difference given by the core under a perturbation of the inputs
+    /// within the same budget. Not a failure, except with `strict`.
+    Precision {
+        /// The fields that differ beyond the fixed tolerances.
+        fields: Vec<FieldDiff>,
+        /// The backward error, in units of `u₃₂ · S`: the smallest move of
+        /// the inputs that explains the difference (at most
+        /// [`F32_OPERATIONS`]).
+        backward_error: f64,
+        /// When a discrete field differs: the perturbation under which the
+        /// core gives each side's answer.
+        reproduced: Option<Reproduced>,
+    },
     /// Fields differ.
     Diverges {
         /// The fields that differ (when the expectation names a member of
@@ -47,7 +67,10 @@ pub enum Agreement {
 impl Agreement {
     /// Whether the sweep diverges (excused or not).
     pub fn is_divergent(&self) -> bool {
-        matches!(self, Agreement::Diverges { .. })
+        matches!(
+            self,
+            Agreement::Diverges { .. } | Agreement::Precision { .. }
+        )
     }
 
     /// Whether the sweep diverges only as rounding could have made it: a
@@ -58,7 +81,7 @@ impl Agreement {
             Agreement::Diverges {
                 reproduced: Some(_),
                 ..
-            }
+            } | Agreement::Precision { .. }
         )
     }
 
@@ -67,6 +90,7 @@ impl Agreement {
     pub fn fails(&self, strict: bool) -> bool {
         match self {
             Agreement::Diverges { reproduced, .. } => strict || reproduced.is_none(),
+            Agreement::Precision { .. } => strict,
             Agreement::Match | Agreement::Tie => false,
         }
     }
@@ -147,8 +171,13 @@ pub struct Reproduced {
     pub expected: Option<Perturbation>,
     /// The side compared with it (the core's outcome, or an engine's answer).
     pub got: Option<Perturbation>,
-    /// The sweep's rounding unit `u = ε · S`.
+    /// The sweep's rounding unit: `u = ε · S`, or `u₃₂ · S` at single
+    /// precision.
     pub rounding_unit: f64,
+    /// The arithmetic the rounding unit is of (only in the JSON when not
+    /// `f64`).
+    #[serde(skip_serializing_if = "Precision::is_f64")]
+    pub precision: Precision,
 }
 
 impl Reproduced {
@@ -168,11 +197,21 @@ impl Reproduced {
                 one(got, &self.got)
             ),
         };
-        s.push_str(&format!(
-            " (u = {}, the sweep's rounding unit)",
-            num(self.rounding_unit)
-        ));
+        let unit = match self.precision {
+            Precision::F64 => "the sweep's rounding unit",
+            Precision::F32 => "single precision's unit u₃₂ · S",
+        };
+        s.push_str(&format!(" (u = {}, {unit})", num(self.rounding_unit)));
         s
+    }
+
+    /// The larger of the two perturbations, in units of `u`.
+    pub fn units(&self) -> f64 {
+        [self.expected, self.got]
+            .iter()
+            .flatten()
+            .map(|p| p.units.abs())
+            .fold(0.0, f64::max)
     }
 }
 
@@ -185,10 +224,20 @@ const PERTURBED_INPUTS: [&str; 10] = [
     "p0.x", "p0.y", "p0.z", "p1.x", "p1.y", "p1.z", "path.x", "path.y", "path.z", "radius",
 ];
 
+/// The magnitudes of the perturbations at single precision, in units of
+/// `u₃₂ · S`: 1, 2, 4, 8 and [`F32_OPERATIONS`] (the backward-error budget).
+const F32_PERTURBATION_UNITS: [f64; 5] = [1.0, 2.0, 4.0, 8.0, F32_OPERATIONS];
+
 /// The perturbations of a sweep whose rounding unit is `u`, smallest first
 /// (each magnitude over every input, lower before higher).
+#[cfg(test)]
 pub fn perturbations(u: f64) -> impl Iterator<Item = Perturbation> {
-    PERTURBATION_UNITS.into_iter().flat_map(move |k| {
+    perturbations_of(u, &PERTURBATION_UNITS)
+}
+
+/// The perturbations by `units` times `u`, smallest first.
+fn perturbations_of(u: f64, units: &[f64]) -> impl Iterator<Item = Perturbation> + '_ {
+    units.iter().copied().flat_map(move |k| {
         PERTURBED_INPUTS.into_iter().flat_map(move |input| {
             [-k, k].into_iter().map(move |units| Perturbation {
                 input,
@@ -235,21 +284,64 @@ impl Observer for Hits {
     }
 }
 
-/// The core's decision on one sweep: its outcome and the hits that can be
-/// members of its tie set.
-struct Decision {
+/// The core's decision on one sweep under the scene's options and
+/// conventions: its outcome and the hits that can be members of its tie
+/// set.
+struct Decision<'a> {
+    scene: &'a SceneState,
+    sweep: Sweep,
     outcome: Outcome,
     hits: Vec<TestRecord>,
+    /// Under `initial_overlap = alpha0`, when the ball starts in contact:
+    /// every initial contact, all tied at `α = 0`.
+    initial: Vec<SweepHit>,
 }
 
-impl Decision {
-    fn of(mesh: &Mesh, sweep: &Sweep, options: &Options) -> Option<Decision> {
+impl<'a> Decision<'a> {
+    fn of(scene: &'a SceneState, sweep: &Sweep) -> Option<Decision<'a>> {
         let mut hits = Hits::default();
-        let outcome = sweep_mesh_with(mesh, sweep, options, Broadphase::Bvh, &mut hits).ok()?;
+        let outcome = sweep_mesh_with(
+            &scene.mesh,
+            sweep,
+            &scene.options,
+            Broadphase::Bvh,
+            &mut hits,
+        )
+        .ok()?;
+        let initial = if scene.options.initial_overlap == InitialOverlap::Alpha0
+            && outcome.hit.is_some_and(|h| h.alpha == 0.0)
+        {
+            let (lo, hi) = scene.mesh.bounds();
+            let path = SweptPath::new(sweep, &scene.options)
+                .ok()?
+                .with_mesh_scale(&lo, &hi);
+            initial_contacts(&scene.mesh, &path, scene.options.facing)
+                .into_iter()
+                .map(|(h, _)| h)
+                .collect()
+        } else {
+            Vec::new()
+        };
         Some(Decision {
-            outcome,
+            scene,
+            sweep: *sweep,
+            outcome: scene.normals.apply(sweep, outcome),
             hits: hits.0,
+            initial,
         })
+    }
+
+    /// The normal a tie member reports under [`TieRule::Any`]: its own
+    /// (its triangle's face normal, or its contact normal where the
+    /// scene's normal rule gives that).
+    fn member_normal(&self, tie: &Tie, contact: &Point3<f64>) -> Option<[f64; 3]> {
+        let face = self.scene.mesh.triangle_by_index(tie.triangle)?.normal;
+        let alpha = self.outcome.hit.map_or(tie.alpha, |h| h.alpha);
+        let n =
+            self.scene
+                .normals
+                .normal(&self.sweep, alpha, tie.triangle, tie.feature, contact, face);
+        Some([n.x, n.y, n.z])
     }
 
     /// `None` when the decision accepts `answer`: it matches the primary,
@@ -273,6 +365,33 @@ impl Decision {
             member.triangle = Some(Some(tie.triangle));
             member.feature = Some(tie.feature.index());
             member.contact = Some(r.contact().map(|c| [c.x, c.y, c.z]));
+            if tol.ties == TieRule::Any
+                && let Some(contact) = r.contact()
+            {
+                member.normal = Some(self.member_normal(&tie, &contact));
+            }
+            let d = compare(answer, &member, tol);
+            if d.is_empty() {
+                return None;
+            }
+            if names_tie(answer, &tie) {
+                named.get_or_insert(d);
+            }
+        }
+        for h in &self.initial {
+            let tie = Tie {
+                triangle: h.triangle,
+                feature: h.feature,
+                alpha: 0.0,
+            };
+            let mut member = primary;
+            member.kind = tie.kind();
+            member.triangle = Some(Some(tie.triangle));
+            member.feature = Some(tie.feature.index());
+            member.contact = Some(Some([h.contact.x, h.contact.y, h.contact.z]));
+            if tol.ties == TieRule::Any {
+                member.normal = Some(self.member_normal(&tie, &h.contact));
+            }
             let d = compare(answer, &member, tol);
             if d.is_empty() {
                 return None;
@@ -354,6 +473,23 @@ fn judge(
         return Agreement::Match;
     }
     let fragile = result.outcome.fragile;
+    // Single precision: the tolerances widened to this sweep's backward
+    // error bound (computed only here, for a sweep that differs).
+    let sensitivity = match tol.precision {
+        Precision::F64 => None,
+        Precision::F32 => Sensitivity::of(result),
+    };
+    let widened = sensitivity.map(|s| s.widen(tol, F32_OPERATIONS));
+    let tol_judged = widened.as_ref().unwrap_or(tol);
+    if let Some(s) = &sensitivity
+        && compare(expected, got, tol_judged).is_empty()
+    {
+        return Agreement::Precision {
+            backward_error: s.backward_error(&fields, expected, got),
+            fields,
+            reproduced: None,
+        };
+    }
     // Against the core's own outcome, a difference in α or the normal alone
     // cannot be another tie member (the members share the decision's α and
     // averaged normal): no need to run the core again, unless rounding may
@@ -361,21 +497,26 @@ fn judge(
     let values_only = fields
         .iter()
         .all(|f| matches!(f.field, Field::Alpha | Field::Normal));
-    if got_is_core && values_only && fragile.is_robust() {
+    if got_is_core
+        && values_only
+        && fragile.is_robust()
+        && tol.precision == Precision::F64
+        && tol.ties == TieRule::Rule
+    {
         return Agreement::Diverges {
             fields,
             fragile,
             reproduced: None,
         };
     }
-    let mesh = &result.scene.mesh;
-    let Some(decision) = Decision::of(mesh, &result.sweep, result.options()) else {
+    let Some(decision) = Decision::of(&result.scene, &result.sweep) else {
         return Agreement::Diverges {
             fields,
             fragile,
             reproduced: None,
         };
     };
+    let tol = tol_judged;
     let on_expected = decision.disagreement(expected, tol);
     let on_got = if got_is_core {
         None
@@ -391,6 +532,30 @@ fn judge(
         (true, Some(named)) => named.clone(),
         _ => fields,
     };
+    if tol.precision == Precision::F32 {
+        // Single precision: any decision is as fragile as f32's budget.
+        let reproduced = reproduce(
+            expected,
+            on_expected.is_some(),
+            got,
+            on_got.is_some(),
+            result,
+            tol,
+            Precision::F32,
+        );
+        return match reproduced {
+            Some(r) => Agreement::Precision {
+                backward_error: r.units(),
+                fields,
+                reproduced: Some(r),
+            },
+            None => Agreement::Diverges {
+                fields: beyond_f32_bound(expected, got, tol, fields),
+                fragile,
+                reproduced: None,
+            },
+        };
+    }
     let reproduced = if fragile.is_robust() {
         None
     } else {
@@ -401,6 +566,7 @@ fn judge(
             on_got.is_some(),
             result,
             tol,
+            Precision::F64,
         )
     };
     Agreement::Diverges {
@@ -408,6 +574,29 @@ fn judge(
         fragile,
         reproduced,
     }
+}
+
+/// The fields of a divergence at single precision: those beyond this
+/// sweep's backward-error bound (`widened`), each continuous one saying
+/// so; the fixed tolerances' `fields` when every difference is discrete.
+fn beyond_f32_bound(
+    expected: &OutcomeMsg,
+    got: &OutcomeMsg,
+    widened: &Tolerances,
+    fields: Vec<FieldDiff>,
+) -> Vec<FieldDiff> {
+    let mut beyond = compare(expected, got, widened);
+    if beyond.is_empty() {
+        return fields;
+    }
+    for f in &mut beyond {
+        if let Some(detail) = f.detail.as_mut()
+            && matches!(f.field, Field::Alpha | Field::Normal | Field::Contact)
+        {
+            detail.push_str(" (beyond the f32 backward-error bound of this sweep)");
+        }
+    }
+    beyond
 }
 
 /// The smallest perturbations under which the core gives `expected` (when
@@ -420,16 +609,21 @@ fn reproduce(
     got_open: bool,
     result: &SweepResult,
     tol: &Tolerances,
+    precision: Precision,
 ) -> Option<Reproduced> {
     let mesh = &result.scene.mesh;
     let u = rounding_unit(mesh, &result.sweep, result.options())?;
+    let (u, units): (f64, &[f64]) = match precision {
+        Precision::F64 => (u, &PERTURBATION_UNITS),
+        Precision::F32 => (u / f64::EPSILON * F32_UNIT, &F32_PERTURBATION_UNITS),
+    };
     let mut on_expected: Option<Option<Perturbation>> = (!expected_open).then_some(None);
     let mut on_got: Option<Option<Perturbation>> = (!got_open).then_some(None);
-    for p in perturbations(u) {
+    for p in perturbations_of(u, units) {
         if on_expected.is_some() && on_got.is_some() {
             break;
         }
-        let Some(decision) = Decision::of(mesh, &p.apply(&result.sweep), result.options()) else {
+        let Some(decision) = Decision::of(&result.scene, &p.apply(&result.sweep)) else {
             continue;
         };
         if on_expected.is_none() && decision.disagreement(expected, tol).is_none() {
@@ -443,6 +637,7 @@ fn reproduce(
         expected: on_expected?,
         got: on_got?,
         rounding_unit: u,
+        precision,
     })
 }
 

@@ -33,6 +33,7 @@ mod bless;
 mod check;
 mod compare;
 mod config;
+mod conventions;
 mod decision;
 mod diff;
 mod discovery;
@@ -43,6 +44,7 @@ mod infer;
 mod judge;
 mod junit;
 mod mistakes;
+mod precision;
 mod render;
 mod report;
 mod repro;
@@ -54,13 +56,14 @@ pub use check::{
 };
 pub use compare::{
     DEFAULT_ALPHA_TOLERANCE, DEFAULT_CONTACT_TOLERANCE, DEFAULT_NORMAL_TOLERANCE_DEGREES, Field,
-    FieldDiff, FieldSet, Tolerances, angle_degrees, compare,
+    FieldDiff, FieldSet, TieRule, Tolerances, angle_degrees, compare,
 };
 pub use config::excluded_by;
 pub use config::{
-    ConfigError, ConfigFile, Overrides, Setting, Settings, Source, normalize, render_settings_json,
-    render_settings_text, resolve, settings_for,
+    ConfigError, ConfigFile, EngineOverrides, EngineSettings, Overrides, Setting, Settings, Source,
+    normalize, render_settings_json, render_settings_text, resolve, settings_for,
 };
+pub use conventions::{EngineConventions, FacingRule, MarginRule};
 pub(crate) use decision::write_decision_line;
 #[cfg(feature = "viewer")]
 pub(crate) use decision::write_divergence_line;
@@ -77,6 +80,7 @@ pub use infer::{Inferred, Spread};
 pub use judge::{Agreement, Perturbation, Reproduced, agreement, agreement_of};
 pub use junit::{check_junit, github_annotations};
 pub use mistakes::{KNOWN_MISTAKES, Mistake, known_mistake};
+pub use precision::{F32_OPERATIONS, F32_UNIT, Precision, Sensitivity};
 pub use render::{Sides, render_divergence, render_json, render_text};
 pub(crate) use render::{divergence_line, render_divergence_as, values_text};
 pub use report::{

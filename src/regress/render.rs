@@ -280,6 +280,20 @@ pub fn render_text(r: &TraceReport) -> String {
             }
         );
     }
+    if r.precision_divergent > 0 {
+        let _ = write!(
+            counts,
+            ", {} within single precision (largest backward error {} u32 units of the \
+             sweep's scale){}",
+            crate::numbers::counted(r.precision_divergent, "difference", "differences"),
+            crate::core::num(r.max_backward_error),
+            if r.strict {
+                ", failures under --strict"
+            } else {
+                ", not failures without --strict"
+            }
+        );
+    }
     if r.tunnels > 0 && !r.fail_on_tunnel {
         let _ = write!(
             counts,
@@ -329,6 +343,15 @@ pub fn render_text(r: &TraceReport) -> String {
             );
         }
     };
+    let conventions_line = |s: &mut String| {
+        if !r.conventions.is_rules() {
+            let _ = writeln!(
+                s,
+                "  judged under the engine's declared conventions: {}",
+                r.conventions.summary()
+            );
+        }
+    };
     let fragile_details = |s: &mut String| {
         for d in &r.fragile_divergences {
             let _ = writeln!(
@@ -341,6 +364,7 @@ pub fn render_text(r: &TraceReport) -> String {
     match r.status() {
         Status::Ok => {
             let _ = writeln!(s, "ok {}: {counts}", r.trace);
+            conventions_line(&mut s);
             tunnel_lines(&mut s);
             fragile_details(&mut s);
         }
@@ -381,6 +405,7 @@ pub fn render_text(r: &TraceReport) -> String {
                 ));
             }
             let _ = writeln!(s, "FAIL {}: {}; {counts}", r.trace, failures.join("; "));
+            conventions_line(&mut s);
             tunnel_lines(&mut s);
             if r.divergences.is_empty()
                 && let Some(frame) = r.divergent_frames.first()

@@ -13,6 +13,7 @@ use crate::replay::{GhostContact, Tunnel, TunnelAt, TunnelKind};
 use crate::trace::OutcomeMsg;
 
 use super::compare::{FieldDiff, Tolerances};
+use super::conventions::EngineConventions;
 use super::explain::ExpectedTest;
 use super::infer::Inferred;
 use super::judge::Agreement;
@@ -77,6 +78,11 @@ pub struct Divergence {
     /// `conform`). Only in the JSON when true.
     #[serde(skip_serializing_if = "std::ops::Not::not")]
     pub names_tie_member: bool,
+    /// At single precision, when the difference is within what it
+    /// explains: its backward error, in units of `u₃₂ · S` (see
+    /// [`super::Sensitivity`]). Absent otherwise.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub backward_error: Option<f64>,
     /// The sweep's inputs, exactly (shortest round-trip decimals in the
     /// JSON): with them the core makes the same decision.
     pub inputs: SweepInputs,
@@ -245,6 +251,17 @@ pub struct TraceReport {
     pub fragile_divergences: Vec<Divergence>,
     /// Whether fragile divergences fail the check (`--strict`).
     pub strict: bool,
+    /// At single precision (`precision = "f32"`): sweeps whose answers
+    /// differ by no more than single-precision rounding explains
+    /// ([`super::Agreement::Precision`]). Failures only with `strict`,
+    /// where they are also counted in `divergent`. Only in the JSON at
+    /// `f32`.
+    pub precision_divergent: u64,
+    /// The largest backward error among them, in units of `u₃₂ · S`.
+    pub max_backward_error: f64,
+    /// The engine conventions the check judged by (the `[engine]` table;
+    /// only in the JSON when some are declared).
+    pub conventions: EngineConventions,
     /// Tunnels found: a ball's centre through a triangle, front to back,
     /// during a sweep or between two sweeps of the ball. They fail the
     /// check unless `fail_on_tunnel` is off.
@@ -368,6 +385,12 @@ impl Serialize for TraceReport {
             fragile_by_reason: &'a BTreeMap<FragileReason, u64>,
             fragile_divergences: &'a [Divergence],
             strict: bool,
+            #[serde(skip_serializing_if = "Option::is_none")]
+            precision_divergent: Option<u64>,
+            #[serde(skip_serializing_if = "Option::is_none")]
+            max_backward_error: Option<f64>,
+            #[serde(skip_serializing_if = "EngineConventions::is_rules")]
+            conventions: &'a EngineConventions,
             tunnels: u64,
             #[serde(serialize_with = "serialize_by_name")]
             tunnels_by_kind: &'a BTreeMap<TunnelKind, u64>,
@@ -408,6 +431,9 @@ impl Serialize for TraceReport {
             fragile_by_reason,
             fragile_divergences,
             strict,
+            precision_divergent,
+            max_backward_error,
+            conventions,
             tunnels,
             tunnels_by_kind,
             tunnel_details,
@@ -442,6 +468,9 @@ impl Serialize for TraceReport {
             fragile_by_reason,
             fragile_divergences,
             strict: *strict,
+            precision_divergent: (!tolerances.precision.is_f64()).then_some(*precision_divergent),
+            max_backward_error: (!tolerances.precision.is_f64()).then_some(*max_backward_error),
+            conventions,
             tunnels: *tunnels,
             tunnels_by_kind,
             tunnel_details,

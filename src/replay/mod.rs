@@ -38,7 +38,7 @@ pub(crate) use ghost::{GhostLine, ghost_point};
 pub use iter::{
     DEFAULT_BATCH_EVENTS, ParallelReplayIter, ReplayIter, replay_events, replay_events_parallel,
 };
-pub use options::{Detail, FrameRange, ReplayOptions};
+pub use options::{ACTIVE_EDGE_DEGREES, Detail, FrameRange, NormalRule, ReplayOptions};
 #[cfg(feature = "viewer")]
 pub(crate) use pipeline::sweep_of;
 pub use pipeline::{
@@ -46,7 +46,7 @@ pub use pipeline::{
     run_pipeline_unrecorded,
 };
 pub use primary::{CollectPrimary, primary_records};
-pub use replayer::{Replay, ReplayEvent, SceneState, SweepResult, feature_class};
+pub use replayer::{Replay, ReplayEvent, SceneNormals, SceneState, SweepResult, feature_class};
 pub use selection::{Selection, SweepExtent};
 pub use summary::{ReplaySummary, TunnelAt};
 pub use tunnel::{Through, Tunnel, TunnelKind};

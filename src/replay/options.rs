@@ -1,7 +1,7 @@
 //! What a caller chooses about a replay: which sweeps, how much is
 //! explained, and overrides of the scene's margin and facing rule.
 
-use crate::core::Facing;
+use crate::core::{Facing, InitialOverlap};
 
 /// How many test records each sweep keeps.
 #[derive(
@@ -160,7 +160,59 @@ pub struct ReplayOptions {
     pub margin: Option<f64>,
     /// Overrides every scene's facing rule.
     pub facing: Option<Facing>,
+    /// What a ball that starts within `ρ` gets (an engine convention; the
+    /// rules' by default).
+    pub initial_overlap: InitialOverlap,
+    /// Which normal a hit reports (an engine convention; the rules' face
+    /// normal by default).
+    pub normal: NormalRule,
 }
+
+/// Which normal a hit reports: an engine convention (docs/ENGINES.md,
+/// "Conventions"). The rules report the triangle's front normal, averaged
+/// over a tie; engines report the contact normal, the direction from the
+/// contact to the ball's centre, which differs at an edge or a vertex.
+#[derive(
+    Clone,
+    Copy,
+    Debug,
+    Default,
+    PartialEq,
+    Eq,
+    Hash,
+    serde::Serialize,
+    serde::Deserialize,
+    strum::IntoStaticStr,
+    strum::Display,
+    strum::EnumString,
+    strum::VariantNames,
+)]
+#[serde(rename_all = "snake_case")]
+#[strum(serialize_all = "snake_case")]
+pub enum NormalRule {
+    /// The rules: the front normal of the triangle hit, averaged over the
+    /// triangles tied with it.
+    #[default]
+    Face,
+    /// The contact normal at every edge and vertex hit (a face hit keeps
+    /// the face normal, which is its contact normal). On an internal flat
+    /// or concave place that is a ghost contact, and `check` still reports
+    /// it as one.
+    Contact,
+    /// The contact normal at an *active* edge or vertex, the face normal
+    /// elsewhere, as Jolt's meshes do: an edge is active when it is a
+    /// boundary or non-manifold edge, or a convex edge whose faces meet at
+    /// more than [`ACTIVE_EDGE_DEGREES`]; a vertex hit is active when
+    /// either edge of its triangle at the vertex is. An engine that
+    /// removes ghost contacts this way answers the face normal on internal
+    /// flat and concave places.
+    ActiveEdges,
+}
+
+/// The angle between two faces above which their shared convex edge is
+/// active ([`NormalRule::ActiveEdges`]): Jolt's default
+/// (`MeshShapeSettings::mActiveEdgeCosThresholdAngle` = cos 5°).
+pub const ACTIVE_EDGE_DEGREES: f64 = 5.0;
 
 impl ReplayOptions {
     /// An explicit, stable text of every option (`frames=10..20;ball=*;
@@ -169,7 +221,7 @@ impl ReplayOptions {
     /// is renamed or added with its default.
     pub fn stable_encoding(&self) -> String {
         let or_star = |v: Option<String>, none: &str| v.unwrap_or_else(|| none.to_string());
-        format!(
+        let mut text = format!(
             "frames={};ball={};detail={};explain={};margin={};facing={}",
             self.frames,
             or_star(self.ball.map(|b| b.to_string()), "*"),
@@ -177,7 +229,16 @@ impl ReplayOptions {
             u8::from(self.explain.is_some()),
             or_star(self.margin.map(|m| format!("{m:e}")), "scene"),
             or_star(self.facing.map(|f| f.to_string()), "scene"),
-        )
+        );
+        // The conventions only when declared, so that the ids of recordings
+        // under the rules stay what they were.
+        if !self.initial_overlap.is_rules() {
+            text.push_str(&format!(";initial_overlap={}", self.initial_overlap));
+        }
+        if self.normal != NormalRule::Face {
+            text.push_str(&format!(";normal={}", self.normal));
+        }
+        text
     }
 
     /// The frame and ball filters in words (`frames 100..200, ball 0`), or

@@ -202,6 +202,8 @@ impl SimOptions {
         Options {
             margin: self.margin,
             facing: self.facing,
+
+            ..Options::default()
         }
     }
 

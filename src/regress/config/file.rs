@@ -7,6 +7,7 @@ use serde::Deserialize;
 use toml::Spanned;
 
 use super::super::compare::{Field, FieldSet};
+use super::super::conventions::MarginRule;
 use super::normalize;
 use super::settings::{Layer, Setting, Settings, Source};
 use crate::numbers::{self, Rule};
@@ -48,8 +49,22 @@ struct RawFile {
     allow_tunnels: Option<Spanned<bool>>,
     tolerances: Option<RawTolerances>,
     exclude: Option<Spanned<Vec<Spanned<String>>>>,
+    engine: Option<RawEngine>,
     #[serde(default)]
     traces: Vec<RawBlock>,
+}
+
+/// `[engine]`: the engine's conventions (top level only: one engine per
+/// file). Every value a closed set of names, the margin also a number.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawEngine {
+    precision: Option<Spanned<String>>,
+    margin: Option<Spanned<toml::Value>>,
+    facing: Option<Spanned<String>>,
+    initial_overlap: Option<Spanned<String>>,
+    normal: Option<Spanned<String>>,
+    ties: Option<Spanned<String>>,
 }
 
 /// A `[[traces]]` block: a glob and the keys of the top level.
@@ -167,7 +182,64 @@ impl Places<'_> {
             allow_tunnels: allow_tunnels
                 .as_ref()
                 .map(|v| self.setting(v, *v.get_ref())),
+            ..Layer::default()
         })
+    }
+
+    /// `[engine]`'s keys into `layer`, each value checked against its set.
+    fn engine(&self, raw: &RawEngine, layer: &mut Layer) -> Result<(), ConfigError> {
+        fn named<T: std::str::FromStr + strum::VariantNames>(
+            places: &Places<'_>,
+            key: &str,
+            value: &Option<Spanned<String>>,
+        ) -> Result<Option<Setting<T>>, ConfigError> {
+            value
+                .as_ref()
+                .map(|v| {
+                    let parsed = v.get_ref().parse::<T>().map_err(|_| {
+                        places.error(
+                            v,
+                            format!(
+                                "`engine.{key}` is `{}`; it takes one of {}",
+                                v.get_ref(),
+                                T::VARIANTS
+                                    .iter()
+                                    .map(|n| format!("\"{n}\""))
+                                    .collect::<Vec<_>>()
+                                    .join(", ")
+                            ),
+                        )
+                    })?;
+                    Ok(places.setting(v, parsed))
+                })
+                .transpose()
+        }
+        layer.precision = named(self, "precision", &raw.precision)?;
+        layer.facing = named(self, "facing", &raw.facing)?;
+        layer.initial_overlap = named(self, "initial_overlap", &raw.initial_overlap)?;
+        layer.normal = named(self, "normal", &raw.normal)?;
+        layer.ties = named(self, "ties", &raw.ties)?;
+        layer.margin = raw
+            .margin
+            .as_ref()
+            .map(|v| {
+                let text = match v.get_ref() {
+                    toml::Value::String(s) => s.clone(),
+                    toml::Value::Integer(i) => i.to_string(),
+                    toml::Value::Float(f) => format!("{f:?}"),
+                    other => format!("a {}", other.type_str()),
+                };
+                text.parse::<MarginRule>()
+                    .map(|m| self.setting(v, m))
+                    .map_err(|e| {
+                        self.error(
+                            v,
+                            format!("`engine.margin` takes \"scene\" or a number ≥ 0: {e}"),
+                        )
+                    })
+            })
+            .transpose()?;
+        Ok(())
     }
 
     fn field_set(&self, list: &Spanned<Vec<Spanned<String>>>) -> Result<FieldSet, ConfigError> {
@@ -222,12 +294,15 @@ impl ConfigFile {
             at: e.span().map(|s| places.at(s.start)),
             message: toml_message(e.message()),
         })?;
-        let top = places.layer(
+        let mut top = places.layer(
             &raw.fields,
             &raw.strict,
             &raw.allow_tunnels,
             &raw.tolerances,
         )?;
+        if let Some(engine) = &raw.engine {
+            places.engine(engine, &mut top)?;
+        }
         let mut blocks = Vec::with_capacity(raw.traces.len());
         let glob = |key: &str, pattern: &Spanned<String>| {
             globset::GlobBuilder::new(pattern.get_ref())

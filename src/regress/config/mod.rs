@@ -51,7 +51,8 @@ use std::path::{Component, Path, PathBuf};
 pub use file::{ConfigError, ConfigFile};
 use settings::Layer;
 pub use settings::{
-    Overrides, Setting, Settings, Source, render_settings_json, render_settings_text,
+    EngineOverrides, EngineSettings, Overrides, Setting, Settings, Source, render_settings_json,
+    render_settings_text,
 };
 
 /// The name of a suite configuration file.

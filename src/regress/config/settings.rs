@@ -6,10 +6,15 @@ use std::fmt;
 use serde::Serialize;
 
 use super::super::check::CheckOptions;
+use super::super::compare::TieRule;
 use super::super::compare::{
     DEFAULT_ALPHA_TOLERANCE, DEFAULT_CONTACT_TOLERANCE, DEFAULT_NORMAL_TOLERANCE_DEGREES, FieldSet,
     Tolerances,
 };
+use super::super::conventions::{EngineConventions, FacingRule, MarginRule};
+use super::super::precision::Precision;
+use crate::core::InitialOverlap;
+use crate::replay::NormalRule;
 
 /// Where a resolved setting came from.
 #[derive(Clone, Debug, PartialEq, Eq, Serialize)]
@@ -73,6 +78,26 @@ pub struct Overrides {
     pub strict: Option<bool>,
     /// `--allow-tunnels`.
     pub allow_tunnels: Option<bool>,
+    /// The engine conventions given on the command line (`--precision`,
+    /// `--margin`, `--facing`, `--initial-overlap`, `--normal`, `--ties`).
+    pub engine: EngineOverrides,
+}
+
+/// The `[engine]` keys given on the command line (`None`: not given).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct EngineOverrides {
+    /// `--precision`.
+    pub precision: Option<Precision>,
+    /// `--margin`.
+    pub margin: Option<MarginRule>,
+    /// `--facing`.
+    pub facing: Option<FacingRule>,
+    /// `--initial-overlap`.
+    pub initial_overlap: Option<InitialOverlap>,
+    /// `--normal`.
+    pub normal: Option<NormalRule>,
+    /// `--ties`.
+    pub ties: Option<TieRule>,
 }
 
 /// The settings a trace is checked with, each with its [`Source`].
@@ -90,6 +115,68 @@ pub struct Settings {
     pub strict: Setting<bool>,
     /// Whether tunnels are listed without failing (`allow_tunnels`).
     pub allow_tunnels: Setting<bool>,
+    /// The engine's conventions (the `[engine]` table), key by key.
+    pub engine: EngineSettings,
+}
+
+/// The `[engine]` table's keys, each with its [`Source`] (docs/ENGINES.md,
+/// "Conventions").
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct EngineSettings {
+    /// `engine.precision`.
+    pub precision: Setting<Precision>,
+    /// `engine.margin`.
+    pub margin: Setting<MarginRule>,
+    /// `engine.facing`.
+    pub facing: Setting<FacingRule>,
+    /// `engine.initial_overlap`.
+    pub initial_overlap: Setting<InitialOverlap>,
+    /// `engine.normal`.
+    pub normal: Setting<NormalRule>,
+    /// `engine.ties`.
+    pub ties: Setting<TieRule>,
+}
+
+impl Default for EngineSettings {
+    fn default() -> Self {
+        let rules = EngineConventions::default();
+        EngineSettings {
+            precision: Setting::default_value(rules.precision),
+            margin: Setting::default_value(rules.margin),
+            facing: Setting::default_value(rules.facing),
+            initial_overlap: Setting::default_value(rules.initial_overlap),
+            normal: Setting::default_value(rules.normal),
+            ties: Setting::default_value(rules.ties),
+        }
+    }
+}
+
+impl EngineSettings {
+    /// Whether any key was set (by a file or the command line).
+    pub fn is_declared(&self) -> bool {
+        [
+            &self.precision.source,
+            &self.margin.source,
+            &self.facing.source,
+            &self.initial_overlap.source,
+            &self.normal.source,
+            &self.ties.source,
+        ]
+        .iter()
+        .any(|s| **s != Source::Default)
+    }
+
+    /// The conventions these settings declare.
+    pub fn conventions(&self) -> EngineConventions {
+        EngineConventions {
+            precision: self.precision.value,
+            margin: self.margin.value,
+            facing: self.facing.value,
+            initial_overlap: self.initial_overlap.value,
+            normal: self.normal.value,
+            ties: self.ties.value,
+        }
+    }
 }
 
 impl Default for Settings {
@@ -102,6 +189,7 @@ impl Default for Settings {
             fields: Setting::default_value(FieldSet::ALL),
             strict: Setting::default_value(false),
             allow_tunnels: Setting::default_value(false),
+            engine: EngineSettings::default(),
         }
     }
 }
@@ -114,15 +202,19 @@ impl Settings {
             normal_degrees: self.normal_degrees.value,
             contact: self.contact.value,
             fields: self.fields.value,
+            ..Tolerances::default()
         }
     }
 
-    /// `options` with these settings' tolerances, `strict` and tunnel rule.
+    /// `options` with these settings' tolerances, `strict`, tunnel rule
+    /// and engine conventions.
     pub fn check_options(&self, options: CheckOptions) -> CheckOptions {
+        let conventions = self.engine.conventions();
         CheckOptions {
-            tolerances: self.tolerances(),
+            tolerances: conventions.judge_with(self.tolerances()),
             strict: self.strict.value,
             fail_on_tunnel: !self.allow_tunnels.value,
+            replay: conventions.replay_with(options.replay),
             ..options
         }
     }
@@ -137,7 +229,7 @@ impl Settings {
             .map(|f| format!("\"{}\"", f.as_str()))
             .collect::<Vec<_>>()
             .join(", ");
-        vec![
+        let mut entries = vec![
             (
                 "tolerances.alpha",
                 number_text(self.alpha.value),
@@ -160,7 +252,44 @@ impl Settings {
                 self.allow_tunnels.value.to_string(),
                 &self.allow_tunnels.source,
             ),
-        ]
+        ];
+        // The `[engine]` keys only when one is declared: a suite of an
+        // engine that follows the rules reads as it always did.
+        if self.engine.is_declared() {
+            entries.extend([
+                (
+                    "engine.precision",
+                    format!("\"{}\"", self.engine.precision.value),
+                    &self.engine.precision.source,
+                ),
+                (
+                    "engine.margin",
+                    self.engine.conventions().margin_toml(),
+                    &self.engine.margin.source,
+                ),
+                (
+                    "engine.facing",
+                    format!("\"{}\"", self.engine.facing.value),
+                    &self.engine.facing.source,
+                ),
+                (
+                    "engine.initial_overlap",
+                    format!("\"{}\"", self.engine.initial_overlap.value),
+                    &self.engine.initial_overlap.source,
+                ),
+                (
+                    "engine.normal",
+                    format!("\"{}\"", self.engine.normal.value),
+                    &self.engine.normal.source,
+                ),
+                (
+                    "engine.ties",
+                    format!("\"{}\"", self.engine.ties.value),
+                    &self.engine.ties.source,
+                ),
+            ]);
+        }
+        entries
     }
 }
 
@@ -183,6 +312,12 @@ pub(super) struct Layer {
     pub(super) fields: Option<Setting<FieldSet>>,
     pub(super) strict: Option<Setting<bool>>,
     pub(super) allow_tunnels: Option<Setting<bool>>,
+    pub(super) precision: Option<Setting<Precision>>,
+    pub(super) margin: Option<Setting<MarginRule>>,
+    pub(super) facing: Option<Setting<FacingRule>>,
+    pub(super) initial_overlap: Option<Setting<InitialOverlap>>,
+    pub(super) normal: Option<Setting<NormalRule>>,
+    pub(super) ties: Option<Setting<TieRule>>,
 }
 
 impl Layer {
@@ -199,6 +334,12 @@ impl Layer {
         set(&mut settings.fields, &self.fields);
         set(&mut settings.strict, &self.strict);
         set(&mut settings.allow_tunnels, &self.allow_tunnels);
+        set(&mut settings.engine.precision, &self.precision);
+        set(&mut settings.engine.margin, &self.margin);
+        set(&mut settings.engine.facing, &self.facing);
+        set(&mut settings.engine.initial_overlap, &self.initial_overlap);
+        set(&mut settings.engine.normal, &self.normal);
+        set(&mut settings.engine.ties, &self.ties);
     }
 
     pub(super) fn of_command_line(o: &Overrides) -> Layer {
@@ -215,6 +356,12 @@ impl Layer {
             fields: given(o.fields),
             strict: given(o.strict),
             allow_tunnels: given(o.allow_tunnels),
+            precision: given(o.engine.precision),
+            margin: given(o.engine.margin),
+            facing: given(o.engine.facing),
+            initial_overlap: given(o.engine.initial_overlap),
+            normal: given(o.engine.normal),
+            ties: given(o.engine.ties),
         }
     }
 }
@@ -251,9 +398,7 @@ pub fn render_settings_json(traces: &[(String, Settings)]) -> String {
             let entry = |value: serde_json::Value, source: &Source| {
                 serde_json::json!({ "value": value, "source": source })
             };
-            serde_json::json!({
-                "trace": trace,
-                "settings": {
+            let mut settings = serde_json::json!({
                     "tolerances.alpha": entry(s.alpha.value.into(), &s.alpha.source),
                     "tolerances.normal_degrees":
                         entry(s.normal_degrees.value.into(), &s.normal_degrees.source),
@@ -261,8 +406,18 @@ pub fn render_settings_json(traces: &[(String, Settings)]) -> String {
                     "fields": entry(serde_json::json!(s.fields.value), &s.fields.source),
                     "strict": entry(s.strict.value.into(), &s.strict.source),
                     "allow_tunnels": entry(s.allow_tunnels.value.into(), &s.allow_tunnels.source),
-                },
-            })
+            });
+            if s.engine.is_declared()
+                && let Some(map) = settings.as_object_mut()
+            {
+                map.insert("engine.precision".to_string(), entry(serde_json::json!(s.engine.precision.value), &s.engine.precision.source));
+                map.insert("engine.margin".to_string(), entry(serde_json::json!(s.engine.margin.value), &s.engine.margin.source));
+                map.insert("engine.facing".to_string(), entry(serde_json::json!(s.engine.facing.value), &s.engine.facing.source));
+                map.insert("engine.initial_overlap".to_string(), entry(serde_json::json!(s.engine.initial_overlap.value), &s.engine.initial_overlap.source));
+                map.insert("engine.normal".to_string(), entry(serde_json::json!(s.engine.normal.value), &s.engine.normal.source));
+                map.insert("engine.ties".to_string(), entry(serde_json::json!(s.engine.ties.value), &s.engine.ties.source));
+            }
+            serde_json::json!({ "trace": trace, "settings": settings })
         })
         .collect();
     let mut text =

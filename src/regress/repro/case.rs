@@ -62,6 +62,19 @@ pub fn agreement_text(a: &Agreement) -> String {
     match a {
         Agreement::Match => "match".to_string(),
         Agreement::Tie => "tie (the expectation names another member of the tie set)".to_string(),
+        Agreement::Precision {
+            fields,
+            backward_error,
+            ..
+        } => format!(
+            "within single precision ({}; backward error {} u₃₂ · S)",
+            fields
+                .iter()
+                .map(|f| f.field.as_str())
+                .collect::<Vec<_>>()
+                .join(", "),
+            crate::core::num(*backward_error)
+        ),
         Agreement::Diverges {
             fields,
             fragile,
@@ -130,6 +143,7 @@ fn result_of(
             // Not built: the judgement of the sweep reads only the mesh.
             topology: crate::core::Topology::default(),
             options,
+            normals: Default::default(),
         }),
         sweep,
         outcome,

@@ -82,6 +82,8 @@ impl TraceSweep {
         Options {
             margin: self.scene.margin,
             facing: self.scene.facing,
+
+            ..Options::default()
         }
     }
 

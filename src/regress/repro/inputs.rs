@@ -57,6 +57,8 @@ impl SweepInputs {
         Options {
             margin: self.margin,
             facing: self.facing,
+
+            ..Options::default()
         }
     }
 

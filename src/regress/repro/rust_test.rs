@@ -138,7 +138,7 @@ impl ReproCase {
         };
         let _ = writeln!(
             s,
-            "    let options = Options {{ margin: {}, facing: Facing::{facing} }};",
+            "    let options = Options {{ margin: {}, facing: Facing::{facing}, ..Options::default() }};",
             f(self.inputs.margin)
         );
         let kind = match a.kind {

@@ -1,0 +1,302 @@
+//! An engine's conventions: where it departs from the rules of
+//! docs/SEMANTICS.md by design, declared in `sweeptrace.toml`'s `[engine]`
+//! table (or by `check`'s flags) so that a check judges the engine by what
+//! it means to compute.
+//!
+//! **A convention changes the reference answer, not the tolerance**: the
+//! margin, the facing rule, the initial overlap and the normal change what
+//! the core computes (the replay's options, [`ReplayOptions`]); the
+//! precision and the tie rule change how an answer is judged against it
+//! ([`Tolerances`]). A suite without the table is judged by the rules.
+//!
+//! Adding a convention: a closed enum of its values with the rules' value
+//! as the default (`strum` gives the names), a field here, its key in
+//! `config/file.rs` and `config/settings.rs`, its flag in `cli/check.rs`,
+//! its effect in [`EngineConventions::apply`], its evidence in
+//! `infer_conventions.rs`, the conform rules it replaces in
+//! [`EngineConventions::replaces`], and a line in docs/ENGINES.md.
+
+use std::fmt;
+
+use serde::Serialize;
+
+use crate::core::{Facing, InitialOverlap};
+use crate::replay::{NormalRule, ReplayOptions};
+
+use super::compare::{TieRule, Tolerances};
+use super::precision::Precision;
+
+/// The margin an engine uses: the scene's (the rules) or always the same.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub enum MarginRule {
+    /// The margin each scene declares.
+    #[default]
+    Scene,
+    /// This margin for every scene (Jolt, Rapier: 0).
+    Fixed(f64),
+}
+
+impl fmt::Display for MarginRule {
+    /// `scene`, or the number as TOML writes it.
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            MarginRule::Scene => f.write_str("scene"),
+            MarginRule::Fixed(m) => write!(f, "{m:?}"),
+        }
+    }
+}
+
+impl std::str::FromStr for MarginRule {
+    type Err = String;
+    /// `scene`, or a finite number `≥ 0`.
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        if s == "scene" {
+            return Ok(MarginRule::Scene);
+        }
+        let m = crate::numbers::parse_f64(s)
+            .ok_or_else(|| format!("`{s}` is neither `scene` nor a number"))?;
+        crate::numbers::check(m, crate::numbers::Rule::NonNegative)?;
+        Ok(MarginRule::Fixed(m))
+    }
+}
+
+impl Serialize for MarginRule {
+    fn serialize<S: serde::Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        match self {
+            MarginRule::Scene => serializer.serialize_str("scene"),
+            MarginRule::Fixed(m) => serializer.serialize_f64(*m),
+        }
+    }
+}
+
+/// The facing rule an engine uses: the scene's (the rules) or always one.
+#[derive(
+    Clone,
+    Copy,
+    Debug,
+    Default,
+    PartialEq,
+    Eq,
+    Serialize,
+    strum::IntoStaticStr,
+    strum::Display,
+    strum::EnumString,
+    strum::VariantNames,
+)]
+#[serde(rename_all = "snake_case")]
+#[strum(serialize_all = "snake_case")]
+pub enum FacingRule {
+    /// The rule each scene declares.
+    #[default]
+    Scene,
+    /// `n · d < 0` for every scene.
+    Strict,
+    /// `n · d ≤ 0` for every scene (Jolt: a face is a back face only when
+    /// `n · d > 0`).
+    NonStrict,
+}
+
+impl FacingRule {
+    /// The facing rule it imposes, if any.
+    pub fn facing(self) -> Option<Facing> {
+        match self {
+            FacingRule::Scene => None,
+            FacingRule::Strict => Some(Facing::Strict),
+            FacingRule::NonStrict => Some(Facing::NonStrict),
+        }
+    }
+}
+
+/// What an engine does where it departs from the rules: every key of the
+/// `[engine]` table. The default is the rules.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
+pub struct EngineConventions {
+    /// The arithmetic it computes in.
+    pub precision: Precision,
+    /// Its margin.
+    pub margin: MarginRule,
+    /// Its facing rule.
+    pub facing: FacingRule,
+    /// What a ball that starts within `ρ` gets.
+    pub initial_overlap: InitialOverlap,
+    /// The normal it reports.
+    pub normal: NormalRule,
+    /// Which member of a tie it may name.
+    pub ties: TieRule,
+}
+
+impl EngineConventions {
+    /// Whether these are the rules (no convention declared).
+    pub fn is_rules(&self) -> bool {
+        *self == EngineConventions::default()
+    }
+
+    /// The conventions a check with `tolerances` and `replay` judges by.
+    pub fn of(tolerances: &Tolerances, replay: &ReplayOptions) -> EngineConventions {
+        EngineConventions {
+            precision: tolerances.precision,
+            margin: replay.margin.map_or(MarginRule::Scene, MarginRule::Fixed),
+            facing: match replay.facing {
+                None => FacingRule::Scene,
+                Some(Facing::Strict) => FacingRule::Strict,
+                Some(Facing::NonStrict) => FacingRule::NonStrict,
+            },
+            initial_overlap: replay.initial_overlap,
+            normal: replay.normal,
+            ties: tolerances.ties,
+        }
+    }
+
+    /// `tolerances` judged under these conventions (the precision and the
+    /// tie rule).
+    pub fn judge_with(&self, tolerances: Tolerances) -> Tolerances {
+        Tolerances {
+            precision: self.precision,
+            ties: self.ties,
+            ..tolerances
+        }
+    }
+
+    /// `replay` computing the reference answer under these conventions
+    /// (margin, facing, initial overlap, normal).
+    pub fn replay_with(&self, replay: ReplayOptions) -> ReplayOptions {
+        ReplayOptions {
+            margin: match self.margin {
+                MarginRule::Scene => replay.margin,
+                MarginRule::Fixed(m) => Some(m),
+            },
+            facing: self.facing.facing().or(replay.facing),
+            initial_overlap: self.initial_overlap,
+            normal: self.normal,
+            ..replay
+        }
+    }
+
+    /// The conventions that differ from the rules, as `key = value` pairs
+    /// in the table's words.
+    pub fn declared(&self) -> Vec<(&'static str, String)> {
+        let rules = EngineConventions::default();
+        let mut out = Vec::new();
+        if self.precision != rules.precision {
+            out.push(("precision", format!("\"{}\"", self.precision)));
+        }
+        if self.margin != rules.margin {
+            out.push(("margin", self.margin_toml()));
+        }
+        if self.facing != rules.facing {
+            out.push(("facing", format!("\"{}\"", self.facing)));
+        }
+        if self.initial_overlap != rules.initial_overlap {
+            out.push(("initial_overlap", format!("\"{}\"", self.initial_overlap)));
+        }
+        if self.normal != rules.normal {
+            out.push(("normal", format!("\"{}\"", self.normal)));
+        }
+        if self.ties != rules.ties {
+            out.push(("ties", format!("\"{}\"", self.ties)));
+        }
+        out
+    }
+
+    /// The margin as TOML writes it (`"scene"` or a number).
+    pub fn margin_toml(&self) -> String {
+        match self.margin {
+            MarginRule::Scene => "\"scene\"".to_string(),
+            MarginRule::Fixed(m) => format!("{m:?}"),
+        }
+    }
+
+    /// In words, for reports: `precision f32, margin 0, normal
+    /// active_edges`; `the rules` when none is declared.
+    pub fn summary(&self) -> String {
+        let declared = self.declared();
+        if declared.is_empty() {
+            return "the rules".to_string();
+        }
+        declared
+            .iter()
+            .map(|(k, v)| format!("{k} {}", v.trim_matches('"')))
+            .collect::<Vec<_>>()
+            .join(", ")
+    }
+
+    /// Why the conformance rule `rule` (a name of `conform`'s rule list)
+    /// does not apply to an engine with these conventions, if it does not:
+    /// the convention that replaces it (`the engine declares margin = 0`).
+    pub fn replaces(&self, rule: &str) -> Option<String> {
+        let declares =
+            |key: &str, value: String| Some(format!("the engine declares {key} = {value}"));
+        let rule = rule.split('/').next().unwrap_or(rule);
+        let group = rule.split('.').next().unwrap_or(rule);
+        match (group, rule) {
+            ("margin", _) if self.margin != MarginRule::Scene => {
+                declares("margin", self.margin.to_string())
+            }
+            // A declared facing rule replaces the scene's other one.
+            (_, "facing.strict") if self.facing == FacingRule::NonStrict => {
+                declares("facing", self.facing.to_string())
+            }
+            (_, "facing.non-strict") if self.facing == FacingRule::Strict => {
+                declares("facing", self.facing.to_string())
+            }
+            (_, "start.inside") if self.initial_overlap != InitialOverlap::None => {
+                declares("initial_overlap", self.initial_overlap.to_string())
+            }
+            ("tie", _) if self.ties != TieRule::Rule => declares("ties", self.ties.to_string()),
+            _ => None,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_default_is_the_rules_and_changes_nothing() {
+        let c = EngineConventions::default();
+        assert!(c.is_rules());
+        assert!(c.declared().is_empty());
+        assert_eq!(c.summary(), "the rules");
+        let replay = ReplayOptions::default();
+        assert_eq!(c.replay_with(replay), replay);
+        assert_eq!(c.judge_with(Tolerances::default()), Tolerances::default());
+    }
+
+    #[test]
+    fn each_convention_lands_where_it_acts() {
+        let c = EngineConventions {
+            precision: Precision::F32,
+            margin: MarginRule::Fixed(0.0),
+            facing: FacingRule::NonStrict,
+            initial_overlap: InitialOverlap::Alpha0,
+            normal: NormalRule::ActiveEdges,
+            ties: TieRule::Any,
+        };
+        let replay = c.replay_with(ReplayOptions::default());
+        assert_eq!(replay.margin, Some(0.0));
+        assert_eq!(replay.facing, Some(Facing::NonStrict));
+        assert_eq!(replay.initial_overlap, InitialOverlap::Alpha0);
+        assert_eq!(replay.normal, NormalRule::ActiveEdges);
+        let tol = c.judge_with(Tolerances::default());
+        assert_eq!((tol.precision, tol.ties), (Precision::F32, TieRule::Any));
+        assert_eq!(
+            c.summary(),
+            "precision f32, margin 0.0, facing non_strict, initial_overlap alpha0, normal \
+             active_edges, ties any"
+        );
+        assert_eq!(
+            c.replaces("margin.inside-band/0").as_deref(),
+            Some("the engine declares margin = 0.0")
+        );
+        assert_eq!(c.replaces("edge.basic/0"), None);
+    }
+
+    #[test]
+    fn margins_parse_as_scene_or_a_number() {
+        assert_eq!("scene".parse::<MarginRule>(), Ok(MarginRule::Scene));
+        assert_eq!("0".parse::<MarginRule>(), Ok(MarginRule::Fixed(0.0)));
+        assert!("-1".parse::<MarginRule>().is_err());
+        assert!("some".parse::<MarginRule>().is_err());
+    }
+}

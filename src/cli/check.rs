@@ -248,6 +248,51 @@ pub fn run(args: Args) -> anyhow::Result<Exit> {
             engine_options(args.engine_timeout)?,
         )),
     };
+    if args.infer_config {
+        let source = match &engine {
+            Some((command, _)) => format!("the engine `{}`", command.text),
+            None => "the traces' /expected".to_string(),
+        };
+        let inferred = sweeptrace::regress::infer_conventions(|conventions| {
+            let reports: Vec<TraceReport> = traces
+                .iter()
+                .zip(&settings)
+                .map(|(path, settings)| {
+                    let base = settings.check_options(options);
+                    let options = CheckOptions {
+                        tolerances: conventions.judge_with(base.tolerances),
+                        replay: conventions.replay_with(options.replay),
+                        ..base
+                    };
+                    match &engine {
+                        None => check_file(path, &options),
+                        Some((command, engine_options)) => check_file_with_engine(
+                            path,
+                            command,
+                            *engine_options,
+                            Against::Core,
+                            &options,
+                        )
+                        .unwrap_or_else(|err| {
+                            let mut r = check_file(path, &options);
+                            r.add_error(err.to_string());
+                            r
+                        }),
+                    }
+                })
+                .collect();
+            let trial = sweeptrace::regress::Trial::of(&reports);
+            eprintln!(
+                "tried {}: {} of {} compared sweeps fail",
+                conventions.summary(),
+                trial.failing,
+                trial.compared
+            );
+            trial
+        });
+        print!("{}", inferred.to_toml(&source));
+        return Ok(Exit::Success);
+    }
     let junit = args.junit.start()?;
     let (mut reports, mut times): (Vec<TraceReport>, Vec<_>) = (Vec::new(), Vec::new());
     let mut rrd_error = false;

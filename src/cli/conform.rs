@@ -73,6 +73,38 @@ pub struct Args {
     pub json: bool,
     #[command(flatten)]
     pub junit: super::junit::JunitArgs,
+    #[command(flatten)]
+    pub conventions: super::ConventionArgs,
+    /// The engine's conventions from this `sweeptrace.toml` (its `[engine]`
+    /// table) instead of the nearest one from the current directory up.
+    #[arg(long, value_name = "FILE", conflicts_with = "no_config")]
+    pub config: Option<std::path::PathBuf>,
+    /// Judge by the rules and the flags only: read no `sweeptrace.toml`.
+    #[arg(long)]
+    pub no_config: bool,
+}
+
+/// The engine's conventions for `conform`: the `[engine]` table of
+/// `--config FILE`, or of the nearest `sweeptrace.toml` from the current
+/// directory up (none with `--no-config`), under the flags.
+fn conventions(args: &Args) -> anyhow::Result<sweeptrace::regress::EngineConventions> {
+    use sweeptrace::regress::{ConfigFile, Overrides, resolve, settings_for};
+    let overrides = Overrides {
+        engine: args.conventions.to_overrides(),
+        ..Overrides::default()
+    };
+    let here = std::env::current_dir()
+        .context("finding the current directory")?
+        .join("conform");
+    let settings = if args.no_config {
+        resolve(&[], &here, &overrides)
+    } else if let Some(path) = &args.config {
+        let file = ConfigFile::read(path, &path.display().to_string())?;
+        resolve(&[file], &here, &overrides)
+    } else {
+        settings_for(&here, &overrides)?
+    };
+    Ok(settings.engine.conventions())
 }
 
 /// Runs the suite, prints the report, returns the exit code.
@@ -126,6 +158,7 @@ pub fn run(args: Args) -> anyhow::Result<Exit> {
         tolerances: args.tolerances.to_tolerances()?,
         strict: !args.lenient,
         only: args.case.clone(),
+        conventions: conventions(&args)?,
     };
     let junit = args.junit.start()?;
     let report = match conform::run(&command, engine, &cases, &options) {

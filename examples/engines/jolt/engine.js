@@ -1,0 +1,176 @@
+#!/usr/bin/env node
+// Jolt Physics (npm `jolt-physics` 1.1.0 = Jolt 5.6.0, WebAssembly, single
+// precision) as a sweeptrace engine (docs/ENGINE_PROTOCOL.md): each sweep is
+// answered by Jolt's own NarrowPhaseQuery::CastShape of a SphereShape (the
+// ball's radius) against a static MeshShape built from the scene's mesh, with
+// Jolt's defaults (EBackFaceMode::IgnoreBackFaces, no margin, active edges).
+//
+//   npm ci --prefix examples/engines/jolt
+//   sweeptrace check traces/ --engine "node examples/engines/jolt/engine.js"
+//
+// A deliberate mistake for sweeptrace to find: JOLT_VARIANT=NAME in the
+// environment or `--variant NAME` (see VARIANTS and README.md).
+// `--honour-margin` (or JOLT_HONOUR_MARGIN=1), for measurements only: cast a
+// sphere of radius r - margin (the rules' rho) instead of Jolt's r.
+import initJolt from 'jolt-physics';
+import { createInterface } from 'node:readline';
+
+const VARIANTS = ['clean', 'late', 'no_vertex', 'next_triangle', 'back_faces', 'centre_contact', 'flipped_edge_normal'];
+const flag = process.argv.indexOf('--variant');
+const variant = (flag >= 0 ? process.argv[flag + 1] : process.env.JOLT_VARIANT) || 'clean';
+if (!VARIANTS.includes(variant)) fail(`unknown variant \`${variant}\` (one of ${VARIANTS.join(', ')})`);
+const honourMargin = process.argv.includes('--honour-margin') || process.env.JOLT_HONOUR_MARGIN === '1';
+
+// A barycentric weight at most this counts as 0 when the contact point is
+// classified (face / edge / vertex). It is relative to the triangle (a
+// fraction of the altitude) and the same 1e-4 as Jolt's ActiveEdges::FixNormal.
+const BARY_EPS = 1e-4;
+
+function fail(message) {
+  process.stderr.write(`jolt engine: ${message}\n`);
+  process.exit(2);
+}
+
+const Jolt = await initJolt();
+const NON_MOVING = 0, MOVING = 1; // object layers: the mesh, the query
+
+// A physics system with one broad phase layer per object layer (Jolt's examples).
+const settings = new Jolt.JoltSettings();
+const pairs = new Jolt.ObjectLayerPairFilterTable(2);
+pairs.EnableCollision(NON_MOVING, MOVING);
+pairs.EnableCollision(MOVING, MOVING);
+const layers = new Jolt.BroadPhaseLayerInterfaceTable(2, 2);
+layers.MapObjectToBroadPhaseLayer(NON_MOVING, new Jolt.BroadPhaseLayer(0));
+layers.MapObjectToBroadPhaseLayer(MOVING, new Jolt.BroadPhaseLayer(1));
+settings.mObjectLayerPairFilter = pairs;
+settings.mBroadPhaseLayerInterface = layers;
+settings.mObjectVsBroadPhaseLayerFilter = new Jolt.ObjectVsBroadPhaseLayerFilterTable(layers, 2, pairs, 2);
+const system = new Jolt.JoltInterface(settings).GetPhysicsSystem();
+const bodies = system.GetBodyInterface();
+const query = system.GetNarrowPhaseQuery();
+
+// Query filters for a moving-layer shape cast, and Jolt's default cast settings.
+const bpFilter = new Jolt.DefaultBroadPhaseLayerFilter(settings.mObjectVsBroadPhaseLayerFilter, MOVING);
+const objFilter = new Jolt.DefaultObjectLayerFilter(pairs, MOVING);
+const bodyFilter = new Jolt.BodyFilter(), shapeFilter = new Jolt.ShapeFilter();
+const castSettings = new Jolt.ShapeCastSettings();
+if (variant === 'back_faces') castSettings.mBackFaceModeTriangles = Jolt.EBackFaceMode_CollideWithBackFaces;
+const unitScale = new Jolt.Vec3(1, 1, 1), baseOffset = new Jolt.RVec3(0, 0, 0);
+
+let scene = null; // { vertices, triangles, body, mesh } of the current scene
+const spheres = new Map(); // radius -> SphereShape (kept alive with AddRef)
+
+// A new scene replaces the previous one: its body is removed and destroyed.
+function loadScene(msg) {
+  if (scene && scene.body) {
+    bodies.RemoveBody(scene.body);
+    bodies.DestroyBody(scene.body);
+  }
+  scene = { vertices: msg.vertices, triangles: msg.triangles, margin: msg.margin ?? 0, body: null, mesh: null };
+  const vertices = new Jolt.VertexList(), triangles = new Jolt.IndexedTriangleList();
+  for (const [x, y, z] of msg.vertices) {
+    const v = new Jolt.Float3(x, y, z);
+    vertices.push_back(v);
+    Jolt.destroy(v);
+  }
+  msg.triangles.forEach(([a, b, c], index) => {
+    const t = new Jolt.IndexedTriangle(a, b, c, 0, index); // user data: the scene's triangle index
+    triangles.push_back(t);
+    Jolt.destroy(t);
+  });
+  // The constructor drops degenerate and duplicate triangles (Sanitize).
+  const meshSettings = new Jolt.MeshShapeSettings(vertices, triangles, new Jolt.PhysicsMaterialList());
+  meshSettings.mPerTriangleUserData = true;
+  Jolt.destroy(vertices);
+  Jolt.destroy(triangles);
+  if (meshSettings.mIndexedTriangles.size() === 0) return; // nothing to hit: every sweep misses
+  const result = meshSettings.Create();
+  if (result.HasError()) fail(`scene \`${msg.name ?? ''}\`: MeshShape: ${result.GetError().c_str()}`);
+  const mesh = result.Get();
+  const position = new Jolt.RVec3(0, 0, 0), rotation = new Jolt.Quat(0, 0, 0, 1);
+  const bcs = new Jolt.BodyCreationSettings(mesh, position, rotation, Jolt.EMotionType_Static, NON_MOVING);
+  scene.body = bodies.CreateAndAddBody(bcs, Jolt.EActivation_DontActivate);
+  scene.mesh = Jolt.castObject(mesh, Jolt.MeshShape);
+  [position, rotation, bcs].forEach((o) => Jolt.destroy(o));
+}
+
+const sub = (a, b) => [a[0] - b[0], a[1] - b[1], a[2] - b[2]];
+const dot = (a, b) => a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+const cross = (a, b) => [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]];
+const xyz = (v) => [v.GetX(), v.GetY(), v.GetZ()];
+
+// Kind and feature of a contact point p on triangle (a, b, c), from its
+// barycentric weights w[i] (of vertex i): two weights ~0 -> vertex i (the one
+// near 1), one weight w[k] ~0 -> edge (k+1)%3 (joining k+1 and k+2), else face.
+function classify(p, [a, b, c]) {
+  const n = cross(sub(b, a), sub(c, a)), nn = dot(n, n);
+  const w = [dot(n, cross(sub(b, p), sub(c, p))) / nn, dot(n, cross(sub(c, p), sub(a, p))) / nn, 0];
+  w[2] = 1 - w[0] - w[1];
+  const zero = w.map((x) => x <= BARY_EPS);
+  const count = zero.filter(Boolean).length;
+  if (count >= 2) return { kind: 'vertex', feature: w.indexOf(Math.max(...w)) };
+  if (count === 1) return { kind: 'edge', feature: (zero.indexOf(true) + 1) % 3 };
+  return { kind: 'face', feature: null };
+}
+
+function sweep(msg) {
+  const none = { frame: msg.frame, ball: msg.ball, alpha: 1, kind: 'none' };
+  if (!scene) fail(`the sweep of frame ${msg.frame}, ball ${msg.ball} arrived before any scene`);
+  if (!scene.body) return none;
+  const radius = honourMargin ? msg.radius - scene.margin : msg.radius;
+  let sphere = spheres.get(radius);
+  if (!sphere) {
+    sphere = new Jolt.SphereShape(radius);
+    sphere.AddRef();
+    spheres.set(radius, sphere);
+  }
+  const [p0, p1] = [msg.p0, msg.p1], d = sub(p1, p0);
+  const start = new Jolt.RVec3(...p0), direction = new Jolt.Vec3(...d);
+  const transform = Jolt.RMat44.prototype.sTranslation(start);
+  const cast = new Jolt.RShapeCast(sphere, unitScale, transform, direction);
+  const collector = new Jolt.CastShapeClosestHitCollisionCollector();
+  query.CastShape(cast, castSettings, baseOffset, collector, bpFilter, objFilter, bodyFilter, shapeFilter);
+  let answer = none;
+  if (collector.HadHit()) {
+    const hit = collector.get_mHit();
+    const triangle = scene.mesh.GetTriangleUserData(hit.mSubShapeID2);
+    const contact = xyz(hit.mContactPointOn2); // on the mesh (base offset 0: world space)
+    // Jolt's penetration axis points from the ball into the mesh: negate it.
+    const axis = xyz(hit.mPenetrationAxis), len = Math.sqrt(dot(axis, axis));
+    const normal = axis.map((x) => -x / len);
+    const alpha = Math.min(Math.max(hit.mFraction, 0), 1);
+    const { kind, feature } = classify(contact, scene.triangles[triangle].map((i) => scene.vertices[i]));
+    answer = { frame: msg.frame, ball: msg.ball, alpha, kind, triangle, feature, normal, contact };
+  }
+  [start, direction, transform, cast, collector].forEach((o) => Jolt.destroy(o));
+  return mistake(answer, p0, d);
+}
+
+// The deliberate mistakes (variant `clean` has none).
+function mistake(answer, p0, d) {
+  if (answer.kind === 'none') return answer;
+  switch (variant) {
+    case 'late': return { ...answer, alpha: Math.min(answer.alpha * 1.002, 1) };
+    case 'no_vertex': return answer.kind === 'vertex' ? { frame: answer.frame, ball: answer.ball, alpha: 1, kind: 'none' } : answer;
+    case 'next_triangle': return answer.kind === 'face' ? { ...answer, triangle: (answer.triangle + 1) % scene.triangles.length } : answer;
+    case 'centre_contact': return { ...answer, contact: p0.map((x, i) => x + answer.alpha * d[i]) };
+    case 'flipped_edge_normal': return answer.kind === 'edge' ? { ...answer, normal: answer.normal.map((x) => -x) } : answer;
+    default: return answer; // clean, back_faces (a cast setting)
+  }
+}
+
+const lines = createInterface({ input: process.stdin, crlfDelay: Infinity });
+let lineNumber = 0;
+for await (const line of lines) {
+  lineNumber += 1;
+  if (line.trim() === '') continue;
+  let msg;
+  try {
+    msg = JSON.parse(line);
+  } catch (e) {
+    fail(`input line ${lineNumber}: not JSON: ${e.message}`);
+  }
+  if (msg.type === 'scene') loadScene(msg);
+  else if (msg.type === 'sweep') process.stdout.write(JSON.stringify(sweep(msg)) + '\n');
+  // other types: ignored (protocol v1)
+}

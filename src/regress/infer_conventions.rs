@@ -1,0 +1,335 @@
+//! The conventions an engine's answers imply (`check --infer-config`):
+//! each convention is tried on every trace, in a fixed order, and kept when
+//! fewer sweeps fail with it than without; what it changed is its evidence.
+//! The result is a `sweeptrace.toml` with an `[engine]` table whose every
+//! value carries its evidence in a comment.
+//!
+//! The trial order puts precision first: an engine in single precision
+//! differs from the exact rules on most sweeps, which hides what the other
+//! conventions change until rounding is judged as rounding. The margin
+//! comes from [`super::Inferred`] (the margin every trace's face hits
+//! imply); the facing rule is tried both ways.
+//!
+//! Inference never makes a run pass by itself: it prints a file, and the
+//! check that uses it judges as strictly as any other.
+
+use std::fmt::Write as _;
+
+use crate::core::InitialOverlap;
+use crate::replay::NormalRule;
+
+use super::compare::TieRule;
+use super::conventions::{EngineConventions, FacingRule, MarginRule};
+use super::precision::Precision;
+use super::report::TraceReport;
+
+/// What a check of every trace under some conventions came to.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Trial {
+    /// Sweeps that fail.
+    pub failing: u64,
+    /// Sweeps compared.
+    pub compared: u64,
+    /// Differences within single precision, and the largest backward error.
+    pub precision: u64,
+    /// The largest backward error among them.
+    pub max_backward_error: f64,
+    /// Answers that name another member of a tie.
+    pub ties: u64,
+    /// The margins the traces' face hits imply (one per trace that has one).
+    pub margins: Vec<f64>,
+    /// Traces that could not be checked.
+    pub errors: u64,
+}
+
+impl Trial {
+    /// The trial of `reports`.
+    pub fn of(reports: &[TraceReport]) -> Trial {
+        let mut t = Trial::default();
+        for r in reports {
+            t.failing += r.divergent;
+            t.compared += r.compared;
+            t.precision += r.precision_divergent;
+            t.max_backward_error = t.max_backward_error.max(r.max_backward_error);
+            t.ties += r.ties;
+            if let Some(m) = r.inferred.as_ref().and_then(|i| i.margin) {
+                t.margins.push(m);
+            }
+            t.errors += u64::from(!r.errors.is_empty());
+        }
+        t
+    }
+}
+
+/// One candidate change of the conventions.
+type Change = Box<dyn Fn(EngineConventions) -> EngineConventions>;
+
+/// One inferred value with its evidence.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Evidence {
+    /// The key of the `[engine]` table.
+    pub key: &'static str,
+    /// The value, as TOML writes it.
+    pub value: String,
+    /// Why, in words.
+    pub because: String,
+}
+
+/// The conventions inferred, with the evidence for each declared one and
+/// the failing counts before and after.
+#[derive(Clone, Debug, PartialEq)]
+pub struct InferredConventions {
+    /// The conventions.
+    pub conventions: EngineConventions,
+    /// The evidence for each value that differs from the rules.
+    pub evidence: Vec<Evidence>,
+    /// The trial under the rules.
+    pub under_rules: Trial,
+    /// The trial under the inferred conventions.
+    pub under_inferred: Trial,
+}
+
+/// Infers the conventions: `check` runs every trace under the conventions
+/// it is given and returns the trial.
+pub fn infer_conventions(
+    mut check: impl FnMut(&EngineConventions) -> Trial,
+) -> InferredConventions {
+    let rules = EngineConventions::default();
+    let under_rules = check(&rules);
+    let mut best = rules;
+    let mut best_trial = under_rules.clone();
+    let mut evidence: Vec<Evidence> = Vec::new();
+    // Each candidate: the conventions with one key changed, and the words
+    // of its evidence from the trial before and with it.
+    let mut candidates: Vec<(&'static str, Change)> = vec![(
+        "precision",
+        Box::new(|c| EngineConventions {
+            precision: Precision::F32,
+            ..c
+        }),
+    )];
+    if let Some(margin) = common_margin(&under_rules.margins) {
+        candidates.push((
+            "margin",
+            Box::new(move |c| EngineConventions {
+                margin: MarginRule::Fixed(margin),
+                ..c
+            }),
+        ));
+    }
+    candidates.extend([
+        (
+            "facing",
+            Box::new(|c| EngineConventions {
+                facing: FacingRule::NonStrict,
+                ..c
+            }) as Change,
+        ),
+        (
+            "facing",
+            Box::new(|c| EngineConventions {
+                facing: FacingRule::Strict,
+                ..c
+            }),
+        ),
+        (
+            "initial_overlap",
+            Box::new(|c| EngineConventions {
+                initial_overlap: InitialOverlap::Alpha0,
+                ..c
+            }),
+        ),
+        // Active edges first: it is the contact normal where the two can
+        // differ only on flat and concave edges, and where the traces hold
+        // no hit there the two fit alike (the evidence says so).
+        (
+            "normal",
+            Box::new(|c| EngineConventions {
+                normal: NormalRule::ActiveEdges,
+                ..c
+            }),
+        ),
+        (
+            "normal",
+            Box::new(|c| EngineConventions {
+                normal: NormalRule::Contact,
+                ..c
+            }),
+        ),
+        (
+            "ties",
+            Box::new(|c| EngineConventions {
+                ties: TieRule::Any,
+                ..c
+            }),
+        ),
+    ]);
+    for (key, change) in candidates {
+        let trying = change(best);
+        if trying == best {
+            continue;
+        }
+        let trial = check(&trying);
+        if trial.errors > best_trial.errors || trial.failing >= best_trial.failing {
+            if key == "normal"
+                && trial.failing == best_trial.failing
+                && let Some(e) = evidence.iter_mut().find(|e| e.key == "normal")
+            {
+                e.because.push_str(&format!(
+                    " (normal = \"{}\" fits as well: no answer here tells them apart)",
+                    trying.normal
+                ));
+            }
+            continue;
+        }
+        let fixed = best_trial.failing - trial.failing;
+        let because = match key {
+            "precision" => format!(
+                "{} answers differ from the exact rules by no more than single precision \
+                 explains (largest backward error {} u32 units of the sweep's scale); {fixed} \
+                 fewer sweeps fail",
+                trial.precision,
+                crate::core::num(trial.max_backward_error)
+            ),
+            "margin" => format!(
+                "the face hits of every trace imply this margin; {fixed} fewer sweeps fail \
+                 with it than with each scene's own"
+            ),
+            "facing" => format!("{fixed} fewer sweeps fail with it than with each scene's rule"),
+            "initial_overlap" => format!(
+                "{fixed} answers are hits at α = 0 where the ball starts within ρ of the mesh"
+            ),
+            "normal" => format!(
+                "{fixed} fewer sweeps fail: the answers give the contact normal{}",
+                if trying.normal == NormalRule::ActiveEdges {
+                    " at active edges and vertices, the face normal at flat and concave ones"
+                } else {
+                    " at edges and vertices"
+                }
+            ),
+            "ties" => {
+                format!("{fixed} answers name a member of a tie with that member's own normal")
+            }
+            _ => format!("{fixed} fewer sweeps fail"),
+        };
+        evidence.retain(|e: &Evidence| e.key != key);
+        best = trying;
+        best_trial = trial;
+        let value = best
+            .declared()
+            .into_iter()
+            .find(|(k, _)| *k == key)
+            .map_or_else(String::new, |(_, v)| v);
+        evidence.push(Evidence {
+            key,
+            value,
+            because,
+        });
+    }
+    InferredConventions {
+        conventions: best,
+        evidence,
+        under_rules,
+        under_inferred: best_trial,
+    }
+}
+
+/// The margin every estimate agrees on (to 1e-9), if they do.
+fn common_margin(margins: &[f64]) -> Option<f64> {
+    let first = *margins.first()?;
+    margins
+        .iter()
+        .all(|m| (m - first).abs() <= 1e-9)
+        .then_some(first)
+}
+
+impl InferredConventions {
+    /// The `sweeptrace.toml` these conventions make: a header saying where
+    /// it came from and what it changes, then the `[engine]` table, each
+    /// value with its evidence. Valid TOML that `check` reads back.
+    pub fn to_toml(&self, source: &str) -> String {
+        let mut s = String::new();
+        let _ = writeln!(s, "# The conventions {source} implies, inferred by");
+        let _ = writeln!(s, "# `sweeptrace check --infer-config`.");
+        let _ = writeln!(
+            s,
+            "# Under the rules: {} of {} compared sweeps fail; under these conventions: {}.",
+            self.under_rules.failing, self.under_rules.compared, self.under_inferred.failing
+        );
+        let _ = writeln!(
+            s,
+            "# Check again with this file: inference never makes a run pass by itself."
+        );
+        let _ = writeln!(s, "[engine]");
+        if self.evidence.is_empty() {
+            let _ = writeln!(
+                s,
+                "# No convention fits better than the rules (docs/SEMANTICS.md)."
+            );
+        }
+        for e in &self.evidence {
+            let _ = writeln!(s, "# {}", e.because);
+            let _ = writeln!(s, "{} = {}", e.key, e.value);
+        }
+        s
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A fake suite: each convention fixes a known number of sweeps.
+    fn suite(c: &EngineConventions) -> Trial {
+        let mut failing = 100;
+        if c.precision == Precision::F32 {
+            failing -= 60;
+        }
+        if c.initial_overlap == InitialOverlap::Alpha0 {
+            failing -= 20;
+        }
+        if c.normal == NormalRule::ActiveEdges {
+            failing -= 5;
+        }
+        if c.normal == NormalRule::Contact {
+            failing -= 3;
+        }
+        Trial {
+            failing,
+            compared: 1000,
+            precision: if c.precision == Precision::F32 { 60 } else { 0 },
+            max_backward_error: 2.0,
+            margins: vec![0.0, 0.0],
+            ..Trial::default()
+        }
+    }
+
+    #[test]
+    fn keeps_what_fixes_sweeps_and_says_why() {
+        let inferred = infer_conventions(suite);
+        let c = inferred.conventions;
+        assert_eq!(c.precision, Precision::F32);
+        assert_eq!(c.initial_overlap, InitialOverlap::Alpha0);
+        assert_eq!(c.normal, NormalRule::ActiveEdges);
+        assert!(!inferred.to_toml("e").contains("fits as well"));
+        // The margin and the tie rule change nothing in this suite.
+        assert_eq!((c.margin, c.ties), (MarginRule::Scene, TieRule::Rule));
+        assert_eq!(inferred.under_inferred.failing, 15);
+        let toml = inferred.to_toml("the engine");
+        assert!(toml.contains("precision = \"f32\""), "{toml}");
+        assert!(toml.contains("# 20 answers are hits at α = 0"), "{toml}");
+        let parsed: toml::Table = toml::from_str(&toml).expect("valid TOML");
+        assert!(parsed.contains_key("engine"));
+    }
+
+    #[test]
+    fn an_engine_of_the_rules_gets_an_empty_table() {
+        let inferred = infer_conventions(|_| Trial {
+            failing: 0,
+            compared: 10,
+            ..Trial::default()
+        });
+        assert!(inferred.conventions.is_rules());
+        assert!(inferred.to_toml("x").contains("No convention fits better"));
+    }
+}

@@ -139,6 +139,12 @@ pub fn plural(n: u64, noun: &str) -> String {
     }
 }
 
+/// The verb for a subject of `n`: `one` for 1 (`diverges`), `many`
+/// otherwise (`diverge`), as in `1 of 5 sweeps diverges`.
+pub fn verb<'a>(n: u64, one: &'a str, many: &'a str) -> &'a str {
+    if n == 1 { one } else { many }
+}
+
 /// `n` and the word for that many: `1 vertex`, `3 vertices`.
 pub fn counted(n: u64, one: &str, many: &str) -> String {
     format!("{n} {}", if n == 1 { one } else { many })

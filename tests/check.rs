@@ -397,7 +397,7 @@ fn rapier_sample_needs_its_settings_file() -> anyhow::Result<()> {
     ])?;
     ensure!(
         code == 1
-            && out.contains("1 of 556 compared sweeps diverge")
+            && out.contains("1 of 556 compared sweeps diverges")
             && out.contains("normal: expected"),
         "every field: exit {code}: {out}{err}"
     );
@@ -933,13 +933,14 @@ fn bless_binary_requires_output_and_keeps_input() -> anyhow::Result<()> {
         .filter(|e| e.file_name().to_string_lossy().contains(".partial-"))
         .collect();
     ensure!(leftovers.is_empty(), "temporary files left: {leftovers:?}");
-    // A trace that cannot be replayed is refused and nothing is written.
+    // A trace that ends early is refused (exit 3, as every command gives
+    // for one) and nothing is written.
     let cut = dir.path().join("cut.mcap");
     std::fs::write(&cut, &before[..before.len() / 2])?;
     let never = dir.path().join("never.mcap");
     let (code, _, err) = run_bin(os!["bless", cut.as_os_str(), "-o", never.as_os_str()])?;
     ensure!(
-        code == 2 && !never.exists(),
+        code == 3 && !never.exists(),
         "truncated input: exit {code}: {err}"
     );
     Ok(())

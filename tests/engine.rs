@@ -134,7 +134,7 @@ fn wrong_engine_report_explains_the_missed_vertex() -> anyhow::Result<()> {
     let (code, stdout, stderr) = run_bin(os!("check", trace.as_os_str(), "--engine", &engine))?;
     ensure!(code == 1, "exit {code}, want 1:\n{stdout}\n{stderr}");
     for want in [
-        "1 of 4 compared sweeps diverge (none -> vertex: 1)",
+        "1 of 4 compared sweeps diverges (none -> vertex: 1)",
         "first divergence: frame 2, ball 0",
         "kind: engine none, core vertex",
         "primary: vertex 0.0",

@@ -476,10 +476,14 @@ fn conform_junit_fails_exactly_the_failing_rules() -> anyhow::Result<()> {
                             .find(|r| r["rule"] == name)
                             .with_context(|| format!("{name} not in the JSON"))?;
                         let message = attr(outcome(case).context("failure")?, "message")?;
+                        let (failed, cases) = (
+                            rule["failed"].as_u64().unwrap_or(0),
+                            rule["cases"].as_u64().unwrap_or(0),
+                        );
                         let want = format!(
-                            "{} of {} cases fail; first failing case: {} (",
-                            rule["failed"],
-                            rule["cases"],
+                            "{failed} of {cases} {} {}; first failing case: {} (",
+                            if cases == 1 { "case" } else { "cases" },
+                            if failed == 1 { "fails" } else { "fail" },
                             rule["first_failure"]["case"].as_str().unwrap_or("?")
                         );
                         ensure!(message.starts_with(&want), "{name}: {message}\nwant {want}");

@@ -20,6 +20,7 @@ mod exact;
 mod expected_source;
 mod faults;
 mod first_hour;
+mod first_hour_again;
 mod foxglove;
 mod fuzz_corpus;
 mod help;
@@ -151,6 +152,7 @@ fn main() {
     trials.extend(interrupts::tests());
     trials.extend(help::tests());
     trials.extend(first_hour::tests());
+    trials.extend(first_hour_again::tests());
     trials.extend(mesh::tests());
     trials.extend(jolt::tests());
     trials.extend(precision::tests());

@@ -632,7 +632,10 @@ fn bad_obj_is_a_clear_error() -> anyhow::Result<()> {
     }
     let missing = dir.path().join("missing.obj");
     match sim::load_obj(&missing) {
-        Err(e) => ensure!(e.to_string().contains("cannot read"), "missing file: `{e}`"),
+        Err(e) => ensure!(
+            e.to_string().contains("missing.obj: cannot open: "),
+            "missing file: `{e}`"
+        ),
         Ok(_) => return Err(anyhow::anyhow!("a missing file loaded")),
     }
     Ok(())

@@ -494,3 +494,105 @@ fn minimal_engine_runs_through_conform_and_the_docs_show_it_unchanged() {
         "{failing:?}"
     );
 }
+
+/// The commands the docs show for building `examples/c/engine.c`: every
+/// `cc ...` command naming it, in `capi/README.md`,
+/// `docs/ENGINE_PROTOCOL.md` and the file's own header, from code blocks
+/// (continuation lines joined) and inline code spans; each with the file
+/// it came from.
+fn documented_engine_commands() -> Vec<(String, String)> {
+    let mut commands = Vec::new();
+    let mut keep = |file: &str, command: String| {
+        let command = command.split_whitespace().collect::<Vec<_>>().join(" ");
+        if command.starts_with("cc ") && command.contains("examples/c/engine.c") {
+            commands.push((file.to_string(), command));
+        }
+    };
+    for doc in ["capi/README.md", "docs/ENGINE_PROTOCOL.md"] {
+        let text = std::fs::read_to_string(root().join(doc)).expect("reading the doc");
+        // Fenced blocks: lines, a trailing `\` continuing onto the next.
+        let mut outside = String::new();
+        for (i, part) in text.split("```").enumerate() {
+            if i % 2 == 0 {
+                outside.push_str(part);
+                continue;
+            }
+            for command in part.replace("\\\n", " ").lines() {
+                keep(doc, command.to_string());
+            }
+        }
+        // Inline code spans, which may run over lines of prose.
+        for (i, span) in outside.split('`').enumerate() {
+            if i % 2 == 1 {
+                keep(doc, span.replace('\n', " "));
+            }
+        }
+    }
+    let source = std::fs::read_to_string(root().join("examples/c/engine.c")).expect("engine.c");
+    let header = &source[..source.find("*/").expect("a header comment")];
+    let lines: Vec<&str> = header
+        .lines()
+        .map(|l| l.trim_start().trim_start_matches('*').trim())
+        .collect();
+    for command in lines.join("\n").replace("\\\n", " ").lines() {
+        keep("examples/c/engine.c", command.to_string());
+    }
+    commands
+}
+
+/// Every documented command that builds `examples/c/engine.c` links (the
+/// shared-library one too, which needs `-lm` for `sqrt`, `fmin`, `fmax`)
+/// when run as shown, with `target/release` standing for this build's
+/// libraries, and the engine it builds passes `conform`.
+#[test]
+fn documented_engine_build_commands_link_and_the_engine_runs() {
+    let Some(compiler) = compiler("CC", "cc") else {
+        return;
+    };
+    let commands = documented_engine_commands();
+    for (file, count) in [
+        ("capi/README.md", 2),
+        ("docs/ENGINE_PROTOCOL.md", 2),
+        ("examples/c/engine.c", 2),
+    ] {
+        let shown = commands.iter().filter(|(f, _)| f == file).count();
+        assert_eq!(
+            shown, count,
+            "{file}: {shown} commands building engine.c, want {count}: {commands:?}"
+        );
+    }
+    let libraries = static_library()
+        .parent()
+        .expect("the libraries' directory")
+        .display()
+        .to_string();
+    let dir = tempfile::tempdir().expect("a temporary directory");
+    for (i, (file, command)) in commands.iter().enumerate() {
+        assert!(
+            command.contains(" -lm"),
+            "{file}: `{command}` does not link the math library"
+        );
+        let program = dir.path().join(format!("engine_{i}"));
+        let run = command
+            .replacen("cc ", &format!("{} ", compiler.display()), 1)
+            .replace("\"$PWD/target/release\"", &libraries)
+            .replace("target/release", &libraries)
+            .replace("-o engine", &format!("-o {}", program.display()));
+        let output = Command::new("sh")
+            .args(["-c", &run])
+            .current_dir(root())
+            .output()
+            .expect("running sh");
+        assert!(
+            output.status.success(),
+            "{file}: `{command}` failed ({}):\n{}",
+            output.status,
+            String::from_utf8_lossy(&output.stderr)
+        );
+        let failing = conform_failures(&self::command(&program, ""));
+        assert!(
+            failing.is_empty(),
+            "{file}: the engine `{command}` builds fails {failing:?}"
+        );
+    }
+}

@@ -8,6 +8,9 @@
  *   cargo build --release -p sweeptrace-capi
  *   cc -std=c99 -Wall -Wextra -Werror examples/c/engine.c -I capi/include \
  *      target/release/libsweeptrace_capi.a -lpthread -ldl -lm -o engine
+ * or, against the shared library (-lm: sqrt, fmin and fmax are in libm):
+ *   cc -std=c99 -Wall -Wextra -Werror examples/c/engine.c -I capi/include \
+ *      -L target/release -lsweeptrace_capi -lm -Wl,-rpath,"$PWD/target/release" -o engine
  *   sweeptrace conform --engine ./engine
  *   sweeptrace check traces/ --engine ./engine
  *

@@ -21,7 +21,9 @@ Examples:
 
 Each sweep gets the outcome the core computes with the scene's own margin
 and facing rule. The output is written under a temporary name next to it
-and renamed when complete; the input is untouched unless --in-place.")]
+and renamed when complete; the input is untouched unless --in-place. A
+trace that ends early (truncated) is an error, exit 3, and nothing is
+written.")]
 pub struct Args {
     /// The trace (an MCAP file).
     #[arg(value_name = "TRACE")]
@@ -46,9 +48,26 @@ pub fn run(args: Args) -> anyhow::Result<Exit> {
         (None, true) => args.trace.clone(),
         _ => bail!("say where the blessed trace goes: -o OUT, or --in-place"),
     };
+    // The one wording for an input that cannot be opened.
+    drop(super::open_trace(&args.trace)?);
     super::warn_unfinished(&output);
-    let summary = bless_file(&args.trace, &output, ReplayOptions::default())
-        .name_file_once("blessing", args.trace.display())?;
+    let summary = match bless_file(&args.trace, &output, ReplayOptions::default()) {
+        Ok(summary) => summary,
+        // A trace that ends early: exit 3, as every command gives, but
+        // nothing written (in place, the trace is left as it was).
+        Err(err) if err.is_truncation() => {
+            eprintln!(
+                "error: {err}\nnothing written: a blessed trace would lose every sweep after the end{}",
+                if args.in_place {
+                    " (the trace is left as it was)"
+                } else {
+                    ""
+                }
+            );
+            return Ok(Exit::IncompleteInput);
+        }
+        Err(err) => return Err(err).name_file_once("blessing", args.trace.display()),
+    };
     let replaced = match &summary.replaced_expected_source {
         Some(old) => format!(" (expectations were from {old})"),
         None => String::new(),

@@ -29,6 +29,7 @@ Examples:
   sweeptrace check traces/record_cube_corner_margin.mcap --engine 'python3 examples/engines/sweep_engine.py'
   sweeptrace check examples/rapier/rapier_mini_golf.mcap --fields kind,alpha --tolerance 1e-5
   sweeptrace check traces/ --junit report.xml   # a test report for CI
+  sweeptrace check traces/record_mini_golf.mcap --frames 100..200 --ball 1
 
 Under `git bisect run sweeptrace check traces/ --engine ./build/engine`,
 an engine that cannot be started skips the commit (exit 125).
@@ -79,6 +80,12 @@ matching block winning. For example:
   [[traces]]
   match = \"rapier/*.mcap\"
   tolerances = { contact = 1e-5 }
+
+A search of a folder leaves out the Foxglove files `replay --foxglove`
+writes (told by content, whatever their name) and the files the
+`exclude` globs of a settings file match (`exclude = [\"scratch/**\"]`,
+relative to the file's folder; a file named on the command line is checked
+all the same), and says so once on stderr.
 
 The command line overrides the files (--strict=false undoes strict = true);
 --print-config shows each trace's settings and where each came from;
@@ -162,6 +169,14 @@ pub struct Args {
     /// `--engine ./build/engine --against expected`.
     #[arg(long, value_enum, default_value_t = AgainstArg::Core, requires = "engine")]
     pub against: AgainstArg,
+    /// Only frames A..B (A included, B excluded; also `A..`, `..B`,
+    /// `A..=B`, `A`), as `replay --frames`: the other sweeps are neither
+    /// replayed nor compared, e.g. `--frames 100..200`.
+    #[arg(long, value_name = "A..B")]
+    pub frames: Option<sweeptrace::replay::FrameRange>,
+    /// Only ball N, as `replay --ball`, e.g. `--ball 0`.
+    #[arg(long, value_name = "N")]
+    pub ball: Option<u32>,
     #[command(flatten)]
     pub junit: super::junit::JunitArgs,
     #[command(flatten)]
@@ -193,7 +208,8 @@ pub fn run(args: Args) -> anyhow::Result<Exit> {
         engine: args.conventions.to_overrides(),
         ..args.tolerances.to_overrides()?
     };
-    let traces = find_traces(&args.paths)?;
+    let found = find_traces(&args.paths)?;
+    let traces = leave_out(found, &args.paths, args.no_config)?;
     if traces.is_empty() {
         bail!(
             "no trace found (directories are searched for *.mcap): {}",
@@ -224,6 +240,11 @@ pub fn run(args: Args) -> anyhow::Result<Exit> {
         hex: args.hex,
         fail_on_ghost: !args.allow_ghosts,
         ghost_degrees: args.ghost_degrees,
+        replay: ReplayOptions {
+            frames: args.frames.unwrap_or_default(),
+            ball: args.ball,
+            ..ReplayOptions::default()
+        },
         ..CheckOptions::default()
     };
     let engine = match &args.engine {
@@ -334,6 +355,77 @@ pub fn run(args: Args) -> anyhow::Result<Exit> {
     }
     super::junit::finish_check(junit, &reports, &times)?;
     Ok(if rrd_error { Exit::Error } else { outcome })
+}
+
+/// The traces of `found` to check: without the Foxglove files that
+/// `replay --foxglove` writes (MCAP files, but not traces) and, among the
+/// files found by searching a folder (not those named on the command
+/// line), those a `sweeptrace.toml`'s `exclude` globs leave out (unless
+/// `no_config`). Says once on stderr what it left out, and why.
+fn leave_out(
+    found: Vec<PathBuf>,
+    named: &[PathBuf],
+    no_config: bool,
+) -> anyhow::Result<Vec<PathBuf>> {
+    let (mut traces, mut foxglove, mut excluded) = (Vec::new(), Vec::new(), Vec::new());
+    for path in found {
+        if let Some(trace) = sweeptrace::regress::foxglove_output(&path) {
+            foxglove.push((path, trace));
+            continue;
+        }
+        if !no_config && !named.contains(&path) {
+            let by = sweeptrace::regress::excluded_by(&path)?;
+            if let Some((file, pattern)) = by {
+                excluded.push((path, file, pattern));
+                continue;
+            }
+        }
+        traces.push(path);
+    }
+    if !foxglove.is_empty() {
+        let list: Vec<String> = foxglove
+            .iter()
+            .map(|(path, trace)| match trace.as_str() {
+                "" => path.display().to_string(),
+                trace => format!("{} (from {trace})", path.display()),
+            })
+            .collect();
+        let (files, what) = match foxglove.len() {
+            1 => ("1 Foxglove file".to_string(), "not a trace"),
+            n => (format!("{n} Foxglove files"), "not traces"),
+        };
+        eprintln!(
+            "note: left out {files} that `sweeptrace replay --foxglove` wrote ({what}): {}",
+            listed(&list)
+        );
+    }
+    if !excluded.is_empty() {
+        let list: Vec<String> = excluded
+            .iter()
+            .map(|(path, file, pattern)| format!("{} (`{pattern}` in {file})", path.display()))
+            .collect();
+        eprintln!(
+            "note: left out {} excluded by `exclude` in sweeptrace.toml: {}",
+            sweeptrace::numbers::counted(excluded.len() as u64, "file", "files"),
+            listed(&list)
+        );
+    }
+    Ok(traces)
+}
+
+/// The first few of `items`, comma-separated, then how many more.
+fn listed(items: &[String]) -> String {
+    const LISTED: usize = 5;
+    let mut text = items
+        .iter()
+        .take(LISTED)
+        .cloned()
+        .collect::<Vec<_>>()
+        .join(", ");
+    if items.len() > LISTED {
+        text.push_str(&format!(" and {} more", items.len() - LISTED));
+    }
+    text
 }
 
 /// What the check of one trace came to: a divergence is

@@ -2,11 +2,10 @@
 //! (the library's [`sweeptrace::regress`]).
 
 use super::NameFileOnce;
-use std::fs::File;
 use std::io::BufReader;
 use std::path::{Path, PathBuf};
 
-use anyhow::{Context, bail};
+use anyhow::bail;
 
 use super::Exit;
 use sweeptrace::core::Facing;
@@ -71,7 +70,7 @@ pub struct Args {
 
 fn side(path: &Path, options: ReplayOptions) -> anyhow::Result<Side> {
     let name = path.display().to_string();
-    let file = File::open(path).with_context(|| format!("cannot open trace {name}"))?;
+    let file = super::open_trace(path)?;
     let reader = TraceReader::new_indexed(BufReader::with_capacity(1 << 16, file), &name);
     Side::replay(reader, &name, options).name_file_once("replaying", &name)
 }

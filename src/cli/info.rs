@@ -1,11 +1,8 @@
 //! `sweeptrace info`: what a trace holds.
 
 use super::NameFileOnce;
-use std::fs::File;
 use std::io::BufReader;
 use std::path::PathBuf;
-
-use anyhow::Context;
 
 use super::Exit;
 use sweeptrace::trace::{TraceReader, collect_info, render_info_json, render_info_text};
@@ -27,7 +24,7 @@ pub struct Args {
 /// header) gets only the error, and nothing on stdout.
 pub fn run(args: Args) -> anyhow::Result<Exit> {
     let name = args.trace.display().to_string();
-    let file = File::open(&args.trace).with_context(|| format!("cannot open trace {name}"))?;
+    let file = super::open_trace(&args.trace)?;
     let file_bytes = file
         .metadata()
         .ok()
@@ -53,8 +50,12 @@ pub fn run(args: Args) -> anyhow::Result<Exit> {
     }
     match error {
         None => Ok(Exit::Success),
+        // The report says why already (`incomplete:`): the error once.
         Some(err) if err.is_truncation() => {
-            eprintln!("error: {err}");
+            eprintln!(
+                "error: {name} ends early (truncated): the report covers what was read \
+                 before the end"
+            );
             Ok(Exit::IncompleteInput)
         }
         Some(err) => Err(err).name_file_once("reading the trace", &name),

@@ -11,6 +11,7 @@ use serde::Serialize;
 
 use super::Exit;
 use sweeptrace::core::{Defect, DefectKind, EdgeClass, EdgeCounts, Topology};
+use sweeptrace::numbers::counted;
 use sweeptrace::sim::load_obj;
 use sweeptrace::trace::{EventBody, TraceReader};
 
@@ -33,7 +34,8 @@ duplicate_vertex. Thresholds: docs/SEMANTICS.md, \"Mesh topology\".
 
 Exit codes: 0 no defect that changes collisions, 1 such a defect found,
 2 bad input (a file that is neither an OBJ file nor a trace, a parse error,
-an invalid mesh).
+an invalid mesh), 3 a trace that ends early (truncated): the scenes read
+before the end are reported.
 
 Examples:
   sweeptrace mesh tests/fixtures/scanned/bunny_res4.obj
@@ -104,9 +106,12 @@ pub fn defect_line(d: &Defect) -> String {
     let at = point(&d.position);
     match d.kind {
         DefectKind::Flipped => format!(
-            "triangle {} at {at}: a ball from the side its neighbours face passes through it: its winding is opposite to {} neighbour(s)' ({})",
+            "triangle {} at {at}: a ball from the side its neighbours face passes through it: its winding is opposite to {}' ({})",
             t(0),
-            d.neighbours.len(),
+            match d.neighbours.len() {
+                1 => "its neighbour".to_string(),
+                n => format!("{n} neighbours"),
+            },
             list(&d.neighbours)
         ),
         DefectKind::Crack => format!(
@@ -159,18 +164,25 @@ pub fn render_text(file: &str, reports: &[MeshReport]) -> String {
     for r in reports {
         let _ = writeln!(
             out,
-            "mesh `{}` ({file}): {} triangles, {} vertices ({} distinct positions)",
-            r.name, r.triangles, r.vertices, r.welded_vertices
+            "mesh `{}` ({file}): {}, {} ({})",
+            r.name,
+            counted(r.triangles as u64, "triangle", "triangles"),
+            counted(r.vertices as u64, "vertex", "vertices"),
+            counted(
+                r.welded_vertices as u64,
+                "distinct position",
+                "distinct positions"
+            )
         );
         let classes: Vec<String> = EdgeClass::iter()
             .map(|c| format!("{} {}", r.edges.of(c), c.as_str()))
             .collect();
         let _ = writeln!(
             out,
-            "  edges: {} ({}); {} boundary loop(s)",
+            "  edges: {} ({}); {}",
             r.edges.total(),
             classes.join(", "),
-            r.boundary_loops
+            counted(r.boundary_loops as u64, "boundary loop", "boundary loops")
         );
         for kind in DefectKind::iter() {
             let of_kind: Vec<&Defect> = r.defects.iter().filter(|d| d.kind == kind).collect();
@@ -205,9 +217,17 @@ pub fn render_text(file: &str, reports: &[MeshReport]) -> String {
             out,
             "  verdict: {}",
             if serious > 0 {
-                format!("{serious} defect(s) that change collisions, {warnings} warning(s)")
+                format!(
+                    "{} that {} collisions, {}",
+                    counted(serious as u64, "defect", "defects"),
+                    sweeptrace::numbers::verb(serious as u64, "changes", "change"),
+                    counted(warnings as u64, "warning", "warnings")
+                )
             } else if warnings > 0 {
-                format!("no defect that changes collisions, {warnings} warning(s)")
+                format!(
+                    "no defect that changes collisions, {}",
+                    counted(warnings as u64, "warning", "warnings")
+                )
             } else {
                 "clean".to_string()
             }
@@ -238,8 +258,7 @@ pub fn run(args: Args) -> anyhow::Result<Exit> {
     let name = args.file.display().to_string();
     let mut head = [0u8; 8];
     let n = {
-        let mut f =
-            std::fs::File::open(&args.file).with_context(|| format!("cannot open {name}"))?;
+        let mut f = super::open_input(&args.file)?;
         let mut n = 0;
         while n < head.len() {
             let k = f
@@ -253,12 +272,20 @@ pub fn run(args: Args) -> anyhow::Result<Exit> {
         n
     };
     let mut reports = Vec::new();
+    let mut truncated = None;
     if head[..n] == *MCAP_MAGIC {
-        let file =
-            std::fs::File::open(&args.file).with_context(|| format!("cannot open {name}"))?;
+        let file = super::open_input(&args.file)?;
         let reader = TraceReader::new_indexed(std::io::BufReader::new(file), &name);
         for event in reader {
-            let event = event.name_file_once("reading the trace", &name)?;
+            let event = match event {
+                Ok(event) => event,
+                // The scenes before the end are still checked: exit 3.
+                Err(err) if err.is_truncation() => {
+                    truncated = Some(err);
+                    break;
+                }
+                Err(err) => return Err(err).name_file_once("reading the trace", &name),
+            };
             if let EventBody::Scene(scene) = event.body {
                 let index = event.header.index;
                 let topology = Topology::new(&scene.vertices, &scene.triangles)
@@ -266,6 +293,10 @@ pub fn run(args: Args) -> anyhow::Result<Exit> {
                 let shown = scene.name.unwrap_or_else(|| format!("scene {index}"));
                 reports.push(MeshReport::new(shown, &topology));
             }
+        }
+        if let Some(err) = truncated.as_ref().filter(|_| reports.is_empty()) {
+            eprintln!("error: {err}\n0 scenes read before the end: no mesh to check");
+            return Ok(Exit::IncompleteInput);
         }
         if reports.is_empty() {
             anyhow::bail!("{name} is a trace without any /scene message: no mesh to check");
@@ -286,6 +317,13 @@ pub fn run(args: Args) -> anyhow::Result<Exit> {
     print!("{report}");
     if args.json {
         println!();
+    }
+    if let Some(err) = truncated {
+        eprintln!(
+            "error: {err}\nthe report covers the {} read before the end",
+            sweeptrace::numbers::counted(reports.len() as u64, "scene", "scenes")
+        );
+        return Ok(Exit::IncompleteInput);
     }
     Ok(if reports.iter().any(MeshReport::changes_collisions) {
         Exit::Differences

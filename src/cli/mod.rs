@@ -273,6 +273,26 @@ impl<T, E: Into<anyhow::Error>> NameFileOnce<T> for Result<T, E> {
     }
 }
 
+/// Opens the input file `path`. Its error is the one wording every
+/// command gives for a file it cannot open, the file first as in the
+/// library's errors: `run.mcap: cannot open: No such file or directory
+/// (os error 2)` (`check` says the same on its `ERROR` line).
+pub fn open_input(path: &std::path::Path) -> anyhow::Result<std::fs::File> {
+    use anyhow::Context as _;
+    std::fs::File::open(path).with_context(|| format!("{}: cannot open", path.display()))
+}
+
+/// Opens the trace `path` ([`open_input`]); an OBJ file given instead is
+/// an error saying so and what takes one
+/// ([`sweeptrace::sim::obj_instead_of_trace`]).
+pub fn open_trace(path: &std::path::Path) -> anyhow::Result<std::fs::File> {
+    let file = open_input(path)?;
+    if let Some(text) = sweeptrace::sim::obj_instead_of_trace(path) {
+        anyhow::bail!(text);
+    }
+    Ok(file)
+}
+
 /// Warns about temporary files an interrupted earlier run left next to
 /// `target`, and says how to remove them.
 pub fn warn_unfinished(target: &std::path::Path) {

@@ -16,11 +16,7 @@ use sweeptrace::trace::{Encoding, sweeptrace_source, write_trace_file_with_encod
 /// Arguments of `record`. Every simulation option defaults to the scene's
 /// own choice (`sweeptrace::sim::scenes::BuiltinScene::sim_options`).
 #[derive(Debug, clap::Args)]
-#[command(after_help = "Examples:\n  \
-    sweeptrace record --scene mini_golf -o mini_golf.mcap\n  \
-    sweeptrace record --scene terrain --terrain-cells 64 --balls 4 --seed 7 --frames 600 -o hills.mcap\n  \
-    sweeptrace record --scene bowl --encoding cbor -o bowl.mcap\n  \
-    sweeptrace record --mesh tests/fixtures/scanned/bunny_res4.obj --radius 0.005 --position 0,0.1,0.3 --margin 0.001 --frames 200 -o bunny.mcap")]
+#[command(after_help = after_help())]
 pub struct Args {
     /// Built-in scene: `mini_golf` (green, walls, ramp, cup), `bowl`, `box`
     /// (closed, ball inside), `terrain` (height field, 100,352 triangles by
@@ -117,6 +113,88 @@ impl Args {
             separation: defaults.separation,
         }
     }
+}
+
+/// The examples, then the defaults of each scene (from
+/// [`BuiltinScene::sim_options`], so they cannot drift), where the ball
+/// starts with `--mesh`, and what "left the play volume" means.
+fn after_help() -> String {
+    let examples = "Examples:
+  sweeptrace record --scene mini_golf -o mini_golf.mcap
+  sweeptrace record --scene terrain --terrain-cells 64 --balls 4 --seed 7 --frames 600 -o hills.mcap
+  sweeptrace record --scene bowl --encoding cbor -o bowl.mcap
+  sweeptrace record --mesh tests/fixtures/scanned/bunny_res4.obj --radius 0.005 --position 0,0.1,0.3 --margin 0.001 --frames 200 -o bunny.mcap";
+    format!(
+        "{examples}\n\n{}\n\n\
+         With --mesh, ball 0 starts above the middle of the mesh: at the centre of \
+         its bounding box in x and y, two radii above its top (--position \
+         overrides that).\n\n\
+         The play volume is the mesh's bounding box grown on every side by half its \
+         diagonal plus four radii. A ball whose centre leaves it (it fell off the \
+         scene, or was thrown out) \"left the play volume\": it records no further \
+         sweep, and the summary counts it.",
+        defaults_text()
+    )
+}
+
+/// The options' defaults: those every scene shares on one line, then
+/// those that differ, scene by scene (`--mesh` last).
+fn defaults_text() -> String {
+    type Show = fn(&SimOptions) -> String;
+    let fields: [(&str, Show); 13] = [
+        ("--frames", |o| o.frames.to_string()),
+        ("--balls", |o| o.balls.to_string()),
+        ("--radius", |o| o.radius.to_string()),
+        ("--position", |o| {
+            format!("{},{},{}", o.position[0], o.position[1], o.position[2])
+        }),
+        ("--velocity", |o| {
+            format!("{},{},{}", o.velocity[0], o.velocity[1], o.velocity[2])
+        }),
+        ("--position-jitter", |o| o.position_jitter.to_string()),
+        ("--velocity-jitter", |o| o.velocity_jitter.to_string()),
+        ("--restitution", |o| o.restitution.to_string()),
+        ("--seed", |o| o.seed.to_string()),
+        ("--time-step", |o| o.time_step.to_string()),
+        ("--gravity", |o| {
+            format!("{},{},{}", o.gravity[0], o.gravity[1], o.gravity[2])
+        }),
+        ("--margin", |o| o.margin.to_string()),
+        ("--max-substeps", |o| o.max_substeps.to_string()),
+    ];
+    let mut scenes: Vec<(String, SimOptions)> = BuiltinScene::all()
+        .map(|s| (format!("--scene {s}"), s.sim_options()))
+        .collect();
+    scenes.push(("--mesh FILE".to_string(), SimOptions::default()));
+    let shared = |show: Show| {
+        let first = show(&scenes[0].1);
+        scenes
+            .iter()
+            .all(|(_, o)| show(o) == first)
+            .then_some(first)
+    };
+    let common: Vec<String> = fields
+        .iter()
+        .filter_map(|(name, show)| shared(*show).map(|v| format!("{name} {v}")))
+        .collect();
+    let mut text = format!(
+        "Defaults (an option not given takes its scene's value); every scene: {}, --facing {}.",
+        common.join(", "),
+        SimOptions::default().facing
+    );
+    for (scene, options) in &scenes {
+        let mesh = scene.starts_with("--mesh");
+        let own: Vec<String> = fields
+            .iter()
+            .filter(|(_, show)| shared(*show).is_none())
+            .map(|(name, show)| match *name {
+                "--position" if mesh => format!("{name} above the middle of the mesh (below)"),
+                _ => format!("{name} {}", show(options)),
+            })
+            .collect();
+        text.push_str(&format!("\n  {scene}: {}", own.join(", ")));
+    }
+    text
 }
 
 /// Simulates, writes the trace and prints a summary.

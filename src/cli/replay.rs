@@ -50,7 +50,9 @@ written to <trace stem>.rrd in the current directory. The outputs combine:
 one replay can write outcomes, a Rerun recording and a Foxglove file. Files
 are written under a temporary name next to the target and renamed once
 complete: an error (or Ctrl-C, SIGTERM) leaves none of them, only a trace
-that ends early (exit 3) keeps what was read before its end.")]
+that ends early (exit 3) keeps what was read before its end, unless that
+is no sweep at all (\"0 sweeps read before the end\"): an empty outcome file
+or a recording without a sweep would pass for a replay, so none is written.")]
 pub struct Args {
     /// The trace (an MCAP file).
     #[arg(value_name = "TRACE")]
@@ -112,6 +114,12 @@ pub struct Args {
     /// per core]. The outputs do not depend on it.
     #[arg(long, value_name = "N")]
     pub threads: Option<usize>,
+    /// Print the summary as one JSON object on stdout instead of text on
+    /// stderr (sweeps, outcomes by kind, verdicts, expectations, fragile
+    /// decisions, tunnels, the files written, time), e.g. `--json
+    /// --outcomes run.jsonl`. Not with `--outcomes -`, which has stdout.
+    #[arg(long)]
+    pub json: bool,
 }
 
 /// Counts bytes read, for the progress bar.
@@ -141,10 +149,12 @@ impl<R: Read> Read for CountingReader<R> {
 pub fn run(args: Args) -> anyhow::Result<Exit> {
     let started = Instant::now();
     let trace_path = &args.trace;
-    let file =
-        File::open(trace_path).with_context(|| format!("opening {}", trace_path.display()))?;
+    let file = super::open_trace(trace_path)?;
     let total_bytes = file.metadata().map(|m| m.len()).unwrap_or(0);
     let source_name = trace_path.display().to_string();
+    if args.json && args.outcomes.as_deref() == Some(Path::new("-")) {
+        bail!("--json and --outcomes - both write to stdout: give --outcomes a file");
+    }
     if let Some(m) = args.margin {
         numbers::check(m, Rule::NonNegative).map_err(|e| anyhow::anyhow!("--margin {e}"))?;
     }
@@ -239,31 +249,131 @@ pub fn run(args: Args) -> anyhow::Result<Exit> {
         outputs.abandon();
         return Err(err).name_file_once("replaying", &source_name);
     }
+    // A trace that ends before its first sweep (a one-chunk trace cut
+    // anywhere in its chunk) leaves nothing worth a file: an empty outcome
+    // file or a recording without a sweep would pass for a replay.
+    if let Some(err) = trace_error.take_if(|_| summary.sweeps == 0) {
+        outputs.abandon();
+        eprintln!("error: {err:#}\n0 sweeps read before the end: nothing written");
+        if args.json {
+            println!(
+                "{}",
+                summary_json(&args, &summary, None, &[], Some(&err), started)
+            );
+        }
+        return Ok(Exit::IncompleteInput);
+    }
     let selection = summary.selection(&options);
     if selection.is_nothing() {
         outputs.abandon();
         bail!("{source_name}: {selection}; nothing written");
     }
     let streamed = outputs.streams_to_viewer();
-    for line in outputs.finish()? {
+    let wrote = outputs.finish()?;
+    for line in &wrote {
         eprintln!("{line}");
     }
     if streamed {
         eprintln!("streamed the recording to the viewer");
     }
-    eprint!("{}", summary.render_timed(Some(started.elapsed())));
+    if !args.json {
+        eprint!("{}", summary.render_timed(Some(started.elapsed())));
+    }
     if let Selection::Part { .. } = selection {
         eprintln!("{selection}");
     }
-    if let Some(err) = trace_error {
+    if let Some(err) = &trace_error {
         eprintln!(
-            "error: {err:#}\nthe outputs hold the {} read before it{}",
+            "error: {err:#}\n{} read before the end{}: the outputs hold them",
             numbers::counted(summary.sweeps, "sweep", "sweeps"),
             last_frame.map_or(String::new(), |f| format!(" (up to frame {f})"))
         );
-        return Ok(Exit::IncompleteInput);
     }
-    Ok(Exit::Success)
+    if args.json {
+        let selected = matches!(selection, Selection::Part { .. }).then(|| selection.to_string());
+        println!(
+            "{}",
+            summary_json(
+                &args,
+                &summary,
+                selected,
+                &wrote,
+                trace_error.as_deref(),
+                started
+            )
+        );
+    }
+    Ok(if trace_error.is_some() {
+        Exit::IncompleteInput
+    } else {
+        Exit::Success
+    })
+}
+
+/// `--json`'s summary: one object, the counts of [`ReplaySummary`]
+/// (`sweeptrace::replay`) by name, the files written (each "wrote" line),
+/// the selection of a filter that kept part of the trace, and `incomplete`
+/// (the error of a trace that ends early, or `null`).
+fn summary_json(
+    args: &Args,
+    summary: &sweeptrace::replay::ReplaySummary,
+    selection: Option<String>,
+    wrote: &[String],
+    truncation: Option<&sweeptrace::trace::TraceError>,
+    started: Instant,
+) -> String {
+    use serde_json::{Map, Value, json};
+    let counts = |pairs: Vec<(String, u64)>| -> Value {
+        Value::Object(
+            pairs
+                .into_iter()
+                .map(|(k, n)| (k, json!(n)))
+                .collect::<Map<_, _>>(),
+        )
+    };
+    let kinds = [
+        sweeptrace::Kind::Face,
+        sweeptrace::Kind::Edge,
+        sweeptrace::Kind::Vertex,
+        sweeptrace::Kind::None,
+    ];
+    let value = json!({
+        "trace": args.trace.display().to_string(),
+        "sweeps": summary.sweeps,
+        "filtered_out": summary.filtered_out,
+        "selection": selection,
+        "scenes": summary.scenes,
+        "collisions": summary.collisions(),
+        "outcomes": counts(kinds.iter().map(|k| (k.to_string(), summary.outcomes.get(k).copied().unwrap_or(0))).collect()),
+        "verdicts": counts(summary.verdicts.iter().map(|(v, n)| (v.as_str().to_string(), n)).collect()),
+        "skipped": counts(summary.skipped.iter().map(|(r, n)| (r.as_str().to_string(), n)).collect()),
+        "expected": {
+            "attached": summary.expected_matched,
+            "unmatched": summary.expected_unmatched,
+        },
+        "fragile": {
+            "count": summary.fragile,
+            "by_reason": counts(summary.fragile_by_reason.iter().map(|(r, n)| (r.as_str().to_string(), *n)).collect()),
+        },
+        "tunnels": {
+            "count": summary.tunnel_count(),
+            "by_kind": counts(summary.tunnels.iter().map(|(k, n)| (k.to_string(), *n)).collect()),
+            "first": summary.first_tunnels.iter().map(|t| json!({
+                "frame": t.frame,
+                "ball": t.ball,
+                "text": t.to_string(),
+            })).collect::<Vec<_>>(),
+        },
+        "degenerate_triangles": summary.degenerate_triangles,
+        "wrote": wrote,
+        "incomplete": truncation.map(|e| format!("{e:#}")),
+        "seconds": {
+            "total": started.elapsed().as_secs_f64(),
+            "core": summary.elapsed.as_secs_f64(),
+        },
+    });
+    serde_json::to_string_pretty(&value)
+        .unwrap_or_else(|e| format!("{{\"error\": {:?}}}", e.to_string()))
 }
 
 /// Where the recording goes, if anywhere: `--rrd`, `--spawn`,
@@ -353,8 +463,7 @@ impl Outputs {
         let recording = match target {
             None => None,
             Some(target) => {
-                let trace = File::open(trace_path)
-                    .with_context(|| format!("opening {}", trace_path.display()))?;
+                let trace = super::open_trace(trace_path)?;
                 let id = super::recording_id(BufReader::new(trace), "replay", options)
                     .with_context(|| format!("reading {}", trace_path.display()))?;
                 if let Some(path) = &target.file {

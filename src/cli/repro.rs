@@ -4,8 +4,6 @@
 use super::NameFileOnce;
 use std::path::PathBuf;
 
-use anyhow::Context;
-
 use super::Exit;
 use sweeptrace::regress::{ReproCase, find_sweep};
 use sweeptrace::trace::{TraceReader, write_trace_file};
@@ -44,7 +42,7 @@ pub struct Args {
 pub fn run(args: Args) -> anyhow::Result<Exit> {
     let tolerances = args.tolerances.to_tolerances()?;
     let shown = args.trace.display().to_string();
-    let file = std::fs::File::open(&args.trace).with_context(|| format!("cannot open {shown}"))?;
+    let file = super::open_trace(&args.trace)?;
     let reader = TraceReader::new_indexed(std::io::BufReader::new(file), &shown);
     let found = find_sweep(reader, &shown, args.frame, args.ball)?;
     let case = ReproCase::build(&shown, &found, &tolerances)?;

@@ -77,7 +77,7 @@ pub fn run(args: Args) -> anyhow::Result<Exit> {
     let (name, mesh, sweep, options) = if let Some(path) = &args.trace {
         let frame = args.frame.context("--trace needs --frame")?;
         let shown = path.display().to_string();
-        let file = std::fs::File::open(path).with_context(|| format!("cannot open {shown}"))?;
+        let file = super::open_trace(path)?;
         let reader = TraceReader::new_indexed(std::io::BufReader::new(file), &shown);
         let found = find_sweep(reader, &shown, frame, args.ball)?;
         let mesh = sweeptrace::Mesh::new(found.scene.vertices.clone(), &found.scene.triangles)

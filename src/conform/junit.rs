@@ -111,8 +111,11 @@ fn rule_case(rule: &RuleReport, classname: &str) -> Case {
     let result = match first {
         Some(first) if rule.failed > 0 => CaseResult::Failure(Problem {
             message: format!(
-                "{} of {} cases fail; first failing case: {first}",
-                rule.failed, rule.cases
+                "{} of {} {} {}; first failing case: {first}",
+                rule.failed,
+                rule.cases,
+                crate::numbers::plural(rule.cases, "case"),
+                crate::numbers::verb(rule.failed, "fails", "fail")
             ),
             kind: if rule
                 .first_failure

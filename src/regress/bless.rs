@@ -93,6 +93,21 @@ pub enum BlessError {
     },
 }
 
+impl BlessError {
+    /// Whether the input ends early (it is truncated): nothing is written
+    /// then, since a blessed trace would lose the sweeps after the cut.
+    pub fn is_truncation(&self) -> bool {
+        match self {
+            BlessError::Replay {
+                cause: ReplayError::Trace(e),
+                ..
+            } => e.is_truncation(),
+            BlessError::Trace { cause } => cause.is_truncation(),
+            _ => false,
+        }
+    }
+}
+
 /// A replay error in words, naming the file once: a read error names it
 /// already; the other errors (an invalid scene or sweep) do not.
 fn replay_error_text(file: &str, cause: &ReplayError) -> String {

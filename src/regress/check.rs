@@ -358,6 +358,12 @@ impl<'a> ReportBuilder<'a> {
     /// sweep diverged, the inference of the engine's configuration.
     fn finish(mut self, summary: &ReplaySummary) -> TraceReport {
         let report = &mut self.report;
+        // A --frames or --ball filter that keeps no sweep compares nothing:
+        // an error naming what the trace has, as `replay` gives.
+        let selection = summary.selection(&self.options.replay);
+        if selection.is_nothing() && report.errors.len() < MAX_ERRORS {
+            report.errors.push(selection.to_string());
+        }
         report.expectations.unmatched = summary.expected_unmatched;
         report.expectations.read = summary.expected_matched + summary.expected_unmatched;
         if report.divergent + report.fragile.count > 0 {
@@ -396,7 +402,13 @@ pub fn divergence_details(
         margin: result.options().margin,
         facing: result.options().facing,
         got_explanation: explain_outcome(&result.outcome, &records),
-        expected_tests: expected_tests(&expected, &result.outcome, &records, Some(&result.scene)),
+        expected_tests: expected_tests(
+            &expected,
+            &result.outcome,
+            &records,
+            Some(&result.scene),
+            result.sweep.radius - result.options().margin,
+        ),
     }
 }
 
@@ -437,6 +449,11 @@ pub fn frames_around(
 /// report with [`Status::Error`].
 pub fn check_file(path: &std::path::Path, options: &CheckOptions) -> TraceReport {
     let name = path.display().to_string();
+    if let Some(text) = crate::sim::obj_instead_of_trace(path) {
+        let mut report = check_events(std::iter::empty(), &name, options);
+        report.add_error(text);
+        return report;
+    }
     match std::fs::File::open(path) {
         Ok(file) => check_trace(
             TraceReader::new_indexed(std::io::BufReader::with_capacity(1 << 16, file), &name),

@@ -325,8 +325,20 @@ pub fn diff(a: &Side, b: &Side, tolerances: &Tolerances) -> DiffReport {
                 b: ob,
                 a_explanation: explain_outcome(&ra.outcome, &records_a),
                 b_explanation: explain_outcome(&rb.outcome, &records_b),
-                a_test_in_b: expected_tests(&oa, &rb.outcome, &records_b, Some(&rb.scene)),
-                b_test_in_a: expected_tests(&ob, &ra.outcome, &records_a, Some(&ra.scene)),
+                a_test_in_b: expected_tests(
+                    &oa,
+                    &rb.outcome,
+                    &records_b,
+                    Some(&rb.scene),
+                    rb.sweep.radius - rb.options().margin,
+                ),
+                b_test_in_a: expected_tests(
+                    &ob,
+                    &ra.outcome,
+                    &records_a,
+                    Some(&ra.scene),
+                    ra.sweep.radius - ra.options().margin,
+                ),
             });
         }
     }

@@ -21,6 +21,10 @@ pub struct ExpectedTest {
     pub verdict: Option<Verdict>,
     /// Why it did not decide the sweep, in words.
     pub why_not: String,
+    /// The known mistake whose α is the expected one on this test
+    /// ([`super::KNOWN_MISTAKES`]'s name), if any; `why_not`
+    /// says it in words.
+    pub mistake: Option<&'static str>,
 }
 
 /// Re-runs a sweep with every test recorded (the same core, every triangle
@@ -65,12 +69,14 @@ pub fn explain_outcome(outcome: &Outcome, records: &[TestRecord]) -> Vec<String>
 }
 
 /// The tests that would have produced `expected`, each with why it did not
-/// decide the sweep.
+/// decide the sweep (and, when the expected α is what a known mistake
+/// gives on it with the sweep's `rho`, the mistake).
 pub fn expected_tests(
     expected: &OutcomeMsg,
     got: &Outcome,
     records: &[TestRecord],
     scene: Option<&SceneState>,
+    rho: f64,
 ) -> Vec<ExpectedTest> {
     if expected.kind == Kind::None {
         return Vec::new();
@@ -82,7 +88,7 @@ pub fn expected_tests(
             .iter()
             .filter(|r| r.kind() == expected.kind && r.verdict() == Verdict::Hit)
             .take(3)
-            .map(|r| expected_test(r, expected, got))
+            .map(|r| expected_test(r, expected, got, rho))
             .collect();
     };
     let feature = expected.feature.flatten();
@@ -125,17 +131,19 @@ pub fn expected_tests(
             description: why.clone(),
             verdict: None,
             why_not: why,
+            mistake: None,
         }];
     }
     found
         .into_iter()
-        .map(|r| expected_test(r, expected, got))
+        .map(|r| expected_test(r, expected, got, rho))
         .collect()
 }
 
-fn expected_test(r: &TestRecord, expected: &OutcomeMsg, got: &Outcome) -> ExpectedTest {
+fn expected_test(r: &TestRecord, expected: &OutcomeMsg, got: &Outcome, rho: f64) -> ExpectedTest {
     let verdict = r.verdict();
     let decides = got.is_reported_by(r);
+    let mistake = super::mistakes::known_mistake(r, rho, expected.alpha);
     let why_not = match r.alpha() {
         None => format!("it reports no collision ({verdict})"),
         Some(a) if decides && a == expected.alpha => format!(
@@ -149,12 +157,20 @@ fn expected_test(r: &TestRecord, expected: &OutcomeMsg, got: &Outcome) -> Expect
                 (x, y) if x == y => (a.to_string(), expected.alpha.to_string()),
                 short => short,
             };
-            format!(
-                "it is the test that decides the sweep, at α = {here} where the \
-                 compared answer has α = {there}: the same test with other numbers (a \
-                 computation less precise than the tolerances, or another margin or \
-                 facing rule)"
-            )
+            match mistake {
+                Some(m) => format!(
+                    "it is the test that decides the sweep, at α = {here} where the \
+                     compared answer has α = {there}: the same test, computed with a \
+                     known mistake: {}",
+                    m.words
+                ),
+                None => format!(
+                    "it is the test that decides the sweep, at α = {here} where the \
+                     compared answer has α = {there}: the same test with other numbers (a \
+                     computation less precise than the tolerances, or another margin or \
+                     facing rule)"
+                ),
+            }
         }
         Some(a) if got.is_hit() && !got.ties_with(a) => format!(
             "it hits at α = {}, later than the primary collision at α = {}",
@@ -174,10 +190,21 @@ fn expected_test(r: &TestRecord, expected: &OutcomeMsg, got: &Outcome) -> Expect
         ),
         Some(a) => format!("it hits at α = {} but the sweep reports none", num(a)),
     };
+    // Where the mistake is not said yet, after the reason.
+    let why_not = match mistake {
+        Some(m) if !why_not.contains(m.words) => format!(
+            "{why_not}; the compared answer's α = {} is what this test gives with a known \
+             mistake: {}",
+            num(expected.alpha),
+            m.words
+        ),
+        _ => why_not,
+    };
     ExpectedTest {
         test: label(r),
         description: describe(r),
         verdict: Some(verdict),
         why_not,
+        mistake: mistake.map(|m| m.name),
     }
 }

@@ -35,7 +35,22 @@ pub(super) fn count_ghosts(ghosts: &mut Ghosts, result: &SweepResult, judged: &J
                 }
             }
             GhostJudgement::NoNormal => ghosts.unjudged += 1,
+            // An edge or vertex contact that does not say where it is (no
+            // triangle or feature) cannot be placed, so cannot be judged.
+            GhostJudgement::NotApplicable if unplaced(outcome) => ghosts.unjudged += 1,
             GhostJudgement::Fine | GhostJudgement::NotApplicable => {}
         }
     }
+}
+
+/// Whether `outcome` is an edge or vertex contact without its triangle or
+/// its feature.
+fn unplaced(outcome: &crate::trace::OutcomeMsg) -> bool {
+    matches!(
+        outcome.kind,
+        crate::core::Kind::Edge | crate::core::Kind::Vertex
+    ) && !matches!(
+        (outcome.triangle, outcome.feature),
+        (Some(Some(_)), Some(Some(_)))
+    )
 }

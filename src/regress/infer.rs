@@ -119,6 +119,11 @@ impl Inferred {
                 num(s.median),
                 num(s.max)
             ),
+            (None, Some(s)) if self.face_hits == 1 => format!(
+                "no valid margin (the 1 expected face hit gives ε = {}: not 0 ≤ ε < r; the \
+                 scenes' margins kept)",
+                num(s.median)
+            ),
             (None, Some(s)) => format!(
                 "no valid margin (the {} expected face hits give ε from {} to {}, median {}: \
                  not 0 ≤ ε < r; the scenes' margins kept)",
@@ -150,9 +155,13 @@ impl Inferred {
         let mut lines = vec![format!("inferred engine configuration: {margin}, {facing}")];
         if self.back_facing_hits > 0 {
             lines.push(format!(
-                "{} expected hits are back-facing (n·d > 0, first at frame {}): no facing rule allows them",
-                self.back_facing_hits,
-                self.back_facing_frame.unwrap_or_default()
+                "{} back-facing (n·d > 0, first at frame {}): no facing rule allows {}",
+                match self.back_facing_hits {
+                    1 => "1 expected hit is".to_string(),
+                    n => format!("{n} expected hits are"),
+                },
+                self.back_facing_frame.unwrap_or_default(),
+                crate::numbers::verb(self.back_facing_hits, "it", "them")
             ));
         }
         let with_margin = match self.replayed_margin {

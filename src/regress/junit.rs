@@ -66,8 +66,11 @@ pub fn first_problem(r: &TraceReport) -> Option<String> {
                     (None, None) => "not kept".to_string(),
                 };
                 parts.push(format!(
-                    "{} of {} compared sweeps diverge; first divergence: {first}",
-                    r.divergent, r.compared
+                    "{} of {} compared {} {}; first divergence: {first}",
+                    r.divergent,
+                    r.compared,
+                    crate::numbers::plural(r.compared, "sweep"),
+                    crate::numbers::verb(r.divergent, "diverges", "diverge")
                 ));
             }
             if r.fails_on_tunnels() {

@@ -44,6 +44,7 @@ mod infer;
 mod infer_conventions;
 mod judge;
 mod junit;
+mod mistakes;
 mod precision;
 mod render;
 mod report;
@@ -58,6 +59,7 @@ pub use compare::{
     DEFAULT_ALPHA_TOLERANCE, DEFAULT_CONTACT_TOLERANCE, DEFAULT_NORMAL_TOLERANCE_DEGREES, Field,
     FieldDiff, FieldSet, TieRule, Tolerances, angle_degrees, compare,
 };
+pub use config::excluded_by;
 pub use config::{
     ConfigError, ConfigFile, EngineOverrides, EngineSettings, Overrides, Setting, Settings, Source,
     normalize, render_settings_json, render_settings_text, resolve, settings_for,
@@ -70,7 +72,7 @@ pub use decision::{decision_line, divergence};
 pub use diff::{
     DiffReport, FirstDifference, Side, diff, render_diff_json, render_diff_text, scene_differences,
 };
-pub use discovery::{DiscoveryError, find_traces};
+pub use discovery::{DiscoveryError, find_traces, foxglove_output};
 pub use engine_check::check_file_with_engine;
 pub use explain::ExpectedTest;
 pub(crate) use explain::{expected_tests, explain_outcome, explained_records};
@@ -78,6 +80,7 @@ pub use infer::{Inferred, Spread};
 pub use infer_conventions::{Evidence, InferredConventions, Trial, infer_conventions};
 pub use judge::{Agreement, Perturbation, Reproduced, agreement, agreement_of};
 pub use junit::{check_junit, github_annotations};
+pub use mistakes::{KNOWN_MISTAKES, Mistake, known_mistake};
 pub use precision::{F32_OPERATIONS, F32_UNIT, Precision, Sensitivity};
 pub use render::{Sides, render_divergence, render_json, render_text};
 pub(crate) use render::{divergence_line, render_divergence_as, values_text};

@@ -106,7 +106,7 @@ pub fn render_divergence_as(d: &Divergence, indent: &str, sides: Sides) -> Strin
     let mut s = String::new();
     let _ = writeln!(
         s,
-        "{indent}frame {}, ball {}: {} differ (margin {}, facing {}{})",
+        "{indent}frame {}, ball {}: {} {} (margin {}, facing {}{})",
         d.frame,
         d.ball,
         d.fields
@@ -114,6 +114,7 @@ pub fn render_divergence_as(d: &Divergence, indent: &str, sides: Sides) -> Strin
             .map(|f| f.field.as_str())
             .collect::<Vec<_>>()
             .join(", "),
+        crate::numbers::verb(d.fields.len() as u64, "differs", "differ"),
         num(d.margin),
         d.facing,
         if d.fragile.is_robust() {
@@ -176,7 +177,18 @@ pub fn render_divergence_as(d: &Divergence, indent: &str, sides: Sides) -> Strin
         );
     } else {
         for t in &d.expected_tests {
-            let _ = writeln!(s, "{indent}  {whose} test: {}", t.description);
+            // The test that decided the sweep, described just above: named,
+            // not described again.
+            let primary = format!("primary: {}", t.description);
+            if d.got_explanation.contains(&primary) {
+                let _ = writeln!(
+                    s,
+                    "{indent}  {whose} test: the same test, {} (the primary above)",
+                    t.test
+                );
+            } else {
+                let _ = writeln!(s, "{indent}  {whose} test: {}", t.description);
+            }
             let _ = writeln!(s, "{indent}    why not: {}", t.why_not);
         }
     }
@@ -294,8 +306,8 @@ fn counts_text(r: &TraceReport) -> String {
     if r.fragile.count > 0 {
         let _ = write!(
             counts,
-            ", {} fragile divergences ({}){}",
-            r.fragile.count,
+            ", {} ({}){}",
+            crate::numbers::counted(r.fragile.count, "fragile divergence", "fragile divergences"),
             names_and_counts(&r.fragile.by_reason),
             if r.fragile.strict {
                 ", failures under --strict"
@@ -335,6 +347,17 @@ fn counts_text(r: &TraceReport) -> String {
             ghost_words(r.ghosts.count)
         );
     }
+    if r.ghosts.unjudged > 0 {
+        let _ = write!(
+            counts,
+            ", {} not judged for ghost contacts (without a triangle, feature or normal)",
+            crate::numbers::counted(
+                r.ghosts.unjudged,
+                "edge or vertex contact",
+                "edge or vertex contacts"
+            )
+        );
+    }
     counts
 }
 
@@ -353,9 +376,11 @@ fn failures(r: &TraceReport) -> Vec<String> {
     let mut failures: Vec<String> = Vec::new();
     if r.divergent > 0 || !(r.fails_on_tunnels() || r.fails_on_ghosts()) {
         failures.push(format!(
-            "{} of {} compared sweeps diverge ({})",
+            "{} of {} compared {} {} ({})",
             r.divergent,
             r.compared,
+            crate::numbers::plural(r.compared, "sweep"),
+            crate::numbers::verb(r.divergent, "diverges", "diverge"),
             names_and_counts(&r.divergences.by_kind)
         ));
     }
@@ -398,8 +423,9 @@ fn write_tunnels_and_ghosts(s: &mut String, r: &TraceReport) {
     if r.tunnels.count as usize > r.tunnels.details.len() {
         let _ = writeln!(
             s,
-            "  ... {} more tunnels",
-            r.tunnels.count as usize - r.tunnels.details.len()
+            "  ... {} more {}",
+            r.tunnels.count as usize - r.tunnels.details.len(),
+            tunnel_words(r.tunnels.count - r.tunnels.details.len() as u64)
         );
     }
     for g in &r.ghosts.contacts {
@@ -408,8 +434,8 @@ fn write_tunnels_and_ghosts(s: &mut String, r: &TraceReport) {
     if r.ghosts.count as usize > r.ghosts.contacts.len() {
         let _ = writeln!(
             s,
-            "  ... {} more ghost contacts",
-            r.ghosts.count as usize - r.ghosts.contacts.len()
+            "  ... {} more",
+            ghost_words(r.ghosts.count - r.ghosts.contacts.len() as u64)
         );
     }
 }

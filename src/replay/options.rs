@@ -118,6 +118,14 @@ impl std::str::FromStr for FrameRange {
                 start: bound(a)?,
                 end: bound(b)?,
             }
+        } else if let Some((a, b)) = s.split_once(['-', ':']).filter(|(a, b)| {
+            bound(a).is_ok_and(|a| a.is_some()) && bound(b).is_ok_and(|b| b.is_some())
+        }) {
+            let (a, b) = (a.trim(), b.trim());
+            return Err(format!(
+                "`{s}` is not a frame range: did you mean `{a}..{b}` (frames {a} to {b}, \
+                 {b} excluded) or `{a}..={b}` ({b} included)?"
+            ));
         } else {
             let f = bound(s)?.ok_or_else(|| "empty frame range".to_string())?;
             FrameRange {

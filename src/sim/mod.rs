@@ -39,7 +39,7 @@ mod obj;
 pub mod scenes;
 
 use crate::trace::{OutcomeMsg, SceneMsg, SweepMsg};
-pub use obj::{ObjError, load_obj, obj_from_reader};
+pub use obj::{ObjError, load_obj, obj_from_reader, obj_instead_of_trace};
 use scenes::SceneMesh;
 
 /// Largest number of simulation frames.

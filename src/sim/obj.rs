@@ -6,7 +6,16 @@ use super::scenes::SceneMesh;
 #[derive(Debug, thiserror::Error)]
 #[non_exhaustive]
 pub enum ObjError {
-    /// The file could not be opened or read.
+    /// The file could not be opened (the wording every command gives
+    /// for a file it cannot open).
+    #[error("{path}: cannot open: {}", crate::error_text::full_text(.cause))]
+    Open {
+        /// The file.
+        path: String,
+        /// The cause.
+        cause: std::io::Error,
+    },
+    /// The file could not be read.
     #[error("cannot read {path}: {}", crate::error_text::full_text(.cause))]
     Io {
         /// The file.
@@ -37,7 +46,7 @@ pub enum ObjError {
 /// front, as in the OBJ convention. Coordinates are read as `f32`.
 pub fn load_obj(path: &std::path::Path) -> Result<SceneMesh, ObjError> {
     let shown = path.display().to_string();
-    let file = std::fs::File::open(path).map_err(|cause| ObjError::Io {
+    let file = std::fs::File::open(path).map_err(|cause| ObjError::Open {
         path: shown.clone(),
         cause,
     })?;
@@ -173,4 +182,62 @@ fn parse(mut text: &[u8]) -> Result<SceneMesh, ObjError> {
         vertices,
         triangles,
     })
+}
+
+/// How much of a file [`obj_instead_of_trace`] reads.
+const OBJ_PROBE_BYTES: u64 = 1 << 16;
+
+/// When the file at `path`, given where a trace is expected, is a
+/// Wavefront OBJ file (text whose lines are OBJ statements, with a vertex
+/// among them, judged on its first 64 KiB), the error that says so and
+/// what to use instead: `level.obj: this is an OBJ file: use `mesh` or
+/// `--mesh` (...)`. `None` for anything else, the MCAP magic included.
+pub fn obj_instead_of_trace(path: &std::path::Path) -> Option<String> {
+    use std::io::Read;
+    let mut head = Vec::new();
+    std::fs::File::open(path)
+        .ok()?
+        .take(OBJ_PROBE_BYTES)
+        .read_to_end(&mut head)
+        .ok()?;
+    if !looks_like_obj(&head) {
+        return None;
+    }
+    let shown = path.display();
+    Some(format!(
+        "{shown}: this is an OBJ file: use `mesh` or `--mesh` (`sweeptrace mesh {shown}`, \
+         `sweeptrace sweep --mesh {shown} --from X,Y,Z --to X,Y,Z`, \
+         `sweeptrace record --mesh {shown}` to record a trace over it)"
+    ))
+}
+
+/// Whether `head`, the start of a file, is OBJ text: every complete line
+/// blank, a comment or an OBJ statement, at least one of them a vertex.
+fn looks_like_obj(head: &[u8]) -> bool {
+    const STATEMENTS: &[&str] = &[
+        "v", "vn", "vt", "vp", "f", "l", "p", "o", "g", "s", "mtllib", "usemtl",
+    ];
+    if head.starts_with(b"\x89MCAP") || head.contains(&0) {
+        return false;
+    }
+    // The last line may be cut by the probe's end: only complete ones.
+    let complete = match head.iter().rposition(|&b| b == b'\n') {
+        Some(end) if head.len() as u64 >= OBJ_PROBE_BYTES => &head[..end],
+        _ => head,
+    };
+    let Ok(text) = std::str::from_utf8(complete) else {
+        return false;
+    };
+    let mut vertex = false;
+    for line in text.lines().map(str::trim) {
+        if line.is_empty() || line.starts_with('#') {
+            continue;
+        }
+        let keyword = line.split_whitespace().next().unwrap_or("");
+        if !STATEMENTS.contains(&keyword) {
+            return false;
+        }
+        vertex |= keyword == "v";
+    }
+    vertex
 }

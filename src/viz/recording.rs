@@ -112,13 +112,24 @@ pub enum RecordingError {
         /// What failed.
         cause: RecordError,
     },
+    /// The viewer `--spawn` started exited before it listened (as it does
+    /// without a display).
+    #[error(
+        "the Rerun viewer that --spawn started exited ({status}) before it could take the \
+         recording, as it does without a display: see its messages above, or write a file \
+         with --rrd and open it where there is one"
+    )]
+    ViewerExited {
+        /// How it ended (`exit status 1`, `killed by signal 9`).
+        status: String,
+    },
     /// The viewer did not take the recording.
     #[error(
         "streaming to the viewer at {at}: {what}; is a Rerun viewer running there? \
          (start one with `rerun`, or write a file with --rrd)"
     )]
     Unreachable {
-        /// The viewer's address, or "the spawned viewer".
+        /// The viewer's address (for `--spawn`, the one it was started on).
         at: String,
         /// What happened, with how long it was tried.
         what: String,
@@ -138,6 +149,8 @@ pub struct Recording {
     logger: Logger,
     file: Option<(PendingFile, RrdFileWriter)>,
     viewer: Viewer,
+    /// The address of the viewer `--spawn` started.
+    spawned_url: Option<String>,
     since: Instant,
 }
 
@@ -185,6 +198,7 @@ impl Recording {
         let since = Instant::now();
         let mut sinks: Vec<Box<dyn LogSink>> = Vec::new();
         let mut file = None;
+        let mut spawned_url = None;
         if let Some(path) = &target.file {
             let pending = PendingFile::new(path).map_err(|cause| RecordingError::Temporary {
                 target: path.clone(),
@@ -207,7 +221,13 @@ impl Recording {
                     }
                 })?;
                 let url = format!("rerun+http://127.0.0.1:{}/proxy", info.port);
+                // Before any stream to it exists (dropping one to a viewer
+                // that is gone would wait forever).
+                if let Some(pid) = info.child_pid {
+                    wait_for_spawned_viewer(pid, info.port, VIEWER_FLUSH_TIMEOUT)?;
+                }
                 sinks.push(Box::new(GrpcSink::new(parse_address(&url)?)));
+                spawned_url = Some(url);
             }
             Viewer::Connect(url) => sinks.push(Box::new(GrpcSink::new(parse_address(url)?))),
         }
@@ -242,6 +262,7 @@ impl Recording {
             logger,
             file,
             viewer: target.viewer,
+            spawned_url,
             since,
         })
     }
@@ -282,7 +303,10 @@ impl Recording {
                     std::mem::forget(rec);
                     let at = match viewer {
                         Viewer::Connect(url) => url.clone(),
-                        _ => "the spawned viewer".to_string(),
+                        _ => format!(
+                            "{} (started by --spawn)",
+                            self.spawned_url.as_deref().unwrap_or("an unknown address")
+                        ),
                     };
                     // One figure: how long the stream tried, from its start.
                     let tried = self.since.elapsed().as_secs_f64();
@@ -323,6 +347,80 @@ impl Recording {
             std::mem::forget(self.logger);
         }
     }
+}
+
+/// How often [`wait_for_spawned_viewer`] looks.
+const VIEWER_POLL: Duration = Duration::from_millis(50);
+
+/// How long a launcher that exited successfully is given for the viewer it
+/// started to listen (a launcher may start the viewer and exit).
+const VIEWER_EXIT_GRACE: Duration = Duration::from_millis(1500);
+
+/// Waits, up to `limit`, for the viewer `--spawn` started (process `pid`)
+/// to listen on `port`, noticing when it exits first: that is
+/// [`RecordingError::ViewerExited`] at once (a failure status) or when it
+/// still does not listen [`VIEWER_EXIT_GRACE`] after its exit. A viewer
+/// that neither listens nor exits within `limit` is left to the stream's
+/// own timeout.
+fn wait_for_spawned_viewer(pid: u32, port: u16, limit: Duration) -> Result<(), RecordingError> {
+    let address = std::net::SocketAddr::from(([127, 0, 0, 1], port));
+    let start = Instant::now();
+    let mut exited: Option<(Instant, String)> = None;
+    loop {
+        if std::net::TcpStream::connect_timeout(&address, VIEWER_POLL).is_ok() {
+            return Ok(());
+        }
+        if exited.is_none()
+            && let Some((success, status)) = reap(pid)
+        {
+            if !success {
+                return Err(RecordingError::ViewerExited { status });
+            }
+            exited = Some((Instant::now(), status));
+        }
+        if let Some((at, status)) = &exited
+            && at.elapsed() >= VIEWER_EXIT_GRACE
+        {
+            return Err(RecordingError::ViewerExited {
+                status: status.clone(),
+            });
+        }
+        if start.elapsed() >= limit {
+            return Ok(());
+        }
+        std::thread::sleep(VIEWER_POLL);
+    }
+}
+
+/// Whether the child process `pid` has exited, without waiting: whether it
+/// succeeded and its status in words (`exit status 1`).
+#[cfg(unix)]
+fn reap(pid: u32) -> Option<(bool, String)> {
+    let pid = libc::pid_t::try_from(pid).ok()?;
+    let mut status: libc::c_int = 0;
+    // SAFETY: `status` is a valid out pointer; WNOHANG never blocks, and
+    // `pid` is a child this process started (the SDK's spawn).
+    let reaped = unsafe { libc::waitpid(pid, &mut status, libc::WNOHANG) };
+    if reaped != pid {
+        return None;
+    }
+    if libc::WIFEXITED(status) {
+        let code = libc::WEXITSTATUS(status);
+        Some((code == 0, format!("exit status {code}")))
+    } else if libc::WIFSIGNALED(status) {
+        Some((
+            false,
+            format!("killed by signal {}", libc::WTERMSIG(status)),
+        ))
+    } else {
+        Some((false, "ended".to_string()))
+    }
+}
+
+/// Elsewhere the exit is not looked for: the stream's timeout applies.
+#[cfg(not(unix))]
+fn reap(_pid: u32) -> Option<(bool, String)> {
+    None
 }
 
 fn parse_address(url: &str) -> Result<rerun::external::re_uri::ProxyUri, RecordingError> {

@@ -48,6 +48,7 @@ struct RawFile {
     strict: Option<Spanned<bool>>,
     allow_tunnels: Option<Spanned<bool>>,
     tolerances: Option<RawTolerances>,
+    exclude: Option<Spanned<Vec<Spanned<String>>>>,
     engine: Option<RawEngine>,
     #[serde(default)]
     traces: Vec<RawBlock>,
@@ -101,6 +102,9 @@ pub struct ConfigFile {
     name: String,
     top: Layer,
     blocks: Vec<TracesBlock>,
+    /// `exclude`: the globs (as written, and compiled) of the files a
+    /// search of a folder leaves out.
+    exclude: Vec<(String, globset::GlobMatcher)>,
 }
 
 /// Reads a file's text, line by line, to turn byte offsets into places.
@@ -300,22 +304,29 @@ impl ConfigFile {
             places.engine(engine, &mut top)?;
         }
         let mut blocks = Vec::with_capacity(raw.traces.len());
-        for block in &raw.traces {
-            let pattern = &block.pattern;
-            let matcher = globset::GlobBuilder::new(pattern.get_ref())
+        let glob = |key: &str, pattern: &Spanned<String>| {
+            globset::GlobBuilder::new(pattern.get_ref())
                 .literal_separator(true)
                 .build()
+                .map(|g| g.compile_matcher())
                 .map_err(|e| {
                     places.error(
                         pattern,
                         format!(
-                            "`match`: `{}` is not a glob: {}",
+                            "`{key}`: `{}` is not a glob: {}",
                             pattern.get_ref(),
                             e.kind()
                         ),
                     )
-                })?
-                .compile_matcher();
+                })
+        };
+        let mut exclude = Vec::new();
+        for pattern in raw.exclude.as_ref().map_or(&[][..], |l| l.get_ref()) {
+            exclude.push((pattern.get_ref().clone(), glob("exclude", pattern)?));
+        }
+        for block in &raw.traces {
+            let pattern = &block.pattern;
+            let matcher = glob("match", pattern)?;
             let layer = places.layer(
                 &block.fields,
                 &block.strict,
@@ -329,6 +340,7 @@ impl ConfigFile {
             name: name.to_string(),
             top,
             blocks,
+            exclude,
         })
     }
 
@@ -351,6 +363,26 @@ impl ConfigFile {
         &self.name
     }
 
+    /// The `exclude` glob of this file that matches `trace` (relative to
+    /// the file's folder), if any: a search of a folder leaves the trace
+    /// out.
+    pub fn excludes(&self, trace: &Path) -> Option<&str> {
+        let relative = self.relative(trace)?;
+        self.exclude
+            .iter()
+            .find(|(_, m)| m.is_match(&relative))
+            .map(|(pattern, _)| pattern.as_str())
+    }
+
+    /// `trace` relative to the file's folder (`None` when not below it).
+    fn relative(&self, trace: &Path) -> Option<PathBuf> {
+        let dir = normalize(self.path.parent().unwrap_or(Path::new("")));
+        normalize(trace)
+            .strip_prefix(&dir)
+            .map(Path::to_path_buf)
+            .ok()
+    }
+
     /// Applies the file to `settings` for `trace`: its top level, then the
     /// `[[traces]]` blocks that match the trace, in order.
     pub(super) fn apply(&self, trace: &Path, settings: &mut Settings) {
@@ -358,8 +390,7 @@ impl ConfigFile {
         if self.blocks.is_empty() {
             return;
         }
-        let dir = normalize(self.path.parent().unwrap_or(Path::new("")));
-        let Ok(relative) = normalize(trace).strip_prefix(&dir).map(Path::to_path_buf) else {
+        let Some(relative) = self.relative(trace) else {
             return;
         };
         for block in &self.blocks {

@@ -23,6 +23,8 @@
 //! fields = ["kind", "triangle", "feature", "alpha", "contact"]
 //! strict = false
 //! allow_tunnels = false
+//! # Files a search of this folder leaves out (globs relative to it).
+//! exclude = ["scratch/**", "*.partial.mcap"]
 //!
 //! [tolerances]
 //! alpha = 1e-5
@@ -140,4 +142,20 @@ pub fn settings_for(trace: &Path, command_line: &Overrides) -> Result<Settings, 
         cause: e.to_string(),
     })?;
     Ok(resolve(&files, &absolute, command_line))
+}
+
+/// The `exclude` glob that leaves `trace` out of a search of a folder, and
+/// the configuration file that has it (named relative to the working
+/// directory when under it):
+/// the nearest file's globs first, then the farther ones'. Globs are
+/// relative to their file's folder.
+pub fn excluded_by(trace: &Path) -> Result<Option<(String, String)>, ConfigError> {
+    let absolute = std::path::absolute(trace).map_err(|e| ConfigError::Read {
+        file: trace.display().to_string(),
+        cause: e.to_string(),
+    })?;
+    Ok(load_config_files(trace)?.iter().find_map(|file| {
+        file.excludes(&absolute)
+            .map(|pattern| (file.name().to_string(), pattern.to_string()))
+    }))
 }

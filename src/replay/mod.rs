@@ -24,6 +24,7 @@
 mod error;
 mod ghost;
 mod iter;
+mod normals;
 mod options;
 mod pipeline;
 mod primary;
@@ -38,6 +39,7 @@ pub(crate) use ghost::{GhostLine, ghost_point};
 pub use iter::{
     DEFAULT_BATCH_EVENTS, ParallelReplayIter, ReplayIter, replay_events, replay_events_parallel,
 };
+pub use normals::SceneNormals;
 pub use options::{ACTIVE_EDGE_DEGREES, Detail, FrameRange, NormalRule, ReplayOptions};
 #[cfg(feature = "viewer")]
 pub(crate) use pipeline::sweep_of;
@@ -46,7 +48,7 @@ pub use pipeline::{
     run_pipeline_unrecorded,
 };
 pub use primary::{CollectPrimary, primary_records};
-pub use replayer::{Replay, ReplayEvent, SceneNormals, SceneState, SweepResult, feature_class};
+pub use replayer::{Replay, ReplayEvent, SceneState, SweepResult, feature_class};
 pub use selection::{Selection, SweepExtent};
 pub use summary::{ReplaySummary, TunnelAt};
 pub use tunnel::{Through, Tunnel, TunnelKind};

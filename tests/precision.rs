@@ -3,7 +3,9 @@
 //! (what an exact engine fed `f32` coordinates answers) are accepted at
 //! `precision = "f32"` and mostly refused at `f64`; the same answers with
 //! `α` moved by ten times the sweep's reported bound are refused. Seeded
-//! random sweeps over a bumpy height field (faces, edges and vertices hit).
+//! random sweeps over a bumpy height field (faces, edges and vertices hit),
+//! and sweeps that graze an edge, where the first-order bound is infinite
+//! and the bound grows as the square root of the budget.
 
 use anyhow::ensure;
 use libtest_mimic::Trial;
@@ -19,6 +21,7 @@ pub fn tests() -> Vec<Trial> {
     vec![
         trial!(answers_for_inputs_rounded_to_f32_are_accepted_at_f32),
         trial!(alpha_moved_by_ten_bounds_is_refused_at_f32),
+        trial!(grazing_edge_contacts_have_finite_square_root_bounds),
     ]
 }
 
@@ -160,7 +163,7 @@ fn alpha_moved_by_ten_bounds_is_refused_at_f32() -> anyhow::Result<()> {
             continue;
         };
         let Some(hit) = r.outcome.hit else { continue };
-        let bound = F32_OPERATIONS * s.alpha;
+        let bound = s.bounds(F32_OPERATIONS).alpha;
         // Only where ten bounds keep α inside [0, 1] (and the sweep away
         // from a grazing contact, where the bound is the whole path).
         let moved = hit.alpha + 10.0 * bound;
@@ -183,5 +186,90 @@ fn alpha_moved_by_ten_bounds_is_refused_at_f32() -> anyhow::Result<()> {
     }
     ensure!(tried > 200, "only {tried} sweeps tried");
     ensure!(refused == tried, "{refused} of {tried} refused");
+    Ok(())
+}
+
+/// One triangle in the plane `z = 0` (front up) whose edge from
+/// `(1000, 995)` to `(1000, 1005)` faces `+x`.
+fn edge_scene() -> SceneMsg {
+    SceneMsg {
+        name: Some("edge".into()),
+        vertices: vec![
+            [1000.0, 995.0, 0.0],
+            [1000.0, 1005.0, 0.0],
+            [990.0, 1000.0, 0.0],
+        ],
+        triangles: vec![[0, 1, 2]],
+        margin: 0.0,
+        facing: Facing::NonStrict,
+    }
+}
+
+/// Sweeps moving in `-x` over the edge at heights `ρ (1 − t)`, `t` from
+/// 10⁻⁹ to 10⁻², so that the edge is met ever more tangentially (the
+/// double root of the edge's quadratic at `t = 0`).
+fn grazing_sweeps() -> Vec<SweepMsg> {
+    let rho = 0.25;
+    (0..64u64)
+        .map(|frame| {
+            let t = 10f64.powf(-9.0 + 7.0 * frame as f64 / 63.0);
+            let h = rho * (1.0 - t);
+            let y = 999.0 + 0.03 * frame as f64;
+            SweepMsg {
+                frame,
+                ball: 0,
+                radius: rho,
+                p0: [1002.0, y, h],
+                p1: [998.0, y, h],
+            }
+        })
+        .collect()
+}
+
+fn grazing_edge_contacts_have_finite_square_root_bounds() -> anyhow::Result<()> {
+    let scene = edge_scene();
+    let sweeps = grazing_sweeps();
+    let results = results(&scene, &sweeps, |s| f32_answer(&scene, s))?;
+    let f32_tol = tolerances(Precision::F32);
+    let (mut edge_hits, mut refused, mut moved_refused) = (0, Vec::new(), 0);
+    for r in &results {
+        let Some(hit) = r.outcome.hit else { continue };
+        ensure!(
+            hit.feature.kind() == sweeptrace::Kind::Edge,
+            "frame {}: {:?} instead of the edge",
+            r.frame,
+            hit.feature
+        );
+        edge_hits += 1;
+        let s = Sensitivity::of(r).expect("a hit has a sensitivity");
+        let bound = s.bounds(F32_OPERATIONS).alpha;
+        // Finite, and never more than the square-root growth allows: at
+        // most √(2ρε + ε²) + 2ε/3 over |d⊥| with ε = 3 · 16 · δ.
+        let eps = 3.0 * F32_OPERATIONS * s.unit;
+        let ceiling = ((2.0 * 0.25 * eps + eps * eps).sqrt() + 2.0 * eps / 3.0) / 4.0;
+        ensure!(
+            bound.is_finite() && bound <= ceiling * (1.0 + 1e-9) + 1e-12,
+            "frame {}: bound {bound} above the tangent ceiling {ceiling}",
+            r.frame
+        );
+        let expected = r.expected.expect("every sweep has its answer");
+        if sweeptrace::agreement(&expected, r, &f32_tol).fails(false) {
+            refused.push(r.frame);
+        }
+        let mut moved = expected;
+        moved.alpha = hit.alpha + 10.0 * bound;
+        if moved.alpha <= 1.0 && sweeptrace::agreement(&moved, r, &f32_tol).fails(false) {
+            moved_refused += 1;
+        }
+    }
+    ensure!(edge_hits > 50, "only {edge_hits} edge hits");
+    ensure!(
+        refused.is_empty(),
+        "f32-rounded answers refused at frames {refused:?}"
+    );
+    ensure!(
+        moved_refused == edge_hits,
+        "α moved by ten bounds refused on {moved_refused} of {edge_hits} grazing hits"
+    );
     Ok(())
 }

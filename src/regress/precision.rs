@@ -14,7 +14,27 @@
 //! with the centre along the surface (`|Δα| · |d_t|`, `d_t` the part of `d`
 //! across `n`); the normal turns by the moves of the contact and the
 //! centre over `ρ`, and a face normal by `2δ` over the triangle's shortest
-//! edge. A difference in the discrete fields (kind, triangle, feature, hit
+//! edge.
+//!
+//! **Grazing contacts.** On an edge or a vertex the first-order bound
+//! breaks down near a double root of the quadratic: a ball that only
+//! grazes the feature meets it with `d · n → 0`, so `3δ / |d · n|` grows
+//! without bound, while the true move of `α` stays finite and grows as the
+//! square root of the move of the inputs. There the bound is the exact
+//! change of the root of `|d⊥|² (α − α*)² + m² = ρ²` (`d⊥` the part of `d`
+//! across the edge, or all of `d` at a vertex, `m` the path's closest
+//! approach to the feature): with `s = √(ρ² − m²) = ρ |d · n| / |d⊥|`, a
+//! move `ε = 3δ` of the contact distance changes `s²` by at most
+//! `2ρε + ε²`, so `s` moves by at most
+//! `max(√(s² + 2ρε + ε²) − s, s − √(max(0, s² − 2ρε)))`, which is `ρε / s`
+//! to first order and `√(2ρε)` at a tangent contact (`s = 0`); the moves
+//! along the path shift `α*` by `2ε / 3 |d⊥|` more. A face has no double
+//! root (the plane does not curve): its `α` is linear in the moves, and a
+//! ball sliding along the plane is ill-conditioned there, as the bound
+//! says. The backward error inverts these bounds (by bisection, since the
+//! edge and vertex bound is not linear).
+//!
+//! A difference in the discrete fields (kind, triangle, feature, hit
 //! or miss) passes only when a move of one input within the same budget
 //! makes the core give the engine's answer (the perturbations of
 //! [`super::judge`], at `u₃₂ · S` instead of `f64`'s unit).
@@ -23,7 +43,9 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::core::SweptPath;
+use nalgebra::Vector3;
+
+use crate::core::{Feature, SweptPath};
 use crate::replay::SweepResult;
 use crate::trace::OutcomeMsg;
 
@@ -77,17 +99,53 @@ pub const F32_UNIT: f64 = 1.0 / 16_777_216.0;
 /// that meets the surface squarely) is hundreds of units.
 pub const F32_OPERATIONS: f64 = 16.0;
 
-/// How much each continuous field of the reference answer moves per unit
-/// move of the inputs, `δ = u₃₂ · S` (see the module's documentation).
+/// How much each continuous field of the reference answer moves when the
+/// inputs move by `units · δ`, `δ = u₃₂ · S` (see the module's
+/// documentation): [`Sensitivity::bounds`].
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
 pub struct Sensitivity {
     /// `δ = u₃₂ · S`, in the scene's length unit.
     pub unit: f64,
-    /// `|Δα|` per unit move (infinite for a contact met tangentially).
+    /// `|Δα|` per unit move to first order (infinite for a contact met
+    /// tangentially; the bound itself is then finite, see
+    /// [`Sensitivity::bounds`]).
     pub alpha: f64,
-    /// The contact point's move per unit move, a length.
+    /// The contact point's move per unit move to first order, a length.
     pub contact: f64,
-    /// The normal's turn per unit move, in degrees.
+    /// The normal's turn per unit move to first order, in degrees.
+    pub normal_degrees: f64,
+    /// What the bounds are computed from.
+    #[serde(skip)]
+    geometry: Geometry,
+}
+
+/// The quantities of one hit that its bounds depend on.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Geometry {
+    /// `|d · n|`, the speed of approach along the contact normal.
+    closing: f64,
+    /// For an edge or a vertex: `|d⊥|`, the speed across the feature (the
+    /// part of `d` across the edge; all of `d` at a vertex). `None` on a
+    /// face, where `α` is linear in the moves.
+    across_feature: Option<f64>,
+    /// `|d_t|`, the part of `d` across the contact normal.
+    along_surface: f64,
+    /// The path's length `|d|` (the contact cannot move further than it).
+    length: f64,
+    /// The ball's radius `ρ` (with the margin).
+    rho: f64,
+    /// The hit triangle's shortest edge.
+    shortest_edge: f64,
+}
+
+/// The bounds at one budget: how far each continuous field may move.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Bounds {
+    /// `|Δα|`.
+    pub alpha: f64,
+    /// The contact point's move, a length.
+    pub contact: f64,
+    /// The normal's turn, in degrees.
     pub normal_degrees: f64,
 }
 
@@ -110,76 +168,145 @@ impl Sensitivity {
         } else {
             hit.normal
         };
-        let closing = d.dot(&n).abs();
-        let alpha = if closing > 0.0 {
-            3.0 * unit / closing
+        let triangle = scene.mesh.triangle_by_index(hit.triangle);
+        let across_feature = match hit.feature {
+            Feature::Face => None,
+            Feature::Vertex(_) => Some(d.norm()),
+            Feature::Edge(i) => {
+                let frame = triangle.map(|t| t.edges[usize::from(i) % 3]);
+                let along = frame.map_or(0.0, |f| {
+                    (f.edge_from_world_rotation.transpose() * Vector3::x()).dot(&d)
+                });
+                Some((d.norm_squared() - along * along).max(0.0).sqrt())
+            }
+        };
+        let shortest_edge = triangle.map_or(f64::INFINITY, |t| {
+            t.edges
+                .iter()
+                .map(|e| e.length)
+                .fold(f64::INFINITY, f64::min)
+        });
+        let geometry = Geometry {
+            closing: d.dot(&n).abs(),
+            across_feature,
+            along_surface: (d - n * d.dot(&n)).norm(),
+            length: path.length,
+            rho: path.rho,
+            shortest_edge,
+        };
+        let first_order = Sensitivity::first_order(unit, &geometry);
+        Some(Sensitivity {
+            unit,
+            alpha: first_order.alpha,
+            contact: first_order.contact,
+            normal_degrees: first_order.normal_degrees,
+            geometry,
+        })
+    }
+
+    /// The first-order moves per unit move of the inputs.
+    fn first_order(unit: f64, g: &Geometry) -> Bounds {
+        let alpha = if g.closing > 0.0 {
+            3.0 * unit / g.closing
         } else {
             f64::INFINITY
         };
-        let across = (d - n * d.dot(&n)).norm();
-        let moved = 2.0 * unit + (alpha * across).min(path.length + unit);
-        let shortest_edge = scene
-            .mesh
-            .triangle_by_index(hit.triangle)
-            .map_or(f64::INFINITY, |t| {
-                t.edges
-                    .iter()
-                    .map(|e| e.length)
-                    .fold(f64::INFINITY, f64::min)
-            });
-        let turn = 2.0 * unit / shortest_edge + (unit + moved) / path.rho;
-        Some(Sensitivity {
-            unit,
+        Sensitivity::following(unit, 1.0, alpha, g)
+    }
+
+    /// The contact's move and the normal's turn at `units`, given the
+    /// bound on `α` there.
+    fn following(unit: f64, units: f64, alpha: f64, g: &Geometry) -> Bounds {
+        let moved = 2.0 * units * unit + (alpha * g.along_surface).min(g.length + units * unit);
+        let turn = 2.0 * units * unit / g.shortest_edge + (units * unit + moved) / g.rho;
+        Bounds {
             alpha,
             contact: moved,
             normal_degrees: turn.to_degrees(),
-        })
+        }
+    }
+
+    /// How far each continuous field may move when the inputs move by
+    /// `units · δ`: on a face, `units` times the first-order figures; on
+    /// an edge or a vertex, the change of the quadratic's root, which
+    /// stays finite at a tangent contact (the module's documentation).
+    pub fn bounds(&self, units: f64) -> Bounds {
+        let g = &self.geometry;
+        let Some(speed) = g.across_feature.filter(|v| *v > 0.0) else {
+            return Sensitivity::following(self.unit, units, units * self.alpha, g);
+        };
+        let eps = 3.0 * units * self.unit;
+        let s = (g.rho * g.closing / speed).min(g.rho);
+        let grown = ((s * s + 2.0 * g.rho * eps + eps * eps).sqrt() - s).max(0.0);
+        let shrunk = s - (s * s - 2.0 * g.rho * eps).max(0.0).sqrt();
+        let alpha = (grown.max(shrunk) + 2.0 * eps / 3.0) / speed;
+        Sensitivity::following(self.unit, units, alpha, g)
     }
 
     /// `tol` widened to the moves `c` units of the inputs give.
     pub fn widen(&self, tol: &Tolerances, c: f64) -> Tolerances {
+        let b = self.bounds(c);
         Tolerances {
-            alpha: tol.alpha.max(c * self.alpha),
-            contact: tol.contact.max(c * self.contact),
-            normal_degrees: tol.normal_degrees.max(c * self.normal_degrees),
+            alpha: tol.alpha.max(b.alpha),
+            contact: tol.contact.max(b.contact),
+            normal_degrees: tol.normal_degrees.max(b.normal_degrees),
             ..*tol
         }
     }
 
+    /// The smallest budget, in units, whose bound on one field (`of`)
+    /// reaches `difference`: a bisection, the bounds growing with the
+    /// budget. Infinite when no budget up to `2⁶⁰` units does.
+    fn units_for(&self, difference: f64, of: impl Fn(&Bounds) -> f64) -> f64 {
+        if difference <= 0.0 {
+            return 0.0;
+        }
+        let (mut lo, mut hi) = (0.0_f64, 1.0_f64);
+        while of(&self.bounds(hi)) < difference {
+            if hi > 1e18 {
+                return f64::INFINITY;
+            }
+            lo = hi;
+            hi *= 2.0;
+        }
+        for _ in 0..60 {
+            let mid = 0.5 * (lo + hi);
+            if of(&self.bounds(mid)) < difference {
+                lo = mid;
+            } else {
+                hi = mid;
+            }
+        }
+        hi
+    }
+
     /// The backward error of the continuous differences `fields` between
     /// `expected` and `got`: the smallest move of the inputs, in units of
-    /// `u₃₂ · S`, that explains every one of them to first order.
+    /// `u₃₂ · S`, that explains every one of them (to first order on a
+    /// face; through the quadratic's root on an edge or a vertex).
     pub fn backward_error(
         &self,
         fields: &[FieldDiff],
         expected: &OutcomeMsg,
         got: &OutcomeMsg,
     ) -> f64 {
-        let ratio = |difference: f64, per_unit: f64| {
-            if difference <= 0.0 {
-                0.0
-            } else if per_unit > 0.0 {
-                difference / per_unit
-            } else {
-                f64::INFINITY
-            }
-        };
         let points =
             |a: Option<Option<[f64; 3]>>, b: Option<Option<[f64; 3]>>| a.flatten().zip(b.flatten());
         fields
             .iter()
             .map(|f| match f.field {
-                Field::Alpha => ratio((expected.alpha - got.alpha).abs(), self.alpha),
+                Field::Alpha => self.units_for((expected.alpha - got.alpha).abs(), |b| b.alpha),
                 Field::Contact => match points(expected.contact, got.contact) {
-                    Some((a, b)) => ratio(
+                    Some((a, b)) => self.units_for(
                         (nalgebra::Vector3::from(a) - nalgebra::Vector3::from(b)).norm(),
-                        self.contact,
+                        |b| b.contact,
                     ),
                     None => f64::INFINITY,
                 },
                 Field::Normal => match points(expected.normal, got.normal) {
-                    Some((a, b)) => angle_degrees(a, b)
-                        .map_or(f64::INFINITY, |angle| ratio(angle, self.normal_degrees)),
+                    Some((a, b)) => angle_degrees(a, b).map_or(f64::INFINITY, |angle| {
+                        self.units_for(angle, |b| b.normal_degrees)
+                    }),
                     None => f64::INFINITY,
                 },
                 Field::Kind | Field::Triangle | Field::Feature => f64::INFINITY,
@@ -203,5 +330,66 @@ mod tests {
             assert_eq!(p.to_string().parse::<Precision>(), Ok(p));
         }
         assert!("f16".parse::<Precision>().is_err());
+    }
+
+    fn sensitivity(closing: f64, across_feature: Option<f64>) -> Sensitivity {
+        let geometry = Geometry {
+            closing,
+            across_feature,
+            along_surface: 1.0,
+            length: 1.0,
+            rho: 0.5,
+            shortest_edge: 1.0,
+        };
+        let unit = 1e-7;
+        let first = Sensitivity::first_order(unit, &geometry);
+        Sensitivity {
+            unit,
+            alpha: first.alpha,
+            contact: first.contact,
+            normal_degrees: first.normal_degrees,
+            geometry,
+        }
+    }
+
+    #[test]
+    fn a_tangent_contact_has_a_square_root_bound() {
+        // A ball grazing a vertex: d · n = 0, the first order is infinite.
+        let s = sensitivity(0.0, Some(1.0));
+        assert!(s.alpha.is_infinite());
+        let b = s.bounds(16.0).alpha;
+        let eps: f64 = 3.0 * 16.0 * 1e-7;
+        let root = (2.0 * 0.5 * eps + eps * eps).sqrt();
+        assert!((b - (root + 2.0 * eps / 3.0)).abs() < 1e-12, "{b}");
+        // It grows as the square root of the budget, not linearly.
+        let ratio = s.bounds(64.0).alpha / b;
+        assert!((ratio - 2.0).abs() < 0.05, "{ratio}");
+    }
+
+    #[test]
+    fn away_from_tangency_the_bound_is_first_order() {
+        // Head on: d · n = |d⊥| = 1, s = ρ.
+        let s = sensitivity(1.0, Some(1.0));
+        let b = s.bounds(16.0).alpha;
+        let first = 16.0 * s.alpha;
+        assert!(b >= first && b < 2.0 * first, "{b} against {first}");
+        // A face is linear in the moves.
+        let face = sensitivity(0.25, None);
+        assert_eq!(face.bounds(16.0).alpha, 16.0 * face.alpha);
+    }
+
+    #[test]
+    fn the_backward_error_inverts_the_bounds() {
+        for s in [
+            sensitivity(0.0, Some(1.0)),
+            sensitivity(0.3, Some(0.8)),
+            sensitivity(0.25, None),
+        ] {
+            for units in [0.5, 3.0, 16.0, 700.0] {
+                let found = s.units_for(s.bounds(units).alpha, |b| b.alpha);
+                assert!((found / units - 1.0).abs() < 1e-9, "{units}: {found}");
+            }
+            assert_eq!(s.units_for(0.0, |b| b.alpha), 0.0);
+        }
     }
 }

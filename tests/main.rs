@@ -8,6 +8,7 @@ use libtest_mimic::{Arguments, Completion, Failed, Trial};
 mod alt_engine;
 mod architecture;
 mod bisect;
+mod bless_select;
 mod cbor;
 mod check;
 mod conform;
@@ -152,6 +153,7 @@ fn main() {
     trials.extend(interrupts::tests());
     trials.extend(help::tests());
     trials.extend(first_hour::tests());
+    trials.extend(bless_select::tests());
     trials.extend(first_hour_again::tests());
     trials.extend(mesh::tests());
     trials.extend(jolt::tests());

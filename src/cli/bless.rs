@@ -1,16 +1,23 @@
 //! `sweeptrace bless`: rewrite a trace's `/expected` channel with the
-//! current core's outcomes, keeping every other channel, schema, metadata
-//! record and attachment (the library's [`sweeptrace::regress`]).
+//! current core's outcomes (or a running engine's answers), keeping every
+//! other channel, schema, metadata record and attachment (the library's
+//! [`sweeptrace::regress`]). A selection (`--frames`, `--ball`,
+//! `--accept`, `--review`) blesses some sweeps only.
 
 use super::NameFileOnce;
+use std::collections::BTreeSet;
+use std::io::{BufRead, Write};
 use std::path::PathBuf;
 
-use anyhow::bail;
+use anyhow::{Context, bail};
 
 use super::Exit;
+use sweeptrace::engine::EngineCommand;
 use sweeptrace::numbers::counted;
-use sweeptrace::regress::bless_file;
-use sweeptrace::replay::ReplayOptions;
+use sweeptrace::regress::{
+    Against, BlessEngine, BlessError, BlessOptions, BlessSelection, CheckOptions, Divergence,
+    Sides, bless_file_with, check_file, check_file_with_engine, render_divergence_as,
+};
 
 /// Arguments of `bless`.
 #[derive(Debug, clap::Args)]
@@ -18,12 +25,27 @@ use sweeptrace::replay::ReplayOptions;
 Examples:
   sweeptrace bless traces/record_mini_golf.mcap -o golf.mcap
   sweeptrace bless golf.mcap --in-place         # the file the first example wrote
+  sweeptrace bless golf.mcap --frames 100..200 --ball 1 -o golf2.mcap
+  sweeptrace bless golf.mcap --accept 12:0,40:3 -o golf2.mcap
+  sweeptrace bless golf.mcap --review -o golf2.mcap   # accept or reject each change
+  sweeptrace bless traces/record_cube_corner_margin.mcap --engine 'python3 examples/engines/sweep_engine.py' --engine-name sweep_engine --engine-version 1 -o snapshot.mcap
 
 Each sweep gets the outcome the core computes with the scene's own margin
-and facing rule. The output is written under a temporary name next to it
-and renamed when complete; the input is untouched unless --in-place. A
-trace that ends early (truncated) is an error, exit 3, and nothing is
-written.")]
+and facing rule, under the engine conventions of the sweeptrace.toml
+beside or above the trace (or --config, or the convention flags), or,
+with --engine, the engine's answer: an engine snapshot, which `check
+--engine CMD --against expected` compares a later version with.
+
+--frames/--ball, --accept and --review bless some sweeps only: the others
+keep the expectation they had (or none). --review walks the sweeps whose
+new expectation differs from the trace's, one at a time, with the
+explanation `check` prints, and reads a for accept, r for reject, s for
+skip (the skipped are listed as an --accept for later), A to accept the
+rest, q to quit (the rest keep theirs) from standard input, a line each.
+
+The output is written under a temporary name next to it and renamed when
+complete; the input is untouched unless --in-place. A trace that ends
+early (truncated) is an error, exit 3, and nothing is written.")]
 pub struct Args {
     /// The trace (an MCAP file).
     #[arg(value_name = "TRACE")]
@@ -39,6 +61,66 @@ pub struct Args {
     /// Replace the trace itself.
     #[arg(long)]
     pub in_place: bool,
+    /// Bless only frames A..B (A included, B excluded; also `A..`, `..B`,
+    /// `A..=B`, `A`), e.g. `--frames 100..200`.
+    #[arg(long, value_name = "A..B", conflicts_with_all = ["accept", "review"])]
+    pub frames: Option<sweeptrace::replay::FrameRange>,
+    /// Bless only ball N, e.g. `--ball 0`.
+    #[arg(long, value_name = "N", conflicts_with_all = ["accept", "review"])]
+    pub ball: Option<u32>,
+    /// Bless only these sweeps, as FRAME:BALL pairs, e.g. `--accept
+    /// 12:0,40:3` (what --review lists as skipped).
+    #[arg(long, value_name = "FRAME:BALL,...", value_parser = parse_sweeps, conflicts_with = "review")]
+    pub accept: Option<BTreeSet<(u64, u32)>>,
+    /// Walk the sweeps whose new expectation differs from the trace's and
+    /// accept, reject or skip each (answers read from standard input).
+    #[arg(long)]
+    pub review: bool,
+    /// The expectations are this engine's answers (an engine snapshot):
+    /// the command, as `check --engine` runs it.
+    #[arg(long, value_name = "CMD")]
+    pub engine: Option<String>,
+    /// With --engine: the engine's name in the expectations' source
+    /// [default: the command, cut to 128 bytes].
+    #[arg(long, value_name = "NAME", requires = "engine")]
+    pub engine_name: Option<String>,
+    /// With --engine: the engine's version in the expectations' source.
+    #[arg(long, value_name = "VERSION", requires = "engine")]
+    pub engine_version: Option<String>,
+    /// With --engine: the longest wait, in seconds, for the engine's next
+    /// answer.
+    #[arg(long, value_name = "SECONDS", default_value_t = sweeptrace::engine::DEFAULT_TIMEOUT.as_secs_f64(), requires = "engine")]
+    pub engine_timeout: f64,
+    /// Where the `[engine]` table comes from (`check`'s files by default).
+    #[command(flatten)]
+    pub config: super::check_config::ConfigArgs,
+    /// The engine's conventions: the core's answers are computed under
+    /// them (docs/ENGINES.md).
+    #[command(flatten)]
+    pub conventions: super::ConventionArgs,
+}
+
+/// `12:0,40:3` as a set of `(frame, ball)`.
+fn parse_sweeps(text: &str) -> Result<BTreeSet<(u64, u32)>, String> {
+    let mut out = BTreeSet::new();
+    for pair in text.split(',').map(str::trim).filter(|p| !p.is_empty()) {
+        let (frame, ball) = pair
+            .split_once(':')
+            .ok_or_else(|| format!("`{pair}` is not FRAME:BALL (e.g. `12:0`)"))?;
+        let frame = frame
+            .trim()
+            .parse::<u64>()
+            .map_err(|_| format!("`{pair}`: the frame `{frame}` is not a whole number"))?;
+        let ball = ball
+            .trim()
+            .parse::<u32>()
+            .map_err(|_| format!("`{pair}`: the ball `{ball}` is not a whole number"))?;
+        out.insert((frame, ball));
+    }
+    if out.is_empty() {
+        return Err("no FRAME:BALL pair given (e.g. `12:0,40:3`)".to_string());
+    }
+    Ok(out)
 }
 
 /// Blesses the trace.
@@ -50,8 +132,59 @@ pub fn run(args: Args) -> anyhow::Result<Exit> {
     };
     // The one wording for an input that cannot be opened.
     drop(super::open_trace(&args.trace)?);
+    let settings = super::check_config::for_trace(&args.trace, &args.conventions, &args.config)?;
+    let conventions = settings.engine.conventions();
+    if args.engine.is_none()
+        && let Some(line) = super::check_config::conventions_line(&settings)
+    {
+        eprintln!("{line}");
+    }
+    let engine = match &args.engine {
+        None => None,
+        Some(text) => {
+            let command = EngineCommand::parse(text)?;
+            let name = args
+                .engine_name
+                .clone()
+                .unwrap_or_else(|| command.text.clone());
+            Some(BlessEngine {
+                options: super::check::engine_options(args.engine_timeout)?,
+                name,
+                version: args.engine_version.clone().unwrap_or_default(),
+                command,
+            })
+        }
+    };
+    let replay = conventions.replay_with(sweeptrace::replay::ReplayOptions::default());
+    let select = if args.review {
+        let check_options = CheckOptions {
+            tolerances: conventions.judge_with(settings.tolerances()),
+            max_details: usize::MAX,
+            replay,
+            ..CheckOptions::default()
+        };
+        match review(&args, engine.as_ref(), &check_options)? {
+            Some(chosen) => BlessSelection::Sweeps(chosen),
+            None => return Ok(Exit::Success),
+        }
+    } else if let Some(set) = &args.accept {
+        BlessSelection::Sweeps(set.clone())
+    } else if args.frames.is_some() || args.ball.is_some() {
+        BlessSelection::Range {
+            frames: args.frames.unwrap_or_default(),
+            ball: args.ball,
+        }
+    } else {
+        BlessSelection::All
+    };
+    let options = BlessOptions {
+        replay,
+        select,
+        engine,
+        conventions: (!conventions.is_rules()).then(|| conventions.summary()),
+    };
     super::warn_unfinished(&output);
-    let summary = match bless_file(&args.trace, &output, ReplayOptions::default()) {
+    let summary = match bless_file_with(&args.trace, &output, &options) {
         Ok(summary) => summary,
         // A trace that ends early: exit 3, as every command gives, but
         // nothing written (in place, the trace is left as it was).
@@ -66,14 +199,32 @@ pub fn run(args: Args) -> anyhow::Result<Exit> {
             );
             return Ok(Exit::IncompleteInput);
         }
+        Err(BlessError::Engine { cause }) => {
+            let exit = if cause.cannot_start() {
+                Exit::EngineUnavailable
+            } else {
+                Exit::Error
+            };
+            eprintln!("error: {cause}\nnothing written");
+            return Ok(exit);
+        }
         Err(err) => return Err(err).name_file_once("blessing", args.trace.display()),
     };
     let replaced = match &summary.replaced_expected_source {
         Some(old) => format!(" (expectations were from {old})"),
         None => String::new(),
     };
+    let selection = if matches!(options.select, BlessSelection::All) {
+        String::new()
+    } else {
+        format!(
+            " [{} blessed, {} kept]",
+            counted(summary.blessed, "sweep", "sweeps"),
+            summary.kept
+        )
+    };
     eprintln!(
-        "wrote {}: {} from {}{replaced} (replacing {}), {}, {}, {}, {} and {} kept",
+        "wrote {}: {} from {}{replaced}{selection} (replacing {}), {}, {}, {}, {} and {} kept",
         output.display(),
         counted(summary.expected_written, "expectation", "expectations"),
         summary.expected_source,
@@ -89,4 +240,159 @@ pub fn run(args: Args) -> anyhow::Result<Exit> {
         counted(summary.attachments_copied, "attachment", "attachments"),
     );
     Ok(Exit::Success)
+}
+
+/// What the reviewer said of one change.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Answer {
+    Accept,
+    Reject,
+    Skip,
+    AcceptRest,
+    Quit,
+}
+
+/// Reads one answer (a line) from `input`; `None` at the end of input.
+/// Asks again, on `prompt`, after a line that is not an answer. With
+/// `echo` (the answers come from a script, not a terminal), writes each
+/// answer after its prompt, so that the transcript reads as a dialogue.
+fn read_answer(
+    input: &mut impl BufRead,
+    prompt: &mut impl Write,
+    echo: bool,
+) -> anyhow::Result<Option<Answer>> {
+    loop {
+        let mut line = String::new();
+        if input.read_line(&mut line).context("reading the answer")? == 0 {
+            if echo {
+                let _ = writeln!(prompt, "(end of input)");
+            }
+            return Ok(None);
+        }
+        if echo {
+            let _ = writeln!(prompt, "{}", line.trim_end());
+        }
+        let answer = match line.trim() {
+            "a" | "accept" | "y" | "yes" => Answer::Accept,
+            "r" | "reject" | "n" | "no" => Answer::Reject,
+            "s" | "skip" | "" => Answer::Skip,
+            "A" | "all" => Answer::AcceptRest,
+            "q" | "quit" => Answer::Quit,
+            other => {
+                let _ = write!(
+                    prompt,
+                    "`{other}` is not an answer: a (accept), r (reject), s (skip), A (accept the rest), q (quit)? "
+                );
+                let _ = prompt.flush();
+                continue;
+            }
+        };
+        return Ok(Some(answer));
+    }
+}
+
+/// `--review`: checks the trace as `check` does (against the core, or the
+/// engine's answers against the trace's expectations), shows each
+/// divergent sweep with its explanation and asks. Returns the accepted
+/// sweeps, or `None` when there is nothing to write.
+fn review(
+    args: &Args,
+    engine: Option<&BlessEngine>,
+    options: &CheckOptions,
+) -> anyhow::Result<Option<BTreeSet<(u64, u32)>>> {
+    let (report, sides) = match engine {
+        None => (check_file(&args.trace, options), Sides::ExpectedAndCore),
+        Some(e) => (
+            check_file_with_engine(
+                &args.trace,
+                &e.command,
+                e.options,
+                Against::Expected,
+                options,
+            )
+            .map_err(anyhow::Error::new)?,
+            Sides::ExpectedAndEngine,
+        ),
+    };
+    if let Some(error) = report.errors.first() {
+        bail!("{error}");
+    }
+    let changes: Vec<&Divergence> = report
+        .divergences
+        .details
+        .iter()
+        .chain(report.fragile.details.iter())
+        .collect();
+    let new_side = if engine.is_some() {
+        "the engine's answer"
+    } else {
+        "the core's outcome"
+    };
+    if changes.is_empty() {
+        eprintln!(
+            "nothing to review: every expectation of {} agrees with {new_side} ({} compared); nothing written",
+            args.trace.display(),
+            counted(report.compared, "sweep", "sweeps")
+        );
+        return Ok(None);
+    }
+    let stdin = std::io::stdin();
+    let echo = !std::io::IsTerminal::is_terminal(&stdin);
+    let mut input = stdin.lock();
+    let mut prompt = std::io::stderr();
+    let (mut accepted, mut skipped, mut rejected) = (BTreeSet::new(), Vec::new(), 0u64);
+    let mut accept_rest = false;
+    let total = changes.len();
+    for (i, d) in changes.iter().enumerate() {
+        let key = (d.frame, d.ball);
+        if accept_rest {
+            accepted.insert(key);
+            continue;
+        }
+        let _ = write!(
+            prompt,
+            "\n[{}/{total}] {}",
+            i + 1,
+            render_divergence_as(d, "  ", sides)
+        );
+        let _ = write!(
+            prompt,
+            "make {new_side} this sweep's expectation? a (accept), r (reject), s (skip), A (accept the rest), q (quit)? "
+        );
+        let _ = prompt.flush();
+        match read_answer(&mut input, &mut prompt, echo)? {
+            Some(Answer::Accept) => {
+                accepted.insert(key);
+            }
+            Some(Answer::Reject) => rejected += 1,
+            Some(Answer::Skip) => skipped.push(key),
+            Some(Answer::AcceptRest) => {
+                accepted.insert(key);
+                accept_rest = true;
+            }
+            Some(Answer::Quit) | None => {
+                skipped.extend(changes[i..].iter().map(|d| (d.frame, d.ball)));
+                break;
+            }
+        }
+    }
+    eprintln!(
+        "\nreviewed {}: {} accepted, {rejected} rejected, {} skipped",
+        counted(total as u64, "change", "changes"),
+        accepted.len(),
+        skipped.len()
+    );
+    if !skipped.is_empty() {
+        let list = skipped
+            .iter()
+            .map(|(f, b)| format!("{f}:{b}"))
+            .collect::<Vec<_>>()
+            .join(",");
+        eprintln!("the skipped, to accept later: --accept {list}");
+    }
+    if accepted.is_empty() {
+        eprintln!("nothing accepted: nothing written");
+        return Ok(None);
+    }
+    Ok(Some(accepted))
 }

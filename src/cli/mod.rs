@@ -166,6 +166,7 @@ pub struct ConventionArgs {
     /// The engine's margin: `scene` (each scene's) or a number it always
     /// uses [default: scene].
     #[arg(
+        id = "engine_margin",
         long = "engine-margin",
         value_name = "scene|NUMBER",
         help_heading = "Engine conventions"
@@ -174,6 +175,7 @@ pub struct ConventionArgs {
     /// The engine's facing rule: `scene`, `strict` or `non_strict`
     /// [default: scene].
     #[arg(
+        id = "engine_facing",
         long = "engine-facing",
         value_name = "RULE",
         help_heading = "Engine conventions"

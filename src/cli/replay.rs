@@ -102,11 +102,20 @@ pub struct Args {
     #[arg(skip)]
     pub detail_given: bool,
     /// Override every scene's margin ε (tests use ρ = r - ε).
-    #[arg(long, value_name = "EPSILON")]
+    #[arg(long, value_name = "EPSILON", conflicts_with = "engine_margin")]
     pub margin: Option<f64>,
     /// Override every scene's facing rule: `non_strict` (n·d ≤ 0) or `strict` (n·d < 0).
-    #[arg(long, value_name = "RULE")]
+    #[arg(long, value_name = "RULE", conflicts_with = "engine_facing")]
     pub facing: Option<Facing>,
+    /// Where the `[engine]` table comes from (`check`'s files by default).
+    #[command(flatten)]
+    pub config: super::check_config::ConfigArgs,
+    /// The engine's conventions: the reference answers (outcome lines,
+    /// recording, tunnels, ghost contacts) are computed under them, as
+    /// `check` judges (docs/ENGINES.md). Default: the `[engine]` table of
+    /// the `sweeptrace.toml` beside or above the trace, if any.
+    #[command(flatten)]
+    pub conventions: super::ConventionArgs,
     /// Do not embed the default viewer layout (blueprint) in the recording.
     #[arg(long)]
     pub no_blueprint: bool,
@@ -165,7 +174,12 @@ pub fn run(args: Args) -> anyhow::Result<Exit> {
              output was asked for (--rrd, --spawn, --connect or --foxglove give one)"
         );
     }
-    let options = ReplayOptions {
+    // The engine's conventions, as `check` finds them: the reference
+    // answers and the divergence marks follow them.
+    let settings = super::check_config::for_trace(trace_path, &args.conventions, &args.config)?;
+    let conventions = settings.engine.conventions();
+    let tolerances = conventions.judge_with(settings.tolerances());
+    let options = conventions.replay_with(ReplayOptions {
         frames: args.frames.unwrap_or_default(),
         ball: args.ball,
         // The decision lines of the recording and of the Foxglove file
@@ -174,8 +188,11 @@ pub fn run(args: Args) -> anyhow::Result<Exit> {
         margin: args.margin,
         facing: args.facing,
         ..ReplayOptions::default()
-    };
-    let mut outputs = Outputs::open(&args, target, &options)?;
+    });
+    if let Some(line) = super::check_config::conventions_line(&settings) {
+        eprintln!("{line}");
+    }
+    let mut outputs = Outputs::open(&args, target, &options, tolerances)?;
     if args.threads == Some(0) {
         bail!("--threads must be at least 1");
     }
@@ -258,7 +275,15 @@ pub fn run(args: Args) -> anyhow::Result<Exit> {
         if args.json {
             println!(
                 "{}",
-                summary_json(&args, &summary, None, &[], Some(&err), started)
+                summary_json(
+                    &args,
+                    &conventions,
+                    &summary,
+                    None,
+                    &[],
+                    Some(&err),
+                    started
+                )
             );
         }
         return Ok(Exit::IncompleteInput);
@@ -295,6 +320,7 @@ pub fn run(args: Args) -> anyhow::Result<Exit> {
             "{}",
             summary_json(
                 &args,
+                &conventions,
                 &summary,
                 selected,
                 &wrote,
@@ -311,11 +337,14 @@ pub fn run(args: Args) -> anyhow::Result<Exit> {
 }
 
 /// `--json`'s summary: one object, the counts of [`ReplaySummary`]
-/// (`sweeptrace::replay`) by name, the files written (each "wrote" line),
+/// (`sweeptrace::replay`) by name, the engine conventions the answers
+/// were computed under (every key; the rules' values when none is
+/// declared), the files written (each "wrote" line),
 /// the selection of a filter that kept part of the trace, and `incomplete`
 /// (the error of a trace that ends early, or `null`).
 fn summary_json(
     args: &Args,
+    conventions: &sweeptrace::regress::EngineConventions,
     summary: &sweeptrace::replay::ReplaySummary,
     selection: Option<String>,
     wrote: &[String],
@@ -339,6 +368,7 @@ fn summary_json(
     ];
     let value = json!({
         "trace": args.trace.display().to_string(),
+        "conventions": conventions,
         "sweeps": summary.sweeps,
         "filtered_out": summary.filtered_out,
         "selection": selection,
@@ -458,6 +488,7 @@ impl Outputs {
         args: &Args,
         target: Option<RecordingTarget>,
         options: &ReplayOptions,
+        tolerances: Tolerances,
     ) -> anyhow::Result<Outputs> {
         let trace_path = &args.trace;
         let recording = match target {
@@ -477,6 +508,7 @@ impl Outputs {
                     blueprint: !args.no_blueprint,
                     prepare: viz::PrepareOptions {
                         follow_ball: args.ball.unwrap_or(0),
+                        tolerances,
                         ..viz::PrepareOptions::default()
                     },
                     ..viz::LoggerOptions::default()
@@ -517,7 +549,7 @@ impl Outputs {
                         .file_name()
                         .map(|n| n.to_string_lossy().into_owned())
                         .unwrap_or_default(),
-                    tolerances: Tolerances::default(),
+                    tolerances,
                 };
                 Some(FoxgloveFile::create(p, options)?)
             }

@@ -55,12 +55,21 @@ pub struct Args {
     pub to: Option<[f64; 3]>,
     /// Margin ε: tests use the detection radius ρ = r - ε (0 ≤ ε < r)
     /// [default: 0, or the trace's].
-    #[arg(long, allow_negative_numbers = true, value_parser = super::parse_number)]
+    #[arg(long, allow_negative_numbers = true, value_parser = super::parse_number, conflicts_with = "engine_margin")]
     pub margin: Option<f64>,
     /// Facing rule: `non_strict` (n·d ≤ 0) or `strict` (n·d < 0)
     /// [default: non_strict, or the trace's].
-    #[arg(long)]
+    #[arg(long, conflicts_with = "engine_facing")]
     pub facing: Option<Facing>,
+    /// With --trace: where the `[engine]` table comes from (`check`'s
+    /// files by default).
+    #[command(flatten)]
+    pub config: super::check_config::ConfigArgs,
+    /// The engine's conventions: the answer is computed under them, as
+    /// `check` judges (docs/ENGINES.md). With --trace, default: the
+    /// `[engine]` table of the `sweeptrace.toml` beside or above it.
+    #[command(flatten)]
+    pub conventions: super::ConventionArgs,
     /// Explain every test, not only those that came close.
     #[arg(long)]
     pub all: bool,
@@ -74,6 +83,7 @@ pub fn run(args: Args) -> anyhow::Result<Exit> {
     let mut source: Option<String> = None;
     let mut expected: Option<OutcomeMsg> = None;
     let topology: Option<sweeptrace::Topology>;
+    let settings: sweeptrace::regress::Settings;
     let (name, mesh, sweep, options) = if let Some(path) = &args.trace {
         let frame = args.frame.context("--trace needs --frame")?;
         let shown = path.display().to_string();
@@ -84,6 +94,8 @@ pub fn run(args: Args) -> anyhow::Result<Exit> {
             .with_context(|| format!("{shown}: building the scene of frame {frame}"))?;
         topology = sweeptrace::Topology::new(&found.scene.vertices, &found.scene.triangles).ok();
         let mut options = found.options();
+        settings = super::check_config::for_trace(path, &args.conventions, &args.config)?;
+        conventions_applied(&mut options, &settings.engine.conventions());
         options.margin = args.margin.unwrap_or(options.margin);
         options.facing = args.facing.unwrap_or(options.facing);
         source = Some(format!(
@@ -115,11 +127,18 @@ pub fn run(args: Args) -> anyhow::Result<Exit> {
             .from
             .zip(args.to)
             .context("--from and --to are required without --trace")?;
-        let options = Options {
-            margin: args.margin.unwrap_or(0.0),
-            facing: args.facing.unwrap_or_default(),
-            ..Options::default()
-        };
+        settings = super::check_config::for_trace(
+            std::path::Path::new(""),
+            &args.conventions,
+            &super::check_config::ConfigArgs {
+                config: None,
+                no_config: true,
+            },
+        )?;
+        let mut options = Options::default();
+        conventions_applied(&mut options, &settings.engine.conventions());
+        options.margin = args.margin.unwrap_or(options.margin);
+        options.facing = args.facing.unwrap_or(options.facing);
         (
             scene.name,
             mesh,
@@ -136,6 +155,16 @@ pub fn run(args: Args) -> anyhow::Result<Exit> {
         &mut records,
     )
     .context("invalid sweep")?;
+    let normal = settings.engine.normal.value;
+    let outcome = match &topology {
+        Some(t) if normal != sweeptrace::replay::NormalRule::Face => {
+            sweeptrace::replay::SceneNormals::new(normal, &mesh, t).apply(&sweep, outcome)
+        }
+        _ => outcome,
+    };
+    if let Some(line) = super::check_config::conventions_line(&settings) {
+        eprintln!("{line}");
+    }
     let explained = report::SweepReport {
         scene: &name,
         triangles: mesh.triangles().len(),
@@ -156,4 +185,20 @@ pub fn run(args: Args) -> anyhow::Result<Exit> {
         print!("{}", report::sweep_text(&explained));
     }
     Ok(Exit::Success)
+}
+
+/// `options` under the engine's `conventions`: its margin and facing rule
+/// where it declares one, and what a ball starting within `ρ` gets (the
+/// normal rule applies to the outcome, after the query).
+fn conventions_applied(
+    options: &mut Options,
+    conventions: &sweeptrace::regress::EngineConventions,
+) {
+    if let sweeptrace::regress::MarginRule::Fixed(m) = conventions.margin {
+        options.margin = m;
+    }
+    if let Some(facing) = conventions.facing.facing() {
+        options.facing = facing;
+    }
+    options.initial_overlap = conventions.initial_overlap;
 }

@@ -1,9 +1,12 @@
 //! Blessing a trace: replacing its `/expected` channel with the current
-//! core's outcomes, keeping everything else.
+//! core's outcomes (or a running engine's answers: an engine snapshot),
+//! keeping everything else. A selection ([`BlessSelection`]) blesses some
+//! sweeps only; the others keep the expectation they had (or none).
 //!
 //! Three passes over the input bytes:
-//! 1. the trace is replayed (the same [`crate::replay`] engine as `check`)
-//!    and every sweep's outcome is kept, by `(frame, ball)`;
+//! 1. the trace is replayed (the same [`crate::replay`] engine as `check`;
+//!    with an engine, its answers alongside) and every sweep's new
+//!    expectation is kept, by `(frame, ball)`;
 //! 2. a quick scan reads the header and which schemas only `/expected`
 //!    channels use (those are not copied);
 //! 3. the file's records are copied in order with the `mcap` crate's raw
@@ -25,8 +28,12 @@
 //! and renames it when complete, so the output is never half-written and the
 //! input is untouched unless it is also the output.
 
+// An engine's error carries its command, the line and its last stderr
+// lines; it happens once per run, so its size does not matter.
+#![allow(clippy::result_large_err)]
+
 use std::borrow::Cow;
-use std::collections::{BTreeMap, HashMap, HashSet, VecDeque};
+use std::collections::{BTreeMap, BTreeSet, HashMap, HashSet, VecDeque};
 use std::io::{BufWriter, Seek, Write};
 use std::path::Path;
 
@@ -36,12 +43,16 @@ use mcap::{Attachment, McapError};
 use thiserror::Error;
 
 use crate::atomic::{FinishStep, PendingFile};
+use crate::engine::{
+    AnswerSink, EngineAnswers, EngineCommand, EngineError, EngineOptions, EngineSession,
+};
 use crate::error_text::full_text;
-use crate::replay::{ReplayError, ReplayEvent, ReplayOptions, replay_events};
+use crate::replay::{FrameRange, ReplayError, ReplayEvent, ReplayOptions, replay_events};
 use crate::trace::{
-    EXPECTED_SOURCE_METADATA, EXPECTED_TOPIC, Encoding, ExpectedSource, OUTCOME_SCHEMA,
-    OUTCOME_SCHEMA_JSON, OutcomeMsg, SCHEMA_ENCODING, SWEEP_TOPIC, TraceError, TraceReader,
-    default_write_options, frame_of_message, sweeptrace_source,
+    EXPECTED_SOURCE_METADATA, EXPECTED_TOPIC, Encoding, ExpectedSource, MAX_NAME_BYTES,
+    MAX_SETTING_VALUE_BYTES, OUTCOME_SCHEMA, OUTCOME_SCHEMA_JSON, OutcomeMsg, SCHEMA_ENCODING,
+    SWEEP_TOPIC, TraceError, TraceReader, default_write_options, frame_of_message,
+    sweeptrace_source,
 };
 
 /// What went wrong while blessing.
@@ -82,6 +93,12 @@ pub enum BlessError {
         /// The error, naming the output.
         cause: TraceError,
     },
+    /// The engine could not be started, or failed while answering.
+    #[error("{cause}")]
+    Engine {
+        /// What went wrong, naming the command.
+        cause: EngineError,
+    },
     /// A `/sweep` message found in the copy pass has no outcome from the
     /// replay pass (the replay and the copy disagree on the file).
     #[error("{file}: channel `/sweep`, message {index}: no replayed outcome for this sweep")]
@@ -121,8 +138,15 @@ fn replay_error_text(file: &str, cause: &ReplayError) -> String {
 #[derive(Clone, Debug, Default, PartialEq, Eq)]
 #[non_exhaustive]
 pub struct BlessSummary {
-    /// Expectations written (one per sweep).
+    /// Expectations written: the new ones and the kept ones.
     pub expected_written: u64,
+    /// New expectations written (every sweep, unless a selection).
+    pub blessed: u64,
+    /// Sweeps left out of the selection that kept the expectation they
+    /// had (re-encoded in the project's schema).
+    pub kept: u64,
+    /// Sweeps in the trace.
+    pub sweeps: u64,
     /// `/expected` messages of the input dropped.
     pub expected_dropped: u64,
     /// Messages of other channels copied.
@@ -142,12 +166,150 @@ pub struct BlessSummary {
     pub replaced_expected_source: Option<ExpectedSource>,
 }
 
-/// What the replay pass found: the outcomes of every sweep of a trace, by
-/// `(frame, ball)` in trace order, and the source of the new expectations.
+/// Which sweeps a bless gives a new expectation. The others keep the
+/// trace's own expectation, or none if they had none.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub enum BlessSelection {
+    /// Every sweep (the whole `/expected` channel is replaced).
+    #[default]
+    All,
+    /// The sweeps of these frames, of one ball or of all.
+    Range {
+        /// The frames.
+        frames: FrameRange,
+        /// Only this ball.
+        ball: Option<u32>,
+    },
+    /// These `(frame, ball)` sweeps (`--accept`, the review's choices).
+    Sweeps(BTreeSet<(u64, u32)>),
+}
+
+impl BlessSelection {
+    /// Whether the sweep `(frame, ball)` gets a new expectation.
+    pub fn selects(&self, frame: u64, ball: u32) -> bool {
+        match self {
+            BlessSelection::All => true,
+            BlessSelection::Range { frames, ball: b } => {
+                frames.contains(frame) && b.is_none_or(|b| b == ball)
+            }
+            BlessSelection::Sweeps(set) => set.contains(&(frame, ball)),
+        }
+    }
+}
+
+/// The engine whose answers become the expectations (an engine snapshot:
+/// after an upgrade, `check --engine ... --against expected` says which
+/// sweeps changed).
+#[derive(Clone, Debug)]
+pub struct BlessEngine {
+    /// How to start it.
+    pub command: EngineCommand,
+    /// Its timeout and window.
+    pub options: EngineOptions,
+    /// Its name in the expectations' source (the program's, unless given).
+    pub name: String,
+    /// Its version in the expectations' source (empty when not known).
+    pub version: String,
+}
+
+/// How to bless: which sweeps, from the core or an engine.
+#[derive(Clone, Debug, Default)]
+pub struct BlessOptions {
+    /// The replay: the scenes' margin and facing overrides and the
+    /// engine conventions the core's answers are computed under. Its frame
+    /// and ball filters are ignored (`select` chooses).
+    pub replay: ReplayOptions,
+    /// Which sweeps get a new expectation.
+    pub select: BlessSelection,
+    /// The new expectations are this engine's answers instead of the
+    /// core's.
+    pub engine: Option<BlessEngine>,
+    /// The engine conventions the core's answers were computed under, in
+    /// words, when some are declared: written in the source's settings.
+    pub conventions: Option<String>,
+}
+
+/// What the replay pass found: the expectation to write after every sweep
+/// of a trace (`None`: none), by `(frame, ball)` in trace order, and the
+/// source of the new expectations.
 struct Replayed {
-    outcomes: HashMap<(u64, u32), VecDeque<OutcomeMsg>>,
+    outcomes: HashMap<(u64, u32), VecDeque<Option<OutcomeMsg>>>,
     source: ExpectedSource,
     replaced: Option<ExpectedSource>,
+    blessed: u64,
+    kept: u64,
+    sweeps: u64,
+}
+
+/// Pass 1's bookkeeping: each replayed sweep's expectation to write.
+#[derive(Default)]
+struct Collected {
+    outcomes: HashMap<(u64, u32), VecDeque<Option<OutcomeMsg>>>,
+    /// The margins and facing rules the scenes were replayed with, in order.
+    margins: Vec<String>,
+    facings: Vec<String>,
+    blessed: u64,
+    kept: u64,
+    sweeps: u64,
+}
+
+impl Collected {
+    /// Takes one replayed event; `answer` is the engine's answer to it
+    /// (with an engine), else the core's outcome is the new expectation.
+    fn event(
+        &mut self,
+        event: Result<ReplayEvent, ReplayError>,
+        name: &str,
+        select: &BlessSelection,
+        answer: impl FnOnce(u64, u32) -> Option<OutcomeMsg>,
+    ) -> Result<(), BlessError> {
+        match event {
+            Ok(ReplayEvent::Sweep(r)) => {
+                self.sweeps += 1;
+                let written = if select.selects(r.frame, r.ball) {
+                    self.blessed += 1;
+                    Some(answer(r.frame, r.ball).unwrap_or_else(|| r.outcome_msg()))
+                } else {
+                    self.kept += u64::from(r.expected.is_some());
+                    r.expected
+                };
+                self.outcomes
+                    .entry((r.frame, r.ball))
+                    .or_default()
+                    .push_back(written);
+            }
+            Ok(ReplayEvent::Scene(scene)) => {
+                for (list, value) in [
+                    (&mut self.margins, scene.options.margin.to_string()),
+                    (&mut self.facings, scene.options.facing.to_string()),
+                ] {
+                    if !list.contains(&value) {
+                        list.push(value);
+                    }
+                }
+            }
+            Err(cause) => {
+                return Err(BlessError::Replay {
+                    file: name.to_string(),
+                    cause,
+                });
+            }
+        }
+        Ok(())
+    }
+}
+
+/// `text` cut to at most `max` bytes, at a character boundary, with `...`
+/// when cut.
+fn clipped(text: &str, max: usize) -> String {
+    if text.len() <= max {
+        return text.to_string();
+    }
+    let mut end = max.saturating_sub(3);
+    while !text.is_char_boundary(end) {
+        end -= 1;
+    }
+    format!("{}...", &text[..end])
 }
 
 /// Values in words, the first few of many only (a setting's value is
@@ -167,45 +329,86 @@ fn listed(values: &[String]) -> String {
     }
 }
 
-fn outcomes_of(input: &[u8], name: &str, options: ReplayOptions) -> Result<Replayed, BlessError> {
-    let options = ReplayOptions {
+fn outcomes_of(input: &[u8], name: &str, options: &BlessOptions) -> Result<Replayed, BlessError> {
+    let replay = ReplayOptions {
         explain: None,
         frames: Default::default(),
         ball: None,
-        ..options
+        ..options.replay
     };
-    let mut out: HashMap<(u64, u32), VecDeque<OutcomeMsg>> = HashMap::new();
-    // The margins and facing rules the scenes were replayed with, in order.
-    let (mut margins, mut facings): (Vec<String>, Vec<String>) = (Vec::new(), Vec::new());
+    let mut collected = Collected::default();
     let mut reader = TraceReader::new_indexed(std::io::Cursor::new(input), name);
-    for event in replay_events(reader.by_ref(), options) {
-        match event {
-            Ok(ReplayEvent::Sweep(r)) => out
-                .entry((r.frame, r.ball))
-                .or_default()
-                .push_back(r.outcome_msg()),
-            Ok(ReplayEvent::Scene(scene)) => {
-                for (list, value) in [
-                    (&mut margins, scene.options.margin.to_string()),
-                    (&mut facings, scene.options.facing.to_string()),
-                ] {
-                    if !list.contains(&value) {
-                        list.push(value);
-                    }
-                }
+    match &options.engine {
+        None => {
+            for event in replay_events(reader.by_ref(), replay) {
+                collected.event(event, name, &options.select, |_, _| None)?;
             }
-            Err(cause) => {
-                return Err(BlessError::Replay {
-                    file: name.to_string(),
-                    cause,
-                });
+        }
+        Some(engine) => {
+            let session = EngineSession::start(&engine.command, engine.options)
+                .map_err(|cause| BlessError::Engine { cause })?;
+            let sink = AnswerSink::default();
+            let mut answers = EngineAnswers::keeping_expectations(
+                reader.by_ref(),
+                session,
+                engine.options.window,
+                sink.clone(),
+            );
+            for event in replay_events(answers.by_ref(), replay) {
+                collected.event(event, name, &options.select, |frame, ball| {
+                    sink.borrow_mut().remove(&(frame, ball))
+                })?;
+            }
+            if let Some(cause) = answers.finish().error {
+                return Err(BlessError::Engine { cause });
             }
         }
     }
+    let replaced = reader.expected_source().cloned();
+    let mut source = match &options.engine {
+        None => {
+            let source =
+                sweeptrace_source(&listed(&collected.margins), &listed(&collected.facings));
+            match &options.conventions {
+                Some(text) => source.setting("conventions", clipped(text, MAX_SETTING_VALUE_BYTES)),
+                None => source,
+            }
+        }
+        Some(engine) => ExpectedSource::new(
+            clipped(&engine.name, MAX_NAME_BYTES),
+            clipped(&engine.version, MAX_NAME_BYTES),
+        )
+        .setting(
+            "command",
+            clipped(&engine.command.text, MAX_SETTING_VALUE_BYTES),
+        )
+        .setting(
+            "blessed_by",
+            format!("sweeptrace {}", env!("CARGO_PKG_VERSION")),
+        ),
+    };
+    if options.select != BlessSelection::All {
+        let earlier = match &replaced {
+            Some(old) if collected.kept > 0 => {
+                format!(" (from {})", clipped(&old.engine, MAX_NAME_BYTES))
+            }
+            _ => String::new(),
+        };
+        source = source.setting(
+            "blessed",
+            format!(
+                "{} of {} sweeps; {} kept their earlier expectations{earlier}",
+                collected.blessed, collected.sweeps, collected.kept
+            ),
+        );
+    }
     Ok(Replayed {
-        outcomes: out,
-        source: sweeptrace_source(&listed(&margins), &listed(&facings)),
-        replaced: reader.expected_source().cloned(),
+        outcomes: collected.outcomes,
+        source,
+        replaced,
+        blessed: collected.blessed,
+        kept: collected.kept,
+        sweeps: collected.sweeps,
     })
 }
 
@@ -219,7 +422,11 @@ pub fn bless_bytes<W: Write + Seek>(
     output: W,
     options: ReplayOptions,
 ) -> Result<(BlessSummary, W), BlessError> {
-    bless_into(input, name, output, name, options)
+    let options = BlessOptions {
+        replay: options,
+        ..BlessOptions::default()
+    };
+    bless_into(input, name, output, name, &options)
 }
 
 /// [`bless_bytes`], with write errors naming `output_name`.
@@ -228,12 +435,15 @@ fn bless_into<W: Write + Seek>(
     name: &str,
     output: W,
     output_name: &str,
-    options: ReplayOptions,
+    options: &BlessOptions,
 ) -> Result<(BlessSummary, W), BlessError> {
     let Replayed {
         outcomes,
         source,
         replaced,
+        blessed,
+        kept,
+        sweeps,
     } = outcomes_of(input, name, options)?;
     let (write_options, expected_only) = scan(input, name)?;
     let mut writer = write_options
@@ -267,6 +477,9 @@ fn bless_into<W: Write + Seek>(
         summary: BlessSummary {
             expected_source: source,
             replaced_expected_source: replaced,
+            blessed,
+            kept,
+            sweeps,
             ..BlessSummary::default()
         },
     };
@@ -336,8 +549,9 @@ struct Copier<'a, W: Write + Seek> {
     /// The output's name.
     output_name: &'a str,
     writer: mcap::Writer<W>,
-    /// The replayed outcomes by `(frame, ball)`, in trace order.
-    outcomes: HashMap<(u64, u32), VecDeque<OutcomeMsg>>,
+    /// The expectation to write after each sweep by `(frame, ball)`, in
+    /// trace order (`None`: none).
+    outcomes: HashMap<(u64, u32), VecDeque<Option<OutcomeMsg>>>,
     /// The input's schemas that only `/expected` channels use.
     expected_only: HashSet<u16>,
     /// Input schema id to output schema id.
@@ -474,8 +688,9 @@ impl<W: Write + Seek> Copier<'_, W> {
     }
 
     /// Writes the expectation of the sweep message `index` (`header`,
-    /// `data`): the next replayed outcome of its frame and ball, on the
-    /// `/expected` channel of its encoding, at its `log_time`.
+    /// `data`): the next one of its frame and ball, on the `/expected`
+    /// channel of its encoding, at its `log_time` (nothing for a sweep left
+    /// out of the selection that had none).
     fn expectation(
         &mut self,
         index: u64,
@@ -496,6 +711,9 @@ impl<W: Write + Seek> Copier<'_, W> {
                 file: self.name.to_string(),
                 index,
             });
+        };
+        let Some(outcome) = outcome else {
+            return Ok(());
         };
         let channel_id = self.expected_channel(encoding)?;
         let encoded = encoding.encode(&outcome).map_err(|e| BlessError::Io {
@@ -569,11 +787,25 @@ fn ball_of(data: &[u8], encoding: Encoding) -> u32 {
 
 /// Blesses the file `input` into `output` (which may be the same path, for
 /// `--in-place`), through a temporary file in `output`'s directory renamed
-/// when complete.
+/// when complete: every sweep, from the core.
 pub fn bless_file(
     input: &Path,
     output: &Path,
     options: ReplayOptions,
+) -> Result<BlessSummary, BlessError> {
+    let options = BlessOptions {
+        replay: options,
+        ..BlessOptions::default()
+    };
+    bless_file_with(input, output, &options)
+}
+
+/// [`bless_file`] with a selection, an engine's answers or declared
+/// conventions ([`BlessOptions`]).
+pub fn bless_file_with(
+    input: &Path,
+    output: &Path,
+    options: &BlessOptions,
 ) -> Result<BlessSummary, BlessError> {
     let in_name = input.display().to_string();
     let out_name = output.display().to_string();

@@ -50,7 +50,10 @@ mod render;
 mod report;
 mod repro;
 
-pub use bless::{BlessError, BlessSummary, bless_bytes, bless_file};
+pub use bless::{
+    BlessEngine, BlessError, BlessOptions, BlessSelection, BlessSummary, bless_bytes, bless_file,
+    bless_file_with,
+};
 pub(crate) use check::divergence_details;
 pub use check::{
     CheckOptions, DEFAULT_MAX_DETAILS, check_events, check_file, check_reader, frames_around,
@@ -82,8 +85,8 @@ pub use judge::{Agreement, Perturbation, Reproduced, agreement, agreement_of};
 pub use junit::{check_junit, github_annotations};
 pub use mistakes::{KNOWN_MISTAKES, Mistake, known_mistake};
 pub use precision::{F32_OPERATIONS, F32_UNIT, Precision, Sensitivity};
-pub use render::{Sides, render_divergence, render_json, render_text};
-pub(crate) use render::{divergence_line, render_divergence_as, values_text};
+pub use render::{Sides, render_divergence, render_divergence_as, render_json, render_text};
+pub(crate) use render::{divergence_line, values_text};
 pub use report::{
     Against, Divergence, Divergences, EngineCheck, Expectations, Fragile, Ghosts, KindChange,
     MAX_LISTED_TUNNELS, Status, TraceReport, TunnelReport, Tunnels, WithinPrecision,

@@ -40,7 +40,10 @@ pub use read::{
 };
 pub(crate) use schemas::SCHEMA_ENCODING;
 pub use schemas::{OUTCOME_SCHEMA_JSON, SCENE_SCHEMA_JSON, SWEEP_SCHEMA_JSON};
-pub use source::{EXPECTED_SOURCE_METADATA, ExpectedSource, MAX_SETTINGS, sweeptrace_source};
+pub use source::{
+    EXPECTED_SOURCE_METADATA, ExpectedSource, MAX_NAME_BYTES, MAX_SETTING_VALUE_BYTES,
+    MAX_SETTINGS, sweeptrace_source,
+};
 pub use validate::{
     FieldProblem, parse_message, validate_outcome, validate_scene, validate_sweep,
     validate_triangle,

@@ -154,6 +154,11 @@ impl Default for EngineSettings {
 impl EngineSettings {
     /// Whether any key was set (by a file or the command line).
     pub fn is_declared(&self) -> bool {
+        self.sources().iter().any(|s| **s != Source::Default)
+    }
+
+    /// Where each key came from, in the table's order.
+    fn sources(&self) -> [&Source; 6] {
         [
             &self.precision.source,
             &self.margin.source,
@@ -162,8 +167,23 @@ impl EngineSettings {
             &self.normal.source,
             &self.ties.source,
         ]
-        .iter()
-        .any(|s| **s != Source::Default)
+    }
+
+    /// Where the declared keys came from, once each in the order of the
+    /// keys: a file's name, or `the command line`.
+    pub fn declared_sources(&self) -> Vec<String> {
+        let mut out: Vec<String> = Vec::new();
+        for source in self.sources() {
+            let name = match source {
+                Source::Default => continue,
+                Source::File { file, .. } => file.clone(),
+                Source::CommandLine => "the command line".to_string(),
+            };
+            if !out.contains(&name) {
+                out.push(name);
+            }
+        }
+        out
     }
 
     /// The conventions these settings declare.

@@ -193,6 +193,13 @@ fn jolt_conforms_under_its_config_and_its_broken_variants_do_not() -> anyhow::Re
     };
     let (code, report) = conform("")?;
     ensure!(code == 0, "clean Jolt fails rules {:?}", failing(&report));
+    // Its rounding is counted as such, not as fragile decisions.
+    ensure!(
+        report["within_precision"].as_u64() > Some(0) && report["fragile"] == 0,
+        "within_precision {}, fragile {}",
+        report["within_precision"],
+        report["fragile"]
+    );
     let not_applicable: Vec<&str> = report["rules"]
         .as_array()
         .into_iter()

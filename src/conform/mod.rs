@@ -142,6 +142,12 @@ pub struct RuleReport {
     /// level of the inputs' rounding could change it); failures too with
     /// `strict`, where they are also counted in `failed`.
     pub fragile: u64,
+    /// At `precision = "f32"`: cases whose answer differs by no more than
+    /// single-precision rounding explains (backward error within the
+    /// budget). The engine's declared arithmetic: never failures here.
+    /// Only in the JSON when some.
+    #[serde(skip_serializing_if = "is_zero")]
+    pub within_precision: u64,
     /// The first failing case (or, when none fails, the first fragile one).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub first_failure: Option<CaseFailure>,
@@ -188,6 +194,10 @@ pub struct ConformReport {
     pub failed: u64,
     /// Fragile divergences.
     pub fragile: u64,
+    /// Differences within single precision (`precision = "f32"`), not
+    /// failures. Only in the JSON when some.
+    #[serde(skip_serializing_if = "is_zero")]
+    pub within_precision: u64,
     /// Whether fragile divergences fail.
     pub strict: bool,
     /// A fault of the engine, if any (the cases before it are reported).
@@ -330,6 +340,7 @@ pub fn run(
         passed: 0,
         failed: 0,
         fragile: 0,
+        within_precision: 0,
         strict: options.strict,
         error: None,
     };
@@ -370,6 +381,7 @@ pub fn run(
                     passed: 0,
                     failed: 0,
                     fragile: 0,
+                    within_precision: 0,
                     first_failure: None,
                     not_applicable: options.conventions.replaces(case.rule),
                     divergent_cases: Vec::new(),
@@ -415,7 +427,10 @@ pub fn run(
                 } => (fields, reproduced, None, Some(backward_error)),
             };
         let excused = reproduced.is_some() || backward_error.is_some();
-        if excused {
+        if backward_error.is_some() {
+            rule.within_precision += 1;
+            report.within_precision += 1;
+        } else if excused {
             rule.fragile += 1;
             report.fragile += 1;
         }
@@ -491,12 +506,17 @@ pub fn render_text(r: &ConformReport) -> String {
         }
         let _ = writeln!(
             s,
-            "  {:<7} {:<width$}  {} passed, {} failed, {} fragile  ({} {})",
+            "  {:<7} {:<width$}  {} passed, {} failed, {} fragile{}  ({} {})",
             rule.status(),
             rule.rule,
             rule.passed,
             rule.failed,
             rule.fragile,
+            if rule.within_precision > 0 {
+                format!(", {} within f32", rule.within_precision)
+            } else {
+                String::new()
+            },
             rule.cases,
             if rule.cases == 1 { "case" } else { "cases" },
         );
@@ -511,12 +531,20 @@ pub fn render_text(r: &ConformReport) -> String {
     let failing = r.rules.iter().filter(|x| x.failed > 0).count();
     let _ = writeln!(
         s,
-        "{}, {}: {} passed, {} failed, {} fragile{}; {} {}",
+        "{}, {}: {} passed, {} failed, {} fragile{}{}; {} {}",
         crate::numbers::counted(r.rules.len() as u64, "rule", "rules"),
         crate::numbers::counted(r.cases, "case", "cases"),
         r.passed,
         r.failed,
         r.fragile,
+        if r.within_precision > 0 {
+            format!(
+                ", {} within single precision (the engine's declared f32 arithmetic: not failures)",
+                r.within_precision
+            )
+        } else {
+            String::new()
+        },
         match (r.fragile > 0, r.strict) {
             (false, _) => "",
             (true, true) => {
@@ -604,4 +632,9 @@ pub fn render_json(r: &ConformReport, exit_code: u8) -> String {
     let mut s = serde_json::to_string_pretty(&doc).unwrap_or_default();
     s.push('\n');
     s
+}
+
+/// For `serde(skip_serializing_if)`: a count of none.
+fn is_zero(n: &u64) -> bool {
+    *n == 0
 }

@@ -397,7 +397,7 @@ fn rapier_sample_needs_its_settings_file() -> anyhow::Result<()> {
     ])?;
     ensure!(
         code == 1
-            && out.contains("1 of 556 compared sweeps diverges")
+            && out.contains("1 of 553 compared sweeps diverges")
             && out.contains("normal: expected"),
         "every field: exit {code}: {out}{err}"
     );

@@ -422,12 +422,7 @@ fn sweep_lists_the_closest_tests_only() -> anyhow::Result<()> {
         "0.9,-3,0.2"
     ])?;
     ensure!(code == 0, "exit {code}: {err}");
-    let listed: Vec<&str> = out
-        .lines()
-        .skip_while(|l| !l.starts_with("tests that came close"))
-        .skip(1)
-        .take_while(|l| l.starts_with("  "))
-        .collect();
+    let listed = crate::support::close_tests(&out);
     ensure!(!listed.is_empty() && listed.len() <= 5, "listed:\n{out}");
     ensure!(
         listed[0].ends_with("<- primary"),

@@ -49,6 +49,7 @@ mod repro;
 mod scanned;
 mod suite_config;
 mod support;
+mod sweep_story;
 mod trace_io;
 mod tunnel;
 mod tunnel_through;
@@ -155,6 +156,7 @@ fn main() {
     trials.extend(first_hour::tests());
     trials.extend(bless_select::tests());
     trials.extend(first_hour_again::tests());
+    trials.extend(sweep_story::tests());
     trials.extend(mesh::tests());
     trials.extend(jolt::tests());
     trials.extend(precision::tests());

@@ -385,3 +385,13 @@ pub fn write_event<W: std::io::Write + std::io::Seek>(
         EventBody::Expected(outcome) => w.expected(log_time_nanos, outcome),
     }
 }
+
+/// The lines of the tests that came close in `sweep`'s text report (those
+/// after its `tests that came close ...` line, indented).
+pub fn close_tests(out: &str) -> Vec<&str> {
+    out.lines()
+        .skip_while(|l| !l.starts_with("tests that came close"))
+        .skip(1)
+        .take_while(|l| l.starts_with("  "))
+        .collect()
+}

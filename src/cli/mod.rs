@@ -33,7 +33,7 @@ pub struct Cli {
 
 #[derive(Debug, Subcommand)]
 pub enum Command {
-    /// Run one sweep (against a built-in scene, an OBJ mesh, or a trace's scene) and explain every test that came close.
+    /// Run one sweep (against a built-in scene, an OBJ mesh, or a trace's scene) and explain it: the tests that came close, a tunnel through the mesh, the defects within reach.
     Sweep(sweep::Args),
     /// Summarise a trace: scenes, sweeps, frames, channels, compression, metadata.
     Info(info::Args),

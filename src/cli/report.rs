@@ -5,11 +5,11 @@ use std::fmt::Write;
 use serde_json::json;
 
 use sweeptrace::core::{
-    EdgeClass, Feature, Options, Outcome, Sweep, TestRecord, Topology, Verdict,
+    Crossing, EdgeClass, Feature, Options, Outcome, Sweep, TestRecord, Topology, Verdict,
 };
 use sweeptrace::core::{describe, miss_distance, num};
 use sweeptrace::regress::SweepInputs;
-use sweeptrace::replay::feature_class;
+use sweeptrace::replay::{GhostContact, Through, Tunnel, TunnelAt, feature_class};
 use sweeptrace::trace::OutcomeMsg;
 
 /// Formats `[x, y, z]` compactly.
@@ -80,11 +80,16 @@ pub fn outcome_json(o: &Outcome) -> serde_json::Value {
 }
 
 /// Whether a test "came close": it hit, or failed only at the last checks
-/// (contact off the edge, touch point outside the triangle, back-facing).
-/// A back-facing face test whose path stays on one side of the plane,
-/// farther than the detection radius `rho` from it, did not come close:
-/// the ball never got near that face.
-pub fn came_close(r: &TestRecord, rho: f64) -> bool {
+/// (contact off the edge, touch point outside the triangle, back-facing),
+/// or it is the face test of a triangle the centre's path passes through
+/// (`crossed`: from behind, or front to back from a start within `rho`,
+/// where the face test does not look). A back-facing face test whose path
+/// stays on one side of the plane, farther than the detection radius `rho`
+/// from it, did not come close: the ball never got near that face.
+pub fn came_close(r: &TestRecord, rho: f64, crossed: bool) -> bool {
+    if crossed && matches!(r, TestRecord::Face(_)) {
+        return true;
+    }
     match r {
         TestRecord::Face(f) if f.verdict == Verdict::BackFacing => {
             let crosses = (f.h0 <= 0.0) != (f.h1 <= 0.0);
@@ -125,10 +130,17 @@ fn shown_records<'a>(r: &SweepReport<'a>) -> (Vec<&'a TestRecord>, usize) {
         return (shown, 0);
     }
     let rho = r.sweep.radius - r.options.margin;
-    let mut close: Vec<&TestRecord> = r.records.iter().filter(|t| came_close(t, rho)).collect();
-    let rank = |t: &TestRecord| match (t.verdict(), t.alpha()) {
-        (Verdict::Hit, Some(alpha)) => (0u8, alpha),
-        _ => (1u8, miss_distance(t).unwrap_or(f64::INFINITY)),
+    let mut close: Vec<&TestRecord> = r
+        .records
+        .iter()
+        .filter(|t| came_close(t, rho, r.crossing(t).is_some()))
+        .collect();
+    // Hits by α, then the faces the path passes through, where it does,
+    // then the other misses by how near.
+    let rank = |t: &TestRecord| match (t.verdict(), t.alpha(), r.crossing(t)) {
+        (Verdict::Hit, Some(alpha), _) => (0u8, alpha),
+        (_, _, Some(c)) => (1u8, c.fraction),
+        _ => (2u8, miss_distance(t).unwrap_or(f64::INFINITY)),
     };
     close.sort_by(|a, b| {
         let (ka, da) = rank(a);
@@ -167,6 +179,72 @@ pub struct SweepReport<'a> {
     /// For an edge or vertex hit, its place in the mesh's topology
     /// ([`hit_place`]).
     pub place: Option<HitPlace>,
+    /// The frame and ball of the sweep, when it was taken from a trace.
+    pub at: Option<(u64, u32)>,
+    /// Where the ball's centre went through a triangle front to back (or
+    /// a flipped one back to front), as `check` and `replay` find it:
+    /// since its previous sweep, then during this one.
+    pub tunnels: &'a [Tunnel],
+    /// The defects within `ρ` of the centre's path, nearest first.
+    pub within_reach: &'a [Through],
+    /// How many defects the mesh has (`None` without a topology).
+    pub defects: Option<usize>,
+    /// The trace's expectation as a ghost contact, when it is one.
+    pub ghost: Option<&'a GhostContact>,
+    /// The triangles the centre's path passes through, either way, up to
+    /// where the outcome stops it.
+    pub crossings: &'a [Crossing],
+}
+
+impl SweepReport<'_> {
+    /// Where the centre's path passes through the triangle of `t`, when
+    /// `t` is a face test.
+    fn crossing(&self, t: &TestRecord) -> Option<&Crossing> {
+        let TestRecord::Face(f) = t else {
+            return None;
+        };
+        self.crossings.iter().find(|c| c.triangle == f.triangle)
+    }
+
+    /// A tunnel in words: with the frame and ball, as `check` says it,
+    /// when the sweep comes from a trace.
+    fn tunnel_text(&self, t: &Tunnel) -> String {
+        match self.at {
+            Some((frame, ball)) => TunnelAt {
+                frame,
+                ball,
+                tunnel: t.clone(),
+            }
+            .to_string(),
+            None => t.sentence(None),
+        }
+    }
+}
+
+/// Why a face test of a triangle the centre's path passes through did not
+/// count: `the centre's path crosses it at (1, 3, 0), back to front:
+/// back-facing: the ball comes from behind (n·d = +4)`.
+fn crossing_words(t: &TestRecord, c: &Crossing, rho: f64) -> Option<String> {
+    let TestRecord::Face(f) = t else {
+        return None;
+    };
+    let at = vec3(c.point.coords.as_slice());
+    Some(if c.back_to_front {
+        format!(
+            "the centre's path crosses it at {at}, back to front: back-facing: \
+             the ball comes from behind (n·d = +{})",
+            num(f.normal_dot_d)
+        )
+    } else if f.verdict == Verdict::StartsTooClose {
+        format!(
+            "the centre's path crosses it at {at}, front to back: the ball starts within ρ \
+             of its plane (h0 = {} < ρ = {}), where the face test does not look",
+            num(f.h0),
+            num(rho)
+        )
+    } else {
+        format!("the centre's path crosses it at {at}, front to back")
+    })
 }
 
 /// Where an edge or vertex hit is in the mesh's topology.
@@ -245,6 +323,30 @@ pub fn sweep_text(r: &SweepReport) -> String {
     if let Some(e) = r.expected {
         writeln!(s, "expected (the trace's /expected): {}", expected_line(e)).unwrap();
     }
+    for t in r.tunnels {
+        writeln!(s, "tunnel: {}", r.tunnel_text(t)).unwrap();
+    }
+    if let Some(g) = r.ghost {
+        writeln!(s, "ghost contact: {g}").unwrap();
+    }
+    if !r.within_reach.is_empty() {
+        writeln!(
+            s,
+            "defects within reach (within ρ = {} of the centre's path, nearest first):",
+            num(rho)
+        )
+        .unwrap();
+        for d in r.within_reach {
+            writeln!(s, "  {} at {}", d.text, num(d.distance)).unwrap();
+        }
+    } else if let Some(n) = r.defects.filter(|&n| n > 0) {
+        writeln!(
+            s,
+            "defects within reach: none (the mesh has {}; `sweeptrace mesh` lists them)",
+            sweeptrace::numbers::counted(n as u64, "defect", "defects")
+        )
+        .unwrap();
+    }
     if r.outcome.fragile.is_robust() {
         writeln!(s, "decision: robust").unwrap();
     } else {
@@ -272,12 +374,17 @@ pub fn sweep_text(r: &SweepReport) -> String {
             if r.all {
                 ""
             } else {
-                " that came close (hits, contacts off the feature, back-facing), the closest first"
+                " that came close (hits, contacts off the feature, back-facing, faces the centre's \
+                 path passes through), the closest first"
             }
         )
         .unwrap();
         for t in shown {
-            writeln!(s, "  {}{}", describe(t), role(r.outcome, t)).unwrap();
+            let crossing = r
+                .crossing(t)
+                .and_then(|c| crossing_words(t, c, rho))
+                .map_or(String::new(), |w| format!("; {w}"));
+            writeln!(s, "  {}{crossing}{}", describe(t), role(r.outcome, t)).unwrap();
         }
         if more_close > 0 {
             writeln!(
@@ -302,6 +409,7 @@ pub fn sweep_text(r: &SweepReport) -> String {
 /// The `sweep` report as one JSON object.
 pub fn sweep_json(r: &SweepReport) -> String {
     let (shown, more_close) = shown_records(r);
+    let rho = r.sweep.radius - r.options.margin;
     let tests: Vec<serde_json::Value> = shown
         .into_iter()
         .map(|t| {
@@ -309,6 +417,28 @@ pub fn sweep_json(r: &SweepReport) -> String {
             if let Some(obj) = v.as_object_mut() {
                 obj.insert("explanation".into(), json!(describe(t)));
                 obj.insert("primary".into(), json!(r.outcome.is_reported_by(t)));
+                if let Some(c) = r.crossing(t) {
+                    obj.insert(
+                        "crossing".into(),
+                        json!({
+                            "point": [c.point.x, c.point.y, c.point.z],
+                            "fraction": c.fraction,
+                            "back_to_front": c.back_to_front,
+                            "text": crossing_words(t, c, rho),
+                        }),
+                    );
+                }
+            }
+            v
+        })
+        .collect();
+    let tunnels: Vec<serde_json::Value> = r
+        .tunnels
+        .iter()
+        .map(|t| {
+            let mut v = serde_json::to_value(t).unwrap_or(serde_json::Value::Null);
+            if let Some(obj) = v.as_object_mut() {
+                obj.insert("text".into(), json!(r.tunnel_text(t)));
             }
             v
         })
@@ -324,6 +454,9 @@ pub fn sweep_json(r: &SweepReport) -> String {
         "outcome": outcome_json(r.outcome),
         "tests": tests,
         "close_tests_not_shown": more_close,
+        "tunnels": tunnels,
+        "defects_within_reach": r.within_reach,
+        "defects": r.defects,
     });
     let mut value = value;
     if let Some(object) = value.as_object_mut() {
@@ -338,6 +471,17 @@ pub fn sweep_json(r: &SweepReport) -> String {
         }
         if let Some(e) = r.expected {
             object.insert("expected".into(), json!(e));
+        }
+        if let Some((frame, ball)) = r.at {
+            object.insert("frame".into(), json!(frame));
+            object.insert("ball".into(), json!(ball));
+        }
+        if let Some(g) = r.ghost {
+            let mut v = serde_json::to_value(g).unwrap_or(serde_json::Value::Null);
+            if let Some(obj) = v.as_object_mut() {
+                obj.insert("text".into(), json!(g.to_string()));
+            }
+            object.insert("ghost".into(), v);
         }
     }
     serde_json::to_string_pretty(&value).unwrap_or_default()

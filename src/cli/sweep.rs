@@ -7,8 +7,14 @@ use anyhow::Context;
 
 use super::Exit;
 use super::report;
-use sweeptrace::core::{Broadphase, CollectRecords, Facing, Options, Sweep, sweep_mesh_with};
+use sweeptrace::core::{
+    Broadphase, CollectRecords, Facing, Options, Sweep, all_crossings, sweep_mesh_with,
+};
 use sweeptrace::regress::find_sweep;
+use sweeptrace::replay::{
+    FrameRange, ReplayEvent, ReplayOptions, SweepResult, TunnelScene, defects_within_reach,
+    replay_events, sweep_end, tunnel_during_sweep,
+};
 use sweeptrace::sim::load_obj;
 use sweeptrace::sim::scenes::BuiltinScene;
 use sweeptrace::trace::{OutcomeMsg, TraceReader};
@@ -19,6 +25,13 @@ use sweeptrace::trace::{OutcomeMsg, TraceReader};
   sweeptrace sweep --scene cube --radius 0.5 --from 0,3,0.2 --to 0.9,-3,0.2
   sweeptrace sweep --mesh tests/fixtures/scanned/bunny_res4.obj --radius 0.01 --from 0,0.1,0.2 --to 0,0.1,-0.2 --margin 0.001
   sweeptrace sweep --trace traces/record_mini_golf.mcap --frame 120 --ball 0   # that sweep, its scene, margin, facing
+
+Why did my ball fall through? The report names a tunnel (the centre through a
+triangle front to back, or a flipped one back to front) as `check` does, with
+--trace also one since the ball's previous sweep; the mesh defect it went
+through; every defect within ρ of the path (`sweeptrace mesh` lists them all);
+and among the tests, each face the path passes through, with why it did not
+count (back-facing, or a start within ρ of its plane).
 
 Numbers may be written in hexadecimal floating point (0x1.8p+1), read exactly.")]
 pub struct Args {
@@ -82,6 +95,7 @@ pub struct Args {
 pub fn run(args: Args) -> anyhow::Result<Exit> {
     let mut source: Option<String> = None;
     let mut expected: Option<OutcomeMsg> = None;
+    let mut replayed: Option<SweepResult> = None;
     let topology: Option<sweeptrace::Topology>;
     let settings: sweeptrace::regress::Settings;
     let (name, mesh, sweep, options) = if let Some(path) = &args.trace {
@@ -103,6 +117,13 @@ pub fn run(args: Args) -> anyhow::Result<Exit> {
             args.ball, found.scene.margin, found.scene.facing
         ));
         expected = found.expected;
+        replayed = replay_to(
+            path,
+            &shown,
+            (frame, args.ball),
+            &args,
+            &settings.engine.conventions(),
+        )?;
         let name = found
             .scene
             .name
@@ -165,6 +186,28 @@ pub fn run(args: Args) -> anyhow::Result<Exit> {
     if let Some(line) = super::check_config::conventions_line(&settings) {
         eprintln!("{line}");
     }
+    // The tunnels, the defects within reach and the ghost contact, as
+    // `check` and `replay` find them: from a trace, the trace replayed up
+    // to this sweep (a tunnel between the ball's sweeps needs the one
+    // before); otherwise the same function on this sweep alone.
+    let tunnel_scene = topology.as_ref().map(|topology| TunnelScene {
+        mesh: &mesh,
+        topology,
+        rho: sweep.radius - options.margin,
+    });
+    let tunnels = match (&replayed, &tunnel_scene) {
+        (Some(r), _) => r.tunnels.clone(),
+        (None, Some(scene)) => tunnel_during_sweep(scene, &sweep, &outcome)
+            .into_iter()
+            .collect(),
+        (None, None) => Vec::new(),
+    };
+    let within_reach = tunnel_scene
+        .as_ref()
+        .map(|scene| defects_within_reach(scene, &sweep, &outcome))
+        .unwrap_or_default();
+    let ghost = replayed.as_ref().and_then(SweepResult::ghost);
+    let crossings = all_crossings(&mesh, &sweep.p0, &sweep_end(&sweep, &outcome));
     let explained = report::SweepReport {
         scene: &name,
         triangles: mesh.triangles().len(),
@@ -178,6 +221,12 @@ pub fn run(args: Args) -> anyhow::Result<Exit> {
         place: topology
             .as_ref()
             .and_then(|t| report::hit_place(t, &outcome)),
+        at: args.trace.as_ref().and(args.frame).map(|f| (f, args.ball)),
+        tunnels: &tunnels,
+        within_reach: &within_reach,
+        defects: topology.as_ref().map(|t| t.defects().len()),
+        ghost: ghost.as_ref(),
+        crossings: &crossings,
     };
     if args.json {
         println!("{}", report::sweep_json(&explained));
@@ -201,4 +250,40 @@ fn conventions_applied(
         options.facing = facing;
     }
     options.initial_overlap = conventions.initial_overlap;
+}
+
+/// The sweep of `frame` and `ball` replayed as `check` and `replay` replay
+/// it: the trace from its start up to that frame (the ball's earlier
+/// sweeps give the tunnels between them), with the command's margin and
+/// facing overrides, under the engine's `conventions`. `None` when the
+/// replay does not reach it (an invalid sweep; the core's own error says
+/// why).
+fn replay_to(
+    path: &std::path::Path,
+    shown: &str,
+    (frame, ball): (u64, u32),
+    args: &Args,
+    conventions: &sweeptrace::regress::EngineConventions,
+) -> anyhow::Result<Option<SweepResult>> {
+    let file = super::open_trace(path)?;
+    let reader = TraceReader::new_indexed(std::io::BufReader::new(file), shown);
+    let options = conventions.replay_with(ReplayOptions {
+        frames: FrameRange {
+            start: None,
+            end: Some(frame.saturating_add(1)),
+        },
+        ball: Some(ball),
+        margin: args.margin,
+        facing: args.facing,
+        ..ReplayOptions::default()
+    });
+    for event in replay_events(reader, options) {
+        if let Ok(ReplayEvent::Sweep(r)) = event
+            && r.frame == frame
+            && r.ball == ball
+        {
+            return Ok(Some(*r));
+        }
+    }
+    Ok(None)
 }

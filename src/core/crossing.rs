@@ -139,6 +139,26 @@ fn crossing_of(
     })
 }
 
+/// Every triangle of `mesh` the segment `p → q` passes through, either way
+/// (front to back, or back to front with [`Crossing::back_to_front`]), in
+/// the order of the mesh's triangles; each triangle is tested, none
+/// skipped (what an explanation of one sweep needs, not a replay). Empty
+/// for a segment of length 0 or with a non-finite coordinate.
+pub fn all_crossings(mesh: &Mesh, p: &Point3<f64>, q: &Point3<f64>) -> Vec<Crossing> {
+    let length = (q - p).norm();
+    if !(length > 0.0 && length.is_finite()) {
+        return Vec::new();
+    }
+    let tau = crossing_tolerance(mesh, p, q);
+    mesh.triangles()
+        .iter()
+        .filter_map(|t| {
+            triangle_crossing(t, p, q, tau)
+                .or_else(|| triangle_crossing_back_to_front(t, p, q, tau))
+        })
+        .collect()
+}
+
 /// The first front-to-back crossing of a triangle of `mesh` by the segment
 /// `p → q` (see the module documentation), found through the mesh's BVH:
 /// the smallest fraction, and among the crossings within the tie window of

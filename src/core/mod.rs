@@ -40,8 +40,8 @@ mod ties;
 mod topology;
 
 pub use crossing::{
-    Crossing, crossing_tolerance, first_crossing, first_crossing_with_flipped, triangle_crossing,
-    triangle_crossing_back_to_front,
+    Crossing, all_crossings, crossing_tolerance, first_crossing, first_crossing_with_flipped,
+    triangle_crossing, triangle_crossing_back_to_front,
 };
 pub use error::{MeshError, SweepError};
 pub use explain::{describe, miss_distance, num};

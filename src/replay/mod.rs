@@ -51,4 +51,6 @@ pub use primary::{CollectPrimary, primary_records};
 pub use replayer::{Replay, ReplayEvent, SceneState, SweepResult, feature_class};
 pub use selection::{Selection, SweepExtent};
 pub use summary::{ReplaySummary, TunnelAt};
-pub use tunnel::{Through, Tunnel, TunnelKind};
+pub use tunnel::{
+    Through, Tunnel, TunnelKind, TunnelScene, defects_within_reach, sweep_end, tunnel_during_sweep,
+};

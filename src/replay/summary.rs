@@ -3,7 +3,6 @@
 use std::collections::BTreeMap;
 use std::time::Duration;
 
-use crate::core::explain::num;
 use crate::core::{FragileReason, Kind, SkipCounts, VerdictCounts};
 
 use super::ReplayOptions;
@@ -31,28 +30,13 @@ impl std::fmt::Display for TunnelAt {
     /// after the triangle for a flipped one crossed that way and `, through
     /// the flipped triangle 812` (the defect within ρ) at the end.
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        let t = &self.tunnel;
         write!(
             f,
-            "frame {}, ball {}: through triangle {} ",
-            self.frame, self.ball, t.triangle
-        )?;
-        if t.back_to_front {
-            write!(f, "(back to front) ")?;
-        }
-        match (t.kind, t.previous_frame) {
-            (TunnelKind::DuringSweep, _) => write!(f, "during its sweep")?,
-            (TunnelKind::BetweenSweeps, Some(p)) => {
-                write!(f, "between its sweeps of frames {p} and {}", self.frame)?
-            }
-            (TunnelKind::BetweenSweeps, None) => write!(f, "between sweeps")?,
-        }
-        let [x, y, z] = t.point;
-        write!(f, " at ({}, {}, {})", num(x), num(y), num(z))?;
-        if let Some(through) = &t.through {
-            write!(f, ", through {}", through.text)?;
-        }
-        Ok(())
+            "frame {}, ball {}: {}",
+            self.frame,
+            self.ball,
+            self.tunnel.sentence(Some(self.frame))
+        )
     }
 }
 

@@ -9,6 +9,7 @@ use std::collections::HashMap;
 use nalgebra::Point3;
 use serde::Serialize;
 
+use crate::core::explain::num;
 use crate::core::{
     Crossing, Defect, DefectKind, Mesh, Outcome, Sweep, Topology, first_crossing_with_flipped,
 };
@@ -144,6 +145,37 @@ pub struct Tunnel {
     pub through: Option<Through>,
 }
 
+impl Tunnel {
+    /// The tunnel in words, after `frame F, ball B: ` (see
+    /// [`crate::replay::TunnelAt`]): `through triangle T during its sweep
+    /// at (x, y, z)` (or `between its sweeps of frames P and F`, `frame`
+    /// being this sweep's), with `(back to front)` after the triangle for
+    /// a flipped one crossed that way and `, through the flipped triangle
+    /// 812` (the defect within ρ) at the end.
+    pub fn sentence(&self, frame: Option<u64>) -> String {
+        let mut s = format!("through triangle {} ", self.triangle);
+        if self.back_to_front {
+            s.push_str("(back to front) ");
+        }
+        match (self.kind, self.previous_frame, frame) {
+            (TunnelKind::DuringSweep, _, _) => s.push_str("during its sweep"),
+            (TunnelKind::BetweenSweeps, Some(p), Some(f)) => {
+                s.push_str(&format!("between its sweeps of frames {p} and {f}"));
+            }
+            (TunnelKind::BetweenSweeps, Some(p), None) => {
+                s.push_str(&format!("since its sweep of frame {p}"));
+            }
+            (TunnelKind::BetweenSweeps, None, _) => s.push_str("between sweeps"),
+        }
+        let [x, y, z] = self.point;
+        s.push_str(&format!(" at ({}, {}, {})", num(x), num(y), num(z)));
+        if let Some(through) = &self.through {
+            s.push_str(&format!(", through {}", through.text));
+        }
+        s
+    }
+}
+
 /// What a tunnel is judged against: the scene's mesh, its topology (the
 /// flipped triangles, crossed either way, and the defects a tunnel names)
 /// and the ball's detection radius `ρ`.
@@ -164,19 +196,37 @@ impl TunnelScene<'_> {
         first_crossing_with_flipped(self.mesh, self.topology.flipped(), p, q)
     }
 
+    /// Every defect within `ρ` of the centre's path `from → to`: what the
+    /// ball reached on its way, nearest first (see
+    /// [`Topology::defects_along`]).
+    pub fn within_reach(&self, from: &Point3<f64>, to: &Point3<f64>) -> Vec<Through> {
+        if self.topology.defects().is_empty() {
+            return Vec::new();
+        }
+        self.topology
+            .defects_along(self.mesh.vertices(), from, to, self.radius())
+            .into_iter()
+            .map(|(defect, distance)| Through::new(defect, distance))
+            .collect()
+    }
+
+    /// `ρ`, or 0 when it is not a finite number ≥ 0.
+    fn radius(&self) -> f64 {
+        if self.rho.is_finite() {
+            self.rho.max(0.0)
+        } else {
+            0.0
+        }
+    }
+
     /// The defect within `ρ` of `point`, if any.
     fn through(&self, point: &Point3<f64>) -> Option<Through> {
         if self.topology.defects().is_empty() {
             return None;
         }
-        let radius = if self.rho.is_finite() {
-            self.rho.max(0.0)
-        } else {
-            0.0
-        };
         let (_, defect) = self
             .topology
-            .defect_near(self.mesh.vertices(), point, radius)?;
+            .defect_near(self.mesh.vertices(), point, self.radius())?;
         Some(Through::new(
             defect,
             defect.distance(self.mesh.vertices(), point),
@@ -227,6 +277,18 @@ pub fn tunnel_during_sweep(
     scene
         .crossing(&sweep.p0, &end)
         .map(|c| scene.tunnel(TunnelKind::DuringSweep, c, sweep.p0, end, None))
+}
+
+/// The defects within `ρ` of the centre's path during one sweep, from `p0`
+/// to where the outcome stops it ([`sweep_end`]): what the ball reached,
+/// nearest first. A tunnel's [`Tunnel::through`] is the one of these
+/// nearest its crossing point.
+pub fn defects_within_reach(
+    scene: &TunnelScene<'_>,
+    sweep: &Sweep,
+    outcome: &Outcome,
+) -> Vec<Through> {
+    scene.within_reach(&sweep.p0, &sweep_end(sweep, outcome))
 }
 
 /// Where a ball's previous sweep left it.

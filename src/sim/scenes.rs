@@ -272,7 +272,8 @@ pub const GREEN: [f64; 2] = [12.0, 4.0];
 /// and 0.4 deep centred on `(10, 2)`. Every triangle faces the side the ball
 /// plays on: the green and the ramp up, the walls toward the green, the
 /// ramp's sides and drop outward, the cup's walls toward its axis and its
-/// bottom up. 44 triangles.
+/// bottom up. The walls are cut where the green's grid lines meet them, so
+/// that green and walls share their edges. 56 triangles.
 pub fn mini_golf() -> SceneMesh {
     let [length, width] = GREEN;
     let wall = 0.4;
@@ -324,43 +325,37 @@ pub fn mini_golf() -> SceneMesh {
     );
     b.quad([[x0, y0, z], [x1, y0, z], [x1, y1, z], [x0, y1, z]], UP);
 
-    // The walls around the green, facing it.
-    b.quad(
-        [
-            [0.0, 0.0, 0.0],
-            [0.0, width, 0.0],
-            [0.0, width, wall],
-            [0.0, 0.0, wall],
-        ],
-        [1.0, 0.0, 0.0],
-    );
-    b.quad(
-        [
-            [length, 0.0, 0.0],
-            [length, width, 0.0],
-            [length, width, wall],
-            [length, 0.0, wall],
-        ],
-        [-1.0, 0.0, 0.0],
-    );
-    b.quad(
-        [
-            [0.0, 0.0, 0.0],
-            [length, 0.0, 0.0],
-            [length, 0.0, wall],
-            [0.0, 0.0, wall],
-        ],
-        [0.0, 1.0, 0.0],
-    );
-    b.quad(
-        [
-            [0.0, width, 0.0],
-            [length, width, 0.0],
-            [length, width, wall],
-            [0.0, width, wall],
-        ],
-        [0.0, -1.0, 0.0],
-    );
+    // The walls around the green, facing it, each cut where a grid line of
+    // the green meets it, so that the green and the walls share their
+    // edges (no vertex of the green on the interior of a wall's edge: a
+    // T-junction, where a ball meets two boundary edges instead of one
+    // concave edge).
+    for (x, toward) in [(0.0, [1.0, 0.0, 0.0]), (length, [-1.0, 0.0, 0.0])] {
+        for y in ys.windows(2) {
+            b.quad(
+                [
+                    [x, y[0], 0.0],
+                    [x, y[1], 0.0],
+                    [x, y[1], wall],
+                    [x, y[0], wall],
+                ],
+                toward,
+            );
+        }
+    }
+    for (y, toward) in [(0.0, [0.0, 1.0, 0.0]), (width, [0.0, -1.0, 0.0])] {
+        for x in xs.windows(2) {
+            b.quad(
+                [
+                    [x[0], y, 0.0],
+                    [x[1], y, 0.0],
+                    [x[1], y, wall],
+                    [x[0], y, wall],
+                ],
+                toward,
+            );
+        }
+    }
 
     // The ramp: a wedge standing on the green, its slope facing up and
     // back toward the tee, its sides and its drop facing outward.

@@ -7,6 +7,7 @@ use std::collections::{HashMap, HashSet};
 use nalgebra::Point3;
 use serde::Serialize;
 
+use super::distance::{Place, point_segment_distance};
 use super::edges::{BoundaryEdge, Edge};
 use super::{Builder, NEAR_FRACTION, SLIVER_RATIO, sub};
 use crate::core::options::DEGENERATE_TOLERANCE;
@@ -109,51 +110,65 @@ pub struct Defect {
 }
 
 impl Defect {
+    /// The defect's place: its triangles (flipped, degenerate, sliver,
+    /// duplicate triangle), its edges (crack, non-manifold edge, the
+    /// T-junction's edge) or its vertices (duplicate vertex). `vertices`
+    /// are the mesh's positions.
+    fn places(&self, vertices: &[Point3<f64>]) -> Vec<Place> {
+        let at = |i: u32| vertices.get(i as usize).copied();
+        let v = &self.vertices;
+        match self.kind {
+            DefectKind::Flipped
+            | DefectKind::Degenerate
+            | DefectKind::Sliver
+            | DefectKind::DuplicateTriangle => v
+                .chunks_exact(3)
+                .filter_map(|t| Some(Place::Triangle(at(t[0])?, at(t[1])?, at(t[2])?)))
+                .collect(),
+            DefectKind::Crack => v
+                .chunks_exact(2)
+                .filter_map(|e| Some(Place::Segment(at(e[0])?, at(e[1])?)))
+                .collect(),
+            DefectKind::TJunction => v
+                .get(1..3)
+                .and_then(|e| Some(Place::Segment(at(e[0])?, at(e[1])?)))
+                .into_iter()
+                .collect(),
+            DefectKind::NonManifoldEdge => v
+                .get(0..2)
+                .and_then(|e| Some(Place::Segment(at(e[0])?, at(e[1])?)))
+                .into_iter()
+                .collect(),
+            DefectKind::DuplicateVertex => {
+                v.iter().filter_map(|&i| at(i).map(Place::Point)).collect()
+            }
+        }
+    }
+
     /// Distance from `point` to the defect's place: its triangles (flipped,
     /// degenerate, sliver, duplicate triangle), its edges (crack,
     /// non-manifold edge, the T-junction's edge) or its vertices
     /// (duplicate vertex). `vertices` are the mesh's positions.
     pub fn distance(&self, vertices: &[Point3<f64>], point: &Point3<f64>) -> f64 {
-        let at = |i: u32| vertices.get(i as usize).copied();
-        let v = &self.vertices;
-        let mut best = f64::INFINITY;
-        match self.kind {
-            DefectKind::Flipped
-            | DefectKind::Degenerate
-            | DefectKind::Sliver
-            | DefectKind::DuplicateTriangle => {
-                for t in v.chunks_exact(3) {
-                    if let (Some(a), Some(b), Some(c)) = (at(t[0]), at(t[1]), at(t[2])) {
-                        best = best.min(point_triangle_distance(point, &a, &b, &c));
-                    }
-                }
-            }
-            DefectKind::Crack => {
-                for e in v.chunks_exact(2) {
-                    if let (Some(a), Some(b)) = (at(e[0]), at(e[1])) {
-                        best = best.min(point_segment_distance(point, &a, &b));
-                    }
-                }
-            }
-            DefectKind::TJunction => {
-                if let (Some(a), Some(b)) = (at(v[1]), at(v[2])) {
-                    best = point_segment_distance(point, &a, &b);
-                }
-            }
-            DefectKind::NonManifoldEdge => {
-                if let (Some(a), Some(b)) = (at(v[0]), at(v[1])) {
-                    best = point_segment_distance(point, &a, &b);
-                }
-            }
-            DefectKind::DuplicateVertex => {
-                for &i in v {
-                    if let Some(p) = at(i) {
-                        best = best.min((p - point).norm());
-                    }
-                }
-            }
-        }
-        best
+        self.places(vertices)
+            .iter()
+            .map(|place| place.distance_to_point(point))
+            .fold(f64::INFINITY, f64::min)
+    }
+
+    /// Distance from the segment `p q` (a ball centre's path) to the
+    /// defect's place (as in [`Defect::distance`]): 0 when it passes
+    /// through one of its triangles.
+    pub fn distance_to_segment(
+        &self,
+        vertices: &[Point3<f64>],
+        p: &Point3<f64>,
+        q: &Point3<f64>,
+    ) -> f64 {
+        self.places(vertices)
+            .iter()
+            .map(|place| place.distance_to_segment(p, q))
+            .fold(f64::INFINITY, f64::min)
     }
 }
 
@@ -201,45 +216,6 @@ impl std::fmt::Display for Defect {
                 self.triangles.len()
             ),
         }
-    }
-}
-
-/// Closest distance from `p` to the segment `a b`.
-pub(crate) fn point_segment_distance(p: &Point3<f64>, a: &Point3<f64>, b: &Point3<f64>) -> f64 {
-    let ab = b - a;
-    let len2 = ab.norm_squared();
-    let t = if len2 > 0.0 {
-        ((p - a).dot(&ab) / len2).clamp(0.0, 1.0)
-    } else {
-        0.0
-    };
-    (a + ab * t - p).norm()
-}
-
-/// Closest distance from `p` to the triangle `a b c` (its edges when it has
-/// no area).
-fn point_triangle_distance(
-    p: &Point3<f64>,
-    a: &Point3<f64>,
-    b: &Point3<f64>,
-    c: &Point3<f64>,
-) -> f64 {
-    let edges = point_segment_distance(p, a, b)
-        .min(point_segment_distance(p, b, c))
-        .min(point_segment_distance(p, c, a));
-    let cross = (b - a).cross(&(c - a));
-    let area2 = cross.norm();
-    if area2.is_nan() || area2 <= 0.0 {
-        return edges;
-    }
-    let n = cross / area2;
-    let inside = [(a, b), (b, c), (c, a)]
-        .iter()
-        .all(|(u, v)| n.dot(&(*v - *u).cross(&(p - *u))) >= 0.0);
-    if inside {
-        n.dot(&(p - a)).abs().min(edges)
-    } else {
-        edges
     }
 }
 

@@ -22,6 +22,7 @@ use super::error::MeshError;
 use super::options::GRAZING_COSINE;
 
 mod defects;
+mod distance;
 mod edges;
 #[cfg(test)]
 mod tests;
@@ -196,6 +197,35 @@ impl Topology {
             }
         }
         best.map(|(_, _, i)| (i, &self.defects[i]))
+    }
+
+    /// The defects within `radius` of the segment `p q` (a ball centre's
+    /// path, `radius` its detection radius: what the ball reaches on its
+    /// way), each with its distance, nearest first (those that change
+    /// collisions first at the same distance, then in [`Topology::defects`]'
+    /// order).
+    pub fn defects_along(
+        &self,
+        vertices: &[Point3<f64>],
+        p: &Point3<f64>,
+        q: &Point3<f64>,
+        radius: f64,
+    ) -> Vec<(&Defect, f64)> {
+        let mut near: Vec<(usize, f64)> = self
+            .defects
+            .iter()
+            .enumerate()
+            .map(|(i, d)| (i, d.distance_to_segment(vertices, p, q)))
+            .filter(|&(_, distance)| distance <= radius)
+            .collect();
+        near.sort_by(|a, b| {
+            let ka = !self.defects[a.0].kind.changes_collisions();
+            let kb = !self.defects[b.0].kind.changes_collisions();
+            a.1.total_cmp(&b.1).then(ka.cmp(&kb)).then(a.0.cmp(&b.0))
+        });
+        near.into_iter()
+            .map(|(i, distance)| (&self.defects[i], distance))
+            .collect()
     }
 
     /// The edge between input vertices `a` and `b` (after welding), if

@@ -199,3 +199,29 @@ fn bad_input_is_an_error() {
         Err(MeshError::NonFiniteVertex { .. })
     ));
 }
+
+#[test]
+fn defects_along_a_path_within_its_radius() {
+    let (v, mut t) = floor(3, 3);
+    // Triangle 9: (1,1), (2,2), (1,2), wound the other way.
+    t[9].swap(1, 2);
+    let topo = Topology::new(&v, &t).unwrap();
+    let vertices: Vec<Point3<f64>> = v.iter().map(|p| Point3::from(*p)).collect();
+    let p = |x: f64, y: f64, z: f64| Point3::new(x, y, z);
+    // Straight down through it.
+    let through = topo.defects_along(&vertices, &p(1.2, 1.6, 1.0), &p(1.2, 1.6, -1.0), 0.1);
+    assert_eq!(through.len(), 1);
+    assert_eq!(through[0].0.triangles, vec![9]);
+    assert_eq!(through[0].1, 0.0);
+    // Down beside it, 0.3 left of its edge x = 1: out of reach at 0.2, in
+    // reach at 0.5.
+    let (a, b) = (p(0.7, 1.5, 1.0), p(0.7, 1.5, -1.0));
+    assert!(topo.defects_along(&vertices, &a, &b, 0.2).is_empty());
+    let near = topo.defects_along(&vertices, &a, &b, 0.5);
+    assert_eq!(near.len(), 1);
+    assert!((near[0].1 - 0.3).abs() < 1e-12, "{}", near[0].1);
+    // Level over it, 0.25 above: the segment's distance, not its ends'.
+    let over = topo.defects_along(&vertices, &p(0.0, 1.8, 0.25), &p(3.0, 1.8, 0.25), 0.3);
+    assert_eq!(over.len(), 1);
+    assert!((over[0].1 - 0.25).abs() < 1e-12, "{}", over[0].1);
+}

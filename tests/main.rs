@@ -27,6 +27,7 @@ mod help;
 mod interrupts;
 mod jolt;
 mod junit;
+mod lean;
 mod mesh;
 mod oracle;
 mod out_of_order;
@@ -153,6 +154,7 @@ fn main() {
     trials.extend(help::tests());
     trials.extend(first_hour::tests());
     trials.extend(first_hour_again::tests());
+    trials.extend(lean::tests());
     trials.extend(mesh::tests());
     trials.extend(jolt::tests());
     trials.extend(precision::tests());

@@ -28,6 +28,7 @@ mod help;
 mod interrupts;
 mod jolt;
 mod junit;
+mod lean;
 mod mesh;
 mod oracle;
 mod out_of_order;
@@ -157,6 +158,7 @@ fn main() {
     trials.extend(bless_select::tests());
     trials.extend(first_hour_again::tests());
     trials.extend(sweep_story::tests());
+    trials.extend(lean::tests());
     trials.extend(mesh::tests());
     trials.extend(jolt::tests());
     trials.extend(precision::tests());

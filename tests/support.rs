@@ -43,11 +43,25 @@ pub fn run_bin_in(
     dir: &std::path::Path,
     args: &[&std::ffi::OsStr],
 ) -> anyhow::Result<(i32, String, String)> {
-    let out = bin()
+    run_program_in(
+        std::path::Path::new(env!("CARGO_BIN_EXE_sweeptrace")),
+        dir,
+        args,
+    )
+}
+
+/// Runs `program` (another build of the binary) with `args` in `dir`:
+/// exit code (-1 when killed by a signal), stdout, stderr.
+pub fn run_program_in(
+    program: &std::path::Path,
+    dir: &std::path::Path,
+    args: &[&std::ffi::OsStr],
+) -> anyhow::Result<(i32, String, String)> {
+    let out = std::process::Command::new(program)
         .args(args)
         .current_dir(dir)
         .output()
-        .map_err(|e| anyhow::anyhow!("running sweeptrace in {}: {e}", dir.display()))?;
+        .map_err(|e| anyhow::anyhow!("running {} in {}: {e}", program.display(), dir.display()))?;
     Ok((
         out.status.code().unwrap_or(-1),
         String::from_utf8_lossy(&out.stdout).into_owned(),

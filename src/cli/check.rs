@@ -1,7 +1,6 @@
 //! `sweeptrace check`: replay traces and compare every sweep's outcome with
 //! the trace's `/expected` channel (the library's [`sweeptrace::regress`]).
 
-use super::NameFileOnce;
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, bail};
@@ -12,9 +11,7 @@ use sweeptrace::regress::{
     Against, CheckOptions, DEFAULT_MAX_DETAILS, Status, TraceReport, check_file,
     check_file_with_engine, find_traces, frames_around, render_json, render_text,
 };
-use sweeptrace::replay::{Detail, ReplayError, ReplayEvent, ReplayOptions, replay_events};
-use sweeptrace::trace::TraceReader;
-use sweeptrace::viz;
+use sweeptrace::replay::{Detail, ReplayOptions};
 
 /// Frames of context logged before and after the divergences by `--rrd-on-failure`.
 const RRD_CONTEXT_FRAMES: u64 = 10;
@@ -202,6 +199,14 @@ pub enum AgainstArg {
 
 /// Checks every trace, prints the reports, returns the exit code.
 pub fn run(args: Args) -> anyhow::Result<Exit> {
+    #[cfg(not(feature = "viewer"))]
+    if args.rrd_on_failure.is_some() {
+        return Err(super::viewer::needs_viewer(
+            "--rrd-on-failure",
+            "the check itself needs no viewer: run it without --rrd-on-failure \
+             (--json and --junit report the divergences)",
+        ));
+    }
     let overrides = sweeptrace::regress::Overrides {
         strict: args.strict,
         allow_tunnels: args.allow_tunnels,
@@ -474,34 +479,12 @@ fn write_failure_rrd(trace: &Path, dir: &Path, report: &TraceReport) -> anyhow::
     };
     let name = trace.display().to_string();
     let bytes = std::fs::read(trace).with_context(|| format!("reading {name}"))?;
-    let id = super::recording_id(bytes.as_slice(), "check", &options)
-        .with_context(|| format!("reading {name}"))?;
-    let mut recording = viz::Recording::open(
-        &id,
+    super::viewer::write_check_recording(
+        &bytes,
+        &name,
         &format!("{name} (check, frames {frames})"),
-        viz::RecordingTarget {
-            file: Some(target.clone()),
-            ..viz::RecordingTarget::default()
-        },
-        viz::LoggerOptions::default(),
-    )?;
-    let logger = recording.logger();
-    for event in replay_events(
-        TraceReader::new_indexed(std::io::Cursor::new(bytes.as_slice()), &name),
+        &target,
         options,
-    ) {
-        match event {
-            Ok(ReplayEvent::Scene(scene)) => {
-                logger.log_scene(&scene).context("logging the scene")?
-            }
-            Ok(ReplayEvent::Sweep(r)) => logger
-                .log_sweep(&r)
-                .with_context(|| format!("logging frame {}", r.frame))?,
-            // The check already reported read errors; record what was read.
-            Err(ReplayError::Trace(_)) => break,
-            Err(err) => return Err(err).name_file_once("replaying", &name),
-        }
-    }
-    recording.finish(|_, _| {})?.commit()?;
+    )?;
     Ok(target)
 }

@@ -2,7 +2,6 @@
 
 use clap::parser::ValueSource;
 use clap::{CommandFactory, FromArgMatches, Parser, Subcommand};
-use sweeptrace::replay::ReplayOptions;
 
 pub mod bless;
 pub mod check;
@@ -18,14 +17,23 @@ pub mod replay;
 pub mod report;
 pub mod repro;
 pub mod sweep;
+pub mod viewer;
 
 pub use exit::Exit;
+
+/// `--version`: the version, and whether this build lacks the Rerun viewer
+/// (its recordings are refused, see [`viewer`]).
+const VERSION: &str = if cfg!(feature = "viewer") {
+    env!("CARGO_PKG_VERSION")
+} else {
+    concat!(env!("CARGO_PKG_VERSION"), " (without the Rerun viewer)")
+};
 
 /// Replay recorded ball trajectories through a swept-sphere vs triangle-mesh
 /// collision core and see, frame by frame, why each collision was or was not
 /// found.
 #[derive(Debug, Parser)]
-#[command(name = "sweeptrace", version, about, long_about = None)]
+#[command(name = "sweeptrace", version = VERSION, about, long_about = None)]
 pub struct Cli {
     #[command(subcommand)]
     pub command: Command,
@@ -224,31 +232,6 @@ fn field_parser() -> impl clap::builder::TypedValueParser<Value = sweeptrace::re
         name.parse::<sweeptrace::regress::Field>()
             .map_err(|_| format!("`{name}` is not a field"))
     })
-}
-
-/// The recording id of a replay of `trace` for `purpose` (`replay`,
-/// `check`) with `options`: a hash of the trace's bytes, the purpose and the
-/// options' [stable encoding](ReplayOptions::stable_encoding), so the same
-/// trace replayed the same way gets the same id (and the same blueprint).
-pub fn recording_id(
-    mut trace: impl std::io::Read,
-    purpose: &str,
-    options: &ReplayOptions,
-) -> std::io::Result<String> {
-    let mut hasher = sweeptrace::viz::IdHasher::new();
-    let mut buf = vec![0u8; 1 << 16];
-    loop {
-        let n = trace.read(&mut buf)?;
-        if n == 0 {
-            break;
-        }
-        hasher.update(&buf[..n]);
-    }
-    for part in [purpose, &options.stable_encoding()] {
-        hasher.update(&(part.len() as u64).to_le_bytes());
-        hasher.update(part.as_bytes());
-    }
-    Ok(hasher.finish())
 }
 
 /// Context for an error that may already name its file: the library's

@@ -14,6 +14,9 @@ use anyhow::{Context, bail};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 
 use super::Exit;
+use super::viewer::{FinishedRecording, Recording, RecordingTarget};
+#[cfg(feature = "viewer")]
+use super::viewer::{RrdFileOptions, Viewer};
 use sweeptrace::atomic::PendingFile;
 use sweeptrace::core::Facing;
 use sweeptrace::foxglove::{FoxgloveFile, FoxgloveOptions};
@@ -24,9 +27,6 @@ use sweeptrace::replay::{
     replay_events_parallel, run_pipeline,
 };
 use sweeptrace::trace::{DEFAULT_PREFETCH_CHUNK, DEFAULT_PREFETCH_DEPTH, TraceReader, prefetch};
-use sweeptrace::viz::{
-    self, FinishedRecording, Recording, RecordingError, RecordingTarget, Viewer,
-};
 
 /// The viewer address `--connect` uses when given no URL.
 pub const DEFAULT_CONNECT_URL: &str = "rerun+http://127.0.0.1:9876/proxy";
@@ -42,6 +42,12 @@ Examples:
 
 To watch in a Rerun viewer, add --spawn (starts `rerun`, which must be on
 PATH) or --connect (streams to a viewer already running).
+
+--rrd, --spawn, --connect and a replay that names no output write a Rerun
+recording: they need the build with the viewer (the default features). A
+build without it (`--no-default-features --features cli`) refuses them with
+exit 2 and the command that installs the viewer build; its --outcomes,
+--foxglove and --json are the same.
 
 A --frames or --ball filter that selects no sweep is an error naming the
 trace's balls and frames, and writes nothing; one that selects part says how
@@ -167,7 +173,7 @@ pub fn run(args: Args) -> anyhow::Result<Exit> {
     if let Some(m) = args.margin {
         numbers::check(m, Rule::NonNegative).map_err(|e| anyhow::anyhow!("--margin {e}"))?;
     }
-    let target = recording_target(&args);
+    let target = recording_target(&args)?;
     if args.detail_given && target.is_none() && args.foxglove.is_none() {
         eprintln!(
             "warning: --detail only changes what the recording shows, and no recording \
@@ -408,17 +414,14 @@ fn summary_json(
 
 /// Where the recording goes, if anywhere: `--rrd`, `--spawn`,
 /// `--connect`; with no output named at all, `<trace stem>.rrd`.
-fn recording_target(args: &Args) -> Option<RecordingTarget> {
+#[cfg(feature = "viewer")]
+fn recording_target(args: &Args) -> anyhow::Result<Option<RecordingTarget>> {
     let viewer = match (&args.connect, args.spawn) {
         (Some(url), _) => Viewer::Connect(url.clone()),
         (None, true) => Viewer::Spawn,
         (None, false) => Viewer::None,
     };
-    let no_output = args.outcomes.is_none()
-        && args.rrd.is_none()
-        && args.foxglove.is_none()
-        && !viewer.is_some();
-    let file = match (&args.rrd, no_output) {
+    let file = match (&args.rrd, names_no_output(args)) {
         (Some(p), _) => Some(p.clone()),
         (None, true) => {
             let stem = args
@@ -430,13 +433,49 @@ fn recording_target(args: &Args) -> Option<RecordingTarget> {
         }
         (None, false) => None,
     };
-    (file.is_some() || viewer.is_some()).then_some(RecordingTarget {
-        file,
-        file_options: viz::RrdFileOptions {
-            footer: !args.no_rrd_footer,
-        },
-        viewer,
-    })
+    Ok(
+        (file.is_some() || viewer.is_some()).then_some(RecordingTarget {
+            file,
+            file_options: RrdFileOptions {
+                footer: !args.no_rrd_footer,
+            },
+            viewer,
+        }),
+    )
+}
+
+/// In a build without the viewer: the error of the first option that asks
+/// for a recording (a replay that names no output asks for `<trace
+/// stem>.rrd`); otherwise no recording.
+#[cfg(not(feature = "viewer"))]
+fn recording_target(args: &Args) -> anyhow::Result<Option<RecordingTarget>> {
+    let instead = "its outcomes and explanations need no viewer: \
+                   --outcomes FILE (or -), --foxglove FILE (for Foxglove), --json";
+    let asked = if args.rrd.is_some() {
+        Some("--rrd")
+    } else if args.spawn {
+        Some("--spawn")
+    } else if args.connect.is_some() {
+        Some("--connect")
+    } else if names_no_output(args) {
+        Some("a replay without --outcomes or --foxglove (it writes <trace stem>.rrd)")
+    } else {
+        None
+    };
+    match asked {
+        Some(option) => Err(super::viewer::needs_viewer(option, instead)),
+        None => Ok(None),
+    }
+}
+
+/// Whether the command line names no output at all (then the recording
+/// goes to `<trace stem>.rrd`).
+fn names_no_output(args: &Args) -> bool {
+    args.outcomes.is_none()
+        && args.rrd.is_none()
+        && args.foxglove.is_none()
+        && !args.spawn
+        && args.connect.is_none()
 }
 
 /// Where the outcomes go.
@@ -493,35 +532,14 @@ impl Outputs {
         let trace_path = &args.trace;
         let recording = match target {
             None => None,
-            Some(target) => {
-                let trace = super::open_trace(trace_path)?;
-                let id = super::recording_id(BufReader::new(trace), "replay", options)
-                    .with_context(|| format!("reading {}", trace_path.display()))?;
-                if let Some(path) = &target.file {
-                    super::warn_unfinished(path);
-                }
-                let name = trace_path
-                    .file_name()
-                    .map(|n| n.to_string_lossy().into_owned())
-                    .unwrap_or_default();
-                let logger_options = viz::LoggerOptions {
-                    blueprint: !args.no_blueprint,
-                    prepare: viz::PrepareOptions {
-                        follow_ball: args.ball.unwrap_or(0),
-                        tolerances,
-                        ..viz::PrepareOptions::default()
-                    },
-                    ..viz::LoggerOptions::default()
-                };
-                let recording =
-                    Recording::open(&id, &name, target, logger_options).map_err(|e| match e {
-                        RecordingError::Address { url, reason } => {
-                            anyhow::anyhow!("--connect `{url}`: {reason}")
-                        }
-                        e => anyhow::Error::new(e),
-                    })?;
-                Some(recording)
-            }
+            Some(target) => Some(super::viewer::open_replay_recording(
+                trace_path,
+                target,
+                options,
+                tolerances,
+                !args.no_blueprint,
+                args.ball.unwrap_or(0),
+            )?),
         };
         let writing_outcomes = match &args.outcomes {
             Some(p) if p.as_os_str() != "-" => format!("writing the outcomes to {}", p.display()),

@@ -8,8 +8,8 @@
 //! differs from the exact rules on most sweeps, which hides what the other
 //! conventions change until rounding is judged as rounding. The margin
 //! comes from [`super::Inferred`] (the margin every trace's face hits
-//! imply); the facing rule is tried both ways, then both sides (before
-//! the initial overlap, which counts the triangles the sides let through).
+//! imply); the facing rule is tried both ways; both sides after the
+//! initial overlap.
 //!
 //! Inference never makes a run pass by itself: it prints a file, and the
 //! check that uses it judges as strictly as any other.
@@ -136,16 +136,19 @@ pub fn infer_conventions(
             }),
         ),
         (
-            "sides",
-            Box::new(|c| EngineConventions {
-                sides: Sides::Two,
-                ..c
-            }),
-        ),
-        (
             "initial_overlap",
             Box::new(|c| EngineConventions {
                 initial_overlap: InitialOverlap::Alpha0,
+                ..c
+            }),
+        ),
+        // After the initial overlap: a two-sided engine that also reports
+        // starts in contact (Jolt) fits two sides only once those starts
+        // are hits.
+        (
+            "sides",
+            Box::new(|c| EngineConventions {
+                sides: Sides::Two,
                 ..c
             }),
         ),
@@ -208,7 +211,7 @@ pub fn infer_conventions(
             "facing" => format!("{fixed} fewer sweeps fail with it than with each scene's rule"),
             "sides" => format!(
                 "{fixed} answers hit triangles from behind (n·d > 0) as from the front, with \
-                 the normal -n; {fixed} fewer sweeps fail"
+                 the normal -n"
             ),
             "initial_overlap" => format!(
                 "{fixed} answers are hits at α = 0 where the ball starts within ρ of the mesh"

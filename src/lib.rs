@@ -91,8 +91,8 @@ pub mod viz;
 
 pub use crate::core::{
     CollectRecords, Defect, DefectKind, EdgeClass, EdgeCounts, Facing, Feature, InitialOverlap,
-    Kind, Mesh, MeshError, NoObserver, Observer, Options, Outcome, Sweep, SweepError, SweepHit,
-    Tie, Topology, sweep_mesh, sweep_mesh_with, sweep_ties,
+    Kind, Mesh, MeshError, NoObserver, Observer, Options, Outcome, Sides, Sweep, SweepError,
+    SweepHit, Tie, Topology, sweep_mesh, sweep_mesh_with, sweep_ties,
 };
 pub use crate::regress::{
     Agreement, CheckOptions, Status, Tolerances, TraceReport, agreement, check_file, check_reader,

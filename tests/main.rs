@@ -183,6 +183,7 @@ const SLOW: &[&str] = &[
     "jolt::broken_jolt_variants_fail_check_naming_the_difference",
     "jolt::jolt_conforms_under_its_config_and_its_broken_variants_do_not",
     "jolt::jolt_config_is_what_infer_config_prints",
+    "jolt::jolt_with_back_faces_is_judged_two_sided_under_sides_two",
 ];
 
 fn mark_slow(trials: Vec<Trial>) -> Vec<Trial> {

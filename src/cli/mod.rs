@@ -189,6 +189,11 @@ pub struct ConventionArgs {
         help_heading = "Engine conventions"
     )]
     pub facing: Option<sweeptrace::regress::FacingRule>,
+    /// Which sides of a triangle collide: `one` (the rules: a contact
+    /// from behind, `n · d > 0`, is no collision) or `two` (a hit from
+    /// behind too, reported with the normal `-n`) [default: one].
+    #[arg(long, value_name = "one|two", help_heading = "Engine conventions")]
+    pub sides: Option<sweeptrace::Sides>,
     /// A ball that starts within its radius of the mesh: `none` (the
     /// rules: no collision) or `alpha0` (a hit at α = 0 with the nearest
     /// feature) [default: none].
@@ -213,6 +218,7 @@ impl ConventionArgs {
             precision: self.precision,
             margin: self.margin,
             facing: self.facing,
+            sides: self.sides,
             initial_overlap: self.initial_overlap,
             normal: self.normal,
             ties: self.ties,

@@ -68,10 +68,15 @@ pub struct Label<'a>(pub &'a TestRecord);
 impl fmt::Display for Label<'_> {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self.0 {
-            TestRecord::Face(r) => write!(f, "face {}", r.triangle),
-            TestRecord::Edge(r) => write!(f, "edge {}.{}", r.triangle, r.edge),
-            TestRecord::Vertex(r) => write!(f, "vertex {}.{}", r.triangle, r.vertex),
+            TestRecord::Face(r) => write!(f, "face {}", r.triangle)?,
+            TestRecord::Edge(r) => write!(f, "edge {}.{}", r.triangle, r.edge)?,
+            TestRecord::Vertex(r) => write!(f, "vertex {}.{}", r.triangle, r.vertex)?,
         }
+        // Under `sides = two`, a triangle tested from its back.
+        if self.0.back() {
+            f.write_str(" (back side)")?;
+        }
+        Ok(())
     }
 }
 

@@ -7,7 +7,9 @@
 //!
 //! The contact is the point of the mesh nearest to the ball's centre at
 //! `p0`, among the triangles whose facing rule lets the path through (an
-//! engine that ignores back faces ignores them at the start too), named by
+//! engine that ignores back faces ignores them at the start too; under
+//! `sides = two` every triangle, one the path moves toward the back of
+//! with the normal `-n`, as in the sweep), named by
 //! the region of the triangle it lies in: the face's interior, an edge or a
 //! vertex. Every triangle in contact is a hit at `α = 0`, so they tie: the
 //! primary is the first in the rules' tie order (face < edge < vertex, then
@@ -19,7 +21,7 @@ use nalgebra::Point3;
 
 use super::feature::Feature;
 use super::mesh::{Mesh, Triangle};
-use super::options::Facing;
+use super::options::{Facing, Sides};
 use super::outcome::SweepHit;
 use super::path::SweptPath;
 
@@ -70,13 +72,26 @@ pub(crate) fn closest_point(triangle: &Triangle, p: &Point3<f64>) -> (Point3<f64
 /// normal the triangle's front normal), with its distance from `p0`; in
 /// the rules' tie order (face < edge < vertex, then triangle, then
 /// feature). All of them are hits at the same `α`: a tie.
-pub fn initial_contacts(mesh: &Mesh, path: &SweptPath, facing: Facing) -> Vec<(SweepHit, f64)> {
+pub fn initial_contacts(
+    mesh: &Mesh,
+    path: &SweptPath,
+    facing: Facing,
+    sides: Sides,
+) -> Vec<(SweepHit, f64)> {
     let triangles = mesh.triangles();
     let mut found = Vec::new();
     let mut consider = |t: &Triangle| {
-        if !facing.allows(t.normal.dot(&path.d)) {
+        // Under `sides = two` a triangle the path moves toward the back of
+        // is its mirror, as in the sweep: normal `-n`.
+        let normal_dot_d = t.normal.dot(&path.d);
+        if !facing.allows(sides.facing_value(normal_dot_d)) {
             return;
         }
+        let normal = if sides.flips(normal_dot_d) {
+            -t.normal
+        } else {
+            t.normal
+        };
         let (point, feature) = closest_point(t, &path.p0);
         let distance = (path.p0 - point).norm();
         if distance < path.rho {
@@ -84,7 +99,7 @@ pub fn initial_contacts(mesh: &Mesh, path: &SweptPath, facing: Facing) -> Vec<(S
                 alpha: 0.0,
                 triangle: t.index,
                 feature,
-                normal: t.normal,
+                normal,
                 contact: point,
             };
             found.push((hit, distance));
@@ -119,8 +134,9 @@ pub(crate) fn initial_contact(
     mesh: &Mesh,
     path: &SweptPath,
     facing: Facing,
+    sides: Sides,
 ) -> Option<(SweepHit, f64)> {
-    let contacts = initial_contacts(mesh, path, facing);
+    let contacts = initial_contacts(mesh, path, facing, sides);
     let (first, _) = contacts.first()?;
     let mut hit = *first;
     let mut sum = nalgebra::Vector3::zeros();
@@ -187,15 +203,15 @@ mod tests {
             let s = Sweep::new([1.0, 1.0, z], [1.0, 1.0, z + dz], 0.5);
             SweptPath::new(&s, &Options::default()).expect("valid sweep")
         };
-        let (hit, distance) =
-            initial_contact(&m, &path(0.25, -1.0), Facing::NonStrict).expect("a contact");
+        let (hit, distance) = initial_contact(&m, &path(0.25, -1.0), Facing::NonStrict, Sides::One)
+            .expect("a contact");
         assert_eq!(distance, 0.25);
         assert_eq!((hit.alpha, hit.feature), (0.0, Feature::Face));
         assert_eq!(hit.contact, Point3::new(1.0, 1.0, 0.0));
-        assert!(initial_contact(&m, &path(0.75, -1.0), Facing::NonStrict).is_none());
+        assert!(initial_contact(&m, &path(0.75, -1.0), Facing::NonStrict, Sides::One).is_none());
         // Moving away from the front: the facing rule rejects the triangle.
-        assert!(initial_contact(&m, &path(0.25, 1.0), Facing::NonStrict).is_none());
+        assert!(initial_contact(&m, &path(0.25, 1.0), Facing::NonStrict, Sides::One).is_none());
         // Not moving at all: every triangle is looked at.
-        assert!(initial_contact(&m, &path(0.25, 0.0), Facing::NonStrict).is_some());
+        assert!(initial_contact(&m, &path(0.25, 0.0), Facing::NonStrict, Sides::One).is_some());
     }
 }

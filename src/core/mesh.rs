@@ -62,6 +62,22 @@ impl StandardFrame {
     pub fn edge_from_world(&self) -> Isometry3<f64> {
         self.world_from_edge().inverse()
     }
+
+    /// The frame of the same edge for the front normal `-n`: `+y` and `+z`
+    /// negated (a half turn about the edge), so a point's `x` and its
+    /// distance from the edge's line are unchanged.
+    pub fn mirrored(&self) -> Self {
+        let mut m = *self.edge_from_world_rotation.matrix();
+        for row in 1..3 {
+            for column in 0..3 {
+                m[(row, column)] = -m[(row, column)];
+            }
+        }
+        StandardFrame {
+            edge_from_world_rotation: Rotation3::from_matrix_unchecked(m),
+            ..*self
+        }
+    }
 }
 
 /// One usable triangle with its precomputed data.
@@ -77,6 +93,24 @@ pub struct Triangle {
     pub normal: Vector3<f64>,
     /// Standard frame of edge `i`, which joins vertex `i` and `(i + 1) mod 3`.
     pub edges: [StandardFrame; 3],
+    /// Whether this is the triangle seen from its back
+    /// ([`Triangle::mirrored`]): `normal` is then `-n`.
+    pub back: bool,
+}
+
+impl Triangle {
+    /// The triangle seen from its back (`sides = two`, a path moving
+    /// toward the back): the same index, vertices and edges, its normal
+    /// `-n` and its edge frames [mirrored](StandardFrame::mirrored). Every
+    /// test of SEMANTICS.md then treats the back as the front.
+    pub fn mirrored(&self) -> Triangle {
+        Triangle {
+            normal: -self.normal,
+            edges: self.edges.map(|e| e.mirrored()),
+            back: !self.back,
+            ..*self
+        }
+    }
 }
 
 /// A triangle left out because it has no area.
@@ -216,6 +250,7 @@ impl Mesh {
                 vertices: [a, b, c],
                 normal,
                 edges,
+                back: false,
             });
         }
         if usable.is_empty() {

@@ -32,6 +32,8 @@ mod outcome;
 mod path;
 mod quadratic;
 mod record;
+#[cfg(test)]
+mod sides_tests;
 mod sweep_edge;
 mod sweep_face;
 mod sweep_mesh;
@@ -51,7 +53,7 @@ pub use initial::initial_contacts;
 pub use mesh::{DegenerateReason, DegenerateTriangle, Mesh, StandardFrame, Triangle};
 pub use options::{
     ALPHA_SENSITIVITY, DEGENERATE_TOLERANCE, FRAGILE_ULPS, Facing, GRAZING_COSINE, InitialOverlap,
-    Options, PARALLEL_TOLERANCE, TIE_WINDOW_ULPS,
+    Options, PARALLEL_TOLERANCE, Sides, TIE_WINDOW_ULPS,
 };
 pub use outcome::{Outcome, SweepHit, Tie};
 pub use path::{Sweep, SweptPath};

@@ -94,6 +94,65 @@ impl InitialOverlap {
     }
 }
 
+/// Which sides of a triangle collide: an engine convention
+/// (docs/ENGINES.md, "Conventions").
+#[derive(
+    Clone,
+    Copy,
+    Debug,
+    Default,
+    PartialEq,
+    Eq,
+    Hash,
+    Serialize,
+    Deserialize,
+    strum::IntoStaticStr,
+    strum::Display,
+    strum::EnumString,
+    strum::VariantNames,
+)]
+#[serde(rename_all = "snake_case")]
+#[strum(serialize_all = "snake_case")]
+pub enum Sides {
+    /// The rules: only the front. A path moving toward a triangle's back
+    /// (`n · d > 0`) is rejected by the facing rule.
+    #[default]
+    One,
+    /// Both sides, as engines with double-sided meshes (Jolt's
+    /// `CollideWithBackFaces`, PhysX's double-sided meshes, Bullet): a
+    /// triangle the path moves toward the back of (`n · d > 0`) is tested
+    /// as its mirror, with the normal `-n`, so the facing rule sees
+    /// `-n · d = -|n · d| < 0` and the hit reports `-n`. A path parallel to
+    /// the plane (`n · d = 0`) keeps the front normal: `non_strict` lets it
+    /// through, `strict` does not.
+    Two,
+}
+
+impl Sides {
+    /// Whether this is the rules' choice (the default).
+    pub fn is_rules(&self) -> bool {
+        *self == Sides::One
+    }
+
+    /// Whether a triangle whose facing value is `normal_dot_d = n · d` is
+    /// tested from its back, as its mirror with the normal `-n`.
+    #[inline]
+    pub fn flips(self, normal_dot_d: f64) -> bool {
+        self == Sides::Two && normal_dot_d > 0.0
+    }
+
+    /// The facing value the rule judges: `n · d`, or `-|n · d|` for a
+    /// triangle tested from its back.
+    #[inline]
+    pub fn facing_value(self, normal_dot_d: f64) -> f64 {
+        if self.flips(normal_dot_d) {
+            -normal_dot_d
+        } else {
+            normal_dot_d
+        }
+    }
+}
+
 /// Options of the collision core.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct Options {
@@ -106,6 +165,9 @@ pub struct Options {
     /// collision from those tests).
     #[serde(default, skip_serializing_if = "InitialOverlap::is_rules")]
     pub initial_overlap: InitialOverlap,
+    /// Which sides of a triangle collide (the rules: the front only).
+    #[serde(default, skip_serializing_if = "Sides::is_rules")]
+    pub sides: Sides,
 }
 
 /// A path is *parallel* to a plane or an edge when the component of `d`

@@ -164,6 +164,10 @@ pub struct FaceRecord {
     /// lines (positive inside); the touch point counts as inside when this
     /// is at least minus the tie distance.
     pub boundary_distance: Option<f64>,
+    /// Whether the test ran on the triangle seen from its back
+    /// (`sides = two`): the normal and `n · d` are then the mirror's, `-n`.
+    #[serde(skip_serializing_if = "std::ops::Not::not")]
+    pub back: bool,
     /// The verdict.
     pub verdict: Verdict,
 }
@@ -206,6 +210,10 @@ pub struct EdgeRecord {
     pub xc: Option<f64>,
     /// `n · d` in world coordinates.
     pub normal_dot_d: f64,
+    /// Whether the test ran on the triangle seen from its back
+    /// (`sides = two`): the normal and `n · d` are then the mirror's, `-n`.
+    #[serde(skip_serializing_if = "std::ops::Not::not")]
+    pub back: bool,
     /// The verdict.
     pub verdict: Verdict,
 }
@@ -239,6 +247,10 @@ pub struct VertexRecord {
     pub roots: Option<(f64, f64)>,
     /// `n · d` in world coordinates.
     pub normal_dot_d: f64,
+    /// Whether the test ran on the triangle seen from its back
+    /// (`sides = two`): the normal and `n · d` are then the mirror's, `-n`.
+    #[serde(skip_serializing_if = "std::ops::Not::not")]
+    pub back: bool,
     /// The verdict.
     pub verdict: Verdict,
 }
@@ -550,6 +562,14 @@ impl TestRecord {
             TestRecord::Face(_) => Feature::Face,
             TestRecord::Edge(r) => Feature::Edge(r.edge),
             TestRecord::Vertex(r) => Feature::Vertex(r.vertex),
+        }
+    }
+    /// Whether the test ran on the triangle seen from its back (`sides = two`).
+    pub fn back(&self) -> bool {
+        match self {
+            TestRecord::Face(r) => r.back,
+            TestRecord::Edge(r) => r.back,
+            TestRecord::Vertex(r) => r.back,
         }
     }
     /// The verdict.

@@ -39,6 +39,7 @@ pub fn sweep_edge(triangle: &Triangle, edge: u8, path: &SweptPath, facing: Facin
         roots: None,
         xc: None,
         normal_dot_d,
+        back: triangle.back,
         verdict: Verdict::Hit,
     };
     let parallel_limit = PARALLEL_TOLERANCE * path.length;

@@ -34,6 +34,7 @@ pub fn sweep_face(triangle: &Triangle, path: &SweptPath, facing: Facing) -> Face
         touch: None,
         barycentric: None,
         boundary_distance: None,
+        back: triangle.back,
         verdict: Verdict::Hit,
     };
     let rho = path.rho;
@@ -95,7 +96,7 @@ pub fn barycentric(triangle: &Triangle, p: &nalgebra::Point3<f64>) -> [f64; 3] {
 /// Barycentric coordinates of a point in the triangle's plane (as
 /// [`barycentric`]) and its smallest signed distance from the lines of the
 /// triangle's edges, in the plane: positive inside, 0 on the boundary,
-/// negative outside.
+/// negative outside (for a [mirrored](Triangle::mirrored) triangle too).
 #[inline]
 pub fn barycentric_and_distance(triangle: &Triangle, p: &nalgebra::Point3<f64>) -> ([f64; 3], f64) {
     let [a, b, c] = triangle.vertices;
@@ -114,8 +115,11 @@ pub fn barycentric_and_distance(triangle: &Triangle, p: &nalgebra::Point3<f64>) 
         triangle.edges[2].length,
         triangle.edges[0].length,
     ];
+    // Measured along a mirrored triangle's normal `-n` (`sides = two`)
+    // the signed areas change sign, and the area with them.
+    let inside = if area2 < 0.0 { -1.0 } else { 1.0 };
     let distance = (0..3)
-        .map(|i| sub[i] / lengths[i])
+        .map(|i| inside * sub[i] / lengths[i])
         .fold(f64::INFINITY, f64::min);
     (sub.map(|s| s / area2), distance)
 }

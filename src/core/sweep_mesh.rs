@@ -8,7 +8,7 @@ use super::feature::{Feature, Kind};
 use super::fragility::{FragileReason, Fragility};
 use super::initial::initial_contact;
 use super::mesh::{Mesh, Triangle};
-use super::options::{ALPHA_SENSITIVITY, Facing, GRAZING_COSINE, InitialOverlap, Options};
+use super::options::{ALPHA_SENSITIVITY, Facing, GRAZING_COSINE, InitialOverlap, Options, Sides};
 use super::outcome::{Outcome, SweepHit, in_tie_window};
 use super::path::{Sweep, SweptPath};
 use super::record::{NoObserver, Observer, Skip, Verdict};
@@ -43,6 +43,9 @@ struct Hit {
     /// Distance of the contact from its feature's boundary (a length;
     /// infinite for a vertex).
     boundary: f64,
+    /// The normal of the triangle as tested: its front normal, or `-n`
+    /// when it was tested from its back (`sides = two`).
+    normal: Vector3<f64>,
 }
 
 impl Hit {
@@ -56,6 +59,7 @@ impl Hit {
         cosine: 0.0,
         facing_cosine: 0.0,
         boundary: 0.0,
+        normal: Vector3::new(0.0, 0.0, 0.0),
     };
 
     #[inline]
@@ -102,6 +106,7 @@ fn test_triangle<O: Observer, S: Sink>(
         cosine,
         facing_cosine,
         boundary,
+        normal: triangle.normal,
     };
     // Whether a face touch point at `beta` lies within the band of the triangle.
     let touch_near = |beta: f64| {
@@ -329,7 +334,6 @@ impl Sink for Combiner {
 /// Decides from the hits within the band of the final minimum, seen grouped
 /// by triangle in mesh order: the primary, the normal sum and the flags.
 struct Decision<'a> {
-    triangles: &'a [Triangle],
     path: &'a SweptPath,
     min: f64,
     window: f64,
@@ -375,7 +379,7 @@ impl Sink for Decision<'_> {
                 self.primary = Some(h);
             }
             if self.last_position != Some(h.position) {
-                self.normal_sum += self.triangles[h.position as usize].normal;
+                self.normal_sum += h.normal;
                 self.last_position = Some(h.position);
             }
         }
@@ -402,9 +406,16 @@ pub fn sweep_mesh_with<O: Observer>(
 ) -> Result<Outcome, SweepError> {
     let (lo, hi) = mesh.bounds();
     let path = SweptPath::new(sweep, options)?.with_mesh_scale(&lo, &hi);
-    let outcome = sweep_path(mesh, &path, options.facing, broadphase, observer);
+    let outcome = sweep_path(
+        mesh,
+        &path,
+        options.facing,
+        options.sides,
+        broadphase,
+        observer,
+    );
     if options.initial_overlap == InitialOverlap::Alpha0
-        && let Some((hit, distance)) = initial_contact(mesh, &path, options.facing)
+        && let Some((hit, distance)) = initial_contact(mesh, &path, options.facing, options.sides)
     {
         // The tests ran for the observer; the answer is the start's contact.
         let mut fragile = Fragility::ROBUST;
@@ -447,17 +458,26 @@ fn skip<O: Observer>(triangle: &Triangle, path: &SweptPath, facing: Facing) -> O
     ((h0 > clear && h1 > clear) || (h0 < -clear && h1 < -clear)).then_some(Skip::PlaneOutOfReach)
 }
 
+/// The triangle as the tests see it under `sides`: `None` for itself, or
+/// (`sides = two`, the path moving toward its back, `n · d > 0`) its
+/// [mirror](Triangle::mirrored). One comparison under the rules.
+#[inline]
+fn back_side(triangle: &Triangle, path: &SweptPath, sides: Sides) -> Option<Triangle> {
+    (sides == Sides::Two && triangle.normal.dot(&path.d) > 0.0).then(|| triangle.mirrored())
+}
+
 fn visit_triangles<O: Observer>(
     mesh: &Mesh,
     path: &SweptPath,
-    facing: Facing,
+    (facing, sides): (Facing, Sides),
     broadphase: Broadphase,
     observer: &mut O,
     combiner: &mut Combiner,
 ) {
     let triangles = mesh.triangles();
     let run = |position: usize, combiner: &mut Combiner, observer: &mut O| {
-        let t = &triangles[position];
+        let mirrored = back_side(&triangles[position], path, sides);
+        let t = mirrored.as_ref().unwrap_or(&triangles[position]);
         match skip::<O>(t, path, facing) {
             None => test_triangle(t, position, path, facing, observer, combiner),
             Some(reason) => observer.skipped(t.index, reason),
@@ -488,12 +508,20 @@ fn sweep_path<O: Observer>(
     mesh: &Mesh,
     path: &SweptPath,
     facing: Facing,
+    sides: Sides,
     broadphase: Broadphase,
     observer: &mut O,
 ) -> Outcome {
     let band = path.fragile_window();
     let mut combiner = Combiner::new(band);
-    visit_triangles(mesh, path, facing, broadphase, observer, &mut combiner);
+    visit_triangles(
+        mesh,
+        path,
+        (facing, sides),
+        broadphase,
+        observer,
+        &mut combiner,
+    );
     let triangles = mesh.triangles();
     let reference = combiner.min.min(1.0);
     let mut fragile = Fragility::ROBUST;
@@ -510,7 +538,6 @@ fn sweep_path<O: Observer>(
         };
     }
     let mut decision = Decision {
-        triangles,
         path,
         min: combiner.min,
         window: path.tie_window(),
@@ -525,6 +552,8 @@ fn sweep_path<O: Observer>(
         // More hits within the band than the combiner holds: test every
         // triangle again, in mesh order.
         for (position, t) in triangles.iter().enumerate() {
+            let mirrored = back_side(t, path, sides);
+            let t = mirrored.as_ref().unwrap_or(t);
             if skip::<NoObserver>(t, path, facing).is_none() {
                 test_triangle(t, position, path, facing, &mut NoObserver, &mut decision);
             }
@@ -548,7 +577,7 @@ fn sweep_path<O: Observer>(
     let normal = if norm > 1e-9 {
         sum / norm
     } else {
-        triangles[primary.position as usize].normal
+        primary.normal
     };
     Outcome {
         hit: Some(SweepHit {

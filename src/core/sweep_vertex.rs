@@ -33,6 +33,7 @@ pub fn sweep_vertex(
         discriminant,
         roots: None,
         normal_dot_d,
+        back: triangle.back,
         verdict: Verdict::Hit,
     };
     record.verdict = if a == 0.0 {

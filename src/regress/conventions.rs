@@ -4,15 +4,16 @@
 //! it means to compute.
 //!
 //! **A convention changes the reference answer, not the tolerance**: the
-//! margin, the facing rule, the initial overlap and the normal change what
-//! the core computes (the replay's options, [`ReplayOptions`]); the
+//! margin, the facing rule, the sides, the initial overlap and the normal
+//! change what the core computes (the replay's options, [`ReplayOptions`]); the
 //! precision and the tie rule change how an answer is judged against it
 //! ([`Tolerances`]). A suite without the table is judged by the rules.
 //!
 //! Adding a convention: a closed enum of its values with the rules' value
 //! as the default (`strum` gives the names), a field here, its key in
-//! `config/file.rs` and `config/settings.rs`, its flag in `cli/check.rs`,
-//! its effect in [`EngineConventions::apply`], its evidence in
+//! `config/file.rs` and `config/settings.rs`, its flag in `ConventionArgs`
+//! (`cli/mod.rs`), its effect in [`EngineConventions::replay_with`] or
+//! [`EngineConventions::judge_with`], its evidence in
 //! `infer_conventions.rs`, the conform rules it replaces in
 //! [`EngineConventions::replaces`], and a line in docs/ENGINES.md.
 
@@ -20,7 +21,7 @@ use std::fmt;
 
 use serde::Serialize;
 
-use crate::core::{Facing, InitialOverlap};
+use crate::core::{Facing, InitialOverlap, Sides};
 use crate::replay::{NormalRule, ReplayOptions};
 
 use super::compare::{TieRule, Tolerances};
@@ -117,6 +118,8 @@ pub struct EngineConventions {
     pub margin: MarginRule,
     /// Its facing rule.
     pub facing: FacingRule,
+    /// Which sides of a triangle collide.
+    pub sides: Sides,
     /// What a ball that starts within `ρ` gets.
     pub initial_overlap: InitialOverlap,
     /// The normal it reports.
@@ -141,6 +144,7 @@ impl EngineConventions {
                 Some(Facing::Strict) => FacingRule::Strict,
                 Some(Facing::NonStrict) => FacingRule::NonStrict,
             },
+            sides: replay.sides,
             initial_overlap: replay.initial_overlap,
             normal: replay.normal,
             ties: tolerances.ties,
@@ -158,7 +162,7 @@ impl EngineConventions {
     }
 
     /// `replay` computing the reference answer under these conventions
-    /// (margin, facing, initial overlap, normal).
+    /// (margin, facing, sides, initial overlap, normal).
     pub fn replay_with(&self, replay: ReplayOptions) -> ReplayOptions {
         ReplayOptions {
             margin: match self.margin {
@@ -166,6 +170,7 @@ impl EngineConventions {
                 MarginRule::Fixed(m) => Some(m),
             },
             facing: self.facing.facing().or(replay.facing),
+            sides: self.sides,
             initial_overlap: self.initial_overlap,
             normal: self.normal,
             ..replay
@@ -185,6 +190,9 @@ impl EngineConventions {
         }
         if self.facing != rules.facing {
             out.push(("facing", format!("\"{}\"", self.facing)));
+        }
+        if self.sides != rules.sides {
+            out.push(("sides", format!("\"{}\"", self.sides)));
         }
         if self.initial_overlap != rules.initial_overlap {
             out.push(("initial_overlap", format!("\"{}\"", self.initial_overlap)));
@@ -239,6 +247,10 @@ impl EngineConventions {
             (_, "facing.non-strict") if self.facing == FacingRule::Strict => {
                 declares("facing", self.facing.to_string())
             }
+            // Both sides collide: a contact from behind is a hit.
+            (_, "face.miss.back-facing" | "edge.miss.back-facing") if self.sides == Sides::Two => {
+                declares("sides", self.sides.to_string())
+            }
             (_, "start.inside") if self.initial_overlap != InitialOverlap::None => {
                 declares("initial_overlap", self.initial_overlap.to_string())
             }
@@ -269,6 +281,7 @@ mod tests {
             precision: Precision::F32,
             margin: MarginRule::Fixed(0.0),
             facing: FacingRule::NonStrict,
+            sides: Sides::Two,
             initial_overlap: InitialOverlap::Alpha0,
             normal: NormalRule::ActiveEdges,
             ties: TieRule::Any,
@@ -276,20 +289,31 @@ mod tests {
         let replay = c.replay_with(ReplayOptions::default());
         assert_eq!(replay.margin, Some(0.0));
         assert_eq!(replay.facing, Some(Facing::NonStrict));
+        assert_eq!(replay.sides, Sides::Two);
         assert_eq!(replay.initial_overlap, InitialOverlap::Alpha0);
         assert_eq!(replay.normal, NormalRule::ActiveEdges);
         let tol = c.judge_with(Tolerances::default());
         assert_eq!((tol.precision, tol.ties), (Precision::F32, TieRule::Any));
         assert_eq!(
             c.summary(),
-            "precision f32, margin 0.0, facing non_strict, initial_overlap alpha0, normal \
-             active_edges, ties any"
+            "precision f32, margin 0.0, facing non_strict, sides two, initial_overlap alpha0, \
+             normal active_edges, ties any"
         );
         assert_eq!(
             c.replaces("margin.inside-band/0").as_deref(),
             Some("the engine declares margin = 0.0")
         );
         assert_eq!(c.replaces("edge.basic/0"), None);
+        for rule in ["face.miss.back-facing/0", "edge.miss.back-facing"] {
+            assert_eq!(
+                c.replaces(rule).as_deref(),
+                Some("the engine declares sides = two"),
+                "{rule}"
+            );
+        }
+        let one = EngineConventions::default();
+        assert_eq!(one.replaces("face.miss.back-facing/0"), None);
+        assert_eq!(one.replaces("edge.miss.back-facing/0"), None);
     }
 
     #[test]

@@ -155,7 +155,8 @@ impl Inferred {
         let mut lines = vec![format!("inferred engine configuration: {margin}, {facing}")];
         if self.back_facing_hits > 0 {
             lines.push(format!(
-                "{} back-facing (n·d > 0, first at frame {}): no facing rule allows {}",
+                "{} back-facing (n·d > 0, first at frame {}): no facing rule allows {}; the \
+                 convention sides = \"two\" (both sides collide) does",
                 match self.back_facing_hits {
                     1 => "1 expected hit is".to_string(),
                     n => format!("{n} expected hits are"),

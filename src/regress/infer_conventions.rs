@@ -8,14 +8,15 @@
 //! differs from the exact rules on most sweeps, which hides what the other
 //! conventions change until rounding is judged as rounding. The margin
 //! comes from [`super::Inferred`] (the margin every trace's face hits
-//! imply); the facing rule is tried both ways.
+//! imply); the facing rule is tried both ways; both sides after the
+//! initial overlap.
 //!
 //! Inference never makes a run pass by itself: it prints a file, and the
 //! check that uses it judges as strictly as any other.
 
 use std::fmt::Write as _;
 
-use crate::core::InitialOverlap;
+use crate::core::{InitialOverlap, Sides};
 use crate::replay::NormalRule;
 
 use super::compare::TieRule;
@@ -141,6 +142,16 @@ pub fn infer_conventions(
                 ..c
             }),
         ),
+        // After the initial overlap: a two-sided engine that also reports
+        // starts in contact (Jolt) fits two sides only once those starts
+        // are hits.
+        (
+            "sides",
+            Box::new(|c| EngineConventions {
+                sides: Sides::Two,
+                ..c
+            }),
+        ),
         // Active edges first: it is the contact normal where the two can
         // differ only on flat and concave edges, and where the traces hold
         // no hit there the two fit alike (the evidence says so).
@@ -198,6 +209,10 @@ pub fn infer_conventions(
                  with it than with each scene's own"
             ),
             "facing" => format!("{fixed} fewer sweeps fail with it than with each scene's rule"),
+            "sides" => format!(
+                "{fixed} answers hit triangles from behind (n·d > 0) as from the front, with \
+                 the normal -n"
+            ),
             "initial_overlap" => format!(
                 "{fixed} answers are hits at α = 0 where the ball starts within ρ of the mesh"
             ),
@@ -296,6 +311,9 @@ mod tests {
         if c.normal == NormalRule::Contact {
             failing -= 3;
         }
+        if c.sides == Sides::Two {
+            failing -= 7;
+        }
         Trial {
             failing,
             compared: 1000,
@@ -313,15 +331,34 @@ mod tests {
         assert_eq!(c.precision, Precision::F32);
         assert_eq!(c.initial_overlap, InitialOverlap::Alpha0);
         assert_eq!(c.normal, NormalRule::ActiveEdges);
+        assert_eq!(c.sides, Sides::Two);
         assert!(!inferred.to_toml("e").contains("fits as well"));
         // The margin and the tie rule change nothing in this suite.
         assert_eq!((c.margin, c.ties), (MarginRule::Scene, TieRule::Rule));
-        assert_eq!(inferred.under_inferred.failing, 15);
+        assert_eq!(inferred.under_inferred.failing, 8);
         let toml = inferred.to_toml("the engine");
         assert!(toml.contains("precision = \"f32\""), "{toml}");
         assert!(toml.contains("# 20 answers are hits at α = 0"), "{toml}");
+        assert!(
+            toml.contains("# 7 answers hit triangles from behind")
+                && toml.contains("sides = \"two\""),
+            "{toml}"
+        );
         let parsed: toml::Table = toml::from_str(&toml).expect("valid TOML");
         assert!(parsed.contains_key("engine"));
+    }
+
+    #[test]
+    fn a_one_sided_engine_keeps_one_side() {
+        // Both sides make sweeps fail (hits where the engine sees none):
+        // the rules' `one` stays, and a default is not printed.
+        let inferred = infer_conventions(|c| Trial {
+            failing: if c.sides == Sides::Two { 40 } else { 10 },
+            compared: 100,
+            ..Trial::default()
+        });
+        assert_eq!(inferred.conventions.sides, Sides::One);
+        assert!(!inferred.to_toml("x").contains("sides"));
     }
 
     #[test]

@@ -315,10 +315,15 @@ impl<'a> Decision<'a> {
             let path = SweptPath::new(sweep, &scene.options)
                 .ok()?
                 .with_mesh_scale(&lo, &hi);
-            initial_contacts(&scene.mesh, &path, scene.options.facing)
-                .into_iter()
-                .map(|(h, _)| h)
-                .collect()
+            initial_contacts(
+                &scene.mesh,
+                &path,
+                scene.options.facing,
+                scene.options.sides,
+            )
+            .into_iter()
+            .map(|(h, _)| h)
+            .collect()
         } else {
             Vec::new()
         };
@@ -333,9 +338,11 @@ impl<'a> Decision<'a> {
 
     /// The normal a tie member reports under [`TieRule::Any`]: its own
     /// (its triangle's face normal, or its contact normal where the
-    /// scene's normal rule gives that).
-    fn member_normal(&self, tie: &Tie, contact: &Point3<f64>) -> Option<[f64; 3]> {
-        let face = self.scene.mesh.triangle_by_index(tie.triangle)?.normal;
+    /// scene's normal rule gives that). `back`: the member was hit on its
+    /// triangle's back (`sides = two`), whose face normal is `-n`.
+    fn member_normal(&self, tie: &Tie, contact: &Point3<f64>, back: bool) -> Option<[f64; 3]> {
+        let front = self.scene.mesh.triangle_by_index(tie.triangle)?.normal;
+        let face = if back { -front } else { front };
         let alpha = self.outcome.hit.map_or(tie.alpha, |h| h.alpha);
         let n =
             self.scene
@@ -368,7 +375,7 @@ impl<'a> Decision<'a> {
             if tol.ties == TieRule::Any
                 && let Some(contact) = r.contact()
             {
-                member.normal = Some(self.member_normal(&tie, &contact));
+                member.normal = Some(self.member_normal(&tie, &contact, r.back()));
             }
             let d = compare(answer, &member, tol);
             if d.is_empty() {
@@ -390,7 +397,13 @@ impl<'a> Decision<'a> {
             member.feature = Some(tie.feature.index());
             member.contact = Some(Some([h.contact.x, h.contact.y, h.contact.z]));
             if tol.ties == TieRule::Any {
-                member.normal = Some(self.member_normal(&tie, &h.contact));
+                // An initial contact's normal is its side's (`-n` on a back).
+                let back = self
+                    .scene
+                    .mesh
+                    .triangle_by_index(tie.triangle)
+                    .is_some_and(|t| t.normal.dot(&h.normal) < 0.0);
+                member.normal = Some(self.member_normal(&tie, &h.contact, back));
             }
             let d = compare(answer, &member, tol);
             if d.is_empty() {

@@ -41,6 +41,9 @@ pub const KNOWN_MISTAKES: &[Mistake] = &[
             }
         },
     },
+    // Under `sides = "two"` this is the declared convention, not a
+    // mistake: the core then tests such a triangle from its back (its
+    // records have `n · d < 0` and hit), so the entry never applies.
     Mistake {
         name: "two_sided",
         words: "the two-sided rule: a back-facing contact (n·d > 0, the ball moving out of the \
@@ -94,4 +97,61 @@ pub fn known_mistake(
     KNOWN_MISTAKES
         .iter()
         .find(|m| (m.alpha)(record, rho).is_some_and(close))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::core::{Broadphase, CollectRecords, Mesh, Options, Sides, Sweep, sweep_mesh_with};
+
+    /// The face record of worked example 1 from behind, and the α of the
+    /// sweep, under `sides`.
+    fn from_behind(sides: Sides) -> (TestRecord, f64) {
+        let mesh = Mesh::new(
+            vec![[0.0, 0.0, 0.0], [4.0, 0.0, 0.0], [0.0, 4.0, 0.0]],
+            &[[0, 1, 2]],
+        )
+        .expect("valid mesh");
+        let options = Options {
+            sides,
+            ..Options::default()
+        };
+        let sweep = Sweep::new([1.0, 1.0, -3.0], [1.0, 1.0, 3.0], 0.5);
+        let mut records = CollectRecords::default();
+        let outcome = sweep_mesh_with(
+            &mesh,
+            &sweep,
+            &options,
+            Broadphase::Exhaustive,
+            &mut records,
+        )
+        .expect("valid sweep");
+        let face = records
+            .records
+            .into_iter()
+            .find(|r| matches!(r, TestRecord::Face(_)))
+            .expect("a face record");
+        (face, outcome.hit.map_or(1.0, |h| h.alpha))
+    }
+
+    #[test]
+    fn a_hit_from_behind_is_the_two_sided_mistake_only_under_one_side() {
+        let two_sided_alpha = 2.5 / 6.0;
+        let (record, alpha) = from_behind(Sides::One);
+        assert_eq!(alpha, 1.0);
+        assert_eq!(
+            known_mistake(&record, 0.5, two_sided_alpha).map(|m| m.name),
+            Some("two_sided")
+        );
+        let (record, alpha) = from_behind(Sides::Two);
+        assert_eq!(alpha, two_sided_alpha);
+        assert!(record.back());
+        assert!(known_mistake(&record, 0.5, two_sided_alpha).is_none());
+        assert!(
+            KNOWN_MISTAKES
+                .iter()
+                .find(|m| m.name == "two_sided")
+                .is_some_and(|m| (m.alpha)(&record, 0.5).is_none())
+        );
+    }
 }

@@ -1,7 +1,7 @@
 //! What a caller chooses about a replay: which sweeps, how much is
 //! explained, and overrides of the scene's margin and facing rule.
 
-use crate::core::{Facing, InitialOverlap};
+use crate::core::{Facing, InitialOverlap, Sides};
 
 /// How many test records each sweep keeps.
 #[derive(
@@ -163,6 +163,9 @@ pub struct ReplayOptions {
     /// What a ball that starts within `ρ` gets (an engine convention; the
     /// rules' by default).
     pub initial_overlap: InitialOverlap,
+    /// Which sides of a triangle collide (an engine convention; the rules'
+    /// front only by default).
+    pub sides: Sides,
     /// Which normal a hit reports (an engine convention; the rules' face
     /// normal by default).
     pub normal: NormalRule,
@@ -234,6 +237,9 @@ impl ReplayOptions {
         // under the rules stay what they were.
         if !self.initial_overlap.is_rules() {
             text.push_str(&format!(";initial_overlap={}", self.initial_overlap));
+        }
+        if !self.sides.is_rules() {
+            text.push_str(&format!(";sides={}", self.sides));
         }
         if self.normal != NormalRule::Face {
             text.push_str(&format!(";normal={}", self.normal));

@@ -281,6 +281,7 @@ impl Replay {
             margin: self.options.margin.unwrap_or(margin),
             facing: self.options.facing.unwrap_or(facing),
             initial_overlap: self.options.initial_overlap,
+            sides: self.options.sides,
         };
         let normals = SceneNormals::new(self.options.normal, &mesh, &topology);
         let number = self.summary.scenes;

@@ -62,6 +62,7 @@ struct RawEngine {
     precision: Option<Spanned<String>>,
     margin: Option<Spanned<toml::Value>>,
     facing: Option<Spanned<String>>,
+    sides: Option<Spanned<String>>,
     initial_overlap: Option<Spanned<String>>,
     normal: Option<Spanned<String>>,
     ties: Option<Spanned<String>>,
@@ -216,6 +217,7 @@ impl Places<'_> {
         }
         layer.precision = named(self, "precision", &raw.precision)?;
         layer.facing = named(self, "facing", &raw.facing)?;
+        layer.sides = named(self, "sides", &raw.sides)?;
         layer.initial_overlap = named(self, "initial_overlap", &raw.initial_overlap)?;
         layer.normal = named(self, "normal", &raw.normal)?;
         layer.ties = named(self, "ties", &raw.ties)?;

@@ -13,7 +13,7 @@ use super::super::compare::{
 };
 use super::super::conventions::{EngineConventions, FacingRule, MarginRule};
 use super::super::precision::Precision;
-use crate::core::InitialOverlap;
+use crate::core::{InitialOverlap, Sides};
 use crate::replay::NormalRule;
 
 /// Where a resolved setting came from.
@@ -79,7 +79,7 @@ pub struct Overrides {
     /// `--allow-tunnels`.
     pub allow_tunnels: Option<bool>,
     /// The engine conventions given on the command line (`--precision`,
-    /// `--margin`, `--facing`, `--initial-overlap`, `--normal`, `--ties`).
+    /// `--margin`, `--facing`, `--sides`, `--initial-overlap`, `--normal`, `--ties`).
     pub engine: EngineOverrides,
 }
 
@@ -92,6 +92,8 @@ pub struct EngineOverrides {
     pub margin: Option<MarginRule>,
     /// `--facing`.
     pub facing: Option<FacingRule>,
+    /// `--sides`.
+    pub sides: Option<Sides>,
     /// `--initial-overlap`.
     pub initial_overlap: Option<InitialOverlap>,
     /// `--normal`.
@@ -129,6 +131,8 @@ pub struct EngineSettings {
     pub margin: Setting<MarginRule>,
     /// `engine.facing`.
     pub facing: Setting<FacingRule>,
+    /// `engine.sides`.
+    pub sides: Setting<Sides>,
     /// `engine.initial_overlap`.
     pub initial_overlap: Setting<InitialOverlap>,
     /// `engine.normal`.
@@ -144,6 +148,7 @@ impl Default for EngineSettings {
             precision: Setting::default_value(rules.precision),
             margin: Setting::default_value(rules.margin),
             facing: Setting::default_value(rules.facing),
+            sides: Setting::default_value(rules.sides),
             initial_overlap: Setting::default_value(rules.initial_overlap),
             normal: Setting::default_value(rules.normal),
             ties: Setting::default_value(rules.ties),
@@ -163,6 +168,7 @@ impl EngineSettings {
             &self.precision.source,
             &self.margin.source,
             &self.facing.source,
+            &self.sides.source,
             &self.initial_overlap.source,
             &self.normal.source,
             &self.ties.source,
@@ -192,6 +198,7 @@ impl EngineSettings {
             precision: self.precision.value,
             margin: self.margin.value,
             facing: self.facing.value,
+            sides: self.sides.value,
             initial_overlap: self.initial_overlap.value,
             normal: self.normal.value,
             ties: self.ties.value,
@@ -293,6 +300,11 @@ impl Settings {
                     &self.engine.facing.source,
                 ),
                 (
+                    "engine.sides",
+                    format!("\"{}\"", self.engine.sides.value),
+                    &self.engine.sides.source,
+                ),
+                (
                     "engine.initial_overlap",
                     format!("\"{}\"", self.engine.initial_overlap.value),
                     &self.engine.initial_overlap.source,
@@ -335,6 +347,7 @@ pub(super) struct Layer {
     pub(super) precision: Option<Setting<Precision>>,
     pub(super) margin: Option<Setting<MarginRule>>,
     pub(super) facing: Option<Setting<FacingRule>>,
+    pub(super) sides: Option<Setting<Sides>>,
     pub(super) initial_overlap: Option<Setting<InitialOverlap>>,
     pub(super) normal: Option<Setting<NormalRule>>,
     pub(super) ties: Option<Setting<TieRule>>,
@@ -357,6 +370,7 @@ impl Layer {
         set(&mut settings.engine.precision, &self.precision);
         set(&mut settings.engine.margin, &self.margin);
         set(&mut settings.engine.facing, &self.facing);
+        set(&mut settings.engine.sides, &self.sides);
         set(&mut settings.engine.initial_overlap, &self.initial_overlap);
         set(&mut settings.engine.normal, &self.normal);
         set(&mut settings.engine.ties, &self.ties);
@@ -379,6 +393,7 @@ impl Layer {
             precision: given(o.engine.precision),
             margin: given(o.engine.margin),
             facing: given(o.engine.facing),
+            sides: given(o.engine.sides),
             initial_overlap: given(o.engine.initial_overlap),
             normal: given(o.engine.normal),
             ties: given(o.engine.ties),
@@ -433,6 +448,7 @@ pub fn render_settings_json(traces: &[(String, Settings)]) -> String {
                 map.insert("engine.precision".to_string(), entry(serde_json::json!(s.engine.precision.value), &s.engine.precision.source));
                 map.insert("engine.margin".to_string(), entry(serde_json::json!(s.engine.margin.value), &s.engine.margin.source));
                 map.insert("engine.facing".to_string(), entry(serde_json::json!(s.engine.facing.value), &s.engine.facing.source));
+                map.insert("engine.sides".to_string(), entry(serde_json::json!(s.engine.sides.value), &s.engine.sides.source));
                 map.insert("engine.initial_overlap".to_string(), entry(serde_json::json!(s.engine.initial_overlap.value), &s.engine.initial_overlap.source));
                 map.insert("engine.normal".to_string(), entry(serde_json::json!(s.engine.normal.value), &s.engine.normal.source));
                 map.insert("engine.ties".to_string(), entry(serde_json::json!(s.engine.ties.value), &s.engine.ties.source));

@@ -303,3 +303,71 @@ fn normalize_is_lexical() {
     assert_eq!(normalize(Path::new("../a")), PathBuf::from("../a"));
     assert_eq!(normalize(Path::new("/../a")), PathBuf::from("/a"));
 }
+
+#[test]
+fn engine_sides_are_read_with_their_line_and_the_command_line_wins() {
+    use crate::core::Sides;
+    let f = parse(
+        "[engine]\nprecision = \"f32\"\nsides = \"two\"\n",
+        "e/sweeptrace.toml",
+    );
+    let s = resolve(
+        std::slice::from_ref(&f),
+        Path::new("e/t.mcap"),
+        &Overrides::default(),
+    );
+    assert_eq!(s.engine.sides.value, Sides::Two);
+    assert_eq!(s.engine.sides.source, file("e/sweeptrace.toml", 3));
+    assert_eq!(s.engine.conventions().sides, Sides::Two);
+    // `--print-config` names the key and where it came from.
+    let text = render_settings_text(&[("t.mcap".to_string(), s.clone())]);
+    assert!(
+        text.contains("engine.sides = \"two\"") && text.contains("e/sweeptrace.toml:3"),
+        "{text}"
+    );
+    let json = render_settings_json(&[("t.mcap".to_string(), s)]);
+    assert!(json.contains("\"engine.sides\""), "{json}");
+    let command_line = Overrides {
+        engine: EngineOverrides {
+            sides: Some(Sides::One),
+            ..EngineOverrides::default()
+        },
+        ..Overrides::default()
+    };
+    let s = resolve(&[f], Path::new("e/t.mcap"), &command_line);
+    assert_eq!(
+        (s.engine.sides.value, s.engine.sides.source),
+        (Sides::One, Source::CommandLine)
+    );
+}
+
+#[test]
+fn engine_sides_round_trip_through_the_table_inference_writes() {
+    use crate::core::Sides;
+    use crate::regress::conventions::EngineConventions;
+    let declared = EngineConventions {
+        sides: Sides::Two,
+        ..EngineConventions::default()
+    };
+    let table: String = std::iter::once("[engine]\n".to_string())
+        .chain(
+            declared
+                .declared()
+                .into_iter()
+                .map(|(k, v)| format!("{k} = {v}\n")),
+        )
+        .collect();
+    let f = parse(&table, "r/sweeptrace.toml");
+    let s = resolve(&[f], Path::new("r/t.mcap"), &Overrides::default());
+    assert_eq!(s.engine.conventions(), declared, "{table}");
+}
+
+#[test]
+fn an_unknown_sides_value_names_the_closed_set() {
+    let e = error("[engine]\nsides = \"both\"\n");
+    assert!(
+        e.contains("`engine.sides` is `both`; it takes one of \"one\", \"two\""),
+        "{e}"
+    );
+    assert!(e.contains("sweeptrace.toml:2"), "{e}");
+}

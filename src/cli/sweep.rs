@@ -237,8 +237,9 @@ pub fn run(args: Args) -> anyhow::Result<Exit> {
 }
 
 /// `options` under the engine's `conventions`: its margin and facing rule
-/// where it declares one, and what a ball starting within `ρ` gets (the
-/// normal rule applies to the outcome, after the query).
+/// where it declares one, the sides that collide, and what a ball starting
+/// within `ρ` gets (the normal rule applies to the outcome, after the
+/// query).
 fn conventions_applied(
     options: &mut Options,
     conventions: &sweeptrace::regress::EngineConventions,
@@ -249,6 +250,7 @@ fn conventions_applied(
     if let Some(facing) = conventions.facing.facing() {
         options.facing = facing;
     }
+    options.sides = conventions.sides;
     options.initial_overlap = conventions.initial_overlap;
 }
 

@@ -163,7 +163,7 @@ impl EngineSettings {
     }
 
     /// Where each key came from, in the table's order.
-    fn sources(&self) -> [&Source; 6] {
+    fn sources(&self) -> [&Source; 7] {
         [
             &self.precision.source,
             &self.margin.source,

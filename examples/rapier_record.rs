@@ -6,7 +6,7 @@
 //! ```text
 //! cargo run --example rapier_record -- --scene mini_golf -o rapier_mini_golf.mcap
 //! cargo run --example rapier_record -- --mesh level.obj --radius 0.2 --position 0,0,5 -o level.mcap
-//! sweeptrace check rapier_mini_golf.mcap --fields kind,alpha --tolerance 1e-5
+//! sweeptrace check rapier_mini_golf.mcap --normal contact --tolerance 1e-5 --contact-tolerance 1e-5
 //! ```
 //!
 //! Each step: the ball's centre before the step is `p0`, and `p1` is where

@@ -362,8 +362,9 @@ fn check_fields_option_binary() -> anyhow::Result<()> {
 }
 
 /// The Rapier-recorded sample passes with no options, by the settings of
-/// `examples/sweeptrace.toml`, and fails without that file or either part
-/// of its settings (Rapier reports the contact normal at an edge hit; its
+/// `examples/sweeptrace.toml`, every field compared, and fails without
+/// that file or either part of its settings (Rapier reports the contact
+/// normal at an edge hit, its `[engine]` table's `normal = "contact"`; its
 /// α and witness points are accurate to about 1e-5), so every setting is
 /// needed and the test of the sample can fail.
 fn rapier_sample_needs_its_settings_file() -> anyhow::Result<()> {
@@ -371,15 +372,16 @@ fn rapier_sample_needs_its_settings_file() -> anyhow::Result<()> {
     let settings = settings_for(&trace, &Overrides::default())?;
     let tolerances = settings.tolerances();
     ensure!(
-        tolerances.fields.names() == "kind,triangle,feature,alpha,contact"
+        tolerances.fields == FieldSet::ALL
             && tolerances.alpha == 1e-5
             && tolerances.contact == 1e-5
             && tolerances.normal_degrees == Tolerances::default().normal_degrees
+            && settings.engine.normal.value == sweeptrace::replay::NormalRule::Contact
             && !settings.strict.value
             && !settings.allow_tunnels.value,
         "the settings changed ({settings:?}): update this test"
     );
-    for source in [&settings.fields.source, &settings.alpha.source] {
+    for source in [&settings.engine.normal.source, &settings.alpha.source] {
         ensure!(
             matches!(source, Source::File { file, .. } if file == "examples/sweeptrace.toml"),
             "{source:?}"
@@ -389,17 +391,12 @@ fn rapier_sample_needs_its_settings_file() -> anyhow::Result<()> {
     ensure!(code == 0, "with its settings file: exit {code}: {out}{err}");
     let (code, out, err) = run_bin(os!["check", "--no-config", trace.as_os_str()])?;
     ensure!(code == 1, "default options: exit {code}: {out}{err}");
-    let (code, out, err) = run_bin(os![
-        "check",
-        trace.as_os_str(),
-        "--fields",
-        "kind,triangle,feature,alpha,normal,contact",
-    ])?;
+    let (code, out, err) = run_bin(os!["check", trace.as_os_str(), "--normal", "face"])?;
     ensure!(
         code == 1
             && out.contains("1 of 553 compared sweeps diverges")
             && out.contains("normal: expected"),
-        "every field: exit {code}: {out}{err}"
+        "the face normal: exit {code}: {out}{err}"
     );
     // The command line overrides the file, key by key.
     let (code, out, err) = run_bin(os![

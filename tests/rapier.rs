@@ -4,9 +4,7 @@
 //! its expectations' source.
 
 use libtest_mimic::Trial;
-use sweeptrace::regress::{
-    CheckOptions, Field, FieldSet, Status, Tolerances, check_file, render_text,
-};
+use sweeptrace::regress::{CheckOptions, Status, Tolerances, check_file, render_text};
 use sweeptrace::sim::scenes::BuiltinScene;
 
 use crate::ensure;
@@ -150,12 +148,17 @@ fn rapier_recording_passes_check_with_the_readme_options() -> anyhow::Result<()>
         sweeps == 8 * 60 && hits > 0,
         "{sweeps} sweeps, {hits} hits, {starting_in_contact} starting in contact"
     );
-    // `--fields kind,alpha --tolerance 1e-5`
+    // `--normal contact --tolerance 1e-5 --contact-tolerance 1e-5`: every
+    // field compared, under Rapier's normal convention.
     let readme = CheckOptions {
         tolerances: Tolerances {
             alpha: 1e-5,
-            fields: FieldSet::of(&[Field::Kind, Field::Alpha]),
+            contact: 1e-5,
             ..Tolerances::default()
+        },
+        replay: sweeptrace::replay::ReplayOptions {
+            normal: sweeptrace::replay::NormalRule::Contact,
+            ..Default::default()
         },
         ..CheckOptions::default()
     };

@@ -24,7 +24,7 @@ Examples:
   sweeptrace check traces/record_mini_golf.mcap --tolerance 1e-4 --normal-tolerance 0.5
   sweeptrace check tests/fixtures/wrong_engine_config.mcap --json --rrd-on-failure failures
   sweeptrace check traces/record_cube_corner_margin.mcap --engine 'python3 examples/engines/sweep_engine.py'
-  sweeptrace check examples/rapier/rapier_mini_golf.mcap --fields kind,alpha --tolerance 1e-5
+  sweeptrace check examples/rapier/rapier_mini_golf.mcap --fields kind,alpha --tolerance 1e-5 --no-config
   sweeptrace check traces/ --junit report.xml   # a test report for CI
   sweeptrace check traces/record_mini_golf.mcap --frames 100..200 --ball 1
 

@@ -114,8 +114,9 @@ pub struct ToleranceArgs {
     /// Compare only these fields of each expectation (comma-separated:
     /// kind, triangle, feature, alpha, normal, contact; default: every
     /// field the expectation holds). For engines whose answers differ from
-    /// the core's by design in the others: `--fields kind,alpha` for an
-    /// engine that reports the contact normal, not the face normal.
+    /// the core's in the others. An engine that reports the contact normal
+    /// is better described by `--normal contact` (an engine convention),
+    /// which keeps the normal compared.
     #[arg(long, value_name = "FIELD,...", value_delimiter = ',', value_parser = field_parser())]
     pub fields: Vec<sweeptrace::regress::Field>,
 }

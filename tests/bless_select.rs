@@ -520,5 +520,24 @@ fn replay_bless_and_check_agree_under_a_declared_table() -> anyhow::Result<()> {
     ensure!(code == 0, "check under the table: exit {code}: {out}");
     let (code, out, _) = run_bin(os!["check", blessed.as_os_str(), "--no-config"])?;
     ensure!(code == 1, "check by the rules: exit {code}: {out}");
+    // ...and the report sees the convention it was not told of, counts it
+    // and says how to declare it.
+    ensure!(
+        out.contains(&format!(
+            "{hits_at_zero} hits at α = 0 where the ball starts within its radius (initial_overlap = \"alpha0\")"
+        )) && out.contains("declare them in an [engine] table"),
+        "{out}"
+    );
+    let (_, json, _) = run_bin(os!["check", blessed.as_os_str(), "--no-config", "--json"])?;
+    let report: serde_json::Value = serde_json::from_str(&json)?;
+    let trace = report
+        .get("traces")
+        .and_then(|t| t.get(0))
+        .unwrap_or(&report);
+    ensure!(
+        trace["conventions_seen"]["initial_overlap"].as_u64() == Some(u64::from(hits_at_zero)),
+        "{}",
+        trace["conventions_seen"]
+    );
     Ok(())
 }

@@ -328,6 +328,13 @@ impl<'a> ReportBuilder<'a> {
             }
         }
         report.divergent += 1;
+        report.convention_hints.observe(
+            result,
+            (&judged.expected, &judged.got, judged.got_is_core),
+            &fields,
+            &self.options.tolerances,
+            &report.conventions,
+        );
         let divergences = &mut report.divergences;
         *divergences
             .by_kind

@@ -254,6 +254,9 @@ pub fn render_text(r: &TraceReport) -> String {
         Status::Fail => {
             let _ = writeln!(s, "FAIL {}: {}; {counts}", r.trace, failures(r).join("; "));
             write_conventions(&mut s, r);
+            if !r.convention_hints.is_empty() {
+                let _ = writeln!(s, "  {}", r.convention_hints.line());
+            }
             write_tunnels_and_ghosts(&mut s, r);
             write_divergences(&mut s, r, sides);
         }

@@ -15,6 +15,7 @@ use crate::trace::OutcomeMsg;
 use super::compare::{FieldDiff, Tolerances};
 use super::conventions::EngineConventions;
 use super::explain::ExpectedTest;
+use super::hints::ConventionHints;
 use super::infer::Inferred;
 use super::judge::Agreement;
 use super::repro::{HexInputs, SweepInputs};
@@ -260,6 +261,13 @@ pub struct TraceReport {
     /// only in the JSON when some are declared).
     #[serde(skip_serializing_if = "EngineConventions::is_rules")]
     pub conventions: EngineConventions,
+    /// Failing sweeps that an undeclared convention would explain
+    /// (`conventions_seen`; only in the JSON when some).
+    #[serde(
+        rename = "conventions_seen",
+        skip_serializing_if = "ConventionHints::is_empty"
+    )]
+    pub convention_hints: ConventionHints,
     /// Tunnels found.
     #[serde(flatten)]
     pub tunnels: Tunnels,

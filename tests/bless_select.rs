@@ -190,6 +190,21 @@ fn engine_that_cannot_start_writes_nothing_and_exits_125() -> anyhow::Result<()>
         std::fs::read_dir(dir.path())?.next().is_none(),
         "something was written"
     );
+    // The same with --review, which checks through the engine first.
+    let (code, _, err) = run(os![
+        "bless",
+        cube().as_os_str(),
+        "--review",
+        "--engine",
+        "./no-such-engine",
+        "-o",
+        out.as_os_str()
+    ])?;
+    ensure!(
+        code == 125 && err.contains("nothing written"),
+        "--review: exit {code}: {err}"
+    );
+    ensure!(!out.exists(), "something was written");
     Ok(())
 }
 

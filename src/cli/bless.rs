@@ -163,9 +163,18 @@ pub fn run(args: Args) -> anyhow::Result<Exit> {
             replay,
             ..CheckOptions::default()
         };
-        match review(&args, engine.as_ref(), &check_options)? {
-            Some(chosen) => BlessSelection::Sweeps(chosen),
-            None => return Ok(Exit::Success),
+        match review(&args, engine.as_ref(), &check_options) {
+            Ok(Some(chosen)) => BlessSelection::Sweeps(chosen),
+            Ok(None) => return Ok(Exit::Success),
+            // An engine that cannot be started: 125, as without --review.
+            Err(e)
+                if e.downcast_ref::<sweeptrace::engine::EngineError>()
+                    .is_some_and(|c| c.cannot_start()) =>
+            {
+                eprintln!("error: {e}\nnothing written");
+                return Ok(Exit::EngineUnavailable);
+            }
+            Err(e) => return Err(e),
         }
     } else if let Some(set) = &args.accept {
         BlessSelection::Sweeps(set.clone())

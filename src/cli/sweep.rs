@@ -107,11 +107,9 @@ pub fn run(args: Args) -> anyhow::Result<Exit> {
         let mesh = sweeptrace::Mesh::new(found.scene.vertices.clone(), &found.scene.triangles)
             .with_context(|| format!("{shown}: building the scene of frame {frame}"))?;
         topology = sweeptrace::Topology::new(&found.scene.vertices, &found.scene.triangles).ok();
-        let mut options = found.options();
+        let scene = found.options();
         settings = super::check_config::for_trace(path, &args.conventions, &args.config)?;
-        conventions_applied(&mut options, &settings.engine.conventions());
-        options.margin = args.margin.unwrap_or(options.margin);
-        options.facing = args.facing.unwrap_or(options.facing);
+        let options = replay_options(&args, &settings).core_options(scene.margin, scene.facing);
         source = Some(format!(
             "trace {shown}, frame {frame}, ball {} (the trace's margin {}, facing {})",
             args.ball, found.scene.margin, found.scene.facing
@@ -156,10 +154,8 @@ pub fn run(args: Args) -> anyhow::Result<Exit> {
                 no_config: true,
             },
         )?;
-        let mut options = Options::default();
-        conventions_applied(&mut options, &settings.engine.conventions());
-        options.margin = args.margin.unwrap_or(options.margin);
-        options.facing = args.facing.unwrap_or(options.facing);
+        let rules = Options::default();
+        let options = replay_options(&args, &settings).core_options(rules.margin, rules.facing);
         (
             scene.name,
             mesh,
@@ -236,22 +232,15 @@ pub fn run(args: Args) -> anyhow::Result<Exit> {
     Ok(Exit::Success)
 }
 
-/// `options` under the engine's `conventions`: its margin and facing rule
-/// where it declares one, the sides that collide, and what a ball starting
-/// within `ρ` gets (the normal rule applies to the outcome, after the
-/// query).
-fn conventions_applied(
-    options: &mut Options,
-    conventions: &sweeptrace::regress::EngineConventions,
-) {
-    if let sweeptrace::regress::MarginRule::Fixed(m) = conventions.margin {
-        options.margin = m;
-    }
-    if let Some(facing) = conventions.facing.facing() {
-        options.facing = facing;
-    }
-    options.sides = conventions.sides;
-    options.initial_overlap = conventions.initial_overlap;
+/// The replay's options of this command: its margin and facing overrides
+/// under the engine's declared conventions (which decide the margin and
+/// facing where the flags do not, and the sides and initial overlap).
+fn replay_options(args: &Args, settings: &sweeptrace::regress::Settings) -> ReplayOptions {
+    settings.engine.conventions().replay_with(ReplayOptions {
+        margin: args.margin,
+        facing: args.facing,
+        ..ReplayOptions::default()
+    })
 }
 
 /// The sweep of `frame` and `ball` replayed as `check` and `replay` replay

@@ -1,7 +1,7 @@
 //! What a caller chooses about a replay: which sweeps, how much is
 //! explained, and overrides of the scene's margin and facing rule.
 
-use crate::core::{Facing, InitialOverlap, Sides};
+use crate::core::{Facing, InitialOverlap, Options, Sides};
 
 /// How many test records each sweep keeps.
 #[derive(
@@ -218,6 +218,18 @@ pub enum NormalRule {
 pub const ACTIVE_EDGE_DEGREES: f64 = 5.0;
 
 impl ReplayOptions {
+    /// The core's options for a scene whose own margin and facing rule are
+    /// `margin` and `facing`: the overrides where set, and the engine
+    /// conventions the core applies (sides, initial overlap).
+    pub fn core_options(&self, margin: f64, facing: Facing) -> Options {
+        Options {
+            margin: self.margin.unwrap_or(margin),
+            facing: self.facing.unwrap_or(facing),
+            initial_overlap: self.initial_overlap,
+            sides: self.sides,
+        }
+    }
+
     /// An explicit, stable text of every option (`frames=10..20;ball=*;
     /// detail=primary;explain=1;margin=scene;facing=scene`), for hashing into
     /// recording ids: unlike `Debug` output it does not change when a field

@@ -277,12 +277,7 @@ impl Replay {
         let mesh =
             Mesh::new(vertices, &triangles).map_err(|cause| ReplayError::Mesh { index, cause })?;
         let topology = topology.map_err(|cause| ReplayError::Mesh { index, cause })?;
-        let options = Options {
-            margin: self.options.margin.unwrap_or(margin),
-            facing: self.options.facing.unwrap_or(facing),
-            initial_overlap: self.options.initial_overlap,
-            sides: self.options.sides,
-        };
+        let options = self.options.core_options(margin, facing);
         let normals = SceneNormals::new(self.options.normal, &mesh, &topology);
         let number = self.summary.scenes;
         self.summary.scenes += 1;

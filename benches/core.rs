@@ -38,8 +38,8 @@ use criterion::{BenchmarkGroup, BenchmarkId, Criterion, Throughput, criterion_gr
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use sweeptrace::core::{
-    Broadphase, CollectRecords, Mesh, Observer, Options, Outcome, Sweep, Topology, sweep_mesh,
-    sweep_mesh_with,
+    Broadphase, CollectRecords, CountVisits, Mesh, Observer, Options, Outcome, Skip, Sweep,
+    Topology, sweep_mesh, sweep_mesh_with,
 };
 use sweeptrace::replay::{CollectPrimary, primary_records};
 use sweeptrace::sim::{self, scenes::BuiltinScene};
@@ -168,6 +168,45 @@ fn agreement(label: &str, s: &Setup) {
         digest.finish()
     );
     assert!(both > 0, "no sweep of {label} hits the mesh");
+    visits(label, s, &options);
+}
+
+/// Prints the per-node figures of the fast query over the setup's sweeps
+/// (deterministic counts, no timing): the means per sweep of the tree's
+/// nodes opened, child boxes tested, leaves and candidate triangles handed
+/// over, candidates tested and skipped; and the bytes of a node, of a
+/// triangle's record and of the whole tree. The counting observer runs
+/// what the fast query runs (checked: same outcome for every sweep).
+fn visits(label: &str, s: &Setup, options: &Options) {
+    let mut count = CountVisits::default();
+    for sw in &s.sweeps {
+        let counted = sweep_mesh_with(&s.ours, sw, options, Broadphase::Bvh, &mut count);
+        let fast = sweep_mesh(&s.ours, sw, options);
+        assert_eq!(
+            format!("{counted:?}"),
+            format!("{fast:?}"),
+            "the counting observer changes an outcome"
+        );
+    }
+    let per = |n: u64| n as f64 / s.sweeps.len() as f64;
+    let bytes = s.ours.bytes();
+    println!(
+        "per sweep, {label} on {} triangles: {:.2} nodes opened, {:.2} child boxes tested, {:.2} leaves, {:.2} candidate triangles (records read), {:.2} tested (whole record), {:.2} skipped back-facing, {:.2} skipped out of reach; {} bytes a node, {} a triangle record; tree {:.2} MB ({} nodes), triangle records {:.1} MB, index maps {:.1} MB",
+        s.triangles,
+        per(count.nodes),
+        per(count.boxes),
+        per(count.leaves),
+        per(count.candidates),
+        per(count.tested),
+        per(count.skipped.get(Skip::BackFacing)),
+        per(count.skipped.get(Skip::PlaneOutOfReach)),
+        bytes.node,
+        bytes.triangle,
+        bytes.nodes as f64 / 1e6,
+        bytes.nodes / bytes.node,
+        bytes.triangles as f64 / 1e6,
+        bytes.index_maps as f64 / 1e6,
+    );
 }
 
 fn bench(c: &mut Criterion) {

@@ -259,6 +259,18 @@ impl Bvh {
         }
     }
 
+    /// Bytes of one node, and of all the nodes (the array the traversal
+    /// reads; the two index maps are not read by it).
+    pub fn node_bytes(&self) -> (usize, usize) {
+        let one = std::mem::size_of::<Node>();
+        (one, one * self.nodes.len())
+    }
+
+    /// Bytes of the two index maps (position ↔ input index).
+    pub fn map_bytes(&self) -> usize {
+        4 * (self.order.len() + self.position_by_index.len())
+    }
+
     /// Bounds of the whole mesh (exact, not rounded to `f32`).
     pub fn root_bounds(&self) -> (Point3<f64>, Point3<f64>) {
         self.bounds
@@ -274,8 +286,29 @@ impl Bvh {
         p0: &Point3<f64>,
         d: &Vector3<f64>,
         grow: f64,
+        cutoff: f64,
+        leaf: impl FnMut(std::ops::Range<usize>) -> f64,
+    ) {
+        let mut leaf = leaf;
+        self.traverse_with(p0, d, grow, cutoff, &mut (), |_, r| leaf(r), |_, _| {});
+    }
+
+    /// [`Bvh::traverse`] with a state handed to both callbacks, and
+    /// `on_node` told the number of child boxes of every node it opens
+    /// (each tested against the segment): the per-node counts of the
+    /// benchmark. The fast query's `on_node` does nothing and compiles to
+    /// nothing.
+    #[inline]
+    #[allow(clippy::too_many_arguments)] // the segment, its cutoff, and the two callbacks' state
+    pub fn traverse_with<S>(
+        &self,
+        p0: &Point3<f64>,
+        d: &Vector3<f64>,
+        grow: f64,
         mut cutoff: f64,
-        mut leaf: impl FnMut(std::ops::Range<usize>) -> f64,
+        state: &mut S,
+        mut leaf: impl FnMut(&mut S, std::ops::Range<usize>) -> f64,
+        mut on_node: impl FnMut(&mut S, usize),
     ) {
         let inv = Vector3::new(1.0 / d.x, 1.0 / d.y, 1.0 / d.z);
         // (child, count, entry): a node (count 0) or a leaf range.
@@ -284,6 +317,7 @@ impl Bvh {
         let mut node_index = 0u32;
         loop {
             let node = &self.nodes[node_index as usize];
+            on_node(state, node.len as usize);
             let entries = entries(node, p0, d, &inv, grow);
             // The entered children within the cutoff, nearest last, pushed
             // so that the nearest is popped first.
@@ -316,7 +350,7 @@ impl Bvh {
                     break;
                 }
                 let start = child as usize;
-                cutoff = leaf(start..start + count as usize).min(cutoff);
+                cutoff = leaf(state, start..start + count as usize).min(cutoff);
             }
         }
     }

@@ -142,6 +142,22 @@ impl std::fmt::Display for DegenerateTriangle {
     }
 }
 
+/// Sizes of what a mesh holds for the query, in bytes ([`Mesh::bytes`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct MeshBytes {
+    /// One node of the BVH.
+    pub node: usize,
+    /// Every node of the BVH (what the traversal reads).
+    pub nodes: usize,
+    /// One triangle's record ([`Triangle`]).
+    pub triangle: usize,
+    /// Every triangle's record.
+    pub triangles: usize,
+    /// The BVH's two index maps (position ↔ input index; not read by the
+    /// traversal).
+    pub index_maps: usize,
+}
+
 /// A validated triangle mesh, ready for sweeps.
 #[derive(Clone, Debug)]
 pub struct Mesh {
@@ -310,6 +326,20 @@ impl Mesh {
     #[doc(hidden)]
     pub fn build_bvh_again(&self) -> usize {
         Bvh::build(&self.triangles).order().len()
+    }
+
+    /// The bytes the query reads: the tree's nodes and the triangles'
+    /// records (for the benchmark's per-node figures).
+    pub fn bytes(&self) -> MeshBytes {
+        let (node, nodes) = self.bvh.node_bytes();
+        let triangle = std::mem::size_of::<Triangle>();
+        MeshBytes {
+            node,
+            nodes,
+            triangle,
+            triangles: triangle * self.triangles.len(),
+            index_maps: self.bvh.map_bytes(),
+        }
     }
 
     /// Axis-aligned bounds of the mesh (`min`, `max`).

@@ -50,7 +50,7 @@ pub use explain::{describe, miss_distance, num};
 pub use feature::{Feature, Kind};
 pub use fragility::{FragileReason, Fragility};
 pub use initial::initial_contacts;
-pub use mesh::{DegenerateReason, DegenerateTriangle, Mesh, StandardFrame, Triangle};
+pub use mesh::{DegenerateReason, DegenerateTriangle, Mesh, MeshBytes, StandardFrame, Triangle};
 pub use options::{
     ALPHA_SENSITIVITY, DEGENERATE_TOLERANCE, FRAGILE_ULPS, Facing, GRAZING_COSINE, InitialOverlap,
     Options, PARALLEL_TOLERANCE, Sides, TIE_WINDOW_ULPS,
@@ -58,8 +58,8 @@ pub use options::{
 pub use outcome::{Outcome, SweepHit, Tie};
 pub use path::{Sweep, SweptPath};
 pub use record::{
-    CollectRecords, EdgeHit, EdgeRecord, FaceHit, FaceRecord, NoObserver, Observer, Skip,
-    SkipCounts, TestRecord, Verdict, VerdictCounts, VertexHit, VertexRecord,
+    CollectRecords, CountVisits, EdgeHit, EdgeRecord, FaceHit, FaceRecord, NoObserver, Observer,
+    Skip, SkipCounts, TestRecord, Verdict, VerdictCounts, VertexHit, VertexRecord,
 };
 pub(crate) use sweep_edge::sweep_edge;
 pub use sweep_face::{barycentric, sweep_face};

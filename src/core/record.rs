@@ -388,6 +388,16 @@ pub trait Observer {
     #[inline]
     fn skipped(&mut self, _triangle: u32, _reason: Skip) {}
 
+    /// The BVH broadphase opened a node of its tree and tested the segment
+    /// against its `boxes` child boxes.
+    #[inline]
+    fn node(&mut self, _boxes: usize) {}
+
+    /// The BVH broadphase handed over a leaf of `triangles` candidates
+    /// (each then tested or [skipped](Observer::skipped)).
+    #[inline]
+    fn leaf(&mut self, _triangles: usize) {}
+
     /// A face test finished.
     #[inline]
     fn face(&mut self, _record: &FaceRecord) {}
@@ -529,6 +539,52 @@ pub struct NoObserver;
 
 impl Observer for NoObserver {
     const WANTS_RECORDS: bool = false;
+}
+
+/// The observer of the benchmark's per-node counts: runs what the fast
+/// query runs (it wants no records, so the same candidates are skipped) and
+/// counts, over the sweeps it observes, the nodes the broadphase opens, the
+/// child boxes it tests, the leaves and candidate triangles it hands over,
+/// and the candidates tested (their seven tests run) or skipped.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct CountVisits {
+    /// Nodes of the tree opened.
+    pub nodes: u64,
+    /// Child boxes tested against the segment (up to four a node).
+    pub boxes: u64,
+    /// Leaves handed over.
+    pub leaves: u64,
+    /// Candidate triangles handed over (each reads its record's normal and
+    /// first vertex, for the skip tests).
+    pub candidates: u64,
+    /// Candidates tested: their face, edge and vertex tests ran (reading
+    /// the whole record).
+    pub tested: u64,
+    /// Candidates skipped, by reason.
+    pub skipped: SkipCounts,
+}
+
+impl Observer for CountVisits {
+    const WANTS_RECORDS: bool = false;
+
+    #[inline]
+    fn node(&mut self, boxes: usize) {
+        self.nodes += 1;
+        self.boxes += boxes as u64;
+    }
+    #[inline]
+    fn leaf(&mut self, triangles: usize) {
+        self.leaves += 1;
+        self.candidates += triangles as u64;
+    }
+    #[inline]
+    fn skipped(&mut self, _triangle: u32, reason: Skip) {
+        self.skipped.add(reason);
+    }
+    #[inline]
+    fn face(&mut self, _record: &FaceRecord) {
+        self.tested += 1;
+    }
 }
 
 /// Any test's record.

@@ -493,13 +493,22 @@ fn visit_triangles<O: Observer>(
             // Boxes grown by ρ plus a margin far above the fragility band,
             // so every hit and near miss that matters is visited.
             let grow = path.rho + path.broadphase_margin();
-            mesh.bvh()
-                .traverse(&path.p0, &path.d, grow, combiner.cutoff(), |range| {
+            let cutoff = combiner.cutoff();
+            mesh.bvh().traverse_with(
+                &path.p0,
+                &path.d,
+                grow,
+                cutoff,
+                &mut (combiner, observer),
+                |(combiner, observer), range| {
+                    observer.leaf(range.len());
                     for position in range {
                         run(position, combiner, observer);
                     }
                     combiner.cutoff()
-                });
+                },
+                |(_, observer), boxes| observer.node(boxes),
+            );
         }
     }
 }

@@ -30,6 +30,43 @@ pub const WIDTH: usize = 4;
 /// split halving each level).
 const STACK_DEPTH: usize = 4 * 32;
 
+/// What a traversal does with what it finds ([`Bvh::traverse_with`]).
+pub trait Visit {
+    /// Visits a leaf: its range of triangle positions. Returns the new
+    /// cutoff (it may only shrink).
+    fn leaf(&mut self, range: std::ops::Range<usize>) -> f64;
+
+    /// A node was opened and its `boxes` child boxes tested.
+    #[inline]
+    fn node(&mut self, _boxes: usize) {}
+
+    /// A leaf was entered within the cutoff: it is visited later unless
+    /// the cutoff shrinks below its entry first (a time to fetch its
+    /// triangles).
+    #[inline]
+    fn entered(&mut self, _range: std::ops::Range<usize>) {}
+}
+
+/// Asks for the cache lines of `*item` to be fetched, without waiting for
+/// them (nothing where there is no prefetch instruction).
+#[inline(always)]
+pub fn prefetch<T>(item: &T) {
+    #[cfg(target_arch = "x86_64")]
+    {
+        use std::arch::x86_64::{_MM_HINT_T0, _mm_prefetch};
+        let start = item as *const T as *const i8;
+        let mut offset = 0;
+        while offset < std::mem::size_of::<T>() {
+            // SAFETY: a prefetch reads nothing the program sees and
+            // cannot fault; the address is within (or just past) `*item`.
+            unsafe { _mm_prefetch::<_MM_HINT_T0>(start.wrapping_add(offset)) };
+            offset += 64;
+        }
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    let _ = item;
+}
+
 /// One node: the boxes of its (up to) [`WIDTH`] children, and what each is.
 #[derive(Clone, Copy, Debug)]
 #[repr(C, align(64))]
@@ -289,26 +326,26 @@ impl Bvh {
         cutoff: f64,
         leaf: impl FnMut(std::ops::Range<usize>) -> f64,
     ) {
-        let mut leaf = leaf;
-        self.traverse_with(p0, d, grow, cutoff, &mut (), |_, r| leaf(r), |_, _| {});
+        struct Leaves<F>(F);
+        impl<F: FnMut(std::ops::Range<usize>) -> f64> Visit for Leaves<F> {
+            #[inline]
+            fn leaf(&mut self, range: std::ops::Range<usize>) -> f64 {
+                (self.0)(range)
+            }
+        }
+        self.traverse_with(p0, d, grow, cutoff, &mut Leaves(leaf));
     }
 
-    /// [`Bvh::traverse`] with a state handed to both callbacks, and
-    /// `on_node` told the number of child boxes of every node it opens
-    /// (each tested against the segment): the per-node counts of the
-    /// benchmark. The fast query's `on_node` does nothing and compiles to
-    /// nothing.
+    /// [`Bvh::traverse`] with a [`Visit`]or, which is also told of every
+    /// node opened and of every leaf entered before it is visited.
     #[inline]
-    #[allow(clippy::too_many_arguments)] // the segment, its cutoff, and the two callbacks' state
-    pub fn traverse_with<S>(
+    pub fn traverse_with(
         &self,
         p0: &Point3<f64>,
         d: &Vector3<f64>,
         grow: f64,
         mut cutoff: f64,
-        state: &mut S,
-        mut leaf: impl FnMut(&mut S, std::ops::Range<usize>) -> f64,
-        mut on_node: impl FnMut(&mut S, usize),
+        visit: &mut impl Visit,
     ) {
         let inv = Vector3::new(1.0 / d.x, 1.0 / d.y, 1.0 / d.z);
         // (child, count, entry): a node (count 0) or a leaf range.
@@ -317,7 +354,7 @@ impl Bvh {
         let mut node_index = 0u32;
         loop {
             let node = &self.nodes[node_index as usize];
-            on_node(state, node.len as usize);
+            visit.node(node.len as usize);
             let entries = entries(node, p0, d, &inv, grow);
             // The entered children within the cutoff, nearest last, pushed
             // so that the nearest is popped first.
@@ -325,6 +362,14 @@ impl Bvh {
             for (slot, &t) in entries.iter().enumerate().take(node.len as usize) {
                 if t <= cutoff {
                     let item = (node.child[slot], node.count[slot], t);
+                    // Fetch what the child holds while the nearer ones are
+                    // visited.
+                    if item.1 == 0 {
+                        prefetch(&self.nodes[item.0 as usize]);
+                    } else {
+                        let start = item.0 as usize;
+                        visit.entered(start..start + item.1 as usize);
+                    }
                     let mut k = len;
                     while k > base && stack[k - 1].2 < t {
                         stack[k] = stack[k - 1];
@@ -350,7 +395,7 @@ impl Bvh {
                     break;
                 }
                 let start = child as usize;
-                cutoff = leaf(state, start..start + count as usize).min(cutoff);
+                cutoff = visit.leaf(start..start + count as usize).min(cutoff);
             }
         }
     }

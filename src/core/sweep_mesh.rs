@@ -3,6 +3,7 @@
 
 use nalgebra::{Point3, Vector3};
 
+use super::bvh::{Visit, prefetch};
 use super::error::SweepError;
 use super::feature::{Feature, Kind};
 use super::fragility::{FragileReason, Fragility};
@@ -466,6 +467,14 @@ fn back_side(triangle: &Triangle, path: &SweptPath, sides: Sides) -> Option<Tria
     (sides == Sides::Two && triangle.normal.dot(&path.d) > 0.0).then(|| triangle.mirrored())
 }
 
+/// Asks for every cache line of `triangles` to be fetched.
+#[inline]
+fn prefetch_all(triangles: &[Triangle]) {
+    for t in triangles {
+        prefetch(t);
+    }
+}
+
 fn visit_triangles<O: Observer>(
     mesh: &Mesh,
     path: &SweptPath,
@@ -494,20 +503,41 @@ fn visit_triangles<O: Observer>(
             // so every hit and near miss that matters is visited.
             let grow = path.rho + path.broadphase_margin();
             let cutoff = combiner.cutoff();
+            struct Leaves<'a, R, O> {
+                run: R,
+                triangles: &'a [Triangle],
+                combiner: &'a mut Combiner,
+                observer: &'a mut O,
+            }
+            impl<R: Fn(usize, &mut Combiner, &mut O), O: Observer> Visit for Leaves<'_, R, O> {
+                #[inline]
+                fn leaf(&mut self, range: std::ops::Range<usize>) -> f64 {
+                    self.observer.leaf(range.len());
+                    for position in range {
+                        (self.run)(position, self.combiner, self.observer);
+                    }
+                    self.combiner.cutoff()
+                }
+                #[inline]
+                fn node(&mut self, boxes: usize) {
+                    self.observer.node(boxes);
+                }
+                #[inline]
+                fn entered(&mut self, range: std::ops::Range<usize>) {
+                    prefetch_all(&self.triangles[range]);
+                }
+            }
             mesh.bvh().traverse_with(
                 &path.p0,
                 &path.d,
                 grow,
                 cutoff,
-                &mut (combiner, observer),
-                |(combiner, observer), range| {
-                    observer.leaf(range.len());
-                    for position in range {
-                        run(position, combiner, observer);
-                    }
-                    combiner.cutoff()
+                &mut Leaves {
+                    run,
+                    triangles,
+                    combiner,
+                    observer,
                 },
-                |(_, observer), boxes| observer.node(boxes),
             );
         }
     }

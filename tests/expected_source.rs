@@ -572,7 +572,7 @@ fn record_names_sweeptrace_and_bless_replaces_the_source() -> anyhow::Result<()>
         .setting("facing", "non_strict");
     ensure!(
         stderr.contains(&format!(
-            "expectations from {want} (expectations were from {RAPIER_TEXT})"
+            "  expectations from {want}\n  they were from {RAPIER_TEXT}\n"
         )),
         "{stderr}"
     );

@@ -340,6 +340,16 @@ fn lean_refuses_recordings_naming_the_viewer_build() -> anyhow::Result<Completio
             .map(|e| e.file_name())
             .collect();
         ensure!(left.is_empty(), "{args:?}: left files behind: {left:?}");
+        // docs/COMMANDS.md shows the first of these messages as it is
+        // (tests/docs.rs runs the default build, which has the viewer).
+        if option == "--rrd" && options.len() == 2 {
+            let doc = std::fs::read_to_string(root().join("docs/COMMANDS.md"))?;
+            ensure!(
+                doc.contains(&format!("```text\n{err}```")),
+                "docs/COMMANDS.md should show the lean build's error for \
+                 `replay TRACE --rrd golf.rrd` as it is:\n{err}"
+            );
+        }
     }
     Ok(Completion::Completed)
 }

@@ -15,6 +15,7 @@ mod conform;
 mod core_cases;
 mod core_decisions;
 mod core_random;
+mod docs;
 mod engine;
 mod error_messages;
 mod exact;
@@ -163,6 +164,7 @@ fn main() {
     trials.extend(jolt::tests());
     trials.extend(precision::tests());
     trials.extend(architecture::tests());
+    trials.extend(docs::tests());
     let trials = mark_slow(trials);
     libtest_mimic::run(&args, trials).exit();
 }

@@ -90,7 +90,8 @@ fn mesh_fixtures_have_their_one_defect() -> anyhow::Result<()> {
     let (code, out, _) = run_bin(os!["mesh", &fixture("flipped_floor.obj")])?;
     ensure!(code == 1, "text report exit {code}");
     ensure!(
-        out.contains("triangle 9") && out.contains("opposite to 3 neighbours'"),
+        out.contains("triangle 9")
+            && out.contains("opposite to that of its 3 neighbours, triangles"),
         "text report: {out}"
     );
     ensure!(

@@ -88,6 +88,13 @@ fn assert_check_passes(trace: &Path) {
         "{}",
         render_text(&report)
     );
+    // capi/README.md shows this report, for the trace written as run.mcap.
+    let shown = render_text(&report).replace(&trace.display().to_string(), "run.mcap");
+    let readme = std::fs::read_to_string(root().join("capi/README.md")).expect("capi/README.md");
+    assert!(
+        readme.contains(&format!("```text\n{shown}```\n")),
+        "capi/README.md should show `sweeptrace check run.mcap`'s report as it is:\n{shown}"
+    );
 }
 
 #[test]

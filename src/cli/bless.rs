@@ -219,25 +219,28 @@ pub fn run(args: Args) -> anyhow::Result<Exit> {
         }
         Err(err) => return Err(err).name_file_once("blessing", args.trace.display()),
     };
-    let replaced = match &summary.replaced_expected_source {
-        Some(old) => format!(" (expectations were from {old})"),
-        None => String::new(),
-    };
+    // One line for what was written, then one for each thing to know.
     let selection = if matches!(options.select, BlessSelection::All) {
         String::new()
     } else {
         format!(
-            " [{} blessed, {} kept]",
+            " ({} blessed, {} kept)",
             counted(summary.blessed, "sweep", "sweeps"),
             summary.kept
         )
     };
     eprintln!(
-        "wrote {}: {} from {}{replaced}{selection} (replacing {}), {}, {}, {}, {} and {} kept",
+        "wrote {}: {}, replacing {}{selection}",
         output.display(),
         counted(summary.expected_written, "expectation", "expectations"),
-        summary.expected_source,
         summary.expected_dropped,
+    );
+    eprintln!("  expectations from {}", summary.expected_source);
+    if let Some(old) = &summary.replaced_expected_source {
+        eprintln!("  they were from {old}");
+    }
+    eprintln!(
+        "  kept as they were: {}, {}, {}, {} and {}",
         counted(summary.messages_copied, "other message", "other messages"),
         counted(summary.channels_copied, "channel", "channels"),
         counted(summary.schemas_copied, "schema", "schemas"),

@@ -106,11 +106,11 @@ pub fn defect_line(d: &Defect) -> String {
     let at = point(&d.position);
     match d.kind {
         DefectKind::Flipped => format!(
-            "triangle {} at {at}: a ball from the side its neighbours face passes through it: its winding is opposite to {}' ({})",
+            "triangle {} at {at}: a ball from the side its neighbours face passes through it: its winding is opposite to that of {} {}",
             t(0),
             match d.neighbours.len() {
-                1 => "its neighbour".to_string(),
-                n => format!("{n} neighbours"),
+                1 => "its neighbour, triangle".to_string(),
+                n => format!("its {n} neighbours, triangles"),
             },
             list(&d.neighbours)
         ),

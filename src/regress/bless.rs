@@ -390,14 +390,14 @@ fn outcomes_of(input: &[u8], name: &str, options: &BlessOptions) -> Result<Repla
     if options.select != BlessSelection::All {
         let earlier = match &replaced {
             Some(old) if collected.kept > 0 => {
-                format!(" (from {})", clipped(&old.engine, MAX_NAME_BYTES))
+                format!(" from {}", clipped(&old.engine, MAX_NAME_BYTES))
             }
             _ => String::new(),
         };
         source = source.setting(
             "blessed",
             format!(
-                "{} of {} sweeps; {} kept their earlier expectations{earlier}",
+                "{} of {} sweeps; the other {} keep their expectations{earlier}",
                 collected.blessed, collected.sweeps, collected.kept
             ),
         );

@@ -482,10 +482,18 @@ fn write_divergences(s: &mut String, r: &TraceReport, sides: Sides) {
     }
     let kept = divergences.details.len();
     if r.divergent as usize > kept {
+        let rest = (r.divergent as usize - kept) as u64;
         let _ = writeln!(
             s,
-            "  ... {} more divergent sweeps (frames {}{})",
-            r.divergent as usize - kept,
+            "  ... {} (frames {}{})",
+            if kept == 0 {
+                format!(
+                    "{}, none shown in detail (--max-details)",
+                    crate::numbers::counted(rest, "divergent sweep", "divergent sweeps")
+                )
+            } else {
+                crate::numbers::counted(rest, "more divergent sweep", "more divergent sweeps")
+            },
             divergences
                 .frames
                 .iter()

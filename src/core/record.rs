@@ -550,7 +550,7 @@ impl Observer for NoObserver {
 pub struct CountVisits {
     /// Nodes of the tree opened.
     pub nodes: u64,
-    /// Child boxes tested against the segment (up to four a node).
+    /// Child boxes tested against the segment (up to `bvh::WIDTH`, eight, a node).
     pub boxes: u64,
     /// Leaves handed over.
     pub leaves: u64,

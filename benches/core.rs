@@ -44,9 +44,10 @@ use sweeptrace::core::{
 use sweeptrace::replay::{CollectPrimary, primary_records};
 use sweeptrace::sim::{self, scenes::BuiltinScene};
 
-use parry3d_f64::math::{Pose, Vector};
-use parry3d_f64::query::{ShapeCastOptions, cast_shapes};
-use parry3d_f64::shape::{Ball, TriMesh};
+#[path = "parry_cast.rs"]
+mod parry_cast;
+
+use parry3d_f64::shape::TriMesh;
 
 const RADIUS: f64 = 0.25;
 const SWEEPS: usize = 4096;
@@ -105,14 +106,7 @@ struct Setup {
 
 fn setup(n: usize) -> Setup {
     let (vertices, triangles) = terrain(n);
-    let parry = TriMesh::new(
-        vertices
-            .iter()
-            .map(|v| Vector::new(v[0], v[1], v[2]))
-            .collect(),
-        triangles.iter().map(|t| t.map(|i| i as u32)).collect(),
-    )
-    .expect("valid terrain for parry");
+    let parry = parry_cast::parry_mesh(&vertices, &triangles).expect("valid terrain for parry");
     let ours = Mesh::new(vertices, &triangles).expect("valid terrain");
     Setup {
         n,
@@ -124,19 +118,7 @@ fn setup(n: usize) -> Setup {
 }
 
 fn parry_cast(mesh: &TriMesh, s: &Sweep) -> Option<f64> {
-    let v = |p: &nalgebra::Point3<f64>| Vector::new(p.x, p.y, p.z);
-    cast_shapes(
-        &Pose::from_translation(v(&s.p0)),
-        v(&s.p1) - v(&s.p0),
-        &Ball::new(s.radius),
-        &Pose::IDENTITY,
-        Vector::ZERO,
-        mesh,
-        ShapeCastOptions::with_max_time_of_impact(1.0),
-    )
-    .ok()
-    .flatten()
-    .map(|h| h.time_of_impact)
+    parry_cast::parry_cast(mesh, s.p0.into(), s.p1.into(), s.radius)
 }
 
 /// Prints how often sweeptrace and parry agree on hit or miss over the
@@ -191,7 +173,7 @@ fn visits(label: &str, s: &Setup, options: &Options) {
     let per = |n: u64| n as f64 / s.sweeps.len() as f64;
     let bytes = s.ours.bytes();
     println!(
-        "per sweep, {label} on {} triangles: {:.2} nodes opened, {:.2} child boxes tested, {:.2} leaves, {:.2} candidate triangles (records read), {:.2} tested (whole record), {:.2} skipped back-facing, {:.2} skipped out of reach; {} bytes a node, {} a triangle record; tree {:.2} MB ({} nodes), triangle records {:.1} MB, index maps {:.1} MB",
+        "per sweep, {label} on {} triangles: {:.2} nodes opened, {:.2} child boxes tested, {:.2} leaves, {:.2} candidate triangles (planes read), {:.2} tested (whole record read), {:.2} skipped back-facing, {:.2} skipped out of reach; {} bytes a node, {} a triangle plane, {} a triangle record; tree {:.2} MB ({} nodes), triangle planes {:.1} MB, triangle records {:.1} MB, index maps {:.1} MB",
         s.triangles,
         per(count.nodes),
         per(count.boxes),
@@ -201,9 +183,11 @@ fn visits(label: &str, s: &Setup, options: &Options) {
         per(count.skipped.get(Skip::BackFacing)),
         per(count.skipped.get(Skip::PlaneOutOfReach)),
         bytes.node,
+        bytes.plane,
         bytes.triangle,
         bytes.nodes as f64 / 1e6,
         bytes.nodes / bytes.node,
+        bytes.planes as f64 / 1e6,
         bytes.triangles as f64 / 1e6,
         bytes.index_maps as f64 / 1e6,
     );
@@ -298,19 +282,8 @@ fn session(cells: usize) -> (Setup, Options) {
     .expect("the session simulates");
     let step = (all.len() / SWEEPS).max(1);
     let sweeps: Vec<Sweep> = all.into_iter().step_by(step).take(SWEEPS).collect();
-    let parry = TriMesh::new(
-        scene
-            .vertices
-            .iter()
-            .map(|v| Vector::new(v[0], v[1], v[2]))
-            .collect(),
-        scene
-            .triangles
-            .iter()
-            .map(|t| t.map(|i| i as u32))
-            .collect(),
-    )
-    .expect("valid terrain for parry");
+    let parry =
+        parry_cast::parry_mesh(&scene.vertices, &scene.triangles).expect("valid terrain for parry");
     let setup = Setup {
         n: cells,
         triangles: scene.triangles.len(),

@@ -30,7 +30,7 @@
 use nalgebra::Point3;
 use serde::Serialize;
 
-use super::mesh::{Mesh, Triangle};
+use super::mesh::{Mesh, Plane, Triangle};
 use super::options::{BROADPHASE_MARGIN, TIE_WINDOW_ULPS};
 use super::sweep_face::barycentric_and_distance;
 
@@ -122,6 +122,19 @@ fn crossing_along(
     })
 }
 
+/// Whether `p → q` passes the first condition of [`crossing_along`] in
+/// either direction (it starts in front of the plane and ends behind it,
+/// or the reverse), computed from the triangle's [`Plane`] alone: the same
+/// values as from its record (negating `n` negates the heights exactly),
+/// so a triangle this rejects is one [`crossing_of`] rejects, and the
+/// record of most candidates is never read.
+#[inline]
+fn may_cross(plane: &Plane, p: &Point3<f64>, q: &Point3<f64>, tau: f64) -> bool {
+    let hp = plane.normal.dot(&(p - plane.v0));
+    let hq = plane.normal.dot(&(q - plane.v0));
+    (hp >= -tau && hq < -tau) || (-hp >= -tau && -hq < -tau)
+}
+
 /// The crossing of one triangle, in both directions when it is one of the
 /// `flipped` (ascending input indices).
 #[inline]
@@ -193,11 +206,14 @@ pub fn first_crossing_with_flipped(
     // Boxes grown by τ plus a margin far above it, as the sweep grows them.
     let grow = tau + BROADPHASE_MARGIN * s;
     let triangles = mesh.triangles();
+    let planes = mesh.planes();
     // First pass: the smallest fraction.
     let mut first = f64::INFINITY;
     mesh.bvh().traverse(p, &d, grow, 1.0, |range| {
         for position in range {
-            if let Some(c) = crossing_of(&triangles[position], flipped, p, q, tau) {
+            if may_cross(&planes[position], p, q, tau)
+                && let Some(c) = crossing_of(&triangles[position], flipped, p, q, tau)
+            {
                 first = first.min(c.fraction);
             }
         }
@@ -212,7 +228,8 @@ pub fn first_crossing_with_flipped(
     let mut best: Option<Crossing> = None;
     mesh.bvh().traverse(p, &d, grow, cutoff, |range| {
         for position in range {
-            if let Some(c) = crossing_of(&triangles[position], flipped, p, q, tau)
+            if may_cross(&planes[position], p, q, tau)
+                && let Some(c) = crossing_of(&triangles[position], flipped, p, q, tau)
                 && c.fraction <= first + window
                 && best.is_none_or(|b| c.triangle < b.triangle)
             {

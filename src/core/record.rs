@@ -554,8 +554,8 @@ pub struct CountVisits {
     pub boxes: u64,
     /// Leaves handed over.
     pub leaves: u64,
-    /// Candidate triangles handed over (each reads its record's normal and
-    /// first vertex, for the skip tests).
+    /// Candidate triangles handed over (each reads its plane, the normal
+    /// and first vertex kept apart from the records, for the skip tests).
     pub candidates: u64,
     /// Candidates tested: their face, edge and vertex tests ran (reading
     /// the whole record).

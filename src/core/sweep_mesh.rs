@@ -8,7 +8,7 @@ use super::error::SweepError;
 use super::feature::{Feature, Kind};
 use super::fragility::{FragileReason, Fragility};
 use super::initial::initial_contact;
-use super::mesh::{Mesh, Triangle};
+use super::mesh::{Mesh, Plane, Triangle};
 use super::options::{ALPHA_SENSITIVITY, Facing, GRAZING_COSINE, InitialOverlap, Options, Sides};
 use super::outcome::{Outcome, SweepHit, in_tie_window};
 use super::path::{Sweep, SweptPath};
@@ -445,18 +445,37 @@ pub fn sweep_mesh_with<O: Observer>(
 /// hit (the line of an edge, its vertices, its face are no nearer than the
 /// plane): the tests would give no hit and no near miss.
 #[inline]
-fn skip<O: Observer>(triangle: &Triangle, path: &SweptPath, facing: Facing) -> Option<Skip> {
+fn skip<O: Observer>(
+    normal: &Vector3<f64>,
+    v0: &Point3<f64>,
+    path: &SweptPath,
+    facing: Facing,
+) -> Option<Skip> {
     if O::TESTS_EVERY_CANDIDATE {
         return None;
     }
-    let facing_value = triangle.normal.dot(&path.d);
+    let facing_value = normal.dot(&path.d);
     if !facing.allows(facing_value) && facing_value.abs() >= GRAZING_COSINE * path.length {
         return Some(Skip::BackFacing);
     }
-    let h0 = triangle.normal.dot(&(path.p0 - triangle.vertices[0]));
+    let h0 = normal.dot(&(path.p0 - v0));
     let h1 = h0 + facing_value;
     let clear = path.rho + path.broadphase_margin();
     ((h0 > clear && h1 > clear) || (h0 < -clear && h1 < -clear)).then_some(Skip::PlaneOutOfReach)
+}
+
+/// [`skip`] from a triangle's [`Plane`] alone (its record is not read),
+/// with the plane as the tests see it under `sides` (`-n` when the
+/// triangle is tested from its back: [`back_side`]); and whether it is.
+#[inline]
+fn skip_plane<O: Observer>(
+    plane: &Plane,
+    path: &SweptPath,
+    (facing, sides): (Facing, Sides),
+) -> (Option<Skip>, bool) {
+    let back = sides == Sides::Two && plane.normal.dot(&path.d) > 0.0;
+    let normal = if back { -plane.normal } else { plane.normal };
+    (skip::<O>(&normal, &plane.v0, path, facing), back)
 }
 
 /// The triangle as the tests see it under `sides`: `None` for itself, or
@@ -467,10 +486,10 @@ fn back_side(triangle: &Triangle, path: &SweptPath, sides: Sides) -> Option<Tria
     (sides == Sides::Two && triangle.normal.dot(&path.d) > 0.0).then(|| triangle.mirrored())
 }
 
-/// Asks for every cache line of `triangles` to be fetched.
+/// Asks for every cache line of `items` to be fetched.
 #[inline]
-fn prefetch_all(triangles: &[Triangle]) {
-    for t in triangles {
+fn prefetch_all<T>(items: &[T]) {
+    for t in items {
         prefetch(t);
     }
 }
@@ -484,13 +503,20 @@ fn visit_triangles<O: Observer>(
     combiner: &mut Combiner,
 ) {
     let triangles = mesh.triangles();
-    let run = |position: usize, combiner: &mut Combiner, observer: &mut O| {
-        let mirrored = back_side(&triangles[position], path, sides);
-        let t = mirrored.as_ref().unwrap_or(&triangles[position]);
-        match skip::<O>(t, path, facing) {
-            None => test_triangle(t, position, path, facing, observer, combiner),
-            Some(reason) => observer.skipped(t.index, reason),
+    let planes = mesh.planes();
+    // The skip tests read the triangle's plane only; its record is read
+    // when it is tested.
+    let run = |position: usize, combiner: &mut Combiner, observer: &mut O| match skip_plane::<O>(
+        &planes[position],
+        path,
+        (facing, sides),
+    ) {
+        (None, back) => {
+            let mirrored = back.then(|| triangles[position].mirrored());
+            let t = mirrored.as_ref().unwrap_or(&triangles[position]);
+            test_triangle(t, position, path, facing, observer, combiner)
         }
+        (Some(reason), _) => observer.skipped(planes[position].index, reason),
     };
     match broadphase {
         Broadphase::Exhaustive => {
@@ -506,6 +532,9 @@ fn visit_triangles<O: Observer>(
             struct Leaves<'a, R, O> {
                 run: R,
                 triangles: &'a [Triangle],
+                planes: &'a [Plane],
+                path: &'a SweptPath,
+                rules: (Facing, Sides),
                 combiner: &'a mut Combiner,
                 observer: &'a mut O,
             }
@@ -513,6 +542,16 @@ fn visit_triangles<O: Observer>(
                 #[inline]
                 fn leaf(&mut self, range: std::ops::Range<usize>) -> f64 {
                     self.observer.leaf(range.len());
+                    // The records of the triangles that will be tested are
+                    // fetched together, before the first test.
+                    for position in range.clone() {
+                        if skip_plane::<O>(&self.planes[position], self.path, self.rules)
+                            .0
+                            .is_none()
+                        {
+                            prefetch(&self.triangles[position]);
+                        }
+                    }
                     for position in range {
                         (self.run)(position, self.combiner, self.observer);
                     }
@@ -524,7 +563,7 @@ fn visit_triangles<O: Observer>(
                 }
                 #[inline]
                 fn entered(&mut self, range: std::ops::Range<usize>) {
-                    prefetch_all(&self.triangles[range]);
+                    prefetch_all(&self.planes[range]);
                 }
             }
             mesh.bvh().traverse_with(
@@ -535,6 +574,9 @@ fn visit_triangles<O: Observer>(
                 &mut Leaves {
                     run,
                     triangles,
+                    planes,
+                    path,
+                    rules: (facing, sides),
                     combiner,
                     observer,
                 },
@@ -593,7 +635,7 @@ fn sweep_path<O: Observer>(
         for (position, t) in triangles.iter().enumerate() {
             let mirrored = back_side(t, path, sides);
             let t = mirrored.as_ref().unwrap_or(t);
-            if skip::<NoObserver>(t, path, facing).is_none() {
+            if skip::<NoObserver>(&t.normal, &t.vertices[0], path, facing).is_none() {
                 test_triangle(t, position, path, facing, &mut NoObserver, &mut decision);
             }
         }

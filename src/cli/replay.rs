@@ -17,7 +17,7 @@ use super::Exit;
 use super::viewer::{FinishedRecording, Recording, RecordingTarget};
 #[cfg(feature = "viewer")]
 use super::viewer::{RrdFileOptions, Viewer};
-use sweeptrace::atomic::PendingFile;
+use sweeptrace::atomic::{self, PendingFile};
 use sweeptrace::core::Facing;
 use sweeptrace::foxglove::{FoxgloveFile, FoxgloveOptions};
 use sweeptrace::numbers::{self, Rule, plural};
@@ -481,7 +481,9 @@ fn names_no_output(args: &Args) -> bool {
 /// Where the outcomes go.
 enum OutcomeSink {
     Stdout(BufWriter<std::io::Stdout>),
-    File(BufWriter<File>, PendingFile),
+    /// The file, its pending name, and the bytes written since the
+    /// kernel was last asked to start writing them out.
+    File(BufWriter<File>, PendingFile, u64),
 }
 
 /// The outputs besides the recording, which take each event in trace
@@ -505,7 +507,16 @@ impl Sinks {
             };
             let w: &mut dyn Write = match o {
                 OutcomeSink::Stdout(w) => w,
-                OutcomeSink::File(w, _) => w,
+                OutcomeSink::File(w, _, unsynced) => {
+                    // The data goes to the disk as it is written, so that
+                    // the sync at the end has little left to wait for.
+                    *unsynced += line.len() as u64 + 1;
+                    if *unsynced >= atomic::WRITEBACK_BYTES {
+                        atomic::start_writeback(w.get_ref());
+                        *unsynced = 0;
+                    }
+                    w
+                }
             };
             writeln!(w, "{line}").with_context(|| self.writing_outcomes.clone())?;
         }
@@ -555,7 +566,7 @@ impl Outputs {
                 let (pending, f) = PendingFile::create(p).with_context(|| {
                     format!("creating a temporary file next to {}", p.display())
                 })?;
-                Some(OutcomeSink::File(BufWriter::new(f), pending))
+                Some(OutcomeSink::File(BufWriter::new(f), pending, 0))
             }
         };
         let foxglove = match &args.foxglove {
@@ -627,7 +638,7 @@ impl Outputs {
                 w.flush().context(writing_outcomes.clone())?;
                 None
             }
-            Some(OutcomeSink::File(w, pending)) => {
+            Some(OutcomeSink::File(w, pending, _)) => {
                 pending
                     .seal(w)
                     .map_err(|e| anyhow::Error::new(e.cause))

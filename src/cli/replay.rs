@@ -566,7 +566,11 @@ impl Outputs {
                 let (pending, f) = PendingFile::create(p).with_context(|| {
                     format!("creating a temporary file next to {}", p.display())
                 })?;
-                Some(OutcomeSink::File(BufWriter::new(f), pending, 0))
+                Some(OutcomeSink::File(
+                    BufWriter::with_capacity(1 << 20, f),
+                    pending,
+                    0,
+                ))
             }
         };
         let foxglove = match &args.foxglove {

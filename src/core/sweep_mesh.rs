@@ -3,7 +3,7 @@
 
 use nalgebra::{Point3, Vector3};
 
-use super::bvh::{Visit, prefetch};
+use super::bvh::{LEAF_SIZE, Visit, prefetch};
 use super::error::SweepError;
 use super::feature::{Feature, Kind};
 use super::fragility::{FragileReason, Fragility};
@@ -465,8 +465,10 @@ fn skip<O: Observer>(
 }
 
 /// [`skip`] from a triangle's [`Plane`] alone (its record is not read),
-/// with the plane as the tests see it under `sides` (`-n` when the
-/// triangle is tested from its back: [`back_side`]); and whether it is.
+/// with the plane as the tests see it under `sides`; and whether the
+/// triangle is tested from its back (`sides = two`, the path moving toward
+/// its back, `n · d > 0`: the tests then take its
+/// [mirror](Triangle::mirrored), `-n`). One comparison under the rules.
 #[inline]
 fn skip_plane<O: Observer>(
     plane: &Plane,
@@ -476,14 +478,6 @@ fn skip_plane<O: Observer>(
     let back = sides == Sides::Two && plane.normal.dot(&path.d) > 0.0;
     let normal = if back { -plane.normal } else { plane.normal };
     (skip::<O>(&normal, &plane.v0, path, facing), back)
-}
-
-/// The triangle as the tests see it under `sides`: `None` for itself, or
-/// (`sides = two`, the path moving toward its back, `n · d > 0`) its
-/// [mirror](Triangle::mirrored). One comparison under the rules.
-#[inline]
-fn back_side(triangle: &Triangle, path: &SweptPath, sides: Sides) -> Option<Triangle> {
-    (sides == Sides::Two && triangle.normal.dot(&path.d) > 0.0).then(|| triangle.mirrored())
 }
 
 /// Asks for every cache line of `items` to be fetched.
@@ -504,24 +498,24 @@ fn visit_triangles<O: Observer>(
 ) {
     let triangles = mesh.triangles();
     let planes = mesh.planes();
-    // The skip tests read the triangle's plane only; its record is read
-    // when it is tested.
-    let run = |position: usize, combiner: &mut Combiner, observer: &mut O| match skip_plane::<O>(
-        &planes[position],
-        path,
-        (facing, sides),
-    ) {
-        (None, back) => {
+    // The skip tests read the triangle's plane only ([`skip_plane`]); its
+    // record is read when it is tested.
+    let run = |position: usize,
+               (skipped, back): (Option<Skip>, bool),
+               combiner: &mut Combiner,
+               observer: &mut O| match skipped {
+        None => {
             let mirrored = back.then(|| triangles[position].mirrored());
             let t = mirrored.as_ref().unwrap_or(&triangles[position]);
             test_triangle(t, position, path, facing, observer, combiner)
         }
-        (Some(reason), _) => observer.skipped(planes[position].index, reason),
+        Some(reason) => observer.skipped(planes[position].index, reason),
     };
     match broadphase {
         Broadphase::Exhaustive => {
-            for position in 0..triangles.len() {
-                run(position, combiner, observer);
+            for (position, plane) in planes.iter().enumerate() {
+                let decided = skip_plane::<O>(plane, path, (facing, sides));
+                run(position, decided, combiner, observer);
             }
         }
         Broadphase::Bvh => {
@@ -538,22 +532,28 @@ fn visit_triangles<O: Observer>(
                 combiner: &'a mut Combiner,
                 observer: &'a mut O,
             }
-            impl<R: Fn(usize, &mut Combiner, &mut O), O: Observer> Visit for Leaves<'_, R, O> {
+            impl<R, O> Visit for Leaves<'_, R, O>
+            where
+                R: Fn(usize, (Option<Skip>, bool), &mut Combiner, &mut O),
+                O: Observer,
+            {
                 #[inline]
                 fn leaf(&mut self, range: std::ops::Range<usize>) -> f64 {
                     self.observer.leaf(range.len());
-                    // The records of the triangles that will be tested are
-                    // fetched together, before the first test.
-                    for position in range.clone() {
-                        if skip_plane::<O>(&self.planes[position], self.path, self.rules)
-                            .0
-                            .is_none()
-                        {
+                    // Each candidate's skip decided once, from its plane;
+                    // the records of those that will be tested are fetched
+                    // together, before the first test. A leaf holds at
+                    // most LEAF_SIZE triangles.
+                    let mut decided = [(None, false); LEAF_SIZE];
+                    for (slot, position) in range.clone().enumerate() {
+                        decided[slot] =
+                            skip_plane::<O>(&self.planes[position], self.path, self.rules);
+                        if decided[slot].0.is_none() {
                             prefetch(&self.triangles[position]);
                         }
                     }
-                    for position in range {
-                        (self.run)(position, self.combiner, self.observer);
+                    for (slot, position) in range.enumerate() {
+                        (self.run)(position, decided[slot], self.combiner, self.observer);
                     }
                     self.combiner.cutoff()
                 }
@@ -632,10 +632,10 @@ fn sweep_path<O: Observer>(
     if combiner.overflow {
         // More hits within the band than the combiner holds: test every
         // triangle again, in mesh order.
-        for (position, t) in triangles.iter().enumerate() {
-            let mirrored = back_side(t, path, sides);
-            let t = mirrored.as_ref().unwrap_or(t);
-            if skip::<NoObserver>(&t.normal, &t.vertices[0], path, facing).is_none() {
+        for (position, (t, plane)) in triangles.iter().zip(mesh.planes()).enumerate() {
+            if let (None, back) = skip_plane::<NoObserver>(plane, path, (facing, sides)) {
+                let mirrored = back.then(|| t.mirrored());
+                let t = mirrored.as_ref().unwrap_or(t);
                 test_triangle(t, position, path, facing, &mut NoObserver, &mut decision);
             }
         }

@@ -19,7 +19,7 @@ use std::path::PathBuf;
 use std::time::{Duration, Instant};
 
 use sweeptrace::engine::{EngineAnswers, EngineCommand, EngineOptions, EngineSession};
-use sweeptrace::regress::{CheckOptions, check_events};
+use sweeptrace::suite::{CheckOptions, check_events};
 use sweeptrace::trace::{EventBody, TraceEvent, TraceReader};
 
 #[path = "../examples/long_trace.rs"]

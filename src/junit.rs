@@ -4,7 +4,7 @@
 //! (`testsuites` > `testsuite` > `properties`, `testcase` > `failure` /
 //! `error` / `skipped`, `system-out`).
 //!
-//! `check` ([`crate::regress::check_junit`]) and `conform`
+//! `check` ([`crate::suite::check_junit`]) and `conform`
 //! ([`crate::conform::conform_junit`]) build a [`Report`] from their reports;
 //! [`render`] writes it, counting `tests`, `failures`, `errors` and
 //! `skipped` on every suite and on the root. Text is escaped for XML 1.0,

@@ -67,7 +67,7 @@
 //! Rerun recording, `cli` the binary's dependencies).
 //!
 //! Start reading at [`core`] (the collision tests), then [`trace`],
-//! [`replay`], [`regress`]; [`sim`] holds the built-in scenes and the
+//! [`replay`], [`judge`], [`suite`]; [`sim`] holds the built-in scenes and the
 //! simulation behind `record`.
 
 #![warn(missing_docs)]
@@ -79,12 +79,13 @@ pub mod engine;
 pub(crate) mod error_text;
 pub mod foxglove;
 pub mod fuzzing;
+pub mod judge;
 pub mod junit;
 pub mod numbers;
 pub(crate) mod palette;
-pub mod regress;
 pub mod replay;
 pub mod sim;
+pub mod suite;
 pub mod trace;
 #[cfg(feature = "viewer")]
 pub mod viz;
@@ -94,11 +95,9 @@ pub use crate::core::{
     Kind, Mesh, MeshError, NoObserver, Observer, Options, Outcome, Sides, Sweep, SweepError,
     SweepHit, Tie, Topology, sweep_mesh, sweep_mesh_with, sweep_ties,
 };
-pub use crate::regress::{
-    Agreement, CheckOptions, Status, Tolerances, TraceReport, agreement, check_file, check_reader,
-    compare,
-};
+pub use crate::judge::{Agreement, Tolerances, agreement, compare};
 pub use crate::replay::{ReplayOptions, replay_events};
+pub use crate::suite::{CheckOptions, Status, TraceReport, check_file, check_reader};
 pub use crate::trace::{
     Encoding, EventBody, ExpectedSource, OutcomeMsg, SceneMsg, SweepMsg, TraceError, TraceEvent,
     TraceReader, TraceWriter, write_trace_file, write_trace_file_with_encoding,

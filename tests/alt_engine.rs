@@ -29,8 +29,8 @@ use std::io::Cursor;
 
 use libtest_mimic::Trial;
 use sweeptrace::core::{Facing, Kind};
-use sweeptrace::regress::{CheckOptions, Status, check_reader, render_text};
 use sweeptrace::sim::scenes;
+use sweeptrace::suite::{CheckOptions, Status, check_reader, render_text};
 use sweeptrace::trace::{OutcomeMsg, SceneMsg, SweepMsg, TraceWriter};
 
 use crate::ensure;
@@ -592,7 +592,7 @@ fn tie_member_is_judged_with_its_own_contact() -> anyhow::Result<()> {
         normal: Some(Some([0.0, 0.0, 1.0])),
         contact: Some(Some([h, 0.25, h])),
     };
-    let judge = |e: &OutcomeMsg| -> anyhow::Result<sweeptrace::regress::TraceReport> {
+    let judge = |e: &OutcomeMsg| -> anyhow::Result<sweeptrace::suite::TraceReport> {
         let mut w = TraceWriter::new(Cursor::new(Vec::new()))?;
         w.scene(0, &scene)?;
         w.sweep(1, &s)?;

@@ -22,11 +22,12 @@ use std::path::{Path, PathBuf};
 
 use libtest_mimic::Trial;
 use sweeptrace::core::{Facing, Kind};
-use sweeptrace::regress::{
-    CheckOptions, Field, FieldSet, Overrides, Side, Source, Status, Tolerances, bless_bytes,
-    check_file, check_reader, compare, diff, find_traces, render_json, render_text, settings_for,
-};
+use sweeptrace::judge::{Field, FieldSet, Tolerances, compare};
 use sweeptrace::replay::ReplayOptions;
+use sweeptrace::suite::{
+    CheckOptions, Overrides, Side, Source, Status, bless_bytes, check_file, check_reader, diff,
+    find_traces, render_json, render_text, settings_for,
+};
 use sweeptrace::trace::{OutcomeMsg, SceneMsg, SweepMsg, TraceReader, TraceWriter};
 
 use crate::ensure;
@@ -191,7 +192,7 @@ fn report_json_fixture_is_what_check_makes() -> anyhow::Result<()> {
     Ok(())
 }
 
-fn check_bytes(bytes: &[u8]) -> sweeptrace::regress::TraceReport {
+fn check_bytes(bytes: &[u8]) -> sweeptrace::suite::TraceReport {
     check_reader(bytes, "<memory>", &CheckOptions::default())
 }
 
@@ -451,7 +452,7 @@ fn blessed_trace_passes() -> anyhow::Result<()> {
     Ok(())
 }
 
-fn check_fixture_report(report: &sweeptrace::regress::TraceReport) -> anyhow::Result<()> {
+fn check_fixture_report(report: &sweeptrace::suite::TraceReport) -> anyhow::Result<()> {
     let text = render_text(report);
     ensure!(
         report.status() == Status::Fail,
@@ -972,7 +973,7 @@ fn diff_strict_facing_reports_first_divergence() -> anyhow::Result<()> {
         ..ReplayOptions::default()
     })?;
     let r = diff(&a, &b, &Tolerances::default());
-    let text = sweeptrace::regress::render_diff_text(&r);
+    let text = sweeptrace::suite::render_diff_text(&r);
     ensure!(!r.is_same() && r.different == 1, "{text}");
     let first = r.first.as_ref().context("no first divergence")?;
     ensure!(first.frame == 5, "first divergence at frame 5: {text}");

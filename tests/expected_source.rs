@@ -11,7 +11,7 @@ use std::path::{Path, PathBuf};
 use libtest_mimic::{Completion, Trial};
 use mcap::records::{MessageHeader, Metadata};
 use sweeptrace::core::Kind;
-use sweeptrace::regress::{CheckOptions, Status, check_file, render_json, render_text};
+use sweeptrace::suite::{CheckOptions, Status, check_file, render_json, render_text};
 use sweeptrace::trace::{
     EXPECTED_SOURCE_METADATA, ExpectedSource, OutcomeMsg, SceneMsg, SweepMsg, TraceError,
     TraceEvent, TraceReader, TraceWriter, collect_info, write_trace_file,

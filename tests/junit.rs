@@ -12,7 +12,7 @@ use roxmltree::{Document, Node};
 use serde_json::Value;
 
 use sweeptrace::core::Facing;
-use sweeptrace::regress::{CheckOptions, check_file, render_text};
+use sweeptrace::suite::{CheckOptions, check_file, render_text};
 
 use crate::engine::example_engine_command;
 use crate::support::run_bin;
@@ -168,7 +168,7 @@ fn check_junit_of_passing_traces_has_one_suite_per_trace() -> anyhow::Result<()>
     let report = dir.path().join("r.xml");
     let (code, stdout, stderr) = run_bin(os!["check", s(&at("traces")), "--junit", s(&report)])?;
     ensure!(code == 0, "exit {code}\n{stdout}{stderr}");
-    let traces = sweeptrace::regress::find_traces(&[at("traces")])?;
+    let traces = sweeptrace::suite::find_traces(&[at("traces")])?;
     let xml = read(&report)?;
     let doc = parse(&xml)?;
     counts_add_up(&doc)?;

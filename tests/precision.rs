@@ -10,7 +10,7 @@
 use anyhow::ensure;
 use libtest_mimic::Trial;
 use rand::{Rng, SeedableRng};
-use sweeptrace::regress::{F32_OPERATIONS, Precision, Sensitivity, Tolerances};
+use sweeptrace::judge::{F32_OPERATIONS, Precision, Sensitivity, Tolerances};
 use sweeptrace::replay::ReplayEvent;
 use sweeptrace::trace::{OutcomeMsg, SceneMsg, SweepMsg, TraceReader, TraceWriter};
 use sweeptrace::{Agreement, Facing, Mesh, Options, ReplayOptions, Sweep};

@@ -8,8 +8,8 @@ use std::path::Path;
 
 use libtest_mimic::Trial;
 use sweeptrace::core::{Skip, Verdict};
-use sweeptrace::regress::Tolerances;
-use sweeptrace::regress::decision_line;
+use sweeptrace::judge::Tolerances;
+use sweeptrace::judge::decision_line;
 use sweeptrace::replay::{
     Detail, ReplayEvent, ReplayOptions, ReplaySummary, SweepResult, replay_events,
 };

@@ -4,8 +4,9 @@
 //! its expectations' source.
 
 use libtest_mimic::Trial;
-use sweeptrace::regress::{CheckOptions, Status, Tolerances, check_file, render_text};
+use sweeptrace::judge::Tolerances;
 use sweeptrace::sim::scenes::BuiltinScene;
+use sweeptrace::suite::{CheckOptions, Status, check_file, render_text};
 
 use crate::ensure;
 use crate::rapier_record::{Args, Expect, run};

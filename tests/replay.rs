@@ -476,10 +476,10 @@ fn expected_attached_before_and_after() -> anyhow::Result<()> {
         summary.expected_matched == 2 && summary.expected_unmatched == 1,
         "summary {summary:?}"
     );
-    let (line, mismatch) = sweeptrace::regress::decision_line(
+    let (line, mismatch) = sweeptrace::judge::decision_line(
         &results[0],
         results[0].decisive_record(),
-        &sweeptrace::regress::Tolerances::default(),
+        &sweeptrace::judge::Tolerances::default(),
     );
     ensure!(
         mismatch && line.contains("expected face at α = 0.1]"),
@@ -1828,7 +1828,8 @@ fn rrd_shows_edges_features_and_explanations() -> anyhow::Result<()> {
 /// that leads with the divergences.
 fn viewer_and_check_agree_on_divergences() -> anyhow::Result<()> {
     use std::collections::BTreeSet;
-    use sweeptrace::regress::{CheckOptions, Tolerances, check_file};
+    use sweeptrace::judge::Tolerances;
+    use sweeptrace::suite::{CheckOptions, check_file};
     let fixture = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("tests/fixtures/wrong_engine_config.mcap");
     let report = check_file(&fixture, &CheckOptions::default());
@@ -1857,7 +1858,7 @@ fn viewer_and_check_agree_on_divergences() -> anyhow::Result<()> {
     let line_frames: BTreeSet<i64> = results
         .iter()
         .filter(|r| {
-            sweeptrace::regress::decision_line(r, r.decisive_record(), &Tolerances::default()).1
+            sweeptrace::judge::decision_line(r, r.decisive_record(), &Tolerances::default()).1
         })
         .map(|r| r.frame as i64)
         .collect();

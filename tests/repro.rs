@@ -8,12 +8,13 @@ use std::path::{Path, PathBuf};
 
 use libtest_mimic::Trial;
 use sweeptrace::core::{Facing, Kind, Mesh, Sweep, sweep_mesh};
+use sweeptrace::judge::{Agreement, Tolerances, compare};
 use sweeptrace::numbers::parse_f64;
-use sweeptrace::regress::{
-    Agreement, CheckOptions, ReproCase, Status, Tolerances, bless_bytes, check_file, check_reader,
-    compare, find_sweep, render_json, render_text,
-};
 use sweeptrace::replay::ReplayOptions;
+use sweeptrace::suite::{
+    CheckOptions, ReproCase, Status, bless_bytes, check_file, check_reader, find_sweep,
+    render_json, render_text,
+};
 use sweeptrace::trace::{OutcomeMsg, SceneMsg, SweepMsg, TraceReader, TraceWriter};
 
 use crate::ensure;
@@ -101,7 +102,7 @@ fn divergence_inputs_read_back_bit_exactly() -> anyhow::Result<()> {
         "text:\n{text}"
     );
     for d in &report.divergences.details {
-        let block = sweeptrace::regress::render_divergence(d, "");
+        let block = sweeptrace::suite::render_divergence(d, "");
         let inputs = &block[block.find("inputs: ").context("inputs line")?..];
         same_bits("decimal p0", &numbers_after(inputs, "p0 ")?, &d.inputs.p0)?;
         same_bits("decimal p1", &numbers_after(inputs, "p1 ")?, &d.inputs.p1)?;
@@ -274,9 +275,9 @@ fn check_generated_test(case: &ReproCase) -> anyhow::Result<()> {
         rest.retain(|f| {
             !matches!(
                 f.field,
-                sweeptrace::regress::Field::Kind
-                    | sweeptrace::regress::Field::Triangle
-                    | sweeptrace::regress::Field::Feature
+                sweeptrace::judge::Field::Kind
+                    | sweeptrace::judge::Field::Triangle
+                    | sweeptrace::judge::Field::Feature
             )
         });
         ties.iter().any(|t| {

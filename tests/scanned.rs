@@ -27,8 +27,8 @@ use libtest_mimic::Trial;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use sweeptrace::core::{Broadphase, FragileReason, Kind, NoObserver, Sweep, sweep_mesh_with};
-use sweeptrace::regress::{CheckOptions, Status, check_reader, render_text};
 use sweeptrace::sim::scenes::SceneMesh;
+use sweeptrace::suite::{CheckOptions, Status, check_reader, render_text};
 use sweeptrace::trace::{SceneMsg, SweepMsg};
 
 use crate::core_decisions::options;

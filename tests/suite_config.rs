@@ -13,7 +13,8 @@ use crate::os;
 use crate::support::run_bin_in;
 use crate::trial;
 use anyhow::Context as _;
-use sweeptrace::regress::{ConfigFile, Field, FieldSet, Overrides, Source, Tolerances, resolve};
+use sweeptrace::judge::{Field, FieldSet, Tolerances};
+use sweeptrace::suite::{ConfigFile, Overrides, Source, resolve};
 
 pub fn tests() -> Vec<Trial> {
     vec![

@@ -31,13 +31,11 @@ use sweeptrace::core::{
     Facing, Mesh, crossing_tolerance, first_crossing, first_crossing_with_flipped,
     triangle_crossing, triangle_crossing_back_to_front,
 };
-use sweeptrace::regress::{
-    CheckOptions, Status, check_file, check_reader, render_json, render_text,
-};
 use sweeptrace::replay::{
     ReplayEvent, ReplayOptions, SweepResult, TunnelKind, replay_events, replay_events_parallel,
 };
 use sweeptrace::sim::scenes;
+use sweeptrace::suite::{CheckOptions, Status, check_file, check_reader, render_json, render_text};
 use sweeptrace::trace::{SceneMsg, SweepMsg, TraceReader, TraceWriter};
 
 use crate::ensure;
@@ -433,7 +431,7 @@ fn tunnels_of(results: &[SweepResult]) -> Vec<(u64, u32, TunnelKind, u32)> {
         .collect()
 }
 
-fn check_floor_report(report: &sweeptrace::regress::TraceReport) -> anyhow::Result<()> {
+fn check_floor_report(report: &sweeptrace::suite::TraceReport) -> anyhow::Result<()> {
     let text = render_text(report);
     ensure!(report.status() == Status::Fail, "status\n{text}");
     ensure!(
@@ -507,7 +505,7 @@ fn floor_fixture_check() -> anyhow::Result<()> {
     Ok(())
 }
 
-fn check_wall_report(report: &sweeptrace::regress::TraceReport) -> anyhow::Result<()> {
+fn check_wall_report(report: &sweeptrace::suite::TraceReport) -> anyhow::Result<()> {
     let text = render_text(report);
     ensure!(report.status() == Status::Fail, "status\n{text}");
     ensure!(report.divergent == 0, "the expectations all match:\n{text}");
@@ -742,7 +740,7 @@ fn recording_marks_the_tunnel() -> anyhow::Result<()> {
 
 fn sample_traces_have_none() -> anyhow::Result<()> {
     let dir = root().join("traces");
-    let traces = sweeptrace::regress::find_traces(&[dir])?;
+    let traces = sweeptrace::suite::find_traces(&[dir])?;
     ensure!(!traces.is_empty(), "no sample trace");
     for path in traces {
         let bytes = std::fs::read(&path)?;

@@ -15,8 +15,8 @@
 
 use libtest_mimic::Trial;
 use sweeptrace::core::Facing;
-use sweeptrace::regress::{CheckOptions, check_reader, render_json, render_text};
 use sweeptrace::replay::TunnelKind;
+use sweeptrace::suite::{CheckOptions, check_reader, render_json, render_text};
 use sweeptrace::trace::{SceneMsg, SweepMsg};
 
 use crate::ensure;

@@ -11,7 +11,7 @@ use std::time::Duration;
 
 use libtest_mimic::Trial;
 use sweeptrace::core::{Facing, Kind, Mesh, Options, Sweep, sweep_ties};
-use sweeptrace::regress::{Agreement, Tolerances, agreement, agreement_of};
+use sweeptrace::judge::{Agreement, Tolerances, agreement, agreement_of};
 use sweeptrace::replay::{ReplayEvent, ReplayOptions, SweepResult, replay_events};
 use sweeptrace::sim::scenes;
 use sweeptrace::trace::{OutcomeMsg, SceneMsg, SweepMsg, TraceEvent, TraceWriter};

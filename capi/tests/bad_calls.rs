@@ -363,7 +363,7 @@ fn nan_and_out_of_range_values_are_refused_and_the_writer_goes_on() {
         (report.sweeps, report.compared, report.divergent),
         (2, 1, 0),
         "{}",
-        sweeptrace::regress::render_text(&report)
+        sweeptrace::suite::render_text(&report)
     );
 }
 
@@ -435,7 +435,7 @@ fn outcome_fields_for_a_kind_without_them_are_written_as_null() {
         (report.compared, report.divergent),
         (1, 0),
         "{}",
-        sweeptrace::regress::render_text(&report)
+        sweeptrace::suite::render_text(&report)
     );
 }
 

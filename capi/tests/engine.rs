@@ -24,7 +24,7 @@ use sweeptrace::conform::{ConformOptions, cases, run, shell_quote};
 use sweeptrace::core::Facing;
 use sweeptrace::engine::protocol::{parse_answer, scene_line, sweep_line};
 use sweeptrace::engine::{EngineCommand, EngineOptions};
-use sweeptrace::regress::{Against, CheckOptions, Status, check_file_with_engine, render_text};
+use sweeptrace::suite::{Against, CheckOptions, Status, check_file_with_engine, render_text};
 use sweeptrace::trace::PendingTrace;
 use sweeptrace::{SceneMsg, SweepMsg};
 

@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 
 use sweeptrace::ExpectedSource;
-use sweeptrace::regress::{CheckOptions, Status, check_file, render_text};
+use sweeptrace::suite::{CheckOptions, Status, check_file, render_text};
 
 /// The repository's root.
 fn root() -> PathBuf {

@@ -14,7 +14,7 @@ use anyhow::{Context, bail};
 use super::Exit;
 use sweeptrace::engine::EngineCommand;
 use sweeptrace::numbers::counted;
-use sweeptrace::regress::{
+use sweeptrace::suite::{
     Against, BlessEngine, BlessError, BlessOptions, BlessSelection, CheckOptions, Divergence,
     Sides, bless_file_with, check_file, check_file_with_engine, render_divergence_as,
 };

@@ -7,11 +7,11 @@ use anyhow::{Context, bail};
 
 use super::Exit;
 use sweeptrace::engine::{EngineCommand, EngineOptions};
-use sweeptrace::regress::{
+use sweeptrace::replay::{Detail, ReplayOptions};
+use sweeptrace::suite::{
     Against, CheckOptions, DEFAULT_MAX_DETAILS, Status, TraceReport, check_file,
     check_file_with_engine, find_traces, frames_around, render_json, render_text,
 };
-use sweeptrace::replay::{Detail, ReplayOptions};
 
 /// Frames of context logged before and after the divergences by `--rrd-on-failure`.
 const RRD_CONTEXT_FRAMES: u64 = 10;
@@ -207,7 +207,7 @@ pub fn run(args: Args) -> anyhow::Result<Exit> {
              (--json and --junit report the divergences)",
         ));
     }
-    let overrides = sweeptrace::regress::Overrides {
+    let overrides = sweeptrace::suite::Overrides {
         strict: args.strict,
         allow_tunnels: args.allow_tunnels,
         engine: args.conventions.to_overrides(),
@@ -264,7 +264,7 @@ pub fn run(args: Args) -> anyhow::Result<Exit> {
             Some((command, _)) => format!("the engine `{}`", command.text),
             None => "the traces' /expected".to_string(),
         };
-        let inferred = sweeptrace::regress::infer_conventions(|conventions| {
+        let inferred = sweeptrace::suite::infer_conventions(|conventions| {
             let reports: Vec<TraceReport> = traces
                 .iter()
                 .zip(&settings)
@@ -292,7 +292,7 @@ pub fn run(args: Args) -> anyhow::Result<Exit> {
                     }
                 })
                 .collect();
-            let trial = sweeptrace::regress::Trial::of(&reports);
+            let trial = sweeptrace::suite::Trial::of(&reports);
             eprintln!(
                 "tried {}: {} of {} compared sweeps fail",
                 conventions.summary(),
@@ -374,12 +374,12 @@ fn leave_out(
 ) -> anyhow::Result<Vec<PathBuf>> {
     let (mut traces, mut foxglove, mut excluded) = (Vec::new(), Vec::new(), Vec::new());
     for path in found {
-        if let Some(trace) = sweeptrace::regress::foxglove_output(&path) {
+        if let Some(trace) = sweeptrace::suite::foxglove_output(&path) {
             foxglove.push((path, trace));
             continue;
         }
         if !no_config && !named.contains(&path) {
-            let by = sweeptrace::regress::excluded_by(&path)?;
+            let by = sweeptrace::suite::excluded_by(&path)?;
             if let Some((file, pattern)) = by {
                 excluded.push((path, file, pattern));
                 continue;

@@ -1,12 +1,12 @@
 //! `check`'s settings for each trace: the `sweeptrace.toml` files found
 //! beside and above it, then the command line (the library's
-//! [`sweeptrace::regress::settings_for`] does the resolution). `replay`
+//! [`sweeptrace::suite::settings_for`] does the resolution). `replay`
 //! and `sweep --trace` read the same files for the `[engine]` table, so
 //! that their answers are the ones `check` judges by.
 
 use std::path::{Path, PathBuf};
 
-use sweeptrace::regress::{self, Overrides, Settings};
+use sweeptrace::suite::{self, Overrides, Settings};
 
 /// Each trace's settings, in the order of `traces`; with `no_config`, the
 /// defaults and the command line only; with `config`, that file instead of
@@ -19,21 +19,21 @@ pub fn settings(
     config: Option<&std::path::Path>,
 ) -> anyhow::Result<Vec<Settings>> {
     let file = config
-        .map(|path| regress::ConfigFile::read(path, &path.display().to_string()))
+        .map(|path| suite::ConfigFile::read(path, &path.display().to_string()))
         .transpose()?;
     traces
         .iter()
         .map(|trace| {
             if no_config {
-                Ok(regress::resolve(&[], trace, command_line))
+                Ok(suite::resolve(&[], trace, command_line))
             } else if let Some(file) = &file {
-                Ok(regress::resolve(
+                Ok(suite::resolve(
                     std::slice::from_ref(file),
                     trace,
                     command_line,
                 ))
             } else {
-                Ok(regress::settings_for(trace, command_line)?)
+                Ok(suite::settings_for(trace, command_line)?)
             }
         })
         .collect()
@@ -47,9 +47,9 @@ pub fn render(traces: &[PathBuf], settings: &[Settings], json: bool) -> String {
         .map(|(t, s)| (t.display().to_string(), s.clone()))
         .collect();
     if json {
-        regress::render_settings_json(&named)
+        suite::render_settings_json(&named)
     } else {
-        regress::render_settings_text(&named)
+        suite::render_settings_text(&named)
     }
 }
 

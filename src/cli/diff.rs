@@ -10,8 +10,8 @@ use anyhow::bail;
 use super::Exit;
 use sweeptrace::core::Facing;
 use sweeptrace::numbers::{self, Rule};
-use sweeptrace::regress::{Side, diff, render_diff_json, render_diff_text};
 use sweeptrace::replay::{FrameRange, ReplayOptions, Selection};
+use sweeptrace::suite::{Side, diff, render_diff_json, render_diff_text};
 use sweeptrace::trace::TraceReader;
 
 /// Arguments of `diff`.

@@ -1,7 +1,7 @@
 //! How a command ended, as one value; [`Exit::exit_code`] is the
 //! one place that turns it into the process's exit code (the README's
 //! table lists the same codes). The library's reports give their own
-//! status (`regress::Status`, `conform::ConformStatus`); the commands map
+//! status (`suite::Status`, `conform::ConformStatus`); the commands map
 //! it to an `Exit`.
 
 use serde::Serialize;

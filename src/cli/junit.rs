@@ -2,7 +2,7 @@
 //! GitHub Actions annotations: the file is created (under a temporary
 //! name) before the run, so an unwritable place fails at once, and renamed
 //! into place when the report is complete; rendering is the library's
-//! ([`sweeptrace::regress::check_junit`], [`sweeptrace::conform::conform_junit`]).
+//! ([`sweeptrace::suite::check_junit`], [`sweeptrace::conform::conform_junit`]).
 
 use std::io::Write as _;
 use std::path::PathBuf;
@@ -12,7 +12,7 @@ use anyhow::Context;
 
 use sweeptrace::atomic::{FinishStep, PendingFile};
 use sweeptrace::junit::{Detail, JunitOptions};
-use sweeptrace::regress::TraceReport;
+use sweeptrace::suite::TraceReport;
 
 /// The environment variable GitHub Actions sets to `true` in its jobs.
 const GITHUB_ACTIONS: &str = "GITHUB_ACTIONS";
@@ -137,7 +137,7 @@ pub fn finish_check(
     let Some(junit) = junit else {
         return Ok(());
     };
-    let xml = sweeptrace::regress::check_junit(reports, times, junit.options());
+    let xml = sweeptrace::suite::check_junit(reports, times, junit.options());
     junit.finish(&xml)
 }
 
@@ -145,6 +145,6 @@ pub fn finish_check(
 /// annotations on stdout, where the runner reads workflow commands.
 pub fn print_github_annotations(report: &TraceReport) {
     if std::env::var_os(GITHUB_ACTIONS).is_some_and(|v| v == "true") {
-        print!("{}", sweeptrace::regress::github_annotations(report));
+        print!("{}", sweeptrace::suite::github_annotations(report));
     }
 }

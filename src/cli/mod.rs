@@ -118,25 +118,23 @@ pub struct ToleranceArgs {
     /// is better described by `--normal contact` (an engine convention),
     /// which keeps the normal compared.
     #[arg(long, value_name = "FIELD,...", value_delimiter = ',', value_parser = field_parser())]
-    pub fields: Vec<sweeptrace::regress::Field>,
+    pub fields: Vec<sweeptrace::judge::Field>,
 }
 
 impl ToleranceArgs {
     /// The library's tolerances (the defaults where not given), validated.
-    pub fn to_tolerances(&self) -> anyhow::Result<sweeptrace::regress::Tolerances> {
-        use sweeptrace::regress::{
+    pub fn to_tolerances(&self) -> anyhow::Result<sweeptrace::judge::Tolerances> {
+        use sweeptrace::judge::{
             DEFAULT_ALPHA_TOLERANCE, DEFAULT_CONTACT_TOLERANCE, DEFAULT_NORMAL_TOLERANCE_DEGREES,
         };
-        let tolerances = sweeptrace::regress::Tolerances {
+        let tolerances = sweeptrace::judge::Tolerances {
             alpha: self.tolerance.unwrap_or(DEFAULT_ALPHA_TOLERANCE),
             normal_degrees: self
                 .normal_tolerance
                 .unwrap_or(DEFAULT_NORMAL_TOLERANCE_DEGREES),
             contact: self.contact_tolerance.unwrap_or(DEFAULT_CONTACT_TOLERANCE),
-            fields: self
-                .field_set()
-                .unwrap_or(sweeptrace::regress::FieldSet::ALL),
-            ..sweeptrace::regress::Tolerances::default()
+            fields: self.field_set().unwrap_or(sweeptrace::judge::FieldSet::ALL),
+            ..sweeptrace::judge::Tolerances::default()
         };
         tolerances.validate().map_err(anyhow::Error::msg)?;
         Ok(tolerances)
@@ -144,9 +142,9 @@ impl ToleranceArgs {
 
     /// The values given, as the command line's layer of `check`'s settings
     /// (validated).
-    pub fn to_overrides(&self) -> anyhow::Result<sweeptrace::regress::Overrides> {
+    pub fn to_overrides(&self) -> anyhow::Result<sweeptrace::suite::Overrides> {
         self.to_tolerances()?;
-        Ok(sweeptrace::regress::Overrides {
+        Ok(sweeptrace::suite::Overrides {
             alpha: self.tolerance,
             normal_degrees: self.normal_tolerance,
             contact: self.contact_tolerance,
@@ -155,8 +153,8 @@ impl ToleranceArgs {
         })
     }
 
-    fn field_set(&self) -> Option<sweeptrace::regress::FieldSet> {
-        (!self.fields.is_empty()).then(|| sweeptrace::regress::FieldSet::of(&self.fields))
+    fn field_set(&self) -> Option<sweeptrace::judge::FieldSet> {
+        (!self.fields.is_empty()).then(|| sweeptrace::judge::FieldSet::of(&self.fields))
     }
 }
 
@@ -171,7 +169,7 @@ pub struct ConventionArgs {
     /// give it for inputs moved by at most 16 u32 units of the sweep's
     /// scale) [default: f64].
     #[arg(long, value_name = "f64|f32", help_heading = "Engine conventions")]
-    pub precision: Option<sweeptrace::regress::Precision>,
+    pub precision: Option<sweeptrace::judge::Precision>,
     /// The engine's margin: `scene` (each scene's) or a number it always
     /// uses [default: scene].
     #[arg(
@@ -180,7 +178,7 @@ pub struct ConventionArgs {
         value_name = "scene|NUMBER",
         help_heading = "Engine conventions"
     )]
-    pub margin: Option<sweeptrace::regress::MarginRule>,
+    pub margin: Option<sweeptrace::judge::MarginRule>,
     /// The engine's facing rule: `scene`, `strict` or `non_strict`
     /// [default: scene].
     #[arg(
@@ -189,7 +187,7 @@ pub struct ConventionArgs {
         value_name = "RULE",
         help_heading = "Engine conventions"
     )]
-    pub facing: Option<sweeptrace::regress::FacingRule>,
+    pub facing: Option<sweeptrace::judge::FacingRule>,
     /// Which sides of a triangle collide: `one` (the rules: a contact
     /// from behind, `n · d > 0`, is no collision) or `two` (a hit from
     /// behind too, reported with the normal `-n`) [default: one].
@@ -209,13 +207,13 @@ pub struct ConventionArgs {
     /// A tie: `rule` (the decision's α and normal) or `any` (any member
     /// with its own contact and normal) [default: rule].
     #[arg(long, value_name = "rule|any", help_heading = "Engine conventions")]
-    pub ties: Option<sweeptrace::regress::TieRule>,
+    pub ties: Option<sweeptrace::judge::TieRule>,
 }
 
 impl ConventionArgs {
     /// The conventions given, as the command line's layer.
-    pub fn to_overrides(&self) -> sweeptrace::regress::EngineOverrides {
-        sweeptrace::regress::EngineOverrides {
+    pub fn to_overrides(&self) -> sweeptrace::suite::EngineOverrides {
+        sweeptrace::suite::EngineOverrides {
             precision: self.precision,
             margin: self.margin,
             facing: self.facing,
@@ -229,14 +227,14 @@ impl ConventionArgs {
 
 /// The parser of `--fields`: a name that is not a field is an error listing
 /// the valid ones (and the nearest, on a typo).
-fn field_parser() -> impl clap::builder::TypedValueParser<Value = sweeptrace::regress::Field> {
+fn field_parser() -> impl clap::builder::TypedValueParser<Value = sweeptrace::judge::Field> {
     use clap::builder::TypedValueParser;
     use strum::IntoEnumIterator;
-    let names: Vec<&'static str> = sweeptrace::regress::Field::iter()
+    let names: Vec<&'static str> = sweeptrace::judge::Field::iter()
         .map(<&'static str>::from)
         .collect();
     clap::builder::PossibleValuesParser::new(names).try_map(|name: String| {
-        name.parse::<sweeptrace::regress::Field>()
+        name.parse::<sweeptrace::judge::Field>()
             .map_err(|_| format!("`{name}` is not a field"))
     })
 }

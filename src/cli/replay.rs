@@ -20,8 +20,8 @@ use super::viewer::{RrdFileOptions, Viewer};
 use sweeptrace::atomic::{self, PendingFile};
 use sweeptrace::core::Facing;
 use sweeptrace::foxglove::{FoxgloveFile, FoxgloveOptions};
+use sweeptrace::judge::Tolerances;
 use sweeptrace::numbers::{self, Rule, plural};
-use sweeptrace::regress::Tolerances;
 use sweeptrace::replay::{
     Detail, FrameRange, PipelineOptions, ReplayError, ReplayEvent, ReplayOptions, Selection,
     replay_events_parallel, run_pipeline,
@@ -350,7 +350,7 @@ pub fn run(args: Args) -> anyhow::Result<Exit> {
 /// (the error of a trace that ends early, or `null`).
 fn summary_json(
     args: &Args,
-    conventions: &sweeptrace::regress::EngineConventions,
+    conventions: &sweeptrace::judge::EngineConventions,
     summary: &sweeptrace::replay::ReplaySummary,
     selection: Option<String>,
     wrote: &[String],

@@ -8,7 +8,7 @@ use sweeptrace::core::{
     Crossing, EdgeClass, Feature, Options, Outcome, Sweep, TestRecord, Topology, Verdict,
 };
 use sweeptrace::core::{describe, miss_distance, num};
-use sweeptrace::regress::SweepInputs;
+use sweeptrace::judge::SweepInputs;
 use sweeptrace::replay::{GhostContact, Through, Tunnel, TunnelAt, feature_class};
 use sweeptrace::trace::OutcomeMsg;
 

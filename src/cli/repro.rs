@@ -1,11 +1,11 @@
 //! `sweeptrace repro`: one sweep of a trace as a minimal trace and a
-//! ready-to-paste Rust test (the library's [`sweeptrace::regress::ReproCase`]).
+//! ready-to-paste Rust test (the library's [`sweeptrace::suite::ReproCase`]).
 
 use super::NameFileOnce;
 use std::path::PathBuf;
 
 use super::Exit;
-use sweeptrace::regress::{ReproCase, find_sweep};
+use sweeptrace::suite::{ReproCase, find_sweep};
 use sweeptrace::trace::{TraceReader, write_trace_file};
 
 /// Arguments of `repro`.

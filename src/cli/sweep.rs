@@ -10,13 +10,13 @@ use super::report;
 use sweeptrace::core::{
     Broadphase, CollectRecords, Facing, Options, Sweep, all_crossings, sweep_mesh_with,
 };
-use sweeptrace::regress::find_sweep;
 use sweeptrace::replay::{
     FrameRange, ReplayEvent, ReplayOptions, SweepResult, TunnelScene, defects_within_reach,
     replay_events, sweep_end, tunnel_during_sweep,
 };
 use sweeptrace::sim::load_obj;
 use sweeptrace::sim::scenes::BuiltinScene;
+use sweeptrace::suite::find_sweep;
 use sweeptrace::trace::{OutcomeMsg, TraceReader};
 
 /// Arguments of `sweep`.
@@ -97,7 +97,7 @@ pub fn run(args: Args) -> anyhow::Result<Exit> {
     let mut expected: Option<OutcomeMsg> = None;
     let mut replayed: Option<SweepResult> = None;
     let topology: Option<sweeptrace::Topology>;
-    let settings: sweeptrace::regress::Settings;
+    let settings: sweeptrace::suite::Settings;
     let (name, mesh, sweep, options) = if let Some(path) = &args.trace {
         let frame = args.frame.context("--trace needs --frame")?;
         let shown = path.display().to_string();
@@ -235,7 +235,7 @@ pub fn run(args: Args) -> anyhow::Result<Exit> {
 /// The replay's options of this command: its margin and facing overrides
 /// under the engine's declared conventions (which decide the margin and
 /// facing where the flags do not, and the sides and initial overlap).
-fn replay_options(args: &Args, settings: &sweeptrace::regress::Settings) -> ReplayOptions {
+fn replay_options(args: &Args, settings: &sweeptrace::suite::Settings) -> ReplayOptions {
     settings.engine.conventions().replay_with(ReplayOptions {
         margin: args.margin,
         facing: args.facing,
@@ -254,7 +254,7 @@ fn replay_to(
     shown: &str,
     (frame, ball): (u64, u32),
     args: &Args,
-    conventions: &sweeptrace::regress::EngineConventions,
+    conventions: &sweeptrace::judge::EngineConventions,
 ) -> anyhow::Result<Option<SweepResult>> {
     let file = super::open_trace(path)?;
     let reader = TraceReader::new_indexed(std::io::BufReader::new(file), shown);

@@ -72,7 +72,7 @@ pub fn open_replay_recording(
     trace: &Path,
     target: RecordingTarget,
     options: &ReplayOptions,
-    tolerances: sweeptrace::regress::Tolerances,
+    tolerances: sweeptrace::judge::Tolerances,
     blueprint: bool,
     follow_ball: u32,
 ) -> anyhow::Result<Recording> {
@@ -109,7 +109,7 @@ pub fn open_replay_recording(
     _trace: &Path,
     target: RecordingTarget,
     _options: &ReplayOptions,
-    _tolerances: sweeptrace::regress::Tolerances,
+    _tolerances: sweeptrace::judge::Tolerances,
     _blueprint: bool,
     _follow_ball: u32,
 ) -> anyhow::Result<Recording> {

@@ -13,8 +13,9 @@
 
 use std::time::Duration;
 
+use crate::judge::Tolerances;
 use crate::junit::{Case, CaseResult, Detail, JunitOptions, Problem, Report, Suite, one_line};
-use crate::regress::{Sides, Tolerances, divergence_line};
+use crate::suite::{Sides, divergence_line};
 
 use super::{CaseFailure, ConformReport, RuleReport, render_case_failure, render_rule_failure};
 

@@ -1,7 +1,7 @@
 //! The conformance suite: a built-in, generated set of cases that covers
 //! every verdict of every test of docs/SEMANTICS.md ([`cases()`]), run
 //! through a running engine ([`crate::engine`]) and judged against the
-//! core by check's comparison ([`crate::regress::agreement`]: ties are
+//! core by check's comparison ([`crate::judge::agreement`]: ties are
 //! matches; a divergence on a fragile decision is counted as such).
 //!
 //! [`run`] returns a [`ConformReport`], one [`RuleReport`] per rule with
@@ -23,11 +23,9 @@ use serde::Serialize;
 use crate::core::explain::num;
 use crate::core::{Kind, Outcome};
 use crate::engine::{EngineAnswers, EngineCommand, EngineError, EngineOptions, EngineSession};
-use crate::regress::{
-    Agreement, Divergence, EngineConventions, Sides, TieRule, Tolerances, agreement, compare,
-    divergence_details, render_divergence_as,
-};
+use crate::judge::{Agreement, EngineConventions, TieRule, Tolerances, agreement, compare};
 use crate::replay::{ReplayEvent, ReplayOptions, replay_events};
+use crate::suite::{Divergence, Sides, divergence_details, render_divergence_as};
 use crate::trace::{EventBody, EventHeader, OutcomeMsg, TraceEvent};
 
 /// The first failing case of a rule, explained.

@@ -14,14 +14,15 @@ use super::messages::{
 };
 use crate::core::explain::label;
 use crate::core::{DefectKind, EdgeClass, SweepHit, TestRecord};
+use crate::judge::{FieldDiff, write_decision_line};
 use crate::palette::{
     BOUNDARY_EDGE_COLOR, CONCAVE_EDGE_COLOR, CONTACT_BALL_COLOR, CONVEX_EDGE_COLOR, DEFECT_COLOR,
     EXPECTED_COLOR, FACE_NORMAL_COLOR, FLAT_EDGE_COLOR, GHOST_COLOR, HIT_COLOR,
     MAX_DRAWN_DEFECT_LABELS, MESH_COLOR, NON_MANIFOLD_EDGE_COLOR, NORMAL_COLOR, P0_COLOR, P1_COLOR,
     SWEEP_COLOR,
 };
-use crate::regress::{FieldDiff, divergence_details, render_divergence, write_decision_line};
 use crate::replay::{SceneState, SweepResult, ghost_point};
+use crate::suite::{divergence_details, render_divergence};
 use strum::IntoEnumIterator as _;
 
 /// The id of the mesh entity on [`super::MESH_TOPIC`]: one id for every
@@ -545,7 +546,7 @@ pub fn ghost_update(r: &SweepResult) -> SceneUpdate {
 
 /// The decision of a sweep as a Log line, on [`super::DECISIONS_TOPIC`]:
 /// the viewer's decision line; for a sweep that `check` counts as a
-/// divergence (`diffs`, from [`crate::regress::divergence`]) also
+/// divergence (`diffs`, from [`crate::judge::divergence`]) also
 /// `check`'s report of it ([`render_divergence`]). Level WARNING when
 /// `check` fails the sweep (a divergence or a tunnel), INFO otherwise.
 /// `name` is `ball N`, `file` the trace's file name.

@@ -24,7 +24,7 @@
 //! - `messages`: the messages as serde types;
 //! - `convert`: pure functions from a scene or a sweep's result to each
 //!   channel's message (the decision text is
-//!   [`crate::regress::decision_line`]'s and `check`'s, shared with the viewer);
+//!   [`crate::judge::decision_line`]'s and `check`'s, shared with the viewer);
 //! - `writer`: [`FoxgloveWriter`] over any `Write + Seek`, and
 //!   [`FoxgloveFile`], written under a temporary name and renamed.
 

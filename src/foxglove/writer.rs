@@ -27,7 +27,7 @@ use super::{
     METADATA_NAME, NUMBERS_TOPIC, SWEEPS_TOPIC,
 };
 use crate::atomic::PendingFile;
-use crate::regress::{Tolerances, divergence};
+use crate::judge::{Tolerances, divergence};
 use crate::replay::{ReplayEvent, SceneState, SweepResult};
 use crate::trace::library_string;
 

@@ -28,8 +28,8 @@ use super::rows::{
 use super::spill::Spill;
 use super::{RecordError, TIMESTAMP_THRESHOLD_NANOS};
 use crate::core::{DefectKind, EdgeClass, EdgeRecord, Triangle};
+use crate::judge::divergence;
 use crate::palette::MAX_DRAWN_DEFECT_LABELS;
-use crate::regress::divergence;
 use crate::replay::{ReplayEvent, SceneState, SweepResult};
 
 /// Rows buffered before the logger sends them (see [`Logger`]); with

@@ -18,7 +18,7 @@
 //!   expected outcome, plots, status, text); `edge_frame`: its edge tests in
 //!   their standard frames;
 //! - the decision line, and whether a sweep diverges, are
-//!   [`crate::regress::decision_line`] (shared with the Foxglove output);
+//!   [`crate::judge::decision_line`] (shared with the Foxglove output);
 //! - `convert`: conversions to Rerun types, colors and sizes;
 //! - `blueprint`: the default layouts, with fixed ids; `columns`: rows
 //!   buffered as typed columns and sent as chunks (both use SDK internals

@@ -9,7 +9,7 @@ use rerun::components::ClearIsRecursive;
 use super::MAX_EDGE_FRAMES;
 use super::columns::{self, Row};
 use super::paths::Entity;
-use crate::regress::Tolerances;
+use crate::judge::Tolerances;
 
 /// What the rows of a sweep depend on besides the sweep: the same for every
 /// sweep of a recording ([`Logger::prepare_options`]).

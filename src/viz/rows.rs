@@ -25,7 +25,7 @@ use super::out::{Out, PrepareOptions, Shown, set};
 use super::paths::{Entity, FACE_NAMES, QUADRATIC_NAMES};
 use crate::core::explain::Label;
 use crate::core::{EdgeRecord, Kind, TestRecord};
-use crate::regress::{FieldDiff, divergence, write_decision_line, write_divergence_line};
+use crate::judge::{FieldDiff, divergence, write_decision_line, write_divergence_line};
 use crate::replay::{GhostContact, SweepResult, ghost_point};
 use crate::trace::OutcomeMsg;
 

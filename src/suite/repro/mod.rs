@@ -10,9 +10,7 @@
 
 mod case;
 mod find;
-mod inputs;
 mod rust_test;
 
 pub use case::ReproCase;
 pub use find::{ReproError, TraceSweep, find_sweep};
-pub use inputs::{HexInputs, SweepInputs};

@@ -2,8 +2,8 @@
 
 use std::fmt::Write as _;
 
-use crate::regress::compare::Tolerances;
-use crate::regress::judge::Agreement;
+use crate::judge::Agreement;
+use crate::judge::Tolerances;
 
 use crate::core::{Facing, Kind};
 use crate::trace::OutcomeMsg;

@@ -6,10 +6,10 @@ use std::path::{Path, PathBuf};
 use serde::Deserialize;
 use toml::Spanned;
 
-use super::super::compare::{Field, FieldSet};
-use super::super::conventions::MarginRule;
 use super::normalize;
 use super::settings::{Layer, Setting, Settings, Source};
+use crate::judge::MarginRule;
+use crate::judge::{Field, FieldSet};
 use crate::numbers::{self, Rule};
 
 /// Why a configuration file cannot be used. The message names the file,

@@ -1,5 +1,5 @@
 //! The decision line: one sentence per sweep, and whether the sweep
-//! diverges from the trace's expectation (by [`crate::regress::agreement`],
+//! diverges from the trace's expectation (by [`crate::judge::agreement`],
 //! the judgement `check` uses: ties are matches, and a divergence on a
 //! fragile decision is not a failure, as in `check` without `--strict`).
 
@@ -7,7 +7,7 @@ use std::fmt::{self, Write as _};
 
 use crate::core::TestRecord;
 use crate::core::explain::{Num, write_describe};
-use crate::regress::{Agreement, FieldDiff, Tolerances, agreement};
+use crate::judge::{Agreement, FieldDiff, Tolerances, agreement};
 use crate::replay::SweepResult;
 
 /// The fields in which the sweep's outcome differs from the trace's expected

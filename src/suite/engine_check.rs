@@ -13,9 +13,9 @@ use crate::replay::SweepResult;
 use crate::trace::{EXPECTED_TOPIC, OutcomeMsg, TraceReader};
 
 use super::check::{CheckOptions, check_file, check_stream, judge_against_core};
-use super::compare::Tolerances;
-use super::judge::agreement_of;
 use super::report::{Against, EngineCheck, Judged, TraceReport};
+use crate::judge::Tolerances;
+use crate::judge::agreement_of;
 
 /// Checks the trace at `path` against a running engine: the engine answers
 /// every sweep ([`EngineAnswers`]) and the answers are judged by an

@@ -8,11 +8,11 @@ use crate::core::explain::num;
 use crate::core::{Mesh, Options, Outcome, Sweep, SweptPath, sweep_ties};
 use crate::trace::{OutcomeMsg, SceneMsg, SweepMsg, TraceError, TraceWriter};
 
-use crate::regress::compare::{Field, FieldSet, Tolerances};
-use crate::regress::judge::{Agreement, agreement};
+use crate::judge::{Agreement, agreement};
+use crate::judge::{Field, FieldSet, Tolerances};
 
 use super::find::{ReproError, TraceSweep};
-use super::inputs::SweepInputs;
+use crate::judge::SweepInputs;
 
 /// A minimal case reproducing one sweep of a trace.
 #[derive(Clone, Debug)]

@@ -29,8 +29,8 @@ use crate::core::{Facing, Kind, Options, Sweep, sweep_mesh};
 use crate::replay::{SceneState, SweepResult};
 use crate::trace::OutcomeMsg;
 
-use super::compare::Tolerances;
-use super::judge::{Agreement, agreement};
+use crate::judge::Tolerances;
+use crate::judge::{Agreement, agreement};
 
 /// How many compared sweeps (the first ones) the inference of the
 /// recording engine's configuration looks at and replays, so that a

@@ -19,10 +19,10 @@ use std::fmt::Write as _;
 use crate::core::{InitialOverlap, Sides};
 use crate::replay::NormalRule;
 
-use super::compare::TieRule;
-use super::conventions::{EngineConventions, FacingRule, MarginRule};
-use super::precision::Precision;
 use super::report::TraceReport;
+use crate::judge::Precision;
+use crate::judge::TieRule;
+use crate::judge::{EngineConventions, FacingRule, MarginRule};
 
 /// What a check of every trace under some conventions came to.
 #[derive(Clone, Debug, Default, PartialEq)]

@@ -2,7 +2,7 @@
 //! twice with different options (`diff T T --facing-b strict`).
 //!
 //! Sweeps are matched by `(frame, ball)`; every field of the two outcomes is
-//! compared with [`crate::regress::compare()`] and the same [`Tolerances`]. The
+//! compared with [`crate::judge::compare()`] and the same [`Tolerances`]. The
 //! [`DiffReport`] counts the sweeps that are the same, differ, or exist on one
 //! side only, summarises the changes by kind (`edge -> none: 12`) and
 //! explains the first divergence on both sides (the tests that decided, from
@@ -15,11 +15,11 @@ use serde::Serialize;
 use serde_json::json;
 
 use crate::core::explain::num;
-use crate::numbers::plural;
-use crate::regress::{
+use crate::judge::{
     Agreement, ExpectedTest, FieldDiff, Tolerances, agreement, compare, expected_tests,
     explain_outcome, explained_records,
 };
+use crate::numbers::plural;
 use crate::replay::{
     ReplayError, ReplayEvent, ReplayOptions, ReplaySummary, SceneState, SweepResult, replay_events,
 };
@@ -402,7 +402,7 @@ pub fn render_diff_text(r: &DiffReport) -> String {
     if let Some(f) = &r.first {
         let _ = writeln!(s, "first divergence: frame {}, ball {}", f.frame, f.ball);
         for d in &f.fields {
-            let (a, b) = crate::regress::values_text(&d.expected, &d.got);
+            let (a, b) = super::values_text(&d.expected, &d.got);
             let _ = write!(s, "  {}: A {a}, B {b}", d.field);
             if let Some(detail) = &d.detail {
                 let _ = write!(s, " ({detail})");

@@ -18,17 +18,17 @@ use crate::core::Feature;
 use crate::replay::{ReplayError, ReplayEvent, ReplayOptions, ReplaySummary, SweepResult};
 use crate::trace::{EXPECTED_TOPIC, EventBody, OutcomeMsg, TraceError, TraceEvent, TraceReader};
 
-use super::compare::{FieldDiff, Tolerances};
-use super::conventions::EngineConventions;
-use super::explain::{expected_tests, explain_outcome, explained_records};
 use super::ghost_count::count_ghosts;
 use super::infer::{ComparedSweep, MAX_INFERENCE_SWEEPS, infer};
-use super::judge::{Agreement, agreement};
 use super::report::{
     Divergence, Judged, KindChange, MAX_DIVERGENT_FRAMES, MAX_ERRORS, MAX_LISTED_TUNNELS,
     TraceReport, TunnelReport, WithinPrecision,
 };
-use super::repro::SweepInputs;
+use crate::judge::EngineConventions;
+use crate::judge::SweepInputs;
+use crate::judge::{Agreement, agreement};
+use crate::judge::{FieldDiff, Tolerances};
+use crate::judge::{expected_tests, explain_outcome, explained_records};
 
 /// Default number of divergences described in detail per trace.
 pub const DEFAULT_MAX_DETAILS: usize = 3;

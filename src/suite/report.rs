@@ -12,13 +12,13 @@ use crate::core::{Facing, FragileReason, Kind};
 use crate::replay::{GhostContact, Tunnel, TunnelAt, TunnelKind};
 use crate::trace::OutcomeMsg;
 
-use super::compare::{FieldDiff, Tolerances};
-use super::conventions::EngineConventions;
-use super::explain::ExpectedTest;
-use super::hints::ConventionHints;
 use super::infer::Inferred;
-use super::judge::Agreement;
-use super::repro::{HexInputs, SweepInputs};
+use crate::judge::Agreement;
+use crate::judge::ConventionHints;
+use crate::judge::EngineConventions;
+use crate::judge::ExpectedTest;
+use crate::judge::{FieldDiff, Tolerances};
+use crate::judge::{HexInputs, SweepInputs};
 
 /// How many tunnels a report lists, one line each.
 pub const MAX_LISTED_TUNNELS: usize = 10;
@@ -73,7 +73,7 @@ pub struct Divergence {
     /// side's answer (absent otherwise: a fragile decision does not excuse
     /// an answer no rounding gives).
     #[serde(skip_serializing_if = "Option::is_none")]
-    pub reproduced: Option<super::judge::Reproduced>,
+    pub reproduced: Option<crate::judge::Reproduced>,
     /// Whether the expectation names another member of the core's tie set
     /// (a failure only where the tie order must be followed exactly:
     /// `conform`). Only in the JSON when true.

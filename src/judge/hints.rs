@@ -13,9 +13,9 @@ use crate::core::{Kind, Options, SweptPath, initial_contacts};
 use crate::replay::{NormalRule, SweepResult};
 use crate::trace::OutcomeMsg;
 
+use super::agreement::{agreement, agreement_of};
 use super::compare::{Field, FieldDiff, Tolerances, angle_degrees};
 use super::conventions::EngineConventions;
-use super::judge::{agreement, agreement_of};
 use super::precision::Precision;
 
 /// Failing sweeps a convention would explain, by convention. A sweep is

@@ -2,8 +2,8 @@
 
 use super::settings::number_text;
 use super::*;
-use crate::regress::check::CheckOptions;
-use crate::regress::compare::{DEFAULT_NORMAL_TOLERANCE_DEGREES, Field, FieldSet, Tolerances};
+use crate::judge::{DEFAULT_NORMAL_TOLERANCE_DEGREES, Field, FieldSet, Tolerances};
+use crate::suite::CheckOptions;
 
 fn parse(text: &str, path: &str) -> ConfigFile {
     match ConfigFile::parse(text, Path::new(path)) {
@@ -344,7 +344,7 @@ fn engine_sides_are_read_with_their_line_and_the_command_line_wins() {
 #[test]
 fn engine_sides_round_trip_through_the_table_inference_writes() {
     use crate::core::Sides;
-    use crate::regress::conventions::EngineConventions;
+    use crate::judge::EngineConventions;
     let declared = EngineConventions {
         sides: Sides::Two,
         ..EngineConventions::default()

@@ -6,14 +6,14 @@ use std::fmt;
 use serde::Serialize;
 
 use super::super::check::CheckOptions;
-use super::super::compare::TieRule;
-use super::super::compare::{
+use crate::core::{InitialOverlap, Sides};
+use crate::judge::Precision;
+use crate::judge::TieRule;
+use crate::judge::{
     DEFAULT_ALPHA_TOLERANCE, DEFAULT_CONTACT_TOLERANCE, DEFAULT_NORMAL_TOLERANCE_DEGREES, FieldSet,
     Tolerances,
 };
-use super::super::conventions::{EngineConventions, FacingRule, MarginRule};
-use super::super::precision::Precision;
-use crate::core::{InitialOverlap, Sides};
+use crate::judge::{EngineConventions, FacingRule, MarginRule};
 use crate::replay::NormalRule;
 
 /// Where a resolved setting came from.

@@ -1,0 +1,50 @@
+//! The judge: one engine's answer for one sweep against the core's.
+//!
+//! - comparison: an outcome against its expectation, field by field
+//!   ([`compare()`], [`Tolerances`]);
+//! - judgement: the one judgement of a sweep's answer against its
+//!   expectation ([`agreement`], [`agreement_of`]): match, tie, or
+//!   divergence, excused only when a named perturbation within the
+//!   rounding budget reproduces it; shared by `check`, `check --engine`,
+//!   `diff`, `conform` and the viewer;
+//! - the single-precision sensitivity of an answer ([`Sensitivity`]);
+//! - the conventions an engine declares ([`EngineConventions`]);
+//! - the decision line of a sweep in words, and whether it diverges
+//!   ([`decision_line`], [`divergence`]; used by the viewer and the
+//!   Foxglove output);
+//! - why a divergent sweep came out as it did ([`explain_outcome`]), the
+//!   known mistakes it matches ([`known_mistake`]) and the conventions its
+//!   failures hint at ([`ConventionHints`]);
+//! - one sweep's inputs, bit-exactly ([`SweepInputs`]).
+//!
+//! The judge depends on the core, the trace messages and the replay only;
+//! running a folder of traces is the suite's job ([`crate::suite`]).
+//!
+//! The submodules are private: every public item is named once, here.
+
+mod agreement;
+mod compare;
+mod conventions;
+mod decision;
+mod explain;
+mod hints;
+mod inputs;
+mod mistakes;
+mod precision;
+
+pub use agreement::{Agreement, Perturbation, Reproduced, agreement, agreement_of};
+pub use compare::{
+    DEFAULT_ALPHA_TOLERANCE, DEFAULT_CONTACT_TOLERANCE, DEFAULT_NORMAL_TOLERANCE_DEGREES, Field,
+    FieldDiff, FieldSet, TieRule, Tolerances, angle_degrees, compare,
+};
+pub use conventions::{EngineConventions, FacingRule, MarginRule};
+pub(crate) use decision::write_decision_line;
+#[cfg(feature = "viewer")]
+pub(crate) use decision::write_divergence_line;
+pub use decision::{decision_line, divergence};
+pub use explain::ExpectedTest;
+pub(crate) use explain::{expected_tests, explain_outcome, explained_records};
+pub use hints::ConventionHints;
+pub use inputs::{HexInputs, SweepInputs};
+pub use mistakes::{KNOWN_MISTAKES, Mistake, known_mistake};
+pub use precision::{F32_OPERATIONS, F32_UNIT, Precision, Sensitivity};

@@ -16,7 +16,7 @@ use sweeptrace::engine::EngineCommand;
 use sweeptrace::numbers::counted;
 use sweeptrace::suite::{
     Against, BlessEngine, BlessError, BlessOptions, BlessSelection, CheckOptions, Divergence,
-    Sides, bless_file_with, check_file, check_file_with_engine, render_divergence_as,
+    Parties, bless_file_with, check_file, check_file_with_engine, render_divergence_as,
 };
 
 /// Arguments of `bless`.
@@ -313,7 +313,7 @@ fn review(
     options: &CheckOptions,
 ) -> anyhow::Result<Option<BTreeSet<(u64, u32)>>> {
     let (report, sides) = match engine {
-        None => (check_file(&args.trace, options), Sides::ExpectedAndCore),
+        None => (check_file(&args.trace, options), Parties::ExpectedAndCore),
         Some(e) => (
             check_file_with_engine(
                 &args.trace,
@@ -323,7 +323,7 @@ fn review(
                 options,
             )
             .map_err(anyhow::Error::new)?,
-            Sides::ExpectedAndEngine,
+            Parties::ExpectedAndEngine,
         ),
     };
     if let Some(error) = report.errors.first() {

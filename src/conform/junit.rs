@@ -15,7 +15,7 @@ use std::time::Duration;
 
 use crate::judge::Tolerances;
 use crate::junit::{Case, CaseResult, Detail, JunitOptions, Problem, Report, Suite, one_line};
-use crate::suite::{Sides, divergence_line};
+use crate::suite::{Parties, divergence_line};
 
 use super::{CaseFailure, ConformReport, RuleReport, render_case_failure, render_rule_failure};
 
@@ -30,7 +30,7 @@ pub fn rule_group(rule: &str) -> &str {
 fn case_line(f: &CaseFailure) -> String {
     let what = match &f.tie_order {
         Some(t) => format!("tie order: {t}"),
-        None => divergence_line(&f.divergence, Sides::EngineAndCore),
+        None => divergence_line(&f.divergence, Parties::EngineAndCore),
     };
     one_line(&format!("{} ({}): {what}", f.case, f.what))
 }

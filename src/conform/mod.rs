@@ -25,7 +25,7 @@ use crate::core::{Kind, Outcome};
 use crate::engine::{EngineAnswers, EngineCommand, EngineError, EngineOptions, EngineSession};
 use crate::judge::{Agreement, EngineConventions, TieRule, Tolerances, agreement, compare};
 use crate::replay::{ReplayEvent, ReplayOptions, replay_events};
-use crate::suite::{Divergence, Sides, divergence_details, render_divergence_as};
+use crate::suite::{Divergence, Parties, divergence_details, render_divergence_as};
 use crate::trace::{EventBody, EventHeader, OutcomeMsg, TraceEvent};
 
 /// The first failing case of a rule, explained.
@@ -603,7 +603,7 @@ pub fn render_case_failure(f: &CaseFailure, indent: &str) -> String {
     s.push_str(&render_divergence_as(
         &f.divergence,
         indent,
-        Sides::EngineAndCore,
+        Parties::EngineAndCore,
     ));
     let _ = writeln!(s, "{indent}reproduce: {}", f.repro);
     s

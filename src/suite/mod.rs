@@ -53,7 +53,7 @@ pub use engine_check::check_file_with_engine;
 pub use infer::{Inferred, Spread};
 pub use infer_conventions::{Evidence, InferredConventions, Trial, infer_conventions};
 pub use junit::{check_junit, github_annotations};
-pub use render::{Sides, render_divergence, render_divergence_as, render_json, render_text};
+pub use render::{Parties, render_divergence, render_divergence_as, render_json, render_text};
 pub(crate) use render::{divergence_line, values_text};
 pub use report::{
     Against, Divergence, Divergences, EngineCheck, Expectations, Fragile, Ghosts, KindChange,

@@ -51,7 +51,7 @@ pub fn values_text(expected: &Value, got: &Value) -> (String, String) {
 
 /// Who the two sides of a divergence are, in words.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Sides {
+pub enum Parties {
     /// A trace's `/expected` against the core: "expected", "got".
     ExpectedAndCore,
     /// A running engine's answer against the core (`check --engine`,
@@ -62,47 +62,47 @@ pub enum Sides {
     ExpectedAndEngine,
 }
 
-impl Sides {
+impl Parties {
     fn expected(self) -> &'static str {
         match self {
-            Sides::ExpectedAndCore | Sides::ExpectedAndEngine => "expected",
-            Sides::EngineAndCore => "engine",
+            Parties::ExpectedAndCore | Parties::ExpectedAndEngine => "expected",
+            Parties::EngineAndCore => "engine",
         }
     }
 
     /// The expectation's answer, as a phrase.
     fn answer(self) -> &'static str {
         match self {
-            Sides::ExpectedAndCore | Sides::ExpectedAndEngine => "the expected answer",
-            Sides::EngineAndCore => "the engine's answer",
+            Parties::ExpectedAndCore | Parties::ExpectedAndEngine => "the expected answer",
+            Parties::EngineAndCore => "the engine's answer",
         }
     }
 
     /// The other side's answer, as a phrase.
     fn other_answer(self) -> &'static str {
         match self {
-            Sides::ExpectedAndCore => "the core's",
-            Sides::EngineAndCore => "the core's",
-            Sides::ExpectedAndEngine => "the engine's answer",
+            Parties::ExpectedAndCore => "the core's",
+            Parties::EngineAndCore => "the core's",
+            Parties::ExpectedAndEngine => "the engine's answer",
         }
     }
 
     fn got(self) -> &'static str {
         match self {
-            Sides::ExpectedAndCore => "got",
-            Sides::EngineAndCore => "core",
-            Sides::ExpectedAndEngine => "engine",
+            Parties::ExpectedAndCore => "got",
+            Parties::EngineAndCore => "core",
+            Parties::ExpectedAndEngine => "engine",
         }
     }
 }
 
 /// One divergence in words, several lines, indented by `indent`.
 pub fn render_divergence(d: &Divergence, indent: &str) -> String {
-    render_divergence_as(d, indent, Sides::ExpectedAndCore)
+    render_divergence_as(d, indent, Parties::ExpectedAndCore)
 }
 
 /// One divergence in words, naming its two sides as `sides` says.
-pub fn render_divergence_as(d: &Divergence, indent: &str, sides: Sides) -> String {
+pub fn render_divergence_as(d: &Divergence, indent: &str, sides: Parties) -> String {
     let mut s = String::new();
     let _ = writeln!(
         s,
@@ -164,8 +164,8 @@ pub fn render_divergence_as(d: &Divergence, indent: &str, sides: Sides) -> Strin
         let _ = writeln!(s, "{indent}    {line}");
     }
     let (expected, whose) = match sides {
-        Sides::ExpectedAndCore | Sides::ExpectedAndEngine => ("expected", "expected result's"),
-        Sides::EngineAndCore => ("the engine answered", "the engine's result's"),
+        Parties::ExpectedAndCore | Parties::ExpectedAndEngine => ("expected", "expected result's"),
+        Parties::EngineAndCore => ("the engine answered", "the engine's result's"),
     };
     if d.expected.kind == Kind::None {
         let _ = writeln!(s, "{indent}  {expected} no collision");
@@ -199,7 +199,7 @@ pub fn render_divergence_as(d: &Divergence, indent: &str, sides: Sides) -> Strin
 /// sides, and what rounding explains when it does (`frame 2, ball 0: kind
 /// expected edge, got none; alpha expected 0.4, got 1`). The summary CI
 /// reports show ([`github_annotations`](super::github_annotations)).
-pub fn divergence_line(d: &Divergence, sides: Sides) -> String {
+pub fn divergence_line(d: &Divergence, sides: Parties) -> String {
     let fields = d
         .fields
         .iter()
@@ -230,11 +230,11 @@ pub fn divergence_line(d: &Divergence, sides: Sides) -> String {
 }
 
 /// Who the two sides of a report's divergences are.
-pub fn sides_of(r: &TraceReport) -> Sides {
+pub fn sides_of(r: &TraceReport) -> Parties {
     match &r.engine {
-        None => Sides::ExpectedAndCore,
-        Some(e) if e.against == super::Against::Expected => Sides::ExpectedAndEngine,
-        Some(_) => Sides::EngineAndCore,
+        None => Parties::ExpectedAndCore,
+        Some(e) if e.against == super::Against::Expected => Parties::ExpectedAndEngine,
+        Some(_) => Parties::EngineAndCore,
     }
 }
 
@@ -444,7 +444,7 @@ fn write_tunnels_and_ghosts(s: &mut String, r: &TraceReport) {
 }
 
 /// The fragile divergences kept in detail (a passing trace's).
-fn write_fragile_divergences(s: &mut String, r: &TraceReport, sides: Sides) {
+fn write_fragile_divergences(s: &mut String, r: &TraceReport, sides: Parties) {
     for d in &r.fragile.details {
         let _ = writeln!(
             s,
@@ -456,7 +456,7 @@ fn write_fragile_divergences(s: &mut String, r: &TraceReport, sides: Sides) {
 
 /// A failed trace's divergences: the first one, those kept in detail,
 /// then the frames of the next ones.
-fn write_divergences(s: &mut String, r: &TraceReport, sides: Sides) {
+fn write_divergences(s: &mut String, r: &TraceReport, sides: Parties) {
     let divergences = &r.divergences;
     if divergences.details.is_empty()
         && let Some(frame) = divergences.frames.first()

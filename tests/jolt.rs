@@ -167,6 +167,11 @@ fn broken_jolt_variants_fail_check_naming_the_difference() -> anyhow::Result<Com
         ("back_faces", "back_facing"),
         ("centre_contact", "\"contact\""),
         ("flipped_edge_normal", "\"normal\""),
+        // Issue 42: wrong answers that passed as "within single precision".
+        ("tilted_face_normal", "angle 1°"),
+        ("half_normal", "not a unit vector"),
+        ("contact_off_plane", "off the triangle's plane"),
+        ("skin", "beyond the f32 backward-error bound"),
     ];
     for (variant, shows) in variants {
         let (code, report) = check(&engine, variant)?;

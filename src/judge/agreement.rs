@@ -16,7 +16,7 @@ use crate::core::{
 use crate::replay::{SceneState, SweepResult};
 use crate::trace::OutcomeMsg;
 
-use super::compare::{Field, FieldDiff, TieRule, Tolerances, compare};
+use super::compare::{Field, FieldDiff, NOT_A_UNIT_VECTOR, TieRule, Tolerances, compare};
 use super::precision::{F32_OPERATIONS, F32_UNIT, Precision, Sensitivity};
 
 /// How an answer stands against an expectation: the one judgement.
@@ -490,9 +490,10 @@ fn judge(
     // error bound (computed only here, for a sweep that differs).
     let sensitivity = match tol.precision {
         Precision::F64 => None,
-        Precision::F32 => Sensitivity::of(result),
+        Precision::F32 => Sensitivity::of(result).map(|s| s.observing(expected, got, tol)),
     };
     let widened = sensitivity.map(|s| s.widen(tol, F32_OPERATIONS));
+    let fixed = tol;
     let tol_judged = widened.as_ref().unwrap_or(tol);
     if let Some(s) = &sensitivity
         && compare(expected, got, tol_judged).is_empty()
@@ -546,19 +547,20 @@ fn judge(
         _ => fields,
     };
     if tol.precision == Precision::F32 {
-        // Single precision: any decision is as fragile as f32's budget.
-        let reproduced = reproduce(
+        // Single precision: any decision is as fragile as f32's budget; a
+        // perturbation spends part of it, and the rest is what the
+        // continuous fields may still differ by.
+        return match reproduce_f32(
             expected,
             on_expected.is_some(),
             got,
             on_got.is_some(),
             result,
-            tol,
-            Precision::F32,
-        );
-        return match reproduced {
-            Some(r) => Agreement::Precision {
-                backward_error: r.units(),
+            fixed,
+            sensitivity.as_ref(),
+        ) {
+            Some((r, backward_error)) => Agreement::Precision {
+                backward_error,
                 fields,
                 reproduced: Some(r),
             },
@@ -579,7 +581,6 @@ fn judge(
             on_got.is_some(),
             result,
             tol,
-            Precision::F64,
         )
     };
     Agreement::Diverges {
@@ -605,6 +606,7 @@ fn beyond_f32_bound(
     for f in &mut beyond {
         if let Some(detail) = f.detail.as_mut()
             && matches!(f.field, Field::Alpha | Field::Normal | Field::Contact)
+            && !detail.contains(NOT_A_UNIT_VECTOR)
         {
             detail.push_str(" (beyond the f32 backward-error bound of this sweep)");
         }
@@ -612,7 +614,7 @@ fn beyond_f32_bound(
     beyond
 }
 
-/// The smallest perturbations under which the core gives `expected` (when
+/// At double precision: the smallest perturbations under which the core gives `expected` (when
 /// `expected_open`, i.e. its own decision does not) and `got` (when
 /// `got_open`); `None` unless both are found.
 fn reproduce(
@@ -622,14 +624,10 @@ fn reproduce(
     got_open: bool,
     result: &SweepResult,
     tol: &Tolerances,
-    precision: Precision,
 ) -> Option<Reproduced> {
     let mesh = &result.scene.mesh;
     let u = rounding_unit(mesh, &result.sweep, result.options())?;
-    let (u, units): (f64, &[f64]) = match precision {
-        Precision::F64 => (u, &PERTURBATION_UNITS),
-        Precision::F32 => (u / f64::EPSILON * F32_UNIT, &F32_PERTURBATION_UNITS),
-    };
+    let units = &PERTURBATION_UNITS;
     let mut on_expected: Option<Option<Perturbation>> = (!expected_open).then_some(None);
     let mut on_got: Option<Option<Perturbation>> = (!got_open).then_some(None);
     for p in perturbations_of(u, units) {
@@ -650,8 +648,101 @@ fn reproduce(
         expected: on_expected?,
         got: on_got?,
         rounding_unit: u,
-        precision,
+        precision: Precision::F64,
     })
+}
+
+/// At single precision: the smallest perturbations of `c` = [`F32_OPERATIONS`]
+/// units at most under which the core gives `expected` (when
+/// `expected_open`) and `got` (when `got_open`), each side's continuous
+/// fields compared within what is left of the budget (a perturbation of
+/// `k` units leaves `c - k` for the widening: the budget is spent once).
+/// With the backward error of the whole: per side, the perturbation plus
+/// the smallest widening that then accepts the answer; the larger side's.
+fn reproduce_f32(
+    expected: &OutcomeMsg,
+    expected_open: bool,
+    got: &OutcomeMsg,
+    got_open: bool,
+    result: &SweepResult,
+    fixed: &Tolerances,
+    s: Option<&Sensitivity>,
+) -> Option<(Reproduced, f64)> {
+    let u = rounding_unit(&result.scene.mesh, &result.sweep, result.options())? / f64::EPSILON
+        * F32_UNIT;
+    let unperturbed = Decision::of(&result.scene, &result.sweep)?;
+    // Each side: its perturbation (`None`: the core's own decision) and
+    // the budget spent in all.
+    let mut sides: [Option<(Option<Perturbation>, f64)>; 2] = [None, None];
+    for (i, (answer, open)) in [(expected, expected_open), (got, got_open)]
+        .into_iter()
+        .enumerate()
+    {
+        if !open {
+            let spent = widening_needed(&unperturbed, answer, fixed, s, F32_OPERATIONS);
+            sides[i] = Some((None, spent.unwrap_or(F32_OPERATIONS)));
+        }
+    }
+    for p in perturbations_of(u, &F32_PERTURBATION_UNITS) {
+        if sides.iter().all(Option::is_some) {
+            break;
+        }
+        let Some(decision) = Decision::of(&result.scene, &p.apply(&result.sweep)) else {
+            continue;
+        };
+        let left = F32_OPERATIONS - p.units.abs();
+        for (i, answer) in [expected, got].into_iter().enumerate() {
+            if sides[i].is_none()
+                && let Some(widening) = widening_needed(&decision, answer, fixed, s, left)
+            {
+                sides[i] = Some((Some(p), p.units.abs() + widening));
+            }
+        }
+    }
+    let [(on_expected, e), (on_got, g)] = [sides[0]?, sides[1]?];
+    Some((
+        Reproduced {
+            expected: on_expected,
+            got: on_got,
+            rounding_unit: u,
+            precision: Precision::F32,
+        },
+        e.max(g),
+    ))
+}
+
+/// The smallest widening, in units of `u₃₂ · S` up to `budget`, under
+/// which `decision` accepts `answer` (its continuous fields compared
+/// within [`Sensitivity::widen`] of the fixed tolerances; without a
+/// sensitivity, when the core's answer is a miss, the fixed tolerances
+/// alone); `None` when the whole budget does not.
+fn widening_needed(
+    decision: &Decision,
+    answer: &OutcomeMsg,
+    fixed: &Tolerances,
+    s: Option<&Sensitivity>,
+    budget: f64,
+) -> Option<f64> {
+    let accepts = |units: f64| {
+        let tol = s.map_or(*fixed, |s| s.widen(fixed, units));
+        decision.disagreement(answer, &tol).is_none()
+    };
+    if budget < 0.0 || !accepts(budget.max(0.0)) {
+        return None;
+    }
+    if accepts(0.0) {
+        return Some(0.0);
+    }
+    let (mut lo, mut hi) = (0.0_f64, budget);
+    for _ in 0..24 {
+        let mid = 0.5 * (lo + hi);
+        if accepts(mid) {
+            hi = mid;
+        } else {
+            lo = mid;
+        }
+    }
+    Some(hi)
 }
 
 #[cfg(test)]

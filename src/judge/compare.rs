@@ -30,6 +30,11 @@ pub const DEFAULT_CONTACT_TOLERANCE: f64 = 1e-6;
 /// - `contact`: the Euclidean distance is at most `contact`, in the scene's
 ///   length unit (default `1e-6`).
 ///
+/// A normal must also be a unit vector: its length within
+/// [`Tolerances::normal_length`] of 1 (the normal's angular tolerance, in
+/// radians, unless set), on both sides. Two identical normals always
+/// compare equal.
+///
 /// `kind`, `triangle` and `feature` are compared exactly. `fields` limits
 /// the comparison to some fields (default: every field; `check --fields`),
 /// for engines whose answers differ from the core's by design in the others
@@ -40,8 +45,19 @@ pub struct Tolerances {
     pub alpha: f64,
     /// Angular tolerance on the normal, in degrees.
     pub normal_degrees: f64,
-    /// Distance tolerance on the contact point.
+    /// Distance tolerance on the contact point (across
+    /// [`Tolerances::contact_axis`] when one is set).
     pub contact: f64,
+    /// A direction in which the contact point has a tolerance of its own:
+    /// at single precision, the contact normal, along which rounding moves
+    /// the contact far less than across it (set per sweep by
+    /// [`super::Sensitivity::widen`]; not in the JSON).
+    #[serde(skip)]
+    pub contact_axis: Option<ContactAxis>,
+    /// How far a normal's length may be from 1; `None`: the angular
+    /// tolerance `normal_degrees` in radians. Not in the JSON.
+    #[serde(skip)]
+    pub normal_length: Option<f64>,
     /// The fields compared (those the expectation holds among them).
     pub fields: FieldSet,
     /// The arithmetic of the engine judged (`f64`: these tolerances as
@@ -53,6 +69,26 @@ pub struct Tolerances {
     /// `rule`.
     #[serde(skip_serializing_if = "TieRule::is_rule")]
     pub ties: TieRule,
+}
+
+/// The contact's own tolerance along one direction ([`Tolerances::contact_axis`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ContactAxis {
+    /// The direction, a unit vector.
+    pub axis: [f64; 3],
+    /// How far the contact may move along it.
+    pub tolerance: f64,
+    /// Whether the contact is on a face, whose plane the axis is normal to
+    /// (the wording: "off the triangle's plane").
+    pub plane: bool,
+}
+
+impl Tolerances {
+    /// How far a normal's length may be from 1 ([`Tolerances::normal_length`]).
+    pub fn normal_length(&self) -> f64 {
+        self.normal_length
+            .unwrap_or_else(|| self.normal_degrees.to_radians())
+    }
 }
 
 /// Which member of a tie an answer may name: an engine convention (`ties`
@@ -98,6 +134,8 @@ impl Default for Tolerances {
             alpha: DEFAULT_ALPHA_TOLERANCE,
             normal_degrees: DEFAULT_NORMAL_TOLERANCE_DEGREES,
             contact: DEFAULT_CONTACT_TOLERANCE,
+            contact_axis: None,
+            normal_length: None,
             fields: FieldSet::ALL,
             precision: Precision::F64,
             ties: TieRule::Rule,
@@ -243,6 +281,75 @@ fn distance(a: [f64; 3], b: [f64; 3]) -> f64 {
     (Vector3::from(a) - Vector3::from(b)).norm()
 }
 
+/// The words that say a normal's length is wrong (a fixed tolerance, not
+/// one that single precision widens).
+pub(crate) const NOT_A_UNIT_VECTOR: &str = "not a unit vector";
+
+/// How two normals differ, in words; `None` when they match: identical, or
+/// within the angle and both of unit length.
+fn normal_difference(w: [f64; 3], h: [f64; 3], tol: &Tolerances) -> Option<String> {
+    if w == h && w.iter().all(|x| x.is_finite()) {
+        return None;
+    }
+    let Some(angle) = angle_degrees(w, h) else {
+        return Some("one of the normals has zero or non-finite length".to_string());
+    };
+    let mut words = Vec::new();
+    if angle > tol.normal_degrees {
+        words.push(format!(
+            "angle {}° > {}°",
+            num(angle),
+            num(tol.normal_degrees)
+        ));
+    }
+    for v in [w, h] {
+        let length = Vector3::from(v).norm();
+        if (length - 1.0).abs() > tol.normal_length() {
+            words.push(format!(
+                "|n| = {}, {NOT_A_UNIT_VECTOR} (within {} of 1)",
+                num(length),
+                num(tol.normal_length())
+            ));
+        }
+    }
+    (!words.is_empty()).then(|| words.join("; "))
+}
+
+/// How two contact points differ, in words; `None` when they match.
+fn contact_difference(w: [f64; 3], h: [f64; 3], tol: &Tolerances) -> Option<String> {
+    let d = distance(w, h);
+    // NaN (a non-finite point) is a difference too.
+    if d.is_nan() {
+        return Some(format!("distance {} > {}", num(d), num(tol.contact)));
+    }
+    let Some(axis) = tol.contact_axis else {
+        return (d > tol.contact).then(|| format!("distance {} > {}", num(d), num(tol.contact)));
+    };
+    let moved = Vector3::from(h) - Vector3::from(w);
+    let along = moved.dot(&Vector3::from(axis.axis)).abs();
+    let across = (d * d - along * along).max(0.0).sqrt();
+    if along > axis.tolerance {
+        let off = if axis.plane {
+            "off the triangle's plane"
+        } else {
+            "along the contact normal"
+        };
+        return Some(format!(
+            "contact {} {off} > {} (distance {})",
+            num(along),
+            num(axis.tolerance),
+            num(d)
+        ));
+    }
+    (across > tol.contact).then(|| {
+        format!(
+            "distance {} across the normal > {}",
+            num(across),
+            num(tol.contact)
+        )
+    })
+}
+
 /// Compares `got` with `expected`, field by field, **only over the fields
 /// `expected` holds** (an absent field is `None` in [`OutcomeMsg`] and is
 /// not compared; a `null` field is `Some(None)` and is compared: it must be
@@ -311,17 +418,7 @@ fn compare_all(expected: &OutcomeMsg, got: &OutcomeMsg, tol: &Tolerances) -> Vec
         let differs = match (want, have) {
             (None, None) => None,
             (Some(_), None) | (None, Some(_)) => Some(None),
-            (Some(w), Some(h)) => match angle_degrees(w, h) {
-                None => Some(Some(
-                    "one of the normals has zero or non-finite length".to_string(),
-                )),
-                Some(a) if a <= tol.normal_degrees => None,
-                Some(a) => Some(Some(format!(
-                    "angle {}° > {}°",
-                    num(a),
-                    num(tol.normal_degrees)
-                ))),
-            },
+            (Some(w), Some(h)) => normal_difference(w, h, tol).map(Some),
         };
         if let Some(detail) = differs {
             out.push(FieldDiff {
@@ -337,12 +434,7 @@ fn compare_all(expected: &OutcomeMsg, got: &OutcomeMsg, tol: &Tolerances) -> Vec
         let differs = match (want, have) {
             (None, None) => None,
             (Some(_), None) | (None, Some(_)) => Some(None),
-            (Some(w), Some(h)) => {
-                let d = distance(w, h);
-                // NaN (a non-finite point) is a difference too.
-                (d.is_nan() || d > tol.contact)
-                    .then(|| Some(format!("distance {} > {}", num(d), num(tol.contact))))
-            }
+            (Some(w), Some(h)) => contact_difference(w, h, tol).map(Some),
         };
         if let Some(detail) = differs {
             out.push(FieldDiff {

@@ -34,8 +34,9 @@ mod precision;
 
 pub use agreement::{Agreement, Perturbation, Reproduced, agreement, agreement_of};
 pub use compare::{
-    DEFAULT_ALPHA_TOLERANCE, DEFAULT_CONTACT_TOLERANCE, DEFAULT_NORMAL_TOLERANCE_DEGREES, Field,
-    FieldDiff, FieldSet, TieRule, Tolerances, angle_degrees, compare,
+    ContactAxis, DEFAULT_ALPHA_TOLERANCE, DEFAULT_CONTACT_TOLERANCE,
+    DEFAULT_NORMAL_TOLERANCE_DEGREES, Field, FieldDiff, FieldSet, TieRule, Tolerances,
+    angle_degrees, compare,
 };
 pub use conventions::{EngineConventions, FacingRule, MarginRule};
 pub(crate) use decision::write_decision_line;

@@ -9,12 +9,26 @@
 //! sensitivity to a move `δ` of the inputs ([`Sensitivity`]). A ball
 //! meeting a feature along the contact normal `n` closes in at `|d · n|`
 //! per unit of `α`; the centre, the feature and the radius each move the
-//! contact by at most `δ` along `n`, so `|Δα| ≤ 3δ / |d · n|`. The contact
-//! point moves with the feature (`δ`, twice for an edge's two ends) and
+//! contact by at most `δ` along `n`, so `|Δα| ≤ 3δ / |d · n|`.
+//!
+//! The contact point is bounded in two directions. **Along `n`** it moves
+//! only with the feature and the radius, `3δ`: uncertainty in `α` slides a
+//! contact within the surface, never off it, so a face contact off its
+//! triangle's plane by more than that is an error, however slow the sweep.
+//! **Across `n`** it moves with the feature (`2δ`, an edge's two ends) and
 //! with the centre along the surface (`|Δα| · |d_t|`, `d_t` the part of `d`
-//! across `n`); the normal turns by the moves of the contact and the
-//! centre over `ρ`, and a face normal by `2δ` over the triangle's shortest
-//! edge.
+//! across `n`, at most the path's length).
+//!
+//! **The normal.** A face normal (a face hit's, or the face normal the
+//! rules report at an edge or a vertex) is the triangle's whatever `α` is:
+//! it turns only with the triangle's vertices, by `2δ` over the triangle's
+//! shortest edge. A contact normal (the centre minus the contact, at an
+//! edge or a vertex under a contact-normal convention) turns with the moves
+//! of the contact and the centre over `ρ`, where the centre's move along
+//! the surface is the one the answer needs: `|Δα| · |d_t|` with the `Δα`
+//! between the two answers (when `α` is compared), not the worst case of
+//! the bound on `α`. Its length is not a matter of geometry: a normal is a
+//! unit vector within the fixed normal tolerance ([`super::compare`]).
 //!
 //! **Grazing contacts.** On an edge or a vertex the first-order bound
 //! breaks down near a double root of the quadratic: a ball that only
@@ -49,7 +63,7 @@ use crate::core::{Feature, SweptPath};
 use crate::replay::SweepResult;
 use crate::trace::OutcomeMsg;
 
-use super::compare::{Field, FieldDiff, Tolerances, angle_degrees};
+use super::compare::{ContactAxis, Field, FieldDiff, Tolerances, angle_degrees};
 
 /// The arithmetic an engine computes in: an engine convention
 /// (`precision` in `sweeptrace.toml`'s `[engine]` table).
@@ -117,6 +131,11 @@ pub struct Sensitivity {
     /// What the bounds are computed from.
     #[serde(skip)]
     geometry: Geometry,
+    /// `|Δα|` between the two answers judged, when `α` is compared
+    /// ([`Sensitivity::observing`]): a contact normal turns by the centre's
+    /// move that this `Δα` gives, not by the whole bound on `α`.
+    #[serde(skip)]
+    observed_alpha: Option<f64>,
 }
 
 /// The quantities of one hit that its bounds depend on.
@@ -136,6 +155,13 @@ struct Geometry {
     rho: f64,
     /// The hit triangle's shortest edge.
     shortest_edge: f64,
+    /// The contact normal `n` (the centre minus the contact, unit).
+    normal: Vector3<f64>,
+    /// Whether the reported normal is a face normal (the triangle's, or an
+    /// average of simultaneous triangles'), which does not turn with `α`.
+    face_normal: bool,
+    /// Whether the hit is on a face (its contact lies in the plane).
+    on_face: bool,
 }
 
 /// The bounds at one budget: how far each continuous field may move.
@@ -143,8 +169,11 @@ struct Geometry {
 pub struct Bounds {
     /// `|Δα|`.
     pub alpha: f64,
-    /// The contact point's move, a length.
+    /// The contact point's move across the contact normal, a length.
     pub contact: f64,
+    /// The contact point's move along the contact normal (off the
+    /// surface), a length.
+    pub contact_along_normal: f64,
     /// The normal's turn, in degrees.
     pub normal_degrees: f64,
 }
@@ -186,6 +215,14 @@ impl Sensitivity {
                 .map(|e| e.length)
                 .fold(f64::INFINITY, f64::min)
         });
+        // The reported normal is a face normal when it is the triangle's
+        // (either side), or when it is not the contact normal (an average of
+        // simultaneous triangles' face normals).
+        let face_normal = hit.feature == Feature::Face
+            || triangle.is_some_and(|t| {
+                (hit.normal - t.normal).norm() < 1e-9 || (hit.normal + t.normal).norm() < 1e-9
+            })
+            || (hit.normal - n).norm() > 1e-6;
         let geometry = Geometry {
             closing: d.dot(&n).abs(),
             across_feature,
@@ -193,6 +230,9 @@ impl Sensitivity {
             length: path.length,
             rho: path.rho,
             shortest_edge,
+            normal: n,
+            face_normal,
+            on_face: hit.feature == Feature::Face,
         };
         let first_order = Sensitivity::first_order(unit, &geometry);
         Some(Sensitivity {
@@ -201,7 +241,18 @@ impl Sensitivity {
             contact: first_order.contact,
             normal_degrees: first_order.normal_degrees,
             geometry,
+            observed_alpha: None,
         })
+    }
+
+    /// The same sensitivity, judging `expected` against `got`: the `Δα`
+    /// between them (when `tol` compares `α` and both are finite) is the
+    /// move of the centre a contact normal is allowed to follow.
+    pub fn observing(mut self, expected: &OutcomeMsg, got: &OutcomeMsg, tol: &Tolerances) -> Self {
+        let delta = (expected.alpha - got.alpha).abs();
+        self.observed_alpha =
+            (tol.fields.contains(Field::Alpha) && delta.is_finite()).then_some(delta);
+        self
     }
 
     /// The first-order moves per unit move of the inputs.
@@ -211,17 +262,25 @@ impl Sensitivity {
         } else {
             f64::INFINITY
         };
-        Sensitivity::following(unit, 1.0, alpha, g)
+        Sensitivity::following(unit, 1.0, alpha, g, None)
     }
 
-    /// The contact's move and the normal's turn at `units`, given the
-    /// bound on `α` there.
-    fn following(unit: f64, units: f64, alpha: f64, g: &Geometry) -> Bounds {
-        let moved = 2.0 * units * unit + (alpha * g.along_surface).min(g.length + units * unit);
-        let turn = 2.0 * units * unit / g.shortest_edge + (units * unit + moved) / g.rho;
+    /// The contact's moves and the normal's turn at `units`, given the
+    /// bound on `α` there; `observed`: the `Δα` the answers show.
+    fn following(unit: f64, units: f64, alpha: f64, g: &Geometry, observed: Option<f64>) -> Bounds {
+        let move_of = |alpha: f64| (alpha * g.along_surface).min(g.length + units * unit);
+        let face_turn = 2.0 * units * unit / g.shortest_edge;
+        let turn = if g.face_normal {
+            face_turn
+        } else {
+            // The centre's move that the answer needs, at most the bound's.
+            let needed = move_of(observed.map_or(alpha, |o| o.min(alpha)));
+            face_turn + (3.0 * units * unit + needed) / g.rho
+        };
         Bounds {
             alpha,
-            contact: moved,
+            contact: 2.0 * units * unit + move_of(alpha),
+            contact_along_normal: 3.0 * units * unit,
             normal_degrees: turn.to_degrees(),
         }
     }
@@ -233,23 +292,33 @@ impl Sensitivity {
     pub fn bounds(&self, units: f64) -> Bounds {
         let g = &self.geometry;
         let Some(speed) = g.across_feature.filter(|v| *v > 0.0) else {
-            return Sensitivity::following(self.unit, units, units * self.alpha, g);
+            let alpha = units * self.alpha;
+            return Sensitivity::following(self.unit, units, alpha, g, self.observed_alpha);
         };
         let eps = 3.0 * units * self.unit;
         let s = (g.rho * g.closing / speed).min(g.rho);
         let grown = ((s * s + 2.0 * g.rho * eps + eps * eps).sqrt() - s).max(0.0);
         let shrunk = s - (s * s - 2.0 * g.rho * eps).max(0.0).sqrt();
         let alpha = (grown.max(shrunk) + 2.0 * eps / 3.0) / speed;
-        Sensitivity::following(self.unit, units, alpha, g)
+        Sensitivity::following(self.unit, units, alpha, g, self.observed_alpha)
     }
 
-    /// `tol` widened to the moves `c` units of the inputs give.
+    /// `tol` widened to the moves `c` units of the inputs give: `α`, the
+    /// contact across the normal and the normal's direction; the contact
+    /// along the normal by its own bound; the normal's length not at all.
     pub fn widen(&self, tol: &Tolerances, c: f64) -> Tolerances {
         let b = self.bounds(c);
+        let g = &self.geometry;
         Tolerances {
             alpha: tol.alpha.max(b.alpha),
             contact: tol.contact.max(b.contact),
+            contact_axis: Some(ContactAxis {
+                axis: g.normal.into(),
+                tolerance: tol.contact.max(b.contact_along_normal),
+                plane: g.on_face,
+            }),
             normal_degrees: tol.normal_degrees.max(b.normal_degrees),
+            normal_length: Some(tol.normal_length()),
             ..*tol
         }
     }
@@ -297,10 +366,13 @@ impl Sensitivity {
             .map(|f| match f.field {
                 Field::Alpha => self.units_for((expected.alpha - got.alpha).abs(), |b| b.alpha),
                 Field::Contact => match points(expected.contact, got.contact) {
-                    Some((a, b)) => self.units_for(
-                        (nalgebra::Vector3::from(a) - nalgebra::Vector3::from(b)).norm(),
-                        |b| b.contact,
-                    ),
+                    Some((a, b)) => {
+                        let moved = Vector3::from(a) - Vector3::from(b);
+                        let along = moved.dot(&self.geometry.normal).abs();
+                        let across = (moved.norm_squared() - along * along).max(0.0).sqrt();
+                        self.units_for(along, |b| b.contact_along_normal)
+                            .max(self.units_for(across, |b| b.contact))
+                    }
                     None => f64::INFINITY,
                 },
                 Field::Normal => match points(expected.normal, got.normal) {
@@ -340,6 +412,9 @@ mod tests {
             length: 1.0,
             rho: 0.5,
             shortest_edge: 1.0,
+            normal: Vector3::z(),
+            face_normal: across_feature.is_none(),
+            on_face: across_feature.is_none(),
         };
         let unit = 1e-7;
         let first = Sensitivity::first_order(unit, &geometry);
@@ -349,6 +424,7 @@ mod tests {
             contact: first.contact,
             normal_degrees: first.normal_degrees,
             geometry,
+            observed_alpha: None,
         }
     }
 

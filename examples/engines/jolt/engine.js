@@ -15,7 +15,10 @@
 import initJolt from 'jolt-physics';
 import { createInterface } from 'node:readline';
 
-const VARIANTS = ['clean', 'late', 'no_vertex', 'next_triangle', 'back_faces', 'centre_contact', 'flipped_edge_normal'];
+const VARIANTS = [
+  'clean', 'late', 'no_vertex', 'next_triangle', 'back_faces', 'centre_contact', 'flipped_edge_normal',
+  'tilted_face_normal', 'half_normal', 'contact_off_plane', 'skin',
+];
 const flag = process.argv.indexOf('--variant');
 const variant = (flag >= 0 ? process.argv[flag + 1] : process.env.JOLT_VARIANT) || 'clean';
 if (!VARIANTS.includes(variant)) fail(`unknown variant \`${variant}\` (one of ${VARIANTS.join(', ')})`);
@@ -118,6 +121,7 @@ function sweep(msg) {
   if (!scene) fail(`the sweep of frame ${msg.frame}, ball ${msg.ball} arrived before any scene`);
   if (!scene.body) return none;
   const radius = honourMargin ? msg.radius - scene.margin : msg.radius;
+  lastRadius = msg.radius;
   let sphere = spheres.get(radius);
   if (!sphere) {
     sphere = new Jolt.SphereShape(radius);
@@ -146,6 +150,17 @@ function sweep(msg) {
   return mistake(answer, p0, d);
 }
 
+// `n` turned by `angle` radians about an axis perpendicular to it.
+function tilt(n, angle) {
+  const helper = Math.abs(n[0]) < 0.9 ? [1, 0, 0] : [0, 1, 0];
+  const t = cross(n, helper), len = Math.sqrt(dot(t, t));
+  return n.map((x, i) => Math.cos(angle) * x + Math.sin(angle) * t[i] / len);
+}
+
+// The radius of the sweep an answer belongs to (kept by `sweep`).
+let lastRadius = 0;
+const radiusOf = () => lastRadius;
+
 // The deliberate mistakes (variant `clean` has none).
 function mistake(answer, p0, d) {
   if (answer.kind === 'none') return answer;
@@ -155,6 +170,14 @@ function mistake(answer, p0, d) {
     case 'next_triangle': return answer.kind === 'face' ? { ...answer, triangle: (answer.triangle + 1) % scene.triangles.length } : answer;
     case 'centre_contact': return { ...answer, contact: p0.map((x, i) => x + answer.alpha * d[i]) };
     case 'flipped_edge_normal': return answer.kind === 'edge' ? { ...answer, normal: answer.normal.map((x) => -x) } : answer;
+    // A face hit's normal turned by 1 degree (about an axis in the face's plane).
+    case 'tilted_face_normal': return answer.kind === 'face' ? { ...answer, normal: tilt(answer.normal, Math.PI / 180) } : answer;
+    // Normals never normalised: every one of length 0.5.
+    case 'half_normal': return { ...answer, normal: answer.normal.map((x) => 0.5 * x) };
+    // A face contact 1 % of the radius off the triangle's plane, toward the ball.
+    case 'contact_off_plane': return answer.kind === 'face' ? { ...answer, contact: answer.contact.map((x, i) => x + 0.01 * radiusOf(answer) * answer.normal[i]) } : answer;
+    // Every hit backed off by a skin of 1e-3 along the path.
+    case 'skin': return { ...answer, alpha: Math.max(answer.alpha - 1e-3 / Math.sqrt(dot(d, d)), 0) };
     default: return answer; // clean, back_faces (a cast setting)
   }
 }

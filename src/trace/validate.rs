@@ -13,6 +13,7 @@ use serde::de::DeserializeOwned;
 use super::encoding::Encoding;
 use super::error::{MessageAt, TraceError};
 use super::messages::{OutcomeMsg, SceneMsg, SweepMsg};
+use crate::core::Kind;
 use crate::numbers::{self, Rule};
 
 /// A field holding an invalid value, and why.
@@ -245,7 +246,7 @@ pub fn validate_sweep(sweep: &SweepMsg, scene_margin: Option<f64>) -> Result<(),
 }
 
 /// Checks an outcome: `alpha` in `[0, 1]`, `feature` in `0..=2`, finite
-/// `normal` and `contact`.
+/// `normal` and `contact`, and a hit's normal not zero.
 pub fn validate_outcome(outcome: &OutcomeMsg) -> Result<(), FieldProblem> {
     if !(0.0..=1.0).contains(&outcome.alpha) {
         return Err(FieldProblem::new(
@@ -263,6 +264,15 @@ pub fn validate_outcome(outcome: &OutcomeMsg) -> Result<(), FieldProblem> {
     }
     if let Some(Some(normal)) = &outcome.normal {
         finite3("normal", normal)?;
+        // A hit's normal is a direction: a zero vector is no answer (a
+        // miss may carry one, which the comparison reports as a value
+        // where null is expected).
+        if outcome.kind != Kind::None && normal.iter().all(|x| *x == 0.0) {
+            return Err(FieldProblem::new(
+                "normal",
+                "must be a nonzero vector on a hit, got [0, 0, 0]",
+            ));
+        }
     }
     if let Some(Some(contact)) = &outcome.contact {
         finite3("contact", contact)?;
@@ -282,5 +292,27 @@ pub fn validate_triangle(outcome: &OutcomeMsg, scene_triangles: usize) -> Result
             format!("index {triangle} is out of range (the scene has {scene_triangles} triangles)"),
         )),
         _ => Ok(()),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Issue 42: a zero normal is no answer, so `bless --engine` cannot
+    /// write one and `check` never meets two identical answers it calls
+    /// different. A miss may still carry one.
+    #[test]
+    fn a_hit_with_a_zero_normal_is_refused() {
+        let hit = OutcomeMsg::hit(0, 0, 0.5, Kind::Face).normal([0.0, 0.0, 0.0]);
+        let problem = validate_outcome(&hit).expect_err("a zero normal on a hit");
+        assert_eq!(problem.field, "normal");
+        assert!(
+            validate_outcome(&OutcomeMsg::hit(0, 0, 0.5, Kind::Face).normal([0.0, 0.0, 1.0]))
+                .is_ok()
+        );
+        let mut miss = OutcomeMsg::hit(0, 0, 1.0, Kind::None);
+        miss.normal = Some(Some([0.0, 0.0, 0.0]));
+        assert!(validate_outcome(&miss).is_ok());
     }
 }

@@ -335,7 +335,15 @@ fn counts_text(r: &TraceReport) -> String {
             }
         );
     }
-    if r.tunnels.count > 0 && !r.tunnels.fail {
+    if r.tunnels.count > 0 && r.tunnels.of_the_recording {
+        let _ = write!(
+            counts,
+            ", {} {} in the recorded paths (a note about the trace, not the engine's verdict: \
+             the same whatever engine answers)",
+            r.tunnels.count,
+            tunnel_words(r.tunnels.count)
+        );
+    } else if r.tunnels.count > 0 && !r.tunnels.fail {
         let _ = write!(
             counts,
             ", {} {} (not failures: tunnels allowed)",

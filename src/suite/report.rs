@@ -360,6 +360,18 @@ pub struct Tunnels {
     /// Whether they fail the check (`fail_on_tunnel`).
     #[serde(rename = "fail_on_tunnel")]
     pub fail: bool,
+    /// The sweeps were answered by a running engine (`check --engine`):
+    /// the tunnels are the recorded paths' (between sweeps, or where the
+    /// reference stops no ball either), the same whatever engine answers,
+    /// so they are a note about the trace and never fail the engine's
+    /// check. A tunnel the engine's own answers make (a miss where the
+    /// reference hits) is a divergence. Only in the JSON when true, that
+    /// is when there are tunnels (`tunnels_of_the_recording`).
+    #[serde(
+        rename = "tunnels_of_the_recording",
+        skip_serializing_if = "std::ops::Not::not"
+    )]
+    pub of_the_recording: bool,
 }
 
 /// A report's ghost contacts: expectations (or an engine's answers) that

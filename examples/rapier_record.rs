@@ -369,7 +369,14 @@ fn solver_contacts(
             .acos()
             .to_degrees();
         let ghost = matches!(
-            judge_ghost(scene, &outcome, 0, None, GHOST_DEGREES),
+            judge_ghost(
+                &scene.mesh,
+                &scene.topology,
+                &outcome,
+                0,
+                None,
+                GHOST_DEGREES
+            ),
             GhostJudgement::Ghost(_)
         );
         out.push(SolverContact {

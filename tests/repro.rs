@@ -102,7 +102,7 @@ fn divergence_inputs_read_back_bit_exactly() -> anyhow::Result<()> {
         "text:\n{text}"
     );
     for d in &report.divergences.details {
-        let block = sweeptrace::suite::render_divergence(d, "");
+        let block = sweeptrace::judge::render_divergence(d, "");
         let inputs = &block[block.find("inputs: ").context("inputs line")?..];
         same_bits("decimal p0", &numbers_after(inputs, "p0 ")?, &d.inputs.p0)?;
         same_bits("decimal p1", &numbers_after(inputs, "p1 ")?, &d.inputs.p1)?;

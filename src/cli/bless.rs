@@ -13,10 +13,11 @@ use anyhow::{Context, bail};
 
 use super::Exit;
 use sweeptrace::engine::EngineCommand;
+use sweeptrace::judge::{Divergence, Parties, render_divergence_as};
 use sweeptrace::numbers::counted;
 use sweeptrace::suite::{
-    Against, BlessEngine, BlessError, BlessOptions, BlessSelection, CheckOptions, Divergence,
-    Parties, bless_file_with, check_file, check_file_with_engine, render_divergence_as,
+    Against, BlessEngine, BlessError, BlessOptions, BlessSelection, CheckOptions, bless_file_with,
+    check_file, check_file_with_engine,
 };
 
 /// Arguments of `bless`.

@@ -374,7 +374,7 @@ fn leave_out(
 ) -> anyhow::Result<Vec<PathBuf>> {
     let (mut traces, mut foxglove, mut excluded) = (Vec::new(), Vec::new(), Vec::new());
     for path in found {
-        if let Some(trace) = sweeptrace::suite::foxglove_output(&path) {
+        if let Some(trace) = sweeptrace::trace::foxglove_output(&path) {
             foxglove.push((path, trace));
             continue;
         }

@@ -14,8 +14,8 @@
 use std::time::Duration;
 
 use crate::judge::Tolerances;
+use crate::judge::{Parties, divergence_line};
 use crate::junit::{Case, CaseResult, Detail, JunitOptions, Problem, Report, Suite, one_line};
-use crate::suite::{Parties, divergence_line};
 
 use super::{CaseFailure, ConformReport, RuleReport, render_case_failure, render_rule_failure};
 

@@ -24,8 +24,8 @@ use crate::core::explain::num;
 use crate::core::{Kind, Outcome};
 use crate::engine::{EngineAnswers, EngineCommand, EngineError, EngineOptions, EngineSession};
 use crate::judge::{Agreement, EngineConventions, TieRule, Tolerances, agreement, compare};
+use crate::judge::{Divergence, Parties, divergence_details, render_divergence_as};
 use crate::replay::{ReplayEvent, ReplayOptions, replay_events};
-use crate::suite::{Divergence, Parties, divergence_details, render_divergence_as};
 use crate::trace::{EventBody, EventHeader, OutcomeMsg, TraceEvent};
 
 /// The first failing case of a rule, explained.

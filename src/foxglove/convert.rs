@@ -15,14 +15,14 @@ use super::messages::{
 use crate::core::explain::label;
 use crate::core::{DefectKind, EdgeClass, SweepHit, TestRecord};
 use crate::judge::{FieldDiff, write_decision_line};
+use crate::judge::{divergence_details, render_divergence};
 use crate::palette::{
     BOUNDARY_EDGE_COLOR, CONCAVE_EDGE_COLOR, CONTACT_BALL_COLOR, CONVEX_EDGE_COLOR, DEFECT_COLOR,
     EXPECTED_COLOR, FACE_NORMAL_COLOR, FLAT_EDGE_COLOR, GHOST_COLOR, HIT_COLOR,
     MAX_DRAWN_DEFECT_LABELS, MESH_COLOR, NON_MANIFOLD_EDGE_COLOR, NORMAL_COLOR, P0_COLOR, P1_COLOR,
     SWEEP_COLOR,
 };
-use crate::replay::{SceneState, SweepResult, ghost_point};
-use crate::suite::{divergence_details, render_divergence};
+use crate::replay::{SceneState, SweepResult};
 use strum::IntoEnumIterator as _;
 
 /// The id of the mesh entity on [`super::MESH_TOPIC`]: one id for every
@@ -491,7 +491,7 @@ const GHOST_FONT_PIXELS: f64 = 14.0;
 /// The ghost contact of the sweep's expected outcome
 /// ([`SweepResult::ghost`]), on [`super::GHOSTS_TOPIC`]: entity
 /// `ghost/{ball}` with a marker where it is
-/// ([`crate::replay::ghost_point`]), two arrows from there, the expected
+/// ([`SweepResult::ghost_point`]), two arrows from there, the expected
 /// (ghost) normal and the faces' normal, one label (`ghost contact 10.0°:
 /// edge 0.2 is internal and flat`) and `check`'s sentence in the metadata;
 /// otherwise the deletion of that entity.
@@ -505,7 +505,7 @@ pub fn ghost_update(r: &SweepResult) -> SceneUpdate {
         };
     };
     let size = marker_size(r);
-    let at = nalgebra::Point3::from(ghost_point(r, &g));
+    let at = nalgebra::Point3::from(r.ghost_point(&g));
     let mut entity = SceneEntity::new(time, FRAME_ID, id);
     entity.metadata = vec![
         key_value("frame", r.frame),

@@ -16,8 +16,9 @@ use crate::core::{
 use crate::replay::{SceneState, SweepResult};
 use crate::trace::OutcomeMsg;
 
+use super::compare::Precision;
 use super::compare::{Field, FieldDiff, NOT_A_UNIT_VECTOR, TieRule, Tolerances, compare};
-use super::precision::{F32_OPERATIONS, F32_UNIT, Precision, Sensitivity};
+use super::precision::{F32_OPERATIONS, F32_UNIT, Sensitivity};
 
 /// How an answer stands against an expectation: the one judgement.
 #[derive(Clone, Debug, PartialEq)]

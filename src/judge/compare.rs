@@ -10,8 +10,6 @@ use crate::core::explain::num;
 use crate::numbers::{self, Rule};
 use crate::trace::OutcomeMsg;
 
-use super::precision::Precision;
-
 /// Default absolute tolerance on `α` (a fraction of the path, unitless).
 pub const DEFAULT_ALPHA_TOLERANCE: f64 = 1e-6;
 /// Default angular tolerance on the normal, in **degrees**.
@@ -88,6 +86,40 @@ impl Tolerances {
     pub fn normal_length(&self) -> f64 {
         self.normal_length
             .unwrap_or_else(|| self.normal_degrees.to_radians())
+    }
+}
+
+/// The arithmetic an engine computes in: an engine convention
+/// (`precision` in `sweeptrace.toml`'s `[engine]` table).
+#[derive(
+    Clone,
+    Copy,
+    Debug,
+    Default,
+    PartialEq,
+    Eq,
+    Hash,
+    Serialize,
+    serde::Deserialize,
+    strum::IntoStaticStr,
+    strum::Display,
+    strum::EnumString,
+    strum::VariantNames,
+)]
+#[serde(rename_all = "snake_case")]
+#[strum(serialize_all = "snake_case")]
+pub enum Precision {
+    /// Double precision: the fixed tolerances, as always.
+    #[default]
+    F64,
+    /// Single precision: differences judged by backward error.
+    F32,
+}
+
+impl Precision {
+    /// Whether this is the default, `f64`.
+    pub fn is_f64(&self) -> bool {
+        *self == Precision::F64
     }
 }
 

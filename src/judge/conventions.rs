@@ -24,8 +24,8 @@ use serde::Serialize;
 use crate::core::{Facing, InitialOverlap, Sides};
 use crate::replay::{NormalRule, ReplayOptions};
 
+use super::compare::Precision;
 use super::compare::{TieRule, Tolerances};
-use super::precision::Precision;
 
 /// The margin an engine uses: the scene's (the rules) or always the same.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]

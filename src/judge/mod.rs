@@ -15,6 +15,8 @@
 //! - why a divergent sweep came out as it did ([`explain_outcome`]), the
 //!   known mistakes it matches ([`known_mistake`]) and the conventions its
 //!   failures hint at ([`ConventionHints`]);
+//! - one divergent sweep as every report shows it ([`Divergence`],
+//!   [`divergence_details`], [`render_divergence_as`]);
 //! - one sweep's inputs, bit-exactly ([`SweepInputs`]).
 //!
 //! The judge depends on the core, the trace messages and the replay only;
@@ -26,6 +28,7 @@ mod agreement;
 mod compare;
 mod conventions;
 mod decision;
+mod divergence;
 mod explain;
 mod hints;
 mod inputs;
@@ -35,7 +38,7 @@ mod precision;
 pub use agreement::{Agreement, Perturbation, Reproduced, agreement, agreement_of};
 pub use compare::{
     ContactAxis, DEFAULT_ALPHA_TOLERANCE, DEFAULT_CONTACT_TOLERANCE,
-    DEFAULT_NORMAL_TOLERANCE_DEGREES, Field, FieldDiff, FieldSet, TieRule, Tolerances,
+    DEFAULT_NORMAL_TOLERANCE_DEGREES, Field, FieldDiff, FieldSet, Precision, TieRule, Tolerances,
     angle_degrees, compare,
 };
 pub use conventions::{EngineConventions, FacingRule, MarginRule};
@@ -43,9 +46,13 @@ pub(crate) use decision::write_decision_line;
 #[cfg(feature = "viewer")]
 pub(crate) use decision::write_divergence_line;
 pub use decision::{decision_line, divergence};
+pub use divergence::{
+    Divergence, Parties, divergence_details, divergence_line, render_divergence,
+    render_divergence_as, value_text, value_text_exact, values_text,
+};
 pub use explain::ExpectedTest;
 pub(crate) use explain::{expected_tests, explain_outcome, explained_records};
 pub use hints::ConventionHints;
 pub use inputs::{HexInputs, SweepInputs};
 pub use mistakes::{KNOWN_MISTAKES, Mistake, known_mistake};
-pub use precision::{F32_OPERATIONS, F32_UNIT, Precision, Sensitivity};
+pub use precision::{F32_OPERATIONS, F32_UNIT, Sensitivity};

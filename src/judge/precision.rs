@@ -55,7 +55,7 @@
 //!
 //! None of this runs on a sweep that agrees within the fixed tolerances.
 
-use serde::{Deserialize, Serialize};
+use serde::Serialize;
 
 use nalgebra::Vector3;
 
@@ -64,40 +64,6 @@ use crate::replay::SweepResult;
 use crate::trace::OutcomeMsg;
 
 use super::compare::{ContactAxis, Field, FieldDiff, Tolerances, angle_degrees};
-
-/// The arithmetic an engine computes in: an engine convention
-/// (`precision` in `sweeptrace.toml`'s `[engine]` table).
-#[derive(
-    Clone,
-    Copy,
-    Debug,
-    Default,
-    PartialEq,
-    Eq,
-    Hash,
-    Serialize,
-    Deserialize,
-    strum::IntoStaticStr,
-    strum::Display,
-    strum::EnumString,
-    strum::VariantNames,
-)]
-#[serde(rename_all = "snake_case")]
-#[strum(serialize_all = "snake_case")]
-pub enum Precision {
-    /// Double precision: the fixed tolerances, as always.
-    #[default]
-    F64,
-    /// Single precision: differences judged by backward error.
-    F32,
-}
-
-impl Precision {
-    /// Whether this is the default, `f64`.
-    pub fn is_f64(&self) -> bool {
-        *self == Precision::F64
-    }
-}
 
 /// The unit roundoff of `f32`, `u₃₂ = 2⁻²⁴`.
 pub const F32_UNIT: f64 = 1.0 / 16_777_216.0;
@@ -390,6 +356,7 @@ impl Sensitivity {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::judge::Precision;
 
     #[test]
     fn the_unit_is_two_to_the_minus_24() {

@@ -17,9 +17,8 @@ use std::fmt;
 use nalgebra::Vector3;
 use serde::Serialize;
 
-use super::replayer::SceneState;
 use crate::core::explain::num;
-use crate::core::{EdgeClass, Kind, Topology};
+use crate::core::{EdgeClass, Kind, Mesh, Topology};
 use crate::trace::OutcomeMsg;
 
 /// The default angle, in degrees, between an edge or vertex contact's
@@ -94,8 +93,8 @@ pub enum GhostJudgement {
 
 /// The unit front normal of `triangle`, turned over when the topology
 /// calls it flipped (so that the normals around a place agree).
-fn oriented_normal(scene: &SceneState, topology: &Topology, triangle: u32) -> Option<Vector3<f64>> {
-    let n = scene.mesh.triangle_by_index(triangle)?.normal;
+fn oriented_normal(mesh: &Mesh, topology: &Topology, triangle: u32) -> Option<Vector3<f64>> {
+    let n = mesh.triangle_by_index(triangle)?.normal;
     Some(if topology.flipped().binary_search(&triangle).is_ok() {
         -n
     } else {
@@ -109,12 +108,14 @@ fn angle_degrees(a: &Vector3<f64>, b: &Vector3<f64>) -> f64 {
 }
 
 /// Judges `outcome` (an expectation or an answer for a sweep against
-/// `scene`, logged at `log_time_nanos`) for a ghost contact, with the
+/// `mesh` with its `topology` (a scene's, [`super::SceneState`]), logged
+/// at `log_time_nanos`) for a ghost contact, with the
 /// threshold `degrees`. `rule_normal` is the core's own normal for the
 /// sweep: the rules' average over its tie set (which at the end of a seam
 /// takes in the triangles around the vertex), never a ghost.
 pub fn judge_ghost(
-    scene: &SceneState,
+    mesh: &Mesh,
+    topology: &Topology,
     outcome: &OutcomeMsg,
     log_time_nanos: u64,
     rule_normal: Option<&Vector3<f64>>,
@@ -124,7 +125,6 @@ pub fn judge_ghost(
     let (Some(Some(triangle)), Some(Some(feature))) = (outcome.triangle, outcome.feature) else {
         return NotApplicable;
     };
-    let topology = &scene.topology;
     let (place, neighbour, triangles): (GhostPlace, Option<u32>, Vec<u32>) = match outcome.kind {
         Kind::Edge => {
             let Some(edge) = topology.triangle_edge(triangle, feature) else {
@@ -165,7 +165,7 @@ pub fn judge_ghost(
     }
     let nearest = triangles
         .iter()
-        .filter_map(|&t| oriented_normal(scene, topology, t))
+        .filter_map(|&t| oriented_normal(mesh, topology, t))
         .map(|n| (angle_degrees(&given, &n), n))
         .min_by(|a, b| a.0.total_cmp(&b.0));
     let Some((angle, face_normal)) = nearest else {
@@ -285,27 +285,4 @@ impl Serialize for GhostLine<'_> {
         m.serialize_entry("text", &g.to_string())?;
         m.end()
     }
-}
-
-/// Where the viewers mark the ghost contact `g` of the sweep `r`: at the
-/// expected contact; without one, at the core's contact; without a hit, a
-/// detection radius from the ball's centre at the expected α, against the
-/// expected normal.
-pub fn ghost_point(r: &crate::replay::SweepResult, g: &GhostContact) -> [f64; 3] {
-    if let Some(Some(c)) = r.expected.as_ref().and_then(|e| e.contact) {
-        return c;
-    }
-    if let Some(h) = &r.outcome.hit {
-        return h.contact.coords.into();
-    }
-    let alpha = r.expected.as_ref().map_or(1.0, |e| {
-        if e.alpha.is_finite() {
-            e.alpha.clamp(0.0, 1.0)
-        } else {
-            1.0
-        }
-    });
-    let center = r.sweep.p0 + (r.sweep.p1 - r.sweep.p0) * alpha;
-    let n = Vector3::from(g.normal).normalize();
-    (center.coords - n * r.rho()).into()
 }

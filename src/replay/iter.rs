@@ -91,9 +91,6 @@ impl<I> ReplayIter<I> {
     }
 }
 
-/// Trace events per batch of [`replay_events_parallel`] unless told otherwise.
-pub const DEFAULT_BATCH_EVENTS: usize = 4096;
-
 /// Replays a stream of trace events like [`replay_events`], with the core
 /// queries of each batch of `batch_events` events run in parallel on `pool`
 /// (rayon's global pool when `None`). The results, their order, the errors

@@ -34,13 +34,13 @@ mod summary;
 mod tunnel;
 
 pub use error::ReplayError;
+pub(crate) use ghost::GhostLine;
 pub use ghost::{GHOST_DEGREES, GhostContact, GhostJudgement, GhostPlace, judge_ghost};
-pub(crate) use ghost::{GhostLine, ghost_point};
-pub use iter::{
-    DEFAULT_BATCH_EVENTS, ParallelReplayIter, ReplayIter, replay_events, replay_events_parallel,
-};
+pub use iter::{ParallelReplayIter, ReplayIter, replay_events, replay_events_parallel};
 pub use normals::SceneNormals;
-pub use options::{ACTIVE_EDGE_DEGREES, Detail, FrameRange, NormalRule, ReplayOptions};
+pub use options::{
+    ACTIVE_EDGE_DEGREES, DEFAULT_BATCH_EVENTS, Detail, FrameRange, NormalRule, ReplayOptions,
+};
 #[cfg(feature = "viewer")]
 pub(crate) use pipeline::sweep_of;
 pub use pipeline::{

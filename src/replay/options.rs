@@ -3,6 +3,9 @@
 
 use crate::core::{Facing, InitialOverlap, Options, Sides};
 
+/// Trace events per batch of [`super::replay_events_parallel`] unless told otherwise.
+pub const DEFAULT_BATCH_EVENTS: usize = 4096;
+
 /// How many test records each sweep keeps.
 #[derive(
     Clone,
@@ -58,7 +61,7 @@ impl Detail {
     /// held far more memory than the rest of the replay (BENCHMARKS.md).
     pub fn batch_events(self) -> usize {
         match self {
-            Detail::Primary => super::DEFAULT_BATCH_EVENTS,
+            Detail::Primary => DEFAULT_BATCH_EVENTS,
             Detail::Candidates => 256,
             Detail::All => 16,
         }
@@ -277,7 +280,7 @@ impl ReplayOptions {
     /// takes the default batch).
     pub fn batch_events(&self) -> usize {
         self.explain
-            .map_or(super::DEFAULT_BATCH_EVENTS, Detail::batch_events)
+            .map_or(DEFAULT_BATCH_EVENTS, Detail::batch_events)
     }
 
     /// Whether the frame and ball filters keep the sweep of `ball` at `frame`.

@@ -176,7 +176,8 @@ impl SweepResult {
     pub fn ghost(&self) -> Option<crate::replay::GhostContact> {
         let expected = self.expected.as_ref()?;
         match crate::replay::judge_ghost(
-            &self.scene,
+            &self.scene.mesh,
+            &self.scene.topology,
             expected,
             self.log_time_nanos,
             self.outcome.hit.as_ref().map(|h| &h.normal),
@@ -185,6 +186,30 @@ impl SweepResult {
             super::GhostJudgement::Ghost(g) => Some(g),
             _ => None,
         }
+    }
+
+    /// Where the viewers mark the ghost contact `g` of this sweep: at the
+    /// expected contact; without one, at the core's contact; without a hit, a
+    /// detection radius from the ball's centre at the expected α, against the
+    /// expected normal.
+    pub(crate) fn ghost_point(&self, g: &crate::replay::GhostContact) -> [f64; 3] {
+        let r = self;
+        if let Some(Some(c)) = r.expected.as_ref().and_then(|e| e.contact) {
+            return c;
+        }
+        if let Some(h) = &r.outcome.hit {
+            return h.contact.coords.into();
+        }
+        let alpha = r.expected.as_ref().map_or(1.0, |e| {
+            if e.alpha.is_finite() {
+                e.alpha.clamp(0.0, 1.0)
+            } else {
+                1.0
+            }
+        });
+        let center = r.sweep.p0 + (r.sweep.p1 - r.sweep.p0) * alpha;
+        let n = nalgebra::Vector3::from(g.normal).normalize();
+        (center.coords - n * r.rho()).into()
     }
 
     /// The record that decided the sweep: the primary test when something is

@@ -16,19 +16,18 @@
 
 use crate::core::Feature;
 use crate::replay::{ReplayError, ReplayEvent, ReplayOptions, ReplaySummary, SweepResult};
-use crate::trace::{EXPECTED_TOPIC, EventBody, OutcomeMsg, TraceError, TraceEvent, TraceReader};
+use crate::trace::{EXPECTED_TOPIC, EventBody, TraceError, TraceEvent, TraceReader};
 
 use super::ghost_count::count_ghosts;
 use super::infer::{ComparedSweep, MAX_INFERENCE_SWEEPS, infer};
 use super::report::{
-    Divergence, Judged, KindChange, MAX_DIVERGENT_FRAMES, MAX_ERRORS, MAX_LISTED_TUNNELS,
-    TraceReport, TunnelReport, WithinPrecision,
+    Judged, KindChange, MAX_DIVERGENT_FRAMES, MAX_ERRORS, MAX_LISTED_TUNNELS, TraceReport,
+    TunnelReport, WithinPrecision,
 };
 use crate::judge::EngineConventions;
-use crate::judge::SweepInputs;
+use crate::judge::Tolerances;
+use crate::judge::divergence_details;
 use crate::judge::{Agreement, agreement};
-use crate::judge::{FieldDiff, Tolerances};
-use crate::judge::{expected_tests, explain_outcome, explained_records};
 
 /// Default number of divergences described in detail per trace.
 pub const DEFAULT_MAX_DETAILS: usize = 3;
@@ -377,45 +376,6 @@ impl<'a> ReportBuilder<'a> {
             report.inferred = infer(&self.compared, &self.options.tolerances);
         }
         self.report
-    }
-}
-
-/// A divergent sweep explained as `check` reports it (render it with
-/// [`super::render_divergence`]): `fields` are the fields that differ
-/// between `expected` and `got` (the sweep's outcome); the core's tests are
-/// run again with every record kept. `hex` adds the inputs in hexadecimal.
-pub fn divergence_details(
-    result: &SweepResult,
-    expected: OutcomeMsg,
-    got: OutcomeMsg,
-    fields: Vec<FieldDiff>,
-    hex: bool,
-) -> Divergence {
-    let records = explained_records(result);
-    let inputs = SweepInputs::of(&result.sweep, result.options());
-    Divergence {
-        inputs,
-        inputs_hex: hex.then(|| inputs.hex()),
-        frame: result.frame,
-        ball: result.ball,
-        log_time_nanos: result.log_time_nanos,
-        fields,
-        expected,
-        got,
-        fragile: result.outcome.fragile,
-        reproduced: None,
-        names_tie_member: false,
-        backward_error: None,
-        margin: result.options().margin,
-        facing: result.options().facing,
-        got_explanation: explain_outcome(&result.outcome, &records),
-        expected_tests: expected_tests(
-            &expected,
-            &result.outcome,
-            &records,
-            Some(&result.scene),
-            result.sweep.radius - result.options().margin,
-        ),
     }
 }
 

@@ -21,7 +21,8 @@ pub(super) fn count_ghosts(ghosts: &mut Ghosts, result: &SweepResult, judged: &J
     for (outcome, is_answer) in [(Some(&judged.expected), false), (answer, true)] {
         let Some(outcome) = outcome else { continue };
         match judge_ghost(
-            &result.scene,
+            &result.scene.mesh,
+            &result.scene.topology,
             outcome,
             result.log_time_nanos,
             result.outcome.hit.as_ref().map(|h| &h.normal),

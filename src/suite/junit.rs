@@ -19,8 +19,9 @@ use std::time::Duration;
 
 use crate::junit::{Case, CaseResult, Detail, JunitOptions, Problem, Report, Suite};
 
-use super::render::{divergence_line, render_divergence_as, render_text, sides_of};
+use super::render::{render_text, sides_of};
 use super::report::{Status, TraceReport};
+use crate::judge::{divergence_line, render_divergence_as};
 
 /// The `classname` of a trace's test case.
 const TRACE_CLASS: &str = "check";

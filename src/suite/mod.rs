@@ -36,7 +36,6 @@ pub use bless::{
     BlessEngine, BlessError, BlessOptions, BlessSelection, BlessSummary, bless_bytes, bless_file,
     bless_file_with,
 };
-pub(crate) use check::divergence_details;
 pub use check::{
     CheckOptions, DEFAULT_MAX_DETAILS, check_events, check_file, check_reader, frames_around,
 };
@@ -48,15 +47,14 @@ pub use config::{
 pub use diff::{
     DiffReport, FirstDifference, Side, diff, render_diff_json, render_diff_text, scene_differences,
 };
-pub use discovery::{DiscoveryError, find_traces, foxglove_output};
+pub use discovery::{DiscoveryError, find_traces};
 pub use engine_check::check_file_with_engine;
 pub use infer::{Inferred, Spread};
 pub use infer_conventions::{Evidence, InferredConventions, Trial, infer_conventions};
 pub use junit::{check_junit, github_annotations};
-pub use render::{Parties, render_divergence, render_divergence_as, render_json, render_text};
-pub(crate) use render::{divergence_line, values_text};
+pub use render::{render_json, render_text};
 pub use report::{
-    Against, Divergence, Divergences, EngineCheck, Expectations, Fragile, Ghosts, KindChange,
+    Against, Divergences, EngineCheck, Expectations, Fragile, Ghosts, KindChange,
     MAX_LISTED_TUNNELS, Status, TraceReport, TunnelReport, Tunnels, WithinPrecision,
 };
 pub use repro::{ReproCase, ReproError, TraceSweep, find_sweep};

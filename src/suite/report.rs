@@ -8,17 +8,16 @@ use std::collections::BTreeMap;
 
 use serde::{Serialize, Serializer};
 
-use crate::core::{Facing, FragileReason, Kind};
+use crate::core::{FragileReason, Kind};
 use crate::replay::{GhostContact, Tunnel, TunnelAt, TunnelKind};
 use crate::trace::OutcomeMsg;
 
 use super::infer::Inferred;
 use crate::judge::Agreement;
 use crate::judge::ConventionHints;
+use crate::judge::Divergence;
 use crate::judge::EngineConventions;
-use crate::judge::ExpectedTest;
-use crate::judge::{FieldDiff, Tolerances};
-use crate::judge::{HexInputs, SweepInputs};
+use crate::judge::Tolerances;
 
 /// How many tunnels a report lists, one line each.
 pub const MAX_LISTED_TUNNELS: usize = 10;
@@ -49,57 +48,6 @@ impl TunnelReport {
         }
         .to_string()
     }
-}
-
-/// One sweep whose outcome differs from its expectation.
-#[derive(Clone, Debug, PartialEq, Serialize)]
-pub struct Divergence {
-    /// Frame.
-    pub frame: u64,
-    /// Ball.
-    pub ball: u32,
-    /// `log_time` of the sweep, in nanoseconds.
-    pub log_time_nanos: u64,
-    /// The fields that differ.
-    pub fields: Vec<FieldDiff>,
-    /// The expectation.
-    pub expected: OutcomeMsg,
-    /// The core's outcome.
-    pub got: OutcomeMsg,
-    /// Why the core's decision is fragile (empty when robust).
-    pub fragile: crate::core::Fragility,
-    /// When the decision is fragile and rounding explains the divergence:
-    /// the perturbation of the inputs under which the core gives each
-    /// side's answer (absent otherwise: a fragile decision does not excuse
-    /// an answer no rounding gives).
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub reproduced: Option<crate::judge::Reproduced>,
-    /// Whether the expectation names another member of the core's tie set
-    /// (a failure only where the tie order must be followed exactly:
-    /// `conform`). Only in the JSON when true.
-    #[serde(skip_serializing_if = "std::ops::Not::not")]
-    pub names_tie_member: bool,
-    /// At single precision, when the difference is within what it
-    /// explains: its backward error, in units of `u₃₂ · S` (see
-    /// [`super::Sensitivity`]). Absent otherwise.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub backward_error: Option<f64>,
-    /// The sweep's inputs, exactly (shortest round-trip decimals in the
-    /// JSON): with them the core makes the same decision.
-    pub inputs: SweepInputs,
-    /// The inputs as hexadecimal floating point (`check --hex`).
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub inputs_hex: Option<HexInputs>,
-    /// The margin and facing rule the core used.
-    pub margin: f64,
-    /// The facing rule the core used.
-    pub facing: Facing,
-    /// The tests that decided the core's outcome, in words: the primary
-    /// test and the other hits at the same `α`, or the nearest miss.
-    pub got_explanation: Vec<String>,
-    /// The tests that would have produced the expected result (none when the
-    /// expectation is `none`, or names no triangle).
-    pub expected_tests: Vec<ExpectedTest>,
 }
 
 /// The status of one trace.

@@ -8,8 +8,9 @@
 //! [`validate_scene`], [`validate_sweep`] and [`validate_outcome`] are the
 //! message checks both share, [`ExpectedSource`] the record of who computed
 //! the expectations, [`collect_info`] summarises a trace for
-//! `sweeptrace info`, and [`prefetch`] moves a reader to a thread of its
-//! own. The format is described in `docs/TRACE_FORMAT.md`.
+//! `sweeptrace info`, [`prefetch`] moves a reader to a thread of its
+//! own, and [`foxglove_output`] tells a Foxglove file written by `replay
+//! --foxglove` from a trace. The format is described in `docs/TRACE_FORMAT.md`.
 //!
 //! The submodules are private: every public item is named once, here.
 
@@ -22,6 +23,7 @@ mod messages;
 mod prefetch;
 mod read;
 mod schemas;
+mod sniff;
 mod source;
 mod validate;
 mod write;
@@ -40,6 +42,7 @@ pub use read::{
 };
 pub(crate) use schemas::SCHEMA_ENCODING;
 pub use schemas::{OUTCOME_SCHEMA_JSON, SCENE_SCHEMA_JSON, SWEEP_SCHEMA_JSON};
+pub use sniff::{FOXGLOVE_METADATA_NAME, foxglove_output};
 pub use source::{
     EXPECTED_SOURCE_METADATA, ExpectedSource, MAX_NAME_BYTES, MAX_SETTING_VALUE_BYTES,
     MAX_SETTINGS, sweeptrace_source,

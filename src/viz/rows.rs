@@ -26,7 +26,7 @@ use super::paths::{Entity, FACE_NAMES, QUADRATIC_NAMES};
 use crate::core::explain::Label;
 use crate::core::{EdgeRecord, Kind, TestRecord};
 use crate::judge::{FieldDiff, divergence, write_decision_line, write_divergence_line};
-use crate::replay::{GhostContact, SweepResult, ghost_point};
+use crate::replay::{GhostContact, SweepResult};
 use crate::trace::OutcomeMsg;
 
 /// What the rows of `r` show, as the logger with `options` draws them
@@ -614,7 +614,7 @@ pub(crate) fn tunnel_rows(out: &mut Out<'_>, r: &SweepResult) -> bool {
 
 /// A ghost contact (`ghost`, the sweep's expected outcome as
 /// [`SweepResult::ghost`] judges it), in one row: a point where it is
-/// ([`ghost_point`]), labelled when `labelled`, and two arrows from it, the
+/// ([`SweepResult::ghost_point`]), labelled when `labelled`, and two arrows from it, the
 /// expected (ghost) normal and the faces' normal; and a WARN line in the
 /// divergences log. Returns whether it was drawn (the mark is cleared at
 /// the ball's next sweep without one).
@@ -627,7 +627,7 @@ pub(crate) fn ghost_rows(
     let Some(g) = ghost else {
         return false;
     };
-    let at = ghost_point(r, g).map(|x| x as f32);
+    let at = r.ghost_point(g).map(|x| x as f32);
     let length = r.sweep.radius.max(1e-3) * 3.0;
     let arrow = |n: [f64; 3]| {
         let v = nalgebra::Vector3::from(n);

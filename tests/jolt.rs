@@ -21,6 +21,7 @@ pub fn tests() -> Vec<Trial> {
         trial!(jolt_conforms_under_its_config_and_its_broken_variants_do_not),
         trial!(jolt_config_is_what_infer_config_prints),
         trial!(jolt_with_back_faces_is_judged_two_sided_under_sides_two),
+        trial!(conforms_printed_reproduce_command_keeps_the_table),
     ]
 }
 
@@ -333,6 +334,48 @@ fn jolt_with_back_faces_is_judged_two_sided_under_sides_two() -> anyhow::Result<
     ensure!(
         replaced == ["face.miss.back-facing", "edge.miss.back-facing"],
         "{replaced:?}"
+    );
+    Ok(Completion::Completed)
+}
+
+/// Issue 44: `conform --config JOLT.toml` printed `reproduce: sweeptrace
+/// conform --engine '…' --case facing.strict/0` without the table, and run
+/// as printed that case failed though it passed in the configured run. The
+/// printed command carries the conventions as flags (and `--no-config`):
+/// run as printed, from another directory, it passes as the run did.
+fn conforms_printed_reproduce_command_keeps_the_table() -> anyhow::Result<Completion> {
+    let engine = match jolt()? {
+        Ok(e) => e,
+        Err(skip) => return Ok(skip),
+    };
+    let out = crate::support::bin()
+        .args(["conform", "--engine", &engine, "--config", &config()])
+        .output()?;
+    let text = String::from_utf8_lossy(&out.stdout);
+    ensure!(
+        out.status.code() == Some(0),
+        "the configured run fails:\n{text}"
+    );
+    let line = text
+        .lines()
+        .find_map(|l| l.trim().strip_prefix("reproduce: sweeptrace "))
+        .ok_or_else(|| anyhow::anyhow!("no reproduce line:\n{text}"))?;
+    ensure!(
+        line.contains("--precision f32") && line.contains("--no-config"),
+        "the table is not in {line}"
+    );
+    let bin = crate::support::bin().get_program().to_owned();
+    let again = std::process::Command::new("sh")
+        .arg("-c")
+        .arg(format!("\"$0\" {line}"))
+        .arg(&bin)
+        .current_dir(std::env::temp_dir())
+        .output()?;
+    ensure!(
+        again.status.code() == Some(0),
+        "run as printed ({line}): exit {:?}\n{}",
+        again.status.code(),
+        String::from_utf8_lossy(&again.stdout)
     );
     Ok(Completion::Completed)
 }

@@ -20,6 +20,7 @@ pub fn tests() -> Vec<Trial> {
         trial!(sweep_from_the_trace_names_the_tunnel_and_the_flipped_triangle),
         trial!(sweep_on_the_obj_lists_the_triangle_under_the_ball),
         trial!(sweep_names_a_tunnel_between_sweeps_as_check_does),
+        trial!(sweep_json_says_the_conventions_it_ran_under),
     ]
 }
 
@@ -205,5 +206,51 @@ fn sweep_names_a_tunnel_between_sweeps_as_check_does() -> anyhow::Result<()> {
     let (code, out, err) = run_bin_in(root, os!["sweep", "--trace", trace, "--frame", "2"])?;
     ensure!(code == 0, "exit {code}\n{out}{err}");
     ensure!(out.contains(&format!("\ntunnel: {line}\n")), "{out}");
+    Ok(())
+}
+
+/// Issue 44: `sweep --json` omitted the conventions its answer was computed
+/// under. Declared by flags, they are in the document as `check --json`
+/// says them; under the rules there is no `conventions` key.
+fn sweep_json_says_the_conventions_it_ran_under() -> anyhow::Result<()> {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let trace = root.join("traces/record_mini_golf.mcap");
+    let sweep = |more: &[&str]| -> anyhow::Result<serde_json::Value> {
+        let mut args: Vec<&std::ffi::OsStr> = vec![
+            "sweep".as_ref(),
+            "--trace".as_ref(),
+            trace.as_os_str(),
+            "--frame".as_ref(),
+            "55".as_ref(),
+            "--ball".as_ref(),
+            "1".as_ref(),
+            "--json".as_ref(),
+            "--no-config".as_ref(),
+        ];
+        args.extend(more.iter().map(std::ffi::OsStr::new));
+        let (code, out, err) = run_bin_in(root, &args)?;
+        ensure!(code == 0, "exit {code}: {err}");
+        serde_json::from_str(&out).with_context(|| out.clone())
+    };
+    let declared = sweep(&[
+        "--precision",
+        "f32",
+        "--initial-overlap",
+        "alpha0",
+        "--ties",
+        "any",
+    ])?;
+    let conventions = &declared["conventions"];
+    ensure!(
+        conventions["precision"] == "f32"
+            && conventions["initial_overlap"] == "alpha0"
+            && conventions["ties"] == "any",
+        "conventions: {conventions}"
+    );
+    let rules = sweep(&[])?;
+    ensure!(
+        rules.get("conventions").is_none(),
+        "under the rules: {rules}"
+    );
     Ok(())
 }

@@ -472,11 +472,13 @@ fn write_failure_rrd(trace: &Path, dir: &Path, report: &TraceReport) -> anyhow::
     std::fs::create_dir_all(dir)
         .with_context(|| format!("creating the directory {}", dir.display()))?;
     super::warn_unfinished(&target);
-    let options = ReplayOptions {
+    // Replayed and judged as the check was: under the engine's declared
+    // conventions and the run's tolerances.
+    let options = report.conventions.replay_with(ReplayOptions {
         frames,
         explain: Some(Detail::Candidates),
         ..ReplayOptions::default()
-    };
+    });
     let name = trace.display().to_string();
     let bytes = std::fs::read(trace).with_context(|| format!("reading {name}"))?;
     super::viewer::write_check_recording(
@@ -485,6 +487,7 @@ fn write_failure_rrd(trace: &Path, dir: &Path, report: &TraceReport) -> anyhow::
         &format!("{name} (check, frames {frames})"),
         &target,
         options,
+        report.tolerances,
     )?;
     Ok(target)
 }

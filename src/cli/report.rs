@@ -194,6 +194,9 @@ pub struct SweepReport<'a> {
     /// The triangles the centre's path passes through, either way, up to
     /// where the outcome stops it.
     pub crossings: &'a [Crossing],
+    /// The engine conventions the sweep was computed under (in the JSON as
+    /// `conventions` when some are declared, as `check --json` says them).
+    pub conventions: &'a sweeptrace::judge::EngineConventions,
 }
 
 impl SweepReport<'_> {
@@ -462,6 +465,9 @@ pub fn sweep_json(r: &SweepReport) -> String {
     if let Some(object) = value.as_object_mut() {
         if let Some(source) = r.source {
             object.insert("source".into(), json!(source));
+        }
+        if !r.conventions.is_rules() {
+            object.insert("conventions".into(), json!(r.conventions));
         }
         if let Some(place) = &r.place {
             if let Some(outcome) = object.get_mut("outcome").and_then(|o| o.as_object_mut()) {

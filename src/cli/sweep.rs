@@ -223,6 +223,7 @@ pub fn run(args: Args) -> anyhow::Result<Exit> {
         defects: topology.as_ref().map(|t| t.defects().len()),
         ghost: ghost.as_ref(),
         crossings: &crossings,
+        conventions: &settings.engine.conventions(),
     };
     if args.json {
         println!("{}", report::sweep_json(&explained));

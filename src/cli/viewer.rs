@@ -126,6 +126,7 @@ pub fn write_check_recording(
     title: &str,
     target: &Path,
     options: ReplayOptions,
+    tolerances: sweeptrace::judge::Tolerances,
 ) -> anyhow::Result<()> {
     use super::NameFileOnce as _;
     use anyhow::Context as _;
@@ -140,7 +141,13 @@ pub fn write_check_recording(
             file: Some(target.to_path_buf()),
             ..RecordingTarget::default()
         },
-        LoggerOptions::default(),
+        LoggerOptions {
+            prepare: PrepareOptions {
+                tolerances,
+                ..PrepareOptions::default()
+            },
+            ..LoggerOptions::default()
+        },
     )?;
     let logger = recording.logger();
     for event in replay_events(
@@ -172,6 +179,7 @@ pub fn write_check_recording(
     _title: &str,
     _target: &Path,
     _options: ReplayOptions,
+    _tolerances: sweeptrace::judge::Tolerances,
 ) -> anyhow::Result<()> {
     Err(needs_viewer(
         "--rrd-on-failure",

@@ -305,6 +305,50 @@ pub fn case_events(cases: &[Case]) -> Vec<TraceEvent> {
     events
 }
 
+/// The command that runs one case again as this run judged it: the
+/// engine, the case, the declared conventions as flags when there are
+/// some (and `--no-config`, so that no other `sweeptrace.toml` adds to
+/// them), the tolerances that
+/// differ from the defaults, and `--lenient` when the run was.
+fn reproduce_command(engine: &str, case: &str, options: &ConformOptions) -> String {
+    let mut words = vec![
+        "sweeptrace".to_string(),
+        "conform".to_string(),
+        "--engine".to_string(),
+        shell_quote(engine),
+        "--case".to_string(),
+        case.to_string(),
+    ];
+    let flags = options.conventions.flags();
+    if !flags.is_empty() {
+        words.extend(flags.iter().map(|f| shell_quote(f)));
+        words.push("--no-config".to_string());
+    }
+    let (tol, default) = (&options.tolerances, Tolerances::default());
+    for (flag, value, was) in [
+        ("--tolerance", tol.alpha, default.alpha),
+        (
+            "--normal-tolerance",
+            tol.normal_degrees,
+            default.normal_degrees,
+        ),
+        ("--contact-tolerance", tol.contact, default.contact),
+    ] {
+        if value != was {
+            words.push(flag.to_string());
+            words.push(format!("{value:?}"));
+        }
+    }
+    if !tol.fields.is_all() {
+        words.push("--fields".to_string());
+        words.push(tol.fields.names());
+    }
+    if !options.strict {
+        words.push("--lenient".to_string());
+    }
+    words.join(" ")
+}
+
 /// Shell-quotes `s` for a command line to paste (`'...'` when needed).
 pub fn shell_quote(s: &str) -> String {
     let plain = !s.is_empty()
@@ -454,11 +498,7 @@ pub fn run(
             what: case.what.to_string(),
             divergence,
             tie_order,
-            repro: format!(
-                "sweeptrace conform --engine {} --case {}",
-                shell_quote(&command.text),
-                case.id()
-            ),
+            repro: reproduce_command(&command.text, &case.id(), options),
             fails,
         };
         if replace {

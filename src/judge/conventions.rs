@@ -206,6 +206,23 @@ impl EngineConventions {
         out
     }
 
+    /// The command-line flags that declare these conventions (`--precision
+    /// f32 --engine-margin 0 --normal active_edges`), for the commands a
+    /// report prints: run as printed, they judge under the same table.
+    pub fn flags(&self) -> Vec<String> {
+        let mut out = Vec::new();
+        for (key, value) in self.declared() {
+            let flag = match key {
+                "margin" => "engine-margin".to_string(),
+                "facing" => "engine-facing".to_string(),
+                other => other.replace('_', "-"),
+            };
+            out.push(format!("--{flag}"));
+            out.push(value.trim_matches('"').to_string());
+        }
+        out
+    }
+
     /// The margin as TOML writes it (`"scene"` or a number).
     pub fn margin_toml(&self) -> String {
         match self.margin {

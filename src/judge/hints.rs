@@ -14,9 +14,9 @@ use crate::replay::{NormalRule, SweepResult};
 use crate::trace::OutcomeMsg;
 
 use super::agreement::{agreement, agreement_of};
+use super::compare::Precision;
 use super::compare::{Field, FieldDiff, Tolerances, angle_degrees};
 use super::conventions::EngineConventions;
-use super::compare::Precision;
 
 /// Failing sweeps a convention would explain, by convention. A sweep is
 /// counted under the first that explains it, in this order.

@@ -24,6 +24,7 @@ pub fn tests() -> Vec<Trial> {
         trial!(grazing_edge_contacts_have_finite_square_root_bounds),
         trial!(face_answers_bent_off_the_triangle_are_refused_at_f32),
         trial!(a_perturbation_does_not_spend_the_f32_budget_twice),
+        trial!(a_small_bias_shows_in_the_balance_of_later_and_earlier),
     ]
 }
 
@@ -417,6 +418,76 @@ fn a_perturbation_does_not_spend_the_f32_budget_twice() -> anyhow::Result<()> {
     ensure!(
         !sweeptrace::agreement(&rounded, &r, &tolerances(Precision::F32)).fails(false),
         "half a unit's move fails"
+    );
+    Ok(())
+}
+
+/// Issue 42: a bias too small for any one sweep's bound (every α a tenth
+/// of its own f32 bound late) passes sweep by sweep, and shows in the
+/// report's balance of later and earlier α: lopsided beyond chance, where
+/// the exact engine fed f32 inputs is not. The p99 of the backward errors
+/// is reported beside the largest.
+fn a_small_bias_shows_in_the_balance_of_later_and_earlier() -> anyhow::Result<()> {
+    let scene = terrain();
+    let sweeps = sweeps(400);
+    let check = |late: bool| -> anyhow::Result<sweeptrace::TraceReport> {
+        let mut w = TraceWriter::new(std::io::Cursor::new(Vec::new()))?;
+        w.scene(0, &scene)?;
+        let exact = results(&scene, &sweeps, |s| f32_answer(&scene, s))?;
+        for (s, r) in sweeps.iter().zip(&exact) {
+            let t = 1_000 * (s.frame + 1);
+            w.sweep(t, s)?;
+            let mut answer = r.expected.expect("every sweep has its answer");
+            if late && let (Some(hit), Some(sens)) = (r.outcome.hit, Sensitivity::of(r)) {
+                answer.alpha = (hit.alpha + 0.1 * sens.bounds(F32_OPERATIONS).alpha).min(1.0);
+            }
+            w.expected(t, &answer)?;
+        }
+        let bytes = w.finish()?.into_inner();
+        let options = sweeptrace::CheckOptions {
+            tolerances: tolerances(Precision::F32),
+            ..sweeptrace::CheckOptions::default()
+        };
+        Ok(sweeptrace::check_reader(
+            bytes.as_slice(),
+            "bias.mcap",
+            &options,
+        ))
+    };
+    let fair = check(false)?;
+    let biased = check(true)?;
+    for (what, r) in [("fair", &fair), ("biased", &biased)] {
+        ensure!(
+            r.status() == sweeptrace::Status::Ok,
+            "{what}: every sweep is within its bound: {}",
+            sweeptrace::suite::render_text(r)
+        );
+    }
+    let (f, b) = (
+        fair.within_precision.clone().expect("an f32 report"),
+        biased.within_precision.clone().expect("an f32 report"),
+    );
+    ensure!(
+        !f.lopsided(),
+        "fair: {} later, {} earlier",
+        f.alpha_later,
+        f.alpha_earlier
+    );
+    ensure!(
+        b.lopsided() && b.alpha_later > 10 * b.alpha_earlier.max(1),
+        "biased: {} later, {} earlier",
+        b.alpha_later,
+        b.alpha_earlier
+    );
+    ensure!(
+        sweeptrace::suite::render_text(&biased).contains("lopsided beyond chance"),
+        "the report says so"
+    );
+    ensure!(
+        b.p99_backward_error > 0.0 && b.p99_backward_error <= b.max_backward_error,
+        "p99 {} max {}",
+        b.p99_backward_error,
+        b.max_backward_error
     );
     Ok(())
 }

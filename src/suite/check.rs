@@ -14,7 +14,7 @@
 //! ([`crate::core::Broadphase::Exhaustive`]): the fast path stays fast on
 //! passing traces.
 
-use crate::core::Feature;
+use crate::core::{Feature, Kind};
 use crate::replay::{ReplayError, ReplayEvent, ReplayOptions, ReplaySummary, SweepResult};
 use crate::trace::{EXPECTED_TOPIC, EventBody, TraceError, TraceEvent, TraceReader};
 
@@ -25,9 +25,9 @@ use super::report::{
     TunnelReport, WithinPrecision,
 };
 use crate::judge::EngineConventions;
-use crate::judge::Tolerances;
 use crate::judge::divergence_details;
 use crate::judge::{Agreement, agreement};
+use crate::judge::{Field, Tolerances};
 
 /// Default number of divergences described in detail per trace.
 pub const DEFAULT_MAX_DETAILS: usize = 3;
@@ -195,6 +195,9 @@ struct ReportBuilder<'a> {
     /// inference of the engine's configuration (the first ones only, so
     /// memory stays bounded on long traces).
     compared: Vec<ComparedSweep>,
+    /// Every backward error within single precision, for the report's
+    /// percentile (one number a sweep that differs).
+    backward_errors: Vec<f64>,
 }
 
 impl<'a> ReportBuilder<'a> {
@@ -216,6 +219,7 @@ impl<'a> ReportBuilder<'a> {
             report,
             options,
             compared: Vec::new(),
+            backward_errors: Vec::new(),
         }
     }
 
@@ -246,6 +250,17 @@ impl<'a> ReportBuilder<'a> {
     /// match, a tie or a divergence.
     fn judged(&mut self, result: &SweepResult, judged: Judged) {
         self.report.compared += 1;
+        if let Some(within) = self.report.within_precision.as_mut()
+            && judged.expected.kind != Kind::None
+            && judged.got.kind != Kind::None
+            && self.options.tolerances.fields.contains(Field::Alpha)
+        {
+            if judged.expected.alpha > judged.got.alpha {
+                within.alpha_later += 1;
+            } else if judged.expected.alpha < judged.got.alpha {
+                within.alpha_earlier += 1;
+            }
+        }
         count_ghosts(&mut self.report.ghosts, result, &judged);
         if judged.got_is_core && self.compared.len() < MAX_INFERENCE_SWEEPS {
             self.compared.push(ComparedSweep {
@@ -311,6 +326,7 @@ impl<'a> ReportBuilder<'a> {
                 .get_or_insert_with(WithinPrecision::default);
             within.count += 1;
             within.max_backward_error = within.max_backward_error.max(error);
+            self.backward_errors.push(error);
             if !self.options.strict {
                 return;
             }
@@ -375,8 +391,21 @@ impl<'a> ReportBuilder<'a> {
         if report.divergent + report.fragile.count > 0 {
             report.inferred = infer(&self.compared, &self.options.tolerances);
         }
+        if let Some(within) = report.within_precision.as_mut() {
+            within.p99_backward_error = percentile(&mut self.backward_errors, 0.99);
+        }
         self.report
     }
+}
+
+/// The `q` quantile of `values` by nearest rank (0 when empty).
+fn percentile(values: &mut [f64], q: f64) -> f64 {
+    if values.is_empty() {
+        return 0.0;
+    }
+    values.sort_by(f64::total_cmp);
+    let rank = ((q * values.len() as f64).ceil() as usize).clamp(1, values.len());
+    values[rank - 1]
 }
 
 /// A frame range around the first failures: from `before` frames before

@@ -103,14 +103,34 @@ fn counts_text(r: &TraceReport) -> String {
     {
         let _ = write!(
             counts,
-            ", {} within single precision (largest backward error {} u32 units of the \
+            ", {} within single precision (largest backward error {}, p99 {} u32 units of the \
              sweep's scale){}",
             crate::numbers::counted(within.count, "difference", "differences"),
             crate::core::num(within.max_backward_error),
+            crate::core::num(within.p99_backward_error),
             if r.fragile.strict {
                 ", failures under --strict"
             } else {
                 ", not failures without --strict"
+            }
+        );
+    }
+    if let Some(within) = &r.within_precision
+        && within.alpha_later + within.alpha_earlier > 0
+    {
+        let _ = write!(
+            counts,
+            "; of the hits whose α differs, {} later than the core's, {} earlier{}",
+            within.alpha_later,
+            within.alpha_earlier,
+            if within.lopsided() {
+                format!(
+                    " (lopsided beyond chance, z = {:.1}: a bias of the engine or of its \
+                     arithmetic)",
+                    within.balance_z()
+                )
+            } else {
+                String::new()
             }
         );
     }

@@ -287,6 +287,38 @@ pub struct WithinPrecision {
     /// The largest backward error among them, in units of `u₃₂ · S`
     /// (`max_backward_error`).
     pub max_backward_error: f64,
+    /// The 99th percentile of their backward errors (nearest rank; 0 when
+    /// there are none): what the engine needs on all but its worst sweeps
+    /// (`p99_backward_error`).
+    pub p99_backward_error: f64,
+    /// Of the compared sweeps where both sides hit with different `α`
+    /// (within the tolerances or not): how many expectations are later
+    /// than the core's answer (`alpha_later`)...
+    pub alpha_later: u64,
+    /// ...and how many earlier (`alpha_earlier`). Rounding errs both ways
+    /// about as often; a lopsided balance is a bias of the engine (a late
+    /// contact, a penetration skin) or of its arithmetic, which a per-sweep
+    /// bound does not see ([`WithinPrecision::lopsided`]).
+    pub alpha_earlier: u64,
+}
+
+impl WithinPrecision {
+    /// How far the balance of later and earlier `α` is from even, in
+    /// standard deviations of a fair coin (`(later - earlier) / √n`).
+    pub fn balance_z(&self) -> f64 {
+        let n = (self.alpha_later + self.alpha_earlier) as f64;
+        if n == 0.0 {
+            return 0.0;
+        }
+        (self.alpha_later as f64 - self.alpha_earlier as f64) / n.sqrt()
+    }
+
+    /// Whether the balance is lopsided beyond chance: at least 20 differing
+    /// hits and five standard deviations from even (a fair coin does that
+    /// less than once in a million runs).
+    pub fn lopsided(&self) -> bool {
+        self.alpha_later + self.alpha_earlier >= 20 && self.balance_z().abs() >= 5.0
+    }
 }
 
 /// A report's tunnels: a ball's centre through a triangle, front to back,

@@ -47,10 +47,7 @@ pub fn tests() -> Vec<Trial> {
             engine_exit_is_seen_while_its_helper_holds_stdout,
             timeout = LIMIT
         ),
-        trial!(
-            a_helper_outlives_a_hung_engine_by_no_time,
-            timeout = LIMIT
-        ),
+        trial!(a_hung_engine_is_stopped_with_its_helper, timeout = LIMIT),
         trial!(engine_crash_mid_answer_leaves_no_process, timeout = LIMIT),
         trial!(
             engine_garbage_with_a_helper_leaves_no_process,
@@ -181,7 +178,10 @@ fn group_members(group: i32) -> Vec<i32> {
 fn ensure_gone(group: i32, pids: &[i32]) -> anyhow::Result<()> {
     let alive = |pid: i32| {
         std::fs::read_to_string(format!("/proc/{pid}/stat"))
-            .map(|s| s.rsplit_once(')').is_some_and(|(_, r)| !r.trim_start().starts_with('Z')))
+            .map(|s| {
+                s.rsplit_once(')')
+                    .is_some_and(|(_, r)| !r.trim_start().starts_with('Z'))
+            })
             .unwrap_or(false)
     };
     let deadline = Instant::now() + LONG_WAIT;
@@ -321,12 +321,8 @@ fn interrupt(
 fn engine_starts_with_signals_unblocked() -> anyhow::Result<()> {
     let setup = Setup::new()?;
     let command = setup.engine(100, "pass", None)?;
-    let (code, stdout, stderr) = run_bin(os!(
-        "check",
-        setup.trace.as_os_str(),
-        "--engine",
-        &command
-    ))?;
+    let (code, stdout, stderr) =
+        run_bin(os!("check", setup.trace.as_os_str(), "--engine", &command))?;
     // The engine answers "no hit" everywhere: three divergences.
     ensure!(code == 1, "exit {code}, want 1:\n{stdout}\n{stderr}");
     let (_, _, blocked) = setup.ready()?;
@@ -430,13 +426,14 @@ fn engine_exit_is_seen_while_its_helper_holds_stdout() -> anyhow::Result<()> {
     let (_, group, _) = setup.ready()?;
     let gone = ensure_gone(group, &[setup.helper_pid()?]);
     ensure!(code == 2, "exit {code}, want 2:\n{stdout}\n{stderr}");
-    let want = "exited with status 3 after answering 1 sweeps, while frame 1, ball 0 awaited its answer";
+    let want =
+        "exited with status 3 after answering 1 sweeps, while frame 1, ball 0 awaited its answer";
     ensure!(stdout.contains(want), "missing `{want}` in:\n{stdout}");
     gone
 }
 
 /// A hung engine with a helper: stopped at the timeout, with the helper.
-fn a_helper_outlives_a_hung_engine_by_no_time() -> anyhow::Result<()> {
+fn a_hung_engine_is_stopped_with_its_helper() -> anyhow::Result<()> {
     let setup = Setup::new()?;
     let command = setup.engine(1, "time.sleep(600)", Some(&setup.helper()))?;
     let (code, stdout, stderr) = run_bin(os!(
@@ -459,7 +456,8 @@ fn a_helper_outlives_a_hung_engine_by_no_time() -> anyhow::Result<()> {
 /// helper holding stdout: an error, and nothing of it left.
 fn engine_crash_mid_answer_leaves_no_process() -> anyhow::Result<()> {
     let setup = Setup::new()?;
-    let then = "out.write('{\"frame\": 1, \"ba'); out.flush(); os.kill(os.getpid(), signal.SIGSEGV)";
+    let then =
+        "out.write('{\"frame\": 1, \"ba'); out.flush(); os.kill(os.getpid(), signal.SIGSEGV)";
     let command = setup.engine(1, then, Some(&setup.helper()))?;
     let (code, stdout, stderr) = run_bin(os!(
         "check",
@@ -483,12 +481,8 @@ fn engine_garbage_with_a_helper_leaves_no_process() -> anyhow::Result<()> {
     let setup = Setup::new()?;
     let then = "out.write('collision at 0.4\\n'); out.flush(); time.sleep(600)";
     let command = setup.engine(1, then, Some(&setup.helper()))?;
-    let (code, stdout, stderr) = run_bin(os!(
-        "check",
-        setup.trace.as_os_str(),
-        "--engine",
-        &command
-    ))?;
+    let (code, stdout, stderr) =
+        run_bin(os!("check", setup.trace.as_os_str(), "--engine", &command))?;
     let (_, group, _) = setup.ready()?;
     let gone = ensure_gone(group, &[setup.helper_pid()?]);
     ensure!(code == 2, "exit {code}, want 2:\n{stdout}\n{stderr}");
@@ -528,7 +522,10 @@ fn infer_config_engine_faults_exit_2() -> anyhow::Result<()> {
             "out.write('collision at 0.4\\n'); out.flush(); continue",
             "printed a line that is not an outcome",
         ),
-        ("sys.exit(3)", "exited with status 3 after answering 1 sweeps"),
+        (
+            "sys.exit(3)",
+            "exited with status 3 after answering 1 sweeps",
+        ),
         ("time.sleep(600)", "within 3 s (--engine-timeout)"),
     ] {
         let setup = Setup::new()?;
@@ -546,7 +543,10 @@ fn infer_config_engine_faults_exit_2() -> anyhow::Result<()> {
             code == 2,
             "`{then}`: exit {code}, want 2:\n{stdout}\n{stderr}"
         );
-        ensure!(stdout.is_empty(), "`{then}`: a table was printed:\n{stdout}");
+        ensure!(
+            stdout.is_empty(),
+            "`{then}`: a table was printed:\n{stdout}"
+        );
         ensure!(
             stderr.contains(want),
             "`{then}`: missing `{want}` in:\n{stderr}"

@@ -27,15 +27,17 @@ fn main() -> ExitCode {
 }
 
 /// SIGINT (Ctrl-C) and SIGTERM: the unfinished outputs are removed
-/// ([`sweeptrace::atomic::remove_pending_files`]) and the process exits
-/// with 128 + the signal's number (130, 143), as a shell reports a process
-/// ended by it.
+/// ([`sweeptrace::atomic::remove_pending_files`]), the running engine's
+/// process group is stopped ([`sweeptrace::engine::stop_running_engines`]:
+/// SIGTERM, SIGKILL after a short grace) and the process exits with 128 +
+/// the signal's number (130, 143), as a shell reports a process ended by
+/// it.
 #[cfg(unix)]
 mod interrupts {
     /// Blocks the two signals in every thread (called before any other
-    /// thread starts, so all inherit the mask; child processes get the
-    /// default mask back from `std::process::Command`) and waits for them
-    /// on a thread of its own. If that thread cannot be started, the
+    /// thread starts, so all inherit the mask; an engine, a child process,
+    /// is given an empty mask when it starts, since `std::process::Command`
+    /// leaves it ours) and waits for them on a thread of its own. If that thread cannot be started, the
     /// signals keep their default action.
     pub fn handle() {
         // SAFETY: `set` is initialised by sigemptyset before use; the calls
@@ -65,18 +67,26 @@ mod interrupts {
             if unsafe { libc::sigwait(&set, &mut signal) } != 0 {
                 continue;
             }
+            // The outputs first: from now on none is renamed into place,
+            // whatever the engine's end makes the other threads do.
             let removed = sweeptrace::atomic::remove_pending_files();
+            let engines = sweeptrace::engine::stop_running_engines(sweeptrace::engine::STOP_GRACE);
             let name = if signal == libc::SIGINT {
                 "SIGINT"
             } else {
                 "SIGTERM"
             };
             eprintln!(
-                "\ninterrupted ({name}): {}",
+                "\ninterrupted ({name}): {}{}",
                 match removed.len() {
                     0 => "no unfinished output to remove".to_string(),
                     1 => "removed the unfinished output".to_string(),
                     n => format!("removed the {n} unfinished outputs"),
+                },
+                match engines {
+                    0 => String::new(),
+                    1 => "; stopped the engine and its process group".to_string(),
+                    n => format!("; stopped the {n} engines and their process groups"),
                 }
             );
             // SAFETY: ends the process at once, without running destructors

@@ -17,6 +17,7 @@ mod core_decisions;
 mod core_random;
 mod docs;
 mod engine;
+mod engine_faults;
 mod error_messages;
 mod exact;
 mod expected_source;
@@ -143,6 +144,7 @@ fn main() {
     trials.extend(scanned::tests());
     trials.extend(foxglove::tests());
     trials.extend(engine::tests());
+    trials.extend(engine_faults::tests());
     trials.extend(conform::tests());
     trials.extend(junit::tests());
     trials.extend(verdicts::tests());

@@ -218,6 +218,18 @@ pub fn run(args: Args) -> anyhow::Result<Exit> {
             eprintln!("error: {cause}\nnothing written");
             return Ok(exit);
         }
+        // An answer the trace cannot hold: a fault of the engine, exit 2.
+        Err(err @ BlessError::Answer { .. }) => {
+            eprintln!(
+                "error: {err}\nnothing written{}",
+                if args.in_place {
+                    " (the trace is left as it was)"
+                } else {
+                    ""
+                }
+            );
+            return Ok(Exit::Error);
+        }
         Err(err) => return Err(err).name_file_once("blessing", args.trace.display()),
     };
     // One line for what was written, then one for each thing to know.

@@ -264,34 +264,43 @@ pub fn run(args: Args) -> anyhow::Result<Exit> {
             Some((command, _)) => format!("the engine `{}`", command.text),
             None => "the traces' /expected".to_string(),
         };
+        // A trace that cannot be checked, or a fault of the engine, ends
+        // the inference: its exit code and its message; no table.
         let inferred = sweeptrace::suite::infer_conventions(|conventions| {
-            let reports: Vec<TraceReport> = traces
-                .iter()
-                .zip(&settings)
-                .map(|(path, settings)| {
-                    let base = settings.check_options(options);
-                    let options = CheckOptions {
-                        tolerances: conventions.judge_with(base.tolerances),
-                        replay: conventions.replay_with(options.replay),
-                        ..base
-                    };
-                    match &engine {
-                        None => check_file(path, &options),
-                        Some((command, engine_options)) => check_file_with_engine(
-                            path,
-                            command,
-                            *engine_options,
-                            Against::Core,
-                            &options,
+            let mut reports: Vec<TraceReport> = Vec::new();
+            for (path, settings) in traces.iter().zip(&settings) {
+                let base = settings.check_options(options);
+                let options = CheckOptions {
+                    tolerances: conventions.judge_with(base.tolerances),
+                    replay: conventions.replay_with(options.replay),
+                    ..base
+                };
+                let report = match &engine {
+                    None => check_file(path, &options),
+                    Some((command, engine_options)) => check_file_with_engine(
+                        path,
+                        command,
+                        *engine_options,
+                        Against::Core,
+                        &options,
+                    )
+                    .map_err(|err| {
+                        (
+                            Exit::EngineUnavailable,
+                            format!("{}: {err}", path.display()),
                         )
-                        .unwrap_or_else(|err| {
-                            let mut r = check_file(path, &options);
-                            r.add_error(err.to_string());
-                            r
-                        }),
-                    }
-                })
-                .collect();
+                    })?,
+                };
+                if report.status() == Status::Error {
+                    let errors: Vec<String> = report
+                        .errors
+                        .iter()
+                        .map(|e| format!("{}: {e}", path.display()))
+                        .collect();
+                    return Err((outcome_of(&report), errors.join("\nerror: ")));
+                }
+                reports.push(report);
+            }
             let trial = sweeptrace::suite::Trial::of(&reports);
             eprintln!(
                 "tried {}: {} of {} compared sweeps fail",
@@ -299,10 +308,18 @@ pub fn run(args: Args) -> anyhow::Result<Exit> {
                 trial.failing,
                 trial.compared
             );
-            trial
+            Ok(trial)
         });
-        print!("{}", inferred.to_toml(&source));
-        return Ok(Exit::Success);
+        return match inferred {
+            Ok(inferred) => {
+                print!("{}", inferred.to_toml(&source));
+                Ok(Exit::Success)
+            }
+            Err((exit, message)) => {
+                eprintln!("error: {message}\nno configuration inferred");
+                Ok(exit)
+            }
+        };
     }
     let junit = args.junit.start()?;
     let (mut reports, mut times): (Vec<TraceReport>, Vec<_>) = (Vec::new(), Vec::new());

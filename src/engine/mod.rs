@@ -7,6 +7,9 @@
 //!   writer thread feeding its stdin, a reader thread parsing its stdout,
 //!   the last lines of its stderr kept for the error messages, a timeout on
 //!   every answer;
+//! - [`stop_running_engines`]: every running engine's process group
+//!   stopped, for a process ending on a signal (the command line's signal
+//!   thread calls it);
 //! - [`EngineAnswers`]: a trace's events with the engine's answers put in
 //!   as each sweep's expectation, pipelined (up to
 //!   [`EngineOptions::window`] sweeps in flight), so that `check`'s whole
@@ -24,6 +27,7 @@
 mod answers;
 mod command;
 mod error;
+mod groups;
 mod process;
 pub mod protocol;
 
@@ -31,6 +35,7 @@ pub(crate) use answers::AnswerSink;
 pub use answers::{EngineAnswers, EngineRun};
 pub use command::EngineCommand;
 pub use error::EngineError;
+pub use groups::{STOP_GRACE, stop_running_engines};
 pub use process::EngineSession;
 
 use std::time::Duration;

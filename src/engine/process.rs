@@ -1,16 +1,28 @@
 //! The running engine: a child process, a writer thread feeding its stdin,
 //! a reader thread splitting its stdout into lines, a thread keeping the
-//! last lines of its stderr.
+//! last lines of its stderr, and (Unix) a thread waiting for the engine to
+//! exit.
+//!
+//! The engine leads a process group of its own, registered process-wide
+//! ([`super::groups`]) while it runs. It starts with no signal blocked (the
+//! command line blocks SIGINT and SIGTERM in its own threads, and a child
+//! inherits the mask). Its exit is noticed by itself, not only through the
+//! end of its stdout, which a process it started may hold open; the
+//! leader is reaped only after its whole group was killed, so that nothing
+//! it started outlives it and the group's id cannot be another's when it
+//! is signalled.
 
 use std::collections::VecDeque;
 use std::io::{BufRead, BufReader, BufWriter, Read, Write};
 use std::process::{Child, ChildStdin, Command, ExitStatus, Stdio};
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::mpsc::{self, Receiver, RecvTimeoutError, Sender};
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
 use crate::trace::{OutcomeMsg, SceneMsg, SweepMsg};
 
+use super::groups::{self, Group};
 use super::protocol::{MAX_ANSWER_BYTES, parse_answer, scene_line, sweep_line};
 use super::{EngineCommand, EngineError, EngineOptions, STDERR_TAIL_LINES};
 
@@ -20,6 +32,9 @@ enum Output {
     TooLong,
     End,
     Failed(std::io::Error),
+    /// The engine (the group's leader) has exited; it is not reaped yet.
+    /// Its stdout may still be open, held by a process it started.
+    LeaderExited,
 }
 
 /// The last lines of the engine's stderr, shared with the thread reading it.
@@ -63,11 +78,16 @@ impl StderrTail {
     }
 }
 
-/// A running engine. Dropping it stops the engine if it still runs.
+/// A running engine. Dropping it stops the engine if it still runs, and
+/// every process left in its process group.
 pub struct EngineSession {
     command: EngineCommand,
     options: EngineOptions,
     child: Child,
+    /// Set once the engine has exited (by the thread waiting for it).
+    exited: Arc<AtomicBool>,
+    /// Once reaped: how it ended (`None` inside when the wait failed).
+    reaped: Option<Option<ExitStatus>>,
     to_engine: Option<Sender<String>>,
     from_engine: Receiver<Output>,
     stderr: StderrTail,
@@ -103,12 +123,41 @@ impl EngineSession {
         // what it started too (an engine run through `sh -c` is the shell's
         // child: killing the shell alone would leave it running).
         #[cfg(unix)]
-        std::os::unix::process::CommandExt::process_group(&mut engine, 0);
+        {
+            use std::os::unix::process::CommandExt;
+            engine.process_group(0);
+            // The command line blocks SIGINT and SIGTERM in every thread
+            // (a thread of its own waits for them), and `Command` leaves
+            // the child that mask: an engine would ignore `kill`, `timeout`
+            // and a CI runner's SIGTERM.
+            // SAFETY: the closure runs in the child between fork and exec,
+            // and calls only sigemptyset and sigprocmask, which are
+            // async-signal-safe, on a set of its own.
+            unsafe {
+                engine.pre_exec(|| {
+                    let mut set: libc::sigset_t = std::mem::zeroed();
+                    libc::sigemptyset(&mut set);
+                    if libc::sigprocmask(libc::SIG_SETMASK, &set, std::ptr::null_mut()) != 0 {
+                        return Err(std::io::Error::last_os_error());
+                    }
+                    Ok(())
+                });
+            }
+        }
+        // Started and registered under the registry's lock: a signal that
+        // ends this process finds every engine it started.
+        let mut registry = groups::lock();
         let mut child = engine.spawn().map_err(|e| EngineError::CannotStart {
             command: command.text.clone(),
             reason: format!("{}: {e}", command.program),
             stderr_tail: Vec::new(),
         })?;
+        let exited = Arc::new(AtomicBool::new(false));
+        registry.push(Group {
+            id: child.id(),
+            exited: exited.clone(),
+        });
+        drop(registry);
         let io_error = |what, cause| EngineError::Io {
             command: command.text.clone(),
             what,
@@ -136,10 +185,14 @@ impl EngineSession {
                 .spawn(f)
                 .map_err(|e| io_error("starting a thread", e))
         };
+        #[cfg(unix)]
+        let leader = (child.id(), exited.clone(), output.clone());
         let session = EngineSession {
             command: command.clone(),
             options,
             child,
+            exited,
+            reaped: None,
             to_engine: Some(to_engine),
             from_engine,
             stderr: tail.clone(),
@@ -155,6 +208,11 @@ impl EngineSession {
             Box::new(move || read_lines(stdout, output)),
         )?;
         spawn("engine stderr", Box::new(move || keep_tail(stderr, tail)))?;
+        #[cfg(unix)]
+        spawn(
+            "engine exit",
+            Box::new(move || wait_for_leader(leader.0, &leader.1, &leader.2)),
+        )?;
         // The threads run until the pipes close; a failure to start one
         // drops the session, which stops the engine.
         Ok(session)
@@ -203,7 +261,8 @@ impl EngineSession {
     /// The answer to the sweep `due` (frame, ball): the engine's next output
     /// line, which must be an outcome of that sweep, within the timeout.
     pub fn next_answer(&mut self, due: (u64, u32)) -> Result<OutcomeMsg, EngineError> {
-        match self.from_engine.recv_timeout(self.options.timeout) {
+        let deadline = Instant::now() + self.options.timeout;
+        match self.receive(deadline) {
             Ok(Output::Line(line)) => {
                 self.lines_read += 1;
                 let answer = parse_answer(&line)
@@ -230,7 +289,9 @@ impl EngineSession {
                 ))
             }
             Ok(Output::Failed(e)) => Err(self.io("reading its output", e)),
-            Ok(Output::End) | Err(RecvTimeoutError::Disconnected) => Err(self.ended(Some(due))),
+            Ok(Output::End | Output::LeaderExited) | Err(RecvTimeoutError::Disconnected) => {
+                Err(self.ended(Some(due)))
+            }
             Err(RecvTimeoutError::Timeout) => {
                 self.stop();
                 Err(EngineError::Timeout {
@@ -241,6 +302,20 @@ impl EngineSession {
                     answered: self.answered,
                     stderr_tail: self.stderr.snapshot(Duration::from_millis(200)),
                 })
+            }
+        }
+    }
+
+    /// The engine's next output before `deadline`. When the engine exits,
+    /// what is left of its group is killed and its output read on: what
+    /// it wrote before it exited is still there, and the end of its output
+    /// follows, even when a process it started held it open.
+    fn receive(&mut self, deadline: Instant) -> Result<Output, RecvTimeoutError> {
+        loop {
+            let left = deadline.saturating_duration_since(Instant::now());
+            match self.from_engine.recv_timeout(left) {
+                Ok(Output::LeaderExited) => self.kill_what_it_left(),
+                other => return other,
             }
         }
     }
@@ -300,8 +375,7 @@ impl EngineSession {
     pub fn finish(mut self) -> Result<(), EngineError> {
         self.to_engine = None;
         let deadline = Instant::now() + self.options.timeout;
-        let left = deadline.saturating_duration_since(Instant::now());
-        match self.from_engine.recv_timeout(left) {
+        match self.receive(deadline) {
             Ok(Output::Line(line)) => {
                 self.lines_read += 1;
                 let reason = "every sweep was already answered".to_string();
@@ -313,7 +387,7 @@ impl EngineSession {
                 return Err(self.not_an_outcome(b"", reason, None));
             }
             Ok(Output::Failed(e)) => return Err(self.io("reading its output", e)),
-            Ok(Output::End) | Err(RecvTimeoutError::Disconnected) => {}
+            Ok(Output::End | Output::LeaderExited) | Err(RecvTimeoutError::Disconnected) => {}
             Err(RecvTimeoutError::Timeout) => {
                 self.stop();
                 return Err(EngineError::DoesNotExit {
@@ -336,37 +410,82 @@ impl EngineSession {
         }
     }
 
-    /// Waits up to `limit` for the engine to exit.
+    /// Waits up to `limit` for the engine to exit; then kills what is
+    /// left of its group and reaps it.
     fn wait_for_exit(&mut self, limit: Duration) -> Option<ExitStatus> {
         let deadline = Instant::now() + limit;
         loop {
-            match self.child.try_wait() {
-                Ok(Some(status)) => return Some(status),
-                Ok(None) if Instant::now() < deadline => {
-                    std::thread::sleep(Duration::from_millis(2));
-                }
-                _ => return None,
+            if let Some(reaped) = self.reaped {
+                return reaped;
+            }
+            if self.leader_exited() {
+                return self.reap();
+            }
+            if Instant::now() >= deadline {
+                return None;
+            }
+            std::thread::sleep(Duration::from_millis(2));
+        }
+    }
+
+    /// Whether the engine has exited (it may not be reaped yet).
+    fn leader_exited(&mut self) -> bool {
+        if self.exited.load(Ordering::SeqCst) {
+            return true;
+        }
+        // Without a thread waiting for it (not Unix), ask.
+        #[cfg(not(unix))]
+        if let Ok(Some(_)) = self.child.try_wait() {
+            return true;
+        }
+        false
+    }
+
+    /// Kills the processes left in the engine's group once the engine has
+    /// exited (those it started, which may hold its stdout open).
+    fn kill_what_it_left(&mut self) {
+        if self.reaped.is_none() {
+            // The leader is not reaped: its pid keeps the group's id.
+            self.kill_group();
+        }
+    }
+
+    /// SIGKILL to the engine's whole process group (its id is the
+    /// leader's pid, `process_group(0)`), when the leader is not reaped.
+    fn kill_group(&mut self) {
+        #[cfg(unix)]
+        if let Ok(group) = libc::pid_t::try_from(self.child.id()) {
+            // SAFETY: killpg only sends a signal; no memory is involved.
+            unsafe {
+                libc::killpg(group, libc::SIGKILL);
             }
         }
+        #[cfg(not(unix))]
+        let _ = self.child.kill();
+    }
+
+    /// Kills the engine's group (the engine if it still runs, and always
+    /// what it started) and reaps the engine, once; how it ended.
+    fn reap(&mut self) -> Option<ExitStatus> {
+        if let Some(reaped) = self.reaped {
+            return reaped;
+        }
+        // Under the registry's lock: the signal thread never signals the
+        // group once its id may be another's.
+        let mut registry = groups::lock();
+        self.kill_group();
+        let status = self.child.wait().ok();
+        groups::remove(&mut registry, self.child.id());
+        drop(registry);
+        self.reaped = Some(status);
+        status
     }
 
     /// Stops the engine (if it still runs) with every process of its group,
     /// and reaps it.
     fn stop(&mut self) {
         self.to_engine = None;
-        if let Ok(None) = self.child.try_wait() {
-            // The group is the engine's own pid (`process_group(0)`), alive
-            // until reaped below, so the id cannot be another's.
-            #[cfg(unix)]
-            if let Ok(group) = libc::pid_t::try_from(self.child.id()) {
-                // SAFETY: killpg only sends a signal; no memory is involved.
-                unsafe {
-                    libc::killpg(group, libc::SIGKILL);
-                }
-            }
-            let _ = self.child.kill();
-        }
-        let _ = self.child.wait();
+        self.reap();
     }
 }
 
@@ -397,6 +516,31 @@ fn describe_status(status: ExitStatus) -> String {
         }
     }
     format!("ended ({status})")
+}
+
+/// The thread waiting for the engine (the group's leader) to exit: it
+/// says so without reaping it (`WNOWAIT`), so the leader's pid keeps the
+/// group's id until [`EngineSession`] has killed the group and reaps it.
+/// Ends when the engine has exited or has been reaped already.
+#[cfg(unix)]
+fn wait_for_leader(pid: u32, exited: &AtomicBool, output: &Sender<Output>) {
+    let id = libc::id_t::from(pid);
+    loop {
+        // SAFETY: `info` is a valid out pointer, zeroed as waitid expects.
+        let done = unsafe {
+            let mut info: libc::siginfo_t = std::mem::zeroed();
+            libc::waitid(libc::P_PID, id, &mut info, libc::WEXITED | libc::WNOWAIT)
+        };
+        if done == 0 {
+            exited.store(true, Ordering::SeqCst);
+            let _ = output.send(Output::LeaderExited);
+            return;
+        }
+        if std::io::Error::last_os_error().kind() != std::io::ErrorKind::Interrupted {
+            // ECHILD: reaped already.
+            return;
+        }
+    }
 }
 
 /// The writer thread: lines to the engine's stdin, flushed whenever no

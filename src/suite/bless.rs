@@ -47,12 +47,14 @@ use crate::engine::{
     AnswerSink, EngineAnswers, EngineCommand, EngineError, EngineOptions, EngineSession,
 };
 use crate::error_text::full_text;
-use crate::replay::{FrameRange, ReplayError, ReplayEvent, ReplayOptions, replay_events};
+use crate::replay::{
+    FrameRange, ReplayError, ReplayEvent, ReplayOptions, SweepResult, replay_events,
+};
 use crate::trace::{
     EXPECTED_SOURCE_METADATA, EXPECTED_TOPIC, Encoding, ExpectedSource, MAX_NAME_BYTES,
     MAX_SETTING_VALUE_BYTES, OUTCOME_SCHEMA, OUTCOME_SCHEMA_JSON, OutcomeMsg, SCHEMA_ENCODING,
     SWEEP_TOPIC, TraceError, TraceReader, default_write_options, frame_of_message,
-    sweeptrace_source,
+    sweeptrace_source, validate_outcome, validate_triangle,
 };
 
 /// What went wrong while blessing.
@@ -98,6 +100,25 @@ pub enum BlessError {
     Engine {
         /// What went wrong, naming the command.
         cause: EngineError,
+    },
+    /// The engine's answer to a sweep is one the trace cannot hold (a
+    /// triangle the scene does not have): the checks every writer of
+    /// `/expected` makes ([`crate::trace::validate_outcome`],
+    /// [`crate::trace::validate_triangle`]).
+    #[error(
+        "the engine `{command}` answered frame {frame}, ball {ball} with an outcome the trace cannot hold: field `{field}`: {problem}"
+    )]
+    Answer {
+        /// The engine's command.
+        command: String,
+        /// The sweep's frame.
+        frame: u64,
+        /// The sweep's ball.
+        ball: u32,
+        /// The field at fault.
+        field: String,
+        /// What is wrong with it.
+        problem: String,
     },
     /// A `/sweep` message found in the copy pass has no outcome from the
     /// replay pass (the replay and the copy disagree on the file).
@@ -254,21 +275,23 @@ struct Collected {
 }
 
 impl Collected {
-    /// Takes one replayed event; `answer` is the engine's answer to it
-    /// (with an engine), else the core's outcome is the new expectation.
+    /// Takes one replayed event; `answer` gives the engine's answer to a
+    /// sweep, checked (with an engine: every sweep's, selected or not),
+    /// else the core's outcome is the new expectation.
     fn event(
         &mut self,
         event: Result<ReplayEvent, ReplayError>,
         name: &str,
         select: &BlessSelection,
-        answer: impl FnOnce(u64, u32) -> Option<OutcomeMsg>,
+        answer: impl FnOnce(&SweepResult) -> Result<Option<OutcomeMsg>, BlessError>,
     ) -> Result<(), BlessError> {
         match event {
             Ok(ReplayEvent::Sweep(r)) => {
                 self.sweeps += 1;
+                let answer = answer(&r)?;
                 let written = if select.selects(r.frame, r.ball) {
                     self.blessed += 1;
-                    Some(answer(r.frame, r.ball).unwrap_or_else(|| r.outcome_msg()))
+                    Some(answer.unwrap_or_else(|| r.outcome_msg()))
                 } else {
                     self.kept += u64::from(r.expected.is_some());
                     r.expected
@@ -297,6 +320,30 @@ impl Collected {
         }
         Ok(())
     }
+}
+
+/// The engine's answer to the sweep `r`, if it gave one, when the trace
+/// can hold it: checked as every writer of `/expected` checks an outcome
+/// (its values, and a triangle of the sweep's scene), so that a snapshot
+/// is never written that its own reader or writer would refuse.
+fn checked_answer(
+    answer: Option<OutcomeMsg>,
+    r: &SweepResult,
+    engine: &BlessEngine,
+) -> Result<Option<OutcomeMsg>, BlessError> {
+    let Some(answer) = answer else {
+        return Ok(None);
+    };
+    validate_outcome(&answer)
+        .and_then(|()| validate_triangle(&answer, r.scene.mesh.triangles().len()))
+        .map_err(|problem| BlessError::Answer {
+            command: engine.command.text.clone(),
+            frame: r.frame,
+            ball: r.ball,
+            field: problem.field,
+            problem: problem.problem,
+        })?;
+    Ok(Some(answer))
 }
 
 /// `text` cut to at most `max` bytes, at a character boundary, with `...`
@@ -341,7 +388,7 @@ fn outcomes_of(input: &[u8], name: &str, options: &BlessOptions) -> Result<Repla
     match &options.engine {
         None => {
             for event in replay_events(reader.by_ref(), replay) {
-                collected.event(event, name, &options.select, |_, _| None)?;
+                collected.event(event, name, &options.select, |_| Ok(None))?;
             }
         }
         Some(engine) => {
@@ -355,8 +402,8 @@ fn outcomes_of(input: &[u8], name: &str, options: &BlessOptions) -> Result<Repla
                 sink.clone(),
             );
             for event in replay_events(answers.by_ref(), replay) {
-                collected.event(event, name, &options.select, |frame, ball| {
-                    sink.borrow_mut().remove(&(frame, ball))
+                collected.event(event, name, &options.select, |r| {
+                    checked_answer(sink.borrow_mut().remove(&(r.frame, r.ball)), r, engine)
                 })?;
             }
             if let Some(cause) = answers.finish().error {

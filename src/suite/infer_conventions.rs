@@ -93,12 +93,14 @@ pub struct InferredConventions {
 }
 
 /// Infers the conventions: `check` runs every trace under the conventions
-/// it is given and returns the trial.
-pub fn infer_conventions(
-    mut check: impl FnMut(&EngineConventions) -> Trial,
-) -> InferredConventions {
+/// it is given and returns the trial, or an error (a fault of the engine,
+/// a trace that cannot be checked), which ends the inference: a trial that
+/// did not see every sweep is no evidence.
+pub fn infer_conventions<E>(
+    mut check: impl FnMut(&EngineConventions) -> Result<Trial, E>,
+) -> Result<InferredConventions, E> {
     let rules = EngineConventions::default();
-    let under_rules = check(&rules);
+    let under_rules = check(&rules)?;
     let mut best = rules;
     let mut best_trial = under_rules.clone();
     let mut evidence: Vec<Evidence> = Vec::new();
@@ -182,7 +184,7 @@ pub fn infer_conventions(
         if trying == best {
             continue;
         }
-        let trial = check(&trying);
+        let trial = check(&trying)?;
         if trial.errors > best_trial.errors || trial.failing >= best_trial.failing {
             if key == "normal"
                 && trial.failing == best_trial.failing
@@ -243,12 +245,12 @@ pub fn infer_conventions(
             because,
         });
     }
-    InferredConventions {
+    Ok(InferredConventions {
         conventions: best,
         evidence,
         under_rules,
         under_inferred: best_trial,
-    }
+    })
 }
 
 /// The margin every estimate agrees on (to 1e-9), if they do.
@@ -297,7 +299,7 @@ mod tests {
     use super::*;
 
     /// A fake suite: each convention fixes a known number of sweeps.
-    fn suite(c: &EngineConventions) -> Trial {
+    fn suite(c: &EngineConventions) -> Result<Trial, String> {
         let mut failing = 100;
         if c.precision == Precision::F32 {
             failing -= 60;
@@ -314,19 +316,19 @@ mod tests {
         if c.sides == Sides::Two {
             failing -= 7;
         }
-        Trial {
+        Ok(Trial {
             failing,
             compared: 1000,
             precision: if c.precision == Precision::F32 { 60 } else { 0 },
             max_backward_error: 2.0,
             margins: vec![0.0, 0.0],
             ..Trial::default()
-        }
+        })
     }
 
     #[test]
     fn keeps_what_fixes_sweeps_and_says_why() {
-        let inferred = infer_conventions(suite);
+        let inferred = infer_conventions(suite).expect("no fault");
         let c = inferred.conventions;
         assert_eq!(c.precision, Precision::F32);
         assert_eq!(c.initial_overlap, InitialOverlap::Alpha0);
@@ -352,23 +354,48 @@ mod tests {
     fn a_one_sided_engine_keeps_one_side() {
         // Both sides make sweeps fail (hits where the engine sees none):
         // the rules' `one` stays, and a default is not printed.
-        let inferred = infer_conventions(|c| Trial {
-            failing: if c.sides == Sides::Two { 40 } else { 10 },
-            compared: 100,
-            ..Trial::default()
-        });
+        let inferred = infer_conventions(|c| {
+            Ok::<_, String>(Trial {
+                failing: if c.sides == Sides::Two { 40 } else { 10 },
+                compared: 100,
+                ..Trial::default()
+            })
+        })
+        .expect("no fault");
         assert_eq!(inferred.conventions.sides, Sides::One);
         assert!(!inferred.to_toml("x").contains("sides"));
     }
 
     #[test]
     fn an_engine_of_the_rules_gets_an_empty_table() {
-        let inferred = infer_conventions(|_| Trial {
-            failing: 0,
-            compared: 10,
-            ..Trial::default()
-        });
+        let inferred = infer_conventions(|_| {
+            Ok::<_, String>(Trial {
+                failing: 0,
+                compared: 10,
+                ..Trial::default()
+            })
+        })
+        .expect("no fault");
         assert!(inferred.conventions.is_rules());
         assert!(inferred.to_toml("x").contains("No convention fits better"));
+    }
+
+    /// Issue 43: a fault in any trial (here the third) ends the inference
+    /// with that fault; no conventions come of it.
+    #[test]
+    fn a_fault_in_a_trial_is_the_result() {
+        let mut trials = 0;
+        let result = infer_conventions(|c| {
+            trials += 1;
+            if trials == 3 {
+                return Err("the engine exited with status 3".to_string());
+            }
+            suite(c)
+        });
+        assert_eq!(
+            result.map(|i| i.conventions),
+            Err("the engine exited with status 3".to_string())
+        );
+        assert_eq!(trials, 3, "no trial after the fault");
     }
 }

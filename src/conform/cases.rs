@@ -782,7 +782,12 @@ mod tests {
     fn outcome(case: &Case) -> Outcome {
         let mesh = Mesh::new(case.scene.vertices.clone(), &case.scene.triangles).expect("mesh");
         let s = &case.sweep;
-        sweep_mesh(&mesh, &Sweep::new(s.p0, s.p1, s.radius), &Options::default()).expect("sweep")
+        sweep_mesh(
+            &mesh,
+            &Sweep::new(s.p0, s.p1, s.radius),
+            &Options::default(),
+        )
+        .expect("sweep")
     }
 
     fn of_rule(rule: &str) -> Vec<Case> {
@@ -795,7 +800,12 @@ mod tests {
     fn the_closest_hit_is_the_later_listed_triangle() {
         for case in of_rule("mesh.closest-hit") {
             let hit = outcome(&case).hit.expect("a hit");
-            assert_eq!((hit.triangle, hit.feature), (1, Feature::Face), "{}", case.id());
+            assert_eq!(
+                (hit.triangle, hit.feature),
+                (1, Feature::Face),
+                "{}",
+                case.id()
+            );
             // Triangle 0 alone is hit too, later: the case tells them apart.
             let mut alone = case.clone();
             alone.scene.triangles.truncate(1);

@@ -38,6 +38,7 @@ pub fn tests() -> Vec<Trial> {
             tie_vertex_first_bug_fails_exactly_the_kind_order_rules,
             timeout = LIMIT
         ),
+        trial!(issue_42_bugs_fail_the_rules_added_for_them, timeout = LIMIT),
         trial!(lenient_lets_tie_choices_pass, timeout = LIMIT),
         trial!(repro_command_runs_one_case, timeout = LIMIT),
         trial!(conform_engine_not_found_exits_125, timeout = LIMIT),
@@ -209,6 +210,9 @@ fn tie_highest_triangle_bug_fails_exactly_the_triangle_order_rules() -> anyhow::
             "tie.shared-edge.cube",
             "tie.shared-vertex",
             "tie.cube-corner",
+            // Ties too, judged by the rule's order where ties = "rule".
+            "normal.shallow-convex-edge",
+            "normal.flat-edge",
         ],
     )?;
     ensure!(doc["fragile"] == 0, "no failure excused: {doc}");
@@ -234,6 +238,8 @@ fn tie_vertex_first_bug_fails_exactly_the_kind_order_rules() -> anyhow::Result<(
             "tie.shared-edge.planar",
             "tie.kind-order",
             "tie.across-kinds",
+            // Faces and edges tie on the flat diagonal: the face is primary.
+            "normal.flat-edge",
         ],
     )?;
     let why = tie_order_of(&doc, "tie.kind-order");
@@ -252,6 +258,54 @@ fn tie_vertex_first_bug_fails_exactly_the_kind_order_rules() -> anyhow::Result<(
         why.contains("chooses the face of triangle 1") && why.contains("edge 2 of triangle 0"),
         "the face of the higher triangle beats the edge of the lower: {why}"
     );
+    Ok(())
+}
+
+/// Issue 42: six bug classes that `check` saw on the sample traces and
+/// `conform` did not. Each `--bug` of the exact engine now fails the rule
+/// added for it (and only the rules its mistake breaks), with no excuse.
+fn issue_42_bugs_fail_the_rules_added_for_them() -> anyhow::Result<()> {
+    let bugs: [(&str, &[&str]); 6] = [
+        // A ball leaving the surface answered as a hit at α = 0.
+        ("glued", &["start.moving-away"]),
+        // The lowest triangle on the path, not the nearest; the tie rules
+        // fail as well, since only that triangle's hits are averaged.
+        (
+            "first-hit",
+            &[
+                "tie.shared-edge.cube",
+                "tie.shared-vertex",
+                "tie.across-kinds",
+                "tie.cube-corner",
+                "normal.shallow-convex-edge",
+                "mesh.closest-hit",
+            ],
+        ),
+        // A face contact within 1 % of the altitude from an edge called
+        // the edge; so is a contact on a shared edge, against the kind order.
+        (
+            "loose-bary",
+            &[
+                "face.near-edge",
+                "tie.shared-edge.planar",
+                "tie.kind-order",
+                "normal.flat-edge",
+            ],
+        ),
+        ("wide-active-edges", &["normal.shallow-convex-edge"]),
+        (
+            "ghost-flat",
+            &["tie.shared-edge.planar", "normal.flat-edge"],
+        ),
+        ("lost-leaf", &["mesh.large"]),
+    ];
+    for (bug, want) in bugs {
+        let doc = expect_failing(bug, want)?;
+        ensure!(
+            doc["fragile"] == 0,
+            "--bug {bug}: no failure excused: {doc}"
+        );
+    }
     Ok(())
 }
 
@@ -318,10 +372,10 @@ fn cases_written_as_a_trace_check_the_same() -> anyhow::Result<()> {
     ))?;
     ensure!(code == 0, "exit {code}: {stderr}");
     ensure!(
-        stderr.contains("2 cases; frame N is case N: 21 vertex.hit/0, 22 vertex.hit/1"),
+        stderr.contains("2 cases; frame N is case N: 26 vertex.hit/0, 27 vertex.hit/1"),
         "names the frames: {stderr}"
     );
-    let (code, stdout, _) = run_bin(os!("sweep", "--trace", trace.as_os_str(), "--frame", "22"))?;
+    let (code, stdout, _) = run_bin(os!("sweep", "--trace", trace.as_os_str(), "--frame", "27"))?;
     ensure!(
         code == 0 && stdout.contains("outcome: vertex collision"),
         "sweep --trace on case 22: exit {code}:\n{stdout}"

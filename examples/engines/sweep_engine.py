@@ -22,6 +22,20 @@ reports about an engine that has it:
     tie-vertex-first
                     among simultaneous hits, prefers a vertex over an edge
                     and an edge over a face (the rule: face < edge < vertex)
+    glued           a ball that starts within rho of a triangle's plane, over
+                    it, and moves away is a face hit at alpha 0 (the rule: no
+                    collision)
+    first-hit       answers the lowest triangle on the path, not the nearest
+                    (a walk that stops at its first hit)
+    loose-bary      a face hit whose touch point lies within 1 % of the
+                    altitude from an edge is reported as that edge
+    wide-active-edges
+                    at an edge whose two faces meet below 30 degrees, the
+                    primary triangle's normal instead of the tie's average
+    ghost-flat      at an edge shared by two coplanar triangles, the normal
+                    leans 10 degrees toward the edge
+    lost-leaf       in a mesh of more than 64 triangles, the second half of
+                    them is never tested (a lost leaf of a tree)
 """
 
 import argparse
@@ -35,7 +49,19 @@ DEGENERATE_TOLERANCE = 1e-12
 TIE_WINDOW_ULPS = 1024.0
 EPSILON = sys.float_info.epsilon
 
-BUGS = ("skip-vertex", "ignore-margin", "strict-facing", "tie-highest-triangle", "tie-vertex-first")
+BUGS = (
+    "skip-vertex",
+    "ignore-margin",
+    "strict-facing",
+    "tie-highest-triangle",
+    "tie-vertex-first",
+    "glued",
+    "first-hit",
+    "loose-bary",
+    "wide-active-edges",
+    "ghost-flat",
+    "lost-leaf",
+)
 
 
 def sub(a, b):
@@ -106,12 +132,14 @@ def load_scene(msg):
         if not area2 > DEGENERATE_TOLERANCE * longest or math.isinf(area2):
             continue  # degenerate: left out of every test
         triangles.append(Triangle(index, a, b, c, scale(n, 1.0 / area2)))
+    count = len(msg["triangles"])
     bound = 0.0
     for t in triangles:
         for v in t.vertices:
             bound = max(bound, amax(v))
     return {
         "triangles": triangles,
+        "count": count,
         "bound": bound,
         "margin": float(msg.get("margin", 0.0)),
         "facing": msg.get("facing", "non_strict"),
@@ -150,8 +178,16 @@ def sweep(scene, radius, p0, p1, bugs):
     def allows(v):
         return v < 0.0 if strict else v <= 0.0
 
+    if "glued" in bugs:
+        for t in scene["triangles"]:
+            h = dot(t.normal, sub(p0, t.vertices[0]))
+            touch = sub(p0, scale(t.normal, h))
+            if dot(t.normal, d) > 0.0 and abs(h) <= rho and min(weights(t, touch)) >= 0.0:
+                return answer(0.0, "face", t.index, None, t.normal, touch)
     hits = []  # (alpha, kind order, triangle, feature, contact, normal)
     for t in scene["triangles"]:
+        if "lost-leaf" in bugs and scene["count"] > 64 and 2 * t.index >= scene["count"]:
+            continue
         # Cheap rejection: the path's segment never comes near the triangle.
         if norm(sub(t.centre, midpoint)) > t.reach + rho + 0.5 * length + 1e-9 * s:
             continue
@@ -207,6 +243,9 @@ def sweep(scene, radius, p0, p1, bugs):
             hits.append((roots[0], 2, t.index, k, v, n))
     if not hits:
         return {"alpha": 1.0, "kind": "none", "triangle": None, "feature": None, "normal": None, "contact": None}
+    if "first-hit" in bugs:
+        first = min(h[2] for h in hits)
+        hits = [h for h in hits if h[2] == first]
     alpha = min(h[0] for h in hits)
     tied = [h for h in hits if h[0] <= alpha + window]
     # The tie order: kind (face < edge < vertex), then triangle, then feature.
@@ -220,13 +259,50 @@ def sweep(scene, radius, p0, p1, bugs):
             total = add(total, h[5])
     size = norm(total)
     normal = scale(total, 1.0 / size) if size > 1e-9 else primary[5]
+    kind, feature = ("face", "edge", "vertex")[primary[1]], primary[3]
+    by_index = {t.index: t for t in scene["triangles"]}
+    own = by_index[primary[2]]
+    if "loose-bary" in bugs and kind == "face":
+        w = weights(own, primary[4])
+        k = min(range(3), key=lambda i: w[i])
+        if w[k] <= 1e-2:
+            kind, feature = "edge", (k + 1) % 3
+    if "wide-active-edges" in bugs and kind == "edge":
+        # The other triangles of the tie whose normal is within 30 degrees.
+        near = [h for h in tied if h[2] != primary[2] and dot(h[5], own.normal) > math.cos(math.radians(30))]
+        if any(dot(h[5], own.normal) < 1.0 - 1e-12 for h in near):
+            normal = own.normal
+    if "ghost-flat" in bugs:
+        # An edge hit of the tie on an edge shared with a coplanar triangle.
+        for h in tied:
+            t = by_index[h[2]]
+            coplanar = any(g[2] != h[2] and dot(g[5], t.normal) >= 1.0 - 1e-12 for g in tied)
+            if h[1] == 1 and coplanar:
+                v0, x = t.edges[h[3]][0], t.edges[h[3]][1]
+                out = cross(x, t.normal)
+                angle = math.radians(10.0)
+                normal = add(scale(t.normal, math.cos(angle)), scale(out, math.sin(angle)))
+                break
+    return answer(alpha, kind, primary[2], feature, normal, primary[4])
+
+
+def weights(t, p):
+    """The barycentric weights of point p (in t's plane) in triangle t."""
+    pa, pb, pc = (sub(v, p) for v in t.vertices)
+    n = t.normal
+    areas = (dot(n, cross(pb, pc)), dot(n, cross(pc, pa)), dot(n, cross(pa, pb)))
+    total = areas[0] + areas[1] + areas[2]
+    return tuple(a / total for a in areas)
+
+
+def answer(alpha, kind, triangle, feature, normal, contact):
     return {
         "alpha": alpha,
-        "kind": ("face", "edge", "vertex")[primary[1]],
-        "triangle": primary[2],
-        "feature": primary[3],
+        "kind": kind,
+        "triangle": triangle,
+        "feature": feature,
         "normal": list(normal),
-        "contact": list(primary[4]),
+        "contact": list(contact),
     }
 
 

@@ -50,15 +50,6 @@ pub struct CaseFailure {
     pub fails: bool,
 }
 
-impl CaseFailure {
-    /// Whether rounding explains the divergence (a fragile divergence
-    /// reproduced by a perturbation of the inputs), not a failure under
-    /// `--lenient`.
-    fn is_excused(&self) -> bool {
-        self.divergence.reproduced.is_some() && self.tie_order.is_none()
-    }
-}
-
 /// What a hit names, in words: `face of triangle 3`, `edge 2 of triangle 3`.
 fn hit_name(kind: Kind, triangle: Option<u32>, feature: Option<u8>) -> String {
     let on = triangle.map_or_else(String::new, |t| format!(" of triangle {t}"));
@@ -485,8 +476,10 @@ pub fn run(
         }
         let replace = match &rule.first_failure {
             None => true,
-            // A failure is shown before a divergence rounding explains.
-            Some(first) => fails && first.is_excused() && !options.strict,
+            // A failure is shown before a divergence that does not fail
+            // (rounding explains it under --lenient, or it is within the
+            // declared single precision, strict or not).
+            Some(first) => fails && !first.fails,
         };
         let got = result.outcome_msg();
         let mut divergence = divergence_details(&result, answer, got, fields, false);

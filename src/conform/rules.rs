@@ -18,6 +18,10 @@ pub const RULES: &[Rule] = &[
         description: "the ball reaches the plane at ρ with its touch point inside the triangle: a face collision at β (face, step 5)",
     },
     Rule {
+        name: "face.near-edge",
+        description: "the touch point lies inside the triangle, within 0.4 % of its altitude from an edge: still a face collision, not an edge (face, step 5; a classification by barycentric weights needs a threshold below that)",
+    },
+    Rule {
         name: "face.miss.outside-triangle",
         description: "the touch point falls outside the triangle and no edge or vertex is within ρ: no collision (face, step 4)",
     },
@@ -40,6 +44,10 @@ pub const RULES: &[Rule] = &[
     Rule {
         name: "start.touching",
         description: "the ball starts exactly ρ from the plane (h0 = ρ) moving toward it: a face collision at α = 0",
+    },
+    Rule {
+        name: "start.moving-away",
+        description: "the ball starts within ρ of the face or touching it and moves away (n·d > 0): no collision, also under initial_overlap = alpha0, which asks that the ball move toward the triangle (facing rule)",
     },
     Rule {
         name: "path.zero-length",
@@ -130,6 +138,14 @@ pub const RULES: &[Rule] = &[
         description: "a ball coming diagonally at a cube's corner: a vertex collision shared by the corner's triangles, averaged normal",
     },
     Rule {
+        name: "normal.shallow-convex-edge",
+        description: "a ridge whose faces meet at 14.25° hit on its edge: under the rules both faces tie and their normals average; under normal = active_edges the edge is active (beyond 5°) and the normal is the contact normal, not a face's",
+    },
+    Rule {
+        name: "normal.flat-edge",
+        description: "a ball landing on the edge shared by two coplanar triangles: every normal rule reports the plane's normal there, whichever member of the tie is named (no ghost normal leaning toward the edge)",
+    },
+    Rule {
         name: "grazing.face-hit",
         description: "a path descending onto the face at a grazing angle (cosine below 1e-3): still a face collision at β",
     },
@@ -160,5 +176,13 @@ pub const RULES: &[Rule] = &[
     Rule {
         name: "degenerate.skipped",
         description: "degenerate triangles (a repeated index, zero area) are left out of every test; the others keep their indices",
+    },
+    Rule {
+        name: "mesh.closest-hit",
+        description: "of two triangles on the path, the nearer is hit, though the farther comes first in the list: the primary is the smallest α, not the first triangle found",
+    },
+    Rule {
+        name: "mesh.large",
+        description: "a height field of 3,200 triangles hit at cells far apart in space and in index: each sweep finds its triangle (no part of the mesh is lost)",
     },
 ];

@@ -271,6 +271,27 @@ impl EngineConventions {
             (_, "start.inside") if self.initial_overlap != InitialOverlap::None => {
                 declares("initial_overlap", self.initial_overlap.to_string())
             }
+            // Two-sided, a ball within ρ that leaves the front moves toward
+            // the back: an initial contact at α = 0, from behind.
+            (_, "start.moving-away")
+                if self.sides == Sides::Two && self.initial_overlap == InitialOverlap::Alpha0 =>
+            {
+                Some(format!(
+                    "the engine declares sides = {} and initial_overlap = {}",
+                    self.sides, self.initial_overlap
+                ))
+            }
+            // Face normals and any member of a tie: each of the ridge's two
+            // triangles may name its own face normal, which is what the rule
+            // tells apart from the contact normal.
+            (_, "normal.shallow-convex-edge")
+                if self.normal == NormalRule::Face && self.ties != TieRule::Rule =>
+            {
+                Some(format!(
+                    "the engine declares normal = {} and ties = {}",
+                    self.normal, self.ties
+                ))
+            }
             ("tie", _) if self.ties != TieRule::Rule => declares("ties", self.ties.to_string()),
             _ => None,
         }
@@ -328,6 +349,27 @@ mod tests {
                 "{rule}"
             );
         }
+        assert_eq!(
+            c.replaces("start.moving-away/1").as_deref(),
+            Some("the engine declares sides = two and initial_overlap = alpha0")
+        );
+        // Contact normals at active edges: the ridge's normal is judged.
+        assert_eq!(c.replaces("normal.shallow-convex-edge/0"), None);
+        assert_eq!(c.replaces("normal.flat-edge/0"), None);
+        let face_any = EngineConventions {
+            ties: TieRule::Any,
+            ..EngineConventions::default()
+        };
+        assert_eq!(
+            face_any.replaces("normal.shallow-convex-edge").as_deref(),
+            Some("the engine declares normal = face and ties = any")
+        );
+        assert_eq!(face_any.replaces("normal.flat-edge"), None);
+        let one_sided = EngineConventions {
+            initial_overlap: InitialOverlap::Alpha0,
+            ..EngineConventions::default()
+        };
+        assert_eq!(one_sided.replaces("start.moving-away"), None);
         let one = EngineConventions::default();
         assert_eq!(one.replaces("face.miss.back-facing/0"), None);
         assert_eq!(one.replaces("edge.miss.back-facing/0"), None);

@@ -18,6 +18,7 @@ import { createInterface } from 'node:readline';
 const VARIANTS = [
   'clean', 'late', 'no_vertex', 'next_triangle', 'back_faces', 'centre_contact', 'flipped_edge_normal',
   'tilted_face_normal', 'half_normal', 'contact_off_plane', 'skin',
+  'glued', 'first_hit', 'loose_bary', 'wide_active_edges', 'ghost_flat', 'lost_leaf',
 ];
 const flag = process.argv.indexOf('--variant');
 const variant = (flag >= 0 ? process.argv[flag + 1] : process.env.JOLT_VARIANT) || 'clean';
@@ -28,6 +29,8 @@ const honourMargin = process.argv.includes('--honour-margin') || process.env.JOL
 // classified (face / edge / vertex). It is relative to the triangle (a
 // fraction of the altitude) and the same 1e-4 as Jolt's ActiveEdges::FixNormal.
 const BARY_EPS = 1e-4;
+// Variant `loose_bary`: a threshold 100 times looser, 1 % of the altitude.
+const LOOSE_BARY_EPS = 1e-2;
 
 function fail(message) {
   process.stderr.write(`jolt engine: ${message}\n`);
@@ -105,11 +108,15 @@ const xyz = (v) => [v.GetX(), v.GetY(), v.GetZ()];
 // Kind and feature of a contact point p on triangle (a, b, c), from its
 // barycentric weights w[i] (of vertex i): two weights ~0 -> vertex i (the one
 // near 1), one weight w[k] ~0 -> edge (k+1)%3 (joining k+1 and k+2), else face.
-function classify(p, [a, b, c]) {
+function classify(p, triangle) {
+  return classifyWith(p, triangle, variant === 'loose_bary' ? LOOSE_BARY_EPS : BARY_EPS);
+}
+
+function classifyWith(p, [a, b, c], eps) {
   const n = cross(sub(b, a), sub(c, a)), nn = dot(n, n);
   const w = [dot(n, cross(sub(b, p), sub(c, p))) / nn, dot(n, cross(sub(c, p), sub(a, p))) / nn, 0];
   w[2] = 1 - w[0] - w[1];
-  const zero = w.map((x) => x <= BARY_EPS);
+  const zero = w.map((x) => x <= eps);
   const count = zero.filter(Boolean).length;
   if (count >= 2) return { kind: 'vertex', feature: w.indexOf(Math.max(...w)) };
   if (count === 1) return { kind: 'edge', feature: (zero.indexOf(true) + 1) % 3 };
@@ -129,14 +136,22 @@ function sweep(msg) {
     spheres.set(radius, sphere);
   }
   const [p0, p1] = [msg.p0, msg.p1], d = sub(p1, p0);
+  if (variant === 'glued') {
+    const stuck = glued(msg, p0, d);
+    if (stuck) return stuck;
+  }
   const start = new Jolt.RVec3(...p0), direction = new Jolt.Vec3(...d);
   const transform = Jolt.RMat44.prototype.sTranslation(start);
   const cast = new Jolt.RShapeCast(sphere, unitScale, transform, direction);
-  const collector = new Jolt.CastShapeClosestHitCollisionCollector();
+  // Variant `first_hit`: every hit is collected and the one of the lowest
+  // triangle index answered, as a walk that stops at its first hit would.
+  const collector = variant === 'first_hit'
+    ? new Jolt.CastShapeAllHitCollisionCollector()
+    : new Jolt.CastShapeClosestHitCollisionCollector();
   query.CastShape(cast, castSettings, baseOffset, collector, bpFilter, objFilter, bodyFilter, shapeFilter);
   let answer = none;
   if (collector.HadHit()) {
-    const hit = collector.get_mHit();
+    const hit = variant === 'first_hit' ? lowestTriangleHit(collector.get_mHits()) : collector.get_mHit();
     const triangle = scene.mesh.GetTriangleUserData(hit.mSubShapeID2);
     const contact = xyz(hit.mContactPointOn2); // on the mesh (base offset 0: world space)
     // Jolt's penetration axis points from the ball into the mesh: negate it.
@@ -148,6 +163,44 @@ function sweep(msg) {
   }
   [start, direction, transform, cast, collector].forEach((o) => Jolt.destroy(o));
   return mistake(answer, p0, d);
+}
+
+// Of the hits of an all-hit collector, the one on the lowest triangle index.
+function lowestTriangleHit(hits) {
+  let best = null, bestTriangle = Infinity;
+  for (let i = 0; i < hits.size(); i += 1) {
+    const hit = hits.at(i), triangle = scene.mesh.GetTriangleUserData(hit.mSubShapeID2);
+    if (triangle < bestTriangle) [best, bestTriangle] = [hit, triangle];
+  }
+  return best;
+}
+
+// The corners of triangle `t` of the scene, and its unit front normal.
+const corners = (t) => scene.triangles[t].map((i) => scene.vertices[i]);
+function faceNormal(t) {
+  const [a, b, c] = corners(t), n = cross(sub(b, a), sub(c, a)), len = Math.sqrt(dot(n, n));
+  return n.map((x) => x / len);
+}
+
+// The other triangle that has edge `e` of triangle `t` (its vertices
+// e and e+1), or -1.
+function neighbour(t, e) {
+  const tri = scene.triangles[t], [u, v] = [tri[e], tri[(e + 1) % 3]];
+  return scene.triangles.findIndex((o, k) => k !== t && o.includes(u) && o.includes(v));
+}
+
+// Variant `glued`: a ball that starts within its radius of a triangle's
+// plane, over the triangle, and moves away from it (n · d > 0) is answered
+// as a face hit at alpha 0 (a resting ball glued to the surface).
+function glued(msg, p0, d) {
+  for (let t = 0; t < scene.triangles.length; t += 1) {
+    const [a] = corners(t), n = faceNormal(t), h = dot(n, sub(p0, a));
+    if (!(dot(n, d) > 0 && Math.abs(h) <= msg.radius)) continue;
+    const contact = p0.map((x, i) => x - h * n[i]);
+    if (classifyWith(contact, corners(t), 0).kind !== 'face') continue;
+    return { frame: msg.frame, ball: msg.ball, alpha: 0, kind: 'face', triangle: t, feature: null, normal: n, contact };
+  }
+  return null;
 }
 
 // `n` turned by `angle` radians about an axis perpendicular to it.
@@ -178,8 +231,46 @@ function mistake(answer, p0, d) {
     case 'contact_off_plane': return answer.kind === 'face' ? { ...answer, contact: answer.contact.map((x, i) => x + 0.01 * radiusOf(answer) * answer.normal[i]) } : answer;
     // Every hit backed off by a skin of 1e-3 along the path.
     case 'skin': return { ...answer, alpha: Math.max(answer.alpha - 1e-3 / Math.sqrt(dot(d, d)), 0) };
-    default: return answer; // clean, back_faces (a cast setting)
+    // At a convex edge whose faces meet below 30 degrees (Jolt's threshold
+    // is 5), the face normal of the triangle hit instead of the contact normal.
+    case 'wide_active_edges': return answer.kind === 'edge' && edgeAngle(answer) !== null && edgeAngle(answer) < 30
+      ? { ...answer, normal: faceNormal(answer.triangle) } : answer;
+    // At an edge shared with a coplanar triangle, the normal tilted by 10
+    // degrees toward the edge (a ghost normal).
+    case 'ghost_flat': return answer.kind === 'edge' && edgeAngle(answer) === 0 ? { ...answer, normal: ghost(answer) } : answer;
+    // A lost leaf: in a mesh of more than 64 triangles (a tree of many
+    // leaves), every hit on the second half of the triangles dropped.
+    case 'lost_leaf': return scene.triangles.length > 64 && answer.triangle >= scene.triangles.length / 2
+      ? { frame: answer.frame, ball: answer.ball, alpha: 1, kind: 'none' } : answer;
+    default: return answer; // clean, back_faces, first_hit, loose_bary (in the cast), glued (before it)
   }
+}
+
+// At an edge hit, the angle in degrees between the normals of the two
+// triangles that share the edge when it is convex, 0 when they are
+// coplanar; null at a boundary or concave edge.
+function edgeAngle(answer) {
+  const other = neighbour(answer.triangle, answer.feature);
+  if (other < 0) return null;
+  const [n, m] = [faceNormal(answer.triangle), faceNormal(other)];
+  const cos = Math.min(Math.max(dot(n, m), -1), 1);
+  if (cos >= 1 - 1e-12) return 0;
+  // Convex: the other triangle's far corner lies behind this one's plane.
+  const far = corners(other).find((v) => !corners(answer.triangle).some((w) => w.every((x, i) => x === v[i])));
+  const convex = dot(n, sub(far, corners(answer.triangle)[0])) < 0;
+  return convex ? Math.acos(cos) * 180 / Math.PI : null;
+}
+
+// The normal of an edge hit turned by 10 degrees toward the edge, within
+// the plane through the normal and the edge's outward direction.
+function ghost(answer) {
+  const tri = corners(answer.triangle), e = answer.feature;
+  const [u, v] = [tri[e], tri[(e + 1) % 3]], n = faceNormal(answer.triangle);
+  let out = cross(sub(v, u), n);
+  const len = Math.sqrt(dot(out, out));
+  out = out.map((x) => x / len);
+  const angle = 10 * Math.PI / 180;
+  return n.map((x, i) => Math.cos(angle) * x + Math.sin(angle) * out[i]);
 }
 
 const lines = createInterface({ input: process.stdin, crlfDelay: Infinity });

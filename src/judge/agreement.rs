@@ -551,14 +551,17 @@ fn judge(
         // Single precision: any decision is as fragile as f32's budget; a
         // perturbation spends part of it, and the rest is what the
         // continuous fields may still differ by.
-        return match reproduce_f32(
+        let rounding = Rounding::F32 {
+            fixed,
+            sensitivity: sensitivity.as_ref(),
+        };
+        return match reproduce(
             expected,
             on_expected.is_some(),
             got,
             on_got.is_some(),
             result,
-            fixed,
-            sensitivity.as_ref(),
+            rounding,
         ) {
             Some((r, backward_error)) => Agreement::Precision {
                 backward_error,
@@ -581,8 +584,9 @@ fn judge(
             got,
             on_got.is_some(),
             result,
-            tol,
+            Rounding::F64(tol),
         )
+        .map(|(reproduced, _)| reproduced)
     };
     Agreement::Diverges {
         fields,
@@ -615,88 +619,100 @@ fn beyond_f32_bound(
     beyond
 }
 
-/// At double precision: the smallest perturbations under which the core gives `expected` (when
+/// The arithmetic a divergence is excused in: what a perturbation of the
+/// inputs may cost, and how a perturbed decision is asked to accept an
+/// answer.
+#[derive(Clone, Copy)]
+enum Rounding<'a> {
+    /// Double precision: perturbations of the sweep's rounding unit up to
+    /// the fragility band; the perturbed decision accepts an answer within
+    /// the tolerances.
+    F64(&'a Tolerances),
+    /// Single precision: perturbations of `u₃₂ · S` up to
+    /// `c` = [`F32_OPERATIONS`] units; a perturbation of `k` units leaves
+    /// `c - k` for the widening of the continuous fields (the budget is
+    /// spent once).
+    F32 {
+        fixed: &'a Tolerances,
+        sensitivity: Option<&'a Sensitivity>,
+    },
+}
+
+impl Rounding<'_> {
+    /// What the unit `u` of the perturbations is (from the sweep's own
+    /// rounding unit), their magnitudes and the arithmetic's name.
+    fn steps(self, sweep_unit: f64) -> (f64, &'static [f64], Precision) {
+        match self {
+            Rounding::F64(_) => (sweep_unit, &PERTURBATION_UNITS, Precision::F64),
+            Rounding::F32 { .. } => (
+                sweep_unit / f64::EPSILON * F32_UNIT,
+                &F32_PERTURBATION_UNITS,
+                Precision::F32,
+            ),
+        }
+    }
+
+    /// The budget spent when `decision`, under a perturbation of `k`
+    /// units, accepts `answer`; `None` when it does not.
+    fn accepts(self, decision: &Decision, answer: &OutcomeMsg, k: f64) -> Option<f64> {
+        match self {
+            Rounding::F64(tol) => decision.disagreement(answer, tol).is_none().then_some(k),
+            Rounding::F32 { fixed, sensitivity } => {
+                widening_needed(decision, answer, fixed, sensitivity, F32_OPERATIONS - k)
+                    .map(|widening| k + widening)
+            }
+        }
+    }
+}
+
+/// The smallest perturbations under which the core gives `expected` (when
 /// `expected_open`, i.e. its own decision does not) and `got` (when
-/// `got_open`); `None` unless both are found.
+/// `got_open`), in the arithmetic `rounding`; `None` unless both are
+/// found. With the budget spent: per side, the perturbation plus (at f32)
+/// the smallest widening that then accepts the answer; the larger side's.
+/// A side the core's own decision accepts costs nothing at f64, and at f32
+/// the widening it needs.
 fn reproduce(
     expected: &OutcomeMsg,
     expected_open: bool,
     got: &OutcomeMsg,
     got_open: bool,
     result: &SweepResult,
-    tol: &Tolerances,
-) -> Option<Reproduced> {
-    let mesh = &result.scene.mesh;
-    let u = rounding_unit(mesh, &result.sweep, result.options())?;
-    let units = &PERTURBATION_UNITS;
-    let mut on_expected: Option<Option<Perturbation>> = (!expected_open).then_some(None);
-    let mut on_got: Option<Option<Perturbation>> = (!got_open).then_some(None);
-    for p in perturbations_of(u, units) {
-        if on_expected.is_some() && on_got.is_some() {
-            break;
-        }
-        let Some(decision) = Decision::of(&result.scene, &p.apply(&result.sweep)) else {
-            continue;
-        };
-        if on_expected.is_none() && decision.disagreement(expected, tol).is_none() {
-            on_expected = Some(Some(p));
-        }
-        if on_got.is_none() && decision.disagreement(got, tol).is_none() {
-            on_got = Some(Some(p));
-        }
-    }
-    Some(Reproduced {
-        expected: on_expected?,
-        got: on_got?,
-        rounding_unit: u,
-        precision: Precision::F64,
-    })
-}
-
-/// At single precision: the smallest perturbations of `c` = [`F32_OPERATIONS`]
-/// units at most under which the core gives `expected` (when
-/// `expected_open`) and `got` (when `got_open`), each side's continuous
-/// fields compared within what is left of the budget (a perturbation of
-/// `k` units leaves `c - k` for the widening: the budget is spent once).
-/// With the backward error of the whole: per side, the perturbation plus
-/// the smallest widening that then accepts the answer; the larger side's.
-fn reproduce_f32(
-    expected: &OutcomeMsg,
-    expected_open: bool,
-    got: &OutcomeMsg,
-    got_open: bool,
-    result: &SweepResult,
-    fixed: &Tolerances,
-    s: Option<&Sensitivity>,
+    rounding: Rounding,
 ) -> Option<(Reproduced, f64)> {
-    let u = rounding_unit(&result.scene.mesh, &result.sweep, result.options())? / f64::EPSILON
-        * F32_UNIT;
-    let unperturbed = Decision::of(&result.scene, &result.sweep)?;
+    let sweep_unit = rounding_unit(&result.scene.mesh, &result.sweep, result.options())?;
+    let (u, units, precision) = rounding.steps(sweep_unit);
+    let answers = [(expected, expected_open), (got, got_open)];
     // Each side: its perturbation (`None`: the core's own decision) and
     // the budget spent in all.
     let mut sides: [Option<(Option<Perturbation>, f64)>; 2] = [None, None];
-    for (i, (answer, open)) in [(expected, expected_open), (got, got_open)]
-        .into_iter()
-        .enumerate()
-    {
-        if !open {
-            let spent = widening_needed(&unperturbed, answer, fixed, s, F32_OPERATIONS);
-            sides[i] = Some((None, spent.unwrap_or(F32_OPERATIONS)));
+    if answers.iter().any(|(_, open)| !open) {
+        let own = match rounding {
+            Rounding::F64(_) => None,
+            Rounding::F32 { .. } => Some(Decision::of(&result.scene, &result.sweep)?),
+        };
+        for (side, (answer, open)) in sides.iter_mut().zip(answers) {
+            if !open {
+                let spent = own
+                    .as_ref()
+                    .and_then(|d| rounding.accepts(d, answer, 0.0))
+                    .unwrap_or(if own.is_some() { F32_OPERATIONS } else { 0.0 });
+                *side = Some((None, spent));
+            }
         }
     }
-    for p in perturbations_of(u, &F32_PERTURBATION_UNITS) {
+    for p in perturbations_of(u, units) {
         if sides.iter().all(Option::is_some) {
             break;
         }
         let Some(decision) = Decision::of(&result.scene, &p.apply(&result.sweep)) else {
             continue;
         };
-        let left = F32_OPERATIONS - p.units.abs();
-        for (i, answer) in [expected, got].into_iter().enumerate() {
-            if sides[i].is_none()
-                && let Some(widening) = widening_needed(&decision, answer, fixed, s, left)
+        for (side, (answer, _)) in sides.iter_mut().zip(answers) {
+            if side.is_none()
+                && let Some(spent) = rounding.accepts(&decision, answer, p.units.abs())
             {
-                sides[i] = Some((Some(p), p.units.abs() + widening));
+                *side = Some((Some(p), spent));
             }
         }
     }
@@ -706,7 +722,7 @@ fn reproduce_f32(
             expected: on_expected,
             got: on_got,
             rounding_unit: u,
-            precision: Precision::F32,
+            precision,
         },
         e.max(g),
     ))

@@ -33,9 +33,11 @@ mod explain;
 mod hints;
 mod inputs;
 mod mistakes;
+mod perturbation;
 mod precision;
+mod reference;
 
-pub use agreement::{Agreement, Perturbation, Reproduced, agreement, agreement_of};
+pub use agreement::{Agreement, agreement, agreement_of};
 pub use compare::{
     ContactAxis, DEFAULT_ALPHA_TOLERANCE, DEFAULT_CONTACT_TOLERANCE,
     DEFAULT_NORMAL_TOLERANCE_DEGREES, Field, FieldDiff, FieldSet, Precision, TieRule, Tolerances,
@@ -55,4 +57,5 @@ pub(crate) use explain::{expected_tests, explain_outcome, explained_records};
 pub use hints::ConventionHints;
 pub use inputs::{HexInputs, SweepInputs};
 pub use mistakes::{KNOWN_MISTAKES, Mistake, known_mistake};
+pub use perturbation::{Perturbation, Reproduced};
 pub use precision::{F32_OPERATIONS, F32_UNIT, Sensitivity};

@@ -51,7 +51,7 @@
 //! A difference in the discrete fields (kind, triangle, feature, hit
 //! or miss) passes only when a move of one input within the same budget
 //! makes the core give the engine's answer (the perturbations of
-//! [`super::judge`], at `u₃₂ · S` instead of `f64`'s unit).
+//! [`super::agreement`], at `u₃₂ · S` instead of `f64`'s unit).
 //!
 //! None of this runs on a sweep that agrees within the fixed tolerances.
 

@@ -52,7 +52,7 @@ pub struct CheckOptions {
     /// ([`crate::replay::GHOST_DEGREES`] by default).
     pub ghost_degrees: f64,
     /// Whether divergences also give their inputs as hexadecimal floating
-    /// point ([`Divergence::inputs_hex`]).
+    /// point ([`crate::judge::Divergence::inputs_hex`]).
     pub hex: bool,
     /// The replay's options (frames, ball, overrides). `explain` and
     /// `detail` are ignored: the check runs the fast query and explains
@@ -442,7 +442,7 @@ pub fn frames_around(
 }
 
 /// Checks the trace file at `path`; a file that cannot be opened is a
-/// report with [`Status::Error`].
+/// report with [`super::Status::Error`].
 pub fn check_file(path: &std::path::Path, options: &CheckOptions) -> TraceReport {
     let name = path.display().to_string();
     if let Some(text) = crate::sim::obj_instead_of_trace(path) {

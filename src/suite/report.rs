@@ -276,7 +276,7 @@ pub struct Fragile {
 }
 
 /// A report's sweeps whose answers differ by no more than single-precision
-/// rounding explains ([`super::Agreement::Precision`]). Failures only with
+/// rounding explains ([`crate::judge::Agreement::Precision`]). Failures only with
 /// `strict`, where they are also counted in [`TraceReport::divergent`].
 #[derive(Clone, Debug, Default, PartialEq, Serialize)]
 #[non_exhaustive]

@@ -1,0 +1,194 @@
+//! The core's decision on one sweep as the judge sees it ([`Decision`]):
+//! its outcome under the scene's conventions, the hits that can be members
+//! of its tie set, and whether it accepts an answer (the primary, or
+//! another member of the tie set with that member's own contact).
+
+use nalgebra::Point3;
+
+use crate::core::SweepHit;
+use crate::core::{
+    Broadphase, EdgeRecord, FaceRecord, Feature, InitialOverlap, Observer, Outcome, Sweep,
+    SweptPath, TestRecord, Tie, VertexRecord, initial_contacts, sweep_mesh_with,
+};
+use crate::replay::SceneState;
+use crate::trace::OutcomeMsg;
+
+use super::compare::{FieldDiff, TieRule, Tolerances, compare};
+
+/// Keeps the records of the tests that hit.
+#[derive(Default)]
+struct Hits(Vec<TestRecord>);
+
+impl Observer for Hits {
+    // Triangles whose every test ends back-facing hit nothing.
+    const WANTS_RECORDS: bool = false;
+    fn face(&mut self, r: &FaceRecord) {
+        if r.alpha().is_some() {
+            self.0.push(TestRecord::Face(*r));
+        }
+    }
+    fn edge(&mut self, r: &EdgeRecord) {
+        if r.alpha().is_some() {
+            self.0.push(TestRecord::Edge(*r));
+        }
+    }
+    fn vertex(&mut self, r: &VertexRecord) {
+        if r.alpha().is_some() {
+            self.0.push(TestRecord::Vertex(*r));
+        }
+    }
+}
+
+/// The core's decision on one sweep under the scene's options and
+/// conventions: its outcome and the hits that can be members of its tie
+/// set.
+pub(super) struct Decision<'a> {
+    scene: &'a SceneState,
+    sweep: Sweep,
+    outcome: Outcome,
+    hits: Vec<TestRecord>,
+    /// Under `initial_overlap = alpha0`, when the ball starts in contact:
+    /// every initial contact, all tied at `α = 0`.
+    initial: Vec<SweepHit>,
+}
+
+impl<'a> Decision<'a> {
+    pub(super) fn of(scene: &'a SceneState, sweep: &Sweep) -> Option<Decision<'a>> {
+        let mut hits = Hits::default();
+        let outcome = sweep_mesh_with(
+            &scene.mesh,
+            sweep,
+            &scene.options,
+            Broadphase::Bvh,
+            &mut hits,
+        )
+        .ok()?;
+        let initial = if scene.options.initial_overlap == InitialOverlap::Alpha0
+            && outcome.hit.is_some_and(|h| h.alpha == 0.0)
+        {
+            let (lo, hi) = scene.mesh.bounds();
+            let path = SweptPath::new(sweep, &scene.options)
+                .ok()?
+                .with_mesh_scale(&lo, &hi);
+            initial_contacts(
+                &scene.mesh,
+                &path,
+                scene.options.facing,
+                scene.options.sides,
+            )
+            .into_iter()
+            .map(|(h, _)| h)
+            .collect()
+        } else {
+            Vec::new()
+        };
+        Some(Decision {
+            scene,
+            sweep: *sweep,
+            outcome: scene.normals.apply(sweep, outcome),
+            hits: hits.0,
+            initial,
+        })
+    }
+
+    /// The normal a tie member reports under [`TieRule::Any`]: its own
+    /// (its triangle's face normal, or its contact normal where the
+    /// scene's normal rule gives that). `back`: the member was hit on its
+    /// triangle's back (`sides = two`), whose face normal is `-n`.
+    fn member_normal(&self, tie: &Tie, contact: &Point3<f64>, back: bool) -> Option<[f64; 3]> {
+        let front = self.scene.mesh.triangle_by_index(tie.triangle)?.normal;
+        let face = if back { -front } else { front };
+        let alpha = self.outcome.hit.map_or(tie.alpha, |h| h.alpha);
+        let n =
+            self.scene
+                .normals
+                .normal(&self.sweep, alpha, tie.triangle, tie.feature, contact, face);
+        Some([n.x, n.y, n.z])
+    }
+
+    /// `None` when the decision accepts `answer`: it matches the primary,
+    /// or another member of the tie set with that member's own contact.
+    /// Otherwise the fields that differ: from the first member the answer
+    /// names, or from the primary.
+    pub(super) fn disagreement(
+        &self,
+        answer: &OutcomeMsg,
+        tol: &Tolerances,
+    ) -> Option<Vec<FieldDiff>> {
+        let primary = OutcomeMsg::from_outcome(answer.frame, answer.ball, &self.outcome);
+        let differ = compare(answer, &primary, tol);
+        if differ.is_empty() {
+            return None;
+        }
+        let mut named: Option<Vec<FieldDiff>> = None;
+        for r in &self.hits {
+            let Some(tie) = Tie::of(r) else { continue };
+            if !self.outcome.ties_with(tie.alpha) {
+                continue;
+            }
+            let mut member = primary;
+            member.kind = tie.kind();
+            member.triangle = Some(Some(tie.triangle));
+            member.feature = Some(tie.feature.index());
+            member.contact = Some(r.contact().map(|c| [c.x, c.y, c.z]));
+            if tol.ties == TieRule::Any
+                && let Some(contact) = r.contact()
+            {
+                member.normal = Some(self.member_normal(&tie, &contact, r.back()));
+            }
+            let d = compare(answer, &member, tol);
+            if d.is_empty() {
+                return None;
+            }
+            if names_tie(answer, &tie) {
+                named.get_or_insert(d);
+            }
+        }
+        for h in &self.initial {
+            let tie = Tie {
+                triangle: h.triangle,
+                feature: h.feature,
+                alpha: 0.0,
+            };
+            let mut member = primary;
+            member.kind = tie.kind();
+            member.triangle = Some(Some(tie.triangle));
+            member.feature = Some(tie.feature.index());
+            member.contact = Some(Some([h.contact.x, h.contact.y, h.contact.z]));
+            if tol.ties == TieRule::Any {
+                // An initial contact's normal is its side's (`-n` on a back).
+                let back = self
+                    .scene
+                    .mesh
+                    .triangle_by_index(tie.triangle)
+                    .is_some_and(|t| t.normal.dot(&h.normal) < 0.0);
+                member.normal = Some(self.member_normal(&tie, &h.contact, back));
+            }
+            let d = compare(answer, &member, tol);
+            if d.is_empty() {
+                return None;
+            }
+            if names_tie(answer, &tie) {
+                named.get_or_insert(d);
+            }
+        }
+        Some(named.unwrap_or(differ))
+    }
+}
+
+/// Whether `answer` names `tie`. The trace spells "not given" as an absent
+/// field (`None`) and "given as null" as `Some(None)`: a tie is a hit, so a
+/// null triangle never names it, nor a null feature an edge or a vertex.
+fn names_tie(answer: &OutcomeMsg, tie: &Tie) -> bool {
+    let triangle = match answer.triangle {
+        None => None,
+        Some(None) => return false,
+        Some(Some(t)) => Some(t),
+    };
+    let feature = match answer.feature {
+        None => None,
+        Some(None) if tie.feature != Feature::Face => return false,
+        Some(f) => f,
+    };
+    tie.matches(answer.kind, triangle, feature)
+}

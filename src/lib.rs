@@ -74,6 +74,7 @@
 
 pub mod atomic;
 pub mod conform;
+pub mod conventions;
 pub mod core;
 pub mod engine;
 pub(crate) mod error_text;

@@ -377,7 +377,7 @@ fn rapier_sample_needs_its_settings_file() -> anyhow::Result<()> {
             && tolerances.alpha == 1e-5
             && tolerances.contact == 1e-5
             && tolerances.normal_degrees == Tolerances::default().normal_degrees
-            && settings.engine.normal.value == sweeptrace::replay::NormalRule::Contact
+            && settings.engine.normal.value == sweeptrace::conventions::NormalRule::Contact
             && !settings.strict.value
             && !settings.allow_tunnels.value,
         "the settings changed ({settings:?}): update this test"

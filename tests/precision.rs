@@ -10,7 +10,8 @@
 use anyhow::ensure;
 use libtest_mimic::Trial;
 use rand::{Rng, SeedableRng};
-use sweeptrace::judge::{F32_OPERATIONS, Precision, Sensitivity, Tolerances};
+use sweeptrace::conventions::Precision;
+use sweeptrace::judge::{F32_OPERATIONS, Sensitivity, Tolerances};
 use sweeptrace::replay::ReplayEvent;
 use sweeptrace::trace::{OutcomeMsg, SceneMsg, SweepMsg, TraceReader, TraceWriter};
 use sweeptrace::{Agreement, Facing, Mesh, Options, ReplayOptions, Sweep};

@@ -158,7 +158,7 @@ fn rapier_recording_passes_check_with_the_readme_options() -> anyhow::Result<()>
             ..Tolerances::default()
         },
         replay: sweeptrace::replay::ReplayOptions {
-            normal: sweeptrace::replay::NormalRule::Contact,
+            normal: sweeptrace::conventions::NormalRule::Contact,
             ..Default::default()
         },
         ..CheckOptions::default()

@@ -87,7 +87,7 @@ pub struct Args {
 /// The engine's conventions for `conform`: the `[engine]` table of
 /// `--config FILE`, or of the nearest `sweeptrace.toml` from the current
 /// directory up (none with `--no-config`), under the flags.
-fn conventions(args: &Args) -> anyhow::Result<sweeptrace::judge::EngineConventions> {
+fn conventions(args: &Args) -> anyhow::Result<sweeptrace::conventions::EngineConventions> {
     use sweeptrace::suite::{ConfigFile, Overrides, resolve, settings_for};
     let overrides = Overrides {
         engine: args.conventions.to_overrides(),

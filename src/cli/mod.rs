@@ -169,7 +169,7 @@ pub struct ConventionArgs {
     /// give it for inputs moved by at most 16 u32 units of the sweep's
     /// scale) [default: f64].
     #[arg(long, value_name = "f64|f32", help_heading = "Engine conventions")]
-    pub precision: Option<sweeptrace::judge::Precision>,
+    pub precision: Option<sweeptrace::conventions::Precision>,
     /// The engine's margin: `scene` (each scene's) or a number it always
     /// uses [default: scene].
     #[arg(
@@ -178,7 +178,7 @@ pub struct ConventionArgs {
         value_name = "scene|NUMBER",
         help_heading = "Engine conventions"
     )]
-    pub margin: Option<sweeptrace::judge::MarginRule>,
+    pub margin: Option<sweeptrace::conventions::MarginRule>,
     /// The engine's facing rule: `scene`, `strict` or `non_strict`
     /// [default: scene].
     #[arg(
@@ -187,7 +187,7 @@ pub struct ConventionArgs {
         value_name = "RULE",
         help_heading = "Engine conventions"
     )]
-    pub facing: Option<sweeptrace::judge::FacingRule>,
+    pub facing: Option<sweeptrace::conventions::FacingRule>,
     /// Which sides of a triangle collide: `one` (the rules: a contact
     /// from behind, `n · d > 0`, is no collision) or `two` (a hit from
     /// behind too, reported with the normal `-n`) [default: one].
@@ -203,11 +203,11 @@ pub struct ConventionArgs {
     /// vertices) or `active_edges` (the contact normal at active edges
     /// only, as Jolt) [default: face].
     #[arg(long, value_name = "RULE", help_heading = "Engine conventions")]
-    pub normal: Option<sweeptrace::replay::NormalRule>,
+    pub normal: Option<sweeptrace::conventions::NormalRule>,
     /// A tie: `rule` (the decision's α and normal) or `any` (any member
     /// with its own contact and normal) [default: rule].
     #[arg(long, value_name = "rule|any", help_heading = "Engine conventions")]
-    pub ties: Option<sweeptrace::judge::TieRule>,
+    pub ties: Option<sweeptrace::conventions::TieRule>,
 }
 
 impl ConventionArgs {

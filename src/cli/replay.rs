@@ -350,7 +350,7 @@ pub fn run(args: Args) -> anyhow::Result<Exit> {
 /// (the error of a trace that ends early, or `null`).
 fn summary_json(
     args: &Args,
-    conventions: &sweeptrace::judge::EngineConventions,
+    conventions: &sweeptrace::conventions::EngineConventions,
     summary: &sweeptrace::replay::ReplaySummary,
     selection: Option<String>,
     wrote: &[String],

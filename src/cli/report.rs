@@ -196,7 +196,7 @@ pub struct SweepReport<'a> {
     pub crossings: &'a [Crossing],
     /// The engine conventions the sweep was computed under (in the JSON as
     /// `conventions` when some are declared, as `check --json` says them).
-    pub conventions: &'a sweeptrace::judge::EngineConventions,
+    pub conventions: &'a sweeptrace::conventions::EngineConventions,
 }
 
 impl SweepReport<'_> {

@@ -174,7 +174,7 @@ pub fn run(args: Args) -> anyhow::Result<Exit> {
     .context("invalid sweep")?;
     let normal = settings.engine.normal.value;
     let outcome = match &topology {
-        Some(t) if normal != sweeptrace::replay::NormalRule::Face => {
+        Some(t) if normal != sweeptrace::conventions::NormalRule::Face => {
             sweeptrace::replay::SceneNormals::new(normal, &mesh, t).apply(&sweep, outcome)
         }
         _ => outcome,
@@ -255,7 +255,7 @@ fn replay_to(
     shown: &str,
     (frame, ball): (u64, u32),
     args: &Args,
-    conventions: &sweeptrace::judge::EngineConventions,
+    conventions: &sweeptrace::conventions::EngineConventions,
 ) -> anyhow::Result<Option<SweepResult>> {
     let file = super::open_trace(path)?;
     let reader = TraceReader::new_indexed(std::io::BufReader::new(file), shown);

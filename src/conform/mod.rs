@@ -20,10 +20,11 @@ use std::fmt::Write as _;
 
 use serde::Serialize;
 
+use crate::conventions::{EngineConventions, TieRule};
 use crate::core::explain::num;
 use crate::core::{Kind, Outcome};
 use crate::engine::{EngineAnswers, EngineCommand, EngineError, EngineOptions, EngineSession};
-use crate::judge::{Agreement, EngineConventions, TieRule, Tolerances, agreement, compare};
+use crate::judge::{Agreement, Tolerances, agreement, compare};
 use crate::judge::{Divergence, Parties, divergence_details, render_divergence_as};
 use crate::replay::{ReplayEvent, ReplayOptions, replay_events};
 use crate::trace::{EventBody, EventHeader, OutcomeMsg, TraceEvent};

@@ -5,11 +5,11 @@ use crate::core::Fragility;
 use crate::replay::SweepResult;
 use crate::trace::OutcomeMsg;
 
-use super::compare::Precision;
-use super::compare::{Field, FieldDiff, NOT_A_UNIT_VECTOR, TieRule, Tolerances, compare};
+use super::compare::{Field, FieldDiff, NOT_A_UNIT_VECTOR, Tolerances, compare};
 use super::perturbation::{Reproduced, Rounding, reproduce};
 use super::precision::{F32_OPERATIONS, Sensitivity};
 use super::reference::Decision;
+use crate::conventions::{Precision, TieRule};
 
 /// How an answer stands against an expectation: the one judgement.
 #[derive(Clone, Debug, PartialEq)]

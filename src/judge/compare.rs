@@ -5,6 +5,7 @@ use nalgebra::Vector3;
 use serde::Serialize;
 use serde_json::{Value, json};
 
+use crate::conventions::{Precision, TieRule};
 use crate::core::Kind;
 use crate::core::explain::num;
 use crate::numbers::{self, Rule};
@@ -86,77 +87,6 @@ impl Tolerances {
     pub fn normal_length(&self) -> f64 {
         self.normal_length
             .unwrap_or_else(|| self.normal_degrees.to_radians())
-    }
-}
-
-/// The arithmetic an engine computes in: an engine convention
-/// (`precision` in `sweeptrace.toml`'s `[engine]` table).
-#[derive(
-    Clone,
-    Copy,
-    Debug,
-    Default,
-    PartialEq,
-    Eq,
-    Hash,
-    Serialize,
-    serde::Deserialize,
-    strum::IntoStaticStr,
-    strum::Display,
-    strum::EnumString,
-    strum::VariantNames,
-)]
-#[serde(rename_all = "snake_case")]
-#[strum(serialize_all = "snake_case")]
-pub enum Precision {
-    /// Double precision: the fixed tolerances, as always.
-    #[default]
-    F64,
-    /// Single precision: differences judged by backward error.
-    F32,
-}
-
-impl Precision {
-    /// Whether this is the default, `f64`.
-    pub fn is_f64(&self) -> bool {
-        *self == Precision::F64
-    }
-}
-
-/// Which member of a tie an answer may name: an engine convention (`ties`
-/// in `sweeptrace.toml`'s `[engine]` table).
-#[derive(
-    Clone,
-    Copy,
-    Debug,
-    Default,
-    PartialEq,
-    Eq,
-    Hash,
-    Serialize,
-    serde::Deserialize,
-    strum::IntoStaticStr,
-    strum::Display,
-    strum::EnumString,
-    strum::VariantNames,
-)]
-#[serde(rename_all = "snake_case")]
-#[strum(serialize_all = "snake_case")]
-pub enum TieRule {
-    /// Any member of the tie set, with the decision's `α` and normal (the
-    /// averaged normal under the rules) and the member's own contact:
-    /// `check` accepts it as a tie, `conform` asks for the tie order's.
-    #[default]
-    Rule,
-    /// Any member of the tie set with its own contact and its own normal
-    /// (an engine that keeps the first hit it meets, as most do).
-    Any,
-}
-
-impl TieRule {
-    /// Whether this is the default, `rule`.
-    pub fn is_rule(&self) -> bool {
-        *self == TieRule::Rule
     }
 }
 

@@ -9,14 +9,15 @@ use std::fmt::Write as _;
 
 use serde::Serialize;
 
+use crate::conventions::NormalRule;
 use crate::core::{Kind, Options, SweptPath, initial_contacts};
-use crate::replay::{NormalRule, SweepResult};
+use crate::replay::SweepResult;
 use crate::trace::OutcomeMsg;
 
 use super::agreement::{agreement, agreement_of};
-use super::compare::Precision;
 use super::compare::{Field, FieldDiff, Tolerances, angle_degrees};
-use super::conventions::EngineConventions;
+use crate::conventions::EngineConventions;
+use crate::conventions::Precision;
 
 /// Failing sweeps a convention would explain, by convention. A sweep is
 /// counted under the first that explains it, in this order.

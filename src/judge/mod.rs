@@ -8,7 +8,8 @@
 //!   rounding budget reproduces it; shared by `check`, `check --engine`,
 //!   `diff`, `conform` and the viewer;
 //! - the single-precision sensitivity of an answer ([`Sensitivity`]);
-//! - the conventions an engine declares ([`EngineConventions`]);
+//! - where the conventions an engine declares act on the replay and the
+//!   judge ([`crate::conventions::EngineConventions`]);
 //! - the decision line of a sweep in words, and whether it diverges
 //!   ([`decision_line`], [`divergence`]; used by the viewer and the
 //!   Foxglove output);
@@ -40,10 +41,9 @@ mod reference;
 pub use agreement::{Agreement, agreement, agreement_of};
 pub use compare::{
     ContactAxis, DEFAULT_ALPHA_TOLERANCE, DEFAULT_CONTACT_TOLERANCE,
-    DEFAULT_NORMAL_TOLERANCE_DEGREES, Field, FieldDiff, FieldSet, Precision, TieRule, Tolerances,
-    angle_degrees, compare,
+    DEFAULT_NORMAL_TOLERANCE_DEGREES, Field, FieldDiff, FieldSet, Tolerances, angle_degrees,
+    compare,
 };
-pub use conventions::{EngineConventions, FacingRule, MarginRule};
 pub(crate) use decision::write_decision_line;
 #[cfg(feature = "viewer")]
 pub(crate) use decision::write_divergence_line;

@@ -13,9 +13,10 @@ use crate::core::{FRAGILE_ULPS, Mesh, Options, Sweep, SweptPath};
 use crate::replay::SweepResult;
 use crate::trace::OutcomeMsg;
 
-use super::compare::{Precision, Tolerances};
+use super::compare::Tolerances;
 use super::precision::{F32_OPERATIONS, F32_UNIT, Sensitivity};
 use super::reference::Decision;
+use crate::conventions::Precision;
 
 /// One change of one input of a sweep, within its rounding budget.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]

@@ -356,7 +356,7 @@ impl Sensitivity {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::judge::Precision;
+    use crate::conventions::Precision;
 
     #[test]
     fn the_unit_is_two_to_the_minus_24() {

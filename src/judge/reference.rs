@@ -13,7 +13,8 @@ use crate::core::{
 use crate::replay::SceneState;
 use crate::trace::OutcomeMsg;
 
-use super::compare::{FieldDiff, TieRule, Tolerances, compare};
+use super::compare::{FieldDiff, Tolerances, compare};
+use crate::conventions::TieRule;
 
 /// Keeps the records of the tests that hit.
 #[derive(Default)]

@@ -38,9 +38,7 @@ pub(crate) use ghost::GhostLine;
 pub use ghost::{GHOST_DEGREES, GhostContact, GhostJudgement, GhostPlace, judge_ghost};
 pub use iter::{ParallelReplayIter, ReplayIter, replay_events, replay_events_parallel};
 pub use normals::SceneNormals;
-pub use options::{
-    ACTIVE_EDGE_DEGREES, DEFAULT_BATCH_EVENTS, Detail, FrameRange, NormalRule, ReplayOptions,
-};
+pub use options::{DEFAULT_BATCH_EVENTS, Detail, FrameRange, ReplayOptions};
 #[cfg(feature = "viewer")]
 pub(crate) use pipeline::sweep_of;
 pub use pipeline::{

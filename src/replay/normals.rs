@@ -4,7 +4,7 @@
 
 use crate::core::{EdgeClass, Feature, Mesh, Outcome, Sweep, Topology};
 
-use super::options::{ACTIVE_EDGE_DEGREES, NormalRule};
+use crate::conventions::{ACTIVE_EDGE_DEGREES, NormalRule};
 
 /// Which normal the hits of a scene report ([`NormalRule`]), with what the
 /// rule needs of the scene: for [`NormalRule::ActiveEdges`], each

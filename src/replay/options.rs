@@ -1,6 +1,7 @@
 //! What a caller chooses about a replay: which sweeps, how much is
 //! explained, and overrides of the scene's margin and facing rule.
 
+use crate::conventions::NormalRule;
 use crate::core::{Facing, InitialOverlap, Options, Sides};
 
 /// Trace events per batch of [`super::replay_events_parallel`] unless told otherwise.
@@ -173,52 +174,6 @@ pub struct ReplayOptions {
     /// normal by default).
     pub normal: NormalRule,
 }
-
-/// Which normal a hit reports: an engine convention (docs/ENGINES.md,
-/// "Conventions"). The rules report the triangle's front normal, averaged
-/// over a tie; engines report the contact normal, the direction from the
-/// contact to the ball's centre, which differs at an edge or a vertex.
-#[derive(
-    Clone,
-    Copy,
-    Debug,
-    Default,
-    PartialEq,
-    Eq,
-    Hash,
-    serde::Serialize,
-    serde::Deserialize,
-    strum::IntoStaticStr,
-    strum::Display,
-    strum::EnumString,
-    strum::VariantNames,
-)]
-#[serde(rename_all = "snake_case")]
-#[strum(serialize_all = "snake_case")]
-pub enum NormalRule {
-    /// The rules: the front normal of the triangle hit, averaged over the
-    /// triangles tied with it.
-    #[default]
-    Face,
-    /// The contact normal at every edge and vertex hit (a face hit keeps
-    /// the face normal, which is its contact normal). On an internal flat
-    /// or concave place that is a ghost contact, and `check` still reports
-    /// it as one.
-    Contact,
-    /// The contact normal at an *active* edge or vertex, the face normal
-    /// elsewhere, as Jolt's meshes do: an edge is active when it is a
-    /// boundary or non-manifold edge, or a convex edge whose faces meet at
-    /// more than [`ACTIVE_EDGE_DEGREES`]; a vertex hit is active when
-    /// either edge of its triangle at the vertex is. An engine that
-    /// removes ghost contacts this way answers the face normal on internal
-    /// flat and concave places.
-    ActiveEdges,
-}
-
-/// The angle between two faces above which their shared convex edge is
-/// active ([`NormalRule::ActiveEdges`]): Jolt's default
-/// (`MeshShapeSettings::mActiveEdgeCosThresholdAngle` = cos 5°).
-pub const ACTIVE_EDGE_DEGREES: f64 = 5.0;
 
 impl ReplayOptions {
     /// The core's options for a scene whose own margin and facing rule are

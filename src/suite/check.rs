@@ -24,7 +24,7 @@ use super::report::{
     Judged, KindChange, MAX_DIVERGENT_FRAMES, MAX_ERRORS, MAX_LISTED_TUNNELS, TraceReport,
     TunnelReport, WithinPrecision,
 };
-use crate::judge::EngineConventions;
+use crate::conventions::EngineConventions;
 use crate::judge::divergence_details;
 use crate::judge::{Agreement, agreement};
 use crate::judge::{Field, Tolerances};

@@ -16,13 +16,13 @@
 
 use std::fmt::Write as _;
 
+use crate::conventions::NormalRule;
 use crate::core::{InitialOverlap, Sides};
-use crate::replay::NormalRule;
 
 use super::report::TraceReport;
-use crate::judge::Precision;
-use crate::judge::TieRule;
-use crate::judge::{EngineConventions, FacingRule, MarginRule};
+use crate::conventions::Precision;
+use crate::conventions::TieRule;
+use crate::conventions::{EngineConventions, FacingRule, MarginRule};
 
 /// What a check of every trace under some conventions came to.
 #[derive(Clone, Debug, Default, PartialEq)]

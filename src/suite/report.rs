@@ -13,10 +13,10 @@ use crate::replay::{GhostContact, Tunnel, TunnelAt, TunnelKind};
 use crate::trace::OutcomeMsg;
 
 use super::infer::Inferred;
+use crate::conventions::EngineConventions;
 use crate::judge::Agreement;
 use crate::judge::ConventionHints;
 use crate::judge::Divergence;
-use crate::judge::EngineConventions;
 use crate::judge::Tolerances;
 
 /// How many tunnels a report lists, one line each.

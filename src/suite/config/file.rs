@@ -8,7 +8,7 @@ use toml::Spanned;
 
 use super::normalize;
 use super::settings::{Layer, Setting, Settings, Source};
-use crate::judge::MarginRule;
+use crate::conventions::MarginRule;
 use crate::judge::{Field, FieldSet};
 use crate::numbers::{self, Rule};
 

@@ -6,15 +6,15 @@ use std::fmt;
 use serde::Serialize;
 
 use super::super::check::CheckOptions;
+use crate::conventions::NormalRule;
+use crate::conventions::Precision;
+use crate::conventions::TieRule;
+use crate::conventions::{EngineConventions, FacingRule, MarginRule};
 use crate::core::{InitialOverlap, Sides};
-use crate::judge::Precision;
-use crate::judge::TieRule;
 use crate::judge::{
     DEFAULT_ALPHA_TOLERANCE, DEFAULT_CONTACT_TOLERANCE, DEFAULT_NORMAL_TOLERANCE_DEGREES, FieldSet,
     Tolerances,
 };
-use crate::judge::{EngineConventions, FacingRule, MarginRule};
-use crate::replay::NormalRule;
 
 /// Where a resolved setting came from.
 #[derive(Clone, Debug, PartialEq, Eq, Serialize)]

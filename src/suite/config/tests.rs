@@ -343,8 +343,8 @@ fn engine_sides_are_read_with_their_line_and_the_command_line_wins() {
 
 #[test]
 fn engine_sides_round_trip_through_the_table_inference_writes() {
+    use crate::conventions::EngineConventions;
     use crate::core::Sides;
-    use crate::judge::EngineConventions;
     let declared = EngineConventions {
         sides: Sides::Two,
         ..EngineConventions::default()

@@ -5,27 +5,135 @@
 //!
 //! **A convention changes the reference answer, not the tolerance**: the
 //! margin, the facing rule, the sides, the initial overlap and the normal
-//! change what the core computes (the replay's options, [`ReplayOptions`]); the
-//! precision and the tie rule change how an answer is judged against it
-//! ([`Tolerances`]). A suite without the table is judged by the rules.
+//! change what the core computes (the replay's options); the precision and
+//! the tie rule change how an answer is judged against it. A suite without
+//! the table is judged by the rules.
 //!
-//! Adding a convention: a closed enum of its values with the rules' value
-//! as the default (`strum` gives the names), a field here, its key in
-//! `config/file.rs` and `config/settings.rs`, its flag in `ConventionArgs`
-//! (`cli/mod.rs`), its effect in [`EngineConventions::replay_with`] or
-//! [`EngineConventions::judge_with`], its evidence in
-//! `infer_conventions.rs`, the conform rules it replaces in
-//! [`EngineConventions::replaces`], and a line in docs/ENGINES.md.
+//! This module is a leaf: it depends on the core's option values only, so
+//! that the replay, the judge and the suite all carry the same type.
 
 use std::fmt;
 
 use serde::Serialize;
 
 use crate::core::{Facing, InitialOverlap, Sides};
-use crate::replay::{NormalRule, ReplayOptions};
 
-use super::compare::Precision;
-use super::compare::{TieRule, Tolerances};
+/// The arithmetic an engine computes in: an engine convention
+/// (`precision` in `sweeptrace.toml`'s `[engine]` table).
+#[derive(
+    Clone,
+    Copy,
+    Debug,
+    Default,
+    PartialEq,
+    Eq,
+    Hash,
+    Serialize,
+    serde::Deserialize,
+    strum::IntoStaticStr,
+    strum::Display,
+    strum::EnumString,
+    strum::VariantNames,
+)]
+#[serde(rename_all = "snake_case")]
+#[strum(serialize_all = "snake_case")]
+pub enum Precision {
+    /// Double precision: the fixed tolerances, as always.
+    #[default]
+    F64,
+    /// Single precision: differences judged by backward error.
+    F32,
+}
+
+impl Precision {
+    /// Whether this is the default, `f64`.
+    pub fn is_f64(&self) -> bool {
+        *self == Precision::F64
+    }
+}
+
+/// Which member of a tie an answer may name: an engine convention (`ties`
+/// in `sweeptrace.toml`'s `[engine]` table).
+#[derive(
+    Clone,
+    Copy,
+    Debug,
+    Default,
+    PartialEq,
+    Eq,
+    Hash,
+    Serialize,
+    serde::Deserialize,
+    strum::IntoStaticStr,
+    strum::Display,
+    strum::EnumString,
+    strum::VariantNames,
+)]
+#[serde(rename_all = "snake_case")]
+#[strum(serialize_all = "snake_case")]
+pub enum TieRule {
+    /// Any member of the tie set, with the decision's `α` and normal (the
+    /// averaged normal under the rules) and the member's own contact:
+    /// `check` accepts it as a tie, `conform` asks for the tie order's.
+    #[default]
+    Rule,
+    /// Any member of the tie set with its own contact and its own normal
+    /// (an engine that keeps the first hit it meets, as most do).
+    Any,
+}
+
+impl TieRule {
+    /// Whether this is the default, `rule`.
+    pub fn is_rule(&self) -> bool {
+        *self == TieRule::Rule
+    }
+}
+
+/// Which normal a hit reports: an engine convention (docs/ENGINES.md,
+/// "Conventions"). The rules report the triangle's front normal, averaged
+/// over a tie; engines report the contact normal, the direction from the
+/// contact to the ball's centre, which differs at an edge or a vertex.
+#[derive(
+    Clone,
+    Copy,
+    Debug,
+    Default,
+    PartialEq,
+    Eq,
+    Hash,
+    serde::Serialize,
+    serde::Deserialize,
+    strum::IntoStaticStr,
+    strum::Display,
+    strum::EnumString,
+    strum::VariantNames,
+)]
+#[serde(rename_all = "snake_case")]
+#[strum(serialize_all = "snake_case")]
+pub enum NormalRule {
+    /// The rules: the front normal of the triangle hit, averaged over the
+    /// triangles tied with it.
+    #[default]
+    Face,
+    /// The contact normal at every edge and vertex hit (a face hit keeps
+    /// the face normal, which is its contact normal). On an internal flat
+    /// or concave place that is a ghost contact, and `check` still reports
+    /// it as one.
+    Contact,
+    /// The contact normal at an *active* edge or vertex, the face normal
+    /// elsewhere, as Jolt's meshes do: an edge is active when it is a
+    /// boundary or non-manifold edge, or a convex edge whose faces meet at
+    /// more than [`ACTIVE_EDGE_DEGREES`]; a vertex hit is active when
+    /// either edge of its triangle at the vertex is. An engine that
+    /// removes ghost contacts this way answers the face normal on internal
+    /// flat and concave places.
+    ActiveEdges,
+}
+
+/// The angle between two faces above which their shared convex edge is
+/// active ([`NormalRule::ActiveEdges`]): Jolt's default
+/// (`MeshShapeSettings::mActiveEdgeCosThresholdAngle` = cos 5°).
+pub const ACTIVE_EDGE_DEGREES: f64 = 5.0;
 
 /// The margin an engine uses: the scene's (the rules) or always the same.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -132,49 +240,6 @@ impl EngineConventions {
     /// Whether these are the rules (no convention declared).
     pub fn is_rules(&self) -> bool {
         *self == EngineConventions::default()
-    }
-
-    /// The conventions a check with `tolerances` and `replay` judges by.
-    pub fn of(tolerances: &Tolerances, replay: &ReplayOptions) -> EngineConventions {
-        EngineConventions {
-            precision: tolerances.precision,
-            margin: replay.margin.map_or(MarginRule::Scene, MarginRule::Fixed),
-            facing: match replay.facing {
-                None => FacingRule::Scene,
-                Some(Facing::Strict) => FacingRule::Strict,
-                Some(Facing::NonStrict) => FacingRule::NonStrict,
-            },
-            sides: replay.sides,
-            initial_overlap: replay.initial_overlap,
-            normal: replay.normal,
-            ties: tolerances.ties,
-        }
-    }
-
-    /// `tolerances` judged under these conventions (the precision and the
-    /// tie rule).
-    pub fn judge_with(&self, tolerances: Tolerances) -> Tolerances {
-        Tolerances {
-            precision: self.precision,
-            ties: self.ties,
-            ..tolerances
-        }
-    }
-
-    /// `replay` computing the reference answer under these conventions
-    /// (margin, facing, sides, initial overlap, normal).
-    pub fn replay_with(&self, replay: ReplayOptions) -> ReplayOptions {
-        ReplayOptions {
-            margin: match self.margin {
-                MarginRule::Scene => replay.margin,
-                MarginRule::Fixed(m) => Some(m),
-            },
-            facing: self.facing.facing().or(replay.facing),
-            sides: self.sides,
-            initial_overlap: self.initial_overlap,
-            normal: self.normal,
-            ..replay
-        }
     }
 
     /// The conventions that differ from the rules, as `key = value` pairs
@@ -301,79 +366,6 @@ impl EngineConventions {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn the_default_is_the_rules_and_changes_nothing() {
-        let c = EngineConventions::default();
-        assert!(c.is_rules());
-        assert!(c.declared().is_empty());
-        assert_eq!(c.summary(), "the rules");
-        let replay = ReplayOptions::default();
-        assert_eq!(c.replay_with(replay), replay);
-        assert_eq!(c.judge_with(Tolerances::default()), Tolerances::default());
-    }
-
-    #[test]
-    fn each_convention_lands_where_it_acts() {
-        let c = EngineConventions {
-            precision: Precision::F32,
-            margin: MarginRule::Fixed(0.0),
-            facing: FacingRule::NonStrict,
-            sides: Sides::Two,
-            initial_overlap: InitialOverlap::Alpha0,
-            normal: NormalRule::ActiveEdges,
-            ties: TieRule::Any,
-        };
-        let replay = c.replay_with(ReplayOptions::default());
-        assert_eq!(replay.margin, Some(0.0));
-        assert_eq!(replay.facing, Some(Facing::NonStrict));
-        assert_eq!(replay.sides, Sides::Two);
-        assert_eq!(replay.initial_overlap, InitialOverlap::Alpha0);
-        assert_eq!(replay.normal, NormalRule::ActiveEdges);
-        let tol = c.judge_with(Tolerances::default());
-        assert_eq!((tol.precision, tol.ties), (Precision::F32, TieRule::Any));
-        assert_eq!(
-            c.summary(),
-            "precision f32, margin 0.0, facing non_strict, sides two, initial_overlap alpha0, \
-             normal active_edges, ties any"
-        );
-        assert_eq!(
-            c.replaces("margin.inside-band/0").as_deref(),
-            Some("the engine declares margin = 0.0")
-        );
-        assert_eq!(c.replaces("edge.basic/0"), None);
-        for rule in ["face.miss.back-facing/0", "edge.miss.back-facing"] {
-            assert_eq!(
-                c.replaces(rule).as_deref(),
-                Some("the engine declares sides = two"),
-                "{rule}"
-            );
-        }
-        assert_eq!(
-            c.replaces("start.moving-away/1").as_deref(),
-            Some("the engine declares sides = two and initial_overlap = alpha0")
-        );
-        // Contact normals at active edges: the ridge's normal is judged.
-        assert_eq!(c.replaces("normal.shallow-convex-edge/0"), None);
-        assert_eq!(c.replaces("normal.flat-edge/0"), None);
-        let face_any = EngineConventions {
-            ties: TieRule::Any,
-            ..EngineConventions::default()
-        };
-        assert_eq!(
-            face_any.replaces("normal.shallow-convex-edge").as_deref(),
-            Some("the engine declares normal = face and ties = any")
-        );
-        assert_eq!(face_any.replaces("normal.flat-edge"), None);
-        let one_sided = EngineConventions {
-            initial_overlap: InitialOverlap::Alpha0,
-            ..EngineConventions::default()
-        };
-        assert_eq!(one_sided.replaces("start.moving-away"), None);
-        let one = EngineConventions::default();
-        assert_eq!(one.replaces("face.miss.back-facing/0"), None);
-        assert_eq!(one.replaces("edge.miss.back-facing/0"), None);
-    }
 
     #[test]
     fn margins_parse_as_scene_or_a_number() {

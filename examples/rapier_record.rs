@@ -469,6 +469,7 @@ pub fn run(args: Args) -> Result<Counts, String> {
             ..Default::default()
         },
         normals: Default::default(),
+        conventions: Default::default(),
     };
     let corners_of = |t: u32| {
         let triangle = trimesh_triangles.get(t as usize)?;

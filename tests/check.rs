@@ -21,11 +21,12 @@ use std::io::Cursor;
 use std::path::{Path, PathBuf};
 
 use libtest_mimic::Trial;
-use sweeptrace::core::{Facing, Kind};
+use sweeptrace::conventions::Source;
+use sweeptrace::core::Kind;
 use sweeptrace::judge::{Field, FieldSet, Tolerances, compare};
 use sweeptrace::replay::ReplayOptions;
 use sweeptrace::suite::{
-    CheckOptions, Overrides, Side, Source, Status, bless_bytes, check_file, check_reader, diff,
+    CheckOptions, Overrides, Side, Status, bless_bytes, check_file, check_reader, diff,
     find_traces, render_json, render_text, settings_for,
 };
 use sweeptrace::trace::{OutcomeMsg, SceneMsg, SweepMsg, TraceReader, TraceWriter};
@@ -159,7 +160,10 @@ fn fixture_bytes() -> anyhow::Result<Vec<u8>> {
     bless_with(
         &plain,
         ReplayOptions {
-            margin: Some(0.0),
+            conventions: sweeptrace::conventions::EngineConventions {
+                margin: sweeptrace::conventions::MarginRule::Fixed(0.0),
+                ..Default::default()
+            },
             ..ReplayOptions::default()
         },
     )
@@ -377,12 +381,17 @@ fn rapier_sample_needs_its_settings_file() -> anyhow::Result<()> {
             && tolerances.alpha == 1e-5
             && tolerances.contact == 1e-5
             && tolerances.normal_degrees == Tolerances::default().normal_degrees
-            && settings.engine.normal.value == sweeptrace::conventions::NormalRule::Contact
+            && settings.engine.conventions().normal == sweeptrace::conventions::NormalRule::Contact
             && !settings.strict.value
             && !settings.allow_tunnels.value,
         "the settings changed ({settings:?}): update this test"
     );
-    for source in [&settings.engine.normal.source, &settings.alpha.source] {
+    let normal = settings
+        .engine
+        .normal
+        .clone()
+        .map_or(Source::Default, |s| s.source);
+    for source in [&normal, &settings.alpha.source] {
         ensure!(
             matches!(source, Source::File { file, .. } if file == "examples/sweeptrace.toml"),
             "{source:?}"
@@ -969,7 +978,10 @@ fn diff_strict_facing_reports_first_divergence() -> anyhow::Result<()> {
     let side = |o| Side::replay(TraceReader::new(bytes.as_slice(), "t"), "t", o);
     let a = side(ReplayOptions::default())?;
     let b = side(ReplayOptions {
-        facing: Some(Facing::Strict),
+        conventions: sweeptrace::conventions::EngineConventions {
+            facing: sweeptrace::conventions::FacingRule::Strict,
+            ..Default::default()
+        },
         ..ReplayOptions::default()
     })?;
     let r = diff(&a, &b, &Tolerances::default());

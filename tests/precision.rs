@@ -10,7 +10,7 @@
 use anyhow::ensure;
 use libtest_mimic::Trial;
 use rand::{Rng, SeedableRng};
-use sweeptrace::conventions::Precision;
+use sweeptrace::conventions::{EngineConventions, Precision};
 use sweeptrace::judge::{F32_OPERATIONS, Sensitivity, Tolerances};
 use sweeptrace::replay::ReplayEvent;
 use sweeptrace::trace::{OutcomeMsg, SceneMsg, SweepMsg, TraceReader, TraceWriter};
@@ -104,6 +104,16 @@ fn results(
     sweeps: &[SweepMsg],
     answer: impl Fn(&SweepMsg) -> anyhow::Result<OutcomeMsg>,
 ) -> anyhow::Result<Vec<sweeptrace::replay::SweepResult>> {
+    results_at(Precision::F32, scene, sweeps, answer)
+}
+
+/// [`results`] replayed (and so judged) at `precision`.
+fn results_at(
+    precision: Precision,
+    scene: &SceneMsg,
+    sweeps: &[SweepMsg],
+    answer: impl Fn(&SweepMsg) -> anyhow::Result<OutcomeMsg>,
+) -> anyhow::Result<Vec<sweeptrace::replay::SweepResult>> {
     let mut w = TraceWriter::new(std::io::Cursor::new(Vec::new()))?;
     w.scene(0, scene)?;
     for s in sweeps {
@@ -115,7 +125,7 @@ fn results(
     let mut out = Vec::new();
     for event in sweeptrace::replay_events(
         TraceReader::new(bytes.as_slice(), "precision.mcap"),
-        ReplayOptions::default(),
+        at(precision),
     ) {
         if let ReplayEvent::Sweep(r) = event? {
             out.push(*r);
@@ -124,10 +134,15 @@ fn results(
     Ok(out)
 }
 
-fn tolerances(precision: Precision) -> Tolerances {
-    Tolerances {
-        precision,
-        ..Tolerances::default()
+/// A replay under the rules but for the arithmetic: its results are
+/// judged at `precision`.
+fn at(precision: Precision) -> ReplayOptions {
+    ReplayOptions {
+        conventions: EngineConventions {
+            precision,
+            ..EngineConventions::default()
+        },
+        ..ReplayOptions::default()
     }
 }
 
@@ -135,14 +150,15 @@ fn answers_for_inputs_rounded_to_f32_are_accepted_at_f32() -> anyhow::Result<()>
     let scene = terrain();
     let sweeps = sweeps(400);
     let results = results(&scene, &sweeps, |s| f32_answer(&scene, s))?;
+    let results_at_f64 = results_at(Precision::F64, &scene, &sweeps, |s| f32_answer(&scene, s))?;
     let (mut hits, mut refused_at_f64, mut refused_at_f32) = (0, 0, Vec::new());
-    for r in &results {
+    for (r, r64) in results.iter().zip(&results_at_f64) {
         let expected = r.expected.expect("every sweep has its answer");
         hits += u32::from(r.outcome.is_hit());
-        if sweeptrace::agreement(&expected, r, &tolerances(Precision::F64)).fails(false) {
+        if sweeptrace::agreement(&expected, r64, &Tolerances::default()).fails(false) {
             refused_at_f64 += 1;
         }
-        if sweeptrace::agreement(&expected, r, &tolerances(Precision::F32)).fails(false) {
+        if sweeptrace::agreement(&expected, r, &Tolerances::default()).fails(false) {
             refused_at_f32.push(r.frame);
         }
     }
@@ -177,7 +193,7 @@ fn alpha_moved_by_ten_bounds_is_refused_at_f32() -> anyhow::Result<()> {
         let mut expected = r.expected.expect("every sweep has its answer");
         expected.alpha = moved;
         tried += 1;
-        let agreement = sweeptrace::agreement(&expected, r, &tolerances(Precision::F32));
+        let agreement = sweeptrace::agreement(&expected, r, &Tolerances::default());
         if agreement.fails(false) {
             refused += 1;
         } else {
@@ -234,7 +250,7 @@ fn grazing_edge_contacts_have_finite_square_root_bounds() -> anyhow::Result<()> 
     let scene = edge_scene();
     let sweeps = grazing_sweeps();
     let results = results(&scene, &sweeps, |s| f32_answer(&scene, s))?;
-    let f32_tol = tolerances(Precision::F32);
+    let f32_tol = Tolerances::default();
     let (mut edge_hits, mut refused, mut moved_refused) = (0, Vec::new(), 0);
     for r in &results {
         let Some(hit) = r.outcome.hit else { continue };
@@ -335,7 +351,7 @@ fn face_answers_bent_off_the_triangle_are_refused_at_f32() -> anyhow::Result<()>
             inside_the_sphere += u32::from(2.0 * bounds.contact_along_normal < bounds.contact);
             bend(&mut answer, bounds.contact_along_normal);
             tried += 1;
-            match sweeptrace::agreement(&answer, r, &tolerances(Precision::F32)) {
+            match sweeptrace::agreement(&answer, r, &Tolerances::default()) {
                 Agreement::Diverges {
                     fields,
                     reproduced: None,
@@ -375,7 +391,7 @@ fn a_perturbation_does_not_spend_the_f32_budget_twice() -> anyhow::Result<()> {
     let mut found = None;
     for event in sweeptrace::replay_events(
         TraceReader::new(std::io::BufReader::new(file), "record_mini_golf.mcap"),
-        ReplayOptions::default(),
+        at(Precision::F32),
     ) {
         if let ReplayEvent::Sweep(r) = event?
             && r.frame == 55
@@ -402,7 +418,7 @@ fn a_perturbation_does_not_spend_the_f32_budget_twice() -> anyhow::Result<()> {
         "the skin ({}) must be beyond the bound ({bound})",
         hit.alpha - answer.alpha
     );
-    let agreement = sweeptrace::agreement(&answer, &r, &tolerances(Precision::F32));
+    let agreement = sweeptrace::agreement(&answer, &r, &Tolerances::default());
     ensure!(
         matches!(
             agreement,
@@ -417,7 +433,7 @@ fn a_perturbation_does_not_spend_the_f32_budget_twice() -> anyhow::Result<()> {
     let mut rounded = answer;
     rounded.alpha = hit.alpha + 0.5 * bound / F32_OPERATIONS;
     ensure!(
-        !sweeptrace::agreement(&rounded, &r, &tolerances(Precision::F32)).fails(false),
+        !sweeptrace::agreement(&rounded, &r, &Tolerances::default()).fails(false),
         "half a unit's move fails"
     );
     Ok(())
@@ -446,7 +462,7 @@ fn a_small_bias_shows_in_the_balance_of_later_and_earlier() -> anyhow::Result<()
         }
         let bytes = w.finish()?.into_inner();
         let options = sweeptrace::CheckOptions {
-            tolerances: tolerances(Precision::F32),
+            replay: at(Precision::F32),
             ..sweeptrace::CheckOptions::default()
         };
         Ok(sweeptrace::check_reader(

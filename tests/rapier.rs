@@ -158,7 +158,10 @@ fn rapier_recording_passes_check_with_the_readme_options() -> anyhow::Result<()>
             ..Tolerances::default()
         },
         replay: sweeptrace::replay::ReplayOptions {
-            normal: sweeptrace::conventions::NormalRule::Contact,
+            conventions: sweeptrace::conventions::EngineConventions {
+                normal: sweeptrace::conventions::NormalRule::Contact,
+                ..Default::default()
+            },
             ..Default::default()
         },
         ..CheckOptions::default()

@@ -498,8 +498,11 @@ fn scene_overrides_apply() -> anyhow::Result<()> {
         p1: [1.0, 1.0, -3.0],
     };
     let options = ReplayOptions {
-        margin: Some(0.25),
-        facing: Some(Facing::Strict),
+        conventions: sweeptrace::conventions::EngineConventions {
+            margin: sweeptrace::conventions::MarginRule::Fixed(0.25),
+            facing: sweeptrace::conventions::FacingRule::Strict,
+            ..Default::default()
+        },
         ..ReplayOptions::default()
     };
     let (r, _) = run(events_for(triangle_scene(), &[sweep]), options)?;

@@ -31,6 +31,7 @@ pub fn tests() -> Vec<Trial> {
         trial!(fixture_case_gives_the_same_verdict),
         trial!(sample_trace_cases_reproduce_and_their_tests_hold),
         trial!(binary_writes_case_and_test),
+        trial!(repro_honours_the_declared_conventions),
         trial!(sweep_from_trace_and_obj),
         trial!(sweep_flag_errors),
         trial!(infer_wrong_engine_config_margin_0),
@@ -170,7 +171,13 @@ fn case_of(path: &Path, frame: u64, ball: u32) -> anyhow::Result<ReproCase> {
         frame,
         ball,
     )?;
-    ReproCase::build(&name, &found, &Tolerances::default()).map_err(anyhow::Error::from)
+    ReproCase::build(
+        &name,
+        &found,
+        &Tolerances::default(),
+        &sweeptrace::conventions::EngineConventions::default(),
+    )
+    .map_err(anyhow::Error::from)
 }
 
 fn case_bytes(case: &ReproCase) -> anyhow::Result<Vec<u8>> {
@@ -389,6 +396,82 @@ fn sample_trace_cases_reproduce_and_their_tests_hold() -> anyhow::Result<()> {
         }
     }
     ensure!(cases >= 20, "only {cases} cases");
+    Ok(())
+}
+
+/// Issue 44: `repro` wrote its case under the rules even when a table
+/// declared conventions. An engine that declares `initial_overlap =
+/// "alpha0"` answers a hit at α = 0 for a ball that starts within ρ of the
+/// triangle: under that convention (in the trace's `sweeptrace.toml`) the
+/// case matches, its Rust test builds the core's options with it, and the
+/// `check` command it prints passes the written case, which fails under
+/// the rules.
+fn repro_honours_the_declared_conventions() -> anyhow::Result<()> {
+    use sweeptrace::core::{InitialOverlap, Options};
+    let dir = tempfile::tempdir()?;
+    let scene = scene_t(0.0);
+    let mesh = Mesh::new(scene.vertices.clone(), &scene.triangles)?;
+    // Starts 0.25 above the triangle's plane with ρ = 0.5, moving down.
+    let sweep = SweepMsg {
+        frame: 0,
+        ball: 0,
+        radius: 0.5,
+        p0: [0.5, 0.5, 0.25],
+        p1: [0.5, 0.5, -1.0],
+    };
+    let alpha0 = Options {
+        initial_overlap: InitialOverlap::Alpha0,
+        ..Options::default()
+    };
+    let core = sweep_mesh(
+        &mesh,
+        &Sweep::new(sweep.p0, sweep.p1, sweep.radius),
+        &alpha0,
+    )?;
+    ensure!(core.is_hit() && core.travelled() == 0.0, "{core:?}");
+    let trace = dir.path().join("overlap.mcap");
+    let mut w = TraceWriter::new(Cursor::new(Vec::new()))?;
+    w.scene(0, &scene)?;
+    w.sweep(1, &sweep)?;
+    w.expected(1, &OutcomeMsg::from_outcome(0, 0, &core))?;
+    std::fs::write(&trace, w.finish()?.into_inner())?;
+    std::fs::write(
+        dir.path().join("sweeptrace.toml"),
+        "[engine]\ninitial_overlap = \"alpha0\"\n",
+    )?;
+    let out = dir.path().join("case.mcap");
+    let (code, stdout, stderr) = run_bin(os![
+        "repro",
+        trace.as_os_str(),
+        "--frame",
+        "0",
+        "-o",
+        out.as_os_str()
+    ])?;
+    ensure!(code == 0, "exit {code}\n{stdout}\n{stderr}");
+    ensure!(
+        stderr.contains("against the expectation: match")
+            && stderr.contains("initial_overlap alpha0"),
+        "judged under the table:\n{stderr}"
+    );
+    ensure!(
+        stdout.contains("initial_overlap: InitialOverlap::Alpha0")
+            && stdout
+                .contains("use sweeptrace::{Facing, InitialOverlap, Kind, Mesh, Options, Sweep};"),
+        "the test builds the options with the convention:\n{stdout}"
+    );
+    // The printed command judges the case as repro did; the rules fail it.
+    let command = stderr
+        .lines()
+        .find_map(|l| l.split_once("check it under the same conventions: sweeptrace "))
+        .map(|(_, c)| c.to_string())
+        .with_context(|| format!("no check command in:\n{stderr}"))?;
+    let args: Vec<std::ffi::OsString> = command.split(' ').map(Into::into).collect();
+    let args: Vec<&std::ffi::OsStr> = args.iter().map(|a| a.as_os_str()).collect();
+    let (code, stdout, stderr) = run_bin(&args)?;
+    ensure!(code == 0, "{command}: exit {code}\n{stdout}{stderr}");
+    let (code, stdout, _) = run_bin(os!["check", out.as_os_str(), "--no-config"])?;
+    ensure!(code == 1, "under the rules: exit {code}\n{stdout}");
     Ok(())
 }
 
@@ -618,8 +701,11 @@ pub(crate) fn recorded_by(
     }
     let plain = w.finish()?.into_inner();
     let options = ReplayOptions {
-        margin: Some(margin),
-        facing: Some(facing),
+        conventions: sweeptrace::conventions::EngineConventions {
+            margin: sweeptrace::conventions::MarginRule::Fixed(margin),
+            facing: facing.into(),
+            ..Default::default()
+        },
         ..ReplayOptions::default()
     };
     bless_bytes(&plain, "<memory>", Cursor::new(Vec::new()), options)

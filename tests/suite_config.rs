@@ -13,8 +13,9 @@ use crate::os;
 use crate::support::run_bin_in;
 use crate::trial;
 use anyhow::Context as _;
+use sweeptrace::conventions::Source;
 use sweeptrace::judge::{Field, FieldSet, Tolerances};
-use sweeptrace::suite::{ConfigFile, Overrides, Source, resolve};
+use sweeptrace::suite::{ConfigFile, Overrides, resolve};
 
 pub fn tests() -> Vec<Trial> {
     vec![

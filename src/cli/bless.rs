@@ -98,7 +98,7 @@ pub struct Args {
     /// The engine's conventions: the core's answers are computed under
     /// them (docs/ENGINES.md).
     #[command(flatten)]
-    pub conventions: super::ConventionArgs,
+    pub conventions: sweeptrace::conventions::PartialConventions,
 }
 
 /// `12:0,40:3` as a set of `(frame, ball)`.
@@ -156,10 +156,13 @@ pub fn run(args: Args) -> anyhow::Result<Exit> {
             })
         }
     };
-    let replay = conventions.replay_with(sweeptrace::replay::ReplayOptions::default());
+    let replay = sweeptrace::replay::ReplayOptions {
+        conventions,
+        ..Default::default()
+    };
     let select = if args.review {
         let check_options = CheckOptions {
-            tolerances: conventions.judge_with(settings.tolerances()),
+            tolerances: settings.tolerances(),
             max_details: usize::MAX,
             replay,
             ..CheckOptions::default()

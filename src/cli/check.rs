@@ -177,7 +177,7 @@ pub struct Args {
     #[command(flatten)]
     pub junit: super::junit::JunitArgs,
     #[command(flatten)]
-    pub conventions: super::ConventionArgs,
+    pub conventions: sweeptrace::conventions::PartialConventions,
     /// With --engine: run the engine, then print only a `sweeptrace.toml`
     /// whose `[engine]` table declares the conventions its answers imply,
     /// each with its evidence in a comment (`check TRACES --engine CMD
@@ -210,7 +210,7 @@ pub fn run(args: Args) -> anyhow::Result<Exit> {
     let overrides = sweeptrace::suite::Overrides {
         strict: args.strict,
         allow_tunnels: args.allow_tunnels,
-        engine: args.conventions.to_overrides(),
+        engine: args.conventions.clone(),
         ..args.tolerances.to_overrides()?
     };
     let found = find_traces(&args.paths)?;
@@ -271,8 +271,10 @@ pub fn run(args: Args) -> anyhow::Result<Exit> {
             for (path, settings) in traces.iter().zip(&settings) {
                 let base = settings.check_options(options);
                 let options = CheckOptions {
-                    tolerances: conventions.judge_with(base.tolerances),
-                    replay: conventions.replay_with(options.replay),
+                    replay: ReplayOptions {
+                        conventions: *conventions,
+                        ..options.replay
+                    },
                     ..base
                 };
                 let report = match &engine {
@@ -491,11 +493,12 @@ fn write_failure_rrd(trace: &Path, dir: &Path, report: &TraceReport) -> anyhow::
     super::warn_unfinished(&target);
     // Replayed and judged as the check was: under the engine's declared
     // conventions and the run's tolerances.
-    let options = report.conventions.replay_with(ReplayOptions {
+    let options = ReplayOptions {
         frames,
         explain: Some(Detail::Candidates),
+        conventions: report.conventions,
         ..ReplayOptions::default()
-    });
+    };
     let name = trace.display().to_string();
     let bytes = std::fs::read(trace).with_context(|| format!("reading {name}"))?;
     super::viewer::write_check_recording(

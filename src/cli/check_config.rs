@@ -73,11 +73,11 @@ pub struct ConfigArgs {
 /// `config`'s), then `conventions` from the command line.
 pub fn for_trace(
     trace: &Path,
-    conventions: &super::ConventionArgs,
+    conventions: &sweeptrace::conventions::PartialConventions,
     config: &ConfigArgs,
 ) -> anyhow::Result<Settings> {
     let overrides = Overrides {
-        engine: conventions.to_overrides(),
+        engine: conventions.clone(),
         ..Overrides::default()
     };
     let mut all = settings(

@@ -74,7 +74,7 @@ pub struct Args {
     #[command(flatten)]
     pub junit: super::junit::JunitArgs,
     #[command(flatten)]
-    pub conventions: super::ConventionArgs,
+    pub conventions: sweeptrace::conventions::PartialConventions,
     /// The engine's conventions from this `sweeptrace.toml` (its `[engine]`
     /// table) instead of the nearest one from the current directory up.
     #[arg(long, value_name = "FILE", conflicts_with = "no_config")]
@@ -90,7 +90,7 @@ pub struct Args {
 fn conventions(args: &Args) -> anyhow::Result<sweeptrace::conventions::EngineConventions> {
     use sweeptrace::suite::{ConfigFile, Overrides, resolve, settings_for};
     let overrides = Overrides {
-        engine: args.conventions.to_overrides(),
+        engine: args.conventions.clone(),
         ..Overrides::default()
     };
     let here = std::env::current_dir()

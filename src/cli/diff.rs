@@ -8,6 +8,7 @@ use std::path::{Path, PathBuf};
 use anyhow::bail;
 
 use super::Exit;
+use sweeptrace::conventions::{EngineConventions, FacingRule, MarginRule};
 use sweeptrace::core::Facing;
 use sweeptrace::numbers::{self, Rule};
 use sweeptrace::replay::{FrameRange, ReplayOptions, Selection};
@@ -91,16 +92,14 @@ pub fn run(args: Args) -> anyhow::Result<Exit> {
     let a = side(
         &args.a,
         ReplayOptions {
-            margin: args.margin_a,
-            facing: args.facing_a,
+            conventions: overrides(args.margin_a, args.facing_a),
             ..base
         },
     )?;
     let b = side(
         &args.b,
         ReplayOptions {
-            margin: args.margin_b,
-            facing: args.facing_b,
+            conventions: overrides(args.margin_b, args.facing_b),
             ..base
         },
     )?;
@@ -148,4 +147,14 @@ pub fn run(args: Args) -> anyhow::Result<Exit> {
     } else {
         Exit::Differences
     })
+}
+
+/// The conventions of one side: its margin and facing overrides, the rules
+/// otherwise.
+fn overrides(margin: Option<f64>, facing: Option<Facing>) -> EngineConventions {
+    EngineConventions {
+        margin: margin.map_or(MarginRule::Scene, MarginRule::Fixed),
+        facing: facing.map_or(FacingRule::Scene, FacingRule::from),
+        ..EngineConventions::default()
+    }
 }

@@ -18,10 +18,10 @@ use super::viewer::{FinishedRecording, Recording, RecordingTarget};
 #[cfg(feature = "viewer")]
 use super::viewer::{RrdFileOptions, Viewer};
 use sweeptrace::atomic::{self, PendingFile};
-use sweeptrace::core::Facing;
+
 use sweeptrace::foxglove::{FoxgloveFile, FoxgloveOptions};
 use sweeptrace::judge::Tolerances;
-use sweeptrace::numbers::{self, Rule, plural};
+use sweeptrace::numbers::{self, plural};
 use sweeptrace::replay::{
     Detail, FrameRange, PipelineOptions, ReplayError, ReplayEvent, ReplayOptions, Selection,
     replay_events_parallel, run_pipeline,
@@ -107,12 +107,6 @@ pub struct Args {
     /// set by [`super::parse`].
     #[arg(skip)]
     pub detail_given: bool,
-    /// Override every scene's margin ε (tests use ρ = r - ε).
-    #[arg(long, value_name = "EPSILON", conflicts_with = "engine_margin")]
-    pub margin: Option<f64>,
-    /// Override every scene's facing rule: `non_strict` (n·d ≤ 0) or `strict` (n·d < 0).
-    #[arg(long, value_name = "RULE", conflicts_with = "engine_facing")]
-    pub facing: Option<Facing>,
     /// Where the `[engine]` table comes from (`check`'s files by default).
     #[command(flatten)]
     pub config: super::check_config::ConfigArgs,
@@ -121,7 +115,7 @@ pub struct Args {
     /// `check` judges (docs/ENGINES.md). Default: the `[engine]` table of
     /// the `sweeptrace.toml` beside or above the trace, if any.
     #[command(flatten)]
-    pub conventions: super::ConventionArgs,
+    pub conventions: sweeptrace::conventions::PartialConventions,
     /// Do not embed the default viewer layout (blueprint) in the recording.
     #[arg(long)]
     pub no_blueprint: bool,
@@ -170,9 +164,6 @@ pub fn run(args: Args) -> anyhow::Result<Exit> {
     if args.json && args.outcomes.as_deref() == Some(Path::new("-")) {
         bail!("--json and --outcomes - both write to stdout: give --outcomes a file");
     }
-    if let Some(m) = args.margin {
-        numbers::check(m, Rule::NonNegative).map_err(|e| anyhow::anyhow!("--margin {e}"))?;
-    }
     let target = recording_target(&args)?;
     if args.detail_given && target.is_none() && args.foxglove.is_none() {
         eprintln!(
@@ -184,17 +175,15 @@ pub fn run(args: Args) -> anyhow::Result<Exit> {
     // answers and the divergence marks follow them.
     let settings = super::check_config::for_trace(trace_path, &args.conventions, &args.config)?;
     let conventions = settings.engine.conventions();
-    let tolerances = conventions.judge_with(settings.tolerances());
-    let options = conventions.replay_with(ReplayOptions {
+    let tolerances = settings.tolerances();
+    let options = ReplayOptions {
         frames: args.frames.unwrap_or_default(),
         ball: args.ball,
         // The decision lines of the recording and of the Foxglove file
         // describe the decisive test: keep the records.
         explain: (target.is_some() || args.foxglove.is_some()).then_some(args.detail),
-        margin: args.margin,
-        facing: args.facing,
-        ..ReplayOptions::default()
-    });
+        conventions,
+    };
     if let Some(line) = super::check_config::conventions_line(&settings) {
         eprintln!("{line}");
     }

@@ -36,20 +36,54 @@ pub struct Args {
     pub output: PathBuf,
     #[command(flatten)]
     pub tolerances: super::ToleranceArgs,
+    /// Where the `[engine]` table and the tolerances come from (`check`'s
+    /// files by default).
+    #[command(flatten)]
+    pub config: super::check_config::ConfigArgs,
+    /// The engine's conventions: the case is replayed and judged under
+    /// them, as `check` judges (docs/ENGINES.md). Default: the `[engine]`
+    /// table of the `sweeptrace.toml` beside or above the trace.
+    #[command(flatten)]
+    pub conventions: sweeptrace::conventions::PartialConventions,
 }
 
 /// Writes the case and prints the test.
 pub fn run(args: Args) -> anyhow::Result<Exit> {
-    let tolerances = args.tolerances.to_tolerances()?;
+    let overrides = sweeptrace::suite::Overrides {
+        engine: args.conventions.clone(),
+        ..args.tolerances.to_overrides()?
+    };
+    let settings = super::check_config::settings(
+        std::slice::from_ref(&args.trace),
+        &overrides,
+        args.config.no_config,
+        args.config.config.as_deref(),
+    )?
+    .pop()
+    .unwrap_or_default();
+    let tolerances = settings.tolerances();
+    let conventions = settings.engine.conventions();
+    if let Some(line) = super::check_config::conventions_line(&settings) {
+        eprintln!("{line}");
+    }
     let shown = args.trace.display().to_string();
     let file = super::open_trace(&args.trace)?;
     let reader = TraceReader::new_indexed(std::io::BufReader::new(file), &shown);
     let found = find_sweep(reader, &shown, args.frame, args.ball)?;
-    let case = ReproCase::build(&shown, &found, &tolerances)?;
+    let case = ReproCase::build(&shown, &found, &tolerances, &conventions)?;
     write_trace_file(&args.output, |w| case.write(w))
         .name_file_once("writing", args.output.display())?;
     eprint!("{}", case.summary());
     eprintln!("wrote {}", args.output.display());
+    if !conventions.is_rules() {
+        // A trace holds no conventions: the command that judges the case
+        // as this one was judged.
+        eprintln!(
+            "check it under the same conventions: sweeptrace check {} --no-config {}",
+            args.output.display(),
+            conventions.flags().join(" ")
+        );
+    }
     print!("{}", case.rust_test(&tolerances));
     Ok(if case.reproduces() {
         Exit::Success

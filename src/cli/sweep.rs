@@ -8,7 +8,7 @@ use anyhow::Context;
 use super::Exit;
 use super::report;
 use sweeptrace::core::{
-    Broadphase, CollectRecords, Facing, Options, Sweep, all_crossings, sweep_mesh_with,
+    Broadphase, CollectRecords, Options, Sweep, all_crossings, sweep_mesh_with,
 };
 use sweeptrace::replay::{
     FrameRange, ReplayEvent, ReplayOptions, SweepResult, TunnelScene, defects_within_reach,
@@ -46,7 +46,8 @@ pub struct Args {
     pub mesh: Option<PathBuf>,
     /// Take the sweep of --frame and --ball from this trace, with the
     /// trace's scene, margin and facing rule (--margin and --facing
-    /// override them).
+    /// override them). Without it the margin is 0 and the facing rule
+    /// non_strict unless --margin and --facing say otherwise.
     #[arg(long, value_name = "TRACE", requires = "frame")]
     pub trace: Option<PathBuf>,
     /// Frame of the sweep to take from --trace.
@@ -66,14 +67,6 @@ pub struct Args {
     #[arg(long, value_parser = super::parse_point, allow_hyphen_values = true,
           required_unless_present = "trace", conflicts_with = "trace")]
     pub to: Option<[f64; 3]>,
-    /// Margin ε: tests use the detection radius ρ = r - ε (0 ≤ ε < r)
-    /// [default: 0, or the trace's].
-    #[arg(long, allow_negative_numbers = true, value_parser = super::parse_number, conflicts_with = "engine_margin")]
-    pub margin: Option<f64>,
-    /// Facing rule: `non_strict` (n·d ≤ 0) or `strict` (n·d < 0)
-    /// [default: non_strict, or the trace's].
-    #[arg(long, conflicts_with = "engine_facing")]
-    pub facing: Option<Facing>,
     /// With --trace: where the `[engine]` table comes from (`check`'s
     /// files by default).
     #[command(flatten)]
@@ -82,7 +75,7 @@ pub struct Args {
     /// `check` judges (docs/ENGINES.md). With --trace, default: the
     /// `[engine]` table of the `sweeptrace.toml` beside or above it.
     #[command(flatten)]
-    pub conventions: super::ConventionArgs,
+    pub conventions: sweeptrace::conventions::PartialConventions,
     /// Explain every test, not only those that came close.
     #[arg(long)]
     pub all: bool,
@@ -109,7 +102,7 @@ pub fn run(args: Args) -> anyhow::Result<Exit> {
         topology = sweeptrace::Topology::new(&found.scene.vertices, &found.scene.triangles).ok();
         let scene = found.options();
         settings = super::check_config::for_trace(path, &args.conventions, &args.config)?;
-        let options = replay_options(&args, &settings).core_options(scene.margin, scene.facing);
+        let options = replay_options(&settings).core_options(scene.margin, scene.facing);
         source = Some(format!(
             "trace {shown}, frame {frame}, ball {} (the trace's margin {}, facing {})",
             args.ball, found.scene.margin, found.scene.facing
@@ -119,7 +112,6 @@ pub fn run(args: Args) -> anyhow::Result<Exit> {
             path,
             &shown,
             (frame, args.ball),
-            &args,
             &settings.engine.conventions(),
         )?;
         let name = found
@@ -155,7 +147,7 @@ pub fn run(args: Args) -> anyhow::Result<Exit> {
             },
         )?;
         let rules = Options::default();
-        let options = replay_options(&args, &settings).core_options(rules.margin, rules.facing);
+        let options = replay_options(&settings).core_options(rules.margin, rules.facing);
         (
             scene.name,
             mesh,
@@ -172,7 +164,7 @@ pub fn run(args: Args) -> anyhow::Result<Exit> {
         &mut records,
     )
     .context("invalid sweep")?;
-    let normal = settings.engine.normal.value;
+    let normal = settings.engine.conventions().normal;
     let outcome = match &topology {
         Some(t) if normal != sweeptrace::conventions::NormalRule::Face => {
             sweeptrace::replay::SceneNormals::new(normal, &mesh, t).apply(&sweep, outcome)
@@ -233,42 +225,38 @@ pub fn run(args: Args) -> anyhow::Result<Exit> {
     Ok(Exit::Success)
 }
 
-/// The replay's options of this command: its margin and facing overrides
-/// under the engine's declared conventions (which decide the margin and
-/// facing where the flags do not, and the sides and initial overlap).
-fn replay_options(args: &Args, settings: &sweeptrace::suite::Settings) -> ReplayOptions {
-    settings.engine.conventions().replay_with(ReplayOptions {
-        margin: args.margin,
-        facing: args.facing,
+/// The replay's options of this command: the engine's conventions, from
+/// its flags (`--margin`, `--facing`, ...) over the `[engine]` table.
+fn replay_options(settings: &sweeptrace::suite::Settings) -> ReplayOptions {
+    ReplayOptions {
+        conventions: settings.engine.conventions(),
         ..ReplayOptions::default()
-    })
+    }
 }
 
 /// The sweep of `frame` and `ball` replayed as `check` and `replay` replay
 /// it: the trace from its start up to that frame (the ball's earlier
-/// sweeps give the tunnels between them), with the command's margin and
-/// facing overrides, under the engine's `conventions`. `None` when the
+/// sweeps give the tunnels between them), under the engine's
+/// `conventions` (with the command's margin and facing flags). `None` when the
 /// replay does not reach it (an invalid sweep; the core's own error says
 /// why).
 fn replay_to(
     path: &std::path::Path,
     shown: &str,
     (frame, ball): (u64, u32),
-    args: &Args,
     conventions: &sweeptrace::conventions::EngineConventions,
 ) -> anyhow::Result<Option<SweepResult>> {
     let file = super::open_trace(path)?;
     let reader = TraceReader::new_indexed(std::io::BufReader::new(file), shown);
-    let options = conventions.replay_with(ReplayOptions {
+    let options = ReplayOptions {
         frames: FrameRange {
             start: None,
             end: Some(frame.saturating_add(1)),
         },
         ball: Some(ball),
-        margin: args.margin,
-        facing: args.facing,
+        conventions: *conventions,
         ..ReplayOptions::default()
-    });
+    };
     for event in replay_events(reader, options) {
         if let Ok(ReplayEvent::Sweep(r)) = event
             && r.frame == frame

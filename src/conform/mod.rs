@@ -380,9 +380,12 @@ pub fn run(
     };
     let replay = replay_events(
         answers.by_ref(),
-        options.conventions.replay_with(ReplayOptions::default()),
+        ReplayOptions {
+            conventions: options.conventions,
+            ..ReplayOptions::default()
+        },
     );
-    let tolerances = options.conventions.judge_with(options.tolerances);
+    let tolerances = options.tolerances;
     for event in replay {
         let result = match event {
             Ok(ReplayEvent::Sweep(result)) => result,
@@ -438,7 +441,7 @@ pub fn run(
                 }
                 // The cases are exact in binary: the rule's choice among the
                 // tie set is the only right answer, unless --lenient.
-                Agreement::Tie if options.strict && tolerances.ties == TieRule::Rule => (
+                Agreement::Tie if options.strict && options.conventions.ties == TieRule::Rule => (
                     compare(&answer, &result.outcome_msg(), &tolerances),
                     None,
                     Some(tie_order_text(&answer, &result.outcome)),

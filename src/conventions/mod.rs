@@ -18,6 +18,10 @@ use serde::Serialize;
 
 use crate::core::{Facing, InitialOverlap, Sides};
 
+mod partial;
+
+pub use partial::{KEYS, PartialConventions, Setting, Source};
+
 /// The arithmetic an engine computes in: an engine convention
 /// (`precision` in `sweeptrace.toml`'s `[engine]` table).
 #[derive(
@@ -205,6 +209,16 @@ pub enum FacingRule {
     NonStrict,
 }
 
+impl From<Facing> for FacingRule {
+    /// The rule that imposes `facing` on every scene.
+    fn from(facing: Facing) -> FacingRule {
+        match facing {
+            Facing::Strict => FacingRule::Strict,
+            Facing::NonStrict => FacingRule::NonStrict,
+        }
+    }
+}
+
 impl FacingRule {
     /// The facing rule it imposes, if any.
     pub fn facing(self) -> Option<Facing> {
@@ -366,6 +380,92 @@ impl EngineConventions {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_default_is_the_rules_and_changes_nothing() {
+        let c = EngineConventions::default();
+        assert!(c.is_rules());
+        assert!(c.declared().is_empty());
+        assert_eq!(c.summary(), "the rules");
+        let options = crate::replay::ReplayOptions::default().core_options(0.25, Facing::Strict);
+        assert_eq!(
+            (
+                options.margin,
+                options.facing,
+                options.sides,
+                options.initial_overlap
+            ),
+            (0.25, Facing::Strict, Sides::One, InitialOverlap::None)
+        );
+    }
+
+    #[test]
+    fn each_convention_lands_where_it_acts() {
+        let c = EngineConventions {
+            precision: Precision::F32,
+            margin: MarginRule::Fixed(0.0),
+            facing: FacingRule::NonStrict,
+            sides: Sides::Two,
+            initial_overlap: InitialOverlap::Alpha0,
+            normal: NormalRule::ActiveEdges,
+            ties: TieRule::Any,
+        };
+        let replay = crate::replay::ReplayOptions {
+            conventions: c,
+            ..Default::default()
+        };
+        let options = replay.core_options(0.25, Facing::Strict);
+        assert_eq!(
+            (
+                options.margin,
+                options.facing,
+                options.sides,
+                options.initial_overlap
+            ),
+            (0.0, Facing::NonStrict, Sides::Two, InitialOverlap::Alpha0)
+        );
+        assert_eq!(
+            c.summary(),
+            "precision f32, margin 0.0, facing non_strict, sides two, initial_overlap alpha0, \
+             normal active_edges, ties any"
+        );
+        assert_eq!(
+            c.replaces("margin.inside-band/0").as_deref(),
+            Some("the engine declares margin = 0.0")
+        );
+        assert_eq!(c.replaces("edge.basic/0"), None);
+        for rule in ["face.miss.back-facing/0", "edge.miss.back-facing"] {
+            assert_eq!(
+                c.replaces(rule).as_deref(),
+                Some("the engine declares sides = two"),
+                "{rule}"
+            );
+        }
+        assert_eq!(
+            c.replaces("start.moving-away/1").as_deref(),
+            Some("the engine declares sides = two and initial_overlap = alpha0")
+        );
+        // Contact normals at active edges: the ridge's normal is judged.
+        assert_eq!(c.replaces("normal.shallow-convex-edge/0"), None);
+        assert_eq!(c.replaces("normal.flat-edge/0"), None);
+        let face_any = EngineConventions {
+            ties: TieRule::Any,
+            ..EngineConventions::default()
+        };
+        assert_eq!(
+            face_any.replaces("normal.shallow-convex-edge").as_deref(),
+            Some("the engine declares normal = face and ties = any")
+        );
+        assert_eq!(face_any.replaces("normal.flat-edge"), None);
+        let one_sided = EngineConventions {
+            initial_overlap: InitialOverlap::Alpha0,
+            ..EngineConventions::default()
+        };
+        assert_eq!(one_sided.replaces("start.moving-away"), None);
+        let one = EngineConventions::default();
+        assert_eq!(one.replaces("face.miss.back-facing/0"), None);
+        assert_eq!(one.replaces("edge.miss.back-facing/0"), None);
+    }
 
     #[test]
     fn margins_parse_as_scene_or_a_number() {

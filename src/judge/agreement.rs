@@ -111,8 +111,20 @@ impl Agreement {
 /// coordinate of `p0`, of `p1`, of both together (the path moved, which is
 /// the mesh moved the other way), and the radius. The first one that
 /// reproduces an answer, smallest first, is the one reported.
+///
+/// The judgement is under the conventions `result` was computed under
+/// ([`crate::replay::SceneState::conventions`]): at their precision, with
+/// their tie rule.
 pub fn agreement(expected: &OutcomeMsg, result: &SweepResult, tol: &Tolerances) -> Agreement {
-    judge(expected, &result.outcome_msg(), true, result, tol)
+    let precision = result.scene.conventions.precision;
+    judge(
+        expected,
+        &result.outcome_msg(),
+        true,
+        result,
+        tol,
+        precision,
+    )
 }
 
 /// Judges `expected` against another answer `got` to the same sweep (an
@@ -125,7 +137,21 @@ pub fn agreement_of(
     result: &SweepResult,
     tol: &Tolerances,
 ) -> Agreement {
-    judge(expected, got, false, result, tol)
+    let precision = result.scene.conventions.precision;
+    judge(expected, got, false, result, tol, precision)
+}
+
+/// The judgement of [`agreement`] (`got` the core's own outcome,
+/// `got_is_core`) or [`agreement_of`] at `precision` rather than the
+/// declared one: what a check under the rules asks of single precision
+/// ([`super::ConventionHints`]).
+pub(crate) fn agreement_at(
+    (expected, got, got_is_core): (&OutcomeMsg, &OutcomeMsg, bool),
+    result: &SweepResult,
+    tol: &Tolerances,
+    precision: Precision,
+) -> Agreement {
+    judge(expected, got, got_is_core, result, tol, precision)
 }
 
 fn judge(
@@ -134,6 +160,7 @@ fn judge(
     got_is_core: bool,
     result: &SweepResult,
     tol: &Tolerances,
+    precision: Precision,
 ) -> Agreement {
     let fields = compare(expected, got, tol);
     if fields.is_empty() {
@@ -142,7 +169,7 @@ fn judge(
     let fragile = result.outcome.fragile;
     // Single precision: the tolerances widened to this sweep's backward
     // error bound (computed only here, for a sweep that differs).
-    let sensitivity = match tol.precision {
+    let sensitivity = match precision {
         Precision::F64 => None,
         Precision::F32 => Sensitivity::of(result).map(|s| s.observing(expected, got, tol)),
     };
@@ -168,8 +195,8 @@ fn judge(
     if got_is_core
         && values_only
         && fragile.is_robust()
-        && tol.precision == Precision::F64
-        && tol.ties == TieRule::Rule
+        && precision == Precision::F64
+        && result.scene.conventions.ties == TieRule::Rule
     {
         return Agreement::Diverges {
             fields,
@@ -200,7 +227,7 @@ fn judge(
         (true, Some(named)) => named.clone(),
         _ => fields,
     };
-    if tol.precision == Precision::F32 {
+    if precision == Precision::F32 {
         // Single precision: any decision is as fragile as f32's budget; a
         // perturbation spends part of it, and the rest is what the
         // continuous fields may still differ by.

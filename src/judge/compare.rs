@@ -5,7 +5,6 @@ use nalgebra::Vector3;
 use serde::Serialize;
 use serde_json::{Value, json};
 
-use crate::conventions::{Precision, TieRule};
 use crate::core::Kind;
 use crate::core::explain::num;
 use crate::numbers::{self, Rule};
@@ -59,15 +58,6 @@ pub struct Tolerances {
     pub normal_length: Option<f64>,
     /// The fields compared (those the expectation holds among them).
     pub fields: FieldSet,
-    /// The arithmetic of the engine judged (`f64`: these tolerances as
-    /// they are; `f32`: widened per sweep to the backward-error bound,
-    /// [`super::Precision`]). Only in the JSON when not `f64`.
-    #[serde(skip_serializing_if = "Precision::is_f64")]
-    pub precision: Precision,
-    /// Which member of a tie an answer may name. Only in the JSON when not
-    /// `rule`.
-    #[serde(skip_serializing_if = "TieRule::is_rule")]
-    pub ties: TieRule,
 }
 
 /// The contact's own tolerance along one direction ([`Tolerances::contact_axis`]).
@@ -99,8 +89,6 @@ impl Default for Tolerances {
             contact_axis: None,
             normal_length: None,
             fields: FieldSet::ALL,
-            precision: Precision::F64,
-            ties: TieRule::Rule,
         }
     }
 }

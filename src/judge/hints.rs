@@ -14,7 +14,7 @@ use crate::core::{Kind, Options, SweptPath, initial_contacts};
 use crate::replay::SweepResult;
 use crate::trace::OutcomeMsg;
 
-use super::agreement::{agreement, agreement_of};
+use super::agreement::agreement_at;
 use super::compare::{Field, FieldDiff, Tolerances, angle_degrees};
 use crate::conventions::EngineConventions;
 use crate::conventions::Precision;
@@ -65,16 +65,8 @@ impl ConventionHints {
             && is_contact_normal(result, expected, fields, tol)
         {
             self.normal += 1;
-        } else if tol.precision == Precision::F64 {
-            let single = Tolerances {
-                precision: Precision::F32,
-                ..*tol
-            };
-            let judged = if got_is_core {
-                agreement(expected, result, &single)
-            } else {
-                agreement_of(expected, got, result, &single)
-            };
+        } else if declared.precision == Precision::F64 {
+            let judged = agreement_at((expected, got, got_is_core), result, tol, Precision::F32);
             if !judged.fails(false) {
                 self.precision += 1;
             }

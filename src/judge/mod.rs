@@ -27,7 +27,6 @@
 
 mod agreement;
 mod compare;
-mod conventions;
 mod decision;
 mod divergence;
 mod explain;

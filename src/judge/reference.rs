@@ -132,7 +132,7 @@ impl<'a> Decision<'a> {
             member.triangle = Some(Some(tie.triangle));
             member.feature = Some(tie.feature.index());
             member.contact = Some(r.contact().map(|c| [c.x, c.y, c.z]));
-            if tol.ties == TieRule::Any
+            if self.scene.conventions.ties == TieRule::Any
                 && let Some(contact) = r.contact()
             {
                 member.normal = Some(self.member_normal(&tie, &contact, r.back()));
@@ -156,7 +156,7 @@ impl<'a> Decision<'a> {
             member.triangle = Some(Some(tie.triangle));
             member.feature = Some(tie.feature.index());
             member.contact = Some(Some([h.contact.x, h.contact.y, h.contact.z]));
-            if tol.ties == TieRule::Any {
+            if self.scene.conventions.ties == TieRule::Any {
                 // An initial contact's normal is its side's (`-n` on a back).
                 let back = self
                     .scene

@@ -1,8 +1,8 @@
 //! What a caller chooses about a replay: which sweeps, how much is
-//! explained, and overrides of the scene's margin and facing rule.
+//! explained, and the engine's conventions it computes the reference under.
 
-use crate::conventions::NormalRule;
-use crate::core::{Facing, InitialOverlap, Options, Sides};
+use crate::conventions::{EngineConventions, MarginRule, NormalRule};
+use crate::core::{Facing, Options};
 
 /// Trace events per batch of [`super::replay_events_parallel`] unless told otherwise.
 pub const DEFAULT_BATCH_EVENTS: usize = 4096;
@@ -160,19 +160,12 @@ pub struct ReplayOptions {
     /// `--outcomes`, `check` and `bless` need); `Some(detail)` runs the
     /// explained query and keeps `detail`'s records (what a recording needs).
     pub explain: Option<Detail>,
-    /// Overrides every scene's margin `ε`.
-    pub margin: Option<f64>,
-    /// Overrides every scene's facing rule.
-    pub facing: Option<Facing>,
-    /// What a ball that starts within `ρ` gets (an engine convention; the
-    /// rules' by default).
-    pub initial_overlap: InitialOverlap,
-    /// Which sides of a triangle collide (an engine convention; the rules'
-    /// front only by default).
-    pub sides: Sides,
-    /// Which normal a hit reports (an engine convention; the rules' face
-    /// normal by default).
-    pub normal: NormalRule,
+    /// The engine's conventions, whole (the rules by default): the
+    /// reference answer is computed under the margin, facing rule, sides,
+    /// initial overlap and normal they declare (a declared margin or facing
+    /// rule overrides every scene's), and judged under their precision and
+    /// tie rule.
+    pub conventions: EngineConventions,
 }
 
 impl ReplayOptions {
@@ -180,11 +173,15 @@ impl ReplayOptions {
     /// `margin` and `facing`: the overrides where set, and the engine
     /// conventions the core applies (sides, initial overlap).
     pub fn core_options(&self, margin: f64, facing: Facing) -> Options {
+        let c = &self.conventions;
         Options {
-            margin: self.margin.unwrap_or(margin),
-            facing: self.facing.unwrap_or(facing),
-            initial_overlap: self.initial_overlap,
-            sides: self.sides,
+            margin: match c.margin {
+                MarginRule::Scene => margin,
+                MarginRule::Fixed(m) => m,
+            },
+            facing: c.facing.facing().unwrap_or(facing),
+            initial_overlap: c.initial_overlap,
+            sides: c.sides,
         }
     }
 
@@ -194,25 +191,30 @@ impl ReplayOptions {
     /// is renamed or added with its default.
     pub fn stable_encoding(&self) -> String {
         let or_star = |v: Option<String>, none: &str| v.unwrap_or_else(|| none.to_string());
+        let c = &self.conventions;
         let mut text = format!(
             "frames={};ball={};detail={};explain={};margin={};facing={}",
             self.frames,
             or_star(self.ball.map(|b| b.to_string()), "*"),
             self.explain.unwrap_or_default(),
             u8::from(self.explain.is_some()),
-            or_star(self.margin.map(|m| format!("{m:e}")), "scene"),
-            or_star(self.facing.map(|f| f.to_string()), "scene"),
+            match c.margin {
+                MarginRule::Scene => "scene".to_string(),
+                MarginRule::Fixed(m) => format!("{m:e}"),
+            },
+            or_star(c.facing.facing().map(|f| f.to_string()), "scene"),
         );
         // The conventions only when declared, so that the ids of recordings
-        // under the rules stay what they were.
-        if !self.initial_overlap.is_rules() {
-            text.push_str(&format!(";initial_overlap={}", self.initial_overlap));
+        // under the rules stay what they were (the precision and the tie
+        // rule change no recorded value).
+        if !c.initial_overlap.is_rules() {
+            text.push_str(&format!(";initial_overlap={}", c.initial_overlap));
         }
-        if !self.sides.is_rules() {
-            text.push_str(&format!(";sides={}", self.sides));
+        if !c.sides.is_rules() {
+            text.push_str(&format!(";sides={}", c.sides));
         }
-        if self.normal != NormalRule::Face {
-            text.push_str(&format!(";normal={}", self.normal));
+        if c.normal != NormalRule::Face {
+            text.push_str(&format!(";normal={}", c.normal));
         }
         text
     }

@@ -5,6 +5,7 @@ use std::collections::{HashMap, VecDeque};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
+use crate::conventions::EngineConventions;
 use crate::core::explain::nearest_miss;
 use crate::core::{
     Broadphase, CollectRecords, EdgeClass, Feature, Mesh, Observer, Options, Outcome, SkipCounts,
@@ -38,6 +39,10 @@ pub struct SceneState {
     /// Which normal a hit reports, and the scene's active edges when that
     /// depends on them.
     pub normals: SceneNormals,
+    /// The run's conventions, whole ([`super::ReplayOptions::conventions`]):
+    /// the reference answer was computed under them (`options`, `normals`),
+    /// and an answer is judged under their precision and tie rule.
+    pub conventions: EngineConventions,
 }
 
 impl SceneState {
@@ -96,6 +101,7 @@ impl PartialEq for SceneState {
             && self.name == other.name
             && self.options == other.options
             && self.normals == other.normals
+            && self.conventions == other.conventions
     }
 }
 
@@ -303,7 +309,7 @@ impl Replay {
             Mesh::new(vertices, &triangles).map_err(|cause| ReplayError::Mesh { index, cause })?;
         let topology = topology.map_err(|cause| ReplayError::Mesh { index, cause })?;
         let options = self.options.core_options(margin, facing);
-        let normals = SceneNormals::new(self.options.normal, &mesh, &topology);
+        let normals = SceneNormals::new(self.options.conventions.normal, &mesh, &topology);
         let number = self.summary.scenes;
         self.summary.scenes += 1;
         self.summary.degenerate_triangles += mesh.degenerate().len();
@@ -316,6 +322,7 @@ impl Replay {
             topology,
             options,
             normals,
+            conventions: self.options.conventions,
         });
         self.scene = Some(state.clone());
         // A jump across a change of scene is not a move through a surface.

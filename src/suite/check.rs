@@ -24,7 +24,6 @@ use super::report::{
     Judged, KindChange, MAX_DIVERGENT_FRAMES, MAX_ERRORS, MAX_LISTED_TUNNELS, TraceReport,
     TunnelReport, WithinPrecision,
 };
-use crate::conventions::EngineConventions;
 use crate::judge::divergence_details;
 use crate::judge::{Agreement, agreement};
 use crate::judge::{Field, Tolerances};
@@ -210,8 +209,8 @@ impl<'a> ReportBuilder<'a> {
         };
         report.fragile.strict = options.strict;
         report.within_precision =
-            (!options.tolerances.precision.is_f64()).then(WithinPrecision::default);
-        report.conventions = EngineConventions::of(&options.tolerances, &options.replay);
+            (!options.replay.conventions.precision.is_f64()).then(WithinPrecision::default);
+        report.conventions = options.replay.conventions;
         report.tunnels.fail = options.fail_on_tunnel;
         report.ghosts.fail = options.fail_on_ghost;
         report.ghosts.degrees = options.ghost_degrees;

@@ -8,6 +8,7 @@
 //! explains the first divergence on both sides (the tests that decided, from
 //! an exhaustive explained re-run of that one sweep).
 
+use crate::conventions::{FacingRule, MarginRule};
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
 
@@ -162,10 +163,10 @@ impl DiffReport {
 fn describe_side(side: &Side) -> String {
     let mut s = side.name.clone();
     let mut opts = Vec::new();
-    if let Some(m) = side.options.margin {
+    if let MarginRule::Fixed(m) = side.options.conventions.margin {
         opts.push(format!("margin {}", num(m)));
     }
-    if let Some(f) = side.options.facing {
+    if let Some(f) = side.options.conventions.facing.facing() {
         opts.push(format!("facing {f}"));
     }
     if !opts.is_empty() {
@@ -213,8 +214,8 @@ pub fn scene_differences(a: &Side, b: &Side) -> Vec<String> {
                 plural(ta as u64, "triangle"),
             ));
         }
-        if a.options.margin.is_none()
-            && b.options.margin.is_none()
+        if a.options.conventions.margin == MarginRule::Scene
+            && b.options.conventions.margin == MarginRule::Scene
             && sa.options.margin.to_bits() != sb.options.margin.to_bits()
         {
             out.push(format!(
@@ -223,8 +224,8 @@ pub fn scene_differences(a: &Side, b: &Side) -> Vec<String> {
                 num(sb.options.margin)
             ));
         }
-        if a.options.facing.is_none()
-            && b.options.facing.is_none()
+        if a.options.conventions.facing == FacingRule::Scene
+            && b.options.conventions.facing == FacingRule::Scene
             && sa.options.facing != sb.options.facing
         {
             out.push(format!(

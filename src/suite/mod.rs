@@ -41,8 +41,8 @@ pub use check::{
 };
 pub use config::excluded_by;
 pub use config::{
-    ConfigError, ConfigFile, EngineOverrides, EngineSettings, Overrides, Setting, Settings, Source,
-    normalize, render_settings_json, render_settings_text, resolve, settings_for,
+    ConfigError, ConfigFile, Overrides, Settings, normalize, render_settings_json,
+    render_settings_text, resolve, settings_for,
 };
 pub use diff::{
     DiffReport, FirstDifference, Side, diff, render_diff_json, render_diff_text, scene_differences,

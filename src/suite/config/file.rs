@@ -7,8 +7,8 @@ use serde::Deserialize;
 use toml::Spanned;
 
 use super::normalize;
-use super::settings::{Layer, Setting, Settings, Source};
-use crate::conventions::MarginRule;
+use super::settings::{Layer, Settings};
+use crate::conventions::{Setting, Source};
 use crate::judge::{Field, FieldSet};
 use crate::numbers::{self, Rule};
 
@@ -49,23 +49,11 @@ struct RawFile {
     allow_tunnels: Option<Spanned<bool>>,
     tolerances: Option<RawTolerances>,
     exclude: Option<Spanned<Vec<Spanned<String>>>>,
-    engine: Option<RawEngine>,
+    /// `[engine]`: the engine's conventions (top level only: one engine
+    /// per file), read key by key into the conventions' partial type.
+    engine: Option<std::collections::BTreeMap<Spanned<String>, Spanned<toml::Value>>>,
     #[serde(default)]
     traces: Vec<RawBlock>,
-}
-
-/// `[engine]`: the engine's conventions (top level only: one engine per
-/// file). Every value a closed set of names, the margin also a number.
-#[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
-struct RawEngine {
-    precision: Option<Spanned<String>>,
-    margin: Option<Spanned<toml::Value>>,
-    facing: Option<Spanned<String>>,
-    sides: Option<Spanned<String>>,
-    initial_overlap: Option<Spanned<String>>,
-    normal: Option<Spanned<String>>,
-    ties: Option<Spanned<String>>,
 }
 
 /// A `[[traces]]` block: a glob and the keys of the top level.
@@ -187,60 +175,36 @@ impl Places<'_> {
         })
     }
 
-    /// `[engine]`'s keys into `layer`, each value checked against its set.
-    fn engine(&self, raw: &RawEngine, layer: &mut Layer) -> Result<(), ConfigError> {
-        fn named<T: std::str::FromStr + strum::VariantNames>(
-            places: &Places<'_>,
-            key: &str,
-            value: &Option<Spanned<String>>,
-        ) -> Result<Option<Setting<T>>, ConfigError> {
-            value
-                .as_ref()
-                .map(|v| {
-                    let parsed = v.get_ref().parse::<T>().map_err(|_| {
-                        places.error(
-                            v,
-                            format!(
-                                "`engine.{key}` is `{}`; it takes one of {}",
-                                v.get_ref(),
-                                T::VARIANTS
-                                    .iter()
-                                    .map(|n| format!("\"{n}\""))
-                                    .collect::<Vec<_>>()
-                                    .join(", ")
-                            ),
-                        )
-                    })?;
-                    Ok(places.setting(v, parsed))
-                })
-                .transpose()
+    /// `[engine]`'s keys into `layer`, each value checked against its set
+    /// ([`crate::conventions::PartialConventions::set`]).
+    fn engine(
+        &self,
+        raw: &std::collections::BTreeMap<Spanned<String>, Spanned<toml::Value>>,
+        layer: &mut Layer,
+    ) -> Result<(), ConfigError> {
+        // In the order of the file, so that the first fault is reported.
+        let mut keys: Vec<_> = raw.iter().collect();
+        keys.sort_by_key(|(k, _)| k.span().start);
+        for (key, value) in keys {
+            let text = match value.get_ref() {
+                toml::Value::String(s) => s.clone(),
+                toml::Value::Integer(i) => i.to_string(),
+                toml::Value::Float(f) => format!("{f:?}"),
+                other => format!("a {}", other.type_str()),
+            };
+            let source = self.setting(value, ()).source;
+            layer
+                .engine
+                .set(key.get_ref(), &text, source)
+                .map_err(|message| {
+                    // A bad value at the value; an unknown key at the key.
+                    if crate::conventions::KEYS.contains(&key.get_ref().as_str()) {
+                        self.error(value, message)
+                    } else {
+                        self.error(key, message)
+                    }
+                })?;
         }
-        layer.precision = named(self, "precision", &raw.precision)?;
-        layer.facing = named(self, "facing", &raw.facing)?;
-        layer.sides = named(self, "sides", &raw.sides)?;
-        layer.initial_overlap = named(self, "initial_overlap", &raw.initial_overlap)?;
-        layer.normal = named(self, "normal", &raw.normal)?;
-        layer.ties = named(self, "ties", &raw.ties)?;
-        layer.margin = raw
-            .margin
-            .as_ref()
-            .map(|v| {
-                let text = match v.get_ref() {
-                    toml::Value::String(s) => s.clone(),
-                    toml::Value::Integer(i) => i.to_string(),
-                    toml::Value::Float(f) => format!("{f:?}"),
-                    other => format!("a {}", other.type_str()),
-                };
-                text.parse::<MarginRule>()
-                    .map(|m| self.setting(v, m))
-                    .map_err(|e| {
-                        self.error(
-                            v,
-                            format!("`engine.margin` takes \"scene\" or a number ≥ 0: {e}"),
-                        )
-                    })
-            })
-            .transpose()?;
         Ok(())
     }
 

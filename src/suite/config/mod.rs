@@ -50,10 +50,7 @@ use std::path::{Component, Path, PathBuf};
 
 pub use file::{ConfigError, ConfigFile};
 use settings::Layer;
-pub use settings::{
-    EngineOverrides, EngineSettings, Overrides, Setting, Settings, Source, render_settings_json,
-    render_settings_text,
-};
+pub use settings::{Overrides, Settings, render_settings_json, render_settings_text};
 
 /// The name of a suite configuration file.
 pub const CONFIG_FILE_NAME: &str = "sweeptrace.toml";

@@ -1,70 +1,17 @@
 //! The resolved settings of a trace, each with where it came from, and
 //! their `--print-config` renderings.
 
-use std::fmt;
-
-use serde::Serialize;
-
 use super::super::check::CheckOptions;
-use crate::conventions::NormalRule;
-use crate::conventions::Precision;
-use crate::conventions::TieRule;
-use crate::conventions::{EngineConventions, FacingRule, MarginRule};
-use crate::core::{InitialOverlap, Sides};
+use crate::conventions::{PartialConventions, Setting, Source};
 use crate::judge::{
     DEFAULT_ALPHA_TOLERANCE, DEFAULT_CONTACT_TOLERANCE, DEFAULT_NORMAL_TOLERANCE_DEGREES, FieldSet,
     Tolerances,
 };
-
-/// Where a resolved setting came from.
-#[derive(Clone, Debug, PartialEq, Eq, Serialize)]
-#[serde(tag = "kind", rename_all = "snake_case")]
-#[non_exhaustive]
-pub enum Source {
-    /// The built-in default.
-    Default,
-    /// A line of a configuration file.
-    File {
-        /// The file, as written in the report (its name as given to `check`).
-        file: String,
-        /// The line of the key (1-based).
-        line: usize,
-    },
-    /// The command line.
-    CommandLine,
-}
-
-impl fmt::Display for Source {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match self {
-            Source::Default => f.write_str("default"),
-            Source::File { file, line } => write!(f, "{file}:{line}"),
-            Source::CommandLine => f.write_str("command line"),
-        }
-    }
-}
-
-/// A value and where it came from.
-#[derive(Clone, Debug, PartialEq, Serialize)]
-pub struct Setting<T> {
-    /// The value.
-    pub value: T,
-    /// Where it came from.
-    pub source: Source,
-}
-
-impl<T> Setting<T> {
-    pub(super) fn default_value(value: T) -> Setting<T> {
-        Setting {
-            value,
-            source: Source::Default,
-        }
-    }
-}
+use crate::replay::ReplayOptions;
 
 /// Values set by the command line (`None`: not given), the layer above
 /// every file.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[derive(Clone, Debug, Default, PartialEq)]
 pub struct Overrides {
     /// `--tolerance`.
     pub alpha: Option<f64>,
@@ -80,30 +27,11 @@ pub struct Overrides {
     pub allow_tunnels: Option<bool>,
     /// The engine conventions given on the command line (`--precision`,
     /// `--margin`, `--facing`, `--sides`, `--initial-overlap`, `--normal`, `--ties`).
-    pub engine: EngineOverrides,
-}
-
-/// The `[engine]` keys given on the command line (`None`: not given).
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct EngineOverrides {
-    /// `--precision`.
-    pub precision: Option<Precision>,
-    /// `--margin`.
-    pub margin: Option<MarginRule>,
-    /// `--facing`.
-    pub facing: Option<FacingRule>,
-    /// `--sides`.
-    pub sides: Option<Sides>,
-    /// `--initial-overlap`.
-    pub initial_overlap: Option<InitialOverlap>,
-    /// `--normal`.
-    pub normal: Option<NormalRule>,
-    /// `--ties`.
-    pub ties: Option<TieRule>,
+    pub engine: PartialConventions,
 }
 
 /// The settings a trace is checked with, each with its [`Source`].
-#[derive(Clone, Debug, PartialEq, Serialize)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct Settings {
     /// Absolute tolerance on `α` (`tolerances.alpha`).
     pub alpha: Setting<f64>,
@@ -117,93 +45,9 @@ pub struct Settings {
     pub strict: Setting<bool>,
     /// Whether tunnels are listed without failing (`allow_tunnels`).
     pub allow_tunnels: Setting<bool>,
-    /// The engine's conventions (the `[engine]` table), key by key.
-    pub engine: EngineSettings,
-}
-
-/// The `[engine]` table's keys, each with its [`Source`] (docs/ENGINES.md,
-/// "Conventions").
-#[derive(Clone, Debug, PartialEq, Serialize)]
-pub struct EngineSettings {
-    /// `engine.precision`.
-    pub precision: Setting<Precision>,
-    /// `engine.margin`.
-    pub margin: Setting<MarginRule>,
-    /// `engine.facing`.
-    pub facing: Setting<FacingRule>,
-    /// `engine.sides`.
-    pub sides: Setting<Sides>,
-    /// `engine.initial_overlap`.
-    pub initial_overlap: Setting<InitialOverlap>,
-    /// `engine.normal`.
-    pub normal: Setting<NormalRule>,
-    /// `engine.ties`.
-    pub ties: Setting<TieRule>,
-}
-
-impl Default for EngineSettings {
-    fn default() -> Self {
-        let rules = EngineConventions::default();
-        EngineSettings {
-            precision: Setting::default_value(rules.precision),
-            margin: Setting::default_value(rules.margin),
-            facing: Setting::default_value(rules.facing),
-            sides: Setting::default_value(rules.sides),
-            initial_overlap: Setting::default_value(rules.initial_overlap),
-            normal: Setting::default_value(rules.normal),
-            ties: Setting::default_value(rules.ties),
-        }
-    }
-}
-
-impl EngineSettings {
-    /// Whether any key was set (by a file or the command line).
-    pub fn is_declared(&self) -> bool {
-        self.sources().iter().any(|s| **s != Source::Default)
-    }
-
-    /// Where each key came from, in the table's order.
-    fn sources(&self) -> [&Source; 7] {
-        [
-            &self.precision.source,
-            &self.margin.source,
-            &self.facing.source,
-            &self.sides.source,
-            &self.initial_overlap.source,
-            &self.normal.source,
-            &self.ties.source,
-        ]
-    }
-
-    /// Where the declared keys came from, once each in the order of the
-    /// keys: a file's name, or `the command line`.
-    pub fn declared_sources(&self) -> Vec<String> {
-        let mut out: Vec<String> = Vec::new();
-        for source in self.sources() {
-            let name = match source {
-                Source::Default => continue,
-                Source::File { file, .. } => file.clone(),
-                Source::CommandLine => "the command line".to_string(),
-            };
-            if !out.contains(&name) {
-                out.push(name);
-            }
-        }
-        out
-    }
-
-    /// The conventions these settings declare.
-    pub fn conventions(&self) -> EngineConventions {
-        EngineConventions {
-            precision: self.precision.value,
-            margin: self.margin.value,
-            facing: self.facing.value,
-            sides: self.sides.value,
-            initial_overlap: self.initial_overlap.value,
-            normal: self.normal.value,
-            ties: self.ties.value,
-        }
-    }
+    /// The engine's conventions (the `[engine]` tables and flags), key by
+    /// key, each with where it was declared (undeclared: the rules).
+    pub engine: PartialConventions,
 }
 
 impl Default for Settings {
@@ -216,7 +60,7 @@ impl Default for Settings {
             fields: Setting::default_value(FieldSet::ALL),
             strict: Setting::default_value(false),
             allow_tunnels: Setting::default_value(false),
-            engine: EngineSettings::default(),
+            engine: PartialConventions::default(),
         }
     }
 }
@@ -236,90 +80,71 @@ impl Settings {
     /// `options` with these settings' tolerances, `strict`, tunnel rule
     /// and engine conventions.
     pub fn check_options(&self, options: CheckOptions) -> CheckOptions {
-        let conventions = self.engine.conventions();
         CheckOptions {
-            tolerances: conventions.judge_with(self.tolerances()),
+            tolerances: self.tolerances(),
             strict: self.strict.value,
             fail_on_tunnel: !self.allow_tunnels.value,
-            replay: conventions.replay_with(options.replay),
+            replay: ReplayOptions {
+                conventions: self.engine.conventions(),
+                ..options.replay
+            },
             ..options
         }
     }
 
-    /// Each setting as `(key, value in TOML, source)`, in the file's words
-    /// (`tolerances.alpha`, `1e-5`, ...).
-    pub fn entries(&self) -> Vec<(&'static str, String, &Source)> {
-        let fields = self
+    /// Each setting as `(key, value in TOML, its value as JSON, source)`,
+    /// in the file's words (`tolerances.alpha`, `1e-5`, ...). The
+    /// `[engine]` keys only when one is declared: a suite of an engine that
+    /// follows the rules reads as it always did.
+    pub fn entries(&self) -> Vec<(String, String, serde_json::Value, Source)> {
+        let names: Vec<String> = self
             .fields
             .value
             .fields()
             .map(|f| format!("\"{}\"", f.as_str()))
-            .collect::<Vec<_>>()
-            .join(", ");
+            .collect();
         let mut entries = vec![
             (
-                "tolerances.alpha",
+                "tolerances.alpha".to_string(),
                 number_text(self.alpha.value),
-                &self.alpha.source,
+                self.alpha.value.into(),
+                self.alpha.source.clone(),
             ),
             (
-                "tolerances.normal_degrees",
+                "tolerances.normal_degrees".to_string(),
                 number_text(self.normal_degrees.value),
-                &self.normal_degrees.source,
+                self.normal_degrees.value.into(),
+                self.normal_degrees.source.clone(),
             ),
             (
-                "tolerances.contact",
+                "tolerances.contact".to_string(),
                 number_text(self.contact.value),
-                &self.contact.source,
+                self.contact.value.into(),
+                self.contact.source.clone(),
             ),
-            ("fields", format!("[{fields}]"), &self.fields.source),
-            ("strict", self.strict.value.to_string(), &self.strict.source),
             (
-                "allow_tunnels",
+                "fields".to_string(),
+                format!("[{}]", names.join(", ")),
+                serde_json::json!(self.fields.value),
+                self.fields.source.clone(),
+            ),
+            (
+                "strict".to_string(),
+                self.strict.value.to_string(),
+                self.strict.value.into(),
+                self.strict.source.clone(),
+            ),
+            (
+                "allow_tunnels".to_string(),
                 self.allow_tunnels.value.to_string(),
-                &self.allow_tunnels.source,
+                self.allow_tunnels.value.into(),
+                self.allow_tunnels.source.clone(),
             ),
         ];
-        // The `[engine]` keys only when one is declared: a suite of an
-        // engine that follows the rules reads as it always did.
         if self.engine.is_declared() {
-            entries.extend([
-                (
-                    "engine.precision",
-                    format!("\"{}\"", self.engine.precision.value),
-                    &self.engine.precision.source,
-                ),
-                (
-                    "engine.margin",
-                    self.engine.conventions().margin_toml(),
-                    &self.engine.margin.source,
-                ),
-                (
-                    "engine.facing",
-                    format!("\"{}\"", self.engine.facing.value),
-                    &self.engine.facing.source,
-                ),
-                (
-                    "engine.sides",
-                    format!("\"{}\"", self.engine.sides.value),
-                    &self.engine.sides.source,
-                ),
-                (
-                    "engine.initial_overlap",
-                    format!("\"{}\"", self.engine.initial_overlap.value),
-                    &self.engine.initial_overlap.source,
-                ),
-                (
-                    "engine.normal",
-                    format!("\"{}\"", self.engine.normal.value),
-                    &self.engine.normal.source,
-                ),
-                (
-                    "engine.ties",
-                    format!("\"{}\"", self.engine.ties.value),
-                    &self.engine.ties.source,
-                ),
-            ]);
+            for (key, toml, json, source) in self.engine.entries() {
+                entries.push((format!("engine.{key}"), toml, json, source));
+            }
         }
         entries
     }
@@ -344,13 +169,8 @@ pub(super) struct Layer {
     pub(super) fields: Option<Setting<FieldSet>>,
     pub(super) strict: Option<Setting<bool>>,
     pub(super) allow_tunnels: Option<Setting<bool>>,
-    pub(super) precision: Option<Setting<Precision>>,
-    pub(super) margin: Option<Setting<MarginRule>>,
-    pub(super) facing: Option<Setting<FacingRule>>,
-    pub(super) sides: Option<Setting<Sides>>,
-    pub(super) initial_overlap: Option<Setting<InitialOverlap>>,
-    pub(super) normal: Option<Setting<NormalRule>>,
-    pub(super) ties: Option<Setting<TieRule>>,
+    /// The `[engine]` keys this part declares.
+    pub(super) engine: PartialConventions,
 }
 
 impl Layer {
@@ -367,13 +187,7 @@ impl Layer {
         set(&mut settings.fields, &self.fields);
         set(&mut settings.strict, &self.strict);
         set(&mut settings.allow_tunnels, &self.allow_tunnels);
-        set(&mut settings.engine.precision, &self.precision);
-        set(&mut settings.engine.margin, &self.margin);
-        set(&mut settings.engine.facing, &self.facing);
-        set(&mut settings.engine.sides, &self.sides);
-        set(&mut settings.engine.initial_overlap, &self.initial_overlap);
-        set(&mut settings.engine.normal, &self.normal);
-        set(&mut settings.engine.ties, &self.ties);
+        settings.engine.merge(&self.engine);
     }
 
     pub(super) fn of_command_line(o: &Overrides) -> Layer {
@@ -390,13 +204,7 @@ impl Layer {
             fields: given(o.fields),
             strict: given(o.strict),
             allow_tunnels: given(o.allow_tunnels),
-            precision: given(o.engine.precision),
-            margin: given(o.engine.margin),
-            facing: given(o.engine.facing),
-            sides: given(o.engine.sides),
-            initial_overlap: given(o.engine.initial_overlap),
-            normal: given(o.engine.normal),
-            ties: given(o.engine.ties),
+            engine: o.engine.clone(),
         }
     }
 }
@@ -411,10 +219,10 @@ pub fn render_settings_text(traces: &[(String, Settings)]) -> String {
         let entries = settings.entries();
         let width = entries
             .iter()
-            .map(|(k, v, _)| k.len() + 3 + v.chars().count())
+            .map(|(k, v, _, _)| k.len() + 3 + v.chars().count())
             .max()
             .unwrap_or(0);
-        for (key, value, source) in entries {
+        for (key, value, _, source) in entries {
             let line = format!("{key} = {value}");
             let pad = width - line.chars().count();
             out.push_str(&format!("  {line}{:pad$}  # {source}\n", ""));
@@ -430,29 +238,13 @@ pub fn render_settings_json(traces: &[(String, Settings)]) -> String {
     let traces: Vec<serde_json::Value> = traces
         .iter()
         .map(|(trace, s)| {
-            let entry = |value: serde_json::Value, source: &Source| {
-                serde_json::json!({ "value": value, "source": source })
-            };
-            let mut settings = serde_json::json!({
-                    "tolerances.alpha": entry(s.alpha.value.into(), &s.alpha.source),
-                    "tolerances.normal_degrees":
-                        entry(s.normal_degrees.value.into(), &s.normal_degrees.source),
-                    "tolerances.contact": entry(s.contact.value.into(), &s.contact.source),
-                    "fields": entry(serde_json::json!(s.fields.value), &s.fields.source),
-                    "strict": entry(s.strict.value.into(), &s.strict.source),
-                    "allow_tunnels": entry(s.allow_tunnels.value.into(), &s.allow_tunnels.source),
-            });
-            if s.engine.is_declared()
-                && let Some(map) = settings.as_object_mut()
-            {
-                map.insert("engine.precision".to_string(), entry(serde_json::json!(s.engine.precision.value), &s.engine.precision.source));
-                map.insert("engine.margin".to_string(), entry(serde_json::json!(s.engine.margin.value), &s.engine.margin.source));
-                map.insert("engine.facing".to_string(), entry(serde_json::json!(s.engine.facing.value), &s.engine.facing.source));
-                map.insert("engine.sides".to_string(), entry(serde_json::json!(s.engine.sides.value), &s.engine.sides.source));
-                map.insert("engine.initial_overlap".to_string(), entry(serde_json::json!(s.engine.initial_overlap.value), &s.engine.initial_overlap.source));
-                map.insert("engine.normal".to_string(), entry(serde_json::json!(s.engine.normal.value), &s.engine.normal.source));
-                map.insert("engine.ties".to_string(), entry(serde_json::json!(s.engine.ties.value), &s.engine.ties.source));
-            }
+            let settings: serde_json::Map<String, serde_json::Value> = s
+                .entries()
+                .into_iter()
+                .map(|(key, _, value, source)| {
+                    (key, serde_json::json!({ "value": value, "source": source }))
+                })
+                .collect();
             serde_json::json!({ "trace": trace, "settings": settings })
         })
         .collect();

@@ -2,6 +2,7 @@
 
 use super::settings::number_text;
 use super::*;
+use crate::conventions::{PartialConventions, Setting, Source};
 use crate::judge::{DEFAULT_NORMAL_TOLERANCE_DEGREES, Field, FieldSet, Tolerances};
 use crate::suite::CheckOptions;
 
@@ -316,8 +317,13 @@ fn engine_sides_are_read_with_their_line_and_the_command_line_wins() {
         Path::new("e/t.mcap"),
         &Overrides::default(),
     );
-    assert_eq!(s.engine.sides.value, Sides::Two);
-    assert_eq!(s.engine.sides.source, file("e/sweeptrace.toml", 3));
+    assert_eq!(
+        s.engine.sides,
+        Some(Setting {
+            value: Sides::Two,
+            source: file("e/sweeptrace.toml", 3)
+        })
+    );
     assert_eq!(s.engine.conventions().sides, Sides::Two);
     // `--print-config` names the key and where it came from.
     let text = render_settings_text(&[("t.mcap".to_string(), s.clone())]);
@@ -328,16 +334,19 @@ fn engine_sides_are_read_with_their_line_and_the_command_line_wins() {
     let json = render_settings_json(&[("t.mcap".to_string(), s)]);
     assert!(json.contains("\"engine.sides\""), "{json}");
     let command_line = Overrides {
-        engine: EngineOverrides {
-            sides: Some(Sides::One),
-            ..EngineOverrides::default()
+        engine: PartialConventions {
+            sides: Some(Setting {
+                value: Sides::One,
+                source: Source::CommandLine,
+            }),
+            ..PartialConventions::default()
         },
         ..Overrides::default()
     };
     let s = resolve(&[f], Path::new("e/t.mcap"), &command_line);
     assert_eq!(
-        (s.engine.sides.value, s.engine.sides.source),
-        (Sides::One, Source::CommandLine)
+        s.engine.sides.map(|s| (s.value, s.source)),
+        Some((Sides::One, Source::CommandLine))
     );
 }
 

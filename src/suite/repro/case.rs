@@ -8,8 +8,11 @@ use crate::core::explain::num;
 use crate::core::{Mesh, Options, Outcome, Sweep, SweptPath, sweep_ties};
 use crate::trace::{OutcomeMsg, SceneMsg, SweepMsg, TraceError, TraceWriter};
 
+use crate::conventions::{EngineConventions, Precision};
+use crate::core::Topology;
 use crate::judge::{Agreement, agreement};
-use crate::judge::{Field, FieldSet, Tolerances};
+use crate::judge::{F32_OPERATIONS, Field, FieldSet, Sensitivity, Tolerances};
+use crate::replay::{ReplayOptions, SceneNormals};
 
 use super::find::{ReproError, TraceSweep};
 use crate::judge::SweepInputs;
@@ -54,6 +57,11 @@ pub struct ReproCase {
     /// How the reduced scene's outcome stands against the renumbered
     /// expectation.
     pub reduced_agreement: Option<Agreement>,
+    /// The engine's conventions the case is replayed and judged under.
+    pub conventions: EngineConventions,
+    /// The tolerances the test asserts the numbers within: the run's, or
+    /// at single precision the sweep's own bound.
+    pub asserted_tolerances: Tolerances,
 }
 
 /// A short name of an agreement: `match`, `tie`, `diverges (kind, alpha)`,
@@ -120,12 +128,18 @@ fn same_verdict(a: &Agreement, b: &Agreement) -> bool {
     }
 }
 
+/// The conventions a case is replayed and judged under, and the normals
+/// of its scene under them.
+struct Under<'a> {
+    conventions: &'a EngineConventions,
+    normals: SceneNormals,
+}
+
 fn result_of(
     mesh: &Mesh,
-    frame: u64,
-    ball: u32,
+    (frame, ball): (u64, u32),
     sweep: Sweep,
-    options: Options,
+    (options, under): (Options, &Under<'_>),
     outcome: Outcome,
     expected: Option<OutcomeMsg>,
 ) -> crate::replay::SweepResult {
@@ -143,7 +157,8 @@ fn result_of(
             // Not built: the judgement of the sweep reads only the mesh.
             topology: crate::core::Topology::default(),
             options,
-            normals: Default::default(),
+            normals: under.normals.clone(),
+            conventions: *under.conventions,
         }),
         sweep,
         outcome,
@@ -178,10 +193,16 @@ impl ReproCase {
     /// miss by rounding, is kept. The expected triangle is always kept.
     /// Triangles keep their order, vertices their order within each
     /// triangle, so the tie order and the feature numbers are the same.
+    ///
+    /// The sweep is replayed and judged under the engine's `conventions`
+    /// (the rules by default): the margin, facing, sides, initial overlap
+    /// and normal its reference answer is computed under, the precision
+    /// and tie rule its expectation is judged under.
     pub fn build(
         trace: &str,
         found: &TraceSweep,
         tol: &Tolerances,
+        conventions: &EngineConventions,
     ) -> Result<ReproCase, ReproError> {
         let frame = found.sweep.frame;
         let ball = found.sweep.ball;
@@ -194,7 +215,21 @@ impl ReproCase {
             }
         })?;
         let sweep = found.core_sweep();
-        let options = found.options();
+        let replay = ReplayOptions {
+            conventions: *conventions,
+            ..ReplayOptions::default()
+        };
+        let options = replay.core_options(scene.margin, scene.facing);
+        // The normals of a scene under the declared normal rule (its active
+        // edges from the scene's own topology).
+        let normals_of = |mesh: &Mesh, vertices: &[[f64; 3]], triangles: &[[u64; 3]]| {
+            let topology = Topology::new(vertices, triangles).unwrap_or_default();
+            SceneNormals::new(conventions.normal, mesh, &topology)
+        };
+        let under = Under {
+            conventions,
+            normals: normals_of(&mesh, &scene.vertices, &scene.triangles),
+        };
         let sweep_error = |cause| ReproError::Sweep {
             trace: trace.to_string(),
             frame,
@@ -202,6 +237,7 @@ impl ReproCase {
             cause,
         };
         let (outcome, _) = sweep_ties(&mesh, &sweep, &options).map_err(sweep_error)?;
+        let outcome = under.normals.apply(&sweep, outcome);
 
         // The core's own scale and broadphase margin; the reach is the
         // radius r, not ρ = r - ε, so a margin only keeps more triangles.
@@ -305,6 +341,10 @@ impl ReproCase {
                 frame,
                 cause,
             })?;
+        let reduced_under = Under {
+            conventions,
+            normals: normals_of(&reduced, &vertices, &triangles),
+        };
         let reduced_outcome_local =
             crate::core::sweep_mesh(&reduced, &sweep, &options).map_err(|cause| {
                 ReproError::Sweep {
@@ -314,14 +354,31 @@ impl ReproCase {
                     cause,
                 }
             })?;
-        let agreement_on = |mesh: &Mesh, outcome: Outcome, expected: Option<OutcomeMsg>| {
-            expected.map(|e| {
-                let r = result_of(mesh, frame, ball, sweep, options, outcome, Some(e));
-                agreement(&e, &r, tol)
-            })
+        let reduced_outcome_local = reduced_under.normals.apply(&sweep, reduced_outcome_local);
+        let result_on = |mesh: &Mesh, under: &Under<'_>, outcome: Outcome, expected| {
+            result_of(
+                mesh,
+                (frame, ball),
+                sweep,
+                (options, under),
+                outcome,
+                expected,
+            )
         };
-        let full_agreement = agreement_on(&mesh, outcome, found.expected);
-        let reduced_agreement = agreement_on(&reduced, reduced_outcome_local, expected);
+        let agreement_on =
+            |mesh: &Mesh, under: &Under<'_>, outcome: Outcome, expected: Option<OutcomeMsg>| {
+                expected.map(|e| agreement(&e, &result_on(mesh, under, outcome, Some(e)), tol))
+            };
+        let full_agreement = agreement_on(&mesh, &under, outcome, found.expected);
+        let reduced_agreement =
+            agreement_on(&reduced, &reduced_under, reduced_outcome_local, expected);
+        // At single precision the numbers are asserted within the sweep's
+        // own bound, as the judge widens them.
+        let asserted_tolerances = match conventions.precision {
+            Precision::F64 => *tol,
+            Precision::F32 => Sensitivity::of(&result_on(&mesh, &under, outcome, found.expected))
+                .map_or(*tol, |s| s.widen(tol, F32_OPERATIONS)),
+        };
         Ok(ReproCase {
             source: trace.to_string(),
             scene_name: scene.name.clone(),
@@ -339,6 +396,8 @@ impl ReproCase {
             reduced_outcome: reduced_outcome_local,
             agreement: full_agreement,
             reduced_agreement,
+            conventions: *conventions,
+            asserted_tolerances,
         })
     }
 

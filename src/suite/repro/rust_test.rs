@@ -2,8 +2,9 @@
 
 use std::fmt::Write as _;
 
+use crate::conventions::NormalRule;
 use crate::judge::Agreement;
-use crate::judge::Tolerances;
+use crate::judge::{Field, FieldSet, Tolerances};
 
 use crate::core::{Facing, Kind};
 use crate::trace::OutcomeMsg;
@@ -16,6 +17,7 @@ impl ReproCase {
     /// asserted `α` and its tolerance, normal and its tolerance, contact
     /// and its tolerance (those the assertion holds).
     pub fn test_numbers(&self, tol: &Tolerances) -> Vec<f64> {
+        let tol = &self.test_tolerances(tol);
         let mut out: Vec<f64> = self.vertices.iter().flatten().copied().collect();
         out.extend(self.inputs.p0);
         out.extend(self.inputs.p1);
@@ -35,6 +37,22 @@ impl ReproCase {
         out
     }
 
+    /// The tolerances and fields the test asserts: `tol`'s fields within
+    /// the case's tolerances ([`ReproCase::asserted_tolerances`]), the
+    /// normal left out when the engine's normal rule is not the face
+    /// normal (the core's query gives the face normal; the engine's is the
+    /// replay's, which the test does not run).
+    fn test_tolerances(&self, tol: &Tolerances) -> Tolerances {
+        let mut fields: Vec<Field> = tol.fields.fields().collect();
+        if self.conventions.normal != NormalRule::Face {
+            fields.retain(|f| *f != Field::Normal);
+        }
+        Tolerances {
+            fields: FieldSet::of(&fields),
+            ..self.asserted_tolerances
+        }
+    }
+
     /// Whether the test asserts membership of the tie set rather than the
     /// primary: the expectation names another member of the tie set.
     pub fn asserts_tie(&self) -> bool {
@@ -45,6 +63,7 @@ impl ReproCase {
     /// the core through the public API, every number written as the
     /// shortest decimal that reads back to the same bits.
     pub fn rust_test(&self, tol: &Tolerances) -> String {
+        let tol = &self.test_tolerances(tol);
         let mut s = String::new();
         let a = self.asserted_within(tol.fields);
         self.write_test_doc(&mut s);
@@ -56,10 +75,22 @@ impl ReproCase {
             self.frame,
             self.ball
         );
-        let _ = writeln!(
-            s,
-            "    use sweeptrace::{{Facing, Kind, Mesh, Options, Sweep}};"
-        );
+        let mut names = vec!["Facing", "Kind", "Mesh", "Options", "Sweep"];
+        if !self.conventions.sides.is_rules() {
+            names.push("Sides");
+        }
+        if !self.conventions.initial_overlap.is_rules() {
+            names.push("InitialOverlap");
+        }
+        names.sort_unstable();
+        let _ = writeln!(s, "    use sweeptrace::{{{}}};", names.join(", "));
+        if !self.conventions.is_rules() {
+            let _ = writeln!(
+                s,
+                "    // Under the engine's declared conventions: {}.",
+                self.conventions.summary()
+            );
+        }
         self.write_test_inputs(&mut s);
         if self.asserts_tie() {
             write_tie_assertion(&mut s, &a);
@@ -164,9 +195,20 @@ impl ReproCase {
             Facing::NonStrict => "NonStrict",
             Facing::Strict => "Strict",
         };
+        let mut conventions = String::new();
+        if !self.conventions.sides.is_rules() {
+            let _ = write!(conventions, " sides: Sides::{:?},", self.conventions.sides);
+        }
+        if !self.conventions.initial_overlap.is_rules() {
+            let _ = write!(
+                conventions,
+                " initial_overlap: InitialOverlap::{:?},",
+                self.conventions.initial_overlap
+            );
+        }
         let _ = writeln!(
             s,
-            "    let options = Options {{ margin: {}, facing: Facing::{facing}, ..Options::default() }};",
+            "    let options = Options {{ margin: {}, facing: Facing::{facing},{conventions} ..Options::default() }};",
             literal(self.inputs.margin)
         );
     }

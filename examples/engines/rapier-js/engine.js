@@ -150,11 +150,14 @@ const sameBits = (hit, other) => other !== null
 // Among equally near ones the lower index is tried first. -1 if none does.
 function triangleOf(hit, shape, p0, d, sweepScale) {
   const witness = xyz(hit.witness1);
-  const order = scene.corners.map((c, t) => [distanceSquared(witness, c), t]).sort((x, y) => x[0] - y[0] || x[1] - y[1]);
+  const order = scene.corners
+    .map((c, t) => [distanceSquared(witness, c), t])
+    .map(([d2, t]) => [Number.isNaN(d2) ? Infinity : d2, t]) // a degenerate triangle: last
+    .sort((x, y) => x[0] - y[0] || x[1] - y[1]);
   const near = (NEAR * sweepScale) ** 2;
   const tried = (t) => sameBits(hit, triangleShape(t).castShape(
     ORIGIN, IDENTITY, ORIGIN, shape, vec(p0), IDENTITY, vec(d), 0, 1, stopAtPenetration));
-  const first = order.find(([d2, t]) => d2 <= near && tried(t)) ?? order.find(([d2, t]) => d2 > near && tried(t));
+  const first = order.find(([d2, t]) => d2 <= near && tried(t)) ?? order.find(([d2, t]) => !(d2 <= near) && tried(t));
   return first ? first[1] : -1;
 }
 

@@ -3,9 +3,10 @@
 on the Rapier engine (standard library only), sweep by sweep, into causes:
 
   "Leaving" and "behind" are judged with the exact geometry of the triangle
-  the engine names (its vertices read from the trace, through the engine
-  protocol: --sweeptrace BIN): q is its nearest point to the centre at the
-  engine's alpha, and the path leaves it when d . (q - centre) <= 0.
+  the engine names (its vertices read from the trace's first scene, the
+  only one of each sample trace, through the engine protocol: --sweeptrace
+  BIN): q is its nearest point to the centre at the engine's alpha, and the
+  path leaves it when d . (q - centre) <= 0.
 
   leaving_alpha0   a hit at alpha 0 for a ball that starts within its radius
                    of the triangle (up to 1e-3 r) and leaves it, where the

@@ -39,6 +39,7 @@ mod precision;
 mod prefetch;
 mod primary_skips;
 mod rapier;
+mod rapier_js;
 // The Rapier recorder example, run by `rapier` (its `main` is unused here).
 mod edge_class;
 mod ghost;
@@ -164,6 +165,7 @@ fn main() {
     trials.extend(lean::tests());
     trials.extend(mesh::tests());
     trials.extend(jolt::tests());
+    trials.extend(rapier_js::tests());
     trials.extend(precision::tests());
     trials.extend(architecture::tests());
     trials.extend(docs::tests());
@@ -188,6 +190,10 @@ const SLOW: &[&str] = &[
     "jolt::jolt_conforms_under_its_config_and_its_broken_variants_do_not",
     "jolt::jolt_config_is_what_infer_config_prints",
     "jolt::jolt_with_back_faces_is_judged_two_sided_under_sides_two",
+    "rapier_js::rapier_answers_every_sample_sweep_within_its_measured_failures",
+    "rapier_js::rapier_stop_at_penetration_switch_changes_the_starts_only",
+    "rapier_js::rapier_passes_the_miss_rules_of_conform_under_its_table",
+    "rapier_js::rapier_config_is_what_infer_config_prints",
 ];
 
 fn mark_slow(trials: Vec<Trial>) -> Vec<Trial> {

@@ -32,6 +32,7 @@ pub fn tests() -> Vec<Trial> {
         trial!(sample_trace_cases_reproduce_and_their_tests_hold),
         trial!(binary_writes_case_and_test),
         trial!(repro_honours_the_declared_conventions),
+        trial!(alpha0_always_accepts_a_start_within_rho_moving_away),
         trial!(sweep_from_trace_and_obj),
         trial!(sweep_flag_errors),
         trial!(infer_wrong_engine_config_margin_0),
@@ -472,6 +473,42 @@ fn repro_honours_the_declared_conventions() -> anyhow::Result<()> {
     ensure!(code == 0, "{command}: exit {code}\n{stdout}{stderr}");
     let (code, stdout, _) = run_bin(os!["check", out.as_os_str(), "--no-config"])?;
     ensure!(code == 1, "under the rules: exit {code}\n{stdout}");
+    Ok(())
+}
+
+/// Issue 47: Rapier's `stopAtPenetration` answers a hit at α = 0 for a
+/// ball that starts within ρ of the floor and moves away from it. No table
+/// could declare that (`alpha0` asks for an approach); `initial_overlap =
+/// "alpha0_always"` does, and only that answer passes under it.
+fn alpha0_always_accepts_a_start_within_rho_moving_away() -> anyhow::Result<()> {
+    let dir = tempfile::tempdir()?;
+    let scene = scene_t(0.0);
+    // 0.25 above the triangle with ρ = 0.5, moving up and away.
+    let sweep = SweepMsg {
+        frame: 0,
+        ball: 0,
+        radius: 0.5,
+        p0: [0.5, 0.5, 0.25],
+        p1: [0.5, 0.5, 1.5],
+    };
+    let hit = OutcomeMsg::hit(0, 0, 0.0, Kind::Face)
+        .triangle(0)
+        .normal([0.0, 0.0, 1.0])
+        .contact([0.5, 0.5, 0.0]);
+    let trace = dir.path().join("leaving.mcap");
+    let mut w = TraceWriter::new(Cursor::new(Vec::new()))?;
+    w.scene(0, &scene)?;
+    w.sweep(1, &sweep)?;
+    w.expected(1, &hit)?;
+    std::fs::write(&trace, w.finish()?.into_inner())?;
+    let t = trace.as_os_str();
+    for (value, want) in [("none", 1), ("alpha0", 1), ("alpha0_always", 0)] {
+        let (code, out, err) = run_bin(os!["check", t, "--no-config", "--initial-overlap", value])?;
+        ensure!(
+            code == want,
+            "--initial-overlap {value}: exit {code}\n{out}{err}"
+        );
+    }
     Ok(())
 }
 

@@ -352,6 +352,10 @@ impl EngineConventions {
             }
             // Two-sided, a ball within ρ that leaves the front moves toward
             // the back: an initial contact at α = 0, from behind.
+            // A start within ρ is a hit whatever the direction.
+            (_, "start.moving-away") if self.initial_overlap == InitialOverlap::Alpha0Always => {
+                declares("initial_overlap", self.initial_overlap.to_string())
+            }
             (_, "start.moving-away")
                 if self.sides == Sides::Two && self.initial_overlap == InitialOverlap::Alpha0 =>
             {

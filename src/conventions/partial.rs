@@ -114,9 +114,10 @@ pub struct PartialConventions {
     #[cfg_attr(feature = "cli", arg(long, value_name = "one|two", value_parser = one_of::<Sides>(), help_heading = "Engine conventions"))]
     pub sides: Option<Setting<Sides>>,
     /// A ball that starts within its radius of the mesh: `none` (the
-    /// rules: no collision) or `alpha0` (a hit at α = 0 with the nearest
-    /// feature) [default: none].
-    #[cfg_attr(feature = "cli", arg(long, value_name = "none|alpha0", value_parser = one_of::<InitialOverlap>(), help_heading = "Engine conventions"))]
+    /// rules: no collision), `alpha0` (a hit at α = 0 with the nearest
+    /// feature when it moves toward it) or `alpha0_always` (whatever the
+    /// direction, as Rapier's stopAtPenetration) [default: none].
+    #[cfg_attr(feature = "cli", arg(long, value_name = "none|alpha0|alpha0_always", value_parser = one_of::<InitialOverlap>(), help_heading = "Engine conventions"))]
     pub initial_overlap: Option<Setting<InitialOverlap>>,
     /// The normal of a hit: `face` (the rules: the triangle's),
     /// `contact` (centre minus contact, normalised, at edges and

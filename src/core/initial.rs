@@ -21,7 +21,7 @@ use nalgebra::Point3;
 
 use super::feature::Feature;
 use super::mesh::{Mesh, Triangle};
-use super::options::{Facing, Sides};
+use super::options::{InitialOverlap, Options, Sides};
 use super::outcome::SweepHit;
 use super::path::SweptPath;
 
@@ -72,27 +72,38 @@ pub(crate) fn closest_point(triangle: &Triangle, p: &Point3<f64>) -> (Point3<f64
 /// normal the triangle's front normal), with its distance from `p0`; in
 /// the rules' tie order (face < edge < vertex, then triangle, then
 /// feature). All of them are hits at the same `α`: a tie.
-pub fn initial_contacts(
-    mesh: &Mesh,
-    path: &SweptPath,
-    facing: Facing,
-    sides: Sides,
-) -> Vec<(SweepHit, f64)> {
+///
+/// Under [`InitialOverlap::Alpha0Always`] the direction is not asked: every
+/// triangle within `ρ` whose front holds the centre (or, two-sided, any,
+/// the normal facing the centre).
+pub fn initial_contacts(mesh: &Mesh, path: &SweptPath, options: &Options) -> Vec<(SweepHit, f64)> {
+    let (facing, sides) = (options.facing, options.sides);
+    let always = options.initial_overlap == InitialOverlap::Alpha0Always;
     let triangles = mesh.triangles();
     let mut found = Vec::new();
     let mut consider = |t: &Triangle| {
-        // Under `sides = two` a triangle the path moves toward the back of
-        // is its mirror, as in the sweep: normal `-n`.
-        let normal_dot_d = t.normal.dot(&path.d);
-        if !facing.allows(sides.facing_value(normal_dot_d)) {
-            return;
-        }
-        let normal = if sides.flips(normal_dot_d) {
-            -t.normal
-        } else {
-            t.normal
-        };
         let (point, feature) = closest_point(t, &path.p0);
+        let normal = if always {
+            // The side the centre is on, whatever the direction.
+            let centre_side = t.normal.dot(&(path.p0 - point));
+            match (centre_side < 0.0, sides) {
+                (false, _) => t.normal,
+                (true, Sides::Two) => -t.normal,
+                (true, Sides::One) => return,
+            }
+        } else {
+            // Under `sides = two` a triangle the path moves toward the back
+            // of is its mirror, as in the sweep: normal `-n`.
+            let normal_dot_d = t.normal.dot(&path.d);
+            if !facing.allows(sides.facing_value(normal_dot_d)) {
+                return;
+            }
+            if sides.flips(normal_dot_d) {
+                -t.normal
+            } else {
+                t.normal
+            }
+        };
         let distance = (path.p0 - point).norm();
         if distance < path.rho {
             let hit = SweepHit {
@@ -133,10 +144,9 @@ pub fn initial_contacts(
 pub(crate) fn initial_contact(
     mesh: &Mesh,
     path: &SweptPath,
-    facing: Facing,
-    sides: Sides,
+    options: &Options,
 ) -> Option<(SweepHit, f64)> {
-    let contacts = initial_contacts(mesh, path, facing, sides);
+    let contacts = initial_contacts(mesh, path, options);
     let (first, _) = contacts.first()?;
     let mut hit = *first;
     let mut sum = nalgebra::Vector3::zeros();
@@ -203,15 +213,52 @@ mod tests {
             let s = Sweep::new([1.0, 1.0, z], [1.0, 1.0, z + dz], 0.5);
             SweptPath::new(&s, &Options::default()).expect("valid sweep")
         };
-        let (hit, distance) = initial_contact(&m, &path(0.25, -1.0), Facing::NonStrict, Sides::One)
-            .expect("a contact");
+        let alpha0 = Options {
+            initial_overlap: InitialOverlap::Alpha0,
+            ..Options::default()
+        };
+        let (hit, distance) = initial_contact(&m, &path(0.25, -1.0), &alpha0).expect("a contact");
         assert_eq!(distance, 0.25);
         assert_eq!((hit.alpha, hit.feature), (0.0, Feature::Face));
         assert_eq!(hit.contact, Point3::new(1.0, 1.0, 0.0));
-        assert!(initial_contact(&m, &path(0.75, -1.0), Facing::NonStrict, Sides::One).is_none());
+        assert!(initial_contact(&m, &path(0.75, -1.0), &alpha0).is_none());
         // Moving away from the front: the facing rule rejects the triangle.
-        assert!(initial_contact(&m, &path(0.25, 1.0), Facing::NonStrict, Sides::One).is_none());
+        assert!(initial_contact(&m, &path(0.25, 1.0), &alpha0).is_none());
         // Not moving at all: every triangle is looked at.
-        assert!(initial_contact(&m, &path(0.25, 0.0), Facing::NonStrict, Sides::One).is_some());
+        assert!(initial_contact(&m, &path(0.25, 0.0), &alpha0).is_some());
+    }
+
+    /// Issue 47: Rapier's `stopAtPenetration` (parry's
+    /// `stop_at_penetration`) reports a start within ρ as a hit at α = 0
+    /// whatever the direction, moving away included; its normal faces the
+    /// centre (two-sided: from behind, `-n`; one-sided, nothing behind).
+    #[test]
+    fn alpha0_always_is_a_contact_whatever_the_direction() {
+        let m = floor();
+        let path = |z: f64, dz: f64| {
+            let s = Sweep::new([1.0, 1.0, z], [1.0, 1.0, z + dz], 0.5);
+            SweptPath::new(&s, &Options::default()).expect("valid sweep")
+        };
+        let always = |sides| Options {
+            initial_overlap: InitialOverlap::Alpha0Always,
+            sides,
+            ..Options::default()
+        };
+        for dz in [-1.0, 0.0, 1.0] {
+            let (hit, distance) =
+                initial_contact(&m, &path(0.25, dz), &always(Sides::One)).expect("a contact");
+            assert_eq!(
+                (distance, hit.alpha, hit.feature),
+                (0.25, 0.0, Feature::Face)
+            );
+            assert_eq!(hit.normal, nalgebra::Vector3::z(), "dz {dz}");
+        }
+        // From behind: two-sided, the normal faces the centre; one-sided,
+        // no contact.
+        let (hit, _) =
+            initial_contact(&m, &path(-0.25, -1.0), &always(Sides::Two)).expect("a contact");
+        assert_eq!(hit.normal, -nalgebra::Vector3::z());
+        assert!(initial_contact(&m, &path(-0.25, -1.0), &always(Sides::One)).is_none());
+        assert!(initial_contact(&m, &path(0.75, 1.0), &always(Sides::Two)).is_none());
     }
 }

@@ -85,6 +85,13 @@ pub enum InitialOverlap {
     /// PhysX without `eASSUME_NO_INITIAL_OVERLAP`, parry with
     /// `stop_at_penetration`).
     Alpha0,
+    /// A hit at `α = 0` whenever the ball starts within `ρ` of a triangle,
+    /// whatever the direction it moves in, toward the triangle, along it or
+    /// away (Rapier's `stopAtPenetration`, parry's `stop_at_penetration`
+    /// casts): the facing rule is not asked. One-sided, only a triangle
+    /// whose front holds the centre (or whose plane does); two-sided, any,
+    /// the normal facing the centre.
+    Alpha0Always,
 }
 
 impl InitialOverlap {

@@ -9,7 +9,7 @@ use super::feature::{Feature, Kind};
 use super::fragility::{FragileReason, Fragility};
 use super::initial::initial_contact;
 use super::mesh::{Mesh, Plane, Triangle};
-use super::options::{ALPHA_SENSITIVITY, Facing, GRAZING_COSINE, InitialOverlap, Options, Sides};
+use super::options::{ALPHA_SENSITIVITY, Facing, GRAZING_COSINE, Options, Sides};
 use super::outcome::{Outcome, SweepHit, in_tie_window};
 use super::path::{Sweep, SweptPath};
 use super::record::{NoObserver, Observer, Skip, Verdict};
@@ -415,8 +415,8 @@ pub fn sweep_mesh_with<O: Observer>(
         broadphase,
         observer,
     );
-    if options.initial_overlap == InitialOverlap::Alpha0
-        && let Some((hit, distance)) = initial_contact(mesh, &path, options.facing, options.sides)
+    if !options.initial_overlap.is_rules()
+        && let Some((hit, distance)) = initial_contact(mesh, &path, options)
     {
         // The tests ran for the observer; the answer is the start's contact.
         let mut fragile = Fragility::ROBUST;

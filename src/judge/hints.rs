@@ -118,9 +118,8 @@ fn starts_in_contact(result: &SweepResult, expected: &OutcomeMsg) -> bool {
         margin: 0.0,
         ..result.scene.options
     };
-    SweptPath::new(&result.sweep, &options).is_ok_and(|path| {
-        !initial_contacts(&result.scene.mesh, &path, options.facing, options.sides).is_empty()
-    })
+    SweptPath::new(&result.sweep, &options)
+        .is_ok_and(|path| !initial_contacts(&result.scene.mesh, &path, &options).is_empty())
 }
 
 /// Whether only the normal differs, on an edge or vertex answer, and the

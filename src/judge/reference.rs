@@ -7,8 +7,8 @@ use nalgebra::Point3;
 
 use crate::core::SweepHit;
 use crate::core::{
-    Broadphase, EdgeRecord, FaceRecord, Feature, InitialOverlap, Observer, Outcome, Sweep,
-    SweptPath, TestRecord, Tie, VertexRecord, initial_contacts, sweep_mesh_with,
+    Broadphase, EdgeRecord, FaceRecord, Feature, Observer, Outcome, Sweep, SweptPath, TestRecord,
+    Tie, VertexRecord, initial_contacts, sweep_mesh_with,
 };
 use crate::replay::SceneState;
 use crate::trace::OutcomeMsg;
@@ -64,22 +64,17 @@ impl<'a> Decision<'a> {
             &mut hits,
         )
         .ok()?;
-        let initial = if scene.options.initial_overlap == InitialOverlap::Alpha0
+        let initial = if !scene.options.initial_overlap.is_rules()
             && outcome.hit.is_some_and(|h| h.alpha == 0.0)
         {
             let (lo, hi) = scene.mesh.bounds();
             let path = SweptPath::new(sweep, &scene.options)
                 .ok()?
                 .with_mesh_scale(&lo, &hi);
-            initial_contacts(
-                &scene.mesh,
-                &path,
-                scene.options.facing,
-                scene.options.sides,
-            )
-            .into_iter()
-            .map(|(h, _)| h)
-            .collect()
+            initial_contacts(&scene.mesh, &path, &scene.options)
+                .into_iter()
+                .map(|(h, _)| h)
+                .collect()
         } else {
             Vec::new()
         };

@@ -144,6 +144,15 @@ pub fn infer_conventions<E>(
                 ..c
             }),
         ),
+        // Then whatever the direction (Rapier's stopAtPenetration): kept
+        // only when more answers fit it than `alpha0`.
+        (
+            "initial_overlap",
+            Box::new(|c| EngineConventions {
+                initial_overlap: InitialOverlap::Alpha0Always,
+                ..c
+            }),
+        ),
         // After the initial overlap: a two-sided engine that also reports
         // starts in contact (Jolt) fits two sides only once those starts
         // are hits.
@@ -215,6 +224,17 @@ pub fn infer_conventions<E>(
                 "{fixed} answers hit triangles from behind (n·d > 0) as from the front, with \
                  the normal -n"
             ),
+            "initial_overlap" if trying.initial_overlap == InitialOverlap::Alpha0Always => {
+                format!(
+                    "answers are hits at α = 0 where the ball starts within ρ of the mesh, \
+                     moving away from it too; {fixed} fewer sweeps fail than {}",
+                    if best.initial_overlap.is_rules() {
+                        "under the rules".to_string()
+                    } else {
+                        format!("with \"{}\"", best.initial_overlap)
+                    }
+                )
+            }
             "initial_overlap" => format!(
                 "{fixed} answers are hits at α = 0 where the ball starts within ρ of the mesh"
             ),

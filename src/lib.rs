@@ -76,7 +76,7 @@ pub mod atomic;
 pub mod conform;
 pub mod core;
 pub mod engine;
-pub(crate) mod error_text;
+pub mod error_text;
 pub mod foxglove;
 pub mod fuzzing;
 pub mod judge;

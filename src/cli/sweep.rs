@@ -122,11 +122,12 @@ pub fn run(args: Args) -> anyhow::Result<Exit> {
             &args,
             &settings.engine.conventions(),
         )?;
-        let name = found
-            .scene
-            .name
-            .clone()
-            .unwrap_or_else(|| "(unnamed)".into());
+        // The trace's text, shown on a terminal: its control characters
+        // escaped.
+        let name = found.scene.name.as_deref().map_or_else(
+            || "(unnamed)".into(),
+            |n| sweeptrace::error_text::escaped(n).into_owned(),
+        );
         (name, mesh, found.core_sweep(), options)
     } else {
         // clap lets `requires` pass when the required flag conflicts with

@@ -8,7 +8,7 @@ use std::time::{Duration, Instant};
 use crate::core::explain::nearest_miss;
 use crate::core::{
     Broadphase, CollectRecords, EdgeClass, Feature, Mesh, Observer, Options, Outcome, SkipCounts,
-    Sweep, TestRecord, Topology, VerdictCounts, sweep_mesh, sweep_mesh_with,
+    Sweep, SweepError, TestRecord, Topology, VerdictCounts, sweep_mesh, sweep_mesh_with,
 };
 use crate::trace::{EventBody, EventHeader, OutcomeMsg, SceneMsg, SweepMsg, TraceEvent};
 
@@ -539,11 +539,23 @@ pub fn compute_sweep(
 ) -> Result<ComputedSweep, ReplayError> {
     let start = Instant::now();
     let sweep = Sweep::new(msg.p0, msg.p1, msg.radius);
-    let err = |cause| ReplayError::Sweep {
-        frame: msg.frame,
-        ball: msg.ball,
-        index,
-        cause,
+    let err = |cause| match cause {
+        // The margin was given (not the scene's): the setting's fault.
+        SweepError::MarginNotBelowRadius { margin, radius } if options.margin.is_some() => {
+            ReplayError::MarginOverride {
+                frame: msg.frame,
+                ball: msg.ball,
+                index,
+                margin,
+                radius,
+            }
+        }
+        cause => ReplayError::Sweep {
+            frame: msg.frame,
+            ball: msg.ball,
+            index,
+            cause,
+        },
     };
     let mut verdicts = VerdictCounts::default();
     let mut skipped = SkipCounts::default();

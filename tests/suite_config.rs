@@ -465,6 +465,16 @@ fn declared_margin_too_large_is_the_settings_fault_said_once() -> anyhow::Result
     for command in [
         os!["replay", "suite/cube.mcap", "--outcomes", "o.jsonl"].to_vec(),
         os!["bless", "suite/cube.mcap", "-o", "b.mcap"].to_vec(),
+        os![
+            "sweep",
+            "--trace",
+            "suite/cube.mcap",
+            "--frame",
+            "0",
+            "--ball",
+            "0"
+        ]
+        .to_vec(),
     ] {
         let (code, out, err) = run_bin_in(&repo, &command)?;
         ensure!(

@@ -274,6 +274,17 @@ pub struct MarginFault {
 }
 
 impl MarginFault {
+    /// The fault of `margin` against the sweep of `ball` at `frame`, of
+    /// radius `radius`.
+    pub fn new(margin: f64, radius: f64, frame: u64, ball: u32) -> MarginFault {
+        MarginFault {
+            margin,
+            radius,
+            frame,
+            ball,
+        }
+    }
+
     /// The fault a replay error reports, if it is one
     /// ([`ReplayError::MarginOverride`](crate::replay::ReplayError::MarginOverride)).
     pub fn of(err: &crate::replay::ReplayError) -> Option<MarginFault> {

@@ -38,3 +38,38 @@ pub fn repeated_segment(text: &str) -> Option<String> {
             .then(|| (*later).to_string())
     })
 }
+
+/// `text` safe to print on a terminal: each control character (an escape
+/// sequence's ESC, a carriage return, a newline, a bell, ...) written as
+/// Rust writes it in a string (`\u{1b}`, `\r`, `\n`), and a backslash
+/// before one doubled so that the two read apart. For the text of an input
+/// (a settings file's value or key, a scene's name, an answer typed at a
+/// prompt) placed in a message; text without a control character comes
+/// back as it was.
+pub fn escaped(text: &str) -> std::borrow::Cow<'_, str> {
+    if !text.chars().any(char::is_control) {
+        return std::borrow::Cow::Borrowed(text);
+    }
+    let mut out = String::with_capacity(text.len() + 8);
+    for c in text.chars() {
+        if c.is_control() || c == '\\' {
+            out.extend(c.escape_debug());
+        } else {
+            out.push(c);
+        }
+    }
+    std::borrow::Cow::Owned(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::escaped;
+
+    #[test]
+    fn control_characters_are_escaped() {
+        assert_eq!(escaped("plain `text` é"), "plain `text` é");
+        assert_eq!(escaped("a\u{1b}[31mred\r\nb"), "a\\u{1b}[31mred\\r\\nb");
+        assert_eq!(escaped("c:\\dir\u{7}"), "c:\\\\dir\\u{7}");
+        assert_eq!(escaped("\u{9b}2J"), "\\u{9b}2J");
+    }
+}

@@ -77,7 +77,7 @@ pub mod conform;
 pub mod conventions;
 pub mod core;
 pub mod engine;
-pub(crate) mod error_text;
+pub mod error_text;
 pub mod foxglove;
 pub mod fuzzing;
 pub mod judge;

@@ -6,6 +6,31 @@
 //! the caller puts it next to the name the user knows (a JSON field path, a
 //! flag, a parameter).
 
+/// `x` in the shortest decimal that reads back to the same `f64`, as a
+/// person writes it: `0.3`, `250`, `-1.5`; with an exponent when plain
+/// digits would be long (`1e308`, not 309 digits; `1e-7`, not
+/// `0.0000001`). `inf`, `-inf`, `NaN` as Rust writes them. Every number
+/// taken from an input and printed in a message goes through it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Shortest(pub f64);
+
+impl std::fmt::Display for Shortest {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let x = self.0;
+        let a = x.abs();
+        if x.is_finite() && x != 0.0 && !(1e-5..1e16).contains(&a) {
+            write!(f, "{x:e}")
+        } else {
+            write!(f, "{x}")
+        }
+    }
+}
+
+/// [`Shortest`] as a string.
+pub fn shortest(x: f64) -> String {
+    Shortest(x).to_string()
+}
+
 /// What a number must be.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Rule {
@@ -28,7 +53,7 @@ pub fn check(value: f64, rule: Rule) -> Result<(), String> {
     if ok {
         Ok(())
     } else {
-        Err(format!("must be {wanted}, got {value}"))
+        Err(format!("must be {wanted}, got {}", Shortest(value)))
     }
 }
 
@@ -49,7 +74,9 @@ pub fn check_margin(margin: f64, radius: f64) -> Result<(), String> {
         Ok(())
     } else {
         Err(format!(
-            "must be smaller than the radius {radius} (0 ≤ margin < radius), got {margin}"
+            "must be smaller than the radius {} (0 ≤ margin < radius), got {}",
+            Shortest(radius),
+            Shortest(margin)
         ))
     }
 }
@@ -152,7 +179,29 @@ pub fn counted(n: u64, one: &str, many: &str) -> String {
 
 #[cfg(test)]
 mod tests {
-    use super::{hex_float, parse_f64};
+    use super::{Shortest, hex_float, parse_f64};
+
+    #[test]
+    fn shortest_forms_read_back() {
+        for (x, text) in [
+            (0.3, "0.3"),
+            (250.0, "250"),
+            (-1.5, "-1.5"),
+            (0.0, "0"),
+            (1e308, "1e308"),
+            (1e300, "1e300"),
+            (1e-7, "1e-7"),
+            (1.5e-300, "1.5e-300"),
+            (1e15, "1000000000000000"),
+            (1e16, "1e16"),
+            (0.00001, "0.00001"),
+            (f64::MAX, "1.7976931348623157e308"),
+            (f64::INFINITY, "inf"),
+        ] {
+            assert_eq!(Shortest(x).to_string(), text);
+            assert_eq!(parse_f64(text), Some(x));
+        }
+    }
 
     #[test]
     fn hex_floats_round_trip() {

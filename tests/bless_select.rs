@@ -28,6 +28,11 @@ pub fn tests() -> Vec<Trial> {
         trial!(bless_review_from_a_script_accepts_rejects_and_lists_the_skipped),
         trial!(bless_review_at_a_terminal),
         trial!(replay_bless_and_check_agree_under_a_declared_table),
+        trial!(bless_selection_of_nothing_is_an_error_and_writes_nothing),
+        trial!(
+            bless_review_refuses_an_endless_answer_line,
+            timeout = std::time::Duration::from_secs(120)
+        ),
     ]
 }
 
@@ -553,6 +558,106 @@ fn replay_bless_and_check_agree_under_a_declared_table() -> anyhow::Result<()> {
         trace["conventions_seen"]["initial_overlap"].as_u64() == Some(u64::from(hits_at_zero)),
         "{}",
         trace["conventions_seen"]
+    );
+    Ok(())
+}
+
+/// A selection that selects no sweep (frames past the end, a ball the
+/// trace lacks, a pair it lacks) is an error naming what the trace holds,
+/// exit 2, and writes nothing: no output, and in place the trace as it was
+/// (before: exit 0, "0 sweeps blessed", the trace rewritten) (issue 43,
+/// item 10).
+fn bless_selection_of_nothing_is_an_error_and_writes_nothing() -> anyhow::Result<()> {
+    let dir = tempfile::tempdir()?;
+    let trace = dir.path().join("cube.mcap");
+    std::fs::copy(cube(), &trace)?;
+    let before = std::fs::read(&trace)?;
+    let out = dir.path().join("out.mcap");
+    for (selection, filter) in [
+        (os!["--frames", "99999.."], "(frames 99999..)"),
+        (os!["--ball", "999"], "(ball 999)"),
+        (os!["--accept", "99999:0"], "(sweeps 99999:0)"),
+    ] {
+        for target in [
+            os!["-o", out.as_os_str()].to_vec(),
+            os!["--in-place"].to_vec(),
+        ] {
+            let mut args = os!["bless", trace.as_os_str()].to_vec();
+            args.extend_from_slice(selection);
+            args.extend_from_slice(&target);
+            let (code, out_text, err) = run(&args)?;
+            ensure!(
+                code == 2
+                    && err.contains(&format!("the filter {filter} selects none of the trace's"))
+                    && err.contains("; nothing written")
+                    && !err.contains("wrote "),
+                "{args:?}: exit {code}\n{out_text}{err}"
+            );
+            ensure!(!out.exists(), "{args:?} wrote {}", out.display());
+            ensure!(
+                std::fs::read(&trace)? == before,
+                "{args:?} rewrote the trace"
+            );
+        }
+    }
+    Ok(())
+}
+
+/// `--review` reads an answer line up to a bound: a line without end
+/// (`< /dev/zero`, or a long line without a newline) is an error, exit 2,
+/// nothing written (before: the line was read without bound, gigabytes a
+/// second) (issue 43, item 11).
+fn bless_review_refuses_an_endless_answer_line() -> anyhow::Result<()> {
+    let dir = tempfile::tempdir()?;
+    let trace = root().join("tests/fixtures/wrong_engine_config.mcap");
+    let out = dir.path().join("reviewed.mcap");
+    // A long line, then the end of input.
+    let mut child = crate::support::bin()
+        .args(["bless", "--review", "-o"])
+        .arg(&out)
+        .arg(&trace)
+        .stdin(Stdio::piped())
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()?;
+    let mut stdin = child
+        .stdin
+        .take()
+        .ok_or_else(|| anyhow::anyhow!("no stdin"))?;
+    // The binary may stop reading (and close the pipe) before all of it.
+    let _ = stdin.write_all(&[b'x'; 8192]);
+    drop(stdin);
+    let output = child.wait_with_output()?;
+    let err = String::from_utf8_lossy(&output.stderr);
+    ensure!(
+        output.status.code() == Some(2)
+            && err.contains("an answer line longer than 1024 bytes")
+            && !out.exists(),
+        "a long line: {:?}\n{err}",
+        output.status
+    );
+    // /dev/zero: the same, at once (under a 3 GB limit of address space,
+    // so that a regression fails instead of taking the machine's memory).
+    let child = std::process::Command::new("sh")
+        .args([
+            "-c",
+            "ulimit -v 3000000 && exec \"$0\" bless --review -o \"$1\" \"$2\"",
+        ])
+        .arg(env!("CARGO_BIN_EXE_sweeptrace"))
+        .arg(&out)
+        .arg(&trace)
+        .stdin(std::fs::File::open("/dev/zero")?)
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()?;
+    let output = child.wait_with_output()?;
+    let err = String::from_utf8_lossy(&output.stderr);
+    ensure!(
+        output.status.code() == Some(2)
+            && err.contains("an answer line longer than 1024 bytes")
+            && !out.exists(),
+        "/dev/zero: {:?}\n{err}",
+        output.status
     );
     Ok(())
 }

@@ -11,7 +11,10 @@ use crate::{ensure, trial};
 use anyhow::Context as _;
 
 pub fn tests() -> Vec<Trial> {
-    vec![trial!(failing_commands_say_each_thing_once)]
+    vec![
+        trial!(failing_commands_say_each_thing_once),
+        trial!(inputs_are_shown_escaped_and_in_the_users_words),
+    ]
 }
 
 /// One failing command: its arguments, the exit code, and what its message
@@ -197,5 +200,107 @@ fn failing_commands_say_each_thing_once() -> anyhow::Result<()> {
             anyhow::bail!("{what}: the message repeats `{repeated}`: {message}");
         }
     }
+    Ok(())
+}
+
+/// Text taken from an input and shown on a terminal (a settings file's
+/// value or key, a scene's name, an answer) has its control characters
+/// escaped; messages name no type of the program (`expected struct
+/// RawEngine`); a number too large is said to be; an integer prints as
+/// one (a triangle index `1000000`, not `1.0000e6`); `replay --json`
+/// prints one JSON document with the error, as `check --json` does (issue
+/// 43, item 12).
+fn inputs_are_shown_escaped_and_in_the_users_words() -> anyhow::Result<()> {
+    let dir = tempfile::tempdir()?;
+    let repo = dir.path();
+    std::fs::create_dir_all(repo.join(".git"))?;
+    std::fs::copy(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("traces/record_cube_corner_margin.mcap"),
+        repo.join("t.mcap"),
+    )?;
+    let run = |args: &[&str]| {
+        crate::support::run_bin_in(
+            repo,
+            &args.iter().map(std::ffi::OsStr::new).collect::<Vec<_>>(),
+        )
+    };
+    let raw = |text: &str| text.chars().any(|c| c.is_control() && c != '\n');
+    // Settings files: a value and a key with an escape sequence, values
+    // of the wrong type.
+    for (file, must_say) in [
+        (
+            "[engine]\nfacing = \"\\u001b[2Jred\"\n",
+            "`engine.facing` is `\\u{1b}[2Jred`",
+        ),
+        (
+            "[engine]\n\"x\\u001b[2J\" = 1\n",
+            "unknown key `x\\u{1b}[2J`",
+        ),
+        ("engine = 3\n", "expected the `[engine]` table"),
+        ("tolerances = 3\n", "expected the `[tolerances]` table"),
+        ("traces = [1]\n", "expected a `[[traces]]` table"),
+    ] {
+        std::fs::write(repo.join("sweeptrace.toml"), file)?;
+        let (code, out, err) = run(&["check", "t.mcap"])?;
+        ensure!(
+            code == 2 && err.contains(must_say) && !raw(&err) && !err.contains("struct"),
+            "{file:?}: exit {code}\n{out}{err}"
+        );
+    }
+    std::fs::remove_file(repo.join("sweeptrace.toml"))?;
+    // A scene's name, in `info` and `mesh`.
+    let scene = br#"{"name":"evil\u001b[2J\u0007","vertices":[[0,0,0],[4,0,0],[0,4,0]],"triangles":[[0,1,2]]}"#;
+    let sweep = br#"{"frame":0,"radius":0.5,"p0":[1,1,1],"p1":[1,1,-1]}"#;
+    std::fs::write(
+        repo.join("named.mcap"),
+        crate::trace_io::raw_trace(&[("/scene", 0, scene), ("/sweep", 1, sweep)]),
+    )?;
+    for command in [["info", "named.mcap"], ["mesh", "named.mcap"]] {
+        let (code, out, err) = run(&command)?;
+        ensure!(
+            code == 0 && out.contains("evil\\u{1b}[2J\\u{7}") && !raw(&out) && !raw(&err),
+            "{command:?}: exit {code}\n{out}{err}"
+        );
+    }
+    // A ball number too large, an answer with control characters.
+    let (code, out, err) = run(&[
+        "bless",
+        "t.mcap",
+        "--accept",
+        "0:4294967296",
+        "-o",
+        "b.mcap",
+    ])?;
+    ensure!(
+        code == 2 && err.contains("the ball `4294967296` is too large (at most 4294967295)"),
+        "exit {code}\n{out}{err}"
+    );
+    let (code, out, err) = run(&["bless", "t.mcap", "--accept", "0:\u{1b}[2J", "-o", "b.mcap"])?;
+    ensure!(
+        code == 2 && err.contains("the ball `\\u{1b}[2J` is not a whole number") && !raw(&err),
+        "exit {code}\n{out}{err}"
+    );
+    // An integer in a divergence's values.
+    let index = serde_json::json!(1_000_000);
+    ensure!(
+        sweeptrace::judge::value_text(&index) == "1000000"
+            && sweeptrace::judge::value_text_exact(&serde_json::json!(1e300)) == "1e300",
+        "{}",
+        sweeptrace::judge::value_text(&index)
+    );
+    // `replay --json` that fails: one JSON document, with the error.
+    let (code, out, err) = run(&["replay", "missing.mcap", "--outcomes", "o.jsonl", "--json"])?;
+    let v: serde_json::Value =
+        serde_json::from_str(&out).with_context(|| format!("not JSON: {out}{err}"))?;
+    ensure!(
+        code == 2
+            && v["status"] == "error"
+            && v["exit_code"] == 2
+            && v["trace"] == "missing.mcap"
+            && v["error"]
+                .as_str()
+                .is_some_and(|e| e.contains("missing.mcap: cannot open")),
+        "exit {code}\n{out}{err}"
+    );
     Ok(())
 }

@@ -306,8 +306,16 @@ fn replay_json_prints_the_summary_as_one_object() -> anyhow::Result<()> {
     );
     let dir = tempfile::tempdir()?;
     let (code, out, err) = run(dir.path(), os!["replay", t, "--outcomes", "-", "--json"])?;
+    // A failure is one JSON document too, with the error.
+    let v: serde_json::Value =
+        serde_json::from_str(&out).with_context(|| format!("stdout is not JSON: {out}"))?;
     ensure!(
-        code == 2 && err.contains("--json and --outcomes - both write to stdout") && out.is_empty(),
+        code == 2
+            && err.contains("--json and --outcomes - both write to stdout")
+            && v["status"] == "error"
+            && v["error"]
+                .as_str()
+                .is_some_and(|e| e.contains("--json and --outcomes - both write to stdout")),
         "exit {code}\n{out}{err}"
     );
     ensure!(

@@ -20,6 +20,10 @@ pub fn tests() -> Vec<Trial> {
         trial!(mesh_bad_input_exits_2),
         trial!(mesh_builtin_scenes),
         trial!(mesh_reads_a_traces_scenes),
+        trial!(
+            mesh_of_an_endless_input_is_bounded_and_named,
+            timeout = std::time::Duration::from_secs(120)
+        ),
     ]
 }
 
@@ -179,5 +183,30 @@ fn mesh_reads_a_traces_scenes() -> anyhow::Result<()> {
     let golf = format!("{dir}/record_mini_golf.mcap");
     let (_, m) = mesh_json(&golf)?;
     ensure!(m["name"] == "mini_golf", "name {}", m["name"]);
+    Ok(())
+}
+
+/// `mesh /dev/zero` reads up to the largest OBJ file it takes, then stops
+/// with an error naming the file (before: it read until memory ran out,
+/// then said "cannot read <input>"). Run under a 3 GB limit of address
+/// space, so that a regression fails instead of taking the machine's
+/// memory (issue 43, item 11).
+fn mesh_of_an_endless_input_is_bounded_and_named() -> anyhow::Result<()> {
+    let out = std::process::Command::new("sh")
+        .args(["-c", "ulimit -v 3000000 && exec \"$0\" mesh /dev/zero"])
+        .arg(env!("CARGO_BIN_EXE_sweeptrace"))
+        .output()?;
+    let (code, out, err) = (
+        out.status.code().unwrap_or(-1),
+        String::from_utf8_lossy(&out.stdout),
+        String::from_utf8_lossy(&out.stderr),
+    );
+    ensure!(
+        code == 2
+            && err
+                .contains("/dev/zero is larger than 256 MiB: not a Wavefront OBJ file this reads")
+            && !err.contains("<input>"),
+        "exit {code}\n{out}{err}"
+    );
     Ok(())
 }

@@ -6,13 +6,14 @@
 
 use super::NameFileOnce;
 use std::collections::BTreeSet;
-use std::io::{BufRead, Write};
+use std::io::{BufRead, Read, Write};
 use std::path::PathBuf;
 
 use anyhow::{Context, bail};
 
 use super::Exit;
 use sweeptrace::engine::EngineCommand;
+use sweeptrace::error_text::escaped;
 use sweeptrace::judge::{Divergence, Parties, render_divergence_as};
 use sweeptrace::numbers::counted;
 use sweeptrace::suite::{
@@ -42,7 +43,9 @@ keep the expectation they had (or none). --review walks the sweeps whose
 new expectation differs from the trace's, one at a time, with the
 explanation `check` prints, and reads a for accept, r for reject, s for
 skip (the skipped are listed as an --accept for later), A to accept the
-rest, q to quit (the rest keep theirs) from standard input, a line each.
+rest, q to quit (the rest keep theirs) from standard input, a line each
+(at most 1,024 bytes). A selection that selects no sweep is an error
+(exit 2): nothing is written.
 
 The output is written under a temporary name next to it and renamed when
 complete; the input is untouched unless --in-place. A trace that ends
@@ -107,21 +110,39 @@ fn parse_sweeps(text: &str) -> Result<BTreeSet<(u64, u32)>, String> {
     for pair in text.split(',').map(str::trim).filter(|p| !p.is_empty()) {
         let (frame, ball) = pair
             .split_once(':')
-            .ok_or_else(|| format!("`{pair}` is not FRAME:BALL (e.g. `12:0`)"))?;
+            .ok_or_else(|| format!("`{}` is not FRAME:BALL (e.g. `12:0`)", escaped(pair)))?;
         let frame = frame
             .trim()
             .parse::<u64>()
-            .map_err(|_| format!("`{pair}`: the frame `{frame}` is not a whole number"))?;
+            .map_err(|e| number_problem(pair, "frame", frame, &e, u64::MAX))?;
         let ball = ball
             .trim()
             .parse::<u32>()
-            .map_err(|_| format!("`{pair}`: the ball `{ball}` is not a whole number"))?;
+            .map_err(|e| number_problem(pair, "ball", ball, &e, u32::MAX.into()))?;
         out.insert((frame, ball));
     }
     if out.is_empty() {
         return Err("no FRAME:BALL pair given (e.g. `12:0,40:3`)".to_string());
     }
     Ok(out)
+}
+
+/// Why `text`, the `what` of `pair`, is not a frame or ball number: too
+/// large (above `max`), or not a whole number at all.
+fn number_problem(
+    pair: &str,
+    what: &str,
+    text: &str,
+    err: &std::num::ParseIntError,
+    max: u64,
+) -> String {
+    let (pair, text) = (escaped(pair), escaped(text.trim()));
+    match err.kind() {
+        std::num::IntErrorKind::PosOverflow => {
+            format!("`{pair}`: the {what} `{text}` is too large (at most {max})")
+        }
+        _ => format!("`{pair}`: the {what} `{text}` is not a whole number"),
+    }
 }
 
 /// Blesses the trace.
@@ -233,6 +254,23 @@ pub fn run(args: Args) -> anyhow::Result<Exit> {
             );
             return Ok(Exit::Error);
         }
+        // A declared margin that does not fit the balls: the setting's
+        // fault, named where it was set.
+        Err(BlessError::Replay { cause, file }) => match sweeptrace::suite::MarginFault::of(&cause)
+        {
+            Some(fault) => bail!(
+                "{}; nothing written",
+                super::check_config::margin_fault(
+                    &settings,
+                    &args.trace.display().to_string(),
+                    &fault
+                )
+            ),
+            None => {
+                return Err(BlessError::Replay { cause, file })
+                    .name_file_once("blessing", args.trace.display());
+            }
+        },
         Err(err) => return Err(err).name_file_once("blessing", args.trace.display()),
     };
     // One line for what was written, then one for each thing to know.
@@ -270,6 +308,10 @@ pub fn run(args: Args) -> anyhow::Result<Exit> {
     Ok(Exit::Success)
 }
 
+/// The longest answer line `--review` reads: an answer is a word; a longer
+/// line (`--review < /dev/zero`) is an error, not a line kept growing.
+const MAX_ANSWER_LINE_BYTES: usize = 1024;
+
 /// What the reviewer said of one change.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 enum Answer {
@@ -290,15 +332,28 @@ fn read_answer(
     echo: bool,
 ) -> anyhow::Result<Option<Answer>> {
     loop {
-        let mut line = String::new();
-        if input.read_line(&mut line).context("reading the answer")? == 0 {
+        let mut bytes = Vec::new();
+        let limit = MAX_ANSWER_LINE_BYTES as u64 + 1;
+        let n = input
+            .by_ref()
+            .take(limit)
+            .read_until(b'\n', &mut bytes)
+            .context("reading the answer")?;
+        if n == 0 {
             if echo {
                 let _ = writeln!(prompt, "(end of input)");
             }
             return Ok(None);
         }
+        if n as u64 == limit && bytes.last() != Some(&b'\n') {
+            bail!(
+                "an answer line longer than {MAX_ANSWER_LINE_BYTES} bytes on standard input: \
+                 each answer is a line of its own (a, r, s, A or q); nothing written"
+            );
+        }
+        let line = String::from_utf8_lossy(&bytes);
         if echo {
-            let _ = writeln!(prompt, "{}", line.trim_end());
+            let _ = writeln!(prompt, "{}", escaped(line.trim_end()));
         }
         let answer = match line.trim() {
             "a" | "accept" | "y" | "yes" => Answer::Accept,
@@ -309,7 +364,8 @@ fn read_answer(
             other => {
                 let _ = write!(
                     prompt,
-                    "`{other}` is not an answer: a (accept), r (reject), s (skip), A (accept the rest), q (quit)? "
+                    "`{}` is not an answer: a (accept), r (reject), s (skip), A (accept the rest), q (quit)? ",
+                    escaped(other)
                 );
                 let _ = prompt.flush();
                 continue;

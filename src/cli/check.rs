@@ -10,7 +10,7 @@ use sweeptrace::engine::{EngineCommand, EngineOptions};
 use sweeptrace::replay::{Detail, ReplayOptions};
 use sweeptrace::suite::{
     Against, CheckOptions, DEFAULT_MAX_DETAILS, Status, TraceReport, check_file,
-    check_file_with_engine, find_traces, frames_around, render_json, render_text,
+    check_file_with_engine, discover, frames_around, render_json, render_text,
 };
 
 /// Frames of context logged before and after the divergences by `--rrd-on-failure`.
@@ -213,8 +213,27 @@ pub fn run(args: Args) -> anyhow::Result<Exit> {
         engine: args.conventions.clone(),
         ..args.tolerances.to_overrides()?
     };
-    let found = find_traces(&args.paths)?;
-    let traces = leave_out(found, &args.paths, args.no_config)?;
+    let found = discover(&args.paths)?;
+    if !found.dangling.is_empty() {
+        let list: Vec<String> = found
+            .dangling
+            .iter()
+            .map(|p| p.display().to_string())
+            .collect();
+        eprintln!(
+            "note: left out {} whose target does not exist: {}",
+            sweeptrace::numbers::counted(
+                found.dangling.len() as u64,
+                "symbolic link",
+                "symbolic links"
+            ),
+            listed(&list)
+        );
+    }
+    let found = found.traces;
+    let mut files =
+        super::check_config::SettingsFiles::new(args.no_config, args.config.as_deref())?;
+    let traces = leave_out(found, &args.paths, &mut files)?;
     if traces.is_empty() {
         bail!(
             "no trace found (directories are searched for *.mcap): {}",
@@ -225,8 +244,7 @@ pub fn run(args: Args) -> anyhow::Result<Exit> {
                 .join(", ")
         );
     }
-    let settings =
-        super::check_config::settings(&traces, &overrides, args.no_config, args.config.as_deref())?;
+    let settings = super::check_config::settings(&traces, &overrides, &mut files)?;
     if args.print_config {
         print!(
             "{}",
@@ -237,7 +255,7 @@ pub fn run(args: Args) -> anyhow::Result<Exit> {
     if !(args.ghost_degrees.is_finite() && (0.0..=180.0).contains(&args.ghost_degrees)) {
         bail!(
             "--ghost-degrees must be an angle from 0 to 180, got {}",
-            args.ghost_degrees
+            sweeptrace::numbers::Shortest(args.ghost_degrees)
         );
     }
     let options = CheckOptions {
@@ -293,6 +311,14 @@ pub fn run(args: Args) -> anyhow::Result<Exit> {
                         )
                     })?,
                 };
+                if let Some(fault) = report.margin_fault {
+                    let text = super::check_config::margin_fault(
+                        settings,
+                        &path.display().to_string(),
+                        &fault,
+                    );
+                    return Err((Exit::Error, text));
+                }
                 if report.status() == Status::Error {
                     let errors: Vec<String> = report
                         .errors
@@ -329,7 +355,7 @@ pub fn run(args: Args) -> anyhow::Result<Exit> {
     for (path, settings) in traces.iter().zip(&settings) {
         let started = std::time::Instant::now();
         let options = settings.check_options(options);
-        let report = match &engine {
+        let mut report = match &engine {
             None => check_file(path, &options),
             Some((command, engine_options)) => {
                 let against = match args.against {
@@ -346,6 +372,19 @@ pub fn run(args: Args) -> anyhow::Result<Exit> {
             }
         };
         times.push(started.elapsed());
+        // A margin that does not fit the balls is the setting's fault: one
+        // error naming where it was set, and the run stops (exit 2; with
+        // --json, the report of the trace holds the error).
+        let margin_fault = report.margin_fault;
+        if let Some(fault) = &margin_fault {
+            let text =
+                super::check_config::margin_fault(settings, &path.display().to_string(), fault);
+            if !args.json {
+                eprintln!("error: {text}");
+                return Ok(Exit::Error);
+            }
+            report.errors = vec![text];
+        }
         if !args.json {
             print!("{}", render_text(&report));
             super::junit::print_github_annotations(&report);
@@ -362,6 +401,9 @@ pub fn run(args: Args) -> anyhow::Result<Exit> {
             }
         }
         reports.push(report);
+        if margin_fault.is_some() {
+            break;
+        }
     }
     let outcome = Exit::worst(reports.iter().map(outcome_of));
     if args.json {
@@ -384,12 +426,12 @@ pub fn run(args: Args) -> anyhow::Result<Exit> {
 /// The traces of `found` to check: without the Foxglove files that
 /// `replay --foxglove` writes (MCAP files, but not traces) and, among the
 /// files found by searching a folder (not those named on the command
-/// line), those a `sweeptrace.toml`'s `exclude` globs leave out (unless
-/// `no_config`). Says once on stderr what it left out, and why.
+/// line), those the `exclude` globs of the run's settings `files` leave
+/// out. Says once on stderr what it left out, and why.
 fn leave_out(
     found: Vec<PathBuf>,
     named: &[PathBuf],
-    no_config: bool,
+    files: &mut super::check_config::SettingsFiles,
 ) -> anyhow::Result<Vec<PathBuf>> {
     let (mut traces, mut foxglove, mut excluded) = (Vec::new(), Vec::new(), Vec::new());
     for path in found {
@@ -397,8 +439,8 @@ fn leave_out(
             foxglove.push((path, trace));
             continue;
         }
-        if !no_config && !named.contains(&path) {
-            let by = sweeptrace::suite::excluded_by(&path)?;
+        if !named.contains(&path) {
+            let by = files.excluded_by(&path)?;
             if let Some((file, pattern)) = by {
                 excluded.push((path, file, pattern));
                 continue;
@@ -468,7 +510,10 @@ fn outcome_of(report: &TraceReport) -> Exit {
 /// The engine's options from `--engine-timeout`.
 pub fn engine_options(timeout_seconds: f64) -> anyhow::Result<EngineOptions> {
     if !(timeout_seconds.is_finite() && timeout_seconds > 0.0 && timeout_seconds <= 1e6) {
-        bail!("--engine-timeout must be a number of seconds in (0, 1e6], got {timeout_seconds}");
+        bail!(
+            "--engine-timeout must be a number of seconds in (0, 1e6], got {}",
+            sweeptrace::numbers::Shortest(timeout_seconds)
+        );
     }
     Ok(EngineOptions {
         timeout: std::time::Duration::from_secs_f64(timeout_seconds),

@@ -8,34 +8,84 @@ use std::path::{Path, PathBuf};
 
 use sweeptrace::suite::{self, Overrides, Settings};
 
-/// Each trace's settings, in the order of `traces`; with `no_config`, the
-/// defaults and the command line only; with `config`, that file instead of
-/// the ones found beside and above each trace. A configuration file that
-/// cannot be read or is invalid is an error naming it (and its line).
+/// Where a run's settings come from: the `sweeptrace.toml` files found
+/// beside and above each trace (each read once per run), one named file
+/// instead of them (`--config`: the files found are not read at all), or
+/// none (`--no-config`).
+#[derive(Debug)]
+pub enum SettingsFiles {
+    /// The files found beside and above each trace.
+    Found(suite::ConfigFiles),
+    /// `--config FILE`, read and parsed once (its path made absolute, so
+    /// that its globs meet the traces' absolute paths).
+    Named(Box<suite::ConfigFile>),
+    /// `--no-config`.
+    None,
+}
+
+impl SettingsFiles {
+    /// The files of a run: `no_config`, else `config`, else the ones found
+    /// per trace. A named file that cannot be read or is invalid is an
+    /// error naming it (and its line).
+    pub fn new(no_config: bool, config: Option<&Path>) -> anyhow::Result<SettingsFiles> {
+        Ok(match (no_config, config) {
+            (true, _) => SettingsFiles::None,
+            (false, Some(path)) => {
+                let absolute = absolute(path)?;
+                SettingsFiles::Named(Box::new(suite::ConfigFile::read(
+                    &absolute,
+                    &path.display().to_string(),
+                )?))
+            }
+            (false, None) => SettingsFiles::Found(suite::ConfigFiles::new()),
+        })
+    }
+
+    /// The settings of `trace`: the files, then `command_line`.
+    pub fn settings(&mut self, trace: &Path, command_line: &Overrides) -> anyhow::Result<Settings> {
+        Ok(match self {
+            SettingsFiles::None => suite::resolve(&[], trace, command_line),
+            SettingsFiles::Named(file) => suite::resolve(
+                std::slice::from_ref(&**file),
+                &absolute(trace)?,
+                command_line,
+            ),
+            SettingsFiles::Found(files) => files.settings_for(trace, command_line)?,
+        })
+    }
+
+    /// The `exclude` glob that leaves `trace` out of a search of a folder,
+    /// and the file that has it: the named file's own globs with
+    /// `--config`, none with `--no-config`.
+    pub fn excluded_by(&mut self, trace: &Path) -> anyhow::Result<Option<(String, String)>> {
+        Ok(match self {
+            SettingsFiles::None => None,
+            SettingsFiles::Named(file) => file
+                .excludes(&absolute(trace)?)
+                .map(|pattern| (file.name().to_string(), pattern.to_string())),
+            SettingsFiles::Found(files) => files.excluded_by(trace)?,
+        })
+    }
+}
+
+/// `path` made absolute against the working directory, normalized.
+fn absolute(path: &Path) -> anyhow::Result<PathBuf> {
+    let absolute = std::path::absolute(path)
+        .map_err(|e| anyhow::anyhow!("{}: cannot make the path absolute: {e}", path.display()))?;
+    Ok(suite::normalize(&absolute))
+}
+
+/// Each trace's settings, in the order of `traces`, from `files` and the
+/// command line. A configuration file that cannot be read or is invalid is
+/// an error naming it (and its line).
 pub fn settings(
     traces: &[PathBuf],
     command_line: &Overrides,
-    no_config: bool,
-    config: Option<&std::path::Path>,
+    files: &mut SettingsFiles,
 ) -> anyhow::Result<Vec<Settings>> {
-    let file = config
-        .map(|path| suite::ConfigFile::read(path, &path.display().to_string()))
-        .transpose()?;
     traces
         .iter()
-        .map(|trace| {
-            if no_config {
-                Ok(suite::resolve(&[], trace, command_line))
-            } else if let Some(file) = &file {
-                Ok(suite::resolve(
-                    std::slice::from_ref(file),
-                    trace,
-                    command_line,
-                ))
-            } else {
-                Ok(suite::settings_for(trace, command_line)?)
-            }
-        })
+        .map(|trace| files.settings(trace, command_line))
         .collect()
 }
 
@@ -80,13 +130,35 @@ pub fn for_trace(
         engine: conventions.clone(),
         ..Overrides::default()
     };
-    let mut all = settings(
-        &[trace.to_path_buf()],
-        &overrides,
-        config.no_config,
-        config.config.as_deref(),
-    )?;
-    Ok(all.pop().unwrap_or_default())
+    let mut files = SettingsFiles::new(config.no_config, config.config.as_deref())?;
+    files.settings(trace, &overrides)
+}
+
+/// The error of a margin given instead of the scenes' that is not smaller
+/// than a ball's radius in `trace`: a fault of the setting, named where it
+/// was set (`sweeptrace.toml:2: engine.margin = 0.3 ...`, `--engine-margin
+/// 0.3`, `--margin 0.3`), once, not the trace's nor each sweep's.
+pub fn margin_fault(
+    settings: &Settings,
+    trace: &str,
+    fault: &sweeptrace::suite::MarginFault,
+) -> String {
+    use sweeptrace::conventions::{Setting, Source};
+    use sweeptrace::numbers::Shortest;
+    let margin = Shortest(fault.margin);
+    let set = match &settings.engine.margin {
+        Some(Setting {
+            source: Source::File { file, line },
+            ..
+        }) => format!("{file}:{line}: engine.margin = {margin}"),
+        _ => format!("--engine-margin {margin}"),
+    };
+    format!(
+        "{set} must be smaller than the radius of every ball it applies to: {trace} has a ball of radius {} (frame {}, ball {}); stopped there",
+        Shortest(fault.radius),
+        fault.frame,
+        fault.ball
+    )
 }
 
 /// The line that says which conventions the answers were computed under,

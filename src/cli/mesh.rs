@@ -165,7 +165,7 @@ pub fn render_text(file: &str, reports: &[MeshReport]) -> String {
         let _ = writeln!(
             out,
             "mesh `{}` ({file}): {}, {} ({})",
-            r.name,
+            sweeptrace::error_text::escaped(&r.name),
             counted(r.triangles as u64, "triangle", "triangles"),
             counted(r.vertices as u64, "vertex", "vertices"),
             counted(

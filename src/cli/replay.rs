@@ -126,7 +126,8 @@ pub struct Args {
     /// Print the summary as one JSON object on stdout instead of text on
     /// stderr (sweeps, outcomes by kind, verdicts, expectations, fragile
     /// decisions, tunnels, the files written, time), e.g. `--json
-    /// --outcomes run.jsonl`. Not with `--outcomes -`, which has stdout.
+    /// --outcomes run.jsonl`. Not with `--outcomes -`, which has stdout. A
+    /// replay that fails prints one JSON object with the error.
     #[arg(long)]
     pub json: bool,
 }
@@ -153,9 +154,34 @@ impl<R: Read> Read for CountingReader<R> {
     }
 }
 
-/// Runs the replay: the options in, the outputs opened, the pipeline, the
-/// outputs finished, the summary printed.
+/// Runs the replay; with `--json`, a replay that fails still prints one
+/// JSON document, with the error (`check --json` gives its report with
+/// the errors too), and the error goes to stderr as without `--json`.
 pub fn run(args: Args) -> anyhow::Result<Exit> {
+    let json = args.json.then(|| args.trace.display().to_string());
+    let result = run_replay(args);
+    if let (Some(trace), Err(err)) = (json, &result) {
+        println!("{}", error_json(&trace, err));
+    }
+    result
+}
+
+/// `--json`'s document for a replay that failed: the trace, the status,
+/// the exit code and the error's text.
+fn error_json(trace: &str, err: &anyhow::Error) -> String {
+    let value = serde_json::json!({
+        "trace": trace,
+        "status": "error",
+        "exit_code": Exit::Error.exit_code(),
+        "error": format!("{err:#}"),
+    });
+    serde_json::to_string_pretty(&value)
+        .unwrap_or_else(|e| format!("{{\"error\": {:?}}}", e.to_string()))
+}
+
+/// The replay: the options in, the outputs opened, the pipeline, the
+/// outputs finished, the summary printed.
+fn run_replay(args: Args) -> anyhow::Result<Exit> {
     let started = Instant::now();
     let trace_path = &args.trace;
     let file = super::open_trace(trace_path)?;
@@ -242,7 +268,14 @@ pub fn run(args: Args) -> anyhow::Result<Exit> {
                 }
                 // The reader stops here; what was read is still replayed.
                 Err(ReplayError::Trace(err)) => trace_error = Some(err),
-                Err(err) => return Err(err).name_file_once("replaying", &source_name),
+                Err(err) => match sweeptrace::suite::MarginFault::of(&err) {
+                    Some(fault) => anyhow::bail!(super::check_config::margin_fault(
+                        &settings,
+                        &source_name,
+                        &fault
+                    )),
+                    None => return Err(err).name_file_once("replaying", &source_name),
+                },
             }
             Ok(())
         },

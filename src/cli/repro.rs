@@ -53,14 +53,11 @@ pub fn run(args: Args) -> anyhow::Result<Exit> {
         engine: args.conventions.clone(),
         ..args.tolerances.to_overrides()?
     };
-    let settings = super::check_config::settings(
-        std::slice::from_ref(&args.trace),
-        &overrides,
+    let settings = super::check_config::SettingsFiles::new(
         args.config.no_config,
         args.config.config.as_deref(),
     )?
-    .pop()
-    .unwrap_or_default();
+    .settings(&args.trace, &overrides)?;
     let tolerances = settings.tolerances();
     let conventions = settings.engine.conventions();
     if let Some(line) = super::check_config::conventions_line(&settings) {

@@ -16,7 +16,7 @@ use sweeptrace::replay::{
 };
 use sweeptrace::sim::load_obj;
 use sweeptrace::sim::scenes::BuiltinScene;
-use sweeptrace::suite::find_sweep;
+use sweeptrace::suite::{MarginFault, find_sweep};
 use sweeptrace::trace::{OutcomeMsg, TraceReader};
 
 /// Arguments of `sweep`.
@@ -103,6 +103,15 @@ pub fn run(args: Args) -> anyhow::Result<Exit> {
         let scene = found.options();
         settings = super::check_config::for_trace(path, &args.conventions, &args.config)?;
         let options = replay_options(&settings).core_options(scene.margin, scene.facing);
+        // A margin given instead of the scene's that does not fit the
+        // ball: the setting's fault, named where it was set.
+        let radius = found.core_sweep().radius;
+        if settings.engine.conventions().margin != sweeptrace::conventions::MarginRule::Scene
+            && options.margin >= radius
+        {
+            let fault = MarginFault::new(options.margin, radius, frame, args.ball);
+            anyhow::bail!(super::check_config::margin_fault(&settings, &shown, &fault));
+        }
         source = Some(format!(
             "trace {shown}, frame {frame}, ball {} (the trace's margin {}, facing {})",
             args.ball, found.scene.margin, found.scene.facing
@@ -114,11 +123,12 @@ pub fn run(args: Args) -> anyhow::Result<Exit> {
             (frame, args.ball),
             &settings.engine.conventions(),
         )?;
-        let name = found
-            .scene
-            .name
-            .clone()
-            .unwrap_or_else(|| "(unnamed)".into());
+        // The trace's text, shown on a terminal: its control characters
+        // escaped.
+        let name = found.scene.name.as_deref().map_or_else(
+            || "(unnamed)".into(),
+            |n| sweeptrace::error_text::escaped(n).into_owned(),
+        );
         (name, mesh, found.core_sweep(), options)
     } else {
         // clap lets `requires` pass when the required flag conflicts with

@@ -49,7 +49,7 @@ pub enum MeshError {
 #[non_exhaustive]
 pub enum SweepError {
     /// A coordinate or number is NaN or infinite.
-    #[error("`{field}` is not finite ({value})")]
+    #[error("`{field}` is not finite ({})", crate::numbers::Shortest(*.value))]
     NonFinite {
         /// The field (`p0`, `p1`, `radius`, `margin`).
         field: &'static str,
@@ -57,13 +57,17 @@ pub enum SweepError {
         value: f64,
     },
     /// The radius is zero or negative.
-    #[error("`radius` must be > 0, got {0}")]
+    #[error("`radius` must be > 0, got {}", crate::numbers::Shortest(*.0))]
     NonPositiveRadius(f64),
     /// The margin is negative.
-    #[error("`margin` must be ≥ 0, got {0}")]
+    #[error("`margin` must be ≥ 0, got {}", crate::numbers::Shortest(*.0))]
     NegativeMargin(f64),
     /// The margin is not smaller than the radius.
-    #[error("`margin` ({margin}) must be smaller than `radius` ({radius})")]
+    #[error(
+        "`margin` ({}) must be smaller than `radius` ({})",
+        crate::numbers::Shortest(*.margin),
+        crate::numbers::Shortest(*.radius)
+    )]
     MarginNotBelowRadius {
         /// The margin.
         margin: f64,

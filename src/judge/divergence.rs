@@ -117,13 +117,16 @@ pub fn value_text(v: &Value) -> String {
 /// [`value_text`] with every number in full (the shortest decimal that
 /// reads back to the same `f64`).
 pub fn value_text_exact(v: &Value) -> String {
-    text_with(v, |x| x.to_string())
+    text_with(v, crate::numbers::shortest)
 }
 
+/// `v` in words, its numbers by `number`; an integer (a triangle index, a
+/// feature) as the integer it is (`1000000`, not `1.0000e6`).
 fn text_with(v: &Value, number: fn(f64) -> String) -> String {
     match v {
         Value::Null => "null".to_string(),
-        Value::String(s) => s.clone(),
+        Value::String(s) => crate::error_text::escaped(s).into_owned(),
+        Value::Number(n) if n.is_u64() || n.is_i64() => n.to_string(),
         Value::Number(n) => n.as_f64().map(number).unwrap_or_else(|| n.to_string()),
         Value::Array(a) => format!(
             "[{}]",

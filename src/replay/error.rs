@@ -37,6 +37,26 @@ pub enum ReplayError {
         /// What is wrong.
         cause: SweepError,
     },
+    /// The margin the options impose on every scene (an engine's declared
+    /// margin, `--margin`) is not smaller than a sweep's radius: a fault of
+    /// that setting, not of the trace (every ball that small fails alike).
+    #[error(
+        "frame {frame}, ball {ball} (message {index}): the margin {} given instead of the scene's must be smaller than the ball's radius {}",
+        crate::numbers::Shortest(*.margin),
+        crate::numbers::Shortest(*.radius)
+    )]
+    MarginOverride {
+        /// Frame.
+        frame: u64,
+        /// Ball.
+        ball: u32,
+        /// Index of the sweep message.
+        index: u64,
+        /// The margin given.
+        margin: f64,
+        /// The sweep's radius.
+        radius: f64,
+    },
     /// The trace could not be read further.
     /// (Boxed: a trace error is large, and results pass through here.)
     #[error(transparent)]

@@ -5,11 +5,11 @@ use std::collections::{HashMap, VecDeque};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
-use crate::conventions::EngineConventions;
+use crate::conventions::{EngineConventions, MarginRule};
 use crate::core::explain::nearest_miss;
 use crate::core::{
     Broadphase, CollectRecords, EdgeClass, Feature, Mesh, Observer, Options, Outcome, SkipCounts,
-    Sweep, TestRecord, Topology, VerdictCounts, sweep_mesh, sweep_mesh_with,
+    Sweep, SweepError, TestRecord, Topology, VerdictCounts, sweep_mesh, sweep_mesh_with,
 };
 use crate::trace::{EventBody, EventHeader, OutcomeMsg, SceneMsg, SweepMsg, TraceEvent};
 
@@ -546,11 +546,25 @@ pub fn compute_sweep(
 ) -> Result<ComputedSweep, ReplayError> {
     let start = Instant::now();
     let sweep = Sweep::new(msg.p0, msg.p1, msg.radius);
-    let err = |cause| ReplayError::Sweep {
-        frame: msg.frame,
-        ball: msg.ball,
-        index,
-        cause,
+    let err = |cause| match cause {
+        // The margin was given (not the scene's): the setting's fault.
+        SweepError::MarginNotBelowRadius { margin, radius }
+            if options.conventions.margin != MarginRule::Scene =>
+        {
+            ReplayError::MarginOverride {
+                frame: msg.frame,
+                ball: msg.ball,
+                index,
+                margin,
+                radius,
+            }
+        }
+        cause => ReplayError::Sweep {
+            frame: msg.frame,
+            ball: msg.ball,
+            index,
+            cause,
+        },
     };
     let mut verdicts = VerdictCounts::default();
     let mut skipped = SkipCounts::default();

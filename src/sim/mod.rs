@@ -157,14 +157,17 @@ impl SimOptions {
                 "time_step",
                 format!(
                     "must lie in [{MIN_TIME_STEP}, {MAX_TIME_STEP}] seconds, got {}",
-                    self.time_step
+                    numbers::Shortest(self.time_step)
                 ),
             );
         }
         if !(0.0..=1.0).contains(&self.restitution) {
             return invalid(
                 "restitution",
-                format!("must lie in [0, 1], got {}", self.restitution),
+                format!(
+                    "must lie in [0, 1], got {}",
+                    numbers::Shortest(self.restitution)
+                ),
             );
         }
         if self.position_jitter < 0.0 || self.velocity_jitter < 0.0 {
@@ -173,7 +176,10 @@ impl SimOptions {
         if !(0.0..=1e-3).contains(&self.separation) {
             return invalid(
                 "separation",
-                format!("must lie in [0, 1e-3], got {}", self.separation),
+                format!(
+                    "must lie in [0, 1e-3], got {}",
+                    numbers::Shortest(self.separation)
+                ),
             );
         }
         if self.frames > MAX_FRAMES {

@@ -23,6 +23,13 @@ pub enum ObjError {
         /// The cause.
         cause: std::io::Error,
     },
+    /// The file is larger than an OBJ file this reads
+    /// ([`MAX_OBJ_BYTES`]): not read further (`/dev/zero`, a wrong file).
+    #[error("{path} is larger than {} MiB: not a Wavefront OBJ file this reads", MAX_OBJ_BYTES >> 20)]
+    TooLarge {
+        /// The file.
+        path: String,
+    },
     /// The OBJ parser refused the file.
     #[error("{path} is not a valid Wavefront OBJ file: {reason}")]
     Parse {
@@ -38,6 +45,10 @@ pub enum ObjError {
         path: String,
     },
 }
+
+/// The largest Wavefront OBJ file read (256 MiB: some millions of
+/// triangles); a larger input is an error, not a read without end.
+pub const MAX_OBJ_BYTES: u64 = 256 * 1024 * 1024;
 
 /// Loads a Wavefront OBJ file (through `tobj`) as a scene named after the
 /// file's stem. Polygons are triangulated as fans; every object and group
@@ -59,6 +70,13 @@ pub fn load_obj(path: &std::path::Path) -> Result<SceneMesh, ObjError> {
         ObjError::NoTriangles { .. } => ObjError::NoTriangles {
             path: shown.clone(),
         },
+        ObjError::Io { cause, .. } => ObjError::Io {
+            path: shown.clone(),
+            cause,
+        },
+        ObjError::TooLarge { .. } => ObjError::TooLarge {
+            path: shown.clone(),
+        },
         other => other,
     })?;
     scene.name = path
@@ -71,13 +89,20 @@ pub fn load_obj(path: &std::path::Path) -> Result<SceneMesh, ObjError> {
 /// the source `<input>`, and a parse error its line (`line 2 (`v 1 zero
 /// 0`): ...`).
 pub fn obj_from_reader(reader: &mut impl std::io::BufRead) -> Result<SceneMesh, ObjError> {
+    use std::io::Read;
     let mut text = Vec::new();
     reader
+        .take(MAX_OBJ_BYTES + 1)
         .read_to_end(&mut text)
         .map_err(|cause| ObjError::Io {
             path: "<input>".into(),
             cause,
         })?;
+    if text.len() as u64 > MAX_OBJ_BYTES {
+        return Err(ObjError::TooLarge {
+            path: "<input>".into(),
+        });
+    }
     match parse(&text) {
         Err(ObjError::Parse { path, reason }) => {
             let reason = match first_failing_line(&text) {

@@ -48,7 +48,8 @@ use crate::engine::{
 };
 use crate::error_text::full_text;
 use crate::replay::{
-    FrameRange, ReplayError, ReplayEvent, ReplayOptions, SweepResult, replay_events,
+    FrameRange, ReplayError, ReplayEvent, ReplayOptions, Selection, SweepExtent, SweepResult,
+    replay_events,
 };
 use crate::trace::{
     EXPECTED_SOURCE_METADATA, EXPECTED_TOPIC, Encoding, ExpectedSource, MAX_NAME_BYTES,
@@ -119,6 +120,15 @@ pub enum BlessError {
         field: String,
         /// What is wrong with it.
         problem: String,
+    },
+    /// A selection (`--frames`, `--ball`, `--accept`) that selects no
+    /// sweep of the trace: nothing is written.
+    #[error("{file}: {selection}; nothing written")]
+    NothingSelected {
+        /// The input's name.
+        file: String,
+        /// The selection and what the trace holds.
+        selection: Selection,
     },
     /// A `/sweep` message found in the copy pass has no outcome from the
     /// replay pass (the replay and the copy disagree on the file).
@@ -206,6 +216,32 @@ pub enum BlessSelection {
 }
 
 impl BlessSelection {
+    /// The selection in words (`frames 100..200, ball 1`, `sweeps 12:0,
+    /// 40:3`); `None` for every sweep.
+    pub fn text(&self) -> Option<String> {
+        match self {
+            BlessSelection::All => None,
+            BlessSelection::Range { frames, ball } => ReplayOptions {
+                frames: *frames,
+                ball: *ball,
+                ..ReplayOptions::default()
+            }
+            .filter_text(),
+            BlessSelection::Sweeps(set) => {
+                const LISTED: usize = 8;
+                let mut list: Vec<String> = set
+                    .iter()
+                    .take(LISTED)
+                    .map(|(frame, ball)| format!("{frame}:{ball}"))
+                    .collect();
+                if set.len() > LISTED {
+                    list.push(format!("and {} more", set.len() - LISTED));
+                }
+                Some(format!("sweeps {}", list.join(", ")))
+            }
+        }
+    }
+
     /// Whether the sweep `(frame, ball)` gets a new expectation.
     pub fn selects(&self, frame: u64, ball: u32) -> bool {
         match self {
@@ -272,6 +308,8 @@ struct Collected {
     blessed: u64,
     kept: u64,
     sweeps: u64,
+    /// The trace's frames and balls, for a selection that selects none.
+    seen: SweepExtent,
 }
 
 impl Collected {
@@ -288,6 +326,7 @@ impl Collected {
         match event {
             Ok(ReplayEvent::Sweep(r)) => {
                 self.sweeps += 1;
+                self.seen.add(r.frame, r.ball);
                 let answer = answer(&r)?;
                 let written = if select.selects(r.frame, r.ball) {
                     self.blessed += 1;
@@ -410,6 +449,20 @@ fn outcomes_of(input: &[u8], name: &str, options: &BlessOptions) -> Result<Repla
                 return Err(BlessError::Engine { cause });
             }
         }
+    }
+    // A selection that selects no sweep would rewrite the trace for
+    // nothing: an error naming what the trace holds, as a filter of
+    // `check` or `replay` that keeps nothing.
+    if collected.blessed == 0
+        && let Some(filter) = options.select.text()
+    {
+        return Err(BlessError::NothingSelected {
+            file: name.to_string(),
+            selection: Selection::Nothing {
+                filter,
+                seen: collected.seen,
+            },
+        });
     }
     let replaced = reader.expected_source().cloned();
     let mut source = match &options.engine {

@@ -21,8 +21,8 @@ use crate::trace::{EXPECTED_TOPIC, EventBody, TraceError, TraceEvent, TraceReade
 use super::ghost_count::count_ghosts;
 use super::infer::{ComparedSweep, MAX_INFERENCE_SWEEPS, infer};
 use super::report::{
-    Judged, KindChange, MAX_DIVERGENT_FRAMES, MAX_ERRORS, MAX_LISTED_TUNNELS, TraceReport,
-    TunnelReport, WithinPrecision,
+    Judged, KindChange, MAX_DIVERGENT_FRAMES, MAX_ERRORS, MAX_LISTED_TUNNELS, MarginFault,
+    TraceReport, TunnelReport, WithinPrecision,
 };
 use crate::judge::divergence_details;
 use crate::judge::{Agreement, agreement};
@@ -178,7 +178,15 @@ where
                 let judged = judge(&result);
                 report.sweep(&result, judged);
             }
-            Err(err) => report.error(&err),
+            // A margin that does not fit the balls fails every sweep
+            // alike: one error, and the check of the trace stops.
+            Err(err) => match MarginFault::of(&err) {
+                Some(fault) => {
+                    report.margin_fault(fault);
+                    break;
+                }
+                None => report.error(&err),
+            },
         }
     }
     let summary = replay.summary();
@@ -363,6 +371,19 @@ impl<'a> ReportBuilder<'a> {
         if divergences.details.len() < self.options.max_details {
             divergences.details.push(details(fields));
         }
+    }
+
+    /// A margin given instead of the scenes' that does not fit a ball:
+    /// the report's one error.
+    fn margin_fault(&mut self, fault: MarginFault) {
+        self.report.errors = vec![format!(
+            "frame {}, ball {}: the margin {} given instead of the scene's must be smaller than the ball's radius {}",
+            fault.frame,
+            fault.ball,
+            crate::numbers::Shortest(fault.margin),
+            crate::numbers::Shortest(fault.radius)
+        )];
+        self.report.margin_fault = Some(fault);
     }
 
     /// What the replay could not do.

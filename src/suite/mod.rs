@@ -41,13 +41,13 @@ pub use check::{
 };
 pub use config::excluded_by;
 pub use config::{
-    ConfigError, ConfigFile, Overrides, Settings, normalize, render_settings_json,
+    ConfigError, ConfigFile, ConfigFiles, Overrides, Settings, normalize, render_settings_json,
     render_settings_text, resolve, settings_for,
 };
 pub use diff::{
     DiffReport, FirstDifference, Side, diff, render_diff_json, render_diff_text, scene_differences,
 };
-pub use discovery::{DiscoveryError, find_traces};
+pub use discovery::{Discovered, DiscoveryError, discover, find_traces};
 pub use engine_check::check_file_with_engine;
 pub use infer::{Inferred, Spread};
 pub use infer_conventions::{Evidence, InferredConventions, Trial, infer_conventions};
@@ -55,6 +55,6 @@ pub use junit::{check_junit, github_annotations};
 pub use render::{render_json, render_text};
 pub use report::{
     Against, Divergences, EngineCheck, Expectations, Fragile, Ghosts, KindChange,
-    MAX_LISTED_TUNNELS, Status, TraceReport, TunnelReport, Tunnels, WithinPrecision,
+    MAX_LISTED_TUNNELS, MarginFault, Status, TraceReport, TunnelReport, Tunnels, WithinPrecision,
 };
 pub use repro::{ReproCase, ReproError, TraceSweep, find_sweep};

@@ -250,6 +250,60 @@ pub struct TraceReport {
     /// With `check --engine` and `against` `core` the report's
     /// expectations are the engine's answers instead (`engine`).
     pub expected_source: Option<crate::trace::ExpectedSource>,
+    /// The margin given instead of the scenes' (an engine's declared
+    /// margin) is not smaller than a ball's radius: the check of the trace
+    /// stopped at the first such sweep, with one error. A fault of the
+    /// setting, which the command line names.
+    #[serde(skip)]
+    pub margin_fault: Option<MarginFault>,
+}
+
+/// A margin given instead of the scenes' that is not smaller than a
+/// sweep's radius ([`TraceReport::margin_fault`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[non_exhaustive]
+pub struct MarginFault {
+    /// The margin given.
+    pub margin: f64,
+    /// The radius of the first sweep it does not fit.
+    pub radius: f64,
+    /// That sweep's frame.
+    pub frame: u64,
+    /// That sweep's ball.
+    pub ball: u32,
+}
+
+impl MarginFault {
+    /// The fault of `margin` against the sweep of `ball` at `frame`, of
+    /// radius `radius`.
+    pub fn new(margin: f64, radius: f64, frame: u64, ball: u32) -> MarginFault {
+        MarginFault {
+            margin,
+            radius,
+            frame,
+            ball,
+        }
+    }
+
+    /// The fault a replay error reports, if it is one
+    /// ([`ReplayError::MarginOverride`](crate::replay::ReplayError::MarginOverride)).
+    pub fn of(err: &crate::replay::ReplayError) -> Option<MarginFault> {
+        match *err {
+            crate::replay::ReplayError::MarginOverride {
+                frame,
+                ball,
+                margin,
+                radius,
+                ..
+            } => Some(MarginFault {
+                margin,
+                radius,
+                frame,
+                ball,
+            }),
+            _ => None,
+        }
+    }
 }
 
 /// A report's divergences on fragile decisions that rounding explains: a

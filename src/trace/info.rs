@@ -253,7 +253,7 @@ fn write_scenes(out: &mut String, info: &TraceInfo) {
         let name = scene
             .name
             .as_deref()
-            .map(|n| format!("`{n}`"))
+            .map(|n| format!("`{}`", crate::error_text::escaped(n)))
             .unwrap_or_else(|| "(unnamed)".to_string());
         let _ = write!(
             out,

@@ -226,8 +226,9 @@ pub fn validate_sweep(sweep: &SweepMsg, scene_margin: Option<f64>) -> Result<(),
         return Err(FieldProblem::new(
             "radius",
             format!(
-                "must be larger than the scene's margin {margin}, got {}",
-                sweep.radius
+                "must be larger than the scene's margin {}, got {}",
+                numbers::Shortest(margin),
+                numbers::Shortest(sweep.radius)
             ),
         ));
     }
@@ -251,7 +252,10 @@ pub fn validate_outcome(outcome: &OutcomeMsg) -> Result<(), FieldProblem> {
     if !(0.0..=1.0).contains(&outcome.alpha) {
         return Err(FieldProblem::new(
             "alpha",
-            format!("must be a number in [0, 1], got {}", outcome.alpha),
+            format!(
+                "must be a number in [0, 1], got {}",
+                numbers::Shortest(outcome.alpha)
+            ),
         ));
     }
     if let Some(Some(feature)) = outcome.feature

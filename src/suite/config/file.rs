@@ -1,14 +1,17 @@
 //! One `sweeptrace.toml`: parsed, validated, its values located by line
 //! and column.
 
+use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
 use serde::Deserialize;
 use toml::Spanned;
 
+use super::glob::{Pattern, Patterns};
 use super::normalize;
 use super::settings::{Layer, Settings};
 use crate::conventions::{Setting, Source};
+use crate::error_text::escaped;
 use crate::judge::{Field, FieldSet};
 use crate::numbers::{self, Rule};
 
@@ -38,27 +41,57 @@ pub enum ConfigError {
     },
 }
 
+/// The largest settings file read (64 MiB; a large suite's file with
+/// tens of thousands of `[[traces]]` blocks is a few MiB).
+pub const MAX_CONFIG_BYTES: u64 = 64 * 1024 * 1024;
+
 // ------------------------------------------------------------ the file
 
 /// The file as written: every key optional, unknown keys refused.
 #[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
+#[serde(deny_unknown_fields, expecting = "a table of settings")]
 struct RawFile {
     fields: Option<Spanned<Vec<Spanned<String>>>>,
     strict: Option<Spanned<bool>>,
     allow_tunnels: Option<Spanned<bool>>,
     tolerances: Option<RawTolerances>,
     exclude: Option<Spanned<Vec<Spanned<String>>>>,
-    /// `[engine]`: the engine's conventions (top level only: one engine
-    /// per file), read key by key into the conventions' partial type.
-    engine: Option<std::collections::BTreeMap<Spanned<String>, Spanned<toml::Value>>>,
+    engine: Option<RawEngine>,
     #[serde(default)]
     traces: Vec<RawBlock>,
 }
 
+/// `[engine]`: the engine's conventions (top level only: one engine per
+/// file), read key by key into the conventions' partial type
+/// ([`crate::conventions::PartialConventions::set`]).
+struct RawEngine(BTreeMap<Spanned<String>, Spanned<toml::Value>>);
+
+impl<'de> Deserialize<'de> for RawEngine {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        struct Table;
+        impl<'de> serde::de::Visitor<'de> for Table {
+            type Value = RawEngine;
+            fn expecting(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+                f.write_str("the `[engine]` table")
+            }
+            fn visit_map<A: serde::de::MapAccess<'de>>(
+                self,
+                mut map: A,
+            ) -> Result<RawEngine, A::Error> {
+                let mut keys = BTreeMap::new();
+                while let Some((key, value)) = map.next_entry()? {
+                    keys.insert(key, value);
+                }
+                Ok(RawEngine(keys))
+            }
+        }
+        d.deserialize_map(Table)
+    }
+}
+
 /// A `[[traces]]` block: a glob and the keys of the top level.
 #[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
+#[serde(deny_unknown_fields, expecting = "a `[[traces]]` table")]
 struct RawBlock {
     #[serde(rename = "match")]
     pattern: Spanned<String>,
@@ -70,18 +103,11 @@ struct RawBlock {
 
 /// `[tolerances]`.
 #[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
+#[serde(deny_unknown_fields, expecting = "the `[tolerances]` table")]
 struct RawTolerances {
     alpha: Option<Spanned<f64>>,
     normal_degrees: Option<Spanned<f64>>,
     contact: Option<Spanned<f64>>,
-}
-
-/// A `[[traces]]` block, its glob compiled.
-#[derive(Clone, Debug)]
-struct TracesBlock {
-    matcher: globset::GlobMatcher,
-    layer: Layer,
 }
 
 /// One parsed and validated `sweeptrace.toml`.
@@ -90,36 +116,61 @@ pub struct ConfigFile {
     path: PathBuf,
     name: String,
     top: Layer,
-    blocks: Vec<TracesBlock>,
+    /// The `[[traces]]` blocks' globs, and each block's layer (in the
+    /// file's order).
+    patterns: Patterns,
+    blocks: Vec<Layer>,
     /// `exclude`: the globs (as written, and compiled) of the files a
     /// search of a folder leaves out.
-    exclude: Vec<(String, globset::GlobMatcher)>,
+    exclude: Vec<(String, Pattern)>,
 }
 
-/// Reads a file's text, line by line, to turn byte offsets into places.
+/// A file's text and where each of its lines starts, to turn byte
+/// offsets into places (a binary search per place, not a count of the
+/// lines before it: a file with many keys parses in linear time).
 struct Places<'a> {
     text: &'a str,
     name: &'a str,
+    /// The byte offset of each line's start, ascending (the first is 0).
+    line_starts: Vec<usize>,
 }
 
-impl Places<'_> {
+impl<'a> Places<'a> {
+    fn new(text: &'a str, name: &'a str) -> Places<'a> {
+        let line_starts = std::iter::once(0)
+            .chain(text.match_indices('\n').map(|(i, _)| i + 1))
+            .collect();
+        Places {
+            text,
+            name,
+            line_starts,
+        }
+    }
+
     /// 1-based line and column (in characters) of byte `offset`.
     fn at(&self, offset: usize) -> (usize, usize) {
-        let before = &self.text[..offset.min(self.text.len())];
-        let line = before.matches('\n').count() + 1;
-        let column = before.rsplit('\n').next().map_or(0, |l| l.chars().count()) + 1;
-        (line, column)
+        let offset = offset.min(self.text.len());
+        // The last line that starts at or before `offset`.
+        let line = self.line_starts.partition_point(|&start| start <= offset);
+        let start = self.line_starts[line - 1];
+        let column = self
+            .text
+            .get(start..offset)
+            .map_or(0, |before| before.chars().count());
+        (line, column + 1)
     }
 
     fn line<T>(&self, value: &Spanned<T>) -> usize {
         self.at(value.span().start).0
     }
 
+    /// The error `message` at `value`'s place. The message quotes the
+    /// file's text: its control characters are escaped.
     fn error<T>(&self, value: &Spanned<T>, message: String) -> ConfigError {
         ConfigError::Invalid {
             file: self.name.to_string(),
             at: Some(self.at(value.span().start)),
-            message,
+            message: escaped(&message).into_owned(),
         }
     }
 
@@ -177,13 +228,9 @@ impl Places<'_> {
 
     /// `[engine]`'s keys into `layer`, each value checked against its set
     /// ([`crate::conventions::PartialConventions::set`]).
-    fn engine(
-        &self,
-        raw: &std::collections::BTreeMap<Spanned<String>, Spanned<toml::Value>>,
-        layer: &mut Layer,
-    ) -> Result<(), ConfigError> {
+    fn engine(&self, raw: &RawEngine, layer: &mut Layer) -> Result<(), ConfigError> {
         // In the order of the file, so that the first fault is reported.
-        let mut keys: Vec<_> = raw.iter().collect();
+        let mut keys: Vec<_> = raw.0.iter().collect();
         keys.sort_by_key(|(k, _)| k.span().start);
         for (key, value) in keys {
             let text = match value.get_ref() {
@@ -254,7 +301,7 @@ impl ConfigFile {
     /// `name` (a shorter form of `path`, such as one relative to the
     /// working directory).
     pub fn parse_named(text: &str, path: &Path, name: &str) -> Result<ConfigFile, ConfigError> {
-        let places = Places { text, name };
+        let places = Places::new(text, name);
         let raw: RawFile = toml::from_str(text).map_err(|e| ConfigError::Invalid {
             file: name.to_string(),
             at: e.span().map(|s| places.at(s.start)),
@@ -271,51 +318,62 @@ impl ConfigFile {
         }
         let mut blocks = Vec::with_capacity(raw.traces.len());
         let glob = |key: &str, pattern: &Spanned<String>| {
-            globset::GlobBuilder::new(pattern.get_ref())
-                .literal_separator(true)
-                .build()
-                .map(|g| g.compile_matcher())
-                .map_err(|e| {
-                    places.error(
-                        pattern,
-                        format!(
-                            "`{key}`: `{}` is not a glob: {}",
-                            pattern.get_ref(),
-                            e.kind()
-                        ),
-                    )
-                })
+            Pattern::new(pattern.get_ref()).map_err(|e| {
+                places.error(
+                    pattern,
+                    format!(
+                        "`{key}`: `{}` is not a glob: {}",
+                        pattern.get_ref(),
+                        e.kind()
+                    ),
+                )
+            })
         };
         let mut exclude = Vec::new();
         for pattern in raw.exclude.as_ref().map_or(&[][..], |l| l.get_ref()) {
             exclude.push((pattern.get_ref().clone(), glob("exclude", pattern)?));
         }
+        let mut patterns = Patterns::default();
         for block in &raw.traces {
-            let pattern = &block.pattern;
-            let matcher = glob("match", pattern)?;
+            patterns.push(glob("match", &block.pattern)?);
             let layer = places.layer(
                 &block.fields,
                 &block.strict,
                 &block.allow_tunnels,
                 &block.tolerances,
             )?;
-            blocks.push(TracesBlock { matcher, layer });
+            blocks.push(layer);
         }
         Ok(ConfigFile {
             path: path.to_path_buf(),
             name: name.to_string(),
             top,
+            patterns,
             blocks,
             exclude,
         })
     }
 
     /// Reads and parses the file at `path`, named `name` in messages.
+    /// A file larger than [`MAX_CONFIG_BYTES`] is an error, not a read
+    /// without end.
     pub fn read(path: &Path, name: &str) -> Result<ConfigFile, ConfigError> {
-        let text = std::fs::read_to_string(path).map_err(|e| ConfigError::Read {
+        use std::io::Read;
+        let cannot_read = |cause: String| ConfigError::Read {
             file: name.to_string(),
-            cause: e.to_string(),
-        })?;
+            cause,
+        };
+        let file = std::fs::File::open(path).map_err(|e| cannot_read(e.to_string()))?;
+        let mut text = String::new();
+        file.take(MAX_CONFIG_BYTES + 1)
+            .read_to_string(&mut text)
+            .map_err(|e| cannot_read(e.to_string()))?;
+        if text.len() as u64 > MAX_CONFIG_BYTES {
+            return Err(cannot_read(format!(
+                "larger than {} MiB: not a settings file",
+                MAX_CONFIG_BYTES >> 20
+            )));
+        }
         ConfigFile::parse_named(&text, path, name)
     }
 
@@ -353,25 +411,48 @@ impl ConfigFile {
     /// `[[traces]]` blocks that match the trace, in order.
     pub(super) fn apply(&self, trace: &Path, settings: &mut Settings) {
         self.top.apply(settings);
-        if self.blocks.is_empty() {
+        if self.patterns.is_empty() {
             return;
         }
         let Some(relative) = self.relative(trace) else {
             return;
         };
-        for block in &self.blocks {
-            if block.matcher.is_match(&relative) {
-                block.layer.apply(settings);
-            }
+        for i in self.patterns.matching(&relative) {
+            self.blocks[i].apply(settings);
         }
     }
 }
 
-/// toml's message in the file's vocabulary: TOML has keys, not fields.
+/// toml's message in the file's vocabulary (TOML has keys, not fields),
+/// on one line, the file's text it quotes with its control characters
+/// escaped.
 fn toml_message(message: &str) -> String {
-    message
+    let message = message
         .trim()
         .replace("unknown field", "unknown key")
         .replace("missing field", "missing key")
-        .replace('\n', "; ")
+        .replace('\n', "; ");
+    escaped(&message).into_owned()
+}
+
+#[cfg(test)]
+mod places_tests {
+    use super::Places;
+
+    /// The line index gives the places counting the lines before each
+    /// offset gives (the former way, quadratic over a file's keys), on
+    /// every character boundary of a text with blank lines, a last line
+    /// without a newline and characters of several bytes.
+    #[test]
+    fn line_index_gives_the_places_counting_gives() {
+        let text = "a = 1\n\n[[traces]]\nmatch = \"é/ü*.mcap\"\n  x = \"→\"\r\nlast";
+        let places = Places::new(text, "t.toml");
+        for offset in (0..=text.len()).filter(|&i| text.is_char_boundary(i)) {
+            let before = &text[..offset];
+            let line = before.matches('\n').count() + 1;
+            let column = before.rsplit('\n').next().map_or(0, |l| l.chars().count()) + 1;
+            assert_eq!(places.at(offset), (line, column), "offset {offset}");
+        }
+        assert_eq!(places.at(text.len() + 10), places.at(text.len()));
+    }
 }

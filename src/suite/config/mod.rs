@@ -42,11 +42,14 @@
 //! ([`ConfigError`]).
 
 mod file;
+mod glob;
 mod settings;
 #[cfg(test)]
 mod tests;
 
+use std::collections::HashMap;
 use std::path::{Component, Path, PathBuf};
+use std::sync::Arc;
 
 pub use file::{ConfigError, ConfigFile};
 use settings::Layer;
@@ -59,10 +62,19 @@ pub const CONFIG_FILE_NAME: &str = "sweeptrace.toml";
 /// [`find_config_files`] gives them; the farthest applies first), then the
 /// command line. Pure. `trace` and the files' paths must be in the same
 /// frame (both absolute, or both relative to one folder) for the
-/// `[[traces]]` globs to match; [`load_config_files`] gives absolute paths.
+/// `[[traces]]` globs to match; [`ConfigFiles`] gives absolute paths.
 pub fn resolve(files: &[ConfigFile], trace: &Path, command_line: &Overrides) -> Settings {
+    resolve_in(files.iter(), trace, command_line)
+}
+
+/// [`resolve`] over files held elsewhere (nearest first).
+fn resolve_in<'a>(
+    files: impl DoubleEndedIterator<Item = &'a ConfigFile>,
+    trace: &Path,
+    command_line: &Overrides,
+) -> Settings {
     let mut settings = Settings::default();
-    for file in files.iter().rev() {
+    for file in files.rev() {
         file.apply(trace, &mut settings);
     }
     Layer::of_command_line(command_line).apply(&mut settings);
@@ -112,33 +124,11 @@ pub fn find_config_files(trace: &Path) -> Result<Vec<PathBuf>, ConfigError> {
     Ok(found)
 }
 
-/// The configuration files of `trace` ([`find_config_files`]), read and
-/// parsed, each named relative to the working directory when under it.
-pub fn load_config_files(trace: &Path) -> Result<Vec<ConfigFile>, ConfigError> {
-    let cwd = std::env::current_dir().ok().map(|d| normalize(&d));
-    find_config_files(trace)?
-        .into_iter()
-        .map(|path| {
-            let shown = cwd
-                .as_ref()
-                .and_then(|cwd| path.strip_prefix(cwd).ok())
-                .unwrap_or(&path)
-                .display()
-                .to_string();
-            ConfigFile::read(&path, &shown)
-        })
-        .collect()
-}
-
 /// The settings of `trace` from its configuration files
-/// ([`load_config_files`]) and the command line.
+/// ([`ConfigFiles::of`]) and the command line; [`ConfigFiles`] reads each
+/// file once for many traces.
 pub fn settings_for(trace: &Path, command_line: &Overrides) -> Result<Settings, ConfigError> {
-    let files = load_config_files(trace)?;
-    let absolute = std::path::absolute(trace).map_err(|e| ConfigError::Read {
-        file: trace.display().to_string(),
-        cause: e.to_string(),
-    })?;
-    Ok(resolve(&files, &absolute, command_line))
+    ConfigFiles::new().settings_for(trace, command_line)
 }
 
 /// The `exclude` glob that leaves `trace` out of a search of a folder, and
@@ -147,12 +137,94 @@ pub fn settings_for(trace: &Path, command_line: &Overrides) -> Result<Settings, 
 /// the nearest file's globs first, then the farther ones'. Globs are
 /// relative to their file's folder.
 pub fn excluded_by(trace: &Path) -> Result<Option<(String, String)>, ConfigError> {
-    let absolute = std::path::absolute(trace).map_err(|e| ConfigError::Read {
-        file: trace.display().to_string(),
-        cause: e.to_string(),
-    })?;
-    Ok(load_config_files(trace)?.iter().find_map(|file| {
-        file.excludes(&absolute)
-            .map(|pattern| (file.name().to_string(), pattern.to_string()))
-    }))
+    ConfigFiles::new().excluded_by(trace)
+}
+
+/// The configuration files of a run over many traces, each found, read
+/// and parsed once: the traces of one folder share their files, and a file
+/// above many folders is parsed once for all of them. A file that changes
+/// during the run is not read again.
+#[derive(Debug, Default)]
+pub struct ConfigFiles {
+    /// The files of each folder holding a trace (nearest first), by the
+    /// folder's absolute, normalized path.
+    by_folder: HashMap<PathBuf, Vec<Arc<ConfigFile>>>,
+    /// Each file parsed, by its absolute, normalized path.
+    parsed: HashMap<PathBuf, Arc<ConfigFile>>,
+}
+
+impl ConfigFiles {
+    /// An empty cache.
+    pub fn new() -> ConfigFiles {
+        ConfigFiles::default()
+    }
+
+    /// The configuration files of `trace` ([`find_config_files`]), nearest
+    /// first, each named relative to the working directory when under it.
+    pub fn of(&mut self, trace: &Path) -> Result<Vec<Arc<ConfigFile>>, ConfigError> {
+        let absolute = absolute(trace)?;
+        let folder = absolute.parent().unwrap_or(Path::new("")).to_path_buf();
+        if let Some(files) = self.by_folder.get(&folder) {
+            return Ok(files.clone());
+        }
+        let cwd = std::env::current_dir().ok().map(|d| normalize(&d));
+        let mut files = Vec::new();
+        for path in find_config_files(&absolute)? {
+            if let Some(file) = self.parsed.get(&path) {
+                files.push(file.clone());
+                continue;
+            }
+            let shown = cwd
+                .as_ref()
+                .and_then(|cwd| path.strip_prefix(cwd).ok())
+                .unwrap_or(&path)
+                .display()
+                .to_string();
+            let file = Arc::new(ConfigFile::read(&path, &shown)?);
+            self.parsed.insert(path, file.clone());
+            files.push(file);
+        }
+        self.by_folder.insert(folder, files.clone());
+        Ok(files)
+    }
+
+    /// How many files were read and parsed so far.
+    pub fn parsed(&self) -> usize {
+        self.parsed.len()
+    }
+
+    /// The settings of `trace` from its configuration files
+    /// ([`ConfigFiles::of`]) and the command line.
+    pub fn settings_for(
+        &mut self,
+        trace: &Path,
+        command_line: &Overrides,
+    ) -> Result<Settings, ConfigError> {
+        let files = self.of(trace)?;
+        Ok(resolve_in(
+            files.iter().map(|f| &**f),
+            &absolute(trace)?,
+            command_line,
+        ))
+    }
+
+    /// The `exclude` glob that leaves `trace` out of a search of a folder,
+    /// and the configuration file that has it ([`excluded_by`]).
+    pub fn excluded_by(&mut self, trace: &Path) -> Result<Option<(String, String)>, ConfigError> {
+        let absolute = absolute(trace)?;
+        Ok(self.of(&absolute)?.iter().find_map(|file| {
+            file.excludes(&absolute)
+                .map(|pattern| (file.name().to_string(), pattern.to_string()))
+        }))
+    }
+}
+
+/// `path` made absolute (against the working directory) and normalized.
+fn absolute(path: &Path) -> Result<PathBuf, ConfigError> {
+    std::path::absolute(path)
+        .map(|p| normalize(&p))
+        .map_err(|e| ConfigError::Read {
+            file: path.display().to_string(),
+            cause: e.to_string(),
+        })
 }

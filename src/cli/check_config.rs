@@ -174,3 +174,17 @@ pub fn conventions_line(settings: &Settings) -> Option<String> {
         settings.engine.declared_sources().join(", ")
     ))
 }
+
+/// A replay error in words (always an `Err`): a declared margin that does
+/// not fit a ball named where it was declared, any other naming the trace.
+pub fn replay_error(
+    err: sweeptrace::replay::ReplayError,
+    settings: &sweeptrace::suite::Settings,
+    source_name: &str,
+) -> anyhow::Result<()> {
+    use super::NameFileOnce as _;
+    match sweeptrace::suite::MarginFault::of(&err) {
+        Some(fault) => anyhow::bail!(margin_fault(settings, source_name, &fault)),
+        None => Err(err).name_file_once("replaying", source_name),
+    }
+}

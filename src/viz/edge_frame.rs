@@ -17,7 +17,7 @@ use rerun::components::{
 };
 use rerun::{Arrows3D, Capsules3D, LineStrips3D, Points3D, Transform3D};
 
-use super::columns::Row;
+use super::columns::row::Row;
 use super::convert::{
     AXIS_COLORS, CYLINDER_COLOR, EDGE_COLOR, HIT_COLOR, MISS_COLOR, PATH_COLOR, any_value, f32x3,
     quaternion, rgba, ui_points,

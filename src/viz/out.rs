@@ -7,7 +7,7 @@ use rerun::Clear;
 use rerun::components::ClearIsRecursive;
 
 use super::MAX_EDGE_FRAMES;
-use super::columns::{self, Row};
+use super::columns::{self, row::Row};
 use super::paths::Entity;
 use crate::judge::Tolerances;
 

@@ -14,7 +14,7 @@ use rerun::{
     Transform3D,
 };
 
-use super::columns::Row;
+use super::columns::row::Row;
 use super::convert::{
     BOLD_EDGE_POINTS, CONTACT_BALL_COLOR, EXPECTED_COLOR, FACE_NORMAL_COLOR, GHOST_COLOR,
     HIT_COLOR, MISS_COLOR, NORMAL_COLOR, OUTLINE_POINTS, P0_COLOR, P1_COLOR, SWEEP_COLOR,

@@ -33,6 +33,7 @@ pub fn tests() -> Vec<Trial> {
         trial!(binary_writes_case_and_test),
         trial!(repro_honours_the_declared_conventions),
         trial!(alpha0_always_accepts_a_start_within_rho_moving_away),
+        trial!(rrd_on_failure_marks_divergences_under_the_declared_conventions),
         trial!(sweep_from_trace_and_obj),
         trial!(sweep_flag_errors),
         trial!(infer_wrong_engine_config_margin_0),
@@ -509,6 +510,77 @@ fn alpha0_always_accepts_a_start_within_rho_moving_away() -> anyhow::Result<()> 
             "--initial-overlap {value}: exit {code}\n{out}{err}"
         );
     }
+    Ok(())
+}
+
+/// Issue 44: `check --rrd-on-failure` records the frames around a failure
+/// judged as the check judged them. Frame 0 starts within ρ and its
+/// expectation is the hit at α = 0 that `initial_overlap = "alpha0"` (the
+/// trace's table) gives; frame 1's expectation is wrong under any table.
+/// The recording marks only frame 1 as divergent; with `--no-config` (the
+/// rules) it marks both.
+fn rrd_on_failure_marks_divergences_under_the_declared_conventions() -> anyhow::Result<()> {
+    use sweeptrace::core::{InitialOverlap, Options};
+    let dir = tempfile::tempdir()?;
+    let scene = scene_t(0.0);
+    let mesh = Mesh::new(scene.vertices.clone(), &scene.triangles)?;
+    let start_within = SweepMsg {
+        frame: 0,
+        ball: 0,
+        radius: 0.5,
+        p0: [0.5, 0.5, 0.25],
+        p1: [0.5, 0.5, -1.0],
+    };
+    let square = SweepMsg {
+        frame: 1,
+        p0: [1.0, 1.0, 3.0],
+        p1: [1.0, 1.0, -3.0],
+        ..start_within
+    };
+    let alpha0 = Options {
+        initial_overlap: InitialOverlap::Alpha0,
+        ..Options::default()
+    };
+    let sweep = |s: &SweepMsg| Sweep::new(s.p0, s.p1, s.radius);
+    let first = sweep_mesh(&mesh, &sweep(&start_within), &alpha0)?;
+    let trace = dir.path().join("marks.mcap");
+    let mut w = TraceWriter::new(Cursor::new(Vec::new()))?;
+    w.scene(0, &scene)?;
+    w.sweep(1, &start_within)?;
+    w.expected(1, &OutcomeMsg::from_outcome(0, 0, &first))?;
+    w.sweep(2, &square)?;
+    w.expected(2, &OutcomeMsg::miss(1, 0))?;
+    std::fs::write(&trace, w.finish()?.into_inner())?;
+    std::fs::write(
+        dir.path().join("sweeptrace.toml"),
+        "[engine]\ninitial_overlap = \"alpha0\"\n",
+    )?;
+    let marked = |extra: &[&str]| -> anyhow::Result<Vec<i64>> {
+        let out = dir.path().join(format!("rrd{}", extra.len()));
+        let mut args = os![
+            "check",
+            trace.as_os_str(),
+            "--rrd-on-failure",
+            out.as_os_str()
+        ]
+        .to_vec();
+        args.extend(extra.iter().map(std::ffi::OsStr::new));
+        let (code, stdout, stderr) = run_bin(&args)?;
+        ensure!(code == 1, "{args:?}: exit {code}\n{stdout}{stderr}");
+        let decoded = crate::replay::decode_rrd(&out.join("marks.rrd"))?;
+        Ok(decoded
+            .texts
+            .iter()
+            .filter(|((entity, _), _)| entity.trim_start_matches('/') == "divergences")
+            .flat_map(|(_, by_frame)| by_frame.keys().copied())
+            .collect::<std::collections::BTreeSet<_>>()
+            .into_iter()
+            .collect())
+    };
+    let under_table = marked(&[])?;
+    ensure!(under_table == [1], "under the table: {under_table:?}");
+    let under_rules = marked(&["--no-config"])?;
+    ensure!(under_rules == [0, 1], "under the rules: {under_rules:?}");
     Ok(())
 }
 

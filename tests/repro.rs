@@ -510,6 +510,32 @@ fn alpha0_always_accepts_a_start_within_rho_moving_away() -> anyhow::Result<()> 
             "--initial-overlap {value}: exit {code}\n{out}{err}"
         );
     }
+    // The seeded bug it must still catch: the same answer for a ball that
+    // starts beyond ρ (0.75 above the plane) is no start in contact.
+    let beyond = dir.path().join("beyond.mcap");
+    let mut w = TraceWriter::new(Cursor::new(Vec::new()))?;
+    w.scene(0, &scene)?;
+    w.sweep(
+        1,
+        &SweepMsg {
+            p0: [0.5, 0.5, 0.75],
+            ..sweep
+        },
+    )?;
+    w.expected(1, &hit)?;
+    std::fs::write(&beyond, w.finish()?.into_inner())?;
+    let b = beyond.as_os_str();
+    let (code, out, err) = run_bin(os![
+        "check",
+        b,
+        "--no-config",
+        "--initial-overlap",
+        "alpha0_always"
+    ])?;
+    ensure!(
+        code == 1,
+        "a start beyond ρ passes: exit {code}\n{out}{err}"
+    );
     Ok(())
 }
 

@@ -365,19 +365,18 @@ impl ReproCase {
                 expected,
             )
         };
-        let agreement_on =
-            |mesh: &Mesh, under: &Under<'_>, outcome: Outcome, expected: Option<OutcomeMsg>| {
-                expected.map(|e| agreement(&e, &result_on(mesh, under, outcome, Some(e)), tol))
-            };
-        let full_agreement = agreement_on(&mesh, &under, outcome, found.expected);
-        let reduced_agreement =
-            agreement_on(&reduced, &reduced_under, reduced_outcome_local, expected);
-        // At single precision the numbers are asserted within the sweep's
-        // own bound, as the judge widens them.
+        // The whole scene's result once: its agreement and, at single
+        // precision, the sweep's own bound the numbers are asserted within
+        // (as the judge widens them).
+        let full = result_on(&mesh, &under, outcome, found.expected);
+        let full_agreement = found.expected.map(|e| agreement(&e, &full, tol));
+        let reduced_agreement = expected.map(|e| {
+            let r = result_on(&reduced, &reduced_under, reduced_outcome_local, Some(e));
+            agreement(&e, &r, tol)
+        });
         let asserted_tolerances = match conventions.precision {
             Precision::F64 => *tol,
-            Precision::F32 => Sensitivity::of(&result_on(&mesh, &under, outcome, found.expected))
-                .map_or(*tol, |s| s.widen(tol, F32_OPERATIONS)),
+            Precision::F32 => Sensitivity::of(&full).map_or(*tol, |s| s.widen(tol, F32_OPERATIONS)),
         };
         Ok(ReproCase {
             source: trace.to_string(),

@@ -29,34 +29,13 @@ pub fn tests() -> Vec<Trial> {
     ]
 }
 
-const REQUIRE_NODE: &str = "SWEEPTRACE_REQUIRE_NODE";
+/// The engine command, or the reason to skip.
+fn rapier() -> anyhow::Result<Result<String, Completion>> {
+    crate::support::node_engine("rapier-js", "@dimforge/rapier3d-compat")
+}
 
 fn root() -> std::path::PathBuf {
     std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-}
-
-/// The engine command, or the reason to skip.
-fn rapier() -> anyhow::Result<Result<String, Completion>> {
-    let dir = root().join("examples/engines/rapier-js");
-    let installed = dir.join("node_modules/@dimforge/rapier3d-compat").is_dir();
-    let missing = match std::process::Command::new("node").arg("--version").output() {
-        Ok(o) if o.status.success() && installed => None,
-        Ok(o) if o.status.success() => Some(
-            "examples/engines/rapier-js has no node_modules (run `npm ci --prefix \
-             examples/engines/rapier-js`)"
-                .to_string(),
-        ),
-        _ => Some("node cannot be run".to_string()),
-    };
-    match missing {
-        None => Ok(Ok(format!("node {}", dir.join("engine.js").display()))),
-        Some(m) if std::env::var_os(REQUIRE_NODE).is_some_and(|v| v == "1") => {
-            anyhow::bail!("{m}, and {REQUIRE_NODE}=1 requires it")
-        }
-        Some(m) => Ok(Err(Completion::ignored_with(format!(
-            "skipped: {m}; {REQUIRE_NODE}=1 makes this a failure"
-        )))),
-    }
 }
 
 fn config() -> String {

@@ -409,3 +409,35 @@ pub fn close_tests(out: &str) -> Vec<&str> {
         .take_while(|l| l.starts_with("  "))
         .collect()
 }
+
+/// The command of the Node example engine in `examples/engines/NAME`
+/// (`node …/engine.js`) when node runs and its `package` is installed;
+/// otherwise the reason to skip, or an error under
+/// `SWEEPTRACE_REQUIRE_NODE=1` (CI installs them).
+pub fn node_engine(
+    name: &str,
+    package: &str,
+) -> anyhow::Result<Result<String, libtest_mimic::Completion>> {
+    const REQUIRE_NODE: &str = "SWEEPTRACE_REQUIRE_NODE";
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("examples/engines")
+        .join(name);
+    let installed = dir.join("node_modules").join(package).is_dir();
+    let missing = match std::process::Command::new("node").arg("--version").output() {
+        Ok(o) if o.status.success() && installed => None,
+        Ok(o) if o.status.success() => Some(format!(
+            "examples/engines/{name} has no node_modules (run `npm ci --prefix \
+             examples/engines/{name}`)"
+        )),
+        _ => Some("node cannot be run".to_string()),
+    };
+    match missing {
+        None => Ok(Ok(format!("node {}", dir.join("engine.js").display()))),
+        Some(m) if std::env::var_os(REQUIRE_NODE).is_some_and(|v| v == "1") => {
+            anyhow::bail!("{m}, and {REQUIRE_NODE}=1 requires it")
+        }
+        Some(m) => Ok(Err(libtest_mimic::Completion::ignored_with(format!(
+            "skipped: {m}; {REQUIRE_NODE}=1 makes this a failure"
+        )))),
+    }
+}

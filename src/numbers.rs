@@ -172,6 +172,17 @@ pub fn verb<'a>(n: u64, one: &'a str, many: &'a str) -> &'a str {
     if n == 1 { one } else { many }
 }
 
+/// A budget in words: `2^12` for a power of two of 32 or more, else the
+/// shortest decimal (`4`, `0.5`, `100`).
+pub fn power_of_two_text(x: f64) -> String {
+    let exponent = x.log2();
+    if x >= 32.0 && x.is_finite() && exponent.fract() == 0.0 {
+        format!("2^{exponent}")
+    } else {
+        shortest(x)
+    }
+}
+
 /// `n` and the word for that many: `1 vertex`, `3 vertices`.
 pub fn counted(n: u64, one: &str, many: &str) -> String {
     format!("{n} {}", if n == 1 { one } else { many })

@@ -210,6 +210,7 @@ mod tests {
             fragile: 0,
             within_precision: 0,
             strict: true,
+            conventions: Default::default(),
             error: Some("the engine exited\nits last stderr line".to_string()),
         };
         let xml = conform_junit(

@@ -190,6 +190,10 @@ pub struct ConformReport {
     pub within_precision: u64,
     /// Whether fragile divergences fail.
     pub strict: bool,
+    /// The declared conventions (for the words of the summary; not in the
+    /// JSON).
+    #[serde(skip)]
+    pub conventions: EngineConventions,
     /// A fault of the engine, if any (the cases before it are reported).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub error: Option<String>,
@@ -376,6 +380,7 @@ pub fn run(
         fragile: 0,
         within_precision: 0,
         strict: options.strict,
+        conventions: options.conventions,
         error: None,
     };
     let replay = replay_events(
@@ -574,8 +579,14 @@ pub fn render_text(r: &ConformReport) -> String {
         r.fragile,
         if r.within_precision > 0 {
             format!(
-                ", {} within single precision (the engine's declared f32 arithmetic: not failures)",
-                r.within_precision
+                ", {} within {}",
+                r.within_precision,
+                if r.conventions.accuracy.is_some() {
+                    format!("{}: not failures", r.conventions.within_words())
+                } else {
+                    "single precision (the engine's declared f32 arithmetic: not failures)"
+                        .to_string()
+                }
             )
         } else {
             String::new()

@@ -230,6 +230,92 @@ impl FacingRule {
     }
 }
 
+/// The backward-error budget an engine is held to, in units of `u₃₂ · S`
+/// (`accuracy` in the `[engine]` table): single precision's own is
+/// [`F32_BUDGET`]; a calibrated engine declares less (what it showed when
+/// known good), an engine whose solver is coarser than its arithmetic more.
+#[derive(Clone, Copy, Debug, PartialEq, PartialOrd)]
+pub struct Accuracy(f64);
+
+/// Single precision's backward-error budget `c`, in units of `u₃₂ · S`:
+/// what a single-precision engine spends on one sweep, when no `accuracy`
+/// is declared. Its inputs are rounded to
+/// `f32` (1 unit each); a compressed mesh stores its vertices on a grid of
+/// 2²¹ steps across its bounds (Jolt's `MeshShape`: 8 units); the cast
+/// transforms the inputs into the shape's space and runs a few dozen
+/// operations on them, each rounding by 1 unit of its own magnitude, of
+/// which a handful add up along one direction. 16 covers those with room
+/// to spare; a real error of the engine (a contact 0.2 % late on a sweep
+/// that meets the surface squarely) is hundreds of units.
+pub const F32_BUDGET: f64 = 16.0;
+
+/// The largest accuracy that can be declared, `2²⁰` units: beyond it the
+/// inputs would move by more than a 16th of the scene's scale, and nothing
+/// would be judged.
+pub const MAX_ACCURACY: f64 = 1_048_576.0;
+
+impl Accuracy {
+    /// A budget of `units`, which must be as [`Accuracy`]'s parser takes
+    /// (clamped into `(0, 2²⁰]` otherwise).
+    pub fn new(units: f64) -> Accuracy {
+        Accuracy(if units > 0.0 { units.min(MAX_ACCURACY) } else { 1.0 })
+    }
+
+    /// The budget, in units of `u₃₂ · S`.
+    pub fn units(self) -> f64 {
+        self.0
+    }
+
+    /// In words, for reports: `2^12 u₃₂·S, coarser than single precision
+    /// explains (16)`, or `4 u₃₂·S, calibrated below single precision's 16`.
+    pub fn words(self) -> String {
+        let size = crate::numbers::power_of_two_text(self.0);
+        if self.0 > F32_BUDGET {
+            format!(
+                "{size} u₃₂·S, coarser than single precision explains ({}): the engine's \
+                 solver tolerance",
+                F32_BUDGET
+            )
+        } else if self.0 < F32_BUDGET {
+            format!("{size} u₃₂·S, calibrated below single precision's {F32_BUDGET}")
+        } else {
+            format!("{size} u₃₂·S, single precision's own")
+        }
+    }
+}
+
+impl fmt::Display for Accuracy {
+    /// The number as TOML writes it (`4096`, `0.5`).
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        if self.0.fract() == 0.0 {
+            write!(f, "{}", self.0 as u64)
+        } else {
+            write!(f, "{:?}", self.0)
+        }
+    }
+}
+
+impl std::str::FromStr for Accuracy {
+    type Err = String;
+    /// A finite number `> 0` and at most [`MAX_ACCURACY`].
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        let a = crate::numbers::parse_f64(s).ok_or_else(|| format!("`{s}` is not a number"))?;
+        if !(a.is_finite() && a > 0.0 && a <= MAX_ACCURACY) {
+            return Err(format!(
+                "`{s}` is not a budget: it takes a number of u32 units of the sweep's scale, \
+                 greater than 0 and at most 2^20 (single precision's own is 16)"
+            ));
+        }
+        Ok(Accuracy(a))
+    }
+}
+
+impl Serialize for Accuracy {
+    fn serialize<S: serde::Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        serializer.serialize_f64(self.0)
+    }
+}
+
 /// What an engine does where it departs from the rules: every key of the
 /// `[engine]` table. The default is the rules.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
@@ -248,9 +334,35 @@ pub struct EngineConventions {
     pub normal: NormalRule,
     /// Which member of a tie it may name.
     pub ties: TieRule,
+    /// The backward-error budget it is held to, when declared (otherwise
+    /// single precision's, [`F32_BUDGET`], under `precision = "f32"`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub accuracy: Option<Accuracy>,
 }
 
 impl EngineConventions {
+    /// The backward-error budget the judgement holds answers to, in units
+    /// of `u₃₂ · S`: the declared accuracy, else [`F32_BUDGET`] under
+    /// `precision = "f32"`; `None`: no backward error, the fixed
+    /// tolerances (the rules at `f64`).
+    pub fn budget(&self) -> Option<f64> {
+        match (self.accuracy, self.precision) {
+            (Some(a), _) => Some(a.units()),
+            (None, Precision::F32) => Some(F32_BUDGET),
+            (None, Precision::F64) => None,
+        }
+    }
+
+    /// What the differences an answer is excused for are within, in words:
+    /// `single precision`, or `the declared accuracy (2^12 u₃₂·S, coarser
+    /// than single precision explains (16): the engine's solver tolerance)`.
+    pub fn within_words(&self) -> String {
+        match self.accuracy {
+            None => "single precision".to_string(),
+            Some(a) => format!("the declared accuracy ({})", a.words()),
+        }
+    }
+
     /// Whether these are the rules (no convention declared).
     pub fn is_rules(&self) -> bool {
         *self == EngineConventions::default()
@@ -281,6 +393,9 @@ impl EngineConventions {
         }
         if self.ties != rules.ties {
             out.push(("ties", format!("\"{}\"", self.ties)));
+        }
+        if let Some(a) = self.accuracy {
+            out.push(("accuracy", a.to_string()));
         }
         out
     }
@@ -413,6 +528,7 @@ mod tests {
             initial_overlap: InitialOverlap::Alpha0,
             normal: NormalRule::ActiveEdges,
             ties: TieRule::Any,
+            accuracy: Some(Accuracy(4096.0)),
         };
         let replay = crate::replay::ReplayOptions {
             conventions: c,
@@ -431,7 +547,13 @@ mod tests {
         assert_eq!(
             c.summary(),
             "precision f32, margin 0.0, facing non_strict, sides two, initial_overlap alpha0, \
-             normal active_edges, ties any"
+             normal active_edges, ties any, accuracy 4096"
+        );
+        assert_eq!(c.budget(), Some(4096.0));
+        assert_eq!(
+            c.flags().join(" "),
+            "--precision f32 --engine-margin 0.0 --engine-facing non_strict --sides two \
+             --initial-overlap alpha0 --normal active_edges --ties any --accuracy 4096"
         );
         assert_eq!(
             c.replaces("margin.inside-band/0").as_deref(),
@@ -469,6 +591,42 @@ mod tests {
         let one = EngineConventions::default();
         assert_eq!(one.replaces("face.miss.back-facing/0"), None);
         assert_eq!(one.replaces("edge.miss.back-facing/0"), None);
+    }
+
+    #[test]
+    fn the_budget_is_the_accuracy_else_single_precisions() {
+        let rules = EngineConventions::default();
+        assert_eq!(rules.budget(), None);
+        let f32 = EngineConventions {
+            precision: Precision::F32,
+            ..rules
+        };
+        assert_eq!(f32.budget(), Some(F32_BUDGET));
+        let calibrated = EngineConventions {
+            accuracy: Some("4".parse().unwrap()),
+            ..f32
+        };
+        assert_eq!(calibrated.budget(), Some(4.0));
+        assert_eq!(calibrated.summary(), "precision f32, accuracy 4");
+        // A declared accuracy judges by backward error at any precision.
+        let coarse = EngineConventions {
+            accuracy: Some("0.5".parse().unwrap()),
+            ..rules
+        };
+        assert_eq!(coarse.budget(), Some(0.5));
+        assert_eq!(coarse.declared(), vec![("accuracy", "0.5".to_string())]);
+        for bad in ["0", "-4", "nan", "inf", "1e7", "some"] {
+            assert!(bad.parse::<Accuracy>().is_err(), "{bad}");
+        }
+        assert_eq!(
+            Accuracy(4096.0).words(),
+            "2^12 u₃₂·S, coarser than single precision explains (16): the engine's solver \
+             tolerance"
+        );
+        assert_eq!(
+            Accuracy(4.0).words(),
+            "4 u₃₂·S, calibrated below single precision's 16"
+        );
     }
 
     #[test]

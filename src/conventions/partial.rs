@@ -10,7 +10,7 @@ use std::str::FromStr;
 
 use serde::Serialize;
 
-use super::{EngineConventions, FacingRule, MarginRule, NormalRule, Precision, TieRule};
+use super::{Accuracy, EngineConventions, FacingRule, MarginRule, NormalRule, Precision, TieRule};
 use crate::core::{InitialOverlap, Sides};
 
 /// Where a setting came from.
@@ -61,7 +61,7 @@ impl<T> Setting<T> {
 }
 
 /// The keys of the `[engine]` table, in the table's order.
-pub const KEYS: [&str; 7] = [
+pub const KEYS: [&str; 8] = [
     "precision",
     "margin",
     "facing",
@@ -69,6 +69,7 @@ pub const KEYS: [&str; 7] = [
     "initial_overlap",
     "normal",
     "ties",
+    "accuracy",
 ];
 
 /// The `[engine]` table's keys as one layer declares them (`None`: not
@@ -129,6 +130,13 @@ pub struct PartialConventions {
     /// with its own contact and normal) [default: rule].
     #[cfg_attr(feature = "cli", arg(long, value_name = "rule|any", value_parser = one_of::<TieRule>(), help_heading = "Engine conventions"))]
     pub ties: Option<Setting<TieRule>>,
+    /// The backward-error budget the engine is held to, in u32 units of
+    /// the sweep's scale: less than 16 for an engine calibrated when known
+    /// good (`--infer-config` proposes it), more for a solver coarser than
+    /// its arithmetic. Judges by backward error at any precision
+    /// [default: 16 under --precision f32].
+    #[cfg_attr(feature = "cli", arg(long, value_name = "UNITS", value_parser = given::<Accuracy>, help_heading = "Engine conventions"))]
+    pub accuracy: Option<Setting<Accuracy>>,
 }
 
 /// The parser of a flag whose values are a closed set: a typo is an error
@@ -193,6 +201,12 @@ impl PartialConventions {
             "initial_overlap" => self.initial_overlap = at(named(key, text)?, source),
             "normal" => self.normal = at(named(key, text)?, source),
             "ties" => self.ties = at(named(key, text)?, source),
+            "accuracy" => {
+                let accuracy = text
+                    .parse::<Accuracy>()
+                    .map_err(|e| format!("`engine.accuracy` is {e}"))?;
+                self.accuracy = at(accuracy, source);
+            }
             _ => {
                 return Err(format!(
                     "unknown key `{key}`, expected one of {}",
@@ -217,6 +231,7 @@ impl PartialConventions {
         set(&mut self.initial_overlap, &over.initial_overlap);
         set(&mut self.normal, &over.normal);
         set(&mut self.ties, &over.ties);
+        set(&mut self.accuracy, &over.accuracy);
     }
 
     /// The conventions: each declared key's value, the rules' elsewhere.
@@ -233,12 +248,13 @@ impl PartialConventions {
             initial_overlap: or(&self.initial_overlap, rules.initial_overlap),
             normal: or(&self.normal, rules.normal),
             ties: or(&self.ties, rules.ties),
+            accuracy: self.accuracy.as_ref().map(|s| s.value),
         }
     }
 
     /// Where each key came from, in the table's order ([`Source::Default`]
     /// where no layer declares it).
-    pub fn sources(&self) -> [Source; 7] {
+    pub fn sources(&self) -> [Source; 8] {
         fn of<T>(s: &Option<Setting<T>>) -> Source {
             s.as_ref().map_or(Source::Default, |s| s.source.clone())
         }
@@ -250,6 +266,7 @@ impl PartialConventions {
             of(&self.initial_overlap),
             of(&self.normal),
             of(&self.ties),
+            of(&self.accuracy),
         ]
     }
 
@@ -276,7 +293,9 @@ impl PartialConventions {
     }
 
     /// Each key as `(key, value as TOML writes it, its value as JSON,
-    /// source)`, in the table's order, the rules' values where undeclared.
+    /// source)`, in the table's order, the rules' values where undeclared;
+    /// `accuracy` only where answers are judged by backward error (its
+    /// default single precision's budget).
     pub fn entries(&self) -> Vec<(&'static str, String, serde_json::Value, Source)> {
         let c = self.conventions();
         let quoted = |s: &dyn fmt::Display| format!("\"{s}\"");
@@ -291,10 +310,18 @@ impl PartialConventions {
             ),
             (quoted(&c.normal), serde_json::json!(c.normal)),
             (quoted(&c.ties), serde_json::json!(c.ties)),
+            match c.budget() {
+                Some(units) => (
+                    crate::numbers::shortest(units),
+                    serde_json::json!(units),
+                ),
+                None => (String::new(), serde_json::Value::Null),
+            },
         ];
         KEYS.into_iter()
             .zip(texts)
             .zip(self.sources())
+            .filter(|((key, _), _)| *key != "accuracy" || c.budget().is_some())
             .map(|((key, (toml, json)), source)| (key, toml, json, source))
             .collect()
     }

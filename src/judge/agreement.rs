@@ -7,9 +7,9 @@ use crate::trace::OutcomeMsg;
 
 use super::compare::{Field, FieldDiff, NOT_A_UNIT_VECTOR, Tolerances, compare};
 use super::perturbation::{Reproduced, Rounding, reproduce};
-use super::precision::{F32_OPERATIONS, Sensitivity};
+use super::precision::Sensitivity;
 use super::reference::Decision;
-use crate::conventions::{Precision, TieRule};
+use crate::conventions::TieRule;
 
 /// How an answer stands against an expectation: the one judgement.
 #[derive(Clone, Debug, PartialEq)]
@@ -33,8 +33,8 @@ pub enum Agreement {
         /// The fields that differ beyond the fixed tolerances.
         fields: Vec<FieldDiff>,
         /// The backward error, in units of `u₃₂ · S`: the smallest move of
-        /// the inputs that explains the difference (at most
-        /// [`F32_OPERATIONS`]).
+        /// the inputs that explains the difference (at most the budget,
+        /// [`crate::conventions::EngineConventions::budget`]).
         backward_error: f64,
         /// When a discrete field differs: the perturbation under which the
         /// core gives each side's answer.
@@ -113,18 +113,11 @@ impl Agreement {
 /// reproduces an answer, smallest first, is the one reported.
 ///
 /// The judgement is under the conventions `result` was computed under
-/// ([`crate::replay::SceneState::conventions`]): at their precision, with
-/// their tie rule.
+/// ([`crate::replay::SceneState::conventions`]): at their precision and
+/// accuracy (the backward-error budget), with their tie rule.
 pub fn agreement(expected: &OutcomeMsg, result: &SweepResult, tol: &Tolerances) -> Agreement {
-    let precision = result.scene.conventions.precision;
-    judge(
-        expected,
-        &result.outcome_msg(),
-        true,
-        result,
-        tol,
-        precision,
-    )
+    let budget = result.scene.conventions.budget();
+    judge(expected, &result.outcome_msg(), true, result, tol, budget)
 }
 
 /// Judges `expected` against another answer `got` to the same sweep (an
@@ -137,21 +130,22 @@ pub fn agreement_of(
     result: &SweepResult,
     tol: &Tolerances,
 ) -> Agreement {
-    let precision = result.scene.conventions.precision;
-    judge(expected, got, false, result, tol, precision)
+    let budget = result.scene.conventions.budget();
+    judge(expected, got, false, result, tol, budget)
 }
 
 /// The judgement of [`agreement`] (`got` the core's own outcome,
-/// `got_is_core`) or [`agreement_of`] at `precision` rather than the
+/// `got_is_core`) or [`agreement_of`] with the backward-error `budget`
+/// (units of `u₃₂ · S`; `None`: the fixed tolerances) rather than the
 /// declared one: what a check under the rules asks of single precision
 /// ([`super::ConventionHints`]).
 pub(crate) fn agreement_at(
     (expected, got, got_is_core): (&OutcomeMsg, &OutcomeMsg, bool),
     result: &SweepResult,
     tol: &Tolerances,
-    precision: Precision,
+    budget: Option<f64>,
 ) -> Agreement {
-    judge(expected, got, got_is_core, result, tol, precision)
+    judge(expected, got, got_is_core, result, tol, budget)
 }
 
 fn judge(
@@ -160,20 +154,19 @@ fn judge(
     got_is_core: bool,
     result: &SweepResult,
     tol: &Tolerances,
-    precision: Precision,
+    budget: Option<f64>,
 ) -> Agreement {
     let fields = compare(expected, got, tol);
     if fields.is_empty() {
         return Agreement::Match;
     }
     let fragile = result.outcome.fragile;
-    // Single precision: the tolerances widened to this sweep's backward
-    // error bound (computed only here, for a sweep that differs).
-    let sensitivity = match precision {
-        Precision::F64 => None,
-        Precision::F32 => Sensitivity::of(result).map(|s| s.observing(expected, got, tol)),
-    };
-    let widened = sensitivity.map(|s| s.widen(tol, F32_OPERATIONS));
+    // By backward error (single precision, or a declared accuracy): the
+    // tolerances widened to this sweep's bound at the budget (computed
+    // only here, for a sweep that differs).
+    let sensitivity = budget
+        .and_then(|_| Sensitivity::of(result).map(|s| s.observing(expected, got, tol)));
+    let widened = sensitivity.zip(budget).map(|(s, c)| s.widen(tol, c));
     let fixed = tol;
     let tol_judged = widened.as_ref().unwrap_or(tol);
     if let Some(s) = &sensitivity
@@ -195,7 +188,7 @@ fn judge(
     if got_is_core
         && values_only
         && fragile.is_robust()
-        && precision == Precision::F64
+        && budget.is_none()
         && result.scene.conventions.ties == TieRule::Rule
     {
         return Agreement::Diverges {
@@ -227,13 +220,14 @@ fn judge(
         (true, Some(named)) => named.clone(),
         _ => fields,
     };
-    if precision == Precision::F32 {
-        // Single precision: any decision is as fragile as f32's budget; a
+    if let Some(budget) = budget {
+        // By backward error: any decision is as fragile as the budget; a
         // perturbation spends part of it, and the rest is what the
         // continuous fields may still differ by.
         let rounding = Rounding::F32 {
             fixed,
             sensitivity: sensitivity.as_ref(),
+            budget,
         };
         return match reproduce(
             expected,

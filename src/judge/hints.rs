@@ -17,7 +17,6 @@ use crate::trace::OutcomeMsg;
 use super::agreement::agreement_at;
 use super::compare::{Field, FieldDiff, Tolerances, angle_degrees};
 use crate::conventions::EngineConventions;
-use crate::conventions::Precision;
 
 /// Failing sweeps a convention would explain, by convention. A sweep is
 /// counted under the first that explains it, in this order.
@@ -65,8 +64,13 @@ impl ConventionHints {
             && is_contact_normal(result, expected, fields, tol)
         {
             self.normal += 1;
-        } else if declared.precision == Precision::F64 {
-            let judged = agreement_at((expected, got, got_is_core), result, tol, Precision::F32);
+        } else if declared.budget().is_none() {
+            let judged = agreement_at(
+                (expected, got, got_is_core),
+                result,
+                tol,
+                Some(crate::conventions::F32_BUDGET),
+            );
             if !judged.fails(false) {
                 self.precision += 1;
             }

@@ -14,7 +14,7 @@ use crate::replay::SweepResult;
 use crate::trace::OutcomeMsg;
 
 use super::compare::Tolerances;
-use super::precision::{F32_OPERATIONS, F32_UNIT, Sensitivity};
+use super::precision::{F32_UNIT, Sensitivity};
 use super::reference::Decision;
 use crate::conventions::Precision;
 
@@ -146,9 +146,18 @@ const PERTURBED_INPUTS: [&str; 10] = [
     "p0.x", "p0.y", "p0.z", "p1.x", "p1.y", "p1.z", "path.x", "path.y", "path.z", "radius",
 ];
 
-/// The magnitudes of the perturbations at single precision, in units of
-/// `u₃₂ · S`: 1, 2, 4, 8 and [`F32_OPERATIONS`] (the backward-error budget).
-const F32_PERTURBATION_UNITS: [f64; 5] = [1.0, 2.0, 4.0, 8.0, F32_OPERATIONS];
+/// The magnitudes of the perturbations by backward error, in units of
+/// `u₃₂ · S`: the powers of two up to the budget (1, 2, 4, 8, 16 at single
+/// precision's), and the budget itself when it is not one.
+fn budget_perturbation_units(budget: f64) -> Vec<f64> {
+    let mut units: Vec<f64> = std::iter::successors(Some(1.0_f64), |k| Some(k * 2.0))
+        .take_while(|k| *k <= budget)
+        .collect();
+    if units.last() != Some(&budget) {
+        units.push(budget);
+    }
+    units
+}
 
 /// The perturbations of a sweep whose rounding unit is `u`, smallest first
 /// (each magnitude over every input, lower before higher).
@@ -191,27 +200,37 @@ pub(super) enum Rounding<'a> {
     /// the fragility band; the perturbed decision accepts an answer within
     /// the tolerances.
     F64(&'a Tolerances),
-    /// Single precision: perturbations of `u₃₂ · S` up to
-    /// `c` = [`F32_OPERATIONS`] units; a perturbation of `k` units leaves
-    /// `c - k` for the widening of the continuous fields (the budget is
-    /// spent once).
+    /// By backward error: perturbations of `u₃₂ · S` up to the budget
+    /// `c` (single precision's 16, or a declared accuracy); a perturbation
+    /// of `k` units leaves `c - k` for the widening of the continuous
+    /// fields (the budget is spent once).
     F32 {
         fixed: &'a Tolerances,
         sensitivity: Option<&'a Sensitivity>,
+        budget: f64,
     },
 }
 
 impl Rounding<'_> {
     /// What the unit `u` of the perturbations is (from the sweep's own
     /// rounding unit), their magnitudes and the arithmetic's name.
-    fn steps(self, sweep_unit: f64) -> (f64, &'static [f64], Precision) {
+    fn steps(self, sweep_unit: f64) -> (f64, Vec<f64>, Precision) {
         match self {
-            Rounding::F64(_) => (sweep_unit, &PERTURBATION_UNITS, Precision::F64),
-            Rounding::F32 { .. } => (
+            Rounding::F64(_) => (sweep_unit, PERTURBATION_UNITS.to_vec(), Precision::F64),
+            Rounding::F32 { budget, .. } => (
                 sweep_unit / f64::EPSILON * F32_UNIT,
-                &F32_PERTURBATION_UNITS,
+                budget_perturbation_units(budget),
                 Precision::F32,
             ),
+        }
+    }
+
+    /// The whole budget, in the units of the perturbations (at `f64`, no
+    /// widening is spent: 0).
+    fn budget(self) -> f64 {
+        match self {
+            Rounding::F64(_) => 0.0,
+            Rounding::F32 { budget, .. } => budget,
         }
     }
 
@@ -220,10 +239,12 @@ impl Rounding<'_> {
     fn accepts(self, decision: &Decision, answer: &OutcomeMsg, k: f64) -> Option<f64> {
         match self {
             Rounding::F64(tol) => decision.disagreement(answer, tol).is_none().then_some(k),
-            Rounding::F32 { fixed, sensitivity } => {
-                widening_needed(decision, answer, fixed, sensitivity, F32_OPERATIONS - k)
-                    .map(|widening| k + widening)
-            }
+            Rounding::F32 {
+                fixed,
+                sensitivity,
+                budget,
+            } => widening_needed(decision, answer, fixed, sensitivity, budget - k)
+                .map(|widening| k + widening),
         }
     }
 }
@@ -259,12 +280,12 @@ pub(super) fn reproduce(
                 let spent = own
                     .as_ref()
                     .and_then(|d| rounding.accepts(d, answer, 0.0))
-                    .unwrap_or(if own.is_some() { F32_OPERATIONS } else { 0.0 });
+                    .unwrap_or(if own.is_some() { rounding.budget() } else { 0.0 });
                 *side = Some((None, spent));
             }
         }
     }
-    for p in perturbations_of(u, units) {
+    for p in perturbations_of(u, &units) {
         if sides.iter().all(Option::is_some) {
             break;
         }

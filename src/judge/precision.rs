@@ -68,16 +68,10 @@ use super::compare::{ContactAxis, Field, FieldDiff, Tolerances, angle_degrees};
 /// The unit roundoff of `f32`, `u₃₂ = 2⁻²⁴`.
 pub const F32_UNIT: f64 = 1.0 / 16_777_216.0;
 
-/// `c`, the backward-error budget in units of `u₃₂ · S`: what a
-/// single-precision engine spends on one sweep. Its inputs are rounded to
-/// `f32` (1 unit each); a compressed mesh stores its vertices on a grid of
-/// 2²¹ steps across its bounds (Jolt's `MeshShape`: 8 units); the cast
-/// transforms the inputs into the shape's space and runs a few dozen
-/// operations on them, each rounding by 1 unit of its own magnitude, of
-/// which a handful add up along one direction. 16 covers those with room
-/// to spare; a real error of the engine (a contact 0.2 % late on a sweep
-/// that meets the surface squarely) is hundreds of units.
-pub const F32_OPERATIONS: f64 = 16.0;
+/// `c`, single precision's backward-error budget in units of `u₃₂ · S`:
+/// [`crate::conventions::F32_BUDGET`], where it is explained. A declared
+/// `accuracy` replaces it ([`crate::conventions::EngineConventions::budget`]).
+pub const F32_OPERATIONS: f64 = crate::conventions::F32_BUDGET;
 
 /// How much each continuous field of the reference answer moves when the
 /// inputs move by `units · δ`, `δ = u₃₂ · S` (see the module's

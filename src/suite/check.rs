@@ -217,7 +217,7 @@ impl<'a> ReportBuilder<'a> {
         };
         report.fragile.strict = options.strict;
         report.within_precision =
-            (!options.replay.conventions.precision.is_f64()).then(WithinPrecision::default);
+            (options.replay.conventions.budget().is_some()).then(WithinPrecision::default);
         report.conventions = options.replay.conventions;
         report.tunnels.fail = options.fail_on_tunnel;
         report.ghosts.fail = options.fail_on_ghost;
@@ -333,6 +333,9 @@ impl<'a> ReportBuilder<'a> {
                 .get_or_insert_with(WithinPrecision::default);
             within.count += 1;
             within.max_backward_error = within.max_backward_error.max(error);
+            if reproduced.is_none() {
+                within.max_value_backward_error = within.max_value_backward_error.max(error);
+            }
             self.backward_errors.push(error);
             if !self.options.strict {
                 return;

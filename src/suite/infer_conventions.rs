@@ -22,7 +22,7 @@ use crate::core::{InitialOverlap, Sides};
 use super::report::TraceReport;
 use crate::conventions::Precision;
 use crate::conventions::TieRule;
-use crate::conventions::{EngineConventions, FacingRule, MarginRule};
+use crate::conventions::{Accuracy, EngineConventions, F32_BUDGET, FacingRule, MarginRule};
 
 /// What a check of every trace under some conventions came to.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -35,6 +35,9 @@ pub struct Trial {
     pub precision: u64,
     /// The largest backward error among them.
     pub max_backward_error: f64,
+    /// The largest among those where only α, the contact or the normal
+    /// differ (the engine's accuracy on the values).
+    pub max_value_backward_error: f64,
     /// Answers that name another member of a tie.
     pub ties: u64,
     /// The margins the traces' face hits imply (one per trace that has one).
@@ -53,6 +56,9 @@ impl Trial {
             if let Some(within) = &r.within_precision {
                 t.precision += within.count;
                 t.max_backward_error = t.max_backward_error.max(within.max_backward_error);
+                t.max_value_backward_error = t
+                    .max_value_backward_error
+                    .max(within.max_value_backward_error);
             }
             t.ties += r.ties;
             if let Some(m) = r.inferred.as_ref().and_then(|i| i.margin) {
@@ -265,12 +271,96 @@ pub fn infer_conventions<E>(
             because,
         });
     }
+    if let Some((accuracy, trial, because)) = calibrate(&mut check, &best, &best_trial)? {
+        best = EngineConventions {
+            accuracy: Some(accuracy),
+            ..best
+        };
+        best_trial = trial;
+        evidence.push(Evidence {
+            key: "accuracy",
+            value: accuracy.to_string(),
+            because,
+        });
+    }
     Ok(InferredConventions {
         conventions: best,
         evidence,
         under_rules,
         under_inferred: best_trial,
     })
+}
+
+/// The widest budget calibration looks through, in units of `u₃₂ · S`
+/// (`2¹⁶`, the f64 fragility band's size in its own units): an engine
+/// coarser than that is not calibrated, its differences stay failures.
+const WIDEST_BUDGET: f64 = 65_536.0;
+
+/// The accuracy the answers showed, when they are judged by backward
+/// error (`best` declares `precision = "f32"`): the largest backward error
+/// among the answers whose kind, triangle and feature agree (the values'),
+/// doubled and rounded up to a power of two, at least 1. Below single
+/// precision's 16 for an engine better than its budget (so that a later
+/// bias it does not show today fails), above it for a solver coarser than
+/// its arithmetic (looked for up to [`WIDEST_BUDGET`] only when sweeps fail
+/// at 16, and kept only when fewer fail). `None` when it would be 16, or
+/// nothing differs, or it fits worse.
+fn calibrate<E>(
+    check: &mut impl FnMut(&EngineConventions) -> Result<Trial, E>,
+    best: &EngineConventions,
+    best_trial: &Trial,
+) -> Result<Option<(Accuracy, Trial, String)>, E> {
+    if best.budget() != Some(F32_BUDGET) {
+        return Ok(None);
+    }
+    let (measured, coarser) = if best_trial.failing > 0 {
+        let wide = check(&EngineConventions {
+            accuracy: Some(Accuracy::new(WIDEST_BUDGET)),
+            ..*best
+        })?;
+        if wide.failing < best_trial.failing && wide.errors <= best_trial.errors {
+            (wide, true)
+        } else {
+            (best_trial.clone(), false)
+        }
+    } else {
+        (best_trial.clone(), false)
+    };
+    let worst = measured.max_value_backward_error;
+    if !(worst > 0.0 && worst.is_finite()) {
+        return Ok(None);
+    }
+    let units = (2.0 * worst).log2().ceil().exp2().max(1.0);
+    if units == F32_BUDGET || (coarser && units <= F32_BUDGET) || units > WIDEST_BUDGET {
+        return Ok(None);
+    }
+    let accuracy = Accuracy::new(units);
+    let trial = check(&EngineConventions {
+        accuracy: Some(accuracy),
+        ..*best
+    })?;
+    if trial.errors > best_trial.errors || trial.failing > best_trial.failing {
+        return Ok(None);
+    }
+    let because = if units < F32_BUDGET {
+        format!(
+            "calibrated: the answers' largest backward error on α, the contact and the \
+             normal is {} u32 units of the sweep's scale; held to twice that, rounded up to a \
+             power of two, instead of single precision's {F32_BUDGET}, so that a later bias \
+             beyond it fails (infer again from a build known to be good)",
+            crate::core::num(worst)
+        )
+    } else {
+        format!(
+            "{} answers differ by more than single precision explains, up to {} u32 units of \
+             the sweep's scale: the engine's solver is coarser than its arithmetic; held to \
+             twice that, rounded up to a power of two, {} fewer sweeps fail",
+            trial.precision.saturating_sub(best_trial.precision),
+            crate::core::num(worst),
+            best_trial.failing - trial.failing
+        )
+    };
+    Ok(Some((accuracy, trial, because)))
 }
 
 /// The margin every estimate agrees on (to 1e-9), if they do.

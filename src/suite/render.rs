@@ -103,9 +103,10 @@ fn counts_text(r: &TraceReport) -> String {
     {
         let _ = write!(
             counts,
-            ", {} within single precision (largest backward error {}, p99 {} u32 units of the \
+            ", {} within {} (largest backward error {}, p99 {} u32 units of the \
              sweep's scale){}",
             crate::numbers::counted(within.count, "difference", "differences"),
+            r.conventions.within_words(),
             crate::core::num(within.max_backward_error),
             crate::core::num(within.p99_backward_error),
             if r.fragile.strict {

@@ -354,6 +354,12 @@ pub struct WithinPrecision {
     /// contact, a penetration skin) or of its arithmetic, which a per-sweep
     /// bound does not see ([`WithinPrecision::lopsided`]).
     pub alpha_earlier: u64,
+    /// The largest backward error among those whose kind, triangle and
+    /// feature agree with the core's (only α, the contact or the normal
+    /// differ): the engine's accuracy on the values, which
+    /// `--infer-config` calibrates from. Not in the JSON.
+    #[serde(skip)]
+    pub max_value_backward_error: f64,
 }
 
 impl WithinPrecision {

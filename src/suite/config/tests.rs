@@ -356,6 +356,7 @@ fn engine_sides_round_trip_through_the_table_inference_writes() {
     use crate::core::Sides;
     let declared = EngineConventions {
         sides: Sides::Two,
+        accuracy: Some("4096".parse().unwrap()),
         ..EngineConventions::default()
     };
     let table: String = std::iter::once("[engine]\n".to_string())

@@ -8,10 +8,10 @@ use crate::core::explain::num;
 use crate::core::{Mesh, Options, Outcome, Sweep, SweptPath, sweep_ties};
 use crate::trace::{OutcomeMsg, SceneMsg, SweepMsg, TraceError, TraceWriter};
 
-use crate::conventions::{EngineConventions, Precision};
+use crate::conventions::EngineConventions;
 use crate::core::Topology;
 use crate::judge::{Agreement, agreement};
-use crate::judge::{F32_OPERATIONS, Field, FieldSet, Sensitivity, Tolerances};
+use crate::judge::{Field, FieldSet, Sensitivity, Tolerances};
 use crate::replay::{ReplayOptions, SceneNormals};
 
 use super::find::{ReproError, TraceSweep};
@@ -374,9 +374,9 @@ impl ReproCase {
             let r = result_on(&reduced, &reduced_under, reduced_outcome_local, Some(e));
             agreement(&e, &r, tol)
         });
-        let asserted_tolerances = match conventions.precision {
-            Precision::F64 => *tol,
-            Precision::F32 => Sensitivity::of(&full).map_or(*tol, |s| s.widen(tol, F32_OPERATIONS)),
+        let asserted_tolerances = match conventions.budget() {
+            None => *tol,
+            Some(c) => Sensitivity::of(&full).map_or(*tol, |s| s.widen(tol, c)),
         };
         Ok(ReproCase {
             source: trace.to_string(),

@@ -98,14 +98,27 @@ pub fn divergence_details(
         backward_error: None,
         margin: result.options().margin,
         facing: result.options().facing,
-        got_explanation: explain_outcome(&result.outcome, &records),
+        got_explanation: match explain_outcome(&result.outcome, &records) {
+            lines if lines.is_empty() => super::explain::explain_initial(result),
+            lines => lines,
+        },
         expected_tests: expected_tests(
             &expected,
             &result.outcome,
             &records,
             Some(&result.scene),
             result.sweep.radius - result.options().margin,
-        ),
+        )
+        .into_iter()
+        .map(|mut test| {
+            if let Some(Some(triangle)) = expected.triangle
+                && let Some(why) = super::explain::initial_why(result, &test, triangle)
+            {
+                test.why_not = why;
+            }
+            test
+        })
+        .collect(),
     }
 }
 

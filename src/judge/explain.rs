@@ -68,6 +68,103 @@ pub fn explain_outcome(outcome: &Outcome, records: &[TestRecord]) -> Vec<String>
         .collect()
 }
 
+/// The initial contacts that decided a hit at `α = 0` under a declared
+/// `initial_overlap` (no test of the sweep reports it): the primary then
+/// the others tied with it, each with its distance from the start; empty
+/// when `result` is no such hit.
+pub fn explain_initial(result: &SweepResult) -> Vec<String> {
+    let options = result.options();
+    let Some(hit) = result.outcome.hit.filter(|h| h.alpha == 0.0) else {
+        return Vec::new();
+    };
+    if options.initial_overlap.is_rules() {
+        return Vec::new();
+    }
+    let (lo, hi) = result.scene.mesh.bounds();
+    let Ok(path) = crate::core::SweptPath::new(&result.sweep, options) else {
+        return Vec::new();
+    };
+    let path = path.with_mesh_scale(&lo, &hi);
+    let contacts = crate::core::initial_contacts(&result.scene.mesh, &path, options);
+    let name = |h: &crate::core::SweepHit| match h.feature.index() {
+        None => format!("face {}", h.triangle),
+        Some(f) => format!("{} {}.{f}", h.feature.kind(), h.triangle),
+    };
+    let mut lines = Vec::new();
+    for (i, (c, distance)) in contacts.iter().enumerate() {
+        let primary = c.triangle == hit.triangle && c.feature == hit.feature;
+        let line = format!(
+            "{}initial contact: {} at distance {} < ρ = {} from the start \
+             (initial_overlap = {}): a hit at α = 0",
+            if primary { "primary: " } else { "also at α = 0: " },
+            name(c),
+            num(*distance),
+            num(path.rho),
+            options.initial_overlap
+        );
+        if primary {
+            lines.insert(0, line);
+        } else if i < 9 {
+            lines.push(line);
+        }
+    }
+    lines
+}
+
+/// For a test that refused a start within `ρ` (`starts_too_close`,
+/// `before_start`) under a declared `initial_overlap`: what that convention
+/// makes of the triangle, in words (an initial contact tied at `α = 0`, or
+/// why it is none); `None` when no such convention is declared.
+pub fn initial_why(result: &SweepResult, test: &ExpectedTest, triangle: u32) -> Option<String> {
+    let options = result.options();
+    if options.initial_overlap.is_rules()
+        || !matches!(
+            test.verdict,
+            Some(Verdict::StartsTooClose | Verdict::BeforeStart)
+        )
+    {
+        return None;
+    }
+    let (lo, hi) = result.scene.mesh.bounds();
+    let path = crate::core::SweptPath::new(&result.sweep, options)
+        .ok()?
+        .with_mesh_scale(&lo, &hi);
+    let convention = format!("initial_overlap = {}", options.initial_overlap);
+    let contacts = crate::core::initial_contacts(&result.scene.mesh, &path, options);
+    Some(match contacts.iter().find(|(h, _)| h.triangle == triangle) {
+        Some((h, distance)) => format!(
+            "the ball starts within ρ of triangle {triangle} (its nearest point, on its {}, \
+             at distance {} < ρ = {}): under {convention} an initial contact at α = 0, tied \
+             with the core's (the answer is compared with that contact)",
+            match h.feature.index() {
+                None => "face".to_string(),
+                Some(f) => format!("{} {f}", h.feature.kind()),
+            },
+            num(*distance),
+            num(path.rho)
+        ),
+        None => {
+            let t = result.scene.mesh.triangle_by_index(triangle)?;
+            let (point, _) = crate::core::closest_point(t, &path.p0);
+            let distance = (path.p0 - point).norm();
+            if distance >= path.rho {
+                format!(
+                    "the ball starts {} from triangle {triangle}, not within ρ = {}: under \
+                     {convention} no initial contact",
+                    num(distance),
+                    num(path.rho)
+                )
+            } else {
+                format!(
+                    "the ball starts within ρ of triangle {triangle} (distance {}) but moves \
+                     away from its front, which {convention} does not count as a contact",
+                    num(distance)
+                )
+            }
+        }
+    })
+}
+
 /// The tests that would have produced `expected`, each with why it did not
 /// decide the sweep (and, when the expected α is what a known mistake
 /// gives on it with the sweep's `rho`, the mistake).

@@ -335,6 +335,7 @@ impl<'a> ReportBuilder<'a> {
             within.max_backward_error = within.max_backward_error.max(error);
             if reproduced.is_none() {
                 within.max_value_backward_error = within.max_value_backward_error.max(error);
+                within.value_backward_errors.push(error);
             }
             self.backward_errors.push(error);
             if !self.options.strict {
@@ -422,7 +423,7 @@ impl<'a> ReportBuilder<'a> {
 }
 
 /// The `q` quantile of `values` by nearest rank (0 when empty).
-fn percentile(values: &mut [f64], q: f64) -> f64 {
+pub(super) fn percentile(values: &mut [f64], q: f64) -> f64 {
     if values.is_empty() {
         return 0.0;
     }

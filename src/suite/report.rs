@@ -360,6 +360,10 @@ pub struct WithinPrecision {
     /// `--infer-config` calibrates from. Not in the JSON.
     #[serde(skip)]
     pub max_value_backward_error: f64,
+    /// Each of those backward errors, in the order met (for the
+    /// percentiles calibration reads). Not in the JSON.
+    #[serde(skip)]
+    pub value_backward_errors: Vec<f64>,
 }
 
 impl WithinPrecision {

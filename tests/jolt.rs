@@ -24,6 +24,7 @@ pub fn tests() -> Vec<Trial> {
         trial!(jolt_with_back_faces_is_judged_two_sided_under_sides_two),
         trial!(conforms_printed_reproduce_command_keeps_the_table),
         trial!(a_calibrated_accuracy_catches_a_bias_single_precision_excuses),
+        trial!(every_seeded_bug_fails_conform_and_check),
     ]
 }
 
@@ -462,6 +463,63 @@ fn a_calibrated_accuracy_catches_a_bias_single_precision_excuses() -> anyhow::Re
         ensure!(
             at_4 > at_16 && at_4 >= 2 * at_16.max(1),
             "{variant}: the terrain fails {at_4} sweeps held to 4 units, {at_16} held to 16"
+        );
+    }
+    Ok(Completion::Completed)
+}
+
+/// The mutation test of the verdict (issue 42; the table in
+/// docs/ENGINES.md, "Seeded bugs"): every deliberate mistake of the Jolt
+/// example fails `conform` under Jolt's own table, and every one the
+/// samples can show fails `check` (`ghost_flat` cannot: no sample ball
+/// lands on a flat internal edge; conform's `normal.flat-edge` does). The
+/// ten variants the test above checks are not run again here.
+fn every_seeded_bug_fails_conform_and_check() -> anyhow::Result<Completion> {
+    let engine = match jolt()? {
+        Ok(e) => e,
+        Err(skip) => return Ok(skip),
+    };
+    let variants = [
+        "late",
+        "no_vertex",
+        "next_triangle",
+        "back_faces",
+        "centre_contact",
+        "flipped_edge_normal",
+        "tilted_face_normal",
+        "half_normal",
+        "contact_off_plane",
+        "skin",
+        "glued",
+        "first_hit",
+        "loose_bary",
+        "wide_active_edges",
+        "ghost_flat",
+        "lost_leaf",
+    ];
+    for variant in variants {
+        let (code, report) = conform_with(&engine, variant, &[])?;
+        ensure!(
+            code == 1 && report["failed"].as_u64() > Some(0),
+            "{variant}: conform exits {code}: {}",
+            report["failing_rules"]
+        );
+    }
+    for variant in [
+        "glued",
+        "first_hit",
+        "loose_bary",
+        "wide_active_edges",
+        "lost_leaf",
+    ] {
+        let (code, report) = check(&engine, variant)?;
+        let failing: u64 = traces_of(&report)
+            .iter()
+            .map(|t| t["divergent"].as_u64().unwrap_or(0))
+            .sum();
+        ensure!(
+            code == 1 && failing > 0,
+            "{variant}: check exits {code} with {failing} failing sweeps"
         );
     }
     Ok(Completion::Completed)

@@ -26,6 +26,7 @@ pub fn tests() -> Vec<Trial> {
         trial!(rapier_passes_the_miss_rules_of_conform_under_its_table),
         trial!(rapier_config_is_what_infer_config_prints),
         trial!(rapier_engine_faults_are_errors),
+        trial!(a_tie_member_is_reported_by_what_differs_from_it),
     ]
 }
 
@@ -286,6 +287,46 @@ fn rapier_engine_faults_are_errors() -> anyhow::Result<Completion> {
         out.status.code() == Some(2) && text.contains("RAPIER_STOP_AT_PENETRATION=maybe"),
         "a bad RAPIER_STOP_AT_PENETRATION: exit {:?}\n{text}",
         out.status.code()
+    );
+    Ok(Completion::Completed)
+}
+
+/// Issue 47's report faults, on Rapier's answer to bowl frame 0, ball 1 (a
+/// ball starting within ρ of a face and of a concave edge; Rapier names
+/// the edge with its contact normal): the report compares it with the
+/// initial contact it names (only the normal differs, a ghost), lists the
+/// core's initial contacts under "the core found", and explains the edge's
+/// test by the declared `initial_overlap`, not by the rules.
+fn a_tie_member_is_reported_by_what_differs_from_it() -> anyhow::Result<Completion> {
+    let engine = match rapier()? {
+        Ok(e) => e,
+        Err(skip) => return Ok(skip),
+    };
+    let trace = root().join("traces/record_bowl_margin.mcap");
+    let trace = trace.display().to_string();
+    let config = config();
+    let args = [
+        "check", &trace, "--frames", "0", "--ball", "1", "--engine", &engine, "--config",
+        &config, "--accuracy", "16",
+    ];
+    let args: Vec<&std::ffi::OsStr> = args.iter().map(std::ffi::OsStr::new).collect();
+    let (_, text, _) = run_bin(&args)?;
+    ensure!(
+        text.contains("frame 0, ball 1: normal differs"),
+        "the tie member's difference: {text}"
+    );
+    ensure!(
+        !text.contains("kind: engine edge, core face"),
+        "not a kind mismatch against the primary: {text}"
+    );
+    ensure!(
+        text.contains("primary: initial contact: face 286")
+            && text.contains("also at α = 0: initial contact: edge 255.1"),
+        "the core's initial contacts: {text}"
+    );
+    ensure!(
+        text.contains("under initial_overlap = alpha0 an initial contact at α = 0"),
+        "the engine's test explained by the convention: {text}"
     );
     Ok(Completion::Completed)
 }

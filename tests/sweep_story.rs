@@ -21,6 +21,7 @@ pub fn tests() -> Vec<Trial> {
         trial!(sweep_on_the_obj_lists_the_triangle_under_the_ball),
         trial!(sweep_names_a_tunnel_between_sweeps_as_check_does),
         trial!(sweep_json_says_the_conventions_it_ran_under),
+        trial!(a_library_user_gets_the_story_sweep_tells),
     ]
 }
 
@@ -251,6 +252,49 @@ fn sweep_json_says_the_conventions_it_ran_under() -> anyhow::Result<()> {
     ensure!(
         rules.get("conventions").is_none(),
         "under the rules: {rules}"
+    );
+    Ok(())
+}
+
+/// `explain_sweep` is the story `sweep` renders, for a library user: on
+/// the same floor and path, the same tunnel through the flipped triangle,
+/// the flipped triangle within reach, the one defect, and a record of
+/// every triangle's face, edge and vertex tests.
+fn a_library_user_gets_the_story_sweep_tells() -> anyhow::Result<()> {
+    use sweeptrace::conventions::NormalRule;
+    use sweeptrace::core::{Options, Sweep};
+    let vertices = vec![[0.0, 0.0, 0.0], [4.0, 0.0, 0.0], [4.0, 4.0, 0.0], [0.0, 4.0, 0.0]];
+    let triangles = [[0, 1, 2], [0, 3, 2]];
+    let mesh = sweeptrace::Mesh::new(vertices.clone(), &triangles)?;
+    let topology = sweeptrace::Topology::new(&vertices, &triangles)?;
+    let sweep = Sweep::new([1.0, 3.0, 2.0], [1.0, 3.0, -2.0], 0.5);
+    let story = sweeptrace::replay::explain_sweep(
+        &mesh,
+        Some(&topology),
+        &sweep,
+        &Options::default(),
+        NormalRule::Face,
+        None,
+    )?;
+    ensure!(story.outcome.hit.is_none(), "{:?}", story.outcome);
+    ensure!(
+        story.tunnels.len() == 1
+            && story.tunnels[0].sentence(None).contains("through the flipped triangle 1"),
+        "{:?}",
+        story.tunnels
+    );
+    ensure!(
+        story.within_reach.iter().any(|d| d.text.contains("triangle 1")) && story.defects == Some(1),
+        "{:?} {:?}",
+        story.within_reach,
+        story.defects
+    );
+    // Each triangle: its face, three edges and three vertices.
+    ensure!(story.records.len() == 14, "{} records", story.records.len());
+    ensure!(
+        story.crossings.iter().any(|c| c.triangle == 1),
+        "{:?}",
+        story.crossings
     );
     Ok(())
 }

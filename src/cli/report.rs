@@ -5,11 +5,11 @@ use std::fmt::Write;
 use serde_json::json;
 
 use sweeptrace::core::{
-    Crossing, EdgeClass, Feature, Options, Outcome, Sweep, TestRecord, Topology, Verdict,
+    Crossing, Options, Outcome, Sweep, TestRecord, Verdict,
 };
 use sweeptrace::core::{describe, miss_distance, num};
 use sweeptrace::judge::SweepInputs;
-use sweeptrace::replay::{GhostContact, Through, Tunnel, TunnelAt, feature_class};
+use sweeptrace::replay::{SweepStory, Tunnel, TunnelAt};
 use sweeptrace::trace::OutcomeMsg;
 
 /// Formats `[x, y, z]` compactly.
@@ -125,12 +125,13 @@ pub const SHOWN_CLOSE_TESTS: usize = 5;
 /// the nearest misses up to [`SHOWN_CLOSE_TESTS`].
 fn shown_records<'a>(r: &SweepReport<'a>) -> (Vec<&'a TestRecord>, usize) {
     if r.all {
-        let mut shown: Vec<&TestRecord> = r.records.iter().collect();
+        let mut shown: Vec<&TestRecord> = r.story.records.iter().collect();
         shown.sort_by_key(|t| (t.triangle(), t.kind(), t.feature()));
         return (shown, 0);
     }
     let rho = r.sweep.radius - r.options.margin;
     let mut close: Vec<&TestRecord> = r
+        .story
         .records
         .iter()
         .filter(|t| came_close(t, rho, r.crossing(t).is_some()))
@@ -170,30 +171,14 @@ pub struct SweepReport<'a> {
     pub sweep: &'a Sweep,
     /// The options.
     pub options: &'a Options,
-    /// The outcome.
-    pub outcome: &'a Outcome,
-    /// Every test's record.
-    pub records: &'a [TestRecord],
+    /// The sweep explained: its outcome, every test's record, the place of
+    /// an edge or vertex hit, the tunnels, the defects within reach, the
+    /// ghost contact and the triangles the centre's path crosses.
+    pub story: &'a SweepStory,
     /// Explain every test, not only those that came close.
     pub all: bool,
-    /// For an edge or vertex hit, its place in the mesh's topology
-    /// ([`hit_place`]).
-    pub place: Option<HitPlace>,
     /// The frame and ball of the sweep, when it was taken from a trace.
     pub at: Option<(u64, u32)>,
-    /// Where the ball's centre went through a triangle front to back (or
-    /// a flipped one back to front), as `check` and `replay` find it:
-    /// since its previous sweep, then during this one.
-    pub tunnels: &'a [Tunnel],
-    /// The defects within `ρ` of the centre's path, nearest first.
-    pub within_reach: &'a [Through],
-    /// How many defects the mesh has (`None` without a topology).
-    pub defects: Option<usize>,
-    /// The trace's expectation as a ghost contact, when it is one.
-    pub ghost: Option<&'a GhostContact>,
-    /// The triangles the centre's path passes through, either way, up to
-    /// where the outcome stops it.
-    pub crossings: &'a [Crossing],
     /// The engine conventions the sweep was computed under (in the JSON as
     /// `conventions` when some are declared, as `check --json` says them).
     pub conventions: &'a sweeptrace::conventions::EngineConventions,
@@ -206,7 +191,7 @@ impl SweepReport<'_> {
         let TestRecord::Face(f) = t else {
             return None;
         };
-        self.crossings.iter().find(|c| c.triangle == f.triangle)
+        self.story.crossings.iter().find(|c| c.triangle == f.triangle)
     }
 
     /// A tunnel in words: with the frame and ball, as `check` says it,
@@ -250,49 +235,6 @@ fn crossing_words(t: &TestRecord, c: &Crossing, rho: f64) -> Option<String> {
     })
 }
 
-/// Where an edge or vertex hit is in the mesh's topology.
-pub struct HitPlace {
-    /// The class of the edge (or the vertex, `replay::feature_class`).
-    pub class: EdgeClass,
-    /// In words: `edge 17.2: an internal flat edge shared with triangle 18`.
-    pub text: String,
-}
-
-/// The place of `outcome`'s edge or vertex hit in `topology`; `None` for a
-/// face hit, a miss, or a feature the topology does not have.
-pub fn hit_place(topology: &Topology, outcome: &Outcome) -> Option<HitPlace> {
-    let hit = outcome.hit.as_ref()?;
-    let (triangle, feature) = (hit.triangle, hit.feature);
-    let class = feature_class(topology, triangle, feature)?;
-    let text = match feature {
-        Feature::Face => return None,
-        Feature::Edge(i) => {
-            let edge = topology.triangle_edge(triangle, i)?;
-            let other = edge.triangles().find(|&t| t != triangle);
-            let shared = other.map_or(String::new(), |o| format!(" shared with triangle {o}"));
-            let what = match class {
-                EdgeClass::Boundary => "a boundary edge (no other triangle has it)".to_string(),
-                EdgeClass::Flat => format!("an internal flat edge{shared}"),
-                EdgeClass::Convex => format!("a convex edge{shared}"),
-                EdgeClass::Concave => format!("a concave edge{shared}"),
-                EdgeClass::NonManifold => {
-                    "a non-manifold edge (three or more triangles have it)".to_string()
-                }
-            };
-            format!("edge {triangle}.{i}: {what}")
-        }
-        Feature::Vertex(i) => {
-            let v = topology.triangle_vertex(triangle, i)?;
-            let edges = topology.edges_at(v).count();
-            format!(
-                "vertex {triangle}.{i} (mesh vertex {v}): a {class} vertex (the most telling class of its {})",
-                sweeptrace::numbers::counted(edges as u64, "edge", "edges")
-            )
-        }
-    };
-    Some(HitPlace { class, text })
-}
-
 /// The `sweep` report as text.
 pub fn sweep_text(r: &SweepReport) -> String {
     let mut s = String::new();
@@ -319,30 +261,30 @@ pub fn sweep_text(r: &SweepReport) -> String {
     )
     .unwrap();
     writeln!(s, "inputs: {}", SweepInputs::of(r.sweep, r.options).text()).unwrap();
-    writeln!(s, "outcome: {}", outcome_text(r.outcome)).unwrap();
-    if let Some(place) = &r.place {
+    writeln!(s, "outcome: {}", outcome_text(&r.story.outcome)).unwrap();
+    if let Some(place) = &r.story.place {
         writeln!(s, "{}", place.text).unwrap();
     }
     if let Some(e) = r.expected {
         writeln!(s, "expected (the trace's /expected): {}", expected_line(e)).unwrap();
     }
-    for t in r.tunnels {
+    for t in &r.story.tunnels {
         writeln!(s, "tunnel: {}", r.tunnel_text(t)).unwrap();
     }
-    if let Some(g) = r.ghost {
+    if let Some(g) = &r.story.ghost {
         writeln!(s, "ghost contact: {g}").unwrap();
     }
-    if !r.within_reach.is_empty() {
+    if !r.story.within_reach.is_empty() {
         writeln!(
             s,
             "defects within reach (within ρ = {} of the centre's path, nearest first):",
             num(rho)
         )
         .unwrap();
-        for d in r.within_reach {
+        for d in &r.story.within_reach {
             writeln!(s, "  {} at {}", d.text, num(d.distance)).unwrap();
         }
-    } else if let Some(n) = r.defects.filter(|&n| n > 0) {
+    } else if let Some(n) = r.story.defects.filter(|&n| n > 0) {
         writeln!(
             s,
             "defects within reach: none (the mesh has {}; `sweeptrace mesh` lists them)",
@@ -350,24 +292,24 @@ pub fn sweep_text(r: &SweepReport) -> String {
         )
         .unwrap();
     }
-    if r.outcome.fragile.is_robust() {
+    if r.story.outcome.fragile.is_robust() {
         writeln!(s, "decision: robust").unwrap();
     } else {
         writeln!(
             s,
             "decision: fragile ({}): a change of the inputs at the level of their rounding \
              could change it (docs/SEMANTICS.md, \"Fragile decisions\")",
-            r.outcome.fragile
+            r.story.outcome.fragile
         )
         .unwrap();
     }
     let (shown, more_close) = shown_records(r);
-    let hidden = r.records.len() - shown.len() - more_close;
+    let hidden = r.story.records.len() - shown.len() - more_close;
     if shown.is_empty() {
         writeln!(
             s,
             "no test came close ({} run; --all explains each)",
-            sweeptrace::numbers::counted(r.records.len() as u64, "test", "tests")
+            sweeptrace::numbers::counted(r.story.records.len() as u64, "test", "tests")
         )
         .unwrap();
     } else {
@@ -387,7 +329,7 @@ pub fn sweep_text(r: &SweepReport) -> String {
                 .crossing(t)
                 .and_then(|c| crossing_words(t, c, rho))
                 .map_or(String::new(), |w| format!("; {w}"));
-            writeln!(s, "  {}{crossing}{}", describe(t), role(r.outcome, t)).unwrap();
+            writeln!(s, "  {}{crossing}{}", describe(t), role(&r.story.outcome, t)).unwrap();
         }
         if more_close > 0 {
             writeln!(
@@ -419,7 +361,7 @@ pub fn sweep_json(r: &SweepReport) -> String {
             let mut v = serde_json::to_value(t).unwrap_or(serde_json::Value::Null);
             if let Some(obj) = v.as_object_mut() {
                 obj.insert("explanation".into(), json!(describe(t)));
-                obj.insert("primary".into(), json!(r.outcome.is_reported_by(t)));
+                obj.insert("primary".into(), json!(r.story.outcome.is_reported_by(t)));
                 if let Some(c) = r.crossing(t) {
                     obj.insert(
                         "crossing".into(),
@@ -436,6 +378,7 @@ pub fn sweep_json(r: &SweepReport) -> String {
         })
         .collect();
     let tunnels: Vec<serde_json::Value> = r
+        .story
         .tunnels
         .iter()
         .map(|t| {
@@ -454,12 +397,12 @@ pub fn sweep_json(r: &SweepReport) -> String {
         "p1": [r.sweep.p1.x, r.sweep.p1.y, r.sweep.p1.z],
         "margin": r.options.margin,
         "facing": r.options.facing,
-        "outcome": outcome_json(r.outcome),
+        "outcome": outcome_json(&r.story.outcome),
         "tests": tests,
         "close_tests_not_shown": more_close,
         "tunnels": tunnels,
-        "defects_within_reach": r.within_reach,
-        "defects": r.defects,
+        "defects_within_reach": &r.story.within_reach,
+        "defects": r.story.defects,
     });
     let mut value = value;
     if let Some(object) = value.as_object_mut() {
@@ -469,7 +412,7 @@ pub fn sweep_json(r: &SweepReport) -> String {
         if !r.conventions.is_rules() {
             object.insert("conventions".into(), json!(r.conventions));
         }
-        if let Some(place) = &r.place {
+        if let Some(place) = &r.story.place {
             if let Some(outcome) = object.get_mut("outcome").and_then(|o| o.as_object_mut()) {
                 outcome.insert("edge_class".into(), json!(place.class));
             }
@@ -482,7 +425,7 @@ pub fn sweep_json(r: &SweepReport) -> String {
             object.insert("frame".into(), json!(frame));
             object.insert("ball".into(), json!(ball));
         }
-        if let Some(g) = r.ghost {
+        if let Some(g) = &r.story.ghost {
             let mut v = serde_json::to_value(g).unwrap_or(serde_json::Value::Null);
             if let Some(obj) = v.as_object_mut() {
                 obj.insert("text".into(), json!(g.to_string()));

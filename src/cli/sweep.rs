@@ -7,12 +7,9 @@ use anyhow::Context;
 
 use super::Exit;
 use super::report;
-use sweeptrace::core::{
-    Broadphase, CollectRecords, Options, Sweep, all_crossings, sweep_mesh_with,
-};
+use sweeptrace::core::{Options, Sweep};
 use sweeptrace::replay::{
-    FrameRange, ReplayEvent, ReplayOptions, SweepResult, TunnelScene, defects_within_reach,
-    replay_events, sweep_end, tunnel_during_sweep,
+    FrameRange, ReplayEvent, ReplayOptions, SweepResult, explain_sweep, replay_events,
 };
 use sweeptrace::sim::load_obj;
 use sweeptrace::sim::scenes::BuiltinScene;
@@ -165,22 +162,6 @@ pub fn run(args: Args) -> anyhow::Result<Exit> {
             options,
         )
     };
-    let mut records = CollectRecords::default();
-    let outcome = sweep_mesh_with(
-        &mesh,
-        &sweep,
-        &options,
-        Broadphase::Exhaustive,
-        &mut records,
-    )
-    .context("invalid sweep")?;
-    let normal = settings.engine.conventions().normal;
-    let outcome = match &topology {
-        Some(t) if normal != sweeptrace::conventions::NormalRule::Face => {
-            sweeptrace::replay::SceneNormals::new(normal, &mesh, t).apply(&sweep, outcome)
-        }
-        _ => outcome,
-    };
     if let Some(line) = super::check_config::conventions_line(&settings) {
         eprintln!("{line}");
     }
@@ -188,24 +169,15 @@ pub fn run(args: Args) -> anyhow::Result<Exit> {
     // `check` and `replay` find them: from a trace, the trace replayed up
     // to this sweep (a tunnel between the ball's sweeps needs the one
     // before); otherwise the same function on this sweep alone.
-    let tunnel_scene = topology.as_ref().map(|topology| TunnelScene {
-        mesh: &mesh,
-        topology,
-        rho: sweep.radius - options.margin,
-    });
-    let tunnels = match (&replayed, &tunnel_scene) {
-        (Some(r), _) => r.tunnels.clone(),
-        (None, Some(scene)) => tunnel_during_sweep(scene, &sweep, &outcome)
-            .into_iter()
-            .collect(),
-        (None, None) => Vec::new(),
-    };
-    let within_reach = tunnel_scene
-        .as_ref()
-        .map(|scene| defects_within_reach(scene, &sweep, &outcome))
-        .unwrap_or_default();
-    let ghost = replayed.as_ref().and_then(SweepResult::ghost);
-    let crossings = all_crossings(&mesh, &sweep.p0, &sweep_end(&sweep, &outcome));
+    let story = explain_sweep(
+        &mesh,
+        topology.as_ref(),
+        &sweep,
+        &options,
+        settings.engine.conventions().normal,
+        replayed.as_ref(),
+    )
+    .context("invalid sweep")?;
     let explained = report::SweepReport {
         scene: &name,
         triangles: mesh.triangles().len(),
@@ -213,18 +185,9 @@ pub fn run(args: Args) -> anyhow::Result<Exit> {
         expected: expected.as_ref(),
         sweep: &sweep,
         options: &options,
-        outcome: &outcome,
-        records: &records.records,
+        story: &story,
         all: args.all,
-        place: topology
-            .as_ref()
-            .and_then(|t| report::hit_place(t, &outcome)),
         at: args.trace.as_ref().and(args.frame).map(|f| (f, args.ball)),
-        tunnels: &tunnels,
-        within_reach: &within_reach,
-        defects: topology.as_ref().map(|t| t.defects().len()),
-        ghost: ghost.as_ref(),
-        crossings: &crossings,
         conventions: &settings.engine.conventions(),
     };
     if args.json {

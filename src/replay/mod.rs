@@ -30,6 +30,7 @@ mod pipeline;
 mod primary;
 mod replayer;
 mod selection;
+mod story;
 mod summary;
 mod tunnel;
 
@@ -48,6 +49,7 @@ pub use pipeline::{
 pub use primary::{CollectPrimary, primary_records};
 pub use replayer::{Replay, ReplayEvent, SceneState, SweepResult, feature_class};
 pub use selection::{Selection, SweepExtent};
+pub use story::{HitPlace, SweepStory, explain_sweep, hit_place};
 pub use summary::{ReplaySummary, TunnelAt};
 pub use tunnel::{
     Through, Tunnel, TunnelKind, TunnelScene, defects_within_reach, sweep_end, tunnel_during_sweep,

@@ -243,8 +243,13 @@ impl Rounding<'_> {
                 fixed,
                 sensitivity,
                 budget,
-            } => widening_needed(decision, answer, fixed, sensitivity, budget - k)
-                .map(|widening| k + widening),
+            } => {
+                // A sweep the core misses has no hit to bound the fields
+                // by: the perturbed decision's hit does.
+                let own = sensitivity.is_none().then(|| decision.sensitivity()).flatten();
+                widening_needed(decision, answer, fixed, sensitivity.or(own.as_ref()), budget - k)
+                    .map(|widening| k + widening)
+            }
         }
     }
 }

@@ -59,8 +59,8 @@ use serde::Serialize;
 
 use nalgebra::Vector3;
 
-use crate::core::{Feature, SweptPath};
-use crate::replay::SweepResult;
+use crate::core::{Feature, Sweep, SweepHit, SweptPath};
+use crate::replay::{SceneState, SweepResult};
 use crate::trace::OutcomeMsg;
 
 use super::compare::{ContactAxis, Field, FieldDiff, Tolerances, angle_degrees};
@@ -142,10 +142,14 @@ impl Sensitivity {
     /// The sensitivity of the core's answer to `result`, which must be a
     /// hit; `None` for a miss or an invalid sweep.
     pub fn of(result: &SweepResult) -> Option<Sensitivity> {
-        let hit = result.outcome.hit?;
-        let scene = &result.scene;
+        Sensitivity::of_hit(&result.scene, &result.sweep, &result.outcome.hit?)
+    }
+
+    /// The sensitivity of the core's hit `hit` on `sweep` in `scene` (a
+    /// perturbed sweep's, when the unperturbed one is a miss).
+    pub(super) fn of_hit(scene: &SceneState, sweep: &Sweep, hit: &SweepHit) -> Option<Sensitivity> {
         let (lo, hi) = scene.mesh.bounds();
-        let path = SweptPath::new(&result.sweep, &scene.options)
+        let path = SweptPath::new(sweep, &scene.options)
             .ok()?
             .with_mesh_scale(&lo, &hi);
         let unit = F32_UNIT * path.scale;

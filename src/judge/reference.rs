@@ -54,6 +54,13 @@ pub(super) struct Decision<'a> {
 }
 
 impl<'a> Decision<'a> {
+    /// The sensitivity of the decision's hit (`None` for a miss): what a
+    /// perturbed decision's answer is widened by when the unperturbed
+    /// sweep has no hit to measure it on.
+    pub(super) fn sensitivity(&self) -> Option<super::precision::Sensitivity> {
+        super::precision::Sensitivity::of_hit(self.scene, &self.sweep, self.outcome.hit.as_ref()?)
+    }
+
     pub(super) fn of(scene: &'a SceneState, sweep: &Sweep) -> Option<Decision<'a>> {
         let mut hits = Hits::default();
         let outcome = sweep_mesh_with(

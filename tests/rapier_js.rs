@@ -27,6 +27,7 @@ pub fn tests() -> Vec<Trial> {
         trial!(rapier_config_is_what_infer_config_prints),
         trial!(rapier_engine_faults_are_errors),
         trial!(a_tie_member_is_reported_by_what_differs_from_it),
+        trial!(rapiers_limitations_are_named_when_they_fail),
     ]
 }
 
@@ -328,5 +329,40 @@ fn a_tie_member_is_reported_by_what_differs_from_it() -> anyhow::Result<Completi
         text.contains("under initial_overlap = alpha0 an initial contact at α = 0"),
         "the engine's test explained by the convention: {text}"
     );
+    Ok(Completion::Completed)
+}
+
+/// Issue 47: held to single precision's 16 units, Rapier's false hit while
+/// leaving at a grazing angle (mini golf frame 77, ball 1) and its hit past
+/// the path's end (bowl frame 218, ball 2) fail, each named in words.
+fn rapiers_limitations_are_named_when_they_fail() -> anyhow::Result<Completion> {
+    let engine = match rapier()? {
+        Ok(e) => e,
+        Err(skip) => return Ok(skip),
+    };
+    let config = config();
+    for (trace, frame, ball, named) in [
+        (
+            "record_mini_golf.mcap",
+            "77",
+            "1",
+            "named: a false hit while leaving at a grazing angle",
+        ),
+        (
+            "record_bowl_margin.mcap",
+            "218",
+            "2",
+            "named: a hit past the path's end",
+        ),
+    ] {
+        let trace = root().join("traces").join(trace).display().to_string();
+        let args = [
+            "check", &trace, "--frames", frame, "--ball", ball, "--engine", &engine, "--config",
+            &config, "--accuracy", "16",
+        ];
+        let args: Vec<&std::ffi::OsStr> = args.iter().map(std::ffi::OsStr::new).collect();
+        let (code, text, _) = run_bin(&args)?;
+        ensure!(code == 1 && text.contains(named), "exit {code}: {text}");
+    }
     Ok(Completion::Completed)
 }

@@ -52,6 +52,12 @@ pub struct Divergence {
     /// [`super::Sensitivity`]). Absent otherwise.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub backward_error: Option<f64>,
+    /// The answer named, when it is one of an engine's known limitations
+    /// (`a hit past the path's end`, `a false hit while leaving at a
+    /// grazing angle`: [`super::explain::limitation`]). Only in the JSON
+    /// when some.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub limitation: Option<String>,
     /// The sweep's inputs, exactly (shortest round-trip decimals in the
     /// JSON): with them the core makes the same decision.
     pub inputs: SweepInputs,
@@ -83,7 +89,7 @@ pub fn divergence_details(
 ) -> Divergence {
     let records = explained_records(result);
     let inputs = SweepInputs::of(&result.sweep, result.options());
-    Divergence {
+    let mut d = Divergence {
         inputs,
         inputs_hex: hex.then(|| inputs.hex()),
         frame: result.frame,
@@ -119,7 +125,10 @@ pub fn divergence_details(
             test
         })
         .collect(),
-    }
+        limitation: None,
+    };
+    d.limitation = super::explain::limitation(result, &d.expected, &d.expected_tests);
+    d
 }
 
 /// A JSON value in words: numbers as [`num`], null as `null`.
@@ -255,6 +264,9 @@ pub fn render_divergence_as(d: &Divergence, indent: &str, sides: Parties) -> Str
             );
         }
         None => {}
+    }
+    if let Some(named) = &d.limitation {
+        let _ = writeln!(s, "{indent}  named: {named}");
     }
     let _ = writeln!(s, "{indent}  inputs: {}", d.inputs.text());
     if let Some(hex) = &d.inputs_hex {

@@ -165,6 +165,54 @@ pub fn initial_why(result: &SweepResult, test: &ExpectedTest, triangle: u32) -> 
     })
 }
 
+/// A hit the core does not find, named when it is one of an engine's known
+/// limitations: `a hit past the path's end` (the exact test meets the
+/// triangle only beyond `α = 1`), or `a false hit while leaving at a
+/// grazing angle` (at the answer's `α` the ball is not within `ρ` of the
+/// triangle and moves away from it). `None` otherwise, and when the core
+/// hits too.
+pub fn limitation(result: &SweepResult, expected: &OutcomeMsg, tests: &[ExpectedTest]) -> Option<String> {
+    if expected.kind == Kind::None || result.outcome.hit.is_some() {
+        return None;
+    }
+    let triangle = expected.triangle.flatten()?;
+    if tests.iter().any(|t| t.verdict == Some(Verdict::BeyondEnd)) {
+        return Some(format!(
+            "a hit past the path's end: the exact test meets triangle {triangle} only beyond \
+             α = 1, the answer says α = {}",
+            num(expected.alpha)
+        ));
+    }
+    if !(0.0..=1.0).contains(&expected.alpha) {
+        return None;
+    }
+    let options = result.options();
+    let (lo, hi) = result.scene.mesh.bounds();
+    let path = crate::core::SweptPath::new(&result.sweep, options)
+        .ok()?
+        .with_mesh_scale(&lo, &hi);
+    let t = result.scene.mesh.triangle_by_index(triangle)?;
+    let centre = path.p0 + path.d * expected.alpha;
+    let (point, _) = crate::core::closest_point(t, &centre);
+    let outward = centre - point;
+    let distance = outward.norm();
+    let length = path.d.norm();
+    if distance == 0.0 || length == 0.0 {
+        return None;
+    }
+    let leaving = path.d.dot(&outward) / (distance * length);
+    if leaving <= 0.0 || distance < path.rho {
+        return None;
+    }
+    Some(format!(
+        "a false hit while leaving at a grazing angle: at the answer's α = {} the ball is {} \
+         beyond ρ from triangle {triangle} and moves away from it, {}° off its surface",
+        num(expected.alpha),
+        num(distance - path.rho),
+        num(leaving.clamp(-1.0, 1.0).asin().to_degrees())
+    ))
+}
+
 /// The tests that would have produced `expected`, each with why it did not
 /// decide the sweep (and, when the expected α is what a known mistake
 /// gives on it with the sweep's `rho`, the mistake).

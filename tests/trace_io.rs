@@ -1069,6 +1069,8 @@ pub fn error_names_where(error: &TraceError, read: u64) -> anyhow::Result<()> {
             *index >= read && text.contains(&format!("message {index}")),
             "the message is not named: {text} ({read} read)"
         ),
+        // A corrupted magic: nothing was read, the file is named.
+        TraceError::NotMcap { .. } => ensure!(read == 0, "{text} after {read} messages"),
         _ => anyhow::bail!("unexpected error while reading: {text}"),
     }
     Ok(())

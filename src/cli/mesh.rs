@@ -39,13 +39,19 @@ before the end are reported.
 
 Examples:
   sweeptrace mesh tests/fixtures/scanned/bunny_res4.obj
-  sweeptrace mesh traces/record_mini_golf.mcap --json"
+  sweeptrace mesh traces/record_mini_golf.mcap --json
+  sweeptrace mesh --scene mini_golf"
 )]
 pub struct Args {
     /// A Wavefront OBJ file, or a trace (MCAP) whose every scene is
     /// checked. Told apart by content: a file starting with the MCAP magic
     /// is a trace, anything else is read as OBJ text.
-    pub file: PathBuf,
+    #[arg(required_unless_present = "scene")]
+    pub file: Option<PathBuf>,
+    /// A built-in scene instead of a file (as `sweep` and `record` take
+    /// it): `cube`, `triangle`, `mini_golf`, `bowl`, `box` or `terrain`.
+    #[arg(long, value_enum, conflicts_with = "file")]
+    pub scene: Option<sweeptrace::sim::scenes::BuiltinScene>,
     /// Print one JSON object instead of text.
     #[arg(long)]
     pub json: bool,
@@ -255,10 +261,21 @@ const MCAP_MAGIC: &[u8] = b"\x89MCAP0\r\n";
 
 /// Reads the file's meshes and prints the report.
 pub fn run(args: Args) -> anyhow::Result<Exit> {
-    let name = args.file.display().to_string();
+    let path = match (&args.file, args.scene) {
+        (Some(path), _) => path.clone(),
+        (None, Some(scene)) => {
+            let scene = scene.mesh();
+            let name = format!("the built-in scene `{}`", scene.name);
+            let topology = Topology::new(&scene.vertices, &scene.triangles)
+                .with_context(|| format!("{name}: the mesh"))?;
+            return finish(&args, &name, &[MeshReport::new(scene.name, &topology)], None);
+        }
+        (None, None) => anyhow::bail!("`mesh` needs a file (OBJ or trace) or --scene NAME"),
+    };
+    let name = path.display().to_string();
     let mut head = [0u8; 8];
     let n = {
-        let mut f = super::open_input(&args.file)?;
+        let mut f = super::open_input(&path)?;
         let mut n = 0;
         while n < head.len() {
             let k = f
@@ -274,7 +291,7 @@ pub fn run(args: Args) -> anyhow::Result<Exit> {
     let mut reports = Vec::new();
     let mut truncated = None;
     if head[..n] == *MCAP_MAGIC {
-        let file = super::open_input(&args.file)?;
+        let file = super::open_input(&path)?;
         let reader = TraceReader::new_indexed(std::io::BufReader::new(file), &name);
         for event in reader {
             let event = match event {
@@ -302,17 +319,29 @@ pub fn run(args: Args) -> anyhow::Result<Exit> {
             anyhow::bail!("{name} is a trace without any /scene message: no mesh to check");
         }
     } else {
-        let scene = load_obj(&args.file).map_err(|e| {
+        let scene = load_obj(&path).map_err(|e| {
             anyhow::anyhow!("{e} (`mesh` reads a Wavefront OBJ file or an MCAP trace)")
         })?;
         let topology = Topology::new(&scene.vertices, &scene.triangles)
             .with_context(|| format!("{name}: the mesh"))?;
         reports.push(MeshReport::new(scene.name, &topology));
     }
+    finish(&args, &name, &reports, truncated)
+}
+
+/// Prints the reports of `name` and says how the run ends: 3 when the
+/// trace was `truncated`, 1 when a mesh has a defect that changes
+/// collisions.
+fn finish(
+    args: &Args,
+    name: &str,
+    reports: &[MeshReport],
+    truncated: Option<sweeptrace::trace::TraceError>,
+) -> anyhow::Result<Exit> {
     let report = if args.json {
-        render_json(&name, &reports)
+        render_json(name, reports)
     } else {
-        render_text(&name, &reports)
+        render_text(name, reports)
     };
     print!("{report}");
     if args.json {

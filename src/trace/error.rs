@@ -55,6 +55,13 @@ pub enum TraceError {
         /// File name.
         file: String,
     },
+    /// The file does not start with MCAP's magic bytes: some other file
+    /// (a README, an OBJ mesh, a JSON report), not a trace.
+    #[error("{file}: not an MCAP trace (it does not start with MCAP's magic bytes)")]
+    NotMcap {
+        /// File name.
+        file: String,
+    },
     /// The file ends in the middle of a record (or before its footer).
     #[error(
         "{file}: the file is truncated: it ends in the middle of a record after {messages} complete messages \

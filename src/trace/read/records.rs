@@ -28,6 +28,7 @@ impl State {
                 TraceError::Empty { file }
             }
             McapError::UnexpectedEof if !in_chunk => TraceError::Truncated { file, messages },
+            McapError::BadMagic if !in_chunk && messages == 0 => TraceError::NotMcap { file },
             McapError::RecordTooLarge { opcode, len } => TraceError::TooLarge {
                 file,
                 what: format!("a record with opcode {opcode:#04x} ({context})"),

@@ -1051,12 +1051,19 @@ fn mesh_takes_a_built_in_scene_as_sweep_and_record_do() -> anyhow::Result<()> {
     let dir = tempfile::tempdir()?;
     let (code, out, err) = run(dir.path(), os!["mesh", "--scene", "mini_golf"])?;
     ensure!(
-        code == 0 && out.starts_with("mesh `mini_golf` (the built-in scene `mini_golf`): 56 triangles"),
+        code == 0
+            && out.starts_with("mesh `mini_golf` (the built-in scene `mini_golf`): 56 triangles"),
         "exit {code}\n{out}{err}"
     );
     let (code, out, err) = run(dir.path(), os!["mesh", "--scene", "cube", "x.obj"])?;
-    ensure!(code == 2 && err.contains("cannot be used with"), "exit {code}\n{out}{err}");
+    ensure!(
+        code == 2 && err.contains("cannot be used with"),
+        "exit {code}\n{out}{err}"
+    );
     let (code, out, err) = run(dir.path(), os!["mesh"])?;
-    ensure!(code == 2 && err.contains("<FILE>"), "exit {code}\n{out}{err}");
+    ensure!(
+        code == 2 && err.contains("<FILE>"),
+        "exit {code}\n{out}{err}"
+    );
     Ok(())
 }

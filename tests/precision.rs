@@ -518,12 +518,15 @@ fn a_small_bias_shows_in_the_balance_of_later_and_earlier() -> anyhow::Result<()
 /// judged within that hit's bound, not the fixed 1e-6 (which failed every
 /// such answer on its contact's last digits); the seeded bugs still fail:
 /// a contact 1 % of ρ off, and a hit for a ball 1 % of ρ away.
-fn a_touching_start_answered_as_a_hit_is_judged_by_the_hit_rounding_gives() -> anyhow::Result<()>
-{
+fn a_touching_start_answered_as_a_hit_is_judged_by_the_hit_rounding_gives() -> anyhow::Result<()> {
     use sweeptrace::core::InitialOverlap;
     let scene = SceneMsg {
         name: Some("triangle".into()),
-        vertices: vec![[100.0, 100.0, 0.0], [104.0, 100.0, 0.0], [100.0, 104.0, 0.0]],
+        vertices: vec![
+            [100.0, 100.0, 0.0],
+            [104.0, 100.0, 0.0],
+            [100.0, 104.0, 0.0],
+        ],
         triangles: vec![[0, 1, 2]],
         margin: 0.0,
         facing: Facing::NonStrict,
@@ -559,7 +562,8 @@ fn a_touching_start_answered_as_a_hit_is_judged_by_the_hit_rounding_gives() -> a
             },
             ..ReplayOptions::default()
         };
-        for event in sweeptrace::replay_events(TraceReader::new(bytes.as_slice(), "t.mcap"), options)
+        for event in
+            sweeptrace::replay_events(TraceReader::new(bytes.as_slice(), "t.mcap"), options)
         {
             if let ReplayEvent::Sweep(r) = event? {
                 ensure!(r.outcome.hit.is_none(), "the core hits: {:?}", r.outcome);
@@ -572,7 +576,13 @@ fn a_touching_start_answered_as_a_hit_is_judged_by_the_hit_rounding_gives() -> a
     // (three units) is rounding.
     let touching = judged(1e-9, [101.0 + 2e-5, 101.0, 0.0])?;
     ensure!(
-        matches!(touching, Agreement::Precision { reproduced: Some(_), .. }),
+        matches!(
+            touching,
+            Agreement::Precision {
+                reproduced: Some(_),
+                ..
+            }
+        ),
         "a touching start's hit with an f32 contact: {touching:?}"
     );
     let off = judged(1e-9, [101.0 + 5e-3, 101.0, 0.0])?;

@@ -263,7 +263,12 @@ fn sweep_json_says_the_conventions_it_ran_under() -> anyhow::Result<()> {
 fn a_library_user_gets_the_story_sweep_tells() -> anyhow::Result<()> {
     use sweeptrace::conventions::NormalRule;
     use sweeptrace::core::{Options, Sweep};
-    let vertices = vec![[0.0, 0.0, 0.0], [4.0, 0.0, 0.0], [4.0, 4.0, 0.0], [0.0, 4.0, 0.0]];
+    let vertices = vec![
+        [0.0, 0.0, 0.0],
+        [4.0, 0.0, 0.0],
+        [4.0, 4.0, 0.0],
+        [0.0, 4.0, 0.0],
+    ];
     let triangles = [[0, 1, 2], [0, 3, 2]];
     let mesh = sweeptrace::Mesh::new(vertices.clone(), &triangles)?;
     let topology = sweeptrace::Topology::new(&vertices, &triangles)?;
@@ -279,12 +284,18 @@ fn a_library_user_gets_the_story_sweep_tells() -> anyhow::Result<()> {
     ensure!(story.outcome.hit.is_none(), "{:?}", story.outcome);
     ensure!(
         story.tunnels.len() == 1
-            && story.tunnels[0].sentence(None).contains("through the flipped triangle 1"),
+            && story.tunnels[0]
+                .sentence(None)
+                .contains("through the flipped triangle 1"),
         "{:?}",
         story.tunnels
     );
     ensure!(
-        story.within_reach.iter().any(|d| d.text.contains("triangle 1")) && story.defects == Some(1),
+        story
+            .within_reach
+            .iter()
+            .any(|d| d.text.contains("triangle 1"))
+            && story.defects == Some(1),
         "{:?} {:?}",
         story.within_reach,
         story.defects

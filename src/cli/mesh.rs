@@ -268,7 +268,12 @@ pub fn run(args: Args) -> anyhow::Result<Exit> {
             let name = format!("the built-in scene `{}`", scene.name);
             let topology = Topology::new(&scene.vertices, &scene.triangles)
                 .with_context(|| format!("{name}: the mesh"))?;
-            return finish(&args, &name, &[MeshReport::new(scene.name, &topology)], None);
+            return finish(
+                &args,
+                &name,
+                &[MeshReport::new(scene.name, &topology)],
+                None,
+            );
         }
         (None, None) => anyhow::bail!("`mesh` needs a file (OBJ or trace) or --scene NAME"),
     };

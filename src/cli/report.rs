@@ -4,9 +4,7 @@ use std::fmt::Write;
 
 use serde_json::json;
 
-use sweeptrace::core::{
-    Crossing, Options, Outcome, Sweep, TestRecord, Verdict,
-};
+use sweeptrace::core::{Crossing, Options, Outcome, Sweep, TestRecord, Verdict};
 use sweeptrace::core::{describe, miss_distance, num};
 use sweeptrace::judge::SweepInputs;
 use sweeptrace::replay::{SweepStory, Tunnel, TunnelAt};
@@ -191,7 +189,10 @@ impl SweepReport<'_> {
         let TestRecord::Face(f) = t else {
             return None;
         };
-        self.story.crossings.iter().find(|c| c.triangle == f.triangle)
+        self.story
+            .crossings
+            .iter()
+            .find(|c| c.triangle == f.triangle)
     }
 
     /// A tunnel in words: with the frame and ball, as `check` says it,
@@ -329,7 +330,13 @@ pub fn sweep_text(r: &SweepReport) -> String {
                 .crossing(t)
                 .and_then(|c| crossing_words(t, c, rho))
                 .map_or(String::new(), |w| format!("; {w}"));
-            writeln!(s, "  {}{crossing}{}", describe(t), role(&r.story.outcome, t)).unwrap();
+            writeln!(
+                s,
+                "  {}{crossing}{}",
+                describe(t),
+                role(&r.story.outcome, t)
+            )
+            .unwrap();
         }
         if more_close > 0 {
             writeln!(

@@ -258,7 +258,11 @@ impl Accuracy {
     /// A budget of `units`, which must be as [`Accuracy`]'s parser takes
     /// (clamped into `(0, 2²⁰]` otherwise).
     pub fn new(units: f64) -> Accuracy {
-        Accuracy(if units > 0.0 { units.min(MAX_ACCURACY) } else { 1.0 })
+        Accuracy(if units > 0.0 {
+            units.min(MAX_ACCURACY)
+        } else {
+            1.0
+        })
     }
 
     /// The budget, in units of `u₃₂ · S`.

@@ -311,10 +311,7 @@ impl PartialConventions {
             (quoted(&c.normal), serde_json::json!(c.normal)),
             (quoted(&c.ties), serde_json::json!(c.ties)),
             match c.budget() {
-                Some(units) => (
-                    crate::numbers::shortest(units),
-                    serde_json::json!(units),
-                ),
+                Some(units) => (crate::numbers::shortest(units), serde_json::json!(units)),
                 None => (String::new(), serde_json::Value::Null),
             },
         ];

@@ -49,8 +49,8 @@ pub use error::{MeshError, SweepError};
 pub use explain::{describe, miss_distance, num};
 pub use feature::{Feature, Kind};
 pub use fragility::{FragileReason, Fragility};
-pub use initial::initial_contacts;
 pub(crate) use initial::closest_point;
+pub use initial::initial_contacts;
 pub use mesh::{DegenerateReason, DegenerateTriangle, Mesh, MeshBytes, StandardFrame, Triangle};
 pub use options::{
     ALPHA_SENSITIVITY, DEGENERATE_TOLERANCE, FRAGILE_ULPS, Facing, GRAZING_COSINE, InitialOverlap,

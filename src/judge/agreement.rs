@@ -164,8 +164,8 @@ fn judge(
     // By backward error (single precision, or a declared accuracy): the
     // tolerances widened to this sweep's bound at the budget (computed
     // only here, for a sweep that differs).
-    let sensitivity = budget
-        .and_then(|_| Sensitivity::of(result).map(|s| s.observing(expected, got, tol)));
+    let sensitivity =
+        budget.and_then(|_| Sensitivity::of(result).map(|s| s.observing(expected, got, tol)));
     let widened = sensitivity.zip(budget).map(|(s, c)| s.widen(tol, c));
     let fixed = tol;
     let tol_judged = widened.as_ref().unwrap_or(tol);

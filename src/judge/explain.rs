@@ -96,7 +96,11 @@ pub fn explain_initial(result: &SweepResult) -> Vec<String> {
         let line = format!(
             "{}initial contact: {} at distance {} < ρ = {} from the start \
              (initial_overlap = {}): a hit at α = 0",
-            if primary { "primary: " } else { "also at α = 0: " },
+            if primary {
+                "primary: "
+            } else {
+                "also at α = 0: "
+            },
             name(c),
             num(*distance),
             num(path.rho),
@@ -131,38 +135,40 @@ pub fn initial_why(result: &SweepResult, test: &ExpectedTest, triangle: u32) -> 
         .with_mesh_scale(&lo, &hi);
     let convention = format!("initial_overlap = {}", options.initial_overlap);
     let contacts = crate::core::initial_contacts(&result.scene.mesh, &path, options);
-    Some(match contacts.iter().find(|(h, _)| h.triangle == triangle) {
-        Some((h, distance)) => format!(
-            "the ball starts within ρ of triangle {triangle} (its nearest point, on its {}, \
+    Some(
+        match contacts.iter().find(|(h, _)| h.triangle == triangle) {
+            Some((h, distance)) => format!(
+                "the ball starts within ρ of triangle {triangle} (its nearest point, on its {}, \
              at distance {} < ρ = {}): under {convention} an initial contact at α = 0, tied \
              with the core's (the answer is compared with that contact)",
-            match h.feature.index() {
-                None => "face".to_string(),
-                Some(f) => format!("{} {f}", h.feature.kind()),
-            },
-            num(*distance),
-            num(path.rho)
-        ),
-        None => {
-            let t = result.scene.mesh.triangle_by_index(triangle)?;
-            let (point, _) = crate::core::closest_point(t, &path.p0);
-            let distance = (path.p0 - point).norm();
-            if distance >= path.rho {
-                format!(
-                    "the ball starts {} from triangle {triangle}, not within ρ = {}: under \
+                match h.feature.index() {
+                    None => "face".to_string(),
+                    Some(f) => format!("{} {f}", h.feature.kind()),
+                },
+                num(*distance),
+                num(path.rho)
+            ),
+            None => {
+                let t = result.scene.mesh.triangle_by_index(triangle)?;
+                let (point, _) = crate::core::closest_point(t, &path.p0);
+                let distance = (path.p0 - point).norm();
+                if distance >= path.rho {
+                    format!(
+                        "the ball starts {} from triangle {triangle}, not within ρ = {}: under \
                      {convention} no initial contact",
-                    num(distance),
-                    num(path.rho)
-                )
-            } else {
-                format!(
-                    "the ball starts within ρ of triangle {triangle} (distance {}) but moves \
+                        num(distance),
+                        num(path.rho)
+                    )
+                } else {
+                    format!(
+                        "the ball starts within ρ of triangle {triangle} (distance {}) but moves \
                      away from its front, which {convention} does not count as a contact",
-                    num(distance)
-                )
+                        num(distance)
+                    )
+                }
             }
-        }
-    })
+        },
+    )
 }
 
 /// A hit the core does not find, named when it is one of an engine's known
@@ -171,7 +177,11 @@ pub fn initial_why(result: &SweepResult, test: &ExpectedTest, triangle: u32) -> 
 /// grazing angle` (at the answer's `α` the ball is not within `ρ` of the
 /// triangle and moves away from it). `None` otherwise, and when the core
 /// hits too.
-pub fn limitation(result: &SweepResult, expected: &OutcomeMsg, tests: &[ExpectedTest]) -> Option<String> {
+pub fn limitation(
+    result: &SweepResult,
+    expected: &OutcomeMsg,
+    tests: &[ExpectedTest],
+) -> Option<String> {
     if expected.kind == Kind::None || result.outcome.hit.is_some() {
         return None;
     }

@@ -246,9 +246,18 @@ impl Rounding<'_> {
             } => {
                 // A sweep the core misses has no hit to bound the fields
                 // by: the perturbed decision's hit does.
-                let own = sensitivity.is_none().then(|| decision.sensitivity()).flatten();
-                widening_needed(decision, answer, fixed, sensitivity.or(own.as_ref()), budget - k)
-                    .map(|widening| k + widening)
+                let own = sensitivity
+                    .is_none()
+                    .then(|| decision.sensitivity())
+                    .flatten();
+                widening_needed(
+                    decision,
+                    answer,
+                    fixed,
+                    sensitivity.or(own.as_ref()),
+                    budget - k,
+                )
+                .map(|widening| k + widening)
             }
         }
     }
@@ -285,7 +294,11 @@ pub(super) fn reproduce(
                 let spent = own
                     .as_ref()
                     .and_then(|d| rounding.accepts(d, answer, 0.0))
-                    .unwrap_or(if own.is_some() { rounding.budget() } else { 0.0 });
+                    .unwrap_or(if own.is_some() {
+                        rounding.budget()
+                    } else {
+                        0.0
+                    });
                 *side = Some((None, spent));
             }
         }

@@ -210,11 +210,17 @@ pub fn infer_conventions<E>(
     // be named) is kept on the second. The second pass tries only the keys
     // the first did not declare.
     // Then the accuracy is calibrated; when it is coarser than single
-    // precision, every key is tried once more under it (an engine's
+    // precision, every key is tried again under it (an engine's
     // convention hidden by its solver's accuracy shows once that is held
-    // apart: Rapier's starts while leaving, alpha0_always).
+    // apart: Rapier's starts while leaving, alpha0_always), pass after
+    // pass while one changes something (at most three).
     let mut declared_in_first: Vec<&'static str> = Vec::new();
-    for pass in 0..3 {
+    let mut changed = true;
+    for pass in 0..5 {
+        if pass >= 3 && !changed {
+            break;
+        }
+        changed = false;
         if pass == 1 {
             declared_in_first = evidence.iter().map(|e| e.key).collect();
         }
@@ -309,6 +315,7 @@ pub fn infer_conventions<E>(
             };
             evidence.retain(|e: &Evidence| e.key != key);
             best = trying;
+            changed = true;
             best_trial = trial;
             let value = best
                 .declared()

@@ -271,7 +271,7 @@ fn check_junit_failure_and_error_carry_the_first_problem() -> anyhow::Result<()>
     ensure!(error.has_tag_name("error"), "{xml}");
     let message = attr(error, "message")?;
     ensure!(
-        message.contains("corrupt MCAP data")
+        message.contains("not an MCAP trace")
             && !message.contains('\n')
             && !message.starts_with(s(&not_a_trace)),
         "error message: {message}"

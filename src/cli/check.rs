@@ -282,11 +282,30 @@ pub fn run(args: Args) -> anyhow::Result<Exit> {
             Some((command, _)) => format!("the engine `{}`", command.text),
             None => "the traces' /expected".to_string(),
         };
+        // The engine runs once per trace: its answers do not depend on
+        // the conventions tried, so every trial judges the same answers
+        // (a run that did not end cleanly is run again in the trial, whose
+        // report says why).
+        let mut recorded: Vec<Option<sweeptrace::suite::RecordedAnswers>> = Vec::new();
+        if let Some((command, engine_options)) = &engine {
+            for path in &traces {
+                match sweeptrace::suite::record_engine_answers(path, command, *engine_options) {
+                    Ok(answers) => recorded.push(answers),
+                    Err(err) => {
+                        eprintln!(
+                            "error: {}: {err}\nno configuration inferred",
+                            path.display()
+                        );
+                        return Ok(Exit::EngineUnavailable);
+                    }
+                }
+            }
+        }
         // A trace that cannot be checked, or a fault of the engine, ends
         // the inference: its exit code and its message; no table.
         let inferred = sweeptrace::suite::infer_conventions(|conventions| {
             let mut reports: Vec<TraceReport> = Vec::new();
-            for (path, settings) in traces.iter().zip(&settings) {
+            for (i, (path, settings)) in traces.iter().zip(&settings).enumerate() {
                 let base = settings.check_options(options);
                 let options = CheckOptions {
                     replay: ReplayOptions {
@@ -295,9 +314,14 @@ pub fn run(args: Args) -> anyhow::Result<Exit> {
                     },
                     ..base
                 };
-                let report = match &engine {
-                    None => check_file(path, &options),
-                    Some((command, engine_options)) => check_file_with_engine(
+                let report = match (&engine, recorded.get(i).and_then(Option::as_ref)) {
+                    (None, _) => check_file(path, &options),
+                    (Some(_), Some(answers)) => sweeptrace::suite::check_recorded_answers(
+                        answers,
+                        &path.display().to_string(),
+                        &options,
+                    ),
+                    (Some((command, engine_options)), None) => check_file_with_engine(
                         path,
                         command,
                         *engine_options,

@@ -10,7 +10,7 @@ use crate::engine::{
     AnswerSink, EngineAnswers, EngineCommand, EngineError, EngineOptions, EngineSession,
 };
 use crate::replay::SweepResult;
-use crate::trace::{EXPECTED_TOPIC, OutcomeMsg, TraceReader};
+use crate::trace::{EXPECTED_TOPIC, ExpectedSource, OutcomeMsg, TraceEvent, TraceReader};
 
 use super::check::{CheckOptions, check_file, check_stream, judge_against_core};
 use super::report::{Against, EngineCheck, Judged, TraceReport};
@@ -113,4 +113,81 @@ pub fn judge_answer_against_expected(
         got: answer,
         got_is_core: false,
     })
+}
+
+/// One engine's answers to one trace, kept to be judged again
+/// ([`record_engine_answers`]): `--infer-config` judges the same answers
+/// under many conventions, and an engine does not answer differently for
+/// them, so it runs once per trace instead of once per trial.
+#[derive(Clone, Debug)]
+pub struct RecordedAnswers {
+    /// The trace's events, the engine's answers as its expectations (the
+    /// trace's own `/expected` left out).
+    events: Vec<TraceEvent>,
+    /// The trace's expectations' source, as its reader found it.
+    expected_source: Option<ExpectedSource>,
+    /// The engine's command, as the report names it.
+    command: String,
+}
+
+/// Runs the engine over the trace at `path` once and keeps its answers;
+/// `Ok(None)` when the run did not end cleanly (the file cannot be
+/// opened, a trace error, a fault of the engine): then judge with
+/// [`check_file_with_engine`], whose report says what went wrong. `Err`
+/// only when the engine cannot be started.
+pub fn record_engine_answers(
+    path: &std::path::Path,
+    command: &EngineCommand,
+    engine: EngineOptions,
+) -> Result<Option<RecordedAnswers>, EngineError> {
+    let name = path.display().to_string();
+    let Ok(file) = std::fs::File::open(path) else {
+        return Ok(None);
+    };
+    let session = EngineSession::start(command, engine)?;
+    let mut reader = TraceReader::new(std::io::BufReader::with_capacity(1 << 16, file), &name);
+    let mut answers = EngineAnswers::new(reader.by_ref(), session, engine.window);
+    let mut events = Vec::new();
+    for event in answers.by_ref() {
+        match event {
+            Ok(event) => events.push(event),
+            Err(_) => return Ok(None),
+        }
+    }
+    if let Some(error) = answers.finish().error {
+        if error.cannot_start() {
+            return Err(error);
+        }
+        return Ok(None);
+    }
+    Ok(Some(RecordedAnswers {
+        events,
+        expected_source: reader.expected_source().cloned(),
+        command: command.text.clone(),
+    }))
+}
+
+/// The report of [`check_file_with_engine`] against the core for the
+/// answers `recorded` kept (the same judgement, without running the
+/// engine again): `name` is the trace's.
+pub fn check_recorded_answers(
+    recorded: &RecordedAnswers,
+    name: &str,
+    options: &CheckOptions,
+) -> TraceReport {
+    let events = recorded.events.iter().cloned().map(Ok);
+    let (mut report, _) = check_stream(events, name, options, |result| {
+        judge_against_core(result, &options.tolerances)
+    });
+    report.engine = Some(EngineCheck {
+        command: recorded.command.clone(),
+        against: Against::Core,
+    });
+    if report.tunnels.count > 0 {
+        report.tunnels.of_the_recording = true;
+        report.tunnels.fail = false;
+    }
+    report.expected_source = recorded.expected_source.clone();
+    report.expectations.has_channel = true;
+    report
 }

@@ -48,7 +48,9 @@ pub use diff::{
     DiffReport, FirstDifference, Side, diff, render_diff_json, render_diff_text, scene_differences,
 };
 pub use discovery::{Discovered, DiscoveryError, discover, find_traces};
-pub use engine_check::check_file_with_engine;
+pub use engine_check::{
+    RecordedAnswers, check_file_with_engine, check_recorded_answers, record_engine_answers,
+};
 pub use infer::{Inferred, Spread};
 pub use infer_conventions::{Evidence, InferredConventions, Trial, infer_conventions};
 pub use junit::{check_junit, github_annotations};

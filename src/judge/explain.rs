@@ -183,14 +183,18 @@ const GRAZING_DEGREES: f64 = 10.0;
 /// (the exact test meets the triangle only beyond `α = 1`), or `a false hit
 /// while leaving at a grazing angle` (at the answer's `α` the ball is not
 /// within `ρ` of the triangle and moves away from it, less than 10° off
-/// its surface). `None` otherwise, and when the core hits too.
+/// its surface); when the core hits later, `an early hit` or `a seam bump`
+/// ([`early_hit`]). `None` otherwise.
 pub fn limitation(
     result: &SweepResult,
     expected: &OutcomeMsg,
     tests: &[ExpectedTest],
 ) -> Option<String> {
-    if expected.kind == Kind::None || result.outcome.hit.is_some() {
+    if expected.kind == Kind::None {
         return None;
+    }
+    if let Some(hit) = result.outcome.hit {
+        return early_hit(result, expected, hit.alpha);
     }
     let triangle = expected.triangle.flatten()?;
     if !(0.0..=1.0).contains(&expected.alpha) {
@@ -240,6 +244,55 @@ pub fn limitation(
         num(expected.alpha),
         num(distance - path.rho),
         num(angle)
+    ))
+}
+
+/// An answer that hits before the core does (`core_alpha`), where at the
+/// answer's `α` the ball is still beyond `ρ` of the answer's triangle, by at
+/// most 1 % of `ρ`: `an early hit`, and `a seam bump` when the answer is at
+/// an internal flat or concave edge or vertex (a ball rolling over a seam
+/// kicked up).
+fn early_hit(result: &SweepResult, expected: &OutcomeMsg, core_alpha: f64) -> Option<String> {
+    if !(expected.alpha >= 0.0 && expected.alpha < core_alpha) {
+        return None;
+    }
+    let triangle = expected.triangle.flatten()?;
+    let options = result.options();
+    let (lo, hi) = result.scene.mesh.bounds();
+    let path = crate::core::SweptPath::new(&result.sweep, options)
+        .ok()?
+        .with_mesh_scale(&lo, &hi);
+    let t = result.scene.mesh.triangle_by_index(triangle)?;
+    let centre = path.p0 + path.d * expected.alpha;
+    let (point, _) = crate::core::closest_point(t, &centre);
+    let gap = (centre - point).norm() - path.rho;
+    if !(gap > 0.0 && gap <= NEAR_MISS * path.rho) {
+        return None;
+    }
+    let feature = match (expected.kind, expected.feature.flatten()) {
+        (Kind::Edge, Some(i)) => Some(crate::core::Feature::Edge(i)),
+        (Kind::Vertex, Some(i)) => Some(crate::core::Feature::Vertex(i)),
+        _ => None,
+    };
+    let seam = feature
+        .and_then(|f| crate::replay::feature_class(&result.scene.topology, triangle, f))
+        .is_some_and(|c| {
+            matches!(
+                c,
+                crate::core::EdgeClass::Flat | crate::core::EdgeClass::Concave
+            )
+        });
+    Some(format!(
+        "{}: at the answer's α = {} the ball is still {} beyond ρ from triangle {triangle}; \
+         the core meets the surface at α = {}",
+        if seam {
+            "a seam bump (an early hit at an internal flat or concave place)"
+        } else {
+            "an early hit"
+        },
+        num(expected.alpha),
+        num(gap),
+        num(core_alpha)
     ))
 }
 

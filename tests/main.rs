@@ -88,9 +88,42 @@ pub fn trial<T: TrialResult, E: support::Fail>(
     f: impl FnOnce() -> Result<T, E> + Send + 'static,
 ) -> Trial {
     Trial::ignorable_test(name, move || {
-        f().map(TrialResult::into_completion)
-            .map_err(|e| Failed::from(e.message()))
+        let completion = f()
+            .map(TrialResult::into_completion)
+            .map_err(|e| Failed::from(e.message()))?;
+        if let Completion::Ignored { reason } = &completion {
+            let reason = reason.as_deref().unwrap_or("(no reason given)");
+            let first = reason.lines().next().unwrap_or(reason).to_string();
+            if let Ok(mut skipped) = SKIPPED.lock() {
+                *skipped.entry(first).or_insert(0) += 1;
+            }
+        }
+        Ok(completion)
     })
+}
+
+/// The tests that found at run time that they cannot run here, by reason
+/// (its first line): summarised after the run, so that "N ignored" says
+/// why without scrolling back.
+static SKIPPED: std::sync::Mutex<std::collections::BTreeMap<String, usize>> =
+    std::sync::Mutex::new(std::collections::BTreeMap::new());
+
+/// The summary of [`SKIPPED`], or nothing when every test could run.
+fn print_skipped() {
+    let Ok(skipped) = SKIPPED.lock() else { return };
+    if skipped.is_empty() {
+        return;
+    }
+    let total: usize = skipped.values().sum();
+    println!(
+        "{total} {} skipped because {} cannot run here (not failures; CI installs \
+         what they need and requires them):",
+        if total == 1 { "test was" } else { "tests were" },
+        if total == 1 { "it" } else { "they" },
+    );
+    for (reason, count) in skipped.iter() {
+        println!("  {count} × {reason}");
+    }
 }
 
 /// Registers the test function `f` under the name `module::f`, so that the
@@ -170,7 +203,9 @@ fn main() {
     trials.extend(architecture::tests());
     trials.extend(docs::tests());
     let trials = mark_slow(trials);
-    libtest_mimic::run(&args, trials).exit();
+    let conclusion = libtest_mimic::run(&args, trials);
+    print_skipped();
+    conclusion.exit();
 }
 
 /// The trials that take seconds each on their own (a 100,000-sweep oracle,
@@ -190,6 +225,8 @@ const SLOW: &[&str] = &[
     "jolt::jolt_conforms_under_its_config_and_its_broken_variants_do_not",
     "jolt::jolt_config_is_what_infer_config_prints",
     "jolt::jolt_with_back_faces_is_judged_two_sided_under_sides_two",
+    "jolt::a_calibrated_accuracy_catches_a_bias_single_precision_excuses",
+    "jolt::every_seeded_bug_fails_conform_and_check",
     "rapier_js::rapier_answers_every_sample_sweep_within_its_measured_failures",
     "rapier_js::rapier_stop_at_penetration_switch_changes_the_starts_only",
     "rapier_js::rapier_passes_the_miss_rules_of_conform_under_its_table",

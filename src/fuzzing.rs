@@ -277,10 +277,8 @@ pub fn check_core(data: &[u8]) -> Result<(), String> {
     }
 
     // The per-test functions on their own, on every triangle.
-    let (lo, hi) = mesh.bounds();
-    let path = SweptPath::new(&sweep, &options)
-        .map_err(|e| format!("the path is refused after the sweep was accepted: {e}"))?
-        .with_mesh_scale(&lo, &hi);
+    let path = SweptPath::against(&mesh, &sweep, &options)
+        .map_err(|e| format!("the path is refused after the sweep was accepted: {e}"))?;
     for triangle in mesh.triangles() {
         check_record_alpha(&TestRecord::Face(sweep_face(triangle, &path, facing)))?;
         for feature in 0..3 {

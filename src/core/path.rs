@@ -99,6 +99,18 @@ impl SweptPath {
         })
     }
 
+    /// The path of `sweep` against `mesh`, as the mesh sweep tests it:
+    /// [`SweptPath::new`] with [`SweptPath::scale`] raised to cover the
+    /// mesh's bounds ([`SweptPath::with_mesh_scale`]).
+    pub fn against(
+        mesh: &super::Mesh,
+        sweep: &Sweep,
+        options: &Options,
+    ) -> Result<SweptPath, SweepError> {
+        let (lo, hi) = mesh.bounds();
+        Ok(SweptPath::new(sweep, options)?.with_mesh_scale(&lo, &hi))
+    }
+
     /// The path with [`SweptPath::scale`] raised to cover a mesh whose
     /// axis-aligned bounds are `(lo, hi)`.
     pub fn with_mesh_scale(mut self, lo: &Point3<f64>, hi: &Point3<f64>) -> SweptPath {

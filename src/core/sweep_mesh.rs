@@ -405,8 +405,7 @@ pub fn sweep_mesh_with<O: Observer>(
     broadphase: Broadphase,
     observer: &mut O,
 ) -> Result<Outcome, SweepError> {
-    let (lo, hi) = mesh.bounds();
-    let path = SweptPath::new(sweep, options)?.with_mesh_scale(&lo, &hi);
+    let path = SweptPath::against(mesh, sweep, options)?;
     let outcome = sweep_path(
         mesh,
         &path,

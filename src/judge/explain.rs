@@ -68,6 +68,12 @@ pub fn explain_outcome(outcome: &Outcome, records: &[TestRecord]) -> Vec<String>
         .collect()
 }
 
+/// The path of `result`'s sweep against its scene's mesh, as the core
+/// tested it; `None` for an invalid sweep.
+fn path_of(result: &SweepResult) -> Option<crate::core::SweptPath> {
+    crate::core::SweptPath::against(&result.scene.mesh, &result.sweep, result.options()).ok()
+}
+
 /// The initial contacts that decided a hit at `α = 0` under a declared
 /// `initial_overlap` (no test of the sweep reports it): the primary then
 /// the others tied with it, each with its distance from the start; empty
@@ -80,11 +86,9 @@ pub fn explain_initial(result: &SweepResult) -> Vec<String> {
     if options.initial_overlap.is_rules() {
         return Vec::new();
     }
-    let (lo, hi) = result.scene.mesh.bounds();
-    let Ok(path) = crate::core::SweptPath::new(&result.sweep, options) else {
+    let Some(path) = path_of(result) else {
         return Vec::new();
     };
-    let path = path.with_mesh_scale(&lo, &hi);
     let contacts = crate::core::initial_contacts(&result.scene.mesh, &path, options);
     let name = |h: &crate::core::SweepHit| match h.feature.index() {
         None => format!("face {}", h.triangle),
@@ -129,10 +133,7 @@ pub fn initial_why(result: &SweepResult, test: &ExpectedTest, triangle: u32) -> 
     {
         return None;
     }
-    let (lo, hi) = result.scene.mesh.bounds();
-    let path = crate::core::SweptPath::new(&result.sweep, options)
-        .ok()?
-        .with_mesh_scale(&lo, &hi);
+    let path = path_of(result)?;
     let convention = format!("initial_overlap = {}", options.initial_overlap);
     let contacts = crate::core::initial_contacts(&result.scene.mesh, &path, options);
     Some(
@@ -200,11 +201,7 @@ pub fn limitation(
     if !(0.0..=1.0).contains(&expected.alpha) {
         return None;
     }
-    let options = result.options();
-    let (lo, hi) = result.scene.mesh.bounds();
-    let path = crate::core::SweptPath::new(&result.sweep, options)
-        .ok()?
-        .with_mesh_scale(&lo, &hi);
+    let path = path_of(result)?;
     let t = result.scene.mesh.triangle_by_index(triangle)?;
     // Only a near miss is named (a gap of at most 1 % of ρ): further off,
     // the answer is some other mistake (a margin ignored, a wrong radius).
@@ -257,11 +254,7 @@ fn early_hit(result: &SweepResult, expected: &OutcomeMsg, core_alpha: f64) -> Op
         return None;
     }
     let triangle = expected.triangle.flatten()?;
-    let options = result.options();
-    let (lo, hi) = result.scene.mesh.bounds();
-    let path = crate::core::SweptPath::new(&result.sweep, options)
-        .ok()?
-        .with_mesh_scale(&lo, &hi);
+    let path = path_of(result)?;
     let t = result.scene.mesh.triangle_by_index(triangle)?;
     let centre = path.p0 + path.d * expected.alpha;
     let (point, _) = crate::core::closest_point(t, &centre);

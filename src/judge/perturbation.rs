@@ -182,13 +182,7 @@ fn perturbations_of(u: f64, units: &[f64]) -> impl Iterator<Item = Perturbation>
 /// The sweep's rounding unit `u = ε · S` against `mesh` (the scale the
 /// core's tests use); `None` when the sweep is invalid.
 fn rounding_unit(mesh: &Mesh, sweep: &Sweep, options: &Options) -> Option<f64> {
-    let (lo, hi) = mesh.bounds();
-    Some(
-        SweptPath::new(sweep, options)
-            .ok()?
-            .with_mesh_scale(&lo, &hi)
-            .rounding(),
-    )
+    Some(SweptPath::against(mesh, sweep, options).ok()?.rounding())
 }
 
 /// The arithmetic a divergence is excused in: what a perturbation of the

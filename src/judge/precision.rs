@@ -148,10 +148,7 @@ impl Sensitivity {
     /// The sensitivity of the core's hit `hit` on `sweep` in `scene` (a
     /// perturbed sweep's, when the unperturbed one is a miss).
     pub(super) fn of_hit(scene: &SceneState, sweep: &Sweep, hit: &SweepHit) -> Option<Sensitivity> {
-        let (lo, hi) = scene.mesh.bounds();
-        let path = SweptPath::new(sweep, &scene.options)
-            .ok()?
-            .with_mesh_scale(&lo, &hi);
+        let path = SweptPath::against(&scene.mesh, sweep, &scene.options).ok()?;
         let unit = F32_UNIT * path.scale;
         let d = path.d;
         let centre = path.p0 + d * hit.alpha;

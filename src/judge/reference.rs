@@ -74,10 +74,7 @@ impl<'a> Decision<'a> {
         let initial = if !scene.options.initial_overlap.is_rules()
             && outcome.hit.is_some_and(|h| h.alpha == 0.0)
         {
-            let (lo, hi) = scene.mesh.bounds();
-            let path = SweptPath::new(sweep, &scene.options)
-                .ok()?
-                .with_mesh_scale(&lo, &hi);
+            let path = SweptPath::against(&scene.mesh, sweep, &scene.options).ok()?;
             initial_contacts(&scene.mesh, &path, &scene.options)
                 .into_iter()
                 .map(|(h, _)| h)

@@ -310,25 +310,7 @@ fn a_tie_member_is_reported_by_what_differs_from_it() -> anyhow::Result<Completi
         Ok(e) => e,
         Err(skip) => return Ok(skip),
     };
-    let trace = root().join("traces/record_bowl_margin.mcap");
-    let trace = trace.display().to_string();
-    let config = config();
-    let args = [
-        "check",
-        &trace,
-        "--frames",
-        "0",
-        "--ball",
-        "1",
-        "--engine",
-        &engine,
-        "--config",
-        &config,
-        "--accuracy",
-        "16",
-    ];
-    let args: Vec<&std::ffi::OsStr> = args.iter().map(std::ffi::OsStr::new).collect();
-    let (_, text, _) = run_bin(&args)?;
+    let (_, text) = one_sweep_held_to_16(&engine, "record_bowl_margin.mcap", "0", "1")?;
     ensure!(
         text.contains("frame 0, ball 1: normal differs"),
         "the tie member's difference: {text}"
@@ -358,7 +340,6 @@ fn rapiers_limitations_are_named_when_they_fail() -> anyhow::Result<Completion> 
         Ok(e) => e,
         Err(skip) => return Ok(skip),
     };
-    let config = config();
     for (trace, frame, ball, named) in [
         (
             "record_mini_golf.mcap",
@@ -379,24 +360,38 @@ fn rapiers_limitations_are_named_when_they_fail() -> anyhow::Result<Completion> 
             "named: a seam bump (an early hit at an internal flat or concave place)",
         ),
     ] {
-        let trace = root().join("traces").join(trace).display().to_string();
-        let args = [
-            "check",
-            &trace,
-            "--frames",
-            frame,
-            "--ball",
-            ball,
-            "--engine",
-            &engine,
-            "--config",
-            &config,
-            "--accuracy",
-            "16",
-        ];
-        let args: Vec<&std::ffi::OsStr> = args.iter().map(std::ffi::OsStr::new).collect();
-        let (code, text, _) = run_bin(&args)?;
+        let (code, text) = one_sweep_held_to_16(&engine, trace, frame, ball)?;
         ensure!(code == 1 && text.contains(named), "exit {code}: {text}");
     }
     Ok(Completion::Completed)
+}
+
+/// `check` of one sweep of a sample trace (`frame`, `ball`) against Rapier
+/// under its table but held to single precision's 16 units: exit code and
+/// text.
+fn one_sweep_held_to_16(
+    engine: &str,
+    trace: &str,
+    frame: &str,
+    ball: &str,
+) -> anyhow::Result<(i32, String)> {
+    let trace = root().join("traces").join(trace).display().to_string();
+    let config = config();
+    let args = [
+        "check",
+        &trace,
+        "--frames",
+        frame,
+        "--ball",
+        ball,
+        "--engine",
+        engine,
+        "--config",
+        &config,
+        "--accuracy",
+        "16",
+    ];
+    let args: Vec<&std::ffi::OsStr> = args.iter().map(std::ffi::OsStr::new).collect();
+    let (code, text, _) = run_bin(&args)?;
+    Ok((code, text))
 }

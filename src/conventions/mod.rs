@@ -132,7 +132,10 @@ pub enum NormalRule {
     /// more than [`ACTIVE_EDGE_DEGREES`]; a vertex hit is active when
     /// either edge of its triangle at the vertex is. An engine that
     /// removes ghost contacts this way answers the face normal on internal
-    /// flat and concave places.
+    /// flat and concave places, except that on a triangle with an active
+    /// edge a contact normal within 1° of the triangle's is kept, as
+    /// Jolt's `ActiveEdges::FixNormal` does
+    /// ([`ACTIVE_EDGE_KEEP_DEGREES`]).
     ActiveEdges,
 }
 
@@ -140,6 +143,14 @@ pub enum NormalRule {
 /// active ([`NormalRule::ActiveEdges`]): Jolt's default
 /// (`MeshShapeSettings::mActiveEdgeCosThresholdAngle` = cos 5°).
 pub const ACTIVE_EDGE_DEGREES: f64 = 5.0;
+
+/// Under [`NormalRule::ActiveEdges`], a contact normal within this angle of
+/// the triangle's normal is kept at an inactive edge or vertex when the
+/// triangle has an active edge (Jolt's `ActiveEdges::FixNormal`: the
+/// contact normal is left alone when it is within 1° of the triangle's,
+/// after the check that the triangle has any active edge). On a triangle
+/// with no active edge the face normal is answered whatever the angle.
+pub const ACTIVE_EDGE_KEEP_DEGREES: f64 = 1.0;
 
 /// The margin an engine uses: the scene's (the rules) or always the same.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]

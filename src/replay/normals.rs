@@ -2,9 +2,11 @@
 //! convention ([`NormalRule`]): the face normal, the contact normal, or the
 //! contact normal at active edges only, with the scene's active edges.
 
+use nalgebra::Vector3;
+
 use crate::core::{EdgeClass, Feature, Mesh, Outcome, Sweep, Topology};
 
-use crate::conventions::{ACTIVE_EDGE_DEGREES, NormalRule};
+use crate::conventions::{ACTIVE_EDGE_DEGREES, ACTIVE_EDGE_KEEP_DEGREES, NormalRule};
 
 /// Which normal the hits of a scene report ([`NormalRule`]), with what the
 /// rule needs of the scene: for [`NormalRule::ActiveEdges`], each
@@ -16,17 +18,25 @@ pub struct SceneNormals {
     /// By input triangle: bit `i` set when edge `i` is *not* active (empty
     /// unless the rule is [`NormalRule::ActiveEdges`]).
     inactive: Vec<u8>,
+    /// By input triangle: its front normal (empty unless the rule is
+    /// [`NormalRule::ActiveEdges`]), for the contact normal kept within
+    /// [`ACTIVE_EDGE_KEEP_DEGREES`] of it.
+    fronts: Vec<Vector3<f64>>,
 }
 
 impl SceneNormals {
     /// The normals of `rule` over `mesh` and its `topology`.
     pub fn new(rule: NormalRule, mesh: &Mesh, topology: &Topology) -> SceneNormals {
-        let inactive = if rule == NormalRule::ActiveEdges {
-            inactive_edges(mesh, topology)
+        let (inactive, fronts) = if rule == NormalRule::ActiveEdges {
+            (inactive_edges(mesh, topology), front_normals(mesh))
         } else {
-            Vec::new()
+            (Vec::new(), Vec::new())
         };
-        SceneNormals { rule, inactive }
+        SceneNormals {
+            rule,
+            inactive,
+            fronts,
+        }
     }
 
     /// Whether feature `feature` of `triangle` reports the contact normal.
@@ -58,17 +68,44 @@ impl SceneNormals {
         contact: &nalgebra::Point3<f64>,
         face_normal: nalgebra::Vector3<f64>,
     ) -> nalgebra::Vector3<f64> {
-        if !self.contact_normal_at(triangle, feature) {
-            return face_normal;
+        let contact_normal = || {
+            let centre = sweep.p0 + (sweep.p1 - sweep.p0) * alpha;
+            let towards = centre - contact;
+            let length = towards.norm();
+            (length > 0.0 && length.is_finite()).then(|| towards / length)
+        };
+        if self.contact_normal_at(triangle, feature) {
+            return contact_normal().unwrap_or(face_normal);
         }
-        let centre = sweep.p0 + (sweep.p1 - sweep.p0) * alpha;
-        let towards = centre - contact;
-        let length = towards.norm();
-        if length > 0.0 && length.is_finite() {
-            towards / length
-        } else {
-            face_normal
+        if self.keeps_near_contact_normal(triangle, feature) {
+            // Jolt keeps a contact normal within 1° of the triangle's own
+            // (on the side the hit faces).
+            let Some(front) = self.fronts.get(triangle as usize) else {
+                return face_normal;
+            };
+            let own = if front.dot(&face_normal) < 0.0 {
+                -front
+            } else {
+                *front
+            };
+            let keep = ACTIVE_EDGE_KEEP_DEGREES.to_radians().cos();
+            if let Some(n) = contact_normal().filter(|n| n.dot(&own) > keep) {
+                return n;
+            }
         }
+        face_normal
+    }
+
+    /// Whether an inactive edge or vertex hit on `triangle` keeps a contact
+    /// normal near the face's ([`ACTIVE_EDGE_KEEP_DEGREES`]): under
+    /// [`NormalRule::ActiveEdges`], when the triangle has an active edge.
+    fn keeps_near_contact_normal(&self, triangle: u32, feature: Feature) -> bool {
+        self.rule == NormalRule::ActiveEdges
+            && feature != Feature::Face
+            && self
+                .inactive
+                .get(triangle as usize)
+                .is_some_and(|bits| bits & 0b111 != 0b111)
     }
 
     /// `outcome` with the normal this rule reports.
@@ -85,6 +122,15 @@ impl SceneNormals {
         }
         outcome
     }
+}
+
+/// By input triangle, its front normal (zero for a triangle left out).
+fn front_normals(mesh: &Mesh) -> Vec<Vector3<f64>> {
+    let mut fronts = vec![Vector3::zeros(); mesh.input_triangle_count()];
+    for t in mesh.triangles() {
+        fronts[t.index as usize] = t.normal;
+    }
+    fronts
 }
 
 /// By input triangle, the bits of its edges that are not active (see
@@ -121,4 +167,94 @@ fn inactive_edges(mesh: &Mesh, topology: &Topology) -> Vec<u8> {
         }
     }
     bits
+}
+
+#[cfg(test)]
+mod tests {
+    use nalgebra::{Point3, Vector3};
+
+    use super::SceneNormals;
+    use crate::conventions::NormalRule;
+    use crate::core::{Feature, Mesh, Sweep, Topology};
+
+    /// Triangle 0 in z = 0 with, across its edge 0 (y = 0), triangle 1
+    /// folded down by 2° (an inactive convex edge) and, across its edge 1,
+    /// triangle 2 folded down by 20° (active).
+    fn ridge() -> (Vec<[f64; 3]>, Vec<[u64; 3]>) {
+        let t2 = 2f64.to_radians().tan();
+        let t20 = 20f64.to_radians().tan();
+        let out = 2.0 / 2f64.sqrt();
+        let vertices = vec![
+            [0.0, 0.0, 0.0],
+            [2.0, 0.0, 0.0],
+            [0.0, 2.0, 0.0],
+            [1.0, -2.0, -2.0 * t2],
+            [1.0 + out, 1.0 + out, -2.0 * t20],
+        ];
+        (vertices, vec![[0, 1, 2], [1, 0, 3], [2, 1, 4]])
+    }
+
+    fn normals(vertices: Vec<[f64; 3]>, triangles: &[[u64; 3]]) -> SceneNormals {
+        let topology = Topology::new(&vertices, triangles).unwrap();
+        let mesh = Mesh::new(vertices, triangles).unwrap();
+        SceneNormals::new(NormalRule::ActiveEdges, &mesh, &topology)
+    }
+
+    /// The normal answered for a ball of radius 1 touching the point (1, 0, 0)
+    /// of edge 0 of `triangle` from a direction `degrees` off +z toward -y.
+    fn answer(normals: &SceneNormals, triangle: u32, degrees: f64) -> Vector3<f64> {
+        let (s, c) = degrees.to_radians().sin_cos();
+        let centre = [1.0, -s, c];
+        let sweep = Sweep::new(centre, [1.0, -s, c - 1.0], 1.0);
+        let contact = Point3::new(1.0, 0.0, 0.0);
+        normals.normal(
+            &sweep,
+            0.0,
+            triangle,
+            Feature::Edge(0),
+            &contact,
+            Vector3::z(),
+        )
+    }
+
+    #[test]
+    fn an_inactive_edge_keeps_a_contact_normal_within_one_degree_when_its_triangle_has_an_active_edge()
+     {
+        let (vertices, triangles) = ridge();
+        let normals = normals(vertices, &triangles);
+        // Jolt's ActiveEdges::FixNormal: within 1° of the face, the contact
+        // normal is left alone.
+        let kept = answer(&normals, 0, 0.5);
+        let (s, c) = 0.5f64.to_radians().sin_cos();
+        assert!((kept - Vector3::new(0.0, -s, c)).norm() < 1e-12, "{kept}");
+        // Beyond 1°, the face normal.
+        assert_eq!(answer(&normals, 0, 1.5), Vector3::z());
+    }
+
+    #[test]
+    fn a_triangle_with_no_active_edge_answers_its_face_normal_at_any_angle() {
+        // A 3 × 3 grid of unit squares in z = 0: the middle square's two
+        // triangles have only flat (inactive) edges.
+        let mut vertices = Vec::new();
+        for y in 0..4 {
+            for x in 0..4 {
+                vertices.push([x as f64, y as f64, 0.0]);
+            }
+        }
+        let mut triangles = Vec::new();
+        for y in 0..3u64 {
+            for x in 0..3u64 {
+                let i = y * 4 + x;
+                triangles.push([i, i + 1, i + 5]);
+                triangles.push([i, i + 5, i + 4]);
+            }
+        }
+        let normals = normals(vertices, &triangles);
+        // Triangle 8 is [5, 6, 10]: its edge 0 runs from (1, 1) to (2, 1).
+        let (s, c) = 0.5f64.to_radians().sin_cos();
+        let sweep = Sweep::new([1.5, 1.0 - s, c], [1.5, 1.0 - s, c - 1.0], 1.0);
+        let contact = Point3::new(1.5, 1.0, 0.0);
+        let n = normals.normal(&sweep, 0.0, 8, Feature::Edge(0), &contact, Vector3::z());
+        assert_eq!(n, Vector3::z());
+    }
 }

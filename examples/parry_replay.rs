@@ -48,7 +48,11 @@ fn main() -> anyhow::Result<()> {
                 None
             }
             Some(EventBody::Scene(scene)) => Some(scene),
-            Some(EventBody::Expected(_)) => continue,
+            Some(
+                EventBody::Expected(_) | EventBody::Contact(_) | EventBody::ExpectedContacts(_),
+            ) => {
+                continue;
+            }
             None => None,
         };
         // A batch is answered when full, before a new scene and at the end.

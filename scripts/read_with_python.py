@@ -10,9 +10,13 @@ encodings of the three channels, that every message is a map in the
 channels' message encoding (`json`, or with --encoding cbor, CBOR decoded
 with `cbor2`, whose numbers must then be 8-byte doubles or integers), and
 the message counts (against the summary's statistics and, when given,
-against --scenes/--sweeps/--expected). Exits 1 on any mismatch.
+against --scenes/--sweeps/--expected/--contacts/--expected-contacts; the
+two contact channels are optional, checked alike when present, and every
+contact message must have a 3-number centre or a list of contacts). Exits
+1 on any mismatch.
 
     venv/bin/python scripts/read_with_python.py TRACE.mcap [--scenes N] [--sweeps N] [--expected N]
+        [--contacts N] [--expected-contacts N]
         [--engine NAME [--engine-version V] [--setting NAME=VALUE ...] | --no-expected-source]
         [--encoding json|cbor]
 """
@@ -28,6 +32,12 @@ CHANNELS = {
     "/scene": "sweeptrace.Scene",
     "/sweep": "sweeptrace.Sweep",
     "/expected": "sweeptrace.Outcome",
+}
+# Channels a trace has only when it holds contact queries (checked alike
+# when present).
+OPTIONAL_CHANNELS = {
+    "/contact": "sweeptrace.Contact",
+    "/expected_contacts": "sweeptrace.Contacts",
 }
 
 
@@ -109,6 +119,8 @@ def main():
     parser.add_argument("--scenes", type=int)
     parser.add_argument("--sweeps", type=int)
     parser.add_argument("--expected", type=int)
+    parser.add_argument("--contacts", type=int, help="/contact messages")
+    parser.add_argument("--expected-contacts", type=int, help="/expected_contacts messages")
     parser.add_argument("--engine", help="the expected source's engine")
     parser.add_argument("--engine-version", default="", help="its version ('' when absent)")
     parser.add_argument("--setting", action="append", default=[], metavar="NAME=VALUE",
@@ -144,7 +156,7 @@ def main():
             seen = set()
             for channel in summary.channels.values():
                 seen.add(channel.topic)
-                want = CHANNELS.get(channel.topic)
+                want = CHANNELS.get(channel.topic, OPTIONAL_CHANNELS.get(channel.topic))
                 if want is None:
                     continue
                 schema = summary.schemas.get(channel.schema_id)
@@ -165,7 +177,7 @@ def main():
         counts = {}
         for _schema, channel, message in reader.iter_messages(log_time_order=False):
             counts[channel.topic] = counts.get(channel.topic, 0) + 1
-            if channel.topic not in CHANNELS:
+            if channel.topic not in CHANNELS and channel.topic not in OPTIONAL_CHANNELS:
                 continue
             try:
                 value = decode(message.data)
@@ -174,15 +186,21 @@ def main():
                 continue
             if not isinstance(value, dict):
                 problems.append(f"{channel.topic}: message at log_time {message.log_time} is not a map: {value!r}")
+            elif channel.topic == "/contact" and not (
+                    isinstance(value.get("centre"), list) and len(value["centre"]) == 3):
+                problems.append(f"{channel.topic}: message at log_time {message.log_time}: centre {value.get('centre')!r} is not 3 numbers")
+            elif channel.topic == "/expected_contacts" and not isinstance(value.get("contacts"), list):
+                problems.append(f"{channel.topic}: message at log_time {message.log_time}: contacts {value.get('contacts')!r} is not a list")
             elif channel.topic == "/sweep" and not isinstance(value.get("radius"), float):
                 problems.append(f"{channel.topic}: message at log_time {message.log_time}: radius {value.get('radius')!r} is not a float")
             if args.encoding == "cbor" and not cbor_doubles_only(message.data):
                 problems.append(f"{channel.topic}: message at log_time {message.log_time} has a float shorter than 8 bytes")
 
-    for topic in CHANNELS:
+    for topic in [*CHANNELS, *OPTIONAL_CHANNELS]:
         if summary_counts and summary_counts.get(topic, 0) != counts.get(topic, 0):
             problems.append(f"{topic}: {counts.get(topic, 0)} messages read, statistics say {summary_counts.get(topic, 0)}")
-    for topic, want in [("/scene", args.scenes), ("/sweep", args.sweeps), ("/expected", args.expected)]:
+    for topic, want in [("/scene", args.scenes), ("/sweep", args.sweeps), ("/expected", args.expected),
+                        ("/contact", args.contacts), ("/expected_contacts", args.expected_contacts)]:
         if want is not None and counts.get(topic, 0) != want:
             problems.append(f"{topic}: {counts.get(topic, 0)} messages, expected {want}")
 

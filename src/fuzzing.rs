@@ -9,12 +9,14 @@
 //! assert too.
 
 use crate::core::{
-    Broadphase, CollectRecords, Facing, Mesh, MeshError, Options, Outcome, Sweep, SweptPath,
-    TestRecord, sweep_edge, sweep_face, sweep_mesh, sweep_mesh_with, sweep_vertex,
+    Broadphase, CollectRecords, ContactQuery, Facing, Mesh, MeshError, Options, Outcome, Sides,
+    Sweep, SweptPath, TestRecord, contact_set, sweep_edge, sweep_face, sweep_mesh, sweep_mesh_with,
+    sweep_vertex,
 };
 use crate::trace::{
     Encoding, EventBody, MessageAt, OutcomeMsg, ReadLimits, SceneMsg, SweepMsg, TraceReader,
-    parse_message_as, validate_outcome, validate_scene, validate_sweep,
+    parse_message_as, validate_contact, validate_contacts, validate_outcome, validate_scene,
+    validate_sweep,
 };
 
 pub use crate::error_text::repeated_segment;
@@ -109,6 +111,29 @@ fn check_reading<R: std::io::Read>(mut reader: TraceReader<R>, input: &[u8]) -> 
             EventBody::Expected(outcome) => {
                 validate_outcome(&outcome)
                     .map_err(|p| format!("a yielded outcome is invalid: {p:?}"))?;
+            }
+            EventBody::Contact(contact) => {
+                let Some((mesh, _, _)) = &scene else {
+                    return Err("a contact query was yielded before any scene".into());
+                };
+                validate_contact(&contact)
+                    .map_err(|p| format!("a yielded contact query is invalid: {p:?}"))?;
+                if let Some(mesh) = mesh {
+                    let query = ContactQuery {
+                        centre: contact.centre.into(),
+                        radius: contact.radius,
+                        distance: contact.distance,
+                    };
+                    for c in contact_set(mesh, &query, Sides::One) {
+                        if !(c.separation.is_finite() && c.normal.iter().all(|x| x.is_finite())) {
+                            return Err(format!("a contact has a non-finite value: {c:?}"));
+                        }
+                    }
+                }
+            }
+            EventBody::ExpectedContacts(contacts) => {
+                validate_contacts(&contacts)
+                    .map_err(|p| format!("yielded contacts are invalid: {p:?}"))?;
             }
         }
     }

@@ -181,7 +181,8 @@ fn cbor_floats_round_trip_bit_for_bit() -> anyhow::Result<()> {
                     out.push(sweep.radius.to_bits());
                     out.extend(sweep.p0.iter().chain(&sweep.p1).map(|x| x.to_bits()));
                 }
-                EventBody::Expected(_) => {}
+                EventBody::Expected(_) | EventBody::Contact(_) | EventBody::ExpectedContacts(_) => {
+                }
             }
         }
         out
@@ -663,32 +664,23 @@ fn cbor_python_reads_ours() -> anyhow::Result<Completion> {
         &path,
         write_events_as(&events, default_opts(), Encoding::Cbor)?,
     )?;
-    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("scripts/read_with_python.py");
-    let run = |extra: &[&str]| {
-        std::process::Command::new("python3")
-            .arg(&script)
-            .arg(&path)
-            .args(extra)
-            .output()
-    };
-    let ok = run(&[
-        "--encoding",
-        "cbor",
-        "--scenes",
-        "2",
-        "--sweeps",
-        "60",
-        "--expected",
-        "30",
-    ])?;
-    ensure!(
-        ok.status.success(),
-        "script failed: {}{}",
-        String::from_utf8_lossy(&ok.stdout),
-        String::from_utf8_lossy(&ok.stderr)
-    );
+    crate::support::read_with_python(
+        &path,
+        &[
+            "--encoding",
+            "cbor",
+            "--scenes",
+            "2",
+            "--sweeps",
+            "60",
+            "--expected",
+            "30",
+        ],
+    )?;
     // And it can fail: the channels are not JSON.
-    let bad = run(&["--sweeps", "60"])?;
-    ensure!(!bad.status.success(), "the script took CBOR for JSON");
+    ensure!(
+        crate::support::read_with_python(&path, &["--sweeps", "60"]).is_err(),
+        "the script took CBOR for JSON"
+    );
     Ok(Completion::Completed)
 }

@@ -12,6 +12,7 @@ mod bless_select;
 mod cbor;
 mod check;
 mod conform;
+mod contacts;
 mod core_cases;
 mod core_decisions;
 mod core_random;
@@ -163,6 +164,7 @@ fn main() {
     trials.extend(suite_config::tests());
     trials.extend(trace_io::tests());
     trials.extend(cbor::tests());
+    trials.extend(contacts::tests());
     trials.extend(replay::tests());
     trials.extend(primary_skips::tests());
     trials.extend(record::tests());

@@ -88,6 +88,7 @@ fn read(bytes: &[u8], name: &str) -> anyhow::Result<Read> {
             EventBody::Scene(scene) => r.scenes.push(scene),
             EventBody::Sweep(sweep) => r.sweeps.push((event.header.log_time_nanos, sweep)),
             EventBody::Expected(outcome) => r.expected.push(outcome),
+            EventBody::Contact(_) | EventBody::ExpectedContacts(_) => {}
         }
     }
     Ok(r)

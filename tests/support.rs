@@ -397,6 +397,8 @@ pub fn write_event<W: std::io::Write + std::io::Seek>(
         EventBody::Scene(scene) => w.scene(log_time_nanos, scene),
         EventBody::Sweep(sweep) => w.sweep(log_time_nanos, sweep),
         EventBody::Expected(outcome) => w.expected(log_time_nanos, outcome),
+        EventBody::Contact(contact) => w.contact(log_time_nanos, contact),
+        EventBody::ExpectedContacts(contacts) => w.expected_contacts(log_time_nanos, contacts),
     }
 }
 
@@ -440,4 +442,24 @@ pub fn node_engine(
             "skipped: {m}; {REQUIRE_NODE}=1 makes this a failure"
         )))),
     }
+}
+
+/// `python3 scripts/read_with_python.py TRACE ARGS...` (the independent
+/// reader): `Ok(())` when it accepts the trace, the error with its output
+/// when it does not.
+pub fn read_with_python(trace: &std::path::Path, args: &[&str]) -> anyhow::Result<()> {
+    let script =
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scripts/read_with_python.py");
+    let out = std::process::Command::new("python3")
+        .arg(&script)
+        .arg(trace)
+        .args(args)
+        .output()?;
+    anyhow::ensure!(
+        out.status.success(),
+        "scripts/read_with_python.py {args:?} refused it: {}{}",
+        String::from_utf8_lossy(&out.stdout),
+        String::from_utf8_lossy(&out.stderr)
+    );
+    Ok(())
 }

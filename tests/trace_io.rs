@@ -3,7 +3,6 @@
 
 use std::collections::BTreeMap;
 use std::io::Cursor;
-use std::path::Path;
 
 use libtest_mimic::{Completion, Trial};
 use mcap::records::MessageHeader;
@@ -1270,24 +1269,15 @@ fn python_reads_our_trace() -> anyhow::Result<Completion> {
     let path = dir.path().join("py.mcap");
     let events = sample_events(30);
     std::fs::write(&path, write_events(&events, default_opts())?)?;
-    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("scripts/read_with_python.py");
-    let run = |extra: &[&str]| {
-        std::process::Command::new("python3")
-            .arg(&script)
-            .arg(&path)
-            .args(extra)
-            .output()
-    };
-    let ok = run(&["--scenes", "2", "--sweeps", "60", "--expected", "30"])?;
-    ensure!(
-        ok.status.success(),
-        "script failed: {}{}",
-        String::from_utf8_lossy(&ok.stdout),
-        String::from_utf8_lossy(&ok.stderr)
-    );
+    crate::support::read_with_python(
+        &path,
+        &["--scenes", "2", "--sweeps", "60", "--expected", "30"],
+    )?;
     // And it can fail.
-    let bad = run(&["--sweeps", "61"])?;
-    ensure!(!bad.status.success(), "script accepted a wrong count");
+    ensure!(
+        crate::support::read_with_python(&path, &["--sweeps", "61"]).is_err(),
+        "script accepted a wrong count"
+    );
     Ok(Completion::Completed)
 }
 

@@ -122,7 +122,9 @@ pub fn run(args: Args) -> anyhow::Result<Exit> {
                 match event.body {
                     EventBody::Scene(scene) => w.scene(log_time_nanos, &scene)?,
                     EventBody::Sweep(sweep) => w.sweep(log_time_nanos, &sweep)?,
-                    EventBody::Expected(_) => {}
+                    EventBody::Expected(_)
+                    | EventBody::Contact(_)
+                    | EventBody::ExpectedContacts(_) => {}
                 }
             }
             Ok::<_, sweeptrace::trace::TraceError>(())

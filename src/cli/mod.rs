@@ -257,6 +257,14 @@ pub fn parse_point(s: &str) -> Result<[f64; 3], String> {
     Ok(out)
 }
 
+/// Parses one finite number `≥ 0` (decimal, or hexadecimal floating
+/// point).
+pub fn parse_non_negative(s: &str) -> Result<f64, String> {
+    let v = sweeptrace::numbers::parse_f64(s).ok_or_else(|| format!("`{s}` is not a number"))?;
+    sweeptrace::numbers::check(v, sweeptrace::numbers::Rule::NonNegative)?;
+    Ok(v)
+}
+
 /// Parses one finite number (decimal, or hexadecimal floating point).
 pub fn parse_number(s: &str) -> Result<f64, String> {
     let v = sweeptrace::numbers::parse_f64(s).ok_or_else(|| format!("`{s}` is not a number"))?;

@@ -89,6 +89,18 @@ pub struct Args {
     /// parsing). See docs/TRACE_FORMAT.md.
     #[arg(long, value_enum, default_value_t = Encoding::Json, value_name = "ENCODING")]
     pub encoding: Encoding,
+    /// Also record a contact query after every sweep (`/contact`, the ball
+    /// where the sweep leaves it), with the core's contacts there as the
+    /// expectation (`/expected_contacts`; face normals, as the rules
+    /// report). See docs/SEMANTICS.md, "Contacts".
+    #[arg(long)]
+    pub contacts: bool,
+    /// The contact distance of the queries `--contacts` records: a triangle
+    /// this far from the ball is still in contact (an engine's speculative
+    /// contact distance) [default: a tenth of the radius, so that a ball
+    /// resting on the mesh is in contact beyond rounding].
+    #[arg(long, value_name = "DISTANCE", requires = "contacts", value_parser = super::parse_non_negative)]
+    pub contact_distance: Option<f64>,
 }
 
 impl Args {
@@ -246,6 +258,9 @@ pub fn run(args: Args) -> anyhow::Result<Exit> {
         .unwrap_or_else(|| PathBuf::from(format!("{}.mcap", scene.name)));
     let scene_msg = sim::scene_message(&scene, &options);
 
+    let contact_distance = args.contact_distance.unwrap_or(options.radius / 10.0);
+    // Queries, queries with a contact, contacts.
+    let mut contacts = (0u64, 0u64, 0u64);
     let bar = progress_bar(options.frames);
     super::warn_unfinished(&output);
     let summary = write_trace_file_with_encoding(
@@ -262,6 +277,14 @@ pub fn run(args: Args) -> anyhow::Result<Exit> {
             let summary = sim::simulate(&mesh, &options, |event| -> anyhow::Result<()> {
                 writer.sweep(event.log_time_nanos, &event.sweep)?;
                 writer.expected(event.log_time_nanos, &event.outcome)?;
+                if args.contacts {
+                    let (query, answer) = event.contacts(&mesh, contact_distance);
+                    contacts.0 += 1;
+                    contacts.1 += u64::from(!answer.contacts.is_empty());
+                    contacts.2 += answer.contacts.len() as u64;
+                    writer.contact(event.log_time_nanos, &query)?;
+                    writer.expected_contacts(event.log_time_nanos, &answer)?;
+                }
                 if event.sim_frame >= shown + 256 {
                     shown = event.sim_frame;
                     bar.set_position(shown);
@@ -283,6 +306,15 @@ pub fn run(args: Args) -> anyhow::Result<Exit> {
             &output.display().to_string()
         )
     );
+    if args.contacts {
+        println!(
+            "Contact queries: {} (one after each sweep, contact distance {}), {} of them with a contact, {} in all.",
+            contacts.0,
+            sweeptrace::numbers::Shortest(contact_distance),
+            contacts.1,
+            sweeptrace::numbers::counted(contacts.2, "contact", "contacts")
+        );
+    }
     Ok(Exit::Success)
 }
 

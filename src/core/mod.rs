@@ -20,6 +20,7 @@
 //! and the defects (flipped windings, cracks, T-junctions, ...).
 
 mod bvh;
+mod contact;
 mod crossing;
 mod error;
 pub(crate) mod explain;
@@ -41,6 +42,7 @@ mod sweep_vertex;
 mod ties;
 mod topology;
 
+pub use contact::{Contact, ContactQuery, contact_set, triangle_contact};
 pub use crossing::{
     Crossing, all_crossings, crossing_tolerance, first_crossing, first_crossing_with_flipped,
     triangle_crossing, triangle_crossing_back_to_front,

@@ -134,6 +134,12 @@ where
                             self.queue.push_back(Queued::Ready(Ok(event)));
                         }
                     }
+                    // Contact queries are not asked of the engine (the
+                    // protocol has no contact request yet): they pass
+                    // through with the trace's own answers.
+                    EventBody::Contact(_) | EventBody::ExpectedContacts(_) => {
+                        self.queue.push_back(Queued::Ready(Ok(event)));
+                    }
                     EventBody::Scene(scene) => {
                         session.send_scene(scene)?;
                         self.queue.push_back(Queued::Ready(Ok(event)));

@@ -18,7 +18,9 @@
 //!   failures hint at ([`ConventionHints`]);
 //! - one divergent sweep as every report shows it ([`Divergence`],
 //!   [`divergence_details`], [`render_divergence_as`]);
-//! - one sweep's inputs, bit-exactly ([`SweepInputs`]).
+//! - one sweep's inputs, bit-exactly ([`SweepInputs`]);
+//! - an engine's contacts for one contact query against the core's contact
+//!   set ([`judge_contacts`], [`ContactVerdict`]).
 //!
 //! The judge depends on the core, the trace messages and the replay only;
 //! running a folder of traces is the suite's job ([`crate::suite`]).
@@ -27,6 +29,7 @@
 
 mod agreement;
 mod compare;
+mod contacts;
 mod decision;
 mod divergence;
 mod explain;
@@ -42,6 +45,9 @@ pub use compare::{
     ContactAxis, DEFAULT_ALPHA_TOLERANCE, DEFAULT_CONTACT_TOLERANCE,
     DEFAULT_NORMAL_TOLERANCE_DEGREES, Field, FieldDiff, FieldSet, Tolerances, angle_degrees,
     compare,
+};
+pub use contacts::{
+    ContactProblem, ContactScene, ContactTolerances, ContactVerdict, judge_contacts,
 };
 pub(crate) use decision::write_decision_line;
 #[cfg(feature = "viewer")]

@@ -74,6 +74,20 @@ impl SceneNormals {
             let length = towards.norm();
             (length > 0.0 && length.is_finite()).then(|| towards / length)
         };
+        self.rule_normal(triangle, feature, contact_normal, face_normal)
+    }
+
+    /// The normal this rule reports on `feature` of `triangle`, given the
+    /// contact normal there (`contact_normal`, asked only when the rule
+    /// needs it; `None` when the centre is on the mesh) and the face normal
+    /// (the rules' normal there).
+    pub fn rule_normal(
+        &self,
+        triangle: u32,
+        feature: Feature,
+        contact_normal: impl FnOnce() -> Option<Vector3<f64>>,
+        face_normal: Vector3<f64>,
+    ) -> Vector3<f64> {
         if self.contact_normal_at(triangle, feature) {
             return contact_normal().unwrap_or(face_normal);
         }

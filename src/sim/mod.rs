@@ -33,12 +33,15 @@ use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use thiserror::Error;
 
-use crate::core::{Facing, Kind, Mesh, Options, Sweep, SweepError, SweepHit, sweep_mesh};
+use crate::core::{
+    ContactQuery, Facing, Kind, Mesh, Options, Sides, Sweep, SweepError, SweepHit, contact_set,
+    sweep_mesh,
+};
 use crate::numbers::{self, Rule};
 mod obj;
 pub mod scenes;
 
-use crate::trace::{OutcomeMsg, SceneMsg, SweepMsg};
+use crate::trace::{ContactMsg, ContactPointMsg, ContactsMsg, OutcomeMsg, SceneMsg, SweepMsg};
 pub use obj::{ObjError, load_obj, obj_from_reader, obj_instead_of_trace};
 use scenes::SceneMesh;
 
@@ -255,6 +258,41 @@ pub struct Event {
     pub sweep: SweepMsg,
     /// The `/expected` message.
     pub outcome: OutcomeMsg,
+}
+
+impl Event {
+    /// The contact query where the event's sweep leaves the ball (its
+    /// centre at the sweep's `α`: touching the mesh after a hit, at the
+    /// path's end after a miss), with the contact `distance`, and the
+    /// core's contacts there as the recording engine's answer (each with
+    /// the rules' normal, the face normal on the ball's side).
+    pub fn contacts(&self, mesh: &Mesh, distance: f64) -> (ContactMsg, ContactsMsg) {
+        let s = &self.sweep;
+        let alpha = self.outcome.alpha;
+        let centre = [0, 1, 2].map(|k| s.p0[k] + (s.p1[k] - s.p0[k]) * alpha);
+        let query = ContactMsg {
+            frame: s.frame,
+            ball: s.ball,
+            radius: s.radius,
+            centre,
+            distance,
+        };
+        let set = contact_set(
+            mesh,
+            &ContactQuery {
+                centre: centre.into(),
+                radius: s.radius,
+                distance,
+            },
+            Sides::One,
+        );
+        let answer = ContactsMsg {
+            frame: s.frame,
+            ball: s.ball,
+            contacts: set.iter().map(ContactPointMsg::from_contact).collect(),
+        };
+        (query, answer)
+    }
 }
 
 /// Why a ball stopped recording.

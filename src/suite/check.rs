@@ -18,6 +18,7 @@ use crate::core::{Feature, Kind};
 use crate::replay::{ReplayError, ReplayEvent, ReplayOptions, ReplaySummary, SweepResult};
 use crate::trace::{EXPECTED_TOPIC, EventBody, TraceError, TraceEvent, TraceReader};
 
+use super::contact_check::{ContactChecker, ContactMode};
 use super::ghost_count::count_ghosts;
 use super::infer::{ComparedSweep, MAX_INFERENCE_SWEEPS, infer};
 use super::report::{
@@ -89,9 +90,13 @@ fn check_trace<R: std::io::Read>(
     name: &str,
     options: &CheckOptions,
 ) -> TraceReport {
-    let (mut report, _) = check_stream(reader.by_ref(), name, options, |result| {
-        judge_against_core(result, &options.tolerances)
-    });
+    let (mut report, _) = check_stream(
+        reader.by_ref(),
+        name,
+        options,
+        ContactMode::Judge,
+        |result| judge_against_core(result, &options.tolerances),
+    );
     report.expectations.has_channel = reader.stats().channels.contains_key(EXPECTED_TOPIC);
     report.expected_source = reader.expected_source().cloned();
     report
@@ -134,7 +139,7 @@ where
     I: Iterator<Item = Result<TraceEvent, TraceError>>,
     J: FnMut(&SweepResult) -> Option<Judged>,
 {
-    let (mut report, saw_expected) = check_stream(events, name, options, judge);
+    let (mut report, saw_expected) = check_stream(events, name, options, ContactMode::Judge, judge);
     report.expectations.has_channel = saw_expected;
     report
 }
@@ -142,11 +147,13 @@ where
 /// The check of a stream of events with `judge`, except whether the trace
 /// has an `/expected` channel (`has_channel` is left false: each caller
 /// sets it once, from what it knows); returns the report and whether any
-/// `/expected` message was seen.
+/// `/expected` message was seen. The contact queries are judged beside
+/// the sweeps, or only counted (`contacts`).
 pub(crate) fn check_stream<I, J>(
     events: I,
     name: &str,
     options: &CheckOptions,
+    contacts: ContactMode,
     mut judge: J,
 ) -> (TraceReport, bool)
 where
@@ -154,15 +161,13 @@ where
     J: FnMut(&SweepResult) -> Option<Judged>,
 {
     let mut saw_expected = false;
+    let mut contact_checker = ContactChecker::new(options, contacts);
     let events = events.inspect(|e| {
-        if matches!(
-            e,
-            Ok(TraceEvent {
-                body: EventBody::Expected(_),
-                ..
-            })
-        ) {
-            saw_expected = true;
+        if let Ok(event) = e {
+            if matches!(event.body, EventBody::Expected(_)) {
+                saw_expected = true;
+            }
+            contact_checker.event(event);
         }
     });
     let replay_options = ReplayOptions {
@@ -191,7 +196,19 @@ where
     }
     let summary = replay.summary();
     drop(replay);
-    (report.finish(&summary), saw_expected)
+    let mut report = report.finish(&summary);
+    let (contacts, ghost_count, ghosts, errors) = contact_checker.finish();
+    report.contacts = contacts;
+    report.ghosts.count += ghost_count;
+    for ghost in ghosts {
+        if report.ghosts.contacts.len() < super::ghost_count::MAX_LISTED_GHOSTS {
+            report.ghosts.contacts.push(ghost);
+        }
+    }
+    for error in errors {
+        report.add_error(error);
+    }
+    (report, saw_expected)
 }
 
 /// `check`'s fold: one trace's report, built sweep by sweep.

@@ -13,6 +13,7 @@ use crate::replay::SweepResult;
 use crate::trace::{EXPECTED_TOPIC, ExpectedSource, OutcomeMsg, TraceEvent, TraceReader};
 
 use super::check::{CheckOptions, check_file, check_stream, judge_against_core};
+use super::contact_check::ContactMode;
 use super::report::{Against, EngineCheck, Judged, TraceReport};
 use crate::judge::Tolerances;
 use crate::judge::agreement_of;
@@ -55,9 +56,13 @@ pub fn check_file_with_engine(
     let (mut report, run) = match against {
         Against::Core => {
             let mut answers = EngineAnswers::new(reader.by_ref(), session, engine.window);
-            let (report, _) = check_stream(answers.by_ref(), &name, options, |result| {
-                judge_against_core(result, &options.tolerances)
-            });
+            let (report, _) = check_stream(
+                answers.by_ref(),
+                &name,
+                options,
+                ContactMode::NotAsked,
+                |result| judge_against_core(result, &options.tolerances),
+            );
             (report, answers.finish())
         }
         Against::Expected => {
@@ -68,10 +73,16 @@ pub fn check_file_with_engine(
                 engine.window,
                 sink.clone(),
             );
-            let (report, _) = check_stream(answers.by_ref(), &name, options, |result| {
-                let answer = sink.borrow_mut().remove(&(result.frame, result.ball))?;
-                judge_answer_against_expected(result, answer, &options.tolerances)
-            });
+            let (report, _) = check_stream(
+                answers.by_ref(),
+                &name,
+                options,
+                ContactMode::NotAsked,
+                |result| {
+                    let answer = sink.borrow_mut().remove(&(result.frame, result.ball))?;
+                    judge_answer_against_expected(result, answer, &options.tolerances)
+                },
+            );
             (report, answers.finish())
         }
     };
@@ -176,7 +187,7 @@ pub fn check_recorded_answers(
     options: &CheckOptions,
 ) -> TraceReport {
     let events = recorded.events.iter().cloned().map(Ok);
-    let (mut report, _) = check_stream(events, name, options, |result| {
+    let (mut report, _) = check_stream(events, name, options, ContactMode::NotAsked, |result| {
         judge_against_core(result, &options.tolerances)
     });
     report.engine = Some(EngineCheck {

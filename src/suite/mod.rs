@@ -21,6 +21,7 @@
 mod bless;
 mod check;
 mod config;
+mod contact_check;
 mod diff;
 mod discovery;
 mod engine_check;
@@ -44,6 +45,7 @@ pub use config::{
     ConfigError, ConfigFile, ConfigFiles, Overrides, Settings, normalize, render_settings_json,
     render_settings_text, resolve, settings_for,
 };
+pub use contact_check::{ContactsReport, MAX_CONTACT_DETAILS};
 pub use diff::{
     DiffReport, FirstDifference, Side, diff, render_diff_json, render_diff_text, scene_differences,
 };

@@ -185,7 +185,8 @@ fn names_and_counts<K: std::fmt::Display>(counts: &BTreeMap<K, u64>) -> String {
 /// contacts.
 fn failures(r: &TraceReport) -> Vec<String> {
     let mut failures: Vec<String> = Vec::new();
-    if r.divergent > 0 || !(r.fails_on_tunnels() || r.fails_on_ghosts()) {
+    let contacts_fail = r.contacts.divergent > 0;
+    if r.divergent > 0 || !(r.fails_on_tunnels() || r.fails_on_ghosts() || contacts_fail) {
         failures.push(format!(
             "{} of {} compared {} {} ({})",
             r.divergent,
@@ -193,6 +194,19 @@ fn failures(r: &TraceReport) -> Vec<String> {
             crate::numbers::plural(r.compared, "sweep"),
             crate::numbers::verb(r.divergent, "diverges", "diverge"),
             names_and_counts(&r.divergences.by_kind)
+        ));
+    }
+    if contacts_fail {
+        failures.push(format!(
+            "{} of {} contact {} {} (the reported contacts are not the core's contact set)",
+            r.contacts.divergent,
+            r.contacts.compared,
+            if r.contacts.compared == 1 {
+                "query"
+            } else {
+                "queries"
+            },
+            crate::numbers::verb(r.contacts.divergent, "diverges", "diverge"),
         ));
     }
     if r.fails_on_tunnels() {
@@ -225,9 +239,57 @@ fn write_conventions(s: &mut String, r: &TraceReport) {
     }
 }
 
+/// The contact queries: their counts, and the first divergent ones with
+/// each problem on a line.
+fn write_contacts(s: &mut String, r: &TraceReport) {
+    let c = &r.contacts;
+    if c.is_empty() {
+        return;
+    }
+    let mut line = format!(
+        "  contacts: {}, {} compared, {} {}",
+        crate::numbers::counted(c.queries, "query", "queries"),
+        c.compared,
+        c.divergent,
+        crate::numbers::verb(c.divergent, "diverges", "diverge")
+    );
+    if c.without_answer > 0 {
+        let _ = write!(line, ", {} without an answer", c.without_answer);
+    }
+    if c.answers_without_query > 0 {
+        let _ = write!(
+            line,
+            ", {} answers without a query",
+            c.answers_without_query
+        );
+    }
+    if c.not_asked > 0 {
+        let _ = write!(
+            line,
+            ", {} not judged (the engine protocol has no contact request yet)",
+            c.not_asked
+        );
+    }
+    let _ = writeln!(s, "{line}");
+    for v in &c.details {
+        let _ = writeln!(
+            s,
+            "  contact divergence at frame {}, ball {}: the core finds {}, the answer has {}",
+            v.frame,
+            v.ball,
+            crate::numbers::counted(v.reference as u64, "contact", "contacts"),
+            v.answered
+        );
+        for p in &v.problems {
+            let _ = writeln!(s, "    {p}");
+        }
+    }
+}
+
 /// The listed tunnels and ghost contacts, one line each, and how many
 /// more there are.
 fn write_tunnels_and_ghosts(s: &mut String, r: &TraceReport) {
+    write_contacts(s, r);
     for t in &r.tunnels.details {
         let _ = writeln!(s, "  tunnel: {}", t.line());
     }

@@ -12,6 +12,7 @@ use crate::core::{FragileReason, Kind};
 use crate::replay::{GhostContact, Tunnel, TunnelAt, TunnelKind};
 use crate::trace::OutcomeMsg;
 
+use super::contact_check::ContactsReport;
 use super::infer::Inferred;
 use crate::conventions::EngineConventions;
 use crate::judge::Agreement;
@@ -105,9 +106,13 @@ impl TraceReport {
     pub fn status(&self) -> Status {
         if !self.errors.is_empty() {
             Status::Error
-        } else if self.divergent > 0 || self.fails_on_tunnels() || self.fails_on_ghosts() {
+        } else if self.divergent > 0
+            || self.contacts.divergent > 0
+            || self.fails_on_tunnels()
+            || self.fails_on_ghosts()
+        {
             Status::Fail
-        } else if self.compared == 0 {
+        } else if self.compared == 0 && self.contacts.compared == 0 {
             Status::NoExpectations
         } else {
             Status::Ok
@@ -228,6 +233,10 @@ pub struct TraceReport {
     /// The divergent sweeps (counted in [`TraceReport::divergent`]).
     #[serde(flatten)]
     pub divergences: Divergences,
+    /// The contact queries judged (`contacts`, absent when the trace has
+    /// none).
+    #[serde(skip_serializing_if = "ContactsReport::is_empty")]
+    pub contacts: ContactsReport,
     /// What could not be checked: read errors, invalid scenes or sweeps.
     pub errors: Vec<String>,
     /// Whether the trace ends early (it is truncated): the sweeps before

@@ -152,12 +152,13 @@ pub enum TraceError {
         /// What is wrong.
         problem: String,
     },
-    /// A sweep comes before any scene.
+    /// A sweep (or a contact query) comes before any scene.
     #[error(
-        "{at}: a sweep comes before any `/scene` message; a scene must be logged at or before the first sweep"
+        "{at}: a {} comes before any `/scene` message; a scene must be logged at or before the first sweep or contact query",
+        if at.channel == "/contact" { "contact query" } else { "sweep" }
     )]
     SweepBeforeScene {
-        /// The sweep message.
+        /// The sweep or contact message.
         at: Box<MessageAt>,
     },
     /// A message's `log_time` is smaller than that of an earlier message.

@@ -10,7 +10,7 @@ use std::io::Read;
 use serde::Serialize;
 
 use super::error::TraceError;
-use super::messages::{EXPECTED_TOPIC, SCENE_TOPIC, SWEEP_TOPIC};
+use super::messages::{EXPECTED_TOPIC, TRACE_TOPICS};
 use super::read::{EventBody, EventHeader, ReadStats, TraceReader};
 use crate::core::{EdgeCounts, Mesh, MeshError, Topology};
 use crate::numbers::counted;
@@ -71,6 +71,12 @@ pub struct TraceInfo {
     pub expected_present: bool,
     /// Number of expected outcomes.
     pub expected: u64,
+    /// Number of contact queries (`/contact`).
+    #[serde(skip_serializing_if = "is_zero")]
+    pub contacts: u64,
+    /// Number of engine contact answers (`/expected_contacts`).
+    #[serde(skip_serializing_if = "is_zero")]
+    pub expected_contacts: u64,
     /// Expected outcomes by kind.
     pub expected_by_kind: BTreeMap<String, u64>,
     /// Who computed them (the `sweeptrace.expected_source` record), if known.
@@ -106,6 +112,8 @@ pub fn collect_info<R: Read>(mut reader: TraceReader<R>) -> (TraceInfo, Option<T
         log_time_nanos: None,
         expected_present: false,
         expected: 0,
+        contacts: 0,
+        expected_contacts: 0,
         expected_by_kind: BTreeMap::new(),
         expected_source: None,
         stats: ReadStats::default(),
@@ -165,6 +173,14 @@ pub fn collect_info<R: Read>(mut reader: TraceReader<R>) -> (TraceInfo, Option<T
                 } else {
                     info.balls_truncated = true;
                 }
+            }
+            EventBody::Contact(contact) => {
+                info.contacts += 1;
+                widen(&mut info.frames, contact.frame);
+            }
+            EventBody::ExpectedContacts(contacts) => {
+                info.expected_contacts += 1;
+                widen(&mut info.frames, contacts.frame);
             }
             EventBody::Expected(outcome) => {
                 info.expected += 1;
@@ -310,6 +326,14 @@ fn write_sweeps(out: &mut String, info: &TraceInfo) {
             )
         }
     );
+    if info.contacts > 0 || info.expected_contacts > 0 {
+        let _ = writeln!(
+            out,
+            "contacts:    {} ({} answered by the recording engine)",
+            counted(info.contacts, "query", "queries"),
+            info.expected_contacts
+        );
+    }
     match info.frames {
         Some((lo, hi)) => {
             let _ = writeln!(out, "frames:      {lo} to {hi}");
@@ -367,7 +391,7 @@ fn write_channels(out: &mut String, s: &ReadStats) {
     }
     let _ = writeln!(out, "channels:");
     for (topic, c) in &s.channels {
-        let ours = [SCENE_TOPIC, SWEEP_TOPIC, EXPECTED_TOPIC].contains(&topic.as_str());
+        let ours = TRACE_TOPICS.contains(&topic.as_str());
         let schema = if c.schema_name.is_empty() {
             "(no schema)".to_string()
         } else {
@@ -403,7 +427,7 @@ fn write_channels(out: &mut String, s: &ReadStats) {
 fn encoding_line(stats: &ReadStats) -> Option<String> {
     let mut by_encoding: BTreeMap<&str, Vec<&str>> = BTreeMap::new();
     for (topic, c) in &stats.channels {
-        if [SCENE_TOPIC, SWEEP_TOPIC, EXPECTED_TOPIC].contains(&topic.as_str()) {
+        if TRACE_TOPICS.contains(&topic.as_str()) {
             by_encoding
                 .entry(c.message_encoding.as_str())
                 .or_default()
@@ -427,4 +451,8 @@ fn encoding_line(stats: &ReadStats) -> Option<String> {
 pub fn render_info_json(info: &TraceInfo) -> String {
     serde_json::to_string_pretty(info)
         .unwrap_or_else(|e| format!("{{\"error\": {:?}}}", e.to_string()))
+}
+
+fn is_zero(n: &u64) -> bool {
+    *n == 0
 }

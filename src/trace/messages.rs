@@ -16,6 +16,22 @@ pub const SCENE_SCHEMA: &str = "sweeptrace.Scene";
 pub const SWEEP_SCHEMA: &str = "sweeptrace.Sweep";
 /// Schema name of `/expected` messages.
 pub const OUTCOME_SCHEMA: &str = "sweeptrace.Outcome";
+/// Topic of the contact-query channel.
+pub const CONTACT_TOPIC: &str = "/contact";
+/// Topic of the expected-contacts channel.
+pub const EXPECTED_CONTACTS_TOPIC: &str = "/expected_contacts";
+/// Schema name of `/contact` messages.
+pub const CONTACT_SCHEMA: &str = "sweeptrace.Contact";
+/// Schema name of `/expected_contacts` messages.
+pub const CONTACTS_SCHEMA: &str = "sweeptrace.Contacts";
+/// Every topic of a trace's own channels (the others are foreign).
+pub(crate) const TRACE_TOPICS: [&str; 5] = [
+    SCENE_TOPIC,
+    SWEEP_TOPIC,
+    EXPECTED_TOPIC,
+    CONTACT_TOPIC,
+    EXPECTED_CONTACTS_TOPIC,
+];
 
 /// A `/scene` message: the mesh that applies to the sweeps logged at or
 /// after its `log_time`, until the next scene.
@@ -194,6 +210,86 @@ impl OutcomeMsg {
             feature: Some(hit.and_then(|h| h.feature.index())),
             normal: Some(hit.map(|h| [h.normal.x, h.normal.y, h.normal.z])),
             contact: Some(hit.map(|h| [h.contact.x, h.contact.y, h.contact.z])),
+        }
+    }
+}
+
+/// A `/contact` message: what a ball of `radius` centred at `centre`
+/// touches (SEMANTICS.md, "Contacts").
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ContactMsg {
+    /// Frame number.
+    pub frame: u64,
+    /// Ball number (default 0).
+    #[serde(default)]
+    pub ball: u32,
+    /// Radius of the ball.
+    pub radius: f64,
+    /// The ball's centre.
+    pub centre: [f64; 3],
+    /// The engine's contact distance: how far apart a triangle is still in
+    /// contact (default 0).
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub distance: f64,
+}
+
+fn is_zero(x: &f64) -> bool {
+    *x == 0.0
+}
+
+/// One contact of an engine's manifold (an element of
+/// [`ContactsMsg::contacts`]). Fields other than `triangle` may be omitted
+/// (a recording engine may not know them); only those present are
+/// compared.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ContactPointMsg {
+    /// The triangle touched.
+    pub triangle: u32,
+    /// The feature's kind: `face`, `edge` or `vertex`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub kind: Option<Kind>,
+    /// The edge or vertex index (0..2) within the triangle.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub feature: Option<u8>,
+    /// The point of the triangle touched.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub point: Option<[f64; 3]>,
+    /// The normal reported, pointing toward the ball's centre.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub normal: Option<[f64; 3]>,
+    /// The signed separation (negative: penetration).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub separation: Option<f64>,
+}
+
+/// An `/expected_contacts` message: the contacts an engine reported for the
+/// `/contact` query of the same `(frame, ball)` (an empty list: none).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ContactsMsg {
+    /// Frame number.
+    pub frame: u64,
+    /// Ball number (default 0).
+    #[serde(default)]
+    pub ball: u32,
+    /// The engine's contacts, in any order.
+    pub contacts: Vec<ContactPointMsg>,
+}
+
+impl ContactPointMsg {
+    /// Every field of a core contact, with the normal the rules report
+    /// (`normal = "face"`): the triangle's, on the ball's side.
+    pub fn from_contact(c: &crate::core::Contact) -> ContactPointMsg {
+        let n = c.face_normal;
+        ContactPointMsg {
+            triangle: c.triangle,
+            kind: Some(c.feature.kind()),
+            feature: c.feature.index(),
+            point: Some([c.point.x, c.point.y, c.point.z]),
+            normal: Some([n.x, n.y, n.z]),
+            separation: Some(c.separation),
         }
     }
 }

@@ -2,7 +2,8 @@
 //!
 //! The messages are [`SceneMsg`], [`SweepMsg`] and [`OutcomeMsg`] (their
 //! JSON Schemas [`SCENE_SCHEMA_JSON`], [`SWEEP_SCHEMA_JSON`],
-//! [`OUTCOME_SCHEMA_JSON`]). [`TraceReader`] streams a trace from any
+//! [`OUTCOME_SCHEMA_JSON`]), and the contact queries [`ContactMsg`] with an
+//! engine's answers [`ContactsMsg`]. [`TraceReader`] streams a trace from any
 //! `Read`, [`TraceWriter`] (or [`write_trace_file`], [`PendingTrace`])
 //! records one, in either message [`Encoding`] (JSON or CBOR);
 //! [`validate_scene`], [`validate_sweep`] and [`validate_outcome`] are the
@@ -33,8 +34,8 @@ pub use encoding::Encoding;
 pub use error::{MessageAt, TraceError};
 pub use info::{SceneSummary, TraceInfo, collect_info, render_info_json, render_info_text};
 pub use messages::{
-    EXPECTED_TOPIC, OUTCOME_SCHEMA, OutcomeMsg, SCENE_SCHEMA, SCENE_TOPIC, SWEEP_SCHEMA,
-    SWEEP_TOPIC, SceneMsg, SweepMsg,
+    ContactMsg, ContactPointMsg, ContactsMsg, EXPECTED_TOPIC, OUTCOME_SCHEMA, OutcomeMsg,
+    SCENE_SCHEMA, SCENE_TOPIC, SWEEP_SCHEMA, SWEEP_TOPIC, SceneMsg, SweepMsg,
 };
 pub use prefetch::{DEFAULT_PREFETCH_CHUNK, DEFAULT_PREFETCH_DEPTH, Prefetched, prefetch};
 pub use read::{
@@ -48,8 +49,8 @@ pub use source::{
     MAX_SETTINGS, sweeptrace_source,
 };
 pub use validate::{
-    FieldProblem, parse_message, validate_outcome, validate_scene, validate_sweep,
-    validate_triangle,
+    FieldProblem, parse_message, validate_contact, validate_contacts, validate_outcome,
+    validate_scene, validate_sweep, validate_triangle,
 };
 pub(crate) use validate::{frame_of_message, parse_message_as};
 pub(crate) use write::library_string;

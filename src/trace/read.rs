@@ -9,7 +9,7 @@ use mcap::sans_io::{LinearReadEvent, LinearReader, LinearReaderOptions};
 
 use super::encoding::Encoding;
 use super::error::TraceError;
-use super::messages::{OutcomeMsg, SceneMsg, SweepMsg};
+use super::messages::{ContactMsg, ContactsMsg, OutcomeMsg, SceneMsg, SweepMsg};
 use super::source::ExpectedSource;
 use log_time_order::LogTimeOrder;
 
@@ -72,6 +72,10 @@ pub enum EventBody {
     Sweep(SweepMsg),
     /// An `/expected` message.
     Expected(OutcomeMsg),
+    /// A `/contact` message: a contact query.
+    Contact(ContactMsg),
+    /// An `/expected_contacts` message: an engine's contacts.
+    ExpectedContacts(ContactsMsg),
 }
 
 /// One channel (or several sharing a topic) as seen in the file.

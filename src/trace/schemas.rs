@@ -6,6 +6,10 @@ pub const SCENE_SCHEMA_JSON: &str = include_str!("../../schemas/scene.schema.jso
 pub const SWEEP_SCHEMA_JSON: &str = include_str!("../../schemas/sweep.schema.json");
 /// JSON Schema of `/expected` messages (`sweeptrace.Outcome`).
 pub const OUTCOME_SCHEMA_JSON: &str = include_str!("../../schemas/outcome.schema.json");
+/// JSON Schema of `/contact` messages (`sweeptrace.Contact`).
+pub(crate) const CONTACT_SCHEMA_JSON: &str = include_str!("../../schemas/contact.schema.json");
+/// JSON Schema of `/expected_contacts` messages (`sweeptrace.Contacts`).
+pub(crate) const CONTACTS_SCHEMA_JSON: &str = include_str!("../../schemas/contacts.schema.json");
 /// Schema encoding of the three channels, in either message encoding (the
 /// JSON Schemas describe the CBOR messages too: the same maps and fields).
 pub const SCHEMA_ENCODING: &str = "jsonschema";

@@ -12,7 +12,7 @@ use serde::de::DeserializeOwned;
 
 use super::encoding::Encoding;
 use super::error::{MessageAt, TraceError};
-use super::messages::{OutcomeMsg, SceneMsg, SweepMsg};
+use super::messages::{ContactMsg, ContactsMsg, OutcomeMsg, SceneMsg, SweepMsg};
 use crate::core::Kind;
 use crate::numbers::{self, Rule};
 
@@ -26,7 +26,7 @@ pub struct FieldProblem {
 }
 
 impl FieldProblem {
-    fn new(field: impl Into<String>, problem: impl Into<String>) -> FieldProblem {
+    pub(crate) fn new(field: impl Into<String>, problem: impl Into<String>) -> FieldProblem {
         FieldProblem {
             field: field.into(),
             problem: problem.into(),
@@ -280,6 +280,62 @@ pub fn validate_outcome(outcome: &OutcomeMsg) -> Result<(), FieldProblem> {
     }
     if let Some(Some(contact)) = &outcome.contact {
         finite3("contact", contact)?;
+    }
+    Ok(())
+}
+
+/// Checks a contact query: a finite radius `> 0`, a finite centre, a
+/// finite contact distance `≥ 0`.
+pub fn validate_contact(contact: &ContactMsg) -> Result<(), FieldProblem> {
+    numbers::check(contact.radius, Rule::Positive).map_err(|e| FieldProblem::new("radius", e))?;
+    finite3("centre", &contact.centre)?;
+    numbers::check(contact.distance, Rule::NonNegative)
+        .map_err(|e| FieldProblem::new("distance", e))?;
+    Ok(())
+}
+
+/// Checks an engine's contacts: per contact, `kind` not `none`, `feature`
+/// in `0..=2` (and absent on a face), finite `point`, `normal` and
+/// `separation`, a nonzero normal.
+pub fn validate_contacts(contacts: &ContactsMsg) -> Result<(), FieldProblem> {
+    for (i, c) in contacts.contacts.iter().enumerate() {
+        let field = |name: &str| format!("contacts[{i}].{name}");
+        if c.kind == Some(Kind::None) {
+            return Err(FieldProblem::new(
+                field("kind"),
+                "must be face, edge or vertex, got none",
+            ));
+        }
+        if let Some(feature) = c.feature {
+            if feature > 2 {
+                return Err(FieldProblem::new(
+                    field("feature"),
+                    format!("must be 0, 1 or 2, got {feature}"),
+                ));
+            }
+            if c.kind == Some(Kind::Face) {
+                return Err(FieldProblem::new(
+                    field("feature"),
+                    format!("a face has no feature index, got {feature}"),
+                ));
+            }
+        }
+        if let Some(point) = &c.point {
+            finite3(&field("point"), point)?;
+        }
+        if let Some(normal) = &c.normal {
+            finite3(&field("normal"), normal)?;
+            if normal.iter().all(|x| *x == 0.0) {
+                return Err(FieldProblem::new(
+                    field("normal"),
+                    "must be a nonzero vector, got [0, 0, 0]",
+                ));
+            }
+        }
+        if let Some(separation) = c.separation {
+            numbers::check(separation, Rule::Finite)
+                .map_err(|e| FieldProblem::new(field("separation"), e))?;
+        }
     }
     Ok(())
 }

@@ -27,16 +27,20 @@ use serde::Serialize;
 use super::encoding::Encoding;
 use super::error::{MessageAt, TraceError};
 use super::messages::{
-    EXPECTED_TOPIC, OUTCOME_SCHEMA, OutcomeMsg, SCENE_SCHEMA, SCENE_TOPIC, SWEEP_SCHEMA,
-    SWEEP_TOPIC, SceneMsg, SweepMsg,
+    CONTACT_SCHEMA, CONTACT_TOPIC, CONTACTS_SCHEMA, ContactMsg, ContactsMsg,
+    EXPECTED_CONTACTS_TOPIC, EXPECTED_TOPIC, OUTCOME_SCHEMA, OutcomeMsg, SCENE_SCHEMA, SCENE_TOPIC,
+    SWEEP_SCHEMA, SWEEP_TOPIC, SceneMsg, SweepMsg,
 };
 use super::read::{MAX_SCENE_BYTES, MAX_SMALL_MESSAGE_BYTES};
 use super::schemas::{
-    FORMAT_VERSION, METADATA_NAME, OUTCOME_SCHEMA_JSON, SCENE_SCHEMA_JSON, SCHEMA_ENCODING,
-    SWEEP_SCHEMA_JSON,
+    CONTACT_SCHEMA_JSON, CONTACTS_SCHEMA_JSON, FORMAT_VERSION, METADATA_NAME, OUTCOME_SCHEMA_JSON,
+    SCENE_SCHEMA_JSON, SCHEMA_ENCODING, SWEEP_SCHEMA_JSON,
 };
 use super::source::{EXPECTED_SOURCE_METADATA, ExpectedSource};
-use super::validate::{validate_outcome, validate_scene, validate_sweep, validate_triangle};
+use super::validate::{
+    validate_contact, validate_contacts, validate_outcome, validate_scene, validate_sweep,
+    validate_triangle,
+};
 use crate::atomic::PendingFile;
 
 /// The library string written into every trace: `sweeptrace <version>`.
@@ -62,6 +66,10 @@ pub struct TraceWriter<W: Write + Seek> {
     scene_channel: u16,
     sweep_channel: u16,
     expected_channel: u16,
+    /// The contact channels, added at their first message (a trace without
+    /// contacts has none).
+    contact_channel: Option<u16>,
+    contacts_channel: Option<u16>,
     messages: u64,
     last_log_time: Option<u64>,
     scene_margin: Option<f64>,
@@ -164,6 +172,8 @@ impl<W: Write + Seek> TraceWriter<W> {
             scene_channel,
             sweep_channel,
             expected_channel,
+            contact_channel: None,
+            contacts_channel: None,
             messages: 0,
             last_log_time: None,
             scene_margin: None,
@@ -364,6 +374,92 @@ impl<W: Write + Seek> TraceWriter<W> {
             log_time_nanos,
             outcome,
         )
+    }
+
+    /// The id of a channel added at its first message.
+    fn lazy_channel(&mut self, contacts: bool) -> Result<u16, TraceError> {
+        let (slot, schema, data, topic) = if contacts {
+            (
+                self.contacts_channel,
+                CONTACTS_SCHEMA,
+                CONTACTS_SCHEMA_JSON,
+                EXPECTED_CONTACTS_TOPIC,
+            )
+        } else {
+            (
+                self.contact_channel,
+                CONTACT_SCHEMA,
+                CONTACT_SCHEMA_JSON,
+                CONTACT_TOPIC,
+            )
+        };
+        if let Some(id) = slot {
+            return Ok(id);
+        }
+        let error = |cause| TraceError::Write {
+            file: self.name.clone(),
+            cause,
+        };
+        let schema_id = self
+            .writer
+            .add_schema(schema, SCHEMA_ENCODING, data.as_bytes())
+            .map_err(error)?;
+        let id = self
+            .writer
+            .add_channel(schema_id, topic, self.encoding.as_str(), &BTreeMap::new())
+            .map_err(error)?;
+        if contacts {
+            self.contacts_channel = Some(id);
+        } else {
+            self.contact_channel = Some(id);
+        }
+        Ok(id)
+    }
+
+    /// Writes a `/contact` query; a scene must have been written before.
+    pub fn contact(&mut self, log_time_nanos: u64, contact: &ContactMsg) -> Result<(), TraceError> {
+        let frame = Some(contact.frame);
+        self.check_time(CONTACT_TOPIC, frame, log_time_nanos)?;
+        if self.scene_margin.is_none() {
+            return Err(TraceError::SweepBeforeScene {
+                at: Box::new(self.at(CONTACT_TOPIC, frame)),
+            });
+        }
+        validate_contact(contact).map_err(|p| p.at(self.at(CONTACT_TOPIC, frame)))?;
+        let id = self.lazy_channel(false)?;
+        self.put(id, CONTACT_TOPIC, frame, log_time_nanos, contact)
+    }
+
+    /// Writes an engine's `/expected_contacts` for the query of the same
+    /// frame and ball. Its triangles must be the current scene's.
+    pub fn expected_contacts(
+        &mut self,
+        log_time_nanos: u64,
+        contacts: &ContactsMsg,
+    ) -> Result<(), TraceError> {
+        let frame = Some(contacts.frame);
+        self.check_time(EXPECTED_CONTACTS_TOPIC, frame, log_time_nanos)?;
+        validate_contacts(contacts)
+            .and_then(|()| {
+                let Some(count) = self.scene_triangles else {
+                    return Ok(());
+                };
+                for (i, c) in contacts.contacts.iter().enumerate() {
+                    if c.triangle as usize >= count {
+                        return Err(super::validate::FieldProblem::new(
+                            format!("contacts[{i}].triangle"),
+                            format!(
+                                "index {} is out of range (the scene has {count} triangles)",
+                                c.triangle
+                            ),
+                        ));
+                    }
+                }
+                Ok(())
+            })
+            .map_err(|p| p.at(self.at(EXPECTED_CONTACTS_TOPIC, frame)))?;
+        let id = self.lazy_channel(true)?;
+        self.put(id, EXPECTED_CONTACTS_TOPIC, frame, log_time_nanos, contacts)
     }
 
     /// Writes the summary and footer and returns the underlying writer.

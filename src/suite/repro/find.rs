@@ -152,6 +152,7 @@ where
                     None => early = early.or(Some(outcome)),
                 }
             }
+            EventBody::Contact(_) | EventBody::ExpectedContacts(_) => {}
         }
     }
     found.ok_or_else(|| ReproError::NotFound {

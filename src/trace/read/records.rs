@@ -13,10 +13,14 @@ use super::{ChannelInfo, EventBody, EventHeader, State, TraceError, TraceEvent, 
 use crate::trace::encoding::Encoding;
 use crate::trace::error::MessageAt;
 use crate::trace::messages::{
-    EXPECTED_TOPIC, OutcomeMsg, SCENE_TOPIC, SWEEP_TOPIC, SceneMsg, SweepMsg,
+    CONTACT_TOPIC, ContactMsg, ContactsMsg, EXPECTED_CONTACTS_TOPIC, OutcomeMsg, SCENE_TOPIC,
+    SWEEP_TOPIC, SceneMsg, SweepMsg, TRACE_TOPICS,
 };
 use crate::trace::source::{EXPECTED_SOURCE_METADATA, ExpectedSource};
-use crate::trace::validate::{parse_message_as, validate_outcome, validate_scene, validate_sweep};
+use crate::trace::validate::{
+    parse_message_as, validate_contact, validate_contacts, validate_outcome, validate_scene,
+    validate_sweep,
+};
 
 impl State {
     pub(super) fn mcap_error(&self, err: McapError, context: &str, in_chunk: bool) -> TraceError {
@@ -133,8 +137,7 @@ impl State {
                     .insert(header.id, (header.name, header.encoding));
             }
             Record::Channel(channel) => {
-                let is_trace =
-                    [SCENE_TOPIC, SWEEP_TOPIC, EXPECTED_TOPIC].contains(&channel.topic.as_str());
+                let is_trace = TRACE_TOPICS.contains(&channel.topic.as_str());
                 let encoding = Encoding::from_message_encoding(&channel.message_encoding);
                 if is_trace && encoding.is_none() {
                     return Err(TraceError::WrongEncoding {
@@ -274,6 +277,21 @@ impl State {
                 validate_sweep(&sweep, self.scene_margin)
                     .map_err(|p| p.at(at(Some(sweep.frame))))?;
                 EventBody::Sweep(sweep)
+            }
+            CONTACT_TOPIC => {
+                let contact: ContactMsg = parse_message_as(data, encoding, || at(None))?;
+                if self.scene_margin.is_none() {
+                    return Err(TraceError::SweepBeforeScene {
+                        at: Box::new(at(Some(contact.frame))),
+                    });
+                }
+                validate_contact(&contact).map_err(|p| p.at(at(Some(contact.frame))))?;
+                EventBody::Contact(contact)
+            }
+            EXPECTED_CONTACTS_TOPIC => {
+                let contacts: ContactsMsg = parse_message_as(data, encoding, || at(None))?;
+                validate_contacts(&contacts).map_err(|p| p.at(at(Some(contacts.frame))))?;
+                EventBody::ExpectedContacts(contacts)
             }
             _ => {
                 let outcome: OutcomeMsg = parse_message_as(data, encoding, || at(None))?;

@@ -1,0 +1,212 @@
+//! `check`'s contact queries: each `/contact` query paired with the
+//! `/expected_contacts` of the same frame and ball (in either order, within
+//! one scene) and judged against the core's contact set
+//! ([`judge_contacts`]), beside the sweeps' replay.
+
+use std::collections::HashMap;
+
+use serde::Serialize;
+
+use crate::core::{Mesh, Topology};
+use crate::judge::{ContactScene, ContactVerdict, judge_contacts};
+use crate::replay::{GhostContact, SceneNormals};
+use crate::trace::{ContactMsg, ContactsMsg, EventBody, SceneMsg, TraceEvent};
+
+use super::check::CheckOptions;
+
+/// How many divergent contact queries a report describes in detail.
+pub const MAX_CONTACT_DETAILS: usize = 3;
+
+/// What `check` reports of a trace's contact queries (`contacts` in the
+/// JSON, absent when the trace has none).
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+#[non_exhaustive]
+pub struct ContactsReport {
+    /// `/contact` queries read (within the frame and ball selection).
+    pub queries: u64,
+    /// Queries judged against their `/expected_contacts`.
+    pub compared: u64,
+    /// Queries whose contacts disagree with the core's.
+    pub divergent: u64,
+    /// Queries without an answer in their scene.
+    pub without_answer: u64,
+    /// Answers without a query in their scene.
+    pub answers_without_query: u64,
+    /// Queries not judged because the answers come from an engine command,
+    /// whose protocol has no contact request yet (`check --engine`).
+    #[serde(skip_serializing_if = "is_zero")]
+    pub not_asked: u64,
+    /// The first divergent queries, in trace order.
+    pub details: Vec<ContactVerdict>,
+}
+
+fn is_zero(n: &u64) -> bool {
+    *n == 0
+}
+
+impl ContactsReport {
+    /// Whether the trace had nothing of contacts.
+    pub fn is_empty(&self) -> bool {
+        self.queries == 0 && self.answers_without_query == 0
+    }
+}
+
+/// Whether `check_stream` judges the trace's contact answers.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum ContactMode {
+    /// Judge them against the core (`check`).
+    Judge,
+    /// Count the queries only: the answers judged come from an engine
+    /// command that is not asked for contacts.
+    NotAsked,
+}
+
+/// The fold over a trace's events.
+pub(crate) struct ContactChecker<'a> {
+    options: &'a CheckOptions,
+    mode: ContactMode,
+    /// The current scene's message, built into a mesh at its first query.
+    scene: Option<SceneMsg>,
+    built: Option<Option<Built>>,
+    queries: HashMap<(u64, u32), ContactMsg>,
+    answers: HashMap<(u64, u32), ContactsMsg>,
+    report: ContactsReport,
+    ghosts: Vec<GhostContact>,
+    ghost_count: u64,
+    errors: Vec<String>,
+}
+
+struct Built {
+    mesh: Mesh,
+    topology: Topology,
+    normals: SceneNormals,
+}
+
+impl<'a> ContactChecker<'a> {
+    pub(crate) fn new(options: &'a CheckOptions, mode: ContactMode) -> Self {
+        ContactChecker {
+            options,
+            mode,
+            scene: None,
+            built: None,
+            queries: HashMap::new(),
+            answers: HashMap::new(),
+            report: ContactsReport::default(),
+            ghosts: Vec::new(),
+            ghost_count: 0,
+            errors: Vec::new(),
+        }
+    }
+
+    /// One event of the trace (sweeps and expectations pass by).
+    pub(crate) fn event(&mut self, event: &TraceEvent) {
+        match &event.body {
+            EventBody::Scene(scene) => {
+                self.flush();
+                self.scene = Some(scene.clone());
+                self.built = None;
+            }
+            EventBody::Contact(query) => {
+                if !self.options.replay.wants(query.frame, query.ball) {
+                    return;
+                }
+                self.report.queries += 1;
+                if self.mode == ContactMode::NotAsked {
+                    self.report.not_asked += 1;
+                    return;
+                }
+                let key = (query.frame, query.ball);
+                match self.answers.remove(&key) {
+                    Some(answer) => self.judge(query, &answer),
+                    None => {
+                        if self.queries.insert(key, *query).is_some() {
+                            self.report.without_answer += 1;
+                        }
+                    }
+                }
+            }
+            EventBody::ExpectedContacts(answer) => {
+                if self.mode == ContactMode::NotAsked
+                    || !self.options.replay.wants(answer.frame, answer.ball)
+                {
+                    return;
+                }
+                let key = (answer.frame, answer.ball);
+                match self.queries.remove(&key) {
+                    Some(query) => self.judge(&query, answer),
+                    None => {
+                        if self.answers.insert(key, answer.clone()).is_some() {
+                            self.report.answers_without_query += 1;
+                        }
+                    }
+                }
+            }
+            EventBody::Sweep(_) | EventBody::Expected(_) => {}
+        }
+    }
+
+    /// The scene's queries and answers left unpaired.
+    fn flush(&mut self) {
+        self.report.without_answer += self.queries.len() as u64;
+        self.report.answers_without_query += self.answers.len() as u64;
+        self.queries.clear();
+        self.answers.clear();
+    }
+
+    fn judge(&mut self, query: &ContactMsg, answer: &ContactsMsg) {
+        let built = self.built.get_or_insert_with(|| {
+            let scene = self.scene.as_ref()?;
+            let mesh = Mesh::new(scene.vertices.clone(), &scene.triangles).ok()?;
+            let topology = Topology::new(&scene.vertices, &scene.triangles).ok()?;
+            let normals =
+                SceneNormals::new(self.options.replay.conventions.normal, &mesh, &topology);
+            Some(Built {
+                mesh,
+                topology,
+                normals,
+            })
+        });
+        let Some(built) = built else {
+            if self.errors.is_empty() {
+                self.errors.push(format!(
+                    "frame {}, ball {}: the contact query's scene has no usable triangle, so contacts cannot be judged",
+                    query.frame, query.ball
+                ));
+            }
+            return;
+        };
+        let scene = ContactScene {
+            mesh: &built.mesh,
+            topology: &built.topology,
+            normals: &built.normals,
+        };
+        let verdict = judge_contacts(
+            &scene,
+            query,
+            answer,
+            &self.options.tolerances,
+            &self.options.replay.conventions,
+            self.options.ghost_degrees,
+        );
+        self.report.compared += 1;
+        self.ghost_count += verdict.ghosts.len() as u64;
+        for ghost in &verdict.ghosts {
+            if self.ghosts.len() < super::ghost_count::MAX_LISTED_GHOSTS {
+                self.ghosts.push(*ghost);
+            }
+        }
+        if !verdict.agrees() {
+            self.report.divergent += 1;
+            if self.report.details.len() < MAX_CONTACT_DETAILS {
+                self.report.details.push(verdict);
+            }
+        }
+    }
+
+    /// The report, the ghost contacts (how many, the first of them) and
+    /// the errors.
+    pub(crate) fn finish(mut self) -> (ContactsReport, u64, Vec<GhostContact>, Vec<String>) {
+        self.flush();
+        (self.report, self.ghost_count, self.ghosts, self.errors)
+    }
+}

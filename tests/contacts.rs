@@ -26,6 +26,7 @@ pub fn tests() -> Vec<Trial> {
         trial!(each_seeded_contact_mistake_fails_check_naming_it),
         trial!(a_geometric_normal_on_a_flat_seam_is_a_ghost_contact),
         trial!(contacts_pass_by_an_engine_check_and_say_so),
+        trial!(an_engine_answers_contact_queries_with_engine_contacts),
         trial!(bad_contact_messages_are_refused_with_the_field),
         trial!(python_reads_the_contact_channels),
     ]
@@ -386,7 +387,45 @@ fn contacts_pass_by_an_engine_check_and_say_so() -> anyhow::Result<()> {
         String::from_utf8_lossy(&out.stderr)
     );
     ensure!(
-        text.contains("contacts: 1 query, 0 compared, 0 diverge, 1 not judged (the engine protocol has no contact request yet)"),
+        text.contains("contacts: 1 query, 0 compared, 0 diverge, 1 not judged (an engine is asked for contacts only with --engine-contacts"),
+        "{text}"
+    );
+    Ok(())
+}
+
+/// `check --engine-contacts`: the queries go to the engine, its answers
+/// replace the trace's. The exact Python engine passes; with its
+/// `contact-normal` bug (the geometric normal everywhere) the report lists
+/// its ghost contacts as the engine's and its normals off the face's.
+fn an_engine_answers_contact_queries_with_engine_contacts() -> anyhow::Result<()> {
+    let dir = tempfile::tempdir()?;
+    let path = record(dir.path(), &[])?;
+    let run = |bug: &str| -> anyhow::Result<(i32, String)> {
+        let engine = crate::engine::example_engine_command(bug);
+        let out = bin()
+            .arg("check")
+            .arg(&path)
+            .args(["--engine", &engine, "--engine-contacts"])
+            .output()?;
+        Ok((
+            out.status.code().unwrap_or(-1),
+            String::from_utf8_lossy(&out.stdout).into_owned(),
+        ))
+    };
+    let (code, text) = run("")?;
+    ensure!(code == 0, "exit {code}: {text}");
+    ensure!(
+        text.contains("contacts: 2238 queries, 2238 compared, 0 diverge"),
+        "{text}"
+    );
+    let (code, text) = run("--bug contact-normal")?;
+    ensure!(code == 1, "exit {code}: {text}");
+    ensure!(
+        text.contains(
+            "ghost contacts (an edge or vertex contact on an internal flat or concave place"
+        ) && text.contains("the engine's normal is")
+            && text.contains("contact queries diverge")
+            && text.contains("from the expected (0, 0, 1)"),
         "{text}"
     );
     Ok(())

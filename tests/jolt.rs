@@ -26,6 +26,7 @@ pub fn tests() -> Vec<Trial> {
         trial!(a_calibrated_accuracy_catches_a_bias_single_precision_excuses),
         trial!(every_seeded_bug_fails_conform_and_check),
         trial!(jolt_keeps_a_contact_normal_within_one_degree_at_an_inactive_edge),
+        trial!(jolts_contacts_pass_and_its_ghosts_show_with_collide_with_all),
     ]
 }
 
@@ -581,6 +582,79 @@ fn jolt_keeps_a_contact_normal_within_one_degree_at_an_inactive_edge() -> anyhow
         code == 0,
         "clean Jolt fails the ridge (exit {code}): {}",
         serde_json::to_string_pretty(&report)?
+    );
+    Ok(Completion::Completed)
+}
+
+/// Contact queries answered by Jolt's own CollideShape (`--engine-contacts`):
+/// on a welded terrain clean Jolt's contacts are the core's contact set
+/// (under its table), and with `EActiveEdgeMode::CollideWithAll`
+/// (`--ghosts`) its ghost contacts are listed. On the mini-golf course,
+/// whose wall segments repeat their vertices, clean Jolt's contacts at two
+/// such seams are ghosts, and the report says why (shared by position only).
+fn jolts_contacts_pass_and_its_ghosts_show_with_collide_with_all() -> anyhow::Result<Completion> {
+    let engine = match jolt()? {
+        Ok(engine) => engine,
+        Err(skip) => return Ok(skip),
+    };
+    let dir = tempfile::tempdir()?;
+    let record = |scene: &str| -> anyhow::Result<String> {
+        let path = dir.path().join(format!("{scene}.mcap"));
+        let out = crate::support::bin()
+            .args([
+                "record",
+                "--scene",
+                scene,
+                "--terrain-cells",
+                "20",
+                "--frames",
+                "200",
+            ])
+            .args(["--contacts", "-o"])
+            .arg(&path)
+            .output()?;
+        ensure!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        Ok(path.display().to_string())
+    };
+    let terrain = record("terrain")?;
+    let with_ghosts = format!("{engine} --ghosts");
+    let check = |trace: &str, engine: &str| {
+        run_json(
+            "clean",
+            &["check", trace, "--engine", engine, "--engine-contacts"],
+        )
+    };
+    let (code, report) = check(&terrain, &engine)?;
+    let t = &traces_of(&report)[0];
+    ensure!(
+        code == 0 && t["contacts"]["compared"].as_u64() > Some(1000) && t["ghosts"] == 0,
+        "clean Jolt's contacts on the terrain (exit {code}): {:#}",
+        t["contacts"]
+    );
+    let (code, report) = check(&terrain, &with_ghosts)?;
+    let t = &traces_of(&report)[0];
+    ensure!(
+        code == 1 && t["ghosts"].as_u64() > Some(3),
+        "Jolt with CollideWithAll (exit {code}): {} ghosts",
+        t["ghosts"]
+    );
+    let golf = record("mini_golf")?;
+    let (code, report) = check(&golf, &engine)?;
+    let t = &traces_of(&report)[0];
+    let ghosts = t["ghost_contacts"].as_array().cloned().unwrap_or_default();
+    ensure!(
+        code == 1
+            && t["contacts"]["divergent"] == 0
+            && !ghosts.is_empty()
+            && ghosts
+                .iter()
+                .all(|g| g["unwelded"] == true && g["answer"] == true),
+        "clean Jolt on the mini-golf course (exit {code}): {:#}",
+        t["ghost_contacts"]
     );
     Ok(Completion::Completed)
 }

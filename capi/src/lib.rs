@@ -970,6 +970,14 @@ unsafe fn serve(
             .map_err(|e| Stop(format!("{at} is not a protocol message: {e}")))?;
         match request {
             Request::Other(_) => {}
+            // The C API has no contact callback: say so rather than leave
+            // sweeptrace waiting for an answer.
+            Request::Contact(contact) => {
+                return Err(Stop(format!(
+                    "{at}: a contact query (frame {}, ball {}), but sweeptrace_serve_engine answers sweeps only: check without --engine-contacts",
+                    contact.frame, contact.ball
+                )));
+            }
             Request::Scene(message) => {
                 validate_scene(&message).map_err(|p| {
                     Stop(format!("{at}: scene: field `{}`: {}", p.field, p.problem))

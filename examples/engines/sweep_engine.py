@@ -36,6 +36,14 @@ reports about an engine that has it:
                     leans 10 degrees toward the edge
     lost-leaf       in a mesh of more than 64 triangles, the second half of
                     them is never tested (a lost leaf of a tree)
+    contact-normal  contact queries answer the geometric normal (centre
+                    minus closest point) instead of the face normal: ghost
+                    contacts on flat seams
+
+It also answers contact queries (`contact` lines, sent by `check
+--engine-contacts`): every triangle within the radius plus the contact
+distance, its closest point and feature, the separation and the face normal
+(docs/SEMANTICS.md, "Contacts").
 """
 
 import argparse
@@ -61,6 +69,7 @@ BUGS = (
     "wide-active-edges",
     "ghost-flat",
     "lost-leaf",
+    "contact-normal",
 )
 
 
@@ -306,6 +315,65 @@ def answer(alpha, kind, triangle, feature, normal, contact):
     }
 
 
+def closest(t, p):
+    """The point of triangle t nearest to p and its feature (Ericson 5.1.5),
+    an edge's point computed in its standard frame: (kind, index, point)."""
+    a, b, c = t.vertices
+    ab, ac, ap = sub(b, a), sub(c, a), sub(p, a)
+    d1, d2 = dot(ab, ap), dot(ac, ap)
+    if d1 <= 0.0 and d2 <= 0.0:
+        return "vertex", 0, a
+    bp = sub(p, b)
+    d3, d4 = dot(ab, bp), dot(ac, bp)
+    if d3 >= 0.0 and d4 <= d3:
+        return "vertex", 1, b
+    vc = d1 * d4 - d3 * d2
+    if vc <= 0.0 and d1 >= 0.0 and d3 <= 0.0:
+        return edge_point(t, 0, p)
+    cp = sub(p, c)
+    d5, d6 = dot(ab, cp), dot(ac, cp)
+    if d6 >= 0.0 and d5 <= d6:
+        return "vertex", 2, c
+    vb = d5 * d2 - d1 * d6
+    if vb <= 0.0 and d2 >= 0.0 and d6 <= 0.0:
+        return edge_point(t, 2, p)
+    va = d3 * d6 - d5 * d4
+    if va <= 0.0 and (d4 - d3) >= 0.0 and (d5 - d6) >= 0.0:
+        return edge_point(t, 1, p)
+    denom = 1.0 / (va + vb + vc)
+    v, w = vb * denom, vc * denom
+    return "face", None, add(add(a, scale(ab, v)), scale(ac, w))
+
+
+def edge_point(t, e, p):
+    """The point of edge e nearest to p, in the edge's standard frame."""
+    v0, x, _y, _z, length = t.edges[e]
+    along = min(max(dot(sub(p, v0), x), 0.0), length)
+    return "edge", e, add(v0, scale(x, along))
+
+
+def contacts(scene, msg, bugs):
+    """The answer to a contact query: one contact per triangle in reach."""
+    centre, radius = tuple(msg["centre"]), msg["radius"]
+    reach = radius + msg.get("distance", 0.0)
+    found = []
+    for t in scene["triangles"]:
+        kind, feature, point = closest(t, centre)
+        towards = sub(centre, point)
+        gap = norm(towards)
+        if gap > reach or dot(t.normal, towards) < 0.0:
+            continue  # out of reach, or its back faces the ball
+        normal = t.normal
+        if "contact-normal" in bugs and gap > 0.0:
+            normal = scale(towards, 1.0 / gap)
+        contact = {"triangle": t.index, "kind": kind, "point": list(point),
+                   "normal": list(normal), "separation": gap - radius}
+        if feature is not None:
+            contact["feature"] = feature
+        found.append(contact)
+    return {"type": "contacts", "frame": msg["frame"], "ball": msg.get("ball", 0), "contacts": found}
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--bug", action="append", default=[], choices=BUGS, help="switch on a deliberate mistake")
@@ -323,6 +391,9 @@ def main():
             answer["frame"] = msg["frame"]
             answer["ball"] = msg.get("ball", 0)
             out.write(json.dumps(answer) + "\n")
+            out.flush()
+        elif msg["type"] == "contact":
+            out.write(json.dumps(contacts(scene, msg, bugs)) + "\n")
             out.flush()
 
 

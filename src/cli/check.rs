@@ -166,6 +166,13 @@ pub struct Args {
     /// `--engine ./build/engine --against expected`.
     #[arg(long, value_enum, default_value_t = AgainstArg::Core, requires = "engine")]
     pub against: AgainstArg,
+    /// With --engine: the engine also answers contact queries (docs/
+    /// ENGINE_PROTOCOL.md, `contact`): each trace's /contact queries are
+    /// sent to it and its contacts judged against the core's contact set,
+    /// in place of the trace's /expected_contacts. Without it, an engine is
+    /// sent sweeps only and the queries are counted as not judged.
+    #[arg(long, requires = "engine")]
+    pub engine_contacts: bool,
     /// Only frames A..B (A included, B excluded; also `A..`, `..B`,
     /// `A..=B`, `A`), as `replay --frames`: the other sweeps are neither
     /// replayed nor compared, e.g. `--frames 100..200`.
@@ -274,7 +281,10 @@ pub fn run(args: Args) -> anyhow::Result<Exit> {
         None => None,
         Some(text) => Some((
             EngineCommand::parse(text)?,
-            engine_options(args.engine_timeout)?,
+            EngineOptions {
+                contacts: args.engine_contacts,
+                ..engine_options(args.engine_timeout)?
+            },
         )),
     };
     if args.infer_config {

@@ -16,6 +16,9 @@ enum Queued {
     Ready(Result<TraceEvent, TraceError>),
     /// A sweep sent to the engine, handed on once its answer is read.
     Sweep(TraceEvent, (u64, u32)),
+    /// A contact query sent to the engine, handed on once its answer is
+    /// read.
+    Contact(TraceEvent, (u64, u32)),
 }
 
 /// The events of a trace, with the trace's own `/expected` messages left
@@ -38,6 +41,12 @@ pub struct EngineAnswers<I> {
     trace_expectations: u64,
     /// When set, the answers go here and the trace's expectations pass.
     sink: Option<AnswerSink>,
+    /// Whether contact queries are sent to the engine (its answers then
+    /// replace the trace's `/expected_contacts`); otherwise they pass with
+    /// the trace's own answers.
+    contacts: bool,
+    /// The trace's own `/expected_contacts`, left out.
+    trace_contacts: u64,
 }
 
 /// Where [`EngineAnswers::keeping_expectations`] puts the engine's
@@ -74,7 +83,17 @@ where
             answered: 0,
             trace_expectations: 0,
             sink: None,
+            contacts: false,
+            trace_contacts: 0,
         }
+    }
+
+    /// Sends the trace's contact queries to the engine too, its answers in
+    /// place of the trace's `/expected_contacts` (only with
+    /// [`EngineAnswers::new`]: compared with the core).
+    pub fn with_contacts(mut self, contacts: bool) -> Self {
+        self.contacts = contacts && self.sink.is_none();
+        self
     }
 
     /// Like [`EngineAnswers::new`], but the trace's own `/expected`
@@ -134,9 +153,16 @@ where
                             self.queue.push_back(Queued::Ready(Ok(event)));
                         }
                     }
-                    // Contact queries are not asked of the engine (the
-                    // protocol has no contact request yet): they pass
-                    // through with the trace's own answers.
+                    EventBody::Contact(query) if self.contacts => {
+                        session.send_contact(query)?;
+                        let key = (query.frame, query.ball);
+                        self.queue.push_back(Queued::Contact(event, key));
+                        self.in_flight += 1;
+                    }
+                    EventBody::ExpectedContacts(_) if self.contacts => self.trace_contacts += 1,
+                    // Not asked of the engine: the queries pass with the
+                    // trace's own answers (the check counts them as not
+                    // judged).
                     EventBody::Contact(_) | EventBody::ExpectedContacts(_) => {
                         self.queue.push_back(Queued::Ready(Ok(event)));
                     }
@@ -176,6 +202,27 @@ where
                 Some(Queued::Ready(event)) => Some(event),
                 _ => None,
             },
+            Queued::Contact(event, key) => {
+                if self.front_answered {
+                    self.front_answered = false;
+                    self.in_flight -= 1;
+                    let event = event.clone();
+                    self.queue.pop_front();
+                    return Some(Ok(event));
+                }
+                let (key, header) = (*key, event.header);
+                let session = self.session.as_mut()?;
+                match session.next_contacts(key) {
+                    Ok(contacts) => {
+                        self.front_answered = true;
+                        Some(Ok(TraceEvent {
+                            header,
+                            body: EventBody::ExpectedContacts(contacts),
+                        }))
+                    }
+                    Err(e) => self.fail(e),
+                }
+            }
             Queued::Sweep(event, key) => {
                 if self.front_answered {
                     self.front_answered = false;

@@ -57,6 +57,10 @@ pub struct EngineOptions {
     /// How many sweeps may be sent before their answers are read (at
     /// least 1): the pipeline that keeps a fast engine busy.
     pub window: usize,
+    /// Whether the engine answers contact queries: a trace's `/contact`
+    /// queries are then sent to it and its answers replace the trace's
+    /// `/expected_contacts` (`check --engine-contacts`).
+    pub contacts: bool,
 }
 
 impl Default for EngineOptions {
@@ -64,6 +68,7 @@ impl Default for EngineOptions {
         EngineOptions {
             timeout: DEFAULT_TIMEOUT,
             window: DEFAULT_WINDOW,
+            contacts: false,
         }
     }
 }

@@ -20,10 +20,12 @@ use std::sync::mpsc::{self, Receiver, RecvTimeoutError, Sender};
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
-use crate::trace::{OutcomeMsg, SceneMsg, SweepMsg};
+use crate::trace::{ContactMsg, ContactsMsg, OutcomeMsg, SceneMsg, SweepMsg};
 
 use super::groups::{self, Group};
-use super::protocol::{MAX_ANSWER_BYTES, parse_answer, scene_line, sweep_line};
+use super::protocol::{
+    MAX_ANSWER_BYTES, contact_line, parse_answer, parse_contacts, scene_line, sweep_line,
+};
 use super::{EngineCommand, EngineError, EngineOptions, STDERR_TAIL_LINES};
 
 /// What the reader thread saw on the engine's stdout.
@@ -242,6 +244,15 @@ impl EngineSession {
         Ok(())
     }
 
+    /// Sends a contact query; its answer comes later, in order with the
+    /// sweeps' ([`Self::next_contacts`]).
+    pub fn send_contact(&mut self, contact: &ContactMsg) -> Result<(), EngineError> {
+        let line =
+            contact_line(contact).map_err(|e| self.io("encoding a contact query", e.into()))?;
+        self.send(line);
+        Ok(())
+    }
+
     fn send(&mut self, line: String) {
         // A writer that has gone (the engine closed its input) shows up as
         // the engine's exit or silence when its answer is awaited.
@@ -261,18 +272,37 @@ impl EngineSession {
     /// The answer to the sweep `due` (frame, ball): the engine's next output
     /// line, which must be an outcome of that sweep, within the timeout.
     pub fn next_answer(&mut self, due: (u64, u32)) -> Result<OutcomeMsg, EngineError> {
+        self.next_line(due, parse_answer, |a| (a.frame, a.ball))
+    }
+
+    /// The answer to the contact query `due` (frame, ball): the engine's
+    /// next output line, which must be the contacts of that query, within
+    /// the timeout.
+    pub fn next_contacts(&mut self, due: (u64, u32)) -> Result<ContactsMsg, EngineError> {
+        self.next_line(due, parse_contacts, |c| (c.frame, c.ball))
+    }
+
+    /// The engine's next output line, parsed by `parse` as the answer to
+    /// `due` (whose frame and ball `key` reads), within the timeout.
+    fn next_line<T>(
+        &mut self,
+        due: (u64, u32),
+        parse: fn(&[u8]) -> Result<T, String>,
+        key: fn(&T) -> (u64, u32),
+    ) -> Result<T, EngineError> {
         let deadline = Instant::now() + self.options.timeout;
         match self.receive(deadline) {
             Ok(Output::Line(line)) => {
                 self.lines_read += 1;
-                let answer = parse_answer(&line)
-                    .map_err(|reason| self.not_an_outcome(&line, reason, Some(due)))?;
-                if (answer.frame, answer.ball) != due {
+                let answer =
+                    parse(&line).map_err(|reason| self.not_an_outcome(&line, reason, Some(due)))?;
+                let (answered_frame, answered_ball) = key(&answer);
+                if (answered_frame, answered_ball) != due {
                     return Err(EngineError::WrongSweep {
                         command: self.command.text.clone(),
                         line_number: self.lines_read,
-                        answered_frame: answer.frame,
-                        answered_ball: answer.ball,
+                        answered_frame,
+                        answered_ball,
                         due_frame: due.0,
                         due_ball: due.1,
                     });

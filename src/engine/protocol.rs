@@ -4,7 +4,9 @@
 
 use serde_json::{Map, Value};
 
-use crate::trace::{OutcomeMsg, SceneMsg, SweepMsg, validate_outcome};
+use crate::trace::{
+    ContactMsg, ContactsMsg, OutcomeMsg, SceneMsg, SweepMsg, validate_contacts, validate_outcome,
+};
 
 /// The longest output line accepted from an engine, in bytes.
 pub const MAX_ANSWER_BYTES: usize = 1 << 16;
@@ -21,6 +23,19 @@ pub fn sweep_line(sweep: &SweepMsg) -> Result<String, serde_json::Error> {
     tagged("sweep", serde_json::to_string(sweep)?)
 }
 
+/// `{"type":"contact","frame":..,"ball":..,"radius":..,"centre":[..],...}`
+/// and a newline: a contact query (sent only to an engine that answers
+/// them, `check --engine-contacts`).
+pub fn contact_line(contact: &ContactMsg) -> Result<String, serde_json::Error> {
+    tagged("contact", serde_json::to_string(contact)?)
+}
+
+/// `{"type":"contacts", ...the /expected_contacts fields}` and a newline:
+/// an engine's answer to a contact query, as [`parse_contacts`] reads it.
+pub fn contacts_line(contacts: &ContactsMsg) -> Result<String, serde_json::Error> {
+    tagged("contacts", serde_json::to_string(contacts)?)
+}
+
 /// `{"type":"outcome", ...the /expected fields}` and a newline: an
 /// engine's answer as [`parse_answer`] reads it.
 pub fn answer_line(outcome: &OutcomeMsg) -> Result<String, serde_json::Error> {
@@ -34,6 +49,8 @@ pub enum Request {
     Scene(SceneMsg),
     /// A `sweep` line.
     Sweep(SweepMsg),
+    /// A `contact` line.
+    Contact(ContactMsg),
     /// A line of another `type`, which a version-1 engine ignores.
     Other(String),
 }
@@ -68,6 +85,7 @@ pub fn parse_request(line: &[u8]) -> Result<Request, String> {
     match kind.as_str() {
         "scene" => fields(object).map(Request::Scene),
         "sweep" => fields(object).map(Request::Sweep),
+        "contact" => fields(object).map(Request::Contact),
         _ => Ok(Request::Other(kind)),
     }
 }
@@ -110,6 +128,38 @@ pub fn parse_answer(line: &[u8]) -> Result<OutcomeMsg, String> {
         })?;
     validate_outcome(&outcome).map_err(|p| format!("field `{}`: {}", p.field, p.problem))?;
     Ok(outcome)
+}
+
+/// Parses one answer to a contact query: a JSON object with the fields of
+/// `/expected_contacts` (`frame` and `contacts` required) and optionally
+/// `"type": "contacts"`. The error says what is wrong, naming the field.
+pub fn parse_contacts(line: &[u8]) -> Result<ContactsMsg, String> {
+    let text = std::str::from_utf8(line).map_err(|_| "it is not UTF-8 text".to_string())?;
+    let mut object: Map<String, Value> = match serde_json::from_str::<Value>(text.trim()) {
+        Ok(Value::Object(o)) => o,
+        Ok(_) => return Err("it is not a JSON object".to_string()),
+        Err(e) => return Err(format!("it is not valid JSON ({e})")),
+    };
+    match object.remove("type") {
+        None => {}
+        Some(Value::String(t)) if t == "contacts" => {}
+        Some(other) => {
+            return Err(format!(
+                "field `type`: the answer to a contact query is of type \"contacts\", got {other}"
+            ));
+        }
+    }
+    let contacts: ContactsMsg =
+        serde_path_to_error::deserialize(Value::Object(object)).map_err(|e| {
+            let path = e.path().to_string();
+            if path == "." {
+                e.inner().to_string()
+            } else {
+                format!("field `{path}`: {}", e.inner())
+            }
+        })?;
+    validate_contacts(&contacts).map_err(|p| format!("field `{}`: {}", p.field, p.problem))?;
+    Ok(contacts)
 }
 
 #[cfg(test)]
@@ -182,6 +232,35 @@ mod tests {
             )
             .unwrap_err()
             .contains("speed")
+        );
+        let query = ContactMsg {
+            frame: 4,
+            ball: 1,
+            radius: 0.5,
+            centre: [0.1, 0.0, 0.4],
+            distance: 0.02,
+        };
+        let line = contact_line(&query).unwrap();
+        assert_eq!(
+            parse_request(line.as_bytes()).unwrap(),
+            Request::Contact(query)
+        );
+        let contacts = ContactsMsg {
+            frame: 4,
+            ball: 1,
+            contacts: Vec::new(),
+        };
+        let line = contacts_line(&contacts).unwrap();
+        assert_eq!(parse_contacts(line.as_bytes()).unwrap(), contacts);
+        assert!(
+            parse_contacts(br#"{"type":"outcome","frame":4,"contacts":[]}"#)
+                .unwrap_err()
+                .contains("type")
+        );
+        assert!(
+            parse_contacts(br#"{"frame":4,"contacts":[{"triangle":0,"normal":[0,0,0]}]}"#)
+                .unwrap_err()
+                .contains("contacts[0].normal")
         );
         let answer = OutcomeMsg::miss(3, 1);
         let line = answer_line(&answer).unwrap();

@@ -24,7 +24,7 @@ use serde::Serialize;
 
 use crate::conventions::EngineConventions;
 use crate::core::{
-    Contact, ContactQuery, Feature, Kind, Mesh, Topology, contact_set, num, triangle_contact,
+    Contact, ContactQuery, Feature, Kind, Mesh, Sides, Topology, contact_set, num, triangle_contact,
 };
 use crate::replay::{GhostContact, GhostJudgement, SceneNormals, judge_ghost};
 use crate::trace::{ContactMsg, ContactPointMsg, ContactsMsg, OutcomeMsg};
@@ -44,20 +44,27 @@ pub struct ContactTolerances {
 }
 
 impl ContactTolerances {
-    /// The tolerances of `query` under the check's `tolerances` and the
-    /// engine's `conventions` (see the module's documentation).
+    /// The tolerances of `query` against a mesh of coordinates up to
+    /// `mesh_scale`, under the check's `tolerances` and the engine's
+    /// `conventions` (see the module's documentation).
     pub fn of(
         query: &ContactQuery,
+        mesh_scale: f64,
         tolerances: &Tolerances,
         conventions: &EngineConventions,
     ) -> ContactTolerances {
         let scale = query
             .centre
             .iter()
-            .fold(query.reach(), |m, c| m.max(c.abs()));
-        let widen = conventions
+            .fold(query.reach().max(mesh_scale), |m, c| m.max(c.abs()));
+        // A closest point is a few roundings of the centre and the
+        // vertices: twice the budget, as for a sweep's contact. The
+        // budget is single precision's at least: an `accuracy` calibrated
+        // tighter on an engine's sweeps is not its contacts'.
+        let units = conventions
             .budget()
-            .map_or(0.0, |units| units * F32_UNIT * scale);
+            .map(|units| units.max(crate::conventions::F32_BUDGET));
+        let widen = units.map_or(0.0, |units| 2.0 * units * F32_UNIT * scale);
         let position = tolerances.contact + widen;
         let normal_radians = tolerances.normal_degrees.to_radians() + widen / query.radius;
         ContactTolerances {
@@ -339,7 +346,21 @@ pub fn judge_contacts(
         radius: query.radius,
         distance: query.distance,
     };
-    let tol = ContactTolerances::of(&q, tolerances, conventions);
+    // The scale of the computation: the centre and the triangles in reach.
+    let near = ContactQuery {
+        distance: 2.0 * q.distance + q.radius,
+        ..q
+    };
+    let mesh_scale = contact_set(scene.mesh, &near, Sides::Two)
+        .iter()
+        .filter_map(|c| scene.mesh.triangle_by_index(c.triangle))
+        .flat_map(|t| {
+            t.vertices
+                .iter()
+                .flat_map(|v| [v.x.abs(), v.y.abs(), v.z.abs()])
+        })
+        .fold(0.0, f64::max);
+    let tol = ContactTolerances::of(&q, mesh_scale, tolerances, conventions);
     let sides = conventions.sides;
     let reference = contact_set(scene.mesh, &q, sides);
     let places: Vec<Place> = reference
@@ -496,10 +517,10 @@ fn judge_one(
         verdict.ghosts.push(ghost);
         return;
     }
-    let expected = scene.normals.rule_normal(
+    let expected = scene.normals.contact_rule_normal(
         triangle,
         reference.feature,
-        || Some(reference.normal),
+        reference.normal,
         reference.face_normal,
     );
     let degrees = angle_degrees(&given, &expected);

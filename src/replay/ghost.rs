@@ -75,6 +75,12 @@ pub struct GhostContact {
     /// the JSON when true.
     #[serde(skip_serializing_if = "std::ops::Not::not")]
     pub answer: bool,
+    /// For an edge: whether its two triangles share it by position only,
+    /// through different vertex indices (an engine that finds a triangle's
+    /// neighbours by vertex index, as Jolt's `MeshShape` does, sees a
+    /// boundary there, an active edge). Only in the JSON when true.
+    #[serde(skip_serializing_if = "std::ops::Not::not")]
+    pub unwelded: bool,
 }
 
 /// What [`judge_ghost`] makes of one outcome.
@@ -174,6 +180,25 @@ pub fn judge_ghost(
     if angle <= degrees || rule_normal.is_some_and(|n| angle_degrees(&given, n) <= degrees) {
         return Fine;
     }
+    // Shared by position only: the two triangles' vertex indices differ.
+    let unwelded = outcome.kind == Kind::Edge
+        && neighbour.is_some_and(|n| {
+            let indices = |t: u32| {
+                mesh.triangle_by_index(t).map(|t| {
+                    let mut v = t.vertex_indices;
+                    v.sort_unstable();
+                    v
+                })
+            };
+            match (mesh.triangle_by_index(triangle), indices(n)) {
+                (Some(t), Some(other)) => {
+                    let e = feature as usize;
+                    let (a, b) = (t.vertex_indices[e], t.vertex_indices[(e + 1) % 3]);
+                    !(other.binary_search(&a).is_ok() && other.binary_search(&b).is_ok())
+                }
+                _ => false,
+            }
+        });
     Ghost(GhostContact {
         frame: outcome.frame,
         ball: outcome.ball,
@@ -187,6 +212,7 @@ pub fn judge_ghost(
         face_normal: (face_normal + Vector3::zeros()).into(),
         neighbour,
         answer: false,
+        unwelded,
     })
 }
 
@@ -235,7 +261,15 @@ impl fmt::Display for GhostContact {
             num(x),
             num(y),
             num(z)
-        )
+        )?;
+        if self.unwelded {
+            f.write_str(
+                " (the two triangles share this edge by position only, through different vertex indices: \
+                 an engine that finds neighbours by index, as Jolt's MeshShape does, sees a boundary here; \
+                 weld the mesh's vertices)",
+            )?;
+        }
+        Ok(())
     }
 }
 

@@ -88,10 +88,41 @@ impl SceneNormals {
         contact_normal: impl FnOnce() -> Option<Vector3<f64>>,
         face_normal: Vector3<f64>,
     ) -> Vector3<f64> {
+        self.rule_normal_of(Query::Sweep, triangle, feature, contact_normal, face_normal)
+    }
+
+    /// [`SceneNormals::rule_normal`] for a contact query: under
+    /// [`NormalRule::ActiveEdges`] an inactive feature answers the face
+    /// normal whatever the angle (Jolt's `CollideSphereVsTriangles`; the
+    /// [`ACTIVE_EDGE_KEEP_DEGREES`] exception is its shape cast's).
+    pub fn contact_rule_normal(
+        &self,
+        triangle: u32,
+        feature: Feature,
+        contact_normal: Vector3<f64>,
+        face_normal: Vector3<f64>,
+    ) -> Vector3<f64> {
+        self.rule_normal_of(
+            Query::Contact,
+            triangle,
+            feature,
+            || Some(contact_normal),
+            face_normal,
+        )
+    }
+
+    fn rule_normal_of(
+        &self,
+        query: Query,
+        triangle: u32,
+        feature: Feature,
+        contact_normal: impl FnOnce() -> Option<Vector3<f64>>,
+        face_normal: Vector3<f64>,
+    ) -> Vector3<f64> {
         if self.contact_normal_at(triangle, feature) {
             return contact_normal().unwrap_or(face_normal);
         }
-        if self.keeps_near_contact_normal(triangle, feature) {
+        if query == Query::Sweep && self.keeps_near_contact_normal(triangle, feature) {
             // Jolt keeps a contact normal within 1° of the triangle's own
             // (on the side the hit faces).
             let Some(front) = self.fronts.get(triangle as usize) else {
@@ -136,6 +167,13 @@ impl SceneNormals {
         }
         outcome
     }
+}
+
+/// Which query a normal is for (the active-edge rule differs in one case).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Query {
+    Sweep,
+    Contact,
 }
 
 /// By input triangle, its front normal (zero for a triangle left out).

@@ -32,8 +32,9 @@ pub struct ContactsReport {
     pub without_answer: u64,
     /// Answers without a query in their scene.
     pub answers_without_query: u64,
-    /// Queries not judged because the answers come from an engine command,
-    /// whose protocol has no contact request yet (`check --engine`).
+    /// Queries not judged because the answers come from an engine command
+    /// that was not asked for contacts (`check --engine` without
+    /// `--engine-contacts`, or against the trace's expectations).
     #[serde(skip_serializing_if = "is_zero")]
     pub not_asked: u64,
     /// The first divergent queries, in trace order.
@@ -56,6 +57,10 @@ impl ContactsReport {
 pub(crate) enum ContactMode {
     /// Judge them against the core (`check`).
     Judge,
+    /// Judge them against the core: they are an engine's answers (`check
+    /// --engine --engine-contacts`; its ghost contacts say "the engine's
+    /// normal").
+    JudgeEngine,
     /// Count the queries only: the answers judged come from an engine
     /// command that is not asked for contacts.
     NotAsked,
@@ -188,6 +193,12 @@ impl<'a> ContactChecker<'a> {
             &self.options.replay.conventions,
             self.options.ghost_degrees,
         );
+        let mut verdict = verdict;
+        if self.mode == ContactMode::JudgeEngine {
+            for ghost in &mut verdict.ghosts {
+                ghost.answer = true;
+            }
+        }
         self.report.compared += 1;
         self.ghost_count += verdict.ghosts.len() as u64;
         for ghost in &verdict.ghosts {

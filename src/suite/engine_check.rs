@@ -55,14 +55,16 @@ pub fn check_file_with_engine(
     let mut reader = TraceReader::new(std::io::BufReader::with_capacity(1 << 16, file), &name);
     let (mut report, run) = match against {
         Against::Core => {
-            let mut answers = EngineAnswers::new(reader.by_ref(), session, engine.window);
-            let (report, _) = check_stream(
-                answers.by_ref(),
-                &name,
-                options,
-                ContactMode::NotAsked,
-                |result| judge_against_core(result, &options.tolerances),
-            );
+            let mut answers = EngineAnswers::new(reader.by_ref(), session, engine.window)
+                .with_contacts(engine.contacts);
+            let contacts = if engine.contacts {
+                ContactMode::JudgeEngine
+            } else {
+                ContactMode::NotAsked
+            };
+            let (report, _) = check_stream(answers.by_ref(), &name, options, contacts, |result| {
+                judge_against_core(result, &options.tolerances)
+            });
             (report, answers.finish())
         }
         Against::Expected => {

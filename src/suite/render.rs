@@ -266,7 +266,7 @@ fn write_contacts(s: &mut String, r: &TraceReport) {
     if c.not_asked > 0 {
         let _ = write!(
             line,
-            ", {} not judged (the engine protocol has no contact request yet)",
+            ", {} not judged (an engine is asked for contacts only with --engine-contacts, its answers compared with the core)",
             c.not_asked
         );
     }

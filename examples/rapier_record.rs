@@ -30,11 +30,13 @@
 //! `TriMeshFlags::FIX_INTERNAL_EDGES`. After each step the recorder judges
 //! the solver's contacts between each ball and the mesh (those touching, a
 //! point at distance ≤ 0) with `check`'s ghost-contact rule and prints how
-//! many are ghosts. `--expect contacts` writes those contacts as the
-//! expectations instead of the shape cast (for each sweep the contact whose
-//! normal leans furthest from its face, at `α = 0`): a trace to list ghost
-//! contacts with, not to compare (examples/rapier/README.md, "Ghost
-//! contacts on a floor and a ramp").
+//! many are ghosts. `--expect contacts` writes the solver's contacts as
+//! contact queries instead of the shape cast's expectations: for each ball
+//! and step a `/contact` query at the ball's centre where the step's
+//! contacts were computed (its start), with Rapier's prediction distance,
+//! and every point of its manifolds against the mesh as the answer
+//! (`/expected_contacts`), which `check` judges against the core's contact
+//! set (examples/rapier/README.md, "Ghost contacts on a floor and a ramp").
 //!
 //! The trace names its expectations' source (the `sweeptrace.expected_source`
 //! record): engine `rapier3d-f64`, the version linked, and the settings that
@@ -62,6 +64,7 @@ use sweeptrace::sim::load_obj;
 use sweeptrace::sim::scenes::BuiltinScene;
 use sweeptrace::sim::scenes::SceneMesh;
 use sweeptrace::sim::{SimOptions, initial_states, play_volume, scene_message};
+use sweeptrace::trace::{ContactMsg, ContactPointMsg, ContactsMsg};
 use sweeptrace::{ExpectedSource, OutcomeMsg, SweepMsg, Topology, write_trace_file};
 
 /// Relative tolerance of the kind read from Rapier's answer (see the module
@@ -84,9 +87,9 @@ usage: rapier_record (--scene NAME | --mesh FILE.obj) -o OUT.mcap [options]
                       build the mesh with TriMeshFlags::FIX_INTERNAL_EDGES
   --expect cast|contacts
                       the expectations: Rapier's shape cast along each sweep
-                      (default), or the solver's contact at the step's start
-                      that leans furthest from its face (to list ghost
-                      contacts with `sweeptrace check`, not to compare)
+                      (default), or the solver's contacts at each step's
+                      start as contact queries (`sweeptrace check` judges
+                      them and lists their ghost contacts)
 
 example: rapier_record --scene mini_golf --balls 2 --frames 240 -o rapier_mini_golf.mcap";
 
@@ -112,11 +115,10 @@ pub enum Expect {
     /// Rapier's shape cast of the ball along the sweep (`--expect cast`).
     #[default]
     Cast,
-    /// The solver's contact at the start of the step (`--expect
-    /// contacts`): of the contacts touching the mesh, the one whose normal
-    /// leans furthest from its triangle's face normal, at `α = 0`. Not a
-    /// first contact along the sweep: a trace to list ghost contacts with,
-    /// not to compare (see examples/rapier/README.md).
+    /// The solver's contacts at the start of the step (`--expect
+    /// contacts`): a contact query per ball and step, answered with every
+    /// point of the solver's manifolds against the mesh (the sweeps get no
+    /// expectation).
     Contacts,
 }
 
@@ -306,22 +308,22 @@ pub fn rapier_source(
         .setting("kind_tolerance", CLASSIFY_TOLERANCE)
 }
 
-/// One of the solver's contacts between a ball and the mesh, as an
-/// outcome at `α = 0` (touching at the start of the step).
+/// One of the solver's contacts between a ball and the mesh (a point of
+/// one of its manifolds).
 struct SolverContact {
-    outcome: OutcomeMsg,
-    /// The angle between its normal and its triangle's face normal, degrees.
-    lean_degrees: f64,
+    /// As an engine's contact.
+    point: ContactPointMsg,
+    /// Whether it touches (distance ≤ 0; the others are speculative).
+    touching: bool,
     /// Whether `check`'s rule (`judge_ghost`) calls it a ghost contact.
     ghost: bool,
 }
 
-/// The solver's manifolds between the ball collider `ball` (of ball number
-/// `ball_number`, at `frame`) and the mesh after a step that touch (a point
-/// at distance ≤ 0; speculative points, still apart, are left out): each
-/// as an outcome with its triangle, the kind and feature read from its
-/// deepest point on the mesh (as for a shape cast's answer), its normal
-/// from the mesh toward the ball, judged by `check`'s ghost rule.
+/// The points of the solver's manifolds between the ball collider `ball`
+/// (of ball number `ball_number`, at `frame`) and the mesh after a step:
+/// each with its triangle, the kind and feature read from its point on the
+/// mesh (as for a shape cast's answer), its normal from the mesh toward the
+/// ball and its distance (the separation), judged by `check`'s ghost rule.
 fn solver_contacts(
     world: &PhysicsWorld,
     (ball, frame, ball_number): (ColliderHandle, u64, u32),
@@ -335,55 +337,53 @@ fn solver_contacts(
     let mesh_first = pair.collider1 == mesh;
     let mut out = Vec::new();
     for manifold in pair.manifolds() {
-        let Some(point) = manifold.find_deepest_contact().filter(|p| p.dist <= 0.0) else {
-            continue;
-        };
         let (triangle, normal) = if mesh_first {
             (manifold.subshape1, manifold.data.normal)
         } else {
             (manifold.subshape2, -manifold.data.normal)
         };
-        // The mesh is fixed at the origin: its local frame is the world's.
-        let witness = if mesh_first {
-            point.local_p1
-        } else {
-            point.local_p2
-        };
         let Some(corners) = corners_of(triangle) else {
             continue;
         };
-        let (kind, feature) = classify(corners, witness, normal);
-        let mut outcome = OutcomeMsg::hit(frame, ball_number, 0.0, kind)
-            .triangle(triangle)
-            .normal(array(normal))
-            .contact(array(witness));
-        if let Some(feature) = feature {
-            outcome = outcome.feature(feature);
+        for point in &manifold.points {
+            // The mesh is fixed at the origin: its local frame is the world's.
+            let witness = if mesh_first {
+                point.local_p1
+            } else {
+                point.local_p2
+            };
+            let (kind, feature) = classify(corners, witness, normal);
+            let mut outcome = OutcomeMsg::hit(frame, ball_number, 0.0, kind)
+                .triangle(triangle)
+                .normal(array(normal))
+                .contact(array(witness));
+            if let Some(feature) = feature {
+                outcome = outcome.feature(feature);
+            }
+            let ghost = matches!(
+                judge_ghost(
+                    &scene.mesh,
+                    &scene.topology,
+                    &outcome,
+                    0,
+                    None,
+                    GHOST_DEGREES
+                ),
+                GhostJudgement::Ghost(_)
+            );
+            out.push(SolverContact {
+                point: ContactPointMsg {
+                    triangle,
+                    kind: Some(kind),
+                    feature,
+                    point: Some(array(witness)),
+                    normal: Some(array(normal)),
+                    separation: Some(point.dist),
+                },
+                touching: point.dist <= 0.0,
+                ghost,
+            });
         }
-        let [a, b, c] = corners;
-        let face = (b - a).cross(c - a).normalize();
-        let lean_degrees = normal
-            .normalize()
-            .dot(face)
-            .clamp(-1.0, 1.0)
-            .acos()
-            .to_degrees();
-        let ghost = matches!(
-            judge_ghost(
-                &scene.mesh,
-                &scene.topology,
-                &outcome,
-                0,
-                None,
-                GHOST_DEGREES
-            ),
-            GhostJudgement::Ghost(_)
-        );
-        out.push(SolverContact {
-            outcome,
-            lean_degrees,
-            ghost,
-        });
     }
     out
 }
@@ -481,10 +481,14 @@ pub fn run(args: Args) -> Result<Counts, String> {
         let mut counts = Counts::default();
         let gravity = vector(options.gravity);
         let dt = options.time_step;
+        // Each ball's centre at the start of the step: where the solver's
+        // contacts of the step were computed.
+        let mut starts: Vec<Option<Vector>> = vec![None; balls.len()];
         for frame in 0..options.frames {
             let log_time_nanos = frame * step_nanos;
             let pipeline = world.query_pipeline_with_filter(QueryFilter::only_fixed());
             for (ball, handle) in balls.iter_mut().enumerate() {
+                starts[ball] = None;
                 let Some((h, _)) = *handle else {
                     continue;
                 };
@@ -499,6 +503,7 @@ pub fn run(args: Args) -> Result<Counts, String> {
                     *handle = None;
                     continue;
                 }
+                starts[ball] = Some(p0);
                 let ball = ball as u32;
                 trace.sweep(
                     log_time_nanos,
@@ -566,13 +571,33 @@ pub fn run(args: Args) -> Result<Counts, String> {
                     &scene_state,
                     corners_of,
                 );
-                counts.solver.manifolds += contacts.len() as u64;
-                counts.solver.ghosts += contacts.iter().filter(|c| c.ghost).count() as u64;
-                let leaning = contacts
-                    .into_iter()
-                    .max_by(|a, b| a.lean_degrees.total_cmp(&b.lean_degrees));
-                if let (Expect::Contacts, Some(contact)) = (args.expect, leaning) {
-                    trace.expected(log_time_nanos, &contact.outcome)?;
+                counts.solver.manifolds += contacts.iter().filter(|c| c.touching).count() as u64;
+                counts.solver.ghosts +=
+                    contacts.iter().filter(|c| c.touching && c.ghost).count() as u64;
+                if let (Expect::Contacts, Some(start)) = (args.expect, starts[ball]) {
+                    let ball = ball as u32;
+                    trace.contact(
+                        log_time_nanos,
+                        &ContactMsg {
+                            frame,
+                            ball,
+                            radius: options.radius,
+                            centre: array(start),
+                            distance: 0.0,
+                        },
+                    )?;
+                    trace.expected_contacts(
+                        log_time_nanos,
+                        &ContactsMsg {
+                            frame,
+                            ball,
+                            contacts: contacts
+                                .into_iter()
+                                .filter(|c| c.touching)
+                                .map(|c| c.point)
+                                .collect(),
+                        },
+                    )?;
                 }
             }
         }

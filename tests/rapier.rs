@@ -85,10 +85,12 @@ fn rapier_ghosts_on_a_floor_go_with_fix_internal_edges() -> anyhow::Result<()> {
 }
 
 /// The committed solver-contact trace (tests/fixtures/rapier_floor_contacts.mcap,
-/// recorded with the arguments of `floor_args` and `--expect contacts`):
+/// recorded with the arguments of `floor_args` and `--expect contacts`: a
+/// contact query per step answered with the solver's touching contacts):
 /// `check` lists exactly its eight ghost contacts, on flat seams, and the
-/// trace fails (its expectations are resting contacts at α = 0, not first
-/// contacts, and the ghosts fail too).
+/// trace fails; recorded with `FIX_INTERNAL_EDGES` the same run's contacts
+/// pass (the flag drops the neighbour's edge contact at a seam, a place its
+/// face already has).
 fn rapier_floor_contacts_trace_lists_its_ghosts() -> anyhow::Result<()> {
     let path = root().join("tests/fixtures/rapier_floor_contacts.mcap");
     let report = check_file(&path, &CheckOptions::default());
@@ -119,6 +121,24 @@ fn rapier_floor_contacts_trace_lists_its_ghosts() -> anyhow::Result<()> {
             && report.status() == Status::Fail,
         "{listed:?}\n{}",
         render_text(&report)
+    );
+    ensure!(
+        report.contacts.compared == 180 && report.compared == 0,
+        "{:?}",
+        report.contacts
+    );
+    let dir = tempfile::tempdir()?;
+    let fixed = dir.path().join("floor_fixed.mcap");
+    let mut args = floor_args(&fixed, true, Expect::Contacts);
+    args.fix_internal_edges = true;
+    run(args).map_err(anyhow::Error::msg)?;
+    let with_flag = check_file(&fixed, &CheckOptions::default());
+    ensure!(
+        with_flag.status() == Status::Ok
+            && with_flag.ghosts.count == 0
+            && with_flag.contacts.compared == 180,
+        "with FIX_INTERNAL_EDGES:\n{}",
+        render_text(&with_flag)
     );
     let source = report.expected_source.context("no expected source")?;
     ensure!(

@@ -202,14 +202,16 @@ where
                 Some(Queued::Ready(event)) => Some(event),
                 _ => None,
             },
-            Queued::Contact(event, key) => {
-                if self.front_answered {
-                    self.front_answered = false;
-                    self.in_flight -= 1;
-                    let event = event.clone();
-                    self.queue.pop_front();
-                    return Some(Ok(event));
+            Queued::Sweep(..) | Queued::Contact(..) if self.front_answered => {
+                // Its answer was handed on: now the query itself.
+                self.front_answered = false;
+                self.in_flight -= 1;
+                match self.queue.pop_front() {
+                    Some(Queued::Sweep(event, _) | Queued::Contact(event, _)) => Some(Ok(event)),
+                    _ => None,
                 }
+            }
+            Queued::Contact(event, key) => {
                 let (key, header) = (*key, event.header);
                 let session = self.session.as_mut()?;
                 match session.next_contacts(key) {
@@ -224,13 +226,6 @@ where
                 }
             }
             Queued::Sweep(event, key) => {
-                if self.front_answered {
-                    self.front_answered = false;
-                    self.in_flight -= 1;
-                    let event = event.clone();
-                    self.queue.pop_front();
-                    return Some(Ok(event));
-                }
                 let (key, header) = (*key, event.header);
                 let session = self.session.as_mut()?;
                 match session.next_answer(key) {

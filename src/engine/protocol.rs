@@ -101,31 +101,7 @@ fn tagged(tag: &str, object: String) -> Result<String, serde_json::Error> {
 /// optionally `"type": "outcome"`. The error says what is wrong, naming the
 /// field.
 pub fn parse_answer(line: &[u8]) -> Result<OutcomeMsg, String> {
-    let text = std::str::from_utf8(line).map_err(|_| "it is not UTF-8 text".to_string())?;
-    let text = text.trim();
-    let mut object: Map<String, Value> = match serde_json::from_str::<Value>(text) {
-        Ok(Value::Object(o)) => o,
-        Ok(_) => return Err("it is not a JSON object".to_string()),
-        Err(e) => return Err(format!("it is not valid JSON ({e})")),
-    };
-    match object.remove("type") {
-        None => {}
-        Some(Value::String(t)) if t == "outcome" => {}
-        Some(other) => {
-            return Err(format!(
-                "field `type`: an answer is of type \"outcome\", got {other}"
-            ));
-        }
-    }
-    let outcome: OutcomeMsg =
-        serde_path_to_error::deserialize(Value::Object(object)).map_err(|e| {
-            let path = e.path().to_string();
-            if path == "." {
-                e.inner().to_string()
-            } else {
-                format!("field `{path}`: {}", e.inner())
-            }
-        })?;
+    let outcome: OutcomeMsg = parse_tagged(line, "outcome", "an answer")?;
     validate_outcome(&outcome).map_err(|p| format!("field `{}`: {}", p.field, p.problem))?;
     Ok(outcome)
 }
@@ -134,6 +110,18 @@ pub fn parse_answer(line: &[u8]) -> Result<OutcomeMsg, String> {
 /// `/expected_contacts` (`frame` and `contacts` required) and optionally
 /// `"type": "contacts"`. The error says what is wrong, naming the field.
 pub fn parse_contacts(line: &[u8]) -> Result<ContactsMsg, String> {
+    let contacts: ContactsMsg = parse_tagged(line, "contacts", "the answer to a contact query")?;
+    validate_contacts(&contacts).map_err(|p| format!("field `{}`: {}", p.field, p.problem))?;
+    Ok(contacts)
+}
+
+/// A JSON object line with the fields of `T` and, optionally, `"type":
+/// tag` (`what` names it in the error).
+fn parse_tagged<T: serde::de::DeserializeOwned>(
+    line: &[u8],
+    tag: &str,
+    what: &str,
+) -> Result<T, String> {
     let text = std::str::from_utf8(line).map_err(|_| "it is not UTF-8 text".to_string())?;
     let mut object: Map<String, Value> = match serde_json::from_str::<Value>(text.trim()) {
         Ok(Value::Object(o)) => o,
@@ -142,24 +130,21 @@ pub fn parse_contacts(line: &[u8]) -> Result<ContactsMsg, String> {
     };
     match object.remove("type") {
         None => {}
-        Some(Value::String(t)) if t == "contacts" => {}
+        Some(Value::String(t)) if t == tag => {}
         Some(other) => {
             return Err(format!(
-                "field `type`: the answer to a contact query is of type \"contacts\", got {other}"
+                "field `type`: {what} is of type \"{tag}\", got {other}"
             ));
         }
     }
-    let contacts: ContactsMsg =
-        serde_path_to_error::deserialize(Value::Object(object)).map_err(|e| {
-            let path = e.path().to_string();
-            if path == "." {
-                e.inner().to_string()
-            } else {
-                format!("field `{path}`: {}", e.inner())
-            }
-        })?;
-    validate_contacts(&contacts).map_err(|p| format!("field `{}`: {}", p.field, p.problem))?;
-    Ok(contacts)
+    serde_path_to_error::deserialize(Value::Object(object)).map_err(|e| {
+        let path = e.path().to_string();
+        if path == "." {
+            e.inner().to_string()
+        } else {
+            format!("field `{path}`: {}", e.inner())
+        }
+    })
 }
 
 #[cfg(test)]

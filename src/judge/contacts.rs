@@ -421,6 +421,12 @@ pub fn judge_contacts(
             &mut verdict,
         );
     }
+    let reported: Vec<u32> = answer
+        .contacts
+        .iter()
+        .map(|c| c.triangle)
+        .filter(|t| reference.iter().any(|r| r.triangle == *t))
+        .collect();
     let mut missing_places = Vec::new();
     for (k, c) in reference.iter().enumerate() {
         if covered[k] || missing_places.contains(&places[k]) {
@@ -431,6 +437,13 @@ pub fn judge_contacts(
         if c.separation >= q.distance - tol.position {
             continue;
         }
+        // A flat seam (or a vertex among flat edges) is part of the plane
+        // its triangles make: an engine that reports one of them has the
+        // place (Rapier's FIX_INTERNAL_EDGES drops the neighbour's edge
+        // contact there; its normal would be the same face normal).
+        if flat_place_reported(scene.topology, places[k], &reported) {
+            continue;
+        }
         verdict.problems.push(ContactProblem::Missing {
             triangle: c.triangle,
             feature: c.feature.to_string(),
@@ -439,6 +452,24 @@ pub fn judge_contacts(
         });
     }
     verdict
+}
+
+/// Whether `place` is a flat edge, or a vertex whose every edge is flat,
+/// one of whose triangles the engine reported.
+fn flat_place_reported(topology: &Topology, place: Place, reported: &[u32]) -> bool {
+    use crate::core::EdgeClass;
+    match place {
+        Place::Edge([a, b]) => topology.edge_between(a, b).is_some_and(|e| {
+            e.class == EdgeClass::Flat && e.triangles().any(|t| reported.contains(&t))
+        }),
+        Place::Vertex(v) => {
+            let mut edges = topology.edges_at(v).peekable();
+            edges.peek().is_some()
+                && topology.edges_at(v).all(|e| e.class == EdgeClass::Flat)
+                && edges.any(|e| e.triangles().any(|t| reported.contains(&t)))
+        }
+        Place::Face(_) | Place::Alone(..) => false,
+    }
 }
 
 /// One engine contact against the reference contact of its triangle.

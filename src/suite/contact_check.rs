@@ -14,9 +14,6 @@ use crate::trace::{ContactMsg, ContactsMsg, EventBody, SceneMsg, TraceEvent};
 
 use super::check::CheckOptions;
 
-/// How many divergent contact queries a report describes in detail.
-pub const MAX_CONTACT_DETAILS: usize = 3;
-
 /// What `check` reports of a trace's contact queries (`contacts` in the
 /// JSON, absent when the trace has none).
 #[derive(Clone, Debug, Default, PartialEq, Serialize)]
@@ -37,7 +34,8 @@ pub struct ContactsReport {
     /// `--engine-contacts`, or against the trace's expectations).
     #[serde(skip_serializing_if = "is_zero")]
     pub not_asked: u64,
-    /// The first divergent queries, in trace order.
+    /// The first divergent queries, in trace order (as many as the check's
+    /// `max_details`).
     pub details: Vec<ContactVerdict>,
 }
 
@@ -208,7 +206,7 @@ impl<'a> ContactChecker<'a> {
         }
         if !verdict.agrees() {
             self.report.divergent += 1;
-            if self.report.details.len() < MAX_CONTACT_DETAILS {
+            if self.report.details.len() < self.options.max_details {
                 self.report.details.push(verdict);
             }
         }

@@ -45,7 +45,7 @@ pub use config::{
     ConfigError, ConfigFile, ConfigFiles, Overrides, Settings, normalize, render_settings_json,
     render_settings_text, resolve, settings_for,
 };
-pub use contact_check::{ContactsReport, MAX_CONTACT_DETAILS};
+pub use contact_check::ContactsReport;
 pub use diff::{
     DiffReport, FirstDifference, Side, diff, render_diff_json, render_diff_text, scene_differences,
 };

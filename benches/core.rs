@@ -38,8 +38,8 @@ use criterion::{BenchmarkGroup, BenchmarkId, Criterion, Throughput, criterion_gr
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use sweeptrace::core::{
-    Broadphase, CollectRecords, CountVisits, Mesh, Observer, Options, Outcome, Skip, Sweep,
-    Topology, sweep_mesh, sweep_mesh_with,
+    Broadphase, CollectRecords, ContactQuery, CountVisits, Mesh, Observer, Options, Outcome, Sides,
+    Skip, Sweep, Topology, contact_set, sweep_mesh, sweep_mesh_with,
 };
 use sweeptrace::replay::{CollectPrimary, primary_records};
 use sweeptrace::sim::{self, scenes::BuiltinScene};
@@ -331,6 +331,37 @@ fn bench_session(c: &mut Criterion) {
             b.iter(|| {
                 i = (i + 1) % n;
                 black_box(parry_cast(&s.parry, &s.sweeps[i]))
+            })
+        });
+        // The contact query `record --contacts` makes after each of these
+        // sweeps: the ball where the sweep leaves it, contact distance a
+        // tenth of the radius.
+        let queries: Vec<ContactQuery> = s
+            .sweeps
+            .iter()
+            .map(|w| {
+                let alpha = sweep_mesh(&s.ours, w, &options).map_or(1.0, |o| o.travelled());
+                ContactQuery {
+                    centre: w.p0 + (w.p1 - w.p0) * alpha,
+                    radius: w.radius,
+                    distance: w.radius / 10.0,
+                }
+            })
+            .collect();
+        let touching = queries
+            .iter()
+            .filter(|q| !contact_set(&s.ours, q, Sides::One).is_empty())
+            .count();
+        println!(
+            "contacts {}: {touching} of {} queries touch the mesh",
+            s.triangles,
+            queries.len()
+        );
+        let mut i = 0usize;
+        group.bench_with_input(BenchmarkId::new("contacts", s.triangles), &s, |b, s| {
+            b.iter(|| {
+                i = (i + 1) % n;
+                black_box(contact_set(&s.ours, &queries[i], Sides::One))
             })
         });
     }

@@ -81,7 +81,7 @@ pub(crate) fn closest_feature(triangle: &Triangle, p: &Point3<f64>) -> (Point3<f
 
 /// The contact of `triangle` with the ball of `query`, if its closest point
 /// is within reach and (under [`Sides::One`]) the centre is not behind it.
-pub fn triangle_contact(
+pub(crate) fn triangle_contact(
     triangle: &Triangle,
     query: &ContactQuery,
     sides: Sides,
@@ -128,10 +128,21 @@ pub fn contact_set(mesh: &Mesh, query: &ContactQuery, sides: Sides) -> Vec<Conta
     // are rounded outward; the margin covers the rounding of the test.
     let size = query.centre.iter().fold(reach, |m, c| m.max(c.abs()));
     let grow = reach + 8.0 * f64::EPSILON * size;
-    let triangles = mesh.triangles();
+    let (triangles, planes) = (mesh.triangles(), mesh.planes());
+    // The closest point lies in the triangle's plane, so its distance is at
+    // least the centre's height over the plane, and (one-sided) the centre
+    // is behind it when that height is negative: a cheap rejection, kept
+    // loose by the rounding of the height so that `triangle_contact`
+    // decides every case it could accept.
+    let slack = 64.0 * f64::EPSILON * size;
     mesh.bvh()
         .traverse(&query.centre, &Vector3::zeros(), grow, 0.0, |range| {
             for position in range {
+                let plane = &planes[position];
+                let height = plane.normal.dot(&(query.centre - plane.v0));
+                if height.abs() > reach + slack || (sides == Sides::One && height < -slack) {
+                    continue;
+                }
                 if let Some(contact) = triangle_contact(&triangles[position], query, sides) {
                     found.push(contact);
                 }

@@ -259,7 +259,7 @@ impl ContactVerdict {
 
 /// What a query is judged against: the scene's mesh, its topology and the
 /// normals its `normal` convention expects.
-pub struct ContactScene<'a> {
+pub(crate) struct ContactScene<'a> {
     /// The mesh.
     pub mesh: &'a Mesh,
     /// Its topology (places are grouped by its weld).
@@ -333,7 +333,7 @@ fn angle_degrees(a: &Vector3<f64>, b: &Vector3<f64>) -> f64 {
 /// Judges the engine's `answer` to `query` against the reference over
 /// `scene`, under `conventions` (its `sides` and precision) and the check's
 /// `tolerances`; ghost contacts above `ghost_degrees`.
-pub fn judge_contacts(
+pub(crate) fn judge_contacts(
     scene: &ContactScene<'_>,
     query: &ContactMsg,
     answer: &ContactsMsg,

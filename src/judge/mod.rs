@@ -20,7 +20,7 @@
 //!   [`divergence_details`], [`render_divergence_as`]);
 //! - one sweep's inputs, bit-exactly ([`SweepInputs`]);
 //! - an engine's contacts for one contact query against the core's contact
-//!   set ([`judge_contacts`], [`ContactVerdict`]).
+//!   set (`judge_contacts`, its [`ContactVerdict`]).
 //!
 //! The judge depends on the core, the trace messages and the replay only;
 //! running a folder of traces is the suite's job ([`crate::suite`]).
@@ -46,9 +46,8 @@ pub use compare::{
     DEFAULT_NORMAL_TOLERANCE_DEGREES, Field, FieldDiff, FieldSet, Tolerances, angle_degrees,
     compare,
 };
-pub use contacts::{
-    ContactProblem, ContactScene, ContactTolerances, ContactVerdict, judge_contacts,
-};
+pub use contacts::{ContactProblem, ContactTolerances, ContactVerdict};
+pub(crate) use contacts::{ContactScene, judge_contacts};
 pub(crate) use decision::write_decision_line;
 #[cfg(feature = "viewer")]
 pub(crate) use decision::write_divergence_line;

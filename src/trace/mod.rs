@@ -49,9 +49,10 @@ pub use source::{
     MAX_SETTINGS, sweeptrace_source,
 };
 pub use validate::{
-    FieldProblem, parse_message, validate_contact, validate_contacts, validate_outcome,
-    validate_scene, validate_sweep, validate_triangle,
+    FieldProblem, parse_message, validate_outcome, validate_scene, validate_sweep,
+    validate_triangle,
 };
+pub(crate) use validate::{validate_contact, validate_contacts};
 pub(crate) use validate::{frame_of_message, parse_message_as};
 pub(crate) use write::library_string;
 pub use write::{

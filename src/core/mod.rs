@@ -42,8 +42,8 @@ mod sweep_vertex;
 mod ties;
 mod topology;
 
-pub use contact::{Contact, ContactQuery, contact_set};
 pub(crate) use contact::triangle_contact;
+pub use contact::{Contact, ContactQuery, contact_set};
 pub use crossing::{
     Crossing, all_crossings, crossing_tolerance, first_crossing, first_crossing_with_flipped,
     triangle_crossing, triangle_crossing_back_to_front,

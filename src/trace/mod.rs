@@ -52,8 +52,8 @@ pub use validate::{
     FieldProblem, parse_message, validate_outcome, validate_scene, validate_sweep,
     validate_triangle,
 };
-pub(crate) use validate::{validate_contact, validate_contacts};
 pub(crate) use validate::{frame_of_message, parse_message_as};
+pub(crate) use validate::{validate_contact, validate_contacts};
 pub(crate) use write::library_string;
 pub use write::{
     PendingTrace, TraceWriter, default_write_options, write_trace_file,

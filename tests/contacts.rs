@@ -29,6 +29,7 @@ pub fn tests() -> Vec<Trial> {
         trial!(an_engine_answers_contact_queries_with_engine_contacts),
         trial!(bad_contact_messages_are_refused_with_the_field),
         trial!(python_reads_the_contact_channels),
+        trial!(the_recording_draws_each_query_and_marks_its_ghosts),
     ]
 }
 
@@ -554,4 +555,53 @@ fn python_reads_the_contact_channels() -> anyhow::Result<Completion> {
         "the script accepted a wrong count"
     );
     Ok(Completion::Completed)
+}
+
+/// `replay --rrd` of Rapier's solver-contact fixture draws each contact
+/// query at its frame (points and normals), labels the ghost contacts with
+/// their angle, logs them to the divergences, and plots the count per ball.
+fn the_recording_draws_each_query_and_marks_its_ghosts() -> anyhow::Result<()> {
+    let dir = tempfile::tempdir()?;
+    let rrd = dir.path().join("contacts.rrd");
+    let fixture =
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/rapier_floor_contacts.mcap");
+    let out = bin()
+        .arg("replay")
+        .arg(&fixture)
+        .arg("--rrd")
+        .arg(&rrd)
+        .output()?;
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    ensure!(out.status.success(), "{stderr}");
+    ensure!(
+        stderr.contains("contacts: 180 queries drawn (159 contacts, 1 diverging from the core's, 8 ghost contacts)"),
+        "{stderr}"
+    );
+    let d = crate::replay::decode_rrd(&rrd)?;
+    let drawn = d.frames_with("/world/ball/0/contacts", "Points3D:positions");
+    // 150 of the 180 queries have contacts (the ball is in the air in the
+    // others); every query is plotted.
+    let normals = d.frames_with("/world/ball/0/contacts/normals", "Arrows3D:vectors");
+    let plotted = d.frames_with("/plots/contacts/ball/0", "Scalars:scalars");
+    ensure!(
+        (drawn.len(), normals.len(), plotted.len()) == (150, 150, 180),
+        "points, normals, plot at {}, {}, {} frames",
+        drawn.len(),
+        normals.len(),
+        plotted.len()
+    );
+    let labels = d.texts_at("/world/ball/0/contacts", "Points3D:labels", 93);
+    ensure!(
+        labels
+            .iter()
+            .any(|l| l == "ghost contact 5.4°: edge 20.2 is internal and flat"),
+        "frame 93: {labels:?}"
+    );
+    let log = d.texts_at("/divergences", "TextLog:text", 93);
+    ensure!(
+        log.iter()
+            .any(|l| l.starts_with("ghost contact: frame 93, ball 0: edge 20.2")),
+        "frame 93's log: {log:?}"
+    );
+    Ok(())
 }

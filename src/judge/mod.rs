@@ -46,8 +46,10 @@ pub use compare::{
     DEFAULT_NORMAL_TOLERANCE_DEGREES, Field, FieldDiff, FieldSet, Tolerances, angle_degrees,
     compare,
 };
+pub(crate) use contacts::ContactPairing;
+#[cfg(feature = "viewer")]
+pub(crate) use contacts::PairedContacts;
 pub use contacts::{ContactProblem, ContactTolerances, ContactVerdict};
-pub(crate) use contacts::{ContactScene, judge_contacts};
 pub(crate) use decision::write_decision_line;
 #[cfg(feature = "viewer")]
 pub(crate) use decision::write_divergence_line;

@@ -461,9 +461,13 @@ impl Replay {
                 self.expected(outcome);
                 Ok(())
             }
-            // Contact queries are judged apart from the sweeps
-            // (suite::contacts); the replay of sweeps passes them by.
-            EventBody::Contact(_) | EventBody::ExpectedContacts(_) => Ok(()),
+            // Contact queries are judged apart from the sweeps (`check`,
+            // the recording's contacts); the replay of sweeps counts them.
+            EventBody::Contact(_) => {
+                self.summary.contact_queries += 1;
+                Ok(())
+            }
+            EventBody::ExpectedContacts(_) => Ok(()),
         }
     }
 

@@ -80,6 +80,9 @@ pub struct ReplaySummary {
     pub tunnels: BTreeMap<TunnelKind, u64>,
     /// The first tunnels (at most `LISTED_TUNNELS`, 5), in trace order.
     pub first_tunnels: Vec<TunnelAt>,
+    /// `/contact` queries read (not replayed as sweeps: `check` judges
+    /// them, the recording draws them).
+    pub contact_queries: u64,
 }
 
 impl ReplaySummary {

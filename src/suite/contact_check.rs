@@ -3,14 +3,11 @@
 //! one scene) and judged against the core's contact set
 //! ([`judge_contacts`]), beside the sweeps' replay.
 
-use std::collections::HashMap;
-
 use serde::Serialize;
 
-use crate::core::{Mesh, Topology};
-use crate::judge::{ContactScene, ContactVerdict, judge_contacts};
-use crate::replay::{GhostContact, SceneNormals};
-use crate::trace::{ContactMsg, ContactsMsg, EventBody, SceneMsg, TraceEvent};
+use crate::judge::{ContactPairing, ContactVerdict};
+use crate::replay::GhostContact;
+use crate::trace::{EventBody, TraceEvent};
 
 use super::check::CheckOptions;
 
@@ -68,21 +65,10 @@ pub(crate) enum ContactMode {
 pub(crate) struct ContactChecker<'a> {
     options: &'a CheckOptions,
     mode: ContactMode,
-    /// The current scene's message, built into a mesh at its first query.
-    scene: Option<SceneMsg>,
-    built: Option<Option<Built>>,
-    queries: HashMap<(u64, u32), ContactMsg>,
-    answers: HashMap<(u64, u32), ContactsMsg>,
+    pairing: ContactPairing<'a>,
     report: ContactsReport,
     ghosts: Vec<GhostContact>,
     ghost_count: u64,
-    errors: Vec<String>,
-}
-
-struct Built {
-    mesh: Mesh,
-    topology: Topology,
-    normals: SceneNormals,
 }
 
 impl<'a> ContactChecker<'a> {
@@ -90,24 +76,23 @@ impl<'a> ContactChecker<'a> {
         ContactChecker {
             options,
             mode,
-            scene: None,
-            built: None,
-            queries: HashMap::new(),
-            answers: HashMap::new(),
+            pairing: ContactPairing::new(
+                &options.tolerances,
+                &options.replay.conventions,
+                options.ghost_degrees,
+            ),
             report: ContactsReport::default(),
             ghosts: Vec::new(),
             ghost_count: 0,
-            errors: Vec::new(),
         }
     }
 
     /// One event of the trace (sweeps and expectations pass by).
     pub(crate) fn event(&mut self, event: &TraceEvent) {
-        match &event.body {
+        let judged = match &event.body {
             EventBody::Scene(scene) => {
-                self.flush();
-                self.scene = Some(scene.clone());
-                self.built = None;
+                self.pairing.scene(scene);
+                None
             }
             EventBody::Contact(query) => {
                 if !self.options.replay.wants(query.frame, query.ball) {
@@ -118,15 +103,7 @@ impl<'a> ContactChecker<'a> {
                     self.report.not_asked += 1;
                     return;
                 }
-                let key = (query.frame, query.ball);
-                match self.answers.remove(&key) {
-                    Some(answer) => self.judge(query, &answer),
-                    None => {
-                        if self.queries.insert(key, *query).is_some() {
-                            self.report.without_answer += 1;
-                        }
-                    }
-                }
+                self.pairing.query(query, event.header.log_time_nanos)
             }
             EventBody::ExpectedContacts(answer) => {
                 if self.mode == ContactMode::NotAsked
@@ -134,64 +111,16 @@ impl<'a> ContactChecker<'a> {
                 {
                     return;
                 }
-                let key = (answer.frame, answer.ball);
-                match self.queries.remove(&key) {
-                    Some(query) => self.judge(&query, answer),
-                    None => {
-                        if self.answers.insert(key, answer.clone()).is_some() {
-                            self.report.answers_without_query += 1;
-                        }
-                    }
-                }
+                self.pairing.answer(answer)
             }
-            EventBody::Sweep(_) | EventBody::Expected(_) => {}
+            EventBody::Sweep(_) | EventBody::Expected(_) => None,
+        };
+        if let Some(judged) = judged {
+            self.judged(judged.verdict);
         }
     }
 
-    /// The scene's queries and answers left unpaired.
-    fn flush(&mut self) {
-        self.report.without_answer += self.queries.len() as u64;
-        self.report.answers_without_query += self.answers.len() as u64;
-        self.queries.clear();
-        self.answers.clear();
-    }
-
-    fn judge(&mut self, query: &ContactMsg, answer: &ContactsMsg) {
-        let built = self.built.get_or_insert_with(|| {
-            let scene = self.scene.as_ref()?;
-            let mesh = Mesh::new(scene.vertices.clone(), &scene.triangles).ok()?;
-            let topology = Topology::new(&scene.vertices, &scene.triangles).ok()?;
-            let normals =
-                SceneNormals::new(self.options.replay.conventions.normal, &mesh, &topology);
-            Some(Built {
-                mesh,
-                topology,
-                normals,
-            })
-        });
-        let Some(built) = built else {
-            if self.errors.is_empty() {
-                self.errors.push(format!(
-                    "frame {}, ball {}: the contact query's scene has no usable triangle, so contacts cannot be judged",
-                    query.frame, query.ball
-                ));
-            }
-            return;
-        };
-        let scene = ContactScene {
-            mesh: &built.mesh,
-            topology: &built.topology,
-            normals: &built.normals,
-        };
-        let verdict = judge_contacts(
-            &scene,
-            query,
-            answer,
-            &self.options.tolerances,
-            &self.options.replay.conventions,
-            self.options.ghost_degrees,
-        );
-        let mut verdict = verdict;
+    fn judged(&mut self, mut verdict: ContactVerdict) {
         if self.mode == ContactMode::JudgeEngine {
             for ghost in &mut verdict.ghosts {
                 ghost.answer = true;
@@ -215,7 +144,10 @@ impl<'a> ContactChecker<'a> {
     /// The report, the ghost contacts (how many, the first of them) and
     /// the errors.
     pub(crate) fn finish(mut self) -> (ContactsReport, u64, Vec<GhostContact>, Vec<String>) {
-        self.flush();
-        (self.report, self.ghost_count, self.ghosts, self.errors)
+        self.pairing.flush();
+        self.report.without_answer = self.pairing.without_answer;
+        self.report.answers_without_query = self.pairing.answers_without_query;
+        let errors = std::mem::take(&mut self.pairing.errors);
+        (self.report, self.ghost_count, self.ghosts, errors)
     }
 }

@@ -24,10 +24,13 @@
 //!   buffered as typed columns and sent as chunks (both use SDK internals
 //!   pinned to Rerun 0.36.3); `spill`: for a recording file, the buffered
 //!   rows kept in a temporary file and sent in long chunks;
+//! - `contacts`: a trace's contact queries, judged as `check` judges them
+//!   and drawn ([`draw_contacts`]);
 //! - `paths`: every entity path.
 
 mod blueprint;
 mod columns;
+mod contacts;
 mod convert;
 mod edge_frame;
 mod ids;
@@ -42,6 +45,7 @@ mod spill;
 
 use rerun::RecordingStreamBuilder;
 
+pub use contacts::{ContactDrawing, ContactsDrawn, draw_contacts};
 pub use ids::{IdHasher, recording_id};
 pub use logger::{
     DEFAULT_FLUSH_BYTES, DEFAULT_FLUSH_ROWS, Logger, LoggerOptions, PreparedSweeps,

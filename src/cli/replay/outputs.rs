@@ -140,6 +140,11 @@ pub(super) struct Outputs {
     recording: Option<Recording>,
     pub(super) sinks: Sinks,
     foxglove_target: Option<PathBuf>,
+    /// The replay's options and tolerances, for the contacts drawn.
+    #[cfg_attr(not(feature = "viewer"), allow(dead_code))]
+    options: ReplayOptions,
+    #[cfg_attr(not(feature = "viewer"), allow(dead_code))]
+    tolerances: Tolerances,
 }
 
 impl Outputs {
@@ -206,7 +211,54 @@ impl Outputs {
                 foxglove,
             },
             foxglove_target: args.foxglove.clone(),
+            options: *options,
+            tolerances,
         })
+    }
+
+    /// Draws the trace's `queries` contact queries into the recording
+    /// (when there is one and they are some), judged as `check` judges
+    /// them, at their frames: a second read of the trace.
+    #[cfg(feature = "viewer")]
+    pub(super) fn draw_contacts(
+        &mut self,
+        trace_path: &Path,
+        source_name: &str,
+        queries: u64,
+    ) -> anyhow::Result<()> {
+        let (options, tolerances) = (&self.options, &self.tolerances);
+        let Some(recording) = self.recording.as_mut().filter(|_| queries > 0) else {
+            return Ok(());
+        };
+        let file = std::fs::File::open(trace_path)
+            .with_context(|| format!("reading {source_name} again for its contacts"))?;
+        let reader = sweeptrace::TraceReader::new(std::io::BufReader::new(file), source_name);
+        let drawn = sweeptrace::viz::draw_contacts(
+            recording.logger().stream(),
+            reader,
+            &sweeptrace::viz::ContactDrawing {
+                tolerances,
+                conventions: &options.conventions,
+                ghost_degrees: sweeptrace::replay::GHOST_DEGREES,
+                frames: options.frames,
+                ball: options.ball,
+            },
+        )
+        .context("drawing the contact queries")?;
+        eprintln!(
+            "contacts: {} drawn ({} contacts, {} diverging from the core's, {})",
+            sweeptrace::numbers::counted(drawn.queries, "query", "queries"),
+            drawn.contacts,
+            drawn.divergent,
+            sweeptrace::numbers::counted(drawn.ghosts, "ghost contact", "ghost contacts")
+        );
+        Ok(())
+    }
+
+    /// Without the viewer there is no recording to draw into.
+    #[cfg(not(feature = "viewer"))]
+    pub(super) fn draw_contacts(&mut self, _: &Path, _: &str, _: u64) -> anyhow::Result<()> {
+        Ok(())
     }
 
     /// The recording and the other outputs, apart, for the pipeline.

@@ -30,6 +30,7 @@ pub fn tests() -> Vec<Trial> {
         trial!(bad_contact_messages_are_refused_with_the_field),
         trial!(python_reads_the_contact_channels),
         trial!(the_recording_draws_each_query_and_marks_its_ghosts),
+        trial!(a_divergent_contact_query_is_a_junit_failure_and_an_annotation),
     ]
 }
 
@@ -602,6 +603,66 @@ fn the_recording_draws_each_query_and_marks_its_ghosts() -> anyhow::Result<()> {
         log.iter()
             .any(|l| l.starts_with("ghost contact: frame 93, ball 0: edge 20.2")),
         "frame 93's log: {log:?}"
+    );
+    Ok(())
+}
+
+/// A trace that fails on a contact query only: its JUnit test case is a
+/// `contact_divergence` failure whose message names the query and its
+/// problem, with `--junit-detail sweeps` the query is a test case of its
+/// own, and in GitHub Actions it is an annotation.
+fn a_divergent_contact_query_is_a_junit_failure_and_an_annotation() -> anyhow::Result<()> {
+    let dir = tempfile::tempdir()?;
+    let source = events(&record(dir.path(), &[])?)?;
+    let path = seeded(dir.path(), &source, "dropped", |c| {
+        c.contacts.pop().is_some()
+    })?;
+    let xml = dir.path().join("report.xml");
+    let out = bin()
+        .arg("check")
+        .arg(&path)
+        .arg("--junit")
+        .arg(&xml)
+        .args(["--junit-detail", "sweeps"])
+        .env("GITHUB_ACTIONS", "true")
+        .output()?;
+    ensure!(out.status.code() == Some(1), "exit {:?}", out.status.code());
+    let text = std::fs::read_to_string(&xml)?;
+    let doc = roxmltree::Document::parse(&text)?;
+    let failure = |class: &str| {
+        doc.descendants()
+            .filter(|n| n.has_tag_name("testcase") && n.attribute("classname") == Some(class))
+            .filter_map(|n| n.children().find(|c| c.has_tag_name("failure")))
+            .map(|f| {
+                (
+                    f.attribute("type").unwrap_or("").to_string(),
+                    f.attribute("message").unwrap_or("").to_string(),
+                )
+            })
+            .collect::<Vec<_>>()
+    };
+    let trace = failure("check");
+    ensure!(
+        trace.len() == 1
+            && trace[0].0 == "contact_divergence"
+            && trace[0].1.contains(
+                "1 of 2238 contact queries diverge; first: contact query, frame 2, ball 2: missing"
+            ),
+        "{trace:?}"
+    );
+    let query = failure("check.contact_query");
+    ensure!(
+        query.len() == 1
+            && query[0].1.starts_with(
+                "contact query, frame 2, ball 2: missing: the ball touches triangle 5"
+            ),
+        "{query:?}"
+    );
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    ensure!(
+        stdout.lines().any(|l| l.starts_with("::error ")
+            && l.contains("title=sweeptrace check%3A contact query%2C frame 2%2C ball 2 diverges")),
+        "{stdout}"
     );
     Ok(())
 }

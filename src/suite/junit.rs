@@ -4,16 +4,16 @@
 //!
 //! One `<testsuite>` per trace, with the tolerances, the compared fields
 //! and (`check --engine`) the engine's command as `<properties>`. In it, a
-//! `<testcase>` for the trace: a `FAIL` (a divergence, or a tunnel or
-//! ghost contact that fails the check) is a `<failure>` whose `message` is the first
-//! divergence on one line and whose text is what `check` prints for the
+//! `<testcase>` for the trace: a `FAIL` (a divergence, a divergent contact
+//! query, or a tunnel or ghost contact that fails the check) is a
+//! `<failure>` whose `message` is the first divergence on one line and whose text is what `check` prints for the
 //! trace; a trace that could not be checked (`ERROR`, `NO EXPECTATIONS`)
 //! is an `<error>`. Each divergence rounding explains (the report's
 //! `fragile_divergences`, kept apart without `--strict`) is a `<skipped>`
 //! test case of its own; under `--strict` it is a divergence like any
-//! other. With [`Detail::Sweeps`], each divergence kept in detail and each
-//! listed tunnel or ghost contact that fails the check is a failing test
-//! case too.
+//! other. With [`Detail::Sweeps`], each divergence and each divergent
+//! contact query kept in detail, and each listed tunnel or ghost contact
+//! that fails the check, is a failing test case too.
 
 use std::time::Duration;
 
@@ -33,6 +33,25 @@ const FRAGILE_CLASS: &str = "check.fragile";
 const TUNNEL_CLASS: &str = "check.tunnel";
 /// The `classname` of a ghost contact's test case (with [`Detail::Sweeps`]).
 const GHOST_CLASS: &str = "check.ghost_contact";
+/// The `classname` of a divergent contact query's test case (with
+/// [`Detail::Sweeps`]).
+const CONTACT_CLASS: &str = "check.contact_query";
+
+/// A divergent contact query in one line: where, and its first problem.
+fn contact_line(v: &crate::judge::ContactVerdict) -> String {
+    let first = v
+        .problems
+        .first()
+        .map_or_else(String::new, |p| format!(": {p}"));
+    let more = match v.problems.len() {
+        0 | 1 => String::new(),
+        n => format!(" (and {} more)", n - 1),
+    };
+    format!(
+        "contact query, frame {}, ball {}{first}{more}",
+        v.frame, v.ball
+    )
+}
 
 /// The reports of one `check` run as a JUnit XML document. `times[i]` is
 /// how long `reports[i]` took (a trace without one has no `time`).
@@ -72,6 +91,17 @@ pub fn first_problem(r: &TraceReport) -> Option<String> {
                     r.compared,
                     crate::numbers::plural(r.compared, "sweep"),
                     crate::numbers::verb(r.divergent, "diverges", "diverge")
+                ));
+            }
+            if r.contacts.divergent > 0 {
+                let first = r
+                    .contacts
+                    .details
+                    .first()
+                    .map_or_else(String::new, |v| format!("; first: {}", contact_line(v)));
+                parts.push(format!(
+                    "{} of {} contact queries diverge{first}",
+                    r.contacts.divergent, r.contacts.compared
                 ));
             }
             if r.fails_on_tunnels() {
@@ -158,6 +188,8 @@ fn trace_suite(r: &TraceReport, time: Option<Duration>, options: &JunitOptions) 
         (Status::Fail, Some(m)) => CaseResult::Failure(problem(
             if r.divergent > 0 {
                 "divergence"
+            } else if r.contacts.divergent > 0 {
+                "contact_divergence"
             } else if r.fails_on_tunnels() {
                 "tunnel"
             } else {
@@ -195,6 +227,24 @@ fn trace_suite(r: &TraceReport, time: Option<Duration>, options: &JunitOptions) 
                     message: divergence_line(d, sides),
                     kind: "divergence".to_string(),
                     body: render_divergence_as(d, "", sides),
+                }),
+                system_out: None,
+            });
+        }
+        for v in &r.contacts.details {
+            let body: String = v.problems.iter().map(|p| format!("{p}\n")).collect();
+            cases.push(Case {
+                name: format!(
+                    "{}: contact query, frame {}, ball {}",
+                    r.trace, v.frame, v.ball
+                ),
+                classname: CONTACT_CLASS.to_string(),
+                file: file.clone(),
+                time_seconds: None,
+                result: CaseResult::Failure(Problem {
+                    message: contact_line(v),
+                    kind: "contact_divergence".to_string(),
+                    body,
                 }),
                 system_out: None,
             });
@@ -287,6 +337,15 @@ pub fn github_annotations(r: &TraceReport) -> String {
                 && let Some(message) = first_problem(r)
             {
                 lines.push(("sweeptrace check: FAIL".to_string(), message));
+            }
+            for v in &r.contacts.details {
+                lines.push((
+                    format!(
+                        "sweeptrace check: contact query, frame {}, ball {} diverges",
+                        v.frame, v.ball
+                    ),
+                    contact_line(v),
+                ));
             }
             if r.fails_on_tunnels() {
                 for t in &r.tunnels.details {

@@ -14,9 +14,9 @@ use crate::core::{
     sweep_vertex,
 };
 use crate::trace::{
-    Encoding, EventBody, MessageAt, OutcomeMsg, ReadLimits, SceneMsg, SweepMsg, TraceReader,
-    parse_message_as, validate_contact, validate_contacts, validate_outcome, validate_scene,
-    validate_sweep,
+    ContactMsg, ContactsMsg, Encoding, EventBody, MessageAt, OutcomeMsg, ReadLimits, SceneMsg,
+    SweepMsg, TraceReader, parse_message_as, validate_contact, validate_contacts, validate_outcome,
+    validate_scene, validate_sweep,
 };
 
 pub use crate::error_text::repeated_segment;
@@ -206,6 +206,43 @@ fn check_message_validation_as(data: &[u8], encoding: Encoding) -> Result<(), St
                 if !(0.0..=1.0).contains(&outcome.alpha) {
                     return Err(format!("a validated outcome has alpha {}", outcome.alpha));
                 }
+            }
+        }
+    }
+    match parse_message_as::<ContactMsg>(data, encoding, at("/contact")) {
+        Err(err) => check_error_text(&err, data)?,
+        Ok(contact) => {
+            if validate_contact(&contact).is_ok() {
+                round_trip(&contact)?;
+                let mesh = build_mesh(
+                    vec![[-1.0, -1.0, 0.0], [1.0, -1.0, 0.0], [0.0, 1.0, 0.0]],
+                    &[[0, 1, 2]],
+                )?
+                .ok_or("the unit triangle is refused")?;
+                let query = ContactQuery {
+                    centre: contact.centre.into(),
+                    radius: contact.radius,
+                    distance: contact.distance,
+                };
+                for sides in [Sides::One, Sides::Two] {
+                    for c in contact_set(&mesh, &query, sides) {
+                        let finite = c.separation.is_finite()
+                            && c.normal.iter().chain(c.point.iter()).all(|x| x.is_finite());
+                        if !finite {
+                            return Err(format!(
+                                "a validated query gives a non-finite contact: {c:?}"
+                            ));
+                        }
+                    }
+                }
+            }
+        }
+    }
+    match parse_message_as::<ContactsMsg>(data, encoding, at("/expected_contacts")) {
+        Err(err) => check_error_text(&err, data)?,
+        Ok(contacts) => {
+            if validate_contacts(&contacts).is_ok() {
+                round_trip(&contacts)?;
             }
         }
     }

@@ -200,12 +200,26 @@ fn seeded_message_json() -> anyhow::Result<()> {
     ];
     let mut rng = ChaCha8Rng::seed_from_u64(14);
     let mut number = |rng: &mut ChaCha8Rng| NUMBERS[rng.random_range(0..NUMBERS.len())];
-    for case in 0..3_000 {
+    for case in 0..5_000 {
         let point = |rng: &mut ChaCha8Rng,
                      number: &mut dyn FnMut(&mut ChaCha8Rng) -> &'static str| {
             format!("[{},{},{}]", number(rng), number(rng), number(rng))
         };
-        let input = match case % 3 {
+        let input = match case % 5 {
+            // Contact queries and an engine's contacts (issue 45).
+            3 => format!(
+                r#"{{"frame":2,"radius":{},"centre":{},"distance":{}}}"#,
+                number(&mut rng),
+                point(&mut rng, &mut number),
+                number(&mut rng)
+            ),
+            4 => format!(
+                r#"{{"frame":2,"contacts":[{{"triangle":{},"kind":"vertex","feature":{},"normal":{},"separation":{}}}]}}"#,
+                rng.random_range(0..3),
+                rng.random_range(0..5),
+                point(&mut rng, &mut number),
+                number(&mut rng)
+            ),
             0 => format!(
                 r#"{{"vertices":[{},{},{}],"triangles":[[0,1,{}]],"margin":{}}}"#,
                 point(&mut rng, &mut number),

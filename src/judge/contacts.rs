@@ -709,7 +709,7 @@ impl<'a> ContactPairing<'a> {
             topology: &built.topology,
             normals: &built.normals,
         };
-        let verdict = judge_contacts(
+        let mut verdict = judge_contacts(
             &scene,
             &query,
             &answer,
@@ -717,6 +717,9 @@ impl<'a> ContactPairing<'a> {
             self.conventions,
             self.ghost_degrees,
         );
+        for ghost in &mut verdict.ghosts {
+            ghost.log_time_nanos = log_time_nanos;
+        }
         Some(PairedContacts {
             query,
             log_time_nanos,

@@ -134,6 +134,15 @@ pub fn write_divergence_line(s: &mut String, r: &SweepResult, diffs: &[FieldDiff
         Num(r.options().margin),
         r.options().facing
     );
+    // A known limitation of engines, named as `check` names it.
+    if let Some(e) = &r.expected {
+        let records = super::explain::explained_records(r);
+        let rho = r.sweep.radius - r.options().margin;
+        let tests = super::explain::expected_tests(e, &r.outcome, &records, Some(&r.scene), rho);
+        if let Some(named) = super::explain::limitation(r, e, &tests) {
+            let _ = write!(s, "; named: {named}");
+        }
+    }
 }
 
 fn write_fields(s: &mut String, diffs: &[FieldDiff]) {

@@ -473,6 +473,14 @@ fn bad_contact_messages_are_refused_with_the_field() -> anyhow::Result<()> {
             },
             "distance",
         ),
+        (
+            ContactMsg {
+                radius: f64::MAX,
+                distance: f64::MAX,
+                ..query
+            },
+            "overflows",
+        ),
     ] {
         let err = w.contact(1, &bad).expect_err("refused");
         ensure!(err.to_string().contains(field), "{field}: {err}");

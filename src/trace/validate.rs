@@ -291,6 +291,15 @@ pub(crate) fn validate_contact(contact: &ContactMsg) -> Result<(), FieldProblem>
     finite3("centre", &contact.centre)?;
     numbers::check(contact.distance, Rule::NonNegative)
         .map_err(|e| FieldProblem::new("distance", e))?;
+    // The core measures the reach, radius + distance (as a sweep's path
+    // length is measured): finite parts can overflow it.
+    let reach = contact.radius + contact.distance;
+    if !reach.is_finite() {
+        return Err(FieldProblem::new(
+            "distance",
+            format!("is too large: the radius plus the distance overflows to {reach}"),
+        ));
+    }
     Ok(())
 }
 

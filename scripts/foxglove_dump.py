@@ -7,9 +7,13 @@ that every message and schema is JSON; with --sweeps/--scenes, the counts.
 With --dump FILE, writes one JSON line per schema record
 ({"schema", "encoding", "data"}) and then one per message ({"topic",
 "schema", "log_time", "data"}) for tests/foxglove/validate.mjs. Exits 1 on
-any problem.
+any problem. With --trace the file is a sweeptrace trace in JSON (its own
+channels, /scene, /sweep, /expected and the contact channels, instead of
+the Foxglove file's), dumped the same way so that validate.mjs holds every
+message to the schema the trace embeds.
 
     python3 scripts/foxglove_dump.py OUT.mcap [--sweeps N] [--scenes N] [--dump FILE.jsonl]
+    python3 scripts/foxglove_dump.py TRACE.mcap --trace --dump FILE.jsonl
 """
 
 import argparse
@@ -37,6 +41,8 @@ def main():
     parser.add_argument("--sweeps", type=int)
     parser.add_argument("--scenes", type=int)
     parser.add_argument("--dump")
+    parser.add_argument("--trace", action="store_true",
+                        help="a sweeptrace trace (JSON encoding), not a Foxglove file")
     args = parser.parse_args()
     problems = []
     dump = open(args.dump, "w", encoding="utf-8") if args.dump else None
@@ -55,7 +61,11 @@ def main():
                 problems.append(f"{channel.topic}: schema encoding {schema.encoding!r}")
             if channel.message_encoding != "json":
                 problems.append(f"{channel.topic}: message encoding {channel.message_encoding!r}")
-        if topics != CHANNELS:
+        if args.trace:
+            names = set(topics.values())
+            if not names or not all(n and n.startswith("sweeptrace.") for n in names):
+                problems.append(f"channels {topics}: not a sweeptrace trace's")
+        elif topics != CHANNELS:
             problems.append(f"channels {topics}, expected {CHANNELS}")
         for schema in summary.schemas.values():
             try:

@@ -6,7 +6,8 @@
 # against Foxglove's published JSON Schemas with Node and ajv
 # (tests/foxglove/validate.mjs; @foxglove/schemas and ajv pinned by
 # tests/foxglove/package-lock.json). Also checks that the schema copies in
-# schemas/foxglove/ equal the package's.
+# schemas/foxglove/ equal the package's, and holds every message of a
+# `record --contacts` trace to the trace format's own schemas.
 #
 # Installs what it needs: node and npm with apt when missing, the npm
 # packages with `npm ci`, Python's mcap into a virtualenv outside the
@@ -80,6 +81,17 @@ for trace in "${traces[@]}"; do
     fi
     dumps+=("$out/$name.jsonl")
 done
+# The trace format's own schemas (schemas/*.schema.json, embedded in every
+# trace): a recording with contact queries, every message held to the
+# schema of its channel.
+if "$BIN" record --scene mini_golf --frames 100 --contacts -o "$out/contacts.mcap" >"$out/log" 2>&1 \
+    && "$PYTHON" scripts/foxglove_dump.py "$out/contacts.mcap" --trace --dump "$out/contacts.jsonl"; then
+    dumps+=("$out/contacts.jsonl")
+else
+    echo "FAIL record --contacts, or its dump" >&2
+    cat "$out/log" >&2
+    failed=1
+fi
 if [ "${#dumps[@]}" -gt 0 ]; then
     node tests/foxglove/validate.mjs "${dumps[@]}" || failed=1
 fi

@@ -29,6 +29,7 @@
 
 mod agreement;
 mod compare;
+mod contact_pairing;
 mod contacts;
 mod decision;
 mod divergence;
@@ -46,9 +47,9 @@ pub use compare::{
     DEFAULT_NORMAL_TOLERANCE_DEGREES, Field, FieldDiff, FieldSet, Tolerances, angle_degrees,
     compare,
 };
-pub(crate) use contacts::ContactPairing;
+pub(crate) use contact_pairing::ContactPairing;
 #[cfg(feature = "viewer")]
-pub(crate) use contacts::PairedContacts;
+pub(crate) use contact_pairing::PairedContacts;
 pub use contacts::{ContactProblem, ContactTolerances, ContactVerdict};
 pub(crate) use decision::write_decision_line;
 #[cfg(feature = "viewer")]

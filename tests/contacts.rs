@@ -31,6 +31,7 @@ pub fn tests() -> Vec<Trial> {
         trial!(python_reads_the_contact_channels),
         trial!(the_recording_draws_each_query_and_marks_its_ghosts),
         trial!(a_divergent_contact_query_is_a_junit_failure_and_an_annotation),
+        trial!(a_seam_contact_may_be_dropped_where_flat_not_where_concave),
     ]
 }
 
@@ -671,6 +672,68 @@ fn a_divergent_contact_query_is_a_junit_failure_and_an_annotation() -> anyhow::R
         stdout.lines().any(|l| l.starts_with("::error ")
             && l.contains("title=sweeptrace check%3A contact query%2C frame 2%2C ball 2 diverges")),
         "{stdout}"
+    );
+    Ok(())
+}
+
+/// The judgement's one excuse for a missing place: at a flat seam an
+/// engine may keep only the face contact of the triangle the ball rests on
+/// (Rapier's `FIX_INTERNAL_EDGES`), since the seam's normal would be the
+/// same face normal. At a concave seam (a valley) both faces push, so the
+/// same dropped contact still fails.
+fn a_seam_contact_may_be_dropped_where_flat_not_where_concave() -> anyhow::Result<()> {
+    let dir = tempfile::tempdir()?;
+    // Triangle 1 across the seam x = 1 rises by `rise` at x = 2.
+    let check_dropped = |rise: f64| -> anyhow::Result<(i32, String)> {
+        let path = dir.path().join(format!("seam_{rise}.mcap"));
+        let scene = SceneMsg {
+            name: Some("seam".into()),
+            vertices: vec![
+                [0.0, 0.0, 0.0],
+                [1.0, 0.0, 0.0],
+                [1.0, 1.0, 0.0],
+                [2.0, 0.0, rise],
+            ],
+            triangles: vec![[0, 1, 2], [1, 3, 2]],
+            margin: 0.0,
+            facing: Default::default(),
+        };
+        let mut w = TraceWriter::new(std::fs::File::create(&path)?)?;
+        w.scene(0, &scene)?;
+        let query = ContactMsg {
+            frame: 0,
+            ball: 0,
+            radius: 0.25,
+            centre: [1.05, 0.5, 0.24],
+            distance: 0.0,
+        };
+        w.contact(1, &query)?;
+        // Only triangle 1 (whatever its feature), none at triangle 0's edge.
+        let only = ContactPointMsg {
+            triangle: 1,
+            kind: None,
+            feature: None,
+            point: None,
+            normal: None,
+            separation: None,
+        };
+        w.expected_contacts(
+            1,
+            &ContactsMsg {
+                frame: 0,
+                ball: 0,
+                contacts: vec![only],
+            },
+        )?;
+        w.finish()?;
+        check_text(&path)
+    };
+    let (code, text) = check_dropped(0.0)?;
+    ensure!(code == 0, "flat seam: {text}");
+    let (code, text) = check_dropped(0.364)?; // a 20-degree valley
+    ensure!(
+        code == 1 && text.contains("missing: the ball touches triangle 0 (edge 1)"),
+        "concave seam: {text}"
     );
     Ok(())
 }

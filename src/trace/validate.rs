@@ -364,6 +364,27 @@ pub fn validate_triangle(outcome: &OutcomeMsg, scene_triangles: usize) -> Result
     }
 }
 
+/// Checks an engine's contacts' triangles against their scene, as
+/// [`validate_triangle`] checks an outcome's (the writer checks them; the
+/// reader does not, so that a wrong triangle is judged, an extra contact).
+pub(crate) fn validate_contact_triangles(
+    contacts: &ContactsMsg,
+    scene_triangles: usize,
+) -> Result<(), FieldProblem> {
+    for (i, c) in contacts.contacts.iter().enumerate() {
+        if c.triangle as usize >= scene_triangles {
+            return Err(FieldProblem::new(
+                format!("contacts[{i}].triangle"),
+                format!(
+                    "index {} is out of range (the scene has {scene_triangles} triangles)",
+                    c.triangle
+                ),
+            ));
+        }
+    }
+    Ok(())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -38,8 +38,8 @@ use super::schemas::{
 };
 use super::source::{EXPECTED_SOURCE_METADATA, ExpectedSource};
 use super::validate::{
-    validate_contact, validate_contacts, validate_outcome, validate_scene, validate_sweep,
-    validate_triangle,
+    validate_contact, validate_contact_triangles, validate_contacts, validate_outcome,
+    validate_scene, validate_sweep, validate_triangle,
 };
 use crate::atomic::PendingFile;
 
@@ -440,22 +440,9 @@ impl<W: Write + Seek> TraceWriter<W> {
         let frame = Some(contacts.frame);
         self.check_time(EXPECTED_CONTACTS_TOPIC, frame, log_time_nanos)?;
         validate_contacts(contacts)
-            .and_then(|()| {
-                let Some(count) = self.scene_triangles else {
-                    return Ok(());
-                };
-                for (i, c) in contacts.contacts.iter().enumerate() {
-                    if c.triangle as usize >= count {
-                        return Err(super::validate::FieldProblem::new(
-                            format!("contacts[{i}].triangle"),
-                            format!(
-                                "index {} is out of range (the scene has {count} triangles)",
-                                c.triangle
-                            ),
-                        ));
-                    }
-                }
-                Ok(())
+            .and_then(|()| match self.scene_triangles {
+                Some(count) => validate_contact_triangles(contacts, count),
+                None => Ok(()),
             })
             .map_err(|p| p.at(self.at(EXPECTED_CONTACTS_TOPIC, frame)))?;
         let id = self.lazy_channel(true)?;

@@ -37,9 +37,11 @@ use criterion::measurement::WallTime;
 use criterion::{BenchmarkGroup, BenchmarkId, Criterion, Throughput, criterion_group};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
+use sweeptrace::core::record::{CollectRecords, CountVisits, Observer, Skip};
+use sweeptrace::core::topology::Topology;
 use sweeptrace::core::{
-    Broadphase, CollectRecords, ContactQuery, CountVisits, Mesh, Observer, Options, Outcome, Sides,
-    Skip, Sweep, Topology, contact_set, sweep_mesh, sweep_mesh_with,
+    Broadphase, ContactQuery, Mesh, Options, Outcome, Sides, Sweep, contact_set, sweep_mesh,
+    sweep_mesh_with,
 };
 use sweeptrace::replay::{CollectPrimary, primary_records};
 use sweeptrace::sim::{self, scenes::BuiltinScene};

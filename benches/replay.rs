@@ -18,7 +18,8 @@ use sweeptrace::replay::{
     DEFAULT_BATCH_EVENTS, Detail, PipelineOptions, ReplayEvent, ReplayOptions,
     replay_events_parallel, run_pipeline_unrecorded,
 };
-use sweeptrace::trace::{DEFAULT_PREFETCH_CHUNK, DEFAULT_PREFETCH_DEPTH, TraceReader, prefetch};
+use sweeptrace::trace::TraceReader;
+use sweeptrace::trace::prefetch::{DEFAULT_PREFETCH_CHUNK, DEFAULT_PREFETCH_DEPTH, prefetch};
 
 #[path = "../examples/long_trace.rs"]
 mod long_trace;

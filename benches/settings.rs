@@ -23,7 +23,7 @@ use std::path::{Path, PathBuf};
 use criterion::{Criterion, Throughput, criterion_group};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
-use sweeptrace::suite::{ConfigFile, ConfigFiles, Overrides};
+use sweeptrace::suite::config::{ConfigFile, ConfigFiles, Overrides};
 
 const BLOCKS: usize = 20_000;
 const GROUPS: usize = 10;

@@ -22,9 +22,8 @@ mod parry_cast;
 
 use parry3d_f64::shape::TriMesh;
 use rayon::prelude::*;
-use sweeptrace::trace::{
-    DEFAULT_PREFETCH_CHUNK, DEFAULT_PREFETCH_DEPTH, EventBody, SweepMsg, TraceReader, prefetch,
-};
+use sweeptrace::trace::prefetch::{DEFAULT_PREFETCH_CHUNK, DEFAULT_PREFETCH_DEPTH, prefetch};
+use sweeptrace::trace::{EventBody, SweepMsg, TraceReader};
 
 const BATCH: usize = 4096;
 

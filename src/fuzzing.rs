@@ -8,15 +8,15 @@
 //! [`repeated_segment`] is the property of every error message the tests
 //! assert too.
 
+use crate::core::record::{CollectRecords, TestRecord};
 use crate::core::{
-    Broadphase, CollectRecords, ContactQuery, Facing, Mesh, MeshError, Options, Outcome, Sides,
-    Sweep, SweptPath, TestRecord, contact_set, sweep_edge, sweep_face, sweep_mesh, sweep_mesh_with,
-    sweep_vertex,
+    Broadphase, ContactQuery, Facing, Mesh, MeshError, Options, Outcome, Sides, Sweep, SweptPath,
+    contact_set, sweep_edge, sweep_face, sweep_mesh, sweep_mesh_with, sweep_vertex,
 };
+use crate::trace::validate::{validate_outcome, validate_scene, validate_sweep};
 use crate::trace::{
     ContactMsg, ContactsMsg, Encoding, EventBody, MessageAt, OutcomeMsg, ReadLimits, SceneMsg,
-    SweepMsg, TraceReader, parse_message_as, validate_contact, validate_contacts, validate_outcome,
-    validate_scene, validate_sweep,
+    SweepMsg, TraceReader, parse_message_as, validate_contact, validate_contacts,
 };
 
 pub use crate::error_text::repeated_segment;

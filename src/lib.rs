@@ -91,10 +91,11 @@ pub mod trace;
 #[cfg(feature = "viewer")]
 pub mod viz;
 
+pub use crate::core::record::{CollectRecords, NoObserver, Observer};
+pub use crate::core::topology::{Defect, DefectKind, EdgeClass, EdgeCounts, Topology};
 pub use crate::core::{
-    CollectRecords, Defect, DefectKind, EdgeClass, EdgeCounts, Facing, Feature, InitialOverlap,
-    Kind, Mesh, MeshError, NoObserver, Observer, Options, Outcome, Sides, Sweep, SweepError,
-    SweepHit, Tie, Topology, sweep_mesh, sweep_mesh_with, sweep_ties,
+    Facing, Feature, InitialOverlap, Kind, Mesh, MeshError, Options, Outcome, Sides, Sweep,
+    SweepError, SweepHit, Tie, sweep_mesh, sweep_mesh_with, sweep_ties,
 };
 pub use crate::judge::{Agreement, Tolerances, agreement, compare};
 pub use crate::replay::{ReplayOptions, replay_events};

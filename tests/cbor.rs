@@ -11,9 +11,10 @@ use libtest_mimic::{Completion, Trial};
 use mcap::WriteOptions;
 use mcap::records::MessageHeader;
 use rand::{Rng, SeedableRng};
+use sweeptrace::trace::info::{collect_info, render_info_text};
 use sweeptrace::trace::{
     Encoding, EventBody, OutcomeMsg, SceneMsg, SweepMsg, TraceError, TraceEvent, TraceReader,
-    TraceWriter, collect_info, render_info_text,
+    TraceWriter,
 };
 
 use crate::support::run_bin;

@@ -25,10 +25,11 @@ use sweeptrace::conventions::Source;
 use sweeptrace::core::Kind;
 use sweeptrace::judge::{Field, FieldSet, Tolerances, compare};
 use sweeptrace::replay::ReplayOptions;
-use sweeptrace::suite::{
-    CheckOptions, Overrides, Side, Status, bless_bytes, check_file, check_reader, diff,
-    find_traces, render_json, render_text, settings_for,
-};
+use sweeptrace::suite::bless::bless_bytes;
+use sweeptrace::suite::config::{Overrides, settings_for};
+use sweeptrace::suite::diff::{Side, diff};
+use sweeptrace::suite::discovery::find_traces;
+use sweeptrace::suite::{CheckOptions, Status, check_file, check_reader, render_json, render_text};
 use sweeptrace::trace::{OutcomeMsg, SceneMsg, SweepMsg, TraceReader, TraceWriter};
 
 use crate::ensure;
@@ -702,7 +703,7 @@ fn foreign_trace() -> anyhow::Result<Vec<u8>> {
 
 /// [`foreign_trace`], with or without its `/expected` channel.
 fn foreign_trace_with(with_expected: bool) -> anyhow::Result<Vec<u8>> {
-    use sweeptrace::trace::{OUTCOME_SCHEMA_JSON, SCENE_SCHEMA_JSON, SWEEP_SCHEMA_JSON};
+    use sweeptrace::trace::schemas::{OUTCOME_SCHEMA_JSON, SCENE_SCHEMA_JSON, SWEEP_SCHEMA_JSON};
     let mut w = mcap::WriteOptions::new()
         .library("some-engine 3.1")
         .profile("game")
@@ -985,7 +986,7 @@ fn diff_strict_facing_reports_first_divergence() -> anyhow::Result<()> {
         ..ReplayOptions::default()
     })?;
     let r = diff(&a, &b, &Tolerances::default());
-    let text = sweeptrace::suite::render_diff_text(&r);
+    let text = sweeptrace::suite::diff::render_diff_text(&r);
     ensure!(!r.is_same() && r.different == 1, "{text}");
     let first = r.first.as_ref().context("no first divergence")?;
     ensure!(first.frame == 5, "first divergence at frame 5: {text}");

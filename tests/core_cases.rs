@@ -7,9 +7,10 @@
 //! (x, z, -y).
 
 use libtest_mimic::Trial;
+use sweeptrace::core::record::{NoObserver, Verdict};
 use sweeptrace::core::{
-    Broadphase, Facing, FragileReason, Kind, Mesh, MeshError, NoObserver, Options, Outcome, Sweep,
-    SweepError, Verdict, sweep_mesh, sweep_mesh_with,
+    Broadphase, Facing, FragileReason, Kind, Mesh, MeshError, Options, Outcome, Sweep, SweepError,
+    sweep_mesh, sweep_mesh_with,
 };
 
 use crate::ensure;
@@ -1085,7 +1086,8 @@ fn zero_q_gives_a_double_root_only_when_c_is_zero() -> anyhow::Result<()> {
 /// subtracted) and `-(n · d)` disagree in their last bits and sometimes in
 /// sign; every verdict must follow `n · d`.
 fn face_decides_direction_by_n_dot_d_alone() -> anyhow::Result<()> {
-    use sweeptrace::core::{PARALLEL_TOLERANCE, SweptPath, sweep_face};
+    use sweeptrace::core::options::PARALLEL_TOLERANCE;
+    use sweeptrace::core::{SweptPath, sweep_face};
     let mut state = 0x9e37_79b9_7f4a_7c15u64;
     let mut next = move || {
         state ^= state << 13;

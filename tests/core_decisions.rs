@@ -5,9 +5,10 @@ use libtest_mimic::Trial;
 use rand::seq::SliceRandom;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
+use sweeptrace::core::record::CollectRecords;
 use sweeptrace::core::{
-    Broadphase, CollectRecords, Facing, Feature, FragileReason, Kind, Options, Sweep, sweep_mesh,
-    sweep_mesh_with, sweep_ties,
+    Broadphase, Facing, Feature, FragileReason, Kind, Options, Sweep, sweep_mesh, sweep_mesh_with,
+    sweep_ties,
 };
 
 use crate::core_random::{random_patch, random_sweep, random_triangle, uniform, unit};
@@ -386,7 +387,7 @@ fn exact_ties_on_boxes_and_terrains_follow_the_rules() -> anyhow::Result<()> {
                         &Sweep::new(p0, p1, radius),
                         &options(),
                         broadphase,
-                        &mut sweeptrace::core::NoObserver,
+                        &mut sweeptrace::core::record::NoObserver,
                     )?;
                     let got = (
                         o.kind(),

@@ -6,10 +6,12 @@ use libtest_mimic::Trial;
 use nalgebra::{Point3, Rotation3, Vector3};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
+use sweeptrace::core::record::{
+    CollectRecords, EdgeRecord, FaceRecord, NoObserver, Observer, Skip, SkipCounts, TestRecord,
+    VerdictCounts, VertexRecord,
+};
 use sweeptrace::core::{
-    Broadphase, CollectRecords, EdgeRecord, FaceRecord, Facing, Kind, Mesh, NoObserver, Observer,
-    Options, Outcome, Sides, Skip, SkipCounts, Sweep, TestRecord, VerdictCounts, VertexRecord,
-    sweep_mesh, sweep_mesh_with,
+    Broadphase, Facing, Kind, Mesh, Options, Outcome, Sides, Sweep, sweep_mesh, sweep_mesh_with,
 };
 use sweeptrace::replay::{CollectPrimary, primary_records};
 

@@ -283,10 +283,11 @@ fn inputs_are_shown_escaped_and_in_the_users_words() -> anyhow::Result<()> {
     // An integer in a divergence's values.
     let index = serde_json::json!(1_000_000);
     ensure!(
-        sweeptrace::judge::value_text(&index) == "1000000"
-            && sweeptrace::judge::value_text_exact(&serde_json::json!(1e300)) == "1e300",
+        sweeptrace::judge::divergence::value_text(&index) == "1000000"
+            && sweeptrace::judge::divergence::value_text_exact(&serde_json::json!(1e300))
+                == "1e300",
         "{}",
-        sweeptrace::judge::value_text(&index)
+        sweeptrace::judge::divergence::value_text(&index)
     );
     // `replay --json` that fails: one JSON document, with the error.
     let (code, out, err) = run(&["replay", "missing.mcap", "--outcomes", "o.jsonl", "--json"])?;

@@ -12,9 +12,11 @@ use libtest_mimic::{Completion, Trial};
 use mcap::records::{MessageHeader, Metadata};
 use sweeptrace::core::Kind;
 use sweeptrace::suite::{CheckOptions, Status, check_file, render_json, render_text};
+use sweeptrace::trace::info::collect_info;
+use sweeptrace::trace::source::EXPECTED_SOURCE_METADATA;
 use sweeptrace::trace::{
-    EXPECTED_SOURCE_METADATA, ExpectedSource, OutcomeMsg, SceneMsg, SweepMsg, TraceError,
-    TraceEvent, TraceReader, TraceWriter, collect_info, write_trace_file,
+    ExpectedSource, OutcomeMsg, SceneMsg, SweepMsg, TraceError, TraceEvent, TraceReader,
+    TraceWriter, write_trace_file,
 };
 
 use crate::engine::example_engine_command;
@@ -319,10 +321,10 @@ fn old_trace_without_it_reads_as_before() -> anyhow::Result<()> {
     ensure!(!events.is_empty(), "no event");
     let (info, error) = collect_info(TraceReader::new(bytes.as_slice(), "old.mcap"));
     ensure!(error.is_none(), "{error:?}");
-    let text = sweeptrace::trace::render_info_text(&info);
+    let text = sweeptrace::trace::info::render_info_text(&info);
     ensure!(!text.contains("expected by"), "{text}");
     let json: serde_json::Value =
-        serde_json::from_str(&sweeptrace::trace::render_info_json(&info))?;
+        serde_json::from_str(&sweeptrace::trace::info::render_info_json(&info))?;
     ensure!(json["expected_source"].is_null(), "{json}");
     let report = check_file(&old, &CheckOptions::default());
     ensure!(report.status() == Status::Ok, "{}", render_text(&report));

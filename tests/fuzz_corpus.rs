@@ -10,7 +10,8 @@ use libtest_mimic::Trial;
 use rand::{Rng, RngCore, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use sweeptrace::fuzzing::{check_core, check_message_validation, check_trace_reader};
-use sweeptrace::trace::{SweepMsg, TraceError, TraceReader, validate_sweep};
+use sweeptrace::trace::validate::validate_sweep;
+use sweeptrace::trace::{SweepMsg, TraceError, TraceReader};
 
 use crate::{ensure, trial};
 use anyhow::Context as _;
@@ -157,7 +158,7 @@ fn unknown_field_is_named_once() -> anyhow::Result<()> {
         index: 3,
         frame: None,
     };
-    let error = sweeptrace::trace::parse_message::<SweepMsg>(input, at)
+    let error = sweeptrace::trace::validate::parse_message::<SweepMsg>(input, at)
         .err()
         .context("the message was accepted")?
         .to_string();

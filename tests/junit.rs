@@ -168,7 +168,7 @@ fn check_junit_of_passing_traces_has_one_suite_per_trace() -> anyhow::Result<()>
     let report = dir.path().join("r.xml");
     let (code, stdout, stderr) = run_bin(os!["check", s(&at("traces")), "--junit", s(&report)])?;
     ensure!(code == 0, "exit {code}\n{stdout}{stderr}");
-    let traces = sweeptrace::suite::find_traces(&[at("traces")])?;
+    let traces = sweeptrace::suite::discovery::find_traces(&[at("traces")])?;
     let xml = read(&report)?;
     let doc = parse(&xml)?;
     counts_add_up(&doc)?;

@@ -6,7 +6,7 @@
 use libtest_mimic::Trial;
 use serde_json::Value;
 use sweeptrace::Topology;
-use sweeptrace::core::DefectKind;
+use sweeptrace::core::topology::DefectKind;
 use sweeptrace::sim::scenes::BuiltinScene;
 
 use crate::support::run_bin;

@@ -4,7 +4,8 @@ use std::sync::mpsc::{RecvTimeoutError, channel};
 use std::time::Duration;
 
 use libtest_mimic::Trial;
-use sweeptrace::trace::{TraceReader, prefetch};
+use sweeptrace::trace::TraceReader;
+use sweeptrace::trace::prefetch::prefetch;
 
 use crate::ensure;
 use crate::trial;

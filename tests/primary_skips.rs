@@ -7,7 +7,7 @@
 use std::path::Path;
 
 use libtest_mimic::Trial;
-use sweeptrace::core::{Skip, Verdict};
+use sweeptrace::core::record::{Skip, Verdict};
 use sweeptrace::judge::Tolerances;
 use sweeptrace::judge::decision_line;
 use sweeptrace::replay::{

@@ -117,7 +117,8 @@ fn rapier_floor_contacts_trace_lists_its_ghosts() -> anyhow::Result<()> {
                 .ghosts
                 .contacts
                 .iter()
-                .all(|g| g.place == sweeptrace::replay::GhostPlace::Flat && g.angle_degrees > 1.0)
+                .all(|g| g.place == sweeptrace::replay::ghost::GhostPlace::Flat
+                    && g.angle_degrees > 1.0)
             && report.status() == Status::Fail,
         "{listed:?}\n{}",
         render_text(&report)

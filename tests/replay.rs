@@ -12,10 +12,12 @@ use libtest_mimic::Trial;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
-use sweeptrace::core::miss_distance;
+use sweeptrace::core::explain::miss_distance;
+use sweeptrace::core::record::{
+    CollectRecords, EdgeRecord, FaceRecord, Observer, TestRecord, VertexRecord,
+};
 use sweeptrace::core::{
-    Broadphase, CollectRecords, EdgeRecord, FaceRecord, Facing, Kind, Mesh, Observer, Options,
-    Sweep, TestRecord, VertexRecord, sweep_mesh, sweep_mesh_with,
+    Broadphase, Facing, Kind, Mesh, Options, Sweep, sweep_mesh, sweep_mesh_with,
 };
 use sweeptrace::replay::{
     Detail, FrameRange, ReplayEvent, ReplayOptions, ReplaySummary, SweepResult, replay_events,
@@ -2109,7 +2111,8 @@ fn spilled_recording_holds_the_same_rows() -> anyhow::Result<()> {
     let dir = tempfile::tempdir()?;
     let sweeps = random_sweeps(14, 60, 5);
     let write = |path: &std::path::Path, spill: bool| -> anyhow::Result<()> {
-        let (sink, writer) = viz::create_rrd_file(path, viz::RrdFileOptions { footer: true })?;
+        let (sink, writer) =
+            viz::rrd_file::create_rrd_file(path, viz::rrd_file::RrdFileOptions { footer: true })?;
         let id = viz::recording_id(&[b"spill"]);
         let rec = viz::builder(&id, "test")
             .set_sinks(vec![Box::new(sink) as Box<dyn rerun::sink::LogSink>])?;
@@ -2183,7 +2186,8 @@ fn rrd_footer_only_when_asked() -> anyhow::Result<()> {
     let dir = tempfile::tempdir()?;
     let sweeps = random_sweeps(13, 30, 2);
     let write = |path: &std::path::Path, footer: bool| -> anyhow::Result<u64> {
-        let (sink, writer) = viz::create_rrd_file(path, viz::RrdFileOptions { footer })?;
+        let (sink, writer) =
+            viz::rrd_file::create_rrd_file(path, viz::rrd_file::RrdFileOptions { footer })?;
         let id = viz::recording_id(&[b"footer"]);
         let rec = viz::builder(&id, "test")
             .set_sinks(vec![Box::new(sink) as Box<dyn rerun::sink::LogSink>])?;
@@ -2433,7 +2437,7 @@ fn rrd_draws_edges_by_class_and_labels_each_defect() -> anyhow::Result<()> {
         defect_entities == ["/world/mesh/1/defects/flipped"],
         "defect entities {defect_entities:?}"
     );
-    let topology = sweeptrace::core::Topology::new(&floor.vertices, &floor.triangles)?;
+    let topology = sweeptrace::core::topology::Topology::new(&floor.vertices, &floor.triangles)?;
     let labels = d.texts_at("/world/mesh/1/defects/flipped", "Points3D:labels", i64::MIN);
     ensure!(
         labels == ["flipped triangle 9"] && labels.len() == topology.defects().len(),

@@ -11,10 +11,9 @@ use sweeptrace::core::{Facing, Kind, Mesh, Sweep, sweep_mesh};
 use sweeptrace::judge::{Agreement, Tolerances, compare};
 use sweeptrace::numbers::parse_f64;
 use sweeptrace::replay::ReplayOptions;
-use sweeptrace::suite::{
-    CheckOptions, ReproCase, Status, bless_bytes, check_file, check_reader, find_sweep,
-    render_json, render_text,
-};
+use sweeptrace::suite::bless::bless_bytes;
+use sweeptrace::suite::repro::{ReproCase, find_sweep};
+use sweeptrace::suite::{CheckOptions, Status, check_file, check_reader, render_json, render_text};
 use sweeptrace::trace::{OutcomeMsg, SceneMsg, SweepMsg, TraceReader, TraceWriter};
 
 use crate::ensure;
@@ -105,7 +104,7 @@ fn divergence_inputs_read_back_bit_exactly() -> anyhow::Result<()> {
         "text:\n{text}"
     );
     for d in &report.divergences.details {
-        let block = sweeptrace::judge::render_divergence(d, "");
+        let block = sweeptrace::judge::divergence::render_divergence(d, "");
         let inputs = &block[block.find("inputs: ").context("inputs line")?..];
         same_bits("decimal p0", &numbers_after(inputs, "p0 ")?, &d.inputs.p0)?;
         same_bits("decimal p1", &numbers_after(inputs, "p1 ")?, &d.inputs.p1)?;

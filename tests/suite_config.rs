@@ -15,7 +15,7 @@ use crate::trial;
 use anyhow::Context as _;
 use sweeptrace::conventions::Source;
 use sweeptrace::judge::{Field, FieldSet, Tolerances};
-use sweeptrace::suite::{ConfigFile, Overrides, resolve};
+use sweeptrace::suite::config::{ConfigFile, Overrides, resolve};
 
 pub fn tests() -> Vec<Trial> {
     vec![
@@ -557,7 +557,7 @@ fn dangling_symlink_is_left_out_with_a_note() -> anyhow::Result<()> {
 }
 
 /// One run reads each settings file once, however many traces and folders
-/// share it ([`sweeptrace::suite::ConfigFiles`]); the places of its keys
+/// share it ([`sweeptrace::suite::config::ConfigFiles`]); the places of its keys
 /// are the same as from counting lines (issue 43, item 6; the timing is
 /// the `settings` benchmark's).
 fn settings_files_are_parsed_once_per_run() -> anyhow::Result<()> {
@@ -579,7 +579,7 @@ fn settings_files_are_parsed_once_per_run() -> anyhow::Result<()> {
         &repo.join("suite/a/sweeptrace.toml"),
         "allow_tunnels = true\n",
     )?;
-    let mut files = sweeptrace::suite::ConfigFiles::new();
+    let mut files = sweeptrace::suite::config::ConfigFiles::new();
     let mut sources = Vec::new();
     for trace in [
         "suite/cube.mcap",

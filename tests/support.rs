@@ -3,10 +3,8 @@
 use std::sync::mpsc::{self, RecvTimeoutError};
 use std::time::Duration;
 
-use sweeptrace::core::{
-    Broadphase, CollectRecords, EdgeRecord, FaceRecord, Facing, Mesh, Options, Outcome, Sweep,
-    TestRecord, VertexRecord, sweep_mesh_with,
-};
+use sweeptrace::core::record::{CollectRecords, EdgeRecord, FaceRecord, TestRecord, VertexRecord};
+use sweeptrace::core::{Broadphase, Facing, Mesh, Options, Outcome, Sweep, sweep_mesh_with};
 
 /// Fails the test with a message unless `cond` holds.
 #[macro_export]

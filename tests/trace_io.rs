@@ -9,10 +9,10 @@ use mcap::records::MessageHeader;
 use mcap::{Compression, WriteOptions};
 use rand::{Rng, SeedableRng};
 use sweeptrace::core::{Facing, Kind};
+use sweeptrace::trace::info::{collect_info, render_info_json, render_info_text};
 use sweeptrace::trace::{
     EventBody, EventHeader, OutcomeMsg, ReadLimits, ReadStats, SceneMsg, SweepMsg, TraceError,
-    TraceEvent, TraceReader, TraceWriter, collect_info, render_info_json, render_info_text,
-    write_trace_file,
+    TraceEvent, TraceReader, TraceWriter, write_trace_file,
 };
 
 use crate::ensure;
@@ -1284,7 +1284,8 @@ fn python_reads_our_trace() -> anyhow::Result<Completion> {
 /// The names the reports write (`as_str`, `Display`) are the names the JSON
 /// and the trace format write (serde), for every variant, and read back.
 fn enum_names_in_words_are_their_serde_names() -> anyhow::Result<()> {
-    use sweeptrace::core::{FragileReason, Verdict};
+    use sweeptrace::core::FragileReason;
+    use sweeptrace::core::record::Verdict;
     fn same<T>(v: T, words: &str) -> anyhow::Result<()>
     where
         T: serde::Serialize + serde::de::DeserializeOwned + PartialEq + std::fmt::Debug,

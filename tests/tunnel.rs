@@ -27,12 +27,14 @@ use libtest_mimic::Trial;
 use nalgebra::Point3;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
-use sweeptrace::core::{
-    Facing, Mesh, crossing_tolerance, first_crossing, first_crossing_with_flipped,
-    triangle_crossing, triangle_crossing_back_to_front,
+use sweeptrace::core::crossing::{
+    crossing_tolerance, first_crossing, first_crossing_with_flipped, triangle_crossing,
+    triangle_crossing_back_to_front,
 };
+use sweeptrace::core::{Facing, Mesh};
+use sweeptrace::replay::tunnel::TunnelKind;
 use sweeptrace::replay::{
-    ReplayEvent, ReplayOptions, SweepResult, TunnelKind, replay_events, replay_events_parallel,
+    ReplayEvent, ReplayOptions, SweepResult, replay_events, replay_events_parallel,
 };
 use sweeptrace::sim::scenes;
 use sweeptrace::suite::{CheckOptions, Status, check_file, check_reader, render_json, render_text};
@@ -802,7 +804,7 @@ fn recording_marks_the_tunnel() -> anyhow::Result<()> {
 
 fn sample_traces_have_none() -> anyhow::Result<()> {
     let dir = root().join("traces");
-    let traces = sweeptrace::suite::find_traces(&[dir])?;
+    let traces = sweeptrace::suite::discovery::find_traces(&[dir])?;
     ensure!(!traces.is_empty(), "no sample trace");
     for path in traces {
         let bytes = std::fs::read(&path)?;

@@ -15,7 +15,7 @@
 
 use libtest_mimic::Trial;
 use sweeptrace::core::Facing;
-use sweeptrace::replay::TunnelKind;
+use sweeptrace::replay::tunnel::TunnelKind;
 use sweeptrace::suite::{CheckOptions, check_reader, render_json, render_text};
 use sweeptrace::trace::{SceneMsg, SweepMsg};
 

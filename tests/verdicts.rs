@@ -313,7 +313,7 @@ fn a_fragile_divergence_is_excused_only_by_a_named_perturbation() -> anyhow::Res
         "the core's side is its own decision: {r:?}"
     );
     ensure!(
-        p.units.abs() <= sweeptrace::core::FRAGILE_ULPS,
+        p.units.abs() <= sweeptrace::core::options::FRAGILE_ULPS,
         "within the fragility band: {p:?}"
     );
     // The named perturbation does give a miss.

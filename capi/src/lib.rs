@@ -32,7 +32,9 @@ use std::ffi::{CStr, CString, c_char, c_int, c_void};
 use std::panic::{AssertUnwindSafe, catch_unwind};
 use std::path::PathBuf;
 
-use sweeptrace::trace::{MAX_SETTINGS, PendingTrace, validate_triangle};
+use sweeptrace::trace::PendingTrace;
+use sweeptrace::trace::source::MAX_SETTINGS;
+use sweeptrace::trace::validate::validate_triangle;
 use sweeptrace::{Encoding, ExpectedSource, OutcomeMsg, SceneMsg, SweepMsg, TraceError};
 use sweeptrace::{Facing, Kind};
 
@@ -948,7 +950,7 @@ unsafe fn serve(
     output: &mut impl std::io::Write,
 ) -> Result<(), Stop> {
     use sweeptrace::engine::protocol::{Request, answer_line, parse_request};
-    use sweeptrace::trace::{validate_outcome, validate_scene, validate_sweep};
+    use sweeptrace::trace::validate::{validate_outcome, validate_scene, validate_sweep};
 
     let mut scene: Option<SceneData> = None;
     let mut line = Vec::new();

@@ -24,7 +24,9 @@ use sweeptrace::conform::{ConformOptions, cases, run, shell_quote};
 use sweeptrace::core::Facing;
 use sweeptrace::engine::protocol::{parse_answer, scene_line, sweep_line};
 use sweeptrace::engine::{EngineCommand, EngineOptions};
-use sweeptrace::suite::{Against, CheckOptions, Status, check_file_with_engine, render_text};
+use sweeptrace::suite::engine_check::check_file_with_engine;
+use sweeptrace::suite::report::Against;
+use sweeptrace::suite::{CheckOptions, Status, render_text};
 use sweeptrace::trace::PendingTrace;
 use sweeptrace::{SceneMsg, SweepMsg};
 

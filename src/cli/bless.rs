@@ -14,12 +14,14 @@ use anyhow::{Context, bail};
 use super::Exit;
 use sweeptrace::engine::EngineCommand;
 use sweeptrace::error_text::escaped;
-use sweeptrace::judge::{Divergence, Parties, render_divergence_as};
+use sweeptrace::judge::divergence::{Divergence, Parties, render_divergence_as};
 use sweeptrace::numbers::counted;
-use sweeptrace::suite::{
-    Against, BlessEngine, BlessError, BlessOptions, BlessSelection, CheckOptions, bless_file_with,
-    check_file, check_file_with_engine,
+use sweeptrace::suite::bless::{
+    BlessEngine, BlessError, BlessOptions, BlessSelection, bless_file_with,
 };
+use sweeptrace::suite::engine_check::check_file_with_engine;
+use sweeptrace::suite::report::Against;
+use sweeptrace::suite::{CheckOptions, check_file};
 
 /// Arguments of `bless`.
 #[derive(Debug, clap::Args)]
@@ -256,21 +258,22 @@ pub fn run(args: Args) -> anyhow::Result<Exit> {
         }
         // A declared margin that does not fit the balls: the setting's
         // fault, named where it was set.
-        Err(BlessError::Replay { cause, file }) => match sweeptrace::suite::MarginFault::of(&cause)
-        {
-            Some(fault) => bail!(
-                "{}; nothing written",
-                super::check_config::margin_fault(
-                    &settings,
-                    &args.trace.display().to_string(),
-                    &fault
-                )
-            ),
-            None => {
-                return Err(BlessError::Replay { cause, file })
-                    .name_file_once("blessing", args.trace.display());
+        Err(BlessError::Replay { cause, file }) => {
+            match sweeptrace::suite::report::MarginFault::of(&cause) {
+                Some(fault) => bail!(
+                    "{}; nothing written",
+                    super::check_config::margin_fault(
+                        &settings,
+                        &args.trace.display().to_string(),
+                        &fault
+                    )
+                ),
+                None => {
+                    return Err(BlessError::Replay { cause, file })
+                        .name_file_once("blessing", args.trace.display());
+                }
             }
-        },
+        }
         Err(err) => return Err(err).name_file_once("blessing", args.trace.display()),
     };
     // One line for what was written, then one for each thing to know.

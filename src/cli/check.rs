@@ -8,9 +8,12 @@ use anyhow::{Context, bail};
 use super::Exit;
 use sweeptrace::engine::{EngineCommand, EngineOptions};
 use sweeptrace::replay::{Detail, ReplayOptions};
+use sweeptrace::suite::discovery::discover;
+use sweeptrace::suite::engine_check::check_file_with_engine;
+use sweeptrace::suite::report::Against;
 use sweeptrace::suite::{
-    Against, CheckOptions, DEFAULT_MAX_DETAILS, Status, TraceReport, check_file,
-    check_file_with_engine, discover, frames_around, render_json, render_text,
+    CheckOptions, DEFAULT_MAX_DETAILS, Status, TraceReport, check_file, frames_around, render_json,
+    render_text,
 };
 
 /// Frames of context logged before and after the divergences by `--rrd-on-failure`.
@@ -124,7 +127,7 @@ pub struct Args {
     /// The angle, in degrees, between an edge or vertex contact's normal and
     /// the nearest adjacent face's normal above which it is a ghost contact
     /// (docs/SEMANTICS.md), e.g. `--ghost-degrees 5`.
-    #[arg(long, value_name = "DEGREES", default_value_t = sweeptrace::replay::GHOST_DEGREES)]
+    #[arg(long, value_name = "DEGREES", default_value_t = sweeptrace::replay::ghost::GHOST_DEGREES)]
     pub ghost_degrees: f64,
     /// Ignore the sweeptrace.toml files: the defaults and the command line only.
     #[arg(long)]
@@ -214,7 +217,7 @@ pub fn run(args: Args) -> anyhow::Result<Exit> {
              (--json and --junit report the divergences)",
         ));
     }
-    let overrides = sweeptrace::suite::Overrides {
+    let overrides = sweeptrace::suite::config::Overrides {
         strict: args.strict,
         allow_tunnels: args.allow_tunnels,
         engine: args.conventions.clone(),
@@ -296,10 +299,15 @@ pub fn run(args: Args) -> anyhow::Result<Exit> {
         // the conventions tried, so every trial judges the same answers
         // (a run that did not end cleanly is run again in the trial, whose
         // report says why).
-        let mut recorded: Vec<Option<sweeptrace::suite::RecordedAnswers>> = Vec::new();
+        let mut recorded: Vec<Option<sweeptrace::suite::engine_check::RecordedAnswers>> =
+            Vec::new();
         if let Some((command, engine_options)) = &engine {
             for path in &traces {
-                match sweeptrace::suite::record_engine_answers(path, command, *engine_options) {
+                match sweeptrace::suite::engine_check::record_engine_answers(
+                    path,
+                    command,
+                    *engine_options,
+                ) {
                     Ok(answers) => recorded.push(answers),
                     Err(err) => {
                         eprintln!(
@@ -313,7 +321,7 @@ pub fn run(args: Args) -> anyhow::Result<Exit> {
         }
         // A trace that cannot be checked, or a fault of the engine, ends
         // the inference: its exit code and its message; no table.
-        let inferred = sweeptrace::suite::infer_conventions(|conventions| {
+        let inferred = sweeptrace::suite::infer_conventions::infer_conventions(|conventions| {
             let mut reports: Vec<TraceReport> = Vec::new();
             for (i, (path, settings)) in traces.iter().zip(&settings).enumerate() {
                 let base = settings.check_options(options);
@@ -326,11 +334,13 @@ pub fn run(args: Args) -> anyhow::Result<Exit> {
                 };
                 let report = match (&engine, recorded.get(i).and_then(Option::as_ref)) {
                     (None, _) => check_file(path, &options),
-                    (Some(_), Some(answers)) => sweeptrace::suite::check_recorded_answers(
-                        answers,
-                        &path.display().to_string(),
-                        &options,
-                    ),
+                    (Some(_), Some(answers)) => {
+                        sweeptrace::suite::engine_check::check_recorded_answers(
+                            answers,
+                            &path.display().to_string(),
+                            &options,
+                        )
+                    }
                     (Some((command, engine_options)), None) => check_file_with_engine(
                         path,
                         command,
@@ -363,7 +373,7 @@ pub fn run(args: Args) -> anyhow::Result<Exit> {
                 }
                 reports.push(report);
             }
-            let trial = sweeptrace::suite::Trial::of(&reports);
+            let trial = sweeptrace::suite::infer_conventions::Trial::of(&reports);
             eprintln!(
                 "tried {}: {} of {} compared sweeps fail",
                 conventions.summary(),
@@ -469,7 +479,7 @@ fn leave_out(
 ) -> anyhow::Result<Vec<PathBuf>> {
     let (mut traces, mut foxglove, mut excluded) = (Vec::new(), Vec::new(), Vec::new());
     for path in found {
-        if let Some(trace) = sweeptrace::trace::foxglove_output(&path) {
+        if let Some(trace) = sweeptrace::trace::sniff::foxglove_output(&path) {
             foxglove.push((path, trace));
             continue;
         }

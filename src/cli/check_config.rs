@@ -1,12 +1,13 @@
 //! `check`'s settings for each trace: the `sweeptrace.toml` files found
 //! beside and above it, then the command line (the library's
-//! [`sweeptrace::suite::settings_for`] does the resolution). `replay`
+//! [`sweeptrace::suite::config::settings_for`] does the resolution). `replay`
 //! and `sweep --trace` read the same files for the `[engine]` table, so
 //! that their answers are the ones `check` judges by.
 
 use std::path::{Path, PathBuf};
 
-use sweeptrace::suite::{self, Overrides, Settings};
+use sweeptrace::suite;
+use sweeptrace::suite::config::{Overrides, Settings};
 
 /// Where a run's settings come from: the `sweeptrace.toml` files found
 /// beside and above each trace (each read once per run), one named file
@@ -15,10 +16,10 @@ use sweeptrace::suite::{self, Overrides, Settings};
 #[derive(Debug)]
 pub enum SettingsFiles {
     /// The files found beside and above each trace.
-    Found(suite::ConfigFiles),
+    Found(suite::config::ConfigFiles),
     /// `--config FILE`, read and parsed once (its path made absolute, so
     /// that its globs meet the traces' absolute paths).
-    Named(Box<suite::ConfigFile>),
+    Named(Box<suite::config::ConfigFile>),
     /// `--no-config`.
     None,
 }
@@ -32,20 +33,20 @@ impl SettingsFiles {
             (true, _) => SettingsFiles::None,
             (false, Some(path)) => {
                 let absolute = absolute(path)?;
-                SettingsFiles::Named(Box::new(suite::ConfigFile::read(
+                SettingsFiles::Named(Box::new(suite::config::ConfigFile::read(
                     &absolute,
                     &path.display().to_string(),
                 )?))
             }
-            (false, None) => SettingsFiles::Found(suite::ConfigFiles::new()),
+            (false, None) => SettingsFiles::Found(suite::config::ConfigFiles::new()),
         })
     }
 
     /// The settings of `trace`: the files, then `command_line`.
     pub fn settings(&mut self, trace: &Path, command_line: &Overrides) -> anyhow::Result<Settings> {
         Ok(match self {
-            SettingsFiles::None => suite::resolve(&[], trace, command_line),
-            SettingsFiles::Named(file) => suite::resolve(
+            SettingsFiles::None => suite::config::resolve(&[], trace, command_line),
+            SettingsFiles::Named(file) => suite::config::resolve(
                 std::slice::from_ref(&**file),
                 &absolute(trace)?,
                 command_line,
@@ -72,7 +73,7 @@ impl SettingsFiles {
 fn absolute(path: &Path) -> anyhow::Result<PathBuf> {
     let absolute = std::path::absolute(path)
         .map_err(|e| anyhow::anyhow!("{}: cannot make the path absolute: {e}", path.display()))?;
-    Ok(suite::normalize(&absolute))
+    Ok(suite::config::normalize(&absolute))
 }
 
 /// Each trace's settings, in the order of `traces`, from `files` and the
@@ -97,9 +98,9 @@ pub fn render(traces: &[PathBuf], settings: &[Settings], json: bool) -> String {
         .map(|(t, s)| (t.display().to_string(), s.clone()))
         .collect();
     if json {
-        suite::render_settings_json(&named)
+        suite::config::render_settings_json(&named)
     } else {
-        suite::render_settings_text(&named)
+        suite::config::render_settings_text(&named)
     }
 }
 
@@ -141,7 +142,7 @@ pub fn for_trace(
 pub fn margin_fault(
     settings: &Settings,
     trace: &str,
-    fault: &sweeptrace::suite::MarginFault,
+    fault: &sweeptrace::suite::report::MarginFault,
 ) -> String {
     use sweeptrace::conventions::{Setting, Source};
     use sweeptrace::numbers::Shortest;
@@ -179,11 +180,11 @@ pub fn conventions_line(settings: &Settings) -> Option<String> {
 /// not fit a ball named where it was declared, any other naming the trace.
 pub fn replay_error(
     err: sweeptrace::replay::ReplayError,
-    settings: &sweeptrace::suite::Settings,
+    settings: &sweeptrace::suite::config::Settings,
     source_name: &str,
 ) -> anyhow::Result<()> {
     use super::NameFileOnce as _;
-    match sweeptrace::suite::MarginFault::of(&err) {
+    match sweeptrace::suite::report::MarginFault::of(&err) {
         Some(fault) => anyhow::bail!(margin_fault(settings, source_name, &fault)),
         None => Err(err).name_file_once("replaying", source_name),
     }

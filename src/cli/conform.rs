@@ -88,7 +88,7 @@ pub struct Args {
 /// `--config FILE`, or of the nearest `sweeptrace.toml` from the current
 /// directory up (none with `--no-config`), under the flags.
 fn conventions(args: &Args) -> anyhow::Result<sweeptrace::conventions::EngineConventions> {
-    use sweeptrace::suite::{ConfigFile, Overrides, resolve, settings_for};
+    use sweeptrace::suite::config::{ConfigFile, Overrides, resolve, settings_for};
     let overrides = Overrides {
         engine: args.conventions.clone(),
         ..Overrides::default()

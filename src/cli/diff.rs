@@ -12,7 +12,7 @@ use sweeptrace::conventions::{EngineConventions, FacingRule, MarginRule};
 use sweeptrace::core::Facing;
 use sweeptrace::numbers::{self, Rule};
 use sweeptrace::replay::{FrameRange, ReplayOptions, Selection};
-use sweeptrace::suite::{Side, diff, render_diff_json, render_diff_text};
+use sweeptrace::suite::diff::{Side, diff, render_diff_json, render_diff_text};
 use sweeptrace::trace::TraceReader;
 
 /// Arguments of `diff`.

@@ -5,7 +5,8 @@ use std::io::BufReader;
 use std::path::PathBuf;
 
 use super::Exit;
-use sweeptrace::trace::{TraceReader, collect_info, render_info_json, render_info_text};
+use sweeptrace::trace::TraceReader;
+use sweeptrace::trace::info::{collect_info, render_info_json, render_info_text};
 
 /// Arguments of `info`.
 #[derive(Debug, clap::Args)]

@@ -10,7 +10,7 @@ use anyhow::Context;
 use serde::Serialize;
 
 use super::Exit;
-use sweeptrace::core::{Defect, DefectKind, EdgeClass, EdgeCounts, Topology};
+use sweeptrace::core::topology::{Defect, DefectKind, EdgeClass, EdgeCounts, Topology};
 use sweeptrace::numbers::counted;
 use sweeptrace::sim::load_obj;
 use sweeptrace::trace::{EventBody, TraceReader};

@@ -19,7 +19,7 @@ pub mod repro;
 pub mod sweep;
 pub mod viewer;
 
-pub use exit::Exit;
+pub(crate) use exit::Exit;
 
 /// `--version`: the version, and whether this build lacks the Rerun viewer
 /// (its recordings are refused, see [`viewer`]).
@@ -142,9 +142,9 @@ impl ToleranceArgs {
 
     /// The values given, as the command line's layer of `check`'s settings
     /// (validated).
-    pub fn to_overrides(&self) -> anyhow::Result<sweeptrace::suite::Overrides> {
+    pub fn to_overrides(&self) -> anyhow::Result<sweeptrace::suite::config::Overrides> {
         self.to_tolerances()?;
-        Ok(sweeptrace::suite::Overrides {
+        Ok(sweeptrace::suite::config::Overrides {
             alpha: self.tolerance,
             normal_degrees: self.normal_tolerance,
             contact: self.contact_tolerance,

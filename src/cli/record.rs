@@ -11,7 +11,8 @@ use super::Exit;
 use sweeptrace::core::Facing;
 use sweeptrace::sim::scenes::{self, BuiltinScene, SceneMesh};
 use sweeptrace::sim::{self, SimOptions, SimSummary, StopReason};
-use sweeptrace::trace::{Encoding, sweeptrace_source, write_trace_file_with_encoding};
+use sweeptrace::trace::source::sweeptrace_source;
+use sweeptrace::trace::{Encoding, write_trace_file_with_encoding};
 
 /// Arguments of `record`. Every simulation option defaults to the scene's
 /// own choice (`sweeptrace::sim::scenes::BuiltinScene::sim_options`).

@@ -4,10 +4,13 @@ use std::fmt::Write;
 
 use serde_json::json;
 
-use sweeptrace::core::{Crossing, Options, Outcome, Sweep, TestRecord, Verdict};
-use sweeptrace::core::{describe, miss_distance, num};
-use sweeptrace::judge::SweepInputs;
-use sweeptrace::replay::{SweepStory, Tunnel, TunnelAt};
+use sweeptrace::core::crossing::Crossing;
+use sweeptrace::core::explain::{describe, miss_distance, num};
+use sweeptrace::core::record::{TestRecord, Verdict};
+use sweeptrace::core::{Options, Outcome, Sweep};
+use sweeptrace::judge::inputs::SweepInputs;
+use sweeptrace::replay::tunnel::Tunnel;
+use sweeptrace::replay::{SweepStory, TunnelAt};
 use sweeptrace::trace::OutcomeMsg;
 
 /// Formats `[x, y, z]` compactly.

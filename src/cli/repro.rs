@@ -1,11 +1,11 @@
 //! `sweeptrace repro`: one sweep of a trace as a minimal trace and a
-//! ready-to-paste Rust test (the library's [`sweeptrace::suite::ReproCase`]).
+//! ready-to-paste Rust test (the library's [`sweeptrace::suite::repro::ReproCase`]).
 
 use super::NameFileOnce;
 use std::path::PathBuf;
 
 use super::Exit;
-use sweeptrace::suite::{ReproCase, find_sweep};
+use sweeptrace::suite::repro::{ReproCase, find_sweep};
 use sweeptrace::trace::{TraceReader, write_trace_file};
 
 /// Arguments of `repro`.
@@ -49,7 +49,7 @@ pub struct Args {
 
 /// Writes the case and prints the test.
 pub fn run(args: Args) -> anyhow::Result<Exit> {
-    let overrides = sweeptrace::suite::Overrides {
+    let overrides = sweeptrace::suite::config::Overrides {
         engine: args.conventions.clone(),
         ..args.tolerances.to_overrides()?
     };

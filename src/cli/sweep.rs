@@ -13,7 +13,8 @@ use sweeptrace::replay::{
 };
 use sweeptrace::sim::load_obj;
 use sweeptrace::sim::scenes::BuiltinScene;
-use sweeptrace::suite::{MarginFault, find_sweep};
+use sweeptrace::suite::report::MarginFault;
+use sweeptrace::suite::repro::find_sweep;
 use sweeptrace::trace::{OutcomeMsg, TraceReader};
 
 /// Arguments of `sweep`.
@@ -87,7 +88,7 @@ pub fn run(args: Args) -> anyhow::Result<Exit> {
     let mut expected: Option<OutcomeMsg> = None;
     let mut replayed: Option<SweepResult> = None;
     let topology: Option<sweeptrace::Topology>;
-    let settings: sweeptrace::suite::Settings;
+    let settings: sweeptrace::suite::config::Settings;
     let (name, mesh, sweep, options) = if let Some(path) = &args.trace {
         let frame = args.frame.context("--trace needs --frame")?;
         let shown = path.display().to_string();
@@ -200,7 +201,7 @@ pub fn run(args: Args) -> anyhow::Result<Exit> {
 
 /// The replay's options of this command: the engine's conventions, from
 /// its flags (`--margin`, `--facing`, ...) over the `[engine]` table.
-fn replay_options(settings: &sweeptrace::suite::Settings) -> ReplayOptions {
+fn replay_options(settings: &sweeptrace::suite::config::Settings) -> ReplayOptions {
     ReplayOptions {
         conventions: settings.engine.conventions(),
         ..ReplayOptions::default()

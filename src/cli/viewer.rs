@@ -12,12 +12,14 @@ use std::path::Path;
 use sweeptrace::replay::ReplayOptions;
 
 #[cfg(feature = "viewer")]
-pub use sweeptrace::viz::{
+pub(crate) use sweeptrace::viz::rrd_file::RrdFileOptions;
+#[cfg(feature = "viewer")]
+pub(crate) use sweeptrace::viz::{
     FinishedRecording, LoggerOptions, PrepareOptions, Recording, RecordingError, RecordingTarget,
-    RrdFileOptions, Viewer,
+    Viewer,
 };
 #[cfg(not(feature = "viewer"))]
-pub use without::{FinishedRecording, Recording, RecordingTarget};
+pub(crate) use without::{FinishedRecording, Recording, RecordingTarget};
 
 /// The command that installs the build with the Rerun viewer (the default
 /// features), from the repository's checkout.

@@ -14,7 +14,7 @@
 use std::time::Duration;
 
 use crate::judge::Tolerances;
-use crate::judge::{Parties, divergence_line};
+use crate::judge::divergence::{Parties, divergence_line};
 use crate::junit::{Case, CaseResult, Detail, JunitOptions, Problem, Report, Suite, one_line};
 
 use super::{CaseFailure, ConformReport, RuleReport, render_case_failure, render_rule_failure};

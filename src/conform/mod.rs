@@ -24,8 +24,8 @@ use crate::conventions::{EngineConventions, TieRule};
 use crate::core::explain::num;
 use crate::core::{Kind, Outcome};
 use crate::engine::{EngineAnswers, EngineCommand, EngineError, EngineOptions, EngineSession};
+use crate::judge::divergence::{Divergence, divergence_details};
 use crate::judge::{Agreement, Tolerances, agreement, compare};
-use crate::judge::{Divergence, divergence_details};
 use crate::replay::{ReplayEvent, ReplayOptions, replay_events};
 use crate::trace::{EventBody, EventHeader, OutcomeMsg, TraceEvent};
 

@@ -5,7 +5,7 @@
 use std::fmt::Write as _;
 
 use super::{CaseFailure, ConformReport, RuleReport};
-use crate::judge::{Parties, render_divergence_as};
+use crate::judge::divergence::{Parties, render_divergence_as};
 
 /// The report in words: one line per rule (status, counts, what it
 /// checks), then each failing rule's first failing case explained with the

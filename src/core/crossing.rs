@@ -22,7 +22,7 @@
 //! triangle index.
 //!
 //! A *flipped* triangle (wound against its neighbours, see
-//! [`Topology::flipped`](super::Topology::flipped)) is crossed in either
+//! [`Topology::flipped`](super::topology::Topology::flipped)) is crossed in either
 //! direction: front to back by its own winding as above, or back to front,
 //! which is front to back by the winding its neighbours give it (the same
 //! rule with `n` reversed). [`first_crossing_with_flipped`] takes that list.
@@ -182,7 +182,7 @@ pub fn first_crossing(mesh: &Mesh, p: &Point3<f64>, q: &Point3<f64>) -> Option<C
 }
 
 /// [`first_crossing`], with the triangles of `flipped` (input indices,
-/// ascending: [`Topology::flipped`](super::Topology::flipped)) crossed back
+/// ascending: [`Topology::flipped`](super::topology::Topology::flipped)) crossed back
 /// to front too (see the module documentation). Allocates nothing.
 pub fn first_crossing_with_flipped(
     mesh: &Mesh,

@@ -5,7 +5,7 @@ use serde::ser::SerializeSeq;
 use serde::{Serialize, Serializer};
 
 /// One reason a decision is fragile. The thresholds are in
-/// [`options`](super::FRAGILE_ULPS) and in docs/SEMANTICS.md.
+/// [`options`](super::options::FRAGILE_ULPS) and in docs/SEMANTICS.md.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize)]
 #[serde(rename_all = "snake_case")]
 pub enum FragileReason {

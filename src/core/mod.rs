@@ -4,35 +4,35 @@
 //! face test, three edge tests in each edge's standard frame and three
 //! vertex tests; the mesh sweep takes the earliest collision, decides
 //! between the hits tied with it (within the tie window, see
-//! [`TIE_WINDOW_ULPS`]) by kind (face, edge, vertex), triangle and feature,
+//! [`TIE_WINDOW_ULPS`](options::TIE_WINDOW_ULPS)) by kind (face, edge, vertex), triangle and feature,
 //! averages the front normals of the tied triangles, and flags a decision
 //! that rounding could change ([`Fragility`]).
 //!
 //! Two entry points share one implementation: [`sweep_mesh`] (fast, no
 //! allocation) and [`sweep_mesh_with`] (hands every test's record to an
-//! [`Observer`]).
+//! [`Observer`](record::Observer)).
 //!
-//! [`first_crossing`] is a separate query: where a segment (a ball's centre
+//! [`first_crossing`](crossing::first_crossing) is a separate query: where a segment (a ball's centre
 //! moving) passes through a triangle from its front to its back, the fact
 //! behind a tunnel.
 //!
-//! [`Topology`] is the mesh's adjacency: each edge's triangles and class,
+//! [`Topology`](topology::Topology) is the mesh's adjacency: each edge's triangles and class,
 //! and the defects (flipped windings, cracks, T-junctions, ...).
 
 mod bvh;
 mod contact;
-mod crossing;
+pub mod crossing;
 mod error;
-pub(crate) mod explain;
+pub mod explain;
 mod feature;
 mod fragility;
 mod initial;
-mod mesh;
-mod options;
+pub mod mesh;
+pub mod options;
 mod outcome;
 mod path;
 mod quadratic;
-mod record;
+pub mod record;
 #[cfg(test)]
 mod sides_tests;
 mod sweep_edge;
@@ -40,37 +40,21 @@ mod sweep_face;
 mod sweep_mesh;
 mod sweep_vertex;
 mod ties;
-mod topology;
+pub mod topology;
 
 pub(crate) use contact::triangle_contact;
 pub use contact::{Contact, ContactQuery, contact_set};
-pub use crossing::{
-    Crossing, all_crossings, crossing_tolerance, first_crossing, first_crossing_with_flipped,
-    triangle_crossing, triangle_crossing_back_to_front,
-};
 pub use error::{MeshError, SweepError};
-pub use explain::{describe, miss_distance, num};
 pub use feature::{Feature, Kind};
 pub use fragility::{FragileReason, Fragility};
 pub(crate) use initial::closest_point;
 pub use initial::initial_contacts;
-pub use mesh::{DegenerateReason, DegenerateTriangle, Mesh, MeshBytes, StandardFrame, Triangle};
-pub use options::{
-    ALPHA_SENSITIVITY, DEGENERATE_TOLERANCE, FRAGILE_ULPS, Facing, GRAZING_COSINE, InitialOverlap,
-    Options, PARALLEL_TOLERANCE, Sides, TIE_WINDOW_ULPS,
-};
+pub use mesh::Mesh;
+pub use options::{Facing, InitialOverlap, Options, Sides};
 pub use outcome::{Outcome, SweepHit, Tie};
 pub use path::{Sweep, SweptPath};
-pub use record::{
-    CollectRecords, CountVisits, EdgeHit, EdgeRecord, FaceHit, FaceRecord, NoObserver, Observer,
-    Skip, SkipCounts, TestRecord, Verdict, VerdictCounts, VertexHit, VertexRecord,
-};
 pub(crate) use sweep_edge::sweep_edge;
 pub use sweep_face::{barycentric, sweep_face};
 pub use sweep_mesh::{Broadphase, sweep_mesh, sweep_mesh_with};
 pub(crate) use sweep_vertex::sweep_vertex;
 pub use ties::{CollectTies, sweep_ties};
-pub use topology::{
-    Defect, DefectKind, Edge, EdgeClass, EdgeCounts, FLAT_DIHEDRAL_SINE, NEAR_FRACTION,
-    SLIVER_RATIO, Topology,
-};

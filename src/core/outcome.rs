@@ -98,7 +98,7 @@ impl Outcome {
     }
 
     /// The tie set among `records` (the records of this sweep, e.g. from
-    /// [`CollectRecords`](super::CollectRecords) or [`CollectTies`](super::CollectTies)): every
+    /// [`CollectRecords`](super::record::CollectRecords) or [`CollectTies`](super::CollectTies)): every
     /// hit tied with this outcome, in the tie order (the primary first).
     pub fn tie_set(&self, records: &[TestRecord]) -> Vec<Tie> {
         let mut ties: Vec<Tie> = records

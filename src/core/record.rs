@@ -1,4 +1,4 @@
-//! What each test computed: the records handed to an [`Observer`](super::Observer).
+//! What each test computed: the records handed to an [`Observer`].
 
 use nalgebra::{Point3, Vector3};
 use serde::Serialize;

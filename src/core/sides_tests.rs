@@ -6,9 +6,10 @@ use nalgebra::{Point3, Vector3};
 use rand::{Rng, SeedableRng};
 
 use super::explain::describe;
+use super::record::CollectRecords;
 use super::{
-    Broadphase, CollectRecords, Facing, Feature, InitialOverlap, Mesh, Options, Outcome, Sides,
-    Sweep, sweep_mesh, sweep_mesh_with,
+    Broadphase, Facing, Feature, InitialOverlap, Mesh, Options, Outcome, Sides, Sweep, sweep_mesh,
+    sweep_mesh_with,
 };
 
 /// SEMANTICS.md's triangle `T`: front normal `+z`.

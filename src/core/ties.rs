@@ -13,7 +13,7 @@ use super::sweep_mesh::{Broadphase, sweep_mesh_with};
 
 /// An observer that keeps the hits of an explained sweep, from which
 /// [`CollectTies::tie_set`] gives the decision's tie set. Cheaper than
-/// [`CollectRecords`](super::CollectRecords): only hits are kept.
+/// [`CollectRecords`](super::record::CollectRecords): only hits are kept.
 #[derive(Clone, Debug, Default)]
 pub struct CollectTies {
     /// Every hit, in the order the tests ran.

@@ -4,9 +4,8 @@
 
 use serde_json::{Map, Value};
 
-use crate::trace::{
-    ContactMsg, ContactsMsg, OutcomeMsg, SceneMsg, SweepMsg, validate_contacts, validate_outcome,
-};
+use crate::trace::validate::validate_outcome;
+use crate::trace::{ContactMsg, ContactsMsg, OutcomeMsg, SceneMsg, SweepMsg, validate_contacts};
 
 /// The longest output line accepted from an engine, in bytes.
 pub const MAX_ANSWER_BYTES: usize = 1 << 16;
@@ -59,7 +58,7 @@ pub enum Request {
 /// a JSON object with a string `type`; `scene` and `sweep` with the fields
 /// of `/scene` and `/sweep` (an unknown field is an error), any other type
 /// [`Request::Other`]. The error says what is wrong, naming the field.
-/// The values are not validated ([`crate::trace::validate_outcome`] does that).
+/// The values are not validated ([`crate::trace::validate::validate_outcome`] does that).
 pub fn parse_request(line: &[u8]) -> Result<Request, String> {
     let text = std::str::from_utf8(line).map_err(|_| "it is not UTF-8 text".to_string())?;
     let mut object: Map<String, Value> = match serde_json::from_str::<Value>(text.trim()) {

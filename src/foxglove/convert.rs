@@ -12,10 +12,12 @@ use super::messages::{
     SceneUpdate, SpherePrimitive, SweepNumbers, TextPrimitive, Time, TriangleListPrimitive,
     Vector3,
 };
+use crate::core::SweepHit;
 use crate::core::explain::label;
-use crate::core::{DefectKind, EdgeClass, SweepHit, TestRecord};
+use crate::core::record::TestRecord;
+use crate::core::topology::{DefectKind, EdgeClass};
+use crate::judge::divergence::{divergence_details, render_divergence};
 use crate::judge::{FieldDiff, write_decision_line};
-use crate::judge::{divergence_details, render_divergence};
 use crate::palette::{
     BOUNDARY_EDGE_COLOR, CONCAVE_EDGE_COLOR, CONTACT_BALL_COLOR, CONVEX_EDGE_COLOR, DEFECT_COLOR,
     EXPECTED_COLOR, FACE_NORMAL_COLOR, FLAT_EDGE_COLOR, GHOST_COLOR, HIT_COLOR,

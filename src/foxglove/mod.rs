@@ -60,4 +60,4 @@ pub const DECISIONS_TOPIC: &str = "/decisions";
 /// The numbers (Plot).
 pub const NUMBERS_TOPIC: &str = "/numbers";
 /// Name of the metadata record (`trace`: the trace's file name, `writer`).
-pub const METADATA_NAME: &str = crate::trace::FOXGLOVE_METADATA_NAME;
+pub const METADATA_NAME: &str = crate::trace::sniff::FOXGLOVE_METADATA_NAME;

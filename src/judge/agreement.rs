@@ -26,7 +26,7 @@ pub enum Agreement {
     Tie,
     /// Fields differ, by no more than single-precision arithmetic explains
     /// (declared `precision = "f32"`): the continuous fields within their
-    /// backward-error bound ([`super::Sensitivity`]), and any other
+    /// backward-error bound ([`super::precision::Sensitivity`]), and any other
     /// difference given by the core under a perturbation of the inputs
     /// within the same budget. Not a failure, except with `strict`.
     Precision {
@@ -104,10 +104,10 @@ impl Agreement {
 ///   divergence fails, whatever the decision's fragility: a fragile
 ///   decision does not excuse an answer no rounding gives.
 ///
-/// The perturbations ([`super::Perturbation`]) move one input at a time by
+/// The perturbations ([`super::perturbation::Perturbation`]) move one input at a time by
 /// `k · u`, where `u = ε · S` is the sweep's rounding unit (`S` the scale of
 /// [`crate::core::SweptPath`], ε the machine epsilon) and `k` runs over 1, 2⁴, 2⁸, 2¹²
-/// and 2¹⁶ = [`crate::core::FRAGILE_ULPS`] (the fragility band), both signs: each
+/// and 2¹⁶ = [`crate::core::options::FRAGILE_ULPS`] (the fragility band), both signs: each
 /// coordinate of `p0`, of `p1`, of both together (the path moved, which is
 /// the mesh moved the other way), and the radius. The first one that
 /// reproduces an answer, smallest first, is the one reported.

@@ -49,7 +49,7 @@ pub struct Tolerances {
     /// A direction in which the contact point has a tolerance of its own:
     /// at single precision, the contact normal, along which rounding moves
     /// the contact far less than across it (set per sweep by
-    /// [`super::Sensitivity::widen`]; not in the JSON).
+    /// [`super::precision::Sensitivity::widen`]; not in the JSON).
     #[serde(skip)]
     pub contact_axis: Option<ContactAxis>,
     /// How far a normal's length may be from 1; `None`: the angular

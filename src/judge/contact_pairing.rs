@@ -3,7 +3,8 @@
 //! [`super::contacts::judge_contacts`].
 
 use crate::conventions::EngineConventions;
-use crate::core::{Mesh, Topology};
+use crate::core::Mesh;
+use crate::core::topology::Topology;
 use crate::replay::SceneNormals;
 use crate::trace::{ContactMsg, ContactsMsg};
 

@@ -23,10 +23,13 @@ use nalgebra::{Point3, Vector3};
 use serde::Serialize;
 
 use crate::conventions::EngineConventions;
+use crate::core::explain::num;
+use crate::core::topology::Topology;
 use crate::core::{
-    Contact, ContactQuery, Feature, Kind, Mesh, Sides, Topology, contact_set, num, triangle_contact,
+    Contact, ContactQuery, Feature, Kind, Mesh, Sides, contact_set, triangle_contact,
 };
-use crate::replay::{GhostContact, GhostJudgement, SceneNormals, judge_ghost};
+use crate::replay::SceneNormals;
+use crate::replay::ghost::{GhostContact, GhostJudgement, judge_ghost};
 use crate::trace::{ContactMsg, ContactPointMsg, ContactsMsg, OutcomeMsg};
 
 use super::Tolerances;
@@ -457,7 +460,7 @@ pub(crate) fn judge_contacts(
 /// Whether `place` is a flat edge, or a vertex whose every edge is flat,
 /// one of whose triangles the engine reported.
 fn flat_place_reported(topology: &Topology, place: Place, reported: &[u32]) -> bool {
-    use crate::core::EdgeClass;
+    use crate::core::topology::EdgeClass;
     match place {
         Place::Edge([a, b]) => topology.edge_between(a, b).is_some_and(|e| {
             e.class == EdgeClass::Flat && e.triangles().any(|t| reported.contains(&t))

@@ -5,8 +5,8 @@
 
 use std::fmt::{self, Write as _};
 
-use crate::core::TestRecord;
 use crate::core::explain::{Num, write_describe};
+use crate::core::record::TestRecord;
 use crate::judge::{Agreement, FieldDiff, Tolerances, agreement};
 use crate::replay::SweepResult;
 

@@ -41,7 +41,7 @@ pub struct Divergence {
     /// side's answer (absent otherwise: a fragile decision does not excuse
     /// an answer no rounding gives).
     #[serde(skip_serializing_if = "Option::is_none")]
-    pub reproduced: Option<crate::judge::Reproduced>,
+    pub reproduced: Option<crate::judge::perturbation::Reproduced>,
     /// Whether the expectation names another member of the core's tie set
     /// (a failure only where the tie order must be followed exactly:
     /// `conform`). Only in the JSON when true.
@@ -49,7 +49,7 @@ pub struct Divergence {
     pub names_tie_member: bool,
     /// At single precision, when the difference is within what it
     /// explains: its backward error, in units of `u₃₂ · S` (see
-    /// [`super::Sensitivity`]). Absent otherwise.
+    /// [`super::precision::Sensitivity`]). Absent otherwise.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub backward_error: Option<f64>,
     /// The answer named, when it is one of an engine's known limitations

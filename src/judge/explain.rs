@@ -4,9 +4,8 @@
 use serde::Serialize;
 
 use crate::core::explain::{describe, label, nearest_miss, num};
-use crate::core::{
-    Broadphase, CollectRecords, Kind, Outcome, TestRecord, Verdict, sweep_mesh_with,
-};
+use crate::core::record::{CollectRecords, TestRecord, Verdict};
+use crate::core::{Broadphase, Kind, Outcome, sweep_mesh_with};
 use crate::replay::{SceneState, SweepResult, primary_records};
 use crate::trace::OutcomeMsg;
 
@@ -22,7 +21,7 @@ pub struct ExpectedTest {
     /// Why it did not decide the sweep, in words.
     pub why_not: String,
     /// The known mistake whose α is the expected one on this test
-    /// ([`super::KNOWN_MISTAKES`]'s name), if any; `why_not`
+    /// ([`super::mistakes::KNOWN_MISTAKES`]'s name), if any; `why_not`
     /// says it in words.
     pub mistake: Option<&'static str>,
 }
@@ -272,7 +271,7 @@ fn early_hit(result: &SweepResult, expected: &OutcomeMsg, core_alpha: f64) -> Op
         .is_some_and(|c| {
             matches!(
                 c,
-                crate::core::EdgeClass::Flat | crate::core::EdgeClass::Concave
+                crate::core::topology::EdgeClass::Flat | crate::core::topology::EdgeClass::Concave
             )
         });
     Some(format!(

@@ -7,7 +7,7 @@
 //! the α the mistake gives from a test's record and `ρ` (`None` where it
 //! does not apply). To add one, add an entry.
 
-use crate::core::{EdgeRecord, FaceRecord, TestRecord, Verdict, VertexRecord};
+use crate::core::record::{EdgeRecord, FaceRecord, TestRecord, Verdict, VertexRecord};
 
 /// A mistake collision code makes, recognised by the α it gives.
 #[derive(Clone, Copy, Debug)]
@@ -102,7 +102,8 @@ pub fn known_mistake(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::core::{Broadphase, CollectRecords, Mesh, Options, Sides, Sweep, sweep_mesh_with};
+    use crate::core::record::CollectRecords;
+    use crate::core::{Broadphase, Mesh, Options, Sides, Sweep, sweep_mesh_with};
 
     /// The face record of worked example 1 from behind, and the α of the
     /// sweep, under `sides`.

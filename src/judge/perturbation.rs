@@ -9,7 +9,8 @@ use std::fmt;
 use serde::Serialize;
 
 use crate::core::explain::num;
-use crate::core::{FRAGILE_ULPS, Mesh, Options, Sweep, SweptPath};
+use crate::core::options::FRAGILE_ULPS;
+use crate::core::{Mesh, Options, Sweep, SweptPath};
 use crate::replay::SweepResult;
 use crate::trace::OutcomeMsg;
 

@@ -6,9 +6,9 @@
 use nalgebra::Point3;
 
 use crate::core::SweepHit;
+use crate::core::record::{EdgeRecord, FaceRecord, Observer, TestRecord, VertexRecord};
 use crate::core::{
-    Broadphase, EdgeRecord, FaceRecord, Feature, Observer, Outcome, Sweep, SweptPath, TestRecord,
-    Tie, VertexRecord, initial_contacts, sweep_mesh_with,
+    Broadphase, Feature, Outcome, Sweep, SweptPath, Tie, initial_contacts, sweep_mesh_with,
 };
 use crate::replay::SceneState;
 use crate::trace::OutcomeMsg;

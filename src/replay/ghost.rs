@@ -18,7 +18,8 @@ use nalgebra::Vector3;
 use serde::Serialize;
 
 use crate::core::explain::num;
-use crate::core::{EdgeClass, Kind, Mesh, Topology};
+use crate::core::topology::{EdgeClass, Topology};
+use crate::core::{Kind, Mesh};
 use crate::trace::OutcomeMsg;
 
 /// The default angle, in degrees, between an edge or vertex contact's

@@ -11,18 +11,18 @@
 //! after its sweep is still attached to it.
 //!
 //! Each result also says whether the ball's centre went through a triangle
-//! front to back ([`Tunnel`]): during the sweep, or since the ball's
+//! front to back ([`Tunnel`](tunnel::Tunnel)): during the sweep, or since the ball's
 //! previous sweep ([`Replay`] keeps where each ball's last sweep left it),
 //! and whether its contact is a ghost contact: an edge or vertex contact
 //! on an internal flat or concave place whose normal leans off the faces
-//! ([`judge_ghost`]).
+//! ([`judge_ghost`](ghost::judge_ghost)).
 //!
 //! Nothing here knows about the viewer: `viz` turns results into a Rerun
 //! recording, `check`-like commands compare [`SweepResult::outcome_msg`]
 //! with [`SweepResult::expected`].
 
 mod error;
-mod ghost;
+pub mod ghost;
 mod iter;
 mod normals;
 mod options;
@@ -30,13 +30,12 @@ mod pipeline;
 mod primary;
 mod replayer;
 mod selection;
-mod story;
+pub mod story;
 mod summary;
-mod tunnel;
+pub mod tunnel;
 
 pub use error::ReplayError;
 pub(crate) use ghost::GhostLine;
-pub use ghost::{GHOST_DEGREES, GhostContact, GhostJudgement, GhostPlace, judge_ghost};
 pub use iter::{ParallelReplayIter, ReplayIter, replay_events, replay_events_parallel};
 pub use normals::SceneNormals;
 pub use options::{DEFAULT_BATCH_EVENTS, Detail, FrameRange, ReplayOptions};
@@ -49,8 +48,5 @@ pub use pipeline::{
 pub use primary::{CollectPrimary, primary_records};
 pub use replayer::{Replay, ReplayEvent, SceneState, SweepResult, feature_class};
 pub use selection::{Selection, SweepExtent};
-pub use story::{HitPlace, SweepStory, explain_sweep, hit_place};
+pub use story::{SweepStory, explain_sweep};
 pub use summary::{ReplaySummary, TunnelAt};
-pub use tunnel::{
-    Through, Tunnel, TunnelKind, TunnelScene, defects_within_reach, sweep_end, tunnel_during_sweep,
-};

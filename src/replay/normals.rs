@@ -4,7 +4,8 @@
 
 use nalgebra::Vector3;
 
-use crate::core::{EdgeClass, Feature, Mesh, Outcome, Sweep, Topology};
+use crate::core::topology::{EdgeClass, Topology};
+use crate::core::{Feature, Mesh, Outcome, Sweep};
 
 use crate::conventions::{ACTIVE_EDGE_DEGREES, ACTIVE_EDGE_KEEP_DEGREES, NormalRule};
 
@@ -227,7 +228,8 @@ mod tests {
 
     use super::SceneNormals;
     use crate::conventions::NormalRule;
-    use crate::core::{Feature, Mesh, Sweep, Topology};
+    use crate::core::topology::Topology;
+    use crate::core::{Feature, Mesh, Sweep};
 
     /// Triangle 0 in z = 0 with, across its edge 0 (y = 0), triangle 1
     /// folded down by 2° (an inactive convex edge) and, across its edge 1,

@@ -8,12 +8,13 @@
 //! reason, not tested, so the verdict counts cover the tested candidates
 //! and the nearest miss is the nearest among them.
 
+use crate::core::Outcome;
 use crate::core::explain::{
     edge_miss_distance, face_miss_distance, nearest_miss, vertex_miss_distance,
 };
-use crate::core::{
-    EdgeRecord, FaceRecord, Observer, Outcome, Skip, SkipCounts, TestRecord, Verdict,
-    VerdictCounts, VertexRecord,
+use crate::core::record::{
+    EdgeRecord, FaceRecord, Observer, Skip, SkipCounts, TestRecord, Verdict, VerdictCounts,
+    VertexRecord,
 };
 
 /// An observer that keeps, of a sweep's records, only what

@@ -7,9 +7,10 @@ use std::time::{Duration, Instant};
 
 use crate::conventions::{EngineConventions, MarginRule};
 use crate::core::explain::nearest_miss;
+use crate::core::record::{CollectRecords, Observer, SkipCounts, TestRecord, VerdictCounts};
+use crate::core::topology::{EdgeClass, Topology};
 use crate::core::{
-    Broadphase, CollectRecords, EdgeClass, Feature, Mesh, Observer, Options, Outcome, SkipCounts,
-    Sweep, SweepError, TestRecord, Topology, VerdictCounts, sweep_mesh, sweep_mesh_with,
+    Broadphase, Feature, Mesh, Options, Outcome, Sweep, SweepError, sweep_mesh, sweep_mesh_with,
 };
 use crate::trace::{EventBody, EventHeader, OutcomeMsg, SceneMsg, SweepMsg, TraceEvent};
 
@@ -176,20 +177,20 @@ impl SweepResult {
     }
 
     /// The expected outcome as a ghost contact, when it is one: judged as
-    /// `check` judges it ([`crate::replay::judge_ghost`], with the core's
+    /// `check` judges it ([`crate::replay::ghost::judge_ghost`], with the core's
     /// normal for the sweep as the rule's and the default threshold
-    /// [`super::GHOST_DEGREES`]).
-    pub fn ghost(&self) -> Option<crate::replay::GhostContact> {
+    /// [`super::ghost::GHOST_DEGREES`]).
+    pub fn ghost(&self) -> Option<crate::replay::ghost::GhostContact> {
         let expected = self.expected.as_ref()?;
-        match crate::replay::judge_ghost(
+        match crate::replay::ghost::judge_ghost(
             &self.scene.mesh,
             &self.scene.topology,
             expected,
             self.log_time_nanos,
             self.outcome.hit.as_ref().map(|h| &h.normal),
-            super::GHOST_DEGREES,
+            super::ghost::GHOST_DEGREES,
         ) {
-            super::GhostJudgement::Ghost(g) => Some(g),
+            super::ghost::GhostJudgement::Ghost(g) => Some(g),
             _ => None,
         }
     }
@@ -198,7 +199,7 @@ impl SweepResult {
     /// expected contact; without one, at the core's contact; without a hit, a
     /// detection radius from the ball's centre at the expected α, against the
     /// expected normal.
-    pub(crate) fn ghost_point(&self, g: &crate::replay::GhostContact) -> [f64; 3] {
+    pub(crate) fn ghost_point(&self, g: &crate::replay::ghost::GhostContact) -> [f64; 3] {
         let r = self;
         if let Some(Some(c)) = r.expected.as_ref().and_then(|e| e.contact) {
             return c;

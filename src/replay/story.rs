@@ -3,9 +3,11 @@
 //! story the command renders.
 
 use crate::conventions::NormalRule;
+use crate::core::crossing::{Crossing, all_crossings};
+use crate::core::record::{CollectRecords, TestRecord};
+use crate::core::topology::{EdgeClass, Topology};
 use crate::core::{
-    Broadphase, CollectRecords, Crossing, EdgeClass, Feature, Mesh, Options, Outcome, Sweep,
-    SweepError, TestRecord, Topology, all_crossings, sweep_mesh_with,
+    Broadphase, Feature, Mesh, Options, Outcome, Sweep, SweepError, sweep_mesh_with,
 };
 
 use super::ghost::GhostContact;

@@ -3,7 +3,8 @@
 use std::collections::BTreeMap;
 use std::time::Duration;
 
-use crate::core::{FragileReason, Kind, SkipCounts, VerdictCounts};
+use crate::core::record::{SkipCounts, VerdictCounts};
+use crate::core::{FragileReason, Kind};
 
 use super::ReplayOptions;
 use super::selection::{Selection, SweepExtent};

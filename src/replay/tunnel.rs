@@ -2,17 +2,17 @@
 //! its back (or through a flipped triangle either way), during a sweep or
 //! between two sweeps of the same ball, and the mesh defect it went through
 //! when one lies within `ρ` of where it crossed (see SEMANTICS.md,
-//! "Tunnelling", and [`crate::core::first_crossing_with_flipped`]).
+//! "Tunnelling", and [`crate::core::crossing::first_crossing_with_flipped`]).
 
 use std::collections::HashMap;
 
 use nalgebra::Point3;
 use serde::Serialize;
 
+use crate::core::crossing::{Crossing, first_crossing_with_flipped};
 use crate::core::explain::num;
-use crate::core::{
-    Crossing, Defect, DefectKind, Mesh, Outcome, Sweep, Topology, first_crossing_with_flipped,
-};
+use crate::core::topology::{Defect, DefectKind, Topology};
+use crate::core::{Mesh, Outcome, Sweep};
 
 /// Where a tunnel happened.
 #[derive(

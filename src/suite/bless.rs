@@ -48,7 +48,8 @@ use crate::atomic::{FinishStep, PendingFile};
 use crate::engine::{EngineCommand, EngineError, EngineOptions};
 use crate::error_text::full_text;
 use crate::replay::{FrameRange, ReplayError, ReplayOptions, Selection};
-use crate::trace::{EXPECTED_SOURCE_METADATA, ExpectedSource, TraceError};
+use crate::trace::source::EXPECTED_SOURCE_METADATA;
+use crate::trace::{ExpectedSource, TraceError};
 use copy::{Copier, read_error, scan, write_error};
 use expectations::{Replayed, outcomes_of};
 
@@ -98,8 +99,8 @@ pub enum BlessError {
     },
     /// The engine's answer to a sweep is one the trace cannot hold (a
     /// triangle the scene does not have): the checks every writer of
-    /// `/expected` makes ([`crate::trace::validate_outcome`],
-    /// [`crate::trace::validate_triangle`]).
+    /// `/expected` makes ([`crate::trace::validate::validate_outcome`],
+    /// [`crate::trace::validate::validate_triangle`]).
     #[error(
         "the engine `{command}` answered frame {frame}, ball {ball} with an outcome the trace cannot hold: field `{field}`: {problem}"
     )]

@@ -25,7 +25,7 @@ use super::report::{
     Judged, KindChange, MAX_DIVERGENT_FRAMES, MAX_ERRORS, MAX_LISTED_TUNNELS, MarginFault,
     TraceReport, TunnelReport, WithinPrecision,
 };
-use crate::judge::divergence_details;
+use crate::judge::divergence::divergence_details;
 use crate::judge::{Agreement, agreement};
 use crate::judge::{Field, Tolerances};
 
@@ -45,14 +45,14 @@ pub struct CheckOptions {
     /// recording engine, whatever the expectations say).
     pub fail_on_tunnel: bool,
     /// Whether a ghost contact fails the check (the default; see
-    /// [`judge_ghost`](crate::replay::judge_ghost)).
+    /// [`judge_ghost`](crate::replay::ghost::judge_ghost)).
     pub fail_on_ghost: bool,
     /// The angle, in degrees, above which an edge or vertex contact on an
     /// internal flat or concave place is a ghost contact
-    /// ([`crate::replay::GHOST_DEGREES`] by default).
+    /// ([`crate::replay::ghost::GHOST_DEGREES`] by default).
     pub ghost_degrees: f64,
     /// Whether divergences also give their inputs as hexadecimal floating
-    /// point ([`crate::judge::Divergence::inputs_hex`]).
+    /// point ([`crate::judge::divergence::Divergence::inputs_hex`]).
     pub hex: bool,
     /// The replay's options (frames, ball, overrides). `explain` and
     /// `detail` are ignored: the check runs the fast query and explains
@@ -68,7 +68,7 @@ impl Default for CheckOptions {
             strict: false,
             fail_on_tunnel: true,
             fail_on_ghost: true,
-            ghost_degrees: crate::replay::GHOST_DEGREES,
+            ghost_degrees: crate::replay::ghost::GHOST_DEGREES,
             hex: false,
             replay: ReplayOptions::default(),
         }
@@ -115,7 +115,7 @@ pub fn judge_against_core(result: &SweepResult, tolerances: &Tolerances) -> Opti
 }
 
 /// Checks a trace given as a stream of events. Whether it has an
-/// `/expected` channel ([`super::Expectations::has_channel`]) is set from the events (true when any `/expected` message was seen);
+/// `/expected` channel ([`super::report::Expectations::has_channel`]) is set from the events (true when any `/expected` message was seen);
 /// [`check_reader`] sets it from the file's channels instead.
 pub fn check_events<I>(events: I, name: &str, options: &CheckOptions) -> TraceReport
 where

@@ -6,7 +6,7 @@
 use serde::Serialize;
 
 use crate::judge::{ContactPairing, ContactVerdict};
-use crate::replay::GhostContact;
+use crate::replay::ghost::GhostContact;
 use crate::trace::{EventBody, TraceEvent};
 
 use super::check::CheckOptions;

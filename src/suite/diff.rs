@@ -403,7 +403,7 @@ pub fn render_diff_text(r: &DiffReport) -> String {
     if let Some(f) = &r.first {
         let _ = writeln!(s, "first divergence: frame {}, ball {}", f.frame, f.ball);
         for d in &f.fields {
-            let (a, b) = crate::judge::values_text(&d.expected, &d.got);
+            let (a, b) = crate::judge::divergence::values_text(&d.expected, &d.got);
             let _ = write!(s, "  {}: A {a}, B {b}", d.field);
             if let Some(detail) = &d.detail {
                 let _ = write!(s, " ({detail})");

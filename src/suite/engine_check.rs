@@ -1,6 +1,6 @@
 //! `check --engine`: a trace's sweeps answered by a running engine (the
 //! protocol client of [`crate::engine`]) and judged by the one judgement
-//! ([`super::judge`]), in an ordinary check's report.
+//! ([`crate::judge`]), in an ordinary check's report.
 
 // An engine's error carries its command, the line and its last stderr
 // lines; it happens once per run, so its size does not matter.
@@ -20,7 +20,7 @@ use crate::judge::agreement_of;
 
 /// Checks the trace at `path` against a running engine: the engine answers
 /// every sweep ([`EngineAnswers`]) and the answers are judged by an
-/// ordinary check ([`check_events_judged`](super::check_events_judged)): with [`Against::Core`] they
+/// ordinary check ([`check_events_judged`](super::check::check_events_judged)): with [`Against::Core`] they
 /// are the expectations and the core's outcomes are compared with them
 /// (the trace's `/expected` is not used); with [`Against::Expected`] they
 /// are compared with the trace's `/expected` ([`judge_answer_against_expected`]).

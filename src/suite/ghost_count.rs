@@ -5,7 +5,7 @@
 use crate::replay::SweepResult;
 
 use super::report::{Ghosts, Judged};
-use crate::replay::{GhostJudgement, judge_ghost};
+use crate::replay::ghost::{GhostJudgement, judge_ghost};
 
 /// How many ghost contacts a report lists, one line each.
 pub const MAX_LISTED_GHOSTS: usize = 10;

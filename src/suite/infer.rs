@@ -99,7 +99,7 @@ pub struct Inferred {
     /// trace is replayed with what was inferred.
     pub matches: u64,
     /// Expectations compared: the first
-    /// [`MAX_INFERENCE_SWEEPS`](MAX_INFERENCE_SWEEPS) of the
+    /// [`MAX_INFERENCE_SWEEPS`] of the
     /// trace at most.
     pub compared: u64,
     /// With the other facing rule, when both were replayed: how many match.

@@ -10,7 +10,7 @@
 //! The trial order puts precision first: an engine in single precision
 //! differs from the exact rules on most sweeps, which hides what the other
 //! conventions change until rounding is judged as rounding. The margin
-//! comes from [`super::Inferred`] (the margin every trace's face hits
+//! comes from [`super::infer::Inferred`] (the margin every trace's face hits
 //! imply); the facing rule is tried both ways; both sides after the
 //! initial overlap.
 //!
@@ -273,7 +273,7 @@ pub fn infer_conventions<E>(
                  explains (largest backward error {} u32 units of the sweep's scale); {fixed} \
                  fewer sweeps fail",
                     trial.precision,
-                    crate::core::num(trial.max_backward_error)
+                    crate::core::explain::num(trial.max_backward_error)
                 ),
                 "margin" => format!(
                     "the face hits of every trace imply this margin; {fixed} fewer sweeps fail \
@@ -402,7 +402,7 @@ fn calibrate<E>(
              normal is {} u32 units of the sweep's scale; held to twice that, rounded up to a \
              power of two, instead of single precision's {F32_BUDGET}, so that a later bias \
              beyond it fails (infer again from a build known to be good)",
-            crate::core::num(worst)
+            crate::core::explain::num(worst)
         )
     } else {
         format!(
@@ -411,7 +411,7 @@ fn calibrate<E>(
              arithmetic; held to twice that, rounded up to a power of two, {} fewer sweeps \
              fail (the rest are beyond it: look at them)",
             trial.precision.saturating_sub(best_trial.precision),
-            crate::core::num(worst),
+            crate::core::explain::num(worst),
             best_trial.failing - trial.failing
         )
     };

@@ -21,7 +21,7 @@ use crate::junit::{Case, CaseResult, Detail, JunitOptions, Problem, Report, Suit
 
 use super::render::{render_text, sides_of};
 use super::report::{Status, TraceReport};
-use crate::judge::{divergence_line, render_divergence_as};
+use crate::judge::divergence::{divergence_line, render_divergence_as};
 
 /// The `classname` of a trace's test case.
 const TRACE_CLASS: &str = "check";
@@ -165,8 +165,8 @@ fn properties(r: &TraceReport) -> Vec<(String, String)> {
         p.push((
             "against".to_string(),
             match engine.against {
-                super::Against::Core => "core",
-                super::Against::Expected => "expected",
+                super::report::Against::Core => "core",
+                super::report::Against::Expected => "expected",
             }
             .to_string(),
         ));

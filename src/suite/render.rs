@@ -6,13 +6,13 @@ use std::fmt::Write as _;
 use serde_json::json;
 
 use super::report::{Status, TraceReport, counts_by_name};
-use crate::judge::{Parties, render_divergence_as};
+use crate::judge::divergence::{Parties, render_divergence_as};
 
 /// Who the two sides of a report's divergences are.
 pub fn sides_of(r: &TraceReport) -> Parties {
     match &r.engine {
         None => Parties::ExpectedAndCore,
-        Some(e) if e.against == super::Against::Expected => Parties::ExpectedAndEngine,
+        Some(e) if e.against == super::report::Against::Expected => Parties::ExpectedAndEngine,
         Some(_) => Parties::EngineAndCore,
     }
 }
@@ -107,8 +107,8 @@ fn counts_text(r: &TraceReport) -> String {
              sweep's scale){}",
             crate::numbers::counted(within.count, "difference", "differences"),
             r.conventions.within_words(),
-            crate::core::num(within.max_backward_error),
-            crate::core::num(within.p99_backward_error),
+            crate::core::explain::num(within.max_backward_error),
+            crate::core::explain::num(within.p99_backward_error),
             if r.fragile.strict {
                 ", failures under --strict"
             } else {
@@ -422,7 +422,7 @@ fn write_errors(s: &mut String, r: &TraceReport, counts: &str) {
 /// `sweeptrace.expected_source` record; `None` when the trace does not say.
 fn source_line(r: &TraceReport) -> Option<String> {
     match (&r.engine, &r.expected_source) {
-        (Some(e), _) if e.against == super::Against::Core => Some(format!(
+        (Some(e), _) if e.against == super::report::Against::Core => Some(format!(
             "  expectations from the engine command `{}` (answers to every sweep; the \
              trace's /expected is not used)\n",
             e.command

@@ -9,7 +9,9 @@ use std::collections::BTreeMap;
 use serde::{Serialize, Serializer};
 
 use crate::core::{FragileReason, Kind};
-use crate::replay::{GhostContact, Tunnel, TunnelAt, TunnelKind};
+use crate::replay::TunnelAt;
+use crate::replay::ghost::GhostContact;
+use crate::replay::tunnel::{Tunnel, TunnelKind};
 use crate::trace::OutcomeMsg;
 
 use super::contact_check::ContactsReport;
@@ -17,14 +19,14 @@ use super::infer::Inferred;
 use crate::conventions::EngineConventions;
 use crate::judge::Agreement;
 use crate::judge::ConventionHints;
-use crate::judge::Divergence;
 use crate::judge::Tolerances;
+use crate::judge::divergence::Divergence;
 
 /// How many tunnels a report lists, one line each.
 pub const MAX_LISTED_TUNNELS: usize = 10;
 /// A tunnel found in a trace: a ball's centre went through a triangle from
 /// its front to its back, during a sweep or between two of its sweeps (see
-/// [`crate::replay::Tunnel`]).
+/// [`crate::replay::tunnel::Tunnel`]).
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct TunnelReport {
     /// Frame of the sweep.
@@ -430,7 +432,7 @@ pub struct Tunnels {
 /// A report's ghost contacts: expectations (or an engine's answers) that
 /// are edge or vertex contacts on an internal flat or concave place with a
 /// normal more than `degrees` from the faces' there
-/// ([`judge_ghost`](crate::replay::judge_ghost)), whatever the compared
+/// ([`judge_ghost`](crate::replay::ghost::judge_ghost)), whatever the compared
 /// fields. They fail the check unless `fail` is off.
 #[derive(Clone, Debug, Default, PartialEq, Serialize)]
 #[non_exhaustive]

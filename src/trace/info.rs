@@ -12,7 +12,8 @@ use serde::Serialize;
 use super::error::TraceError;
 use super::messages::{EXPECTED_TOPIC, TRACE_TOPICS};
 use super::read::{EventBody, EventHeader, ReadStats, TraceReader};
-use crate::core::{EdgeCounts, Mesh, MeshError, Topology};
+use crate::core::topology::{EdgeCounts, Topology};
+use crate::core::{Mesh, MeshError};
 use crate::numbers::counted;
 
 /// Scenes listed one by one; beyond this only their number is kept.

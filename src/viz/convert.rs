@@ -4,7 +4,7 @@
 use nalgebra::{UnitQuaternion, Vector3};
 use rerun::{Color, ComponentDescriptor};
 
-use crate::core::EdgeClass;
+use crate::core::topology::EdgeClass;
 pub(crate) use crate::palette::{
     BOUNDARY_EDGE_COLOR, CONCAVE_EDGE_COLOR, CONTACT_BALL_COLOR, CONVEX_EDGE_COLOR, DEFECT_COLOR,
     EXPECTED_COLOR, FACE_NORMAL_COLOR, FLAT_EDGE_COLOR, GHOST_COLOR, HIT_COLOR, MESH_COLOR,

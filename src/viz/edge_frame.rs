@@ -25,7 +25,8 @@ use super::convert::{
 use super::out::{Out, set};
 use super::paths::Entity;
 use crate::core::explain::miss_distance;
-use crate::core::{EdgeRecord, Kind, SweptPath, TestRecord, sweep_edge};
+use crate::core::record::{EdgeRecord, TestRecord};
+use crate::core::{Kind, SweptPath, sweep_edge};
 use crate::replay::SweepResult;
 
 /// How an edge test ranks for a slot: hits by α, then misses by how near

@@ -27,7 +27,9 @@ use super::rows::{
 };
 use super::spill::Spill;
 use super::{RecordError, TIMESTAMP_THRESHOLD_NANOS};
-use crate::core::{DefectKind, EdgeClass, EdgeRecord, Triangle};
+use crate::core::mesh::Triangle;
+use crate::core::record::EdgeRecord;
+use crate::core::topology::{DefectKind, EdgeClass};
 use crate::judge::divergence;
 use crate::palette::MAX_DRAWN_DEFECT_LABELS;
 use crate::replay::{ReplayEvent, SceneState, SweepResult};

@@ -40,7 +40,7 @@ mod paths;
 mod pipeline;
 mod recording;
 mod rows;
-mod rrd_file;
+pub mod rrd_file;
 mod spill;
 
 use rerun::RecordingStreamBuilder;
@@ -56,7 +56,6 @@ pub use out::{PrepareOptions, Shown};
 pub use pipeline::LogError;
 pub use recording::{FinishedRecording, Recording, RecordingError, RecordingTarget, Viewer};
 pub use rerun::RecordingStreamError;
-pub use rrd_file::{RrdFileError, RrdFileOptions, RrdFileSink, RrdFileWriter, create_rrd_file};
 pub use spill::{MAX_CHUNK_BYTES, MAX_CHUNK_ROWS};
 
 /// Application id of every recording.

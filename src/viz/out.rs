@@ -12,7 +12,7 @@ use super::paths::Entity;
 use crate::judge::Tolerances;
 
 /// What the rows of a sweep depend on besides the sweep: the same for every
-/// sweep of a recording ([`Logger::prepare_options`]).
+/// sweep of a recording ([`Logger::prepare_options`](super::Logger::prepare_options)).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct PrepareOptions {
     /// At most this many edge tests per sweep get an edge frame.

@@ -5,11 +5,11 @@
 //! world/mesh/{scene}                  Mesh3D of each scene, static
 //! world/mesh/{scene}/edges/{class}    LineStrips3D: the edges of one class (boundary,
 //!                                     convex, flat, concave, non_manifold; see
-//!                                     `core::EdgeClass`), a strip each, in the class's
+//!                                     `core::topology::EdgeClass`), a strip each, in the class's
 //!                                     colour and width, static (a class the mesh has no
 //!                                     edge of is not logged)
 //! world/mesh/{scene}/defects/{kind}   Points3D: the defects of one kind (flipped,
-//!                                     crack, t_junction, ...; see `core::DefectKind`),
+//!                                     crack, t_junction, ...; see `core::topology::DefectKind`),
 //!                                     a point at each with one label each
 //!                                     ("flipped triangle 812"), static (a kind the mesh
 //!                                     has none of is not logged)
@@ -39,7 +39,7 @@
 //!                                     triangle front to back (during this sweep or since
 //!                                     its previous one), labelled with the triangle
 //! world/ball/{ball}/ghost             a ghost contact, when the sweep's expected outcome is
-//!                                     one (see `replay::judge_ghost`):
+//!                                     one (see `replay::ghost::judge_ghost`):
 //!                                       Points3D: the expected contact, labelled
 //!                                       (`ghost contact 10.0°: edge 0.2 is internal and
 //!                                       flat`; the label is the expected ball's instead
@@ -89,7 +89,7 @@
 //! slots hold the other recorded edge tests, hits first. The edge-frame
 //! view of the default blueprint looks at `world/ball/{followed}/edge/0`.
 
-use crate::core::{DefectKind, EdgeClass};
+use crate::core::topology::{DefectKind, EdgeClass};
 
 /// Root of the 3D world.
 pub const WORLD: &str = "world";

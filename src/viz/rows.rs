@@ -23,10 +23,12 @@ use super::convert::{
 use super::edge_frame::{Slot0, count_edges};
 use super::out::{Out, PrepareOptions, Shown, set};
 use super::paths::{Entity, FACE_NAMES, QUADRATIC_NAMES};
+use crate::core::Kind;
 use crate::core::explain::Label;
-use crate::core::{EdgeRecord, Kind, TestRecord};
+use crate::core::record::{EdgeRecord, TestRecord};
 use crate::judge::{FieldDiff, divergence, write_decision_line, write_divergence_line};
-use crate::replay::{GhostContact, SweepResult};
+use crate::replay::SweepResult;
+use crate::replay::ghost::GhostContact;
 use crate::trace::OutcomeMsg;
 
 /// What the rows of `r` show, as the logger with `options` draws them

@@ -239,7 +239,7 @@ impl Outputs {
             &sweeptrace::viz::ContactDrawing {
                 tolerances,
                 conventions: &options.conventions,
-                ghost_degrees: sweeptrace::replay::GHOST_DEGREES,
+                ghost_degrees: sweeptrace::replay::ghost::GHOST_DEGREES,
                 frames: options.frames,
                 ball: options.ball,
             },

@@ -9,10 +9,10 @@ use std::sync::atomic::{AtomicU64, Ordering};
 
 use anyhow::Context;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
-use sweeptrace::trace::{
-    DEFAULT_PREFETCH_CHUNK, DEFAULT_PREFETCH_DEPTH, Prefetched, TraceError, TraceEvent,
-    TraceReader, prefetch,
+use sweeptrace::trace::prefetch::{
+    DEFAULT_PREFETCH_CHUNK, DEFAULT_PREFETCH_DEPTH, Prefetched, prefetch,
 };
+use sweeptrace::trace::{TraceError, TraceEvent, TraceReader};
 
 /// The trace's events, decoded on a thread of their own.
 type ReadAhead = Prefetched<Result<TraceEvent, TraceError>>;

@@ -11,9 +11,11 @@ use mcap::records::{MessageHeader, Record};
 use mcap::{Attachment, McapError};
 
 use super::{BlessError, BlessSummary};
+use crate::trace::schemas::OUTCOME_SCHEMA_JSON;
+use crate::trace::source::EXPECTED_SOURCE_METADATA;
 use crate::trace::{
-    EXPECTED_SOURCE_METADATA, EXPECTED_TOPIC, Encoding, OUTCOME_SCHEMA, OUTCOME_SCHEMA_JSON,
-    OutcomeMsg, SCHEMA_ENCODING, SWEEP_TOPIC, default_write_options, frame_of_message,
+    EXPECTED_TOPIC, Encoding, OUTCOME_SCHEMA, OutcomeMsg, SCHEMA_ENCODING, SWEEP_TOPIC,
+    default_write_options, frame_of_message,
 };
 
 /// An error reading the input `name`'s container.

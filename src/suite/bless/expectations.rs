@@ -10,10 +10,9 @@ use crate::engine::{AnswerSink, EngineAnswers, EngineSession};
 use crate::replay::{
     ReplayError, ReplayEvent, ReplayOptions, Selection, SweepExtent, SweepResult, replay_events,
 };
-use crate::trace::{
-    ExpectedSource, MAX_NAME_BYTES, MAX_SETTING_VALUE_BYTES, OutcomeMsg, TraceReader,
-    sweeptrace_source, validate_outcome, validate_triangle,
-};
+use crate::trace::source::{MAX_NAME_BYTES, MAX_SETTING_VALUE_BYTES, sweeptrace_source};
+use crate::trace::validate::{validate_outcome, validate_triangle};
+use crate::trace::{ExpectedSource, OutcomeMsg, TraceReader};
 
 /// What the replay pass found: the expectation to write after every sweep
 /// of a trace (`None`: none), by `(frame, ball)` in trace order, and the
@@ -128,7 +127,7 @@ fn clipped(text: &str, max: usize) -> String {
 }
 
 /// Values in words, the first few of many only (a setting's value is
-/// bounded: [`crate::trace::MAX_SETTING_VALUE_BYTES`]).
+/// bounded: [`crate::trace::source::MAX_SETTING_VALUE_BYTES`]).
 fn listed(values: &[String]) -> String {
     const SHOWN: usize = 8;
     let text = values

@@ -16,7 +16,7 @@
 //!
 //! So a nearer file overrides a farther one for every key it sets, even a
 //! key the farther file sets in a `[[traces]]` block. Each resolved value
-//! keeps where it came from ([`Source`]), for `check --print-config`.
+//! keeps where it came from ([`Source`](crate::conventions::Source)), for `check --print-config`.
 //!
 //! ```toml
 //! # Settings of every trace under this folder.

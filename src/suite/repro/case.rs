@@ -9,13 +9,14 @@ use crate::core::{Mesh, Options, Outcome, Sweep, SweptPath, sweep_ties};
 use crate::trace::{OutcomeMsg, SceneMsg, SweepMsg, TraceError, TraceWriter};
 
 use crate::conventions::EngineConventions;
-use crate::core::Topology;
+use crate::core::topology::Topology;
+use crate::judge::precision::Sensitivity;
 use crate::judge::{Agreement, agreement};
-use crate::judge::{Field, FieldSet, Sensitivity, Tolerances};
+use crate::judge::{Field, FieldSet, Tolerances};
 use crate::replay::{ReplayOptions, SceneNormals};
 
 use super::find::{ReproError, TraceSweep};
-use crate::judge::SweepInputs;
+use crate::judge::inputs::SweepInputs;
 
 /// A minimal case reproducing one sweep of a trace.
 #[derive(Clone, Debug)]
@@ -81,7 +82,7 @@ pub fn agreement_text(a: &Agreement) -> String {
                 .map(|f| f.field.as_str())
                 .collect::<Vec<_>>()
                 .join(", "),
-            crate::core::num(*backward_error)
+            crate::core::explain::num(*backward_error)
         ),
         Agreement::Diverges {
             fields,
@@ -155,7 +156,7 @@ fn result_of(
             name: None,
             mesh: mesh.clone(),
             // Not built: the judgement of the sweep reads only the mesh.
-            topology: crate::core::Topology::default(),
+            topology: crate::core::topology::Topology::default(),
             options,
             normals: under.normals.clone(),
             conventions: *under.conventions,

@@ -1,5 +1,5 @@
 //! Reproducing one sweep outside its trace: its inputs bit-exactly
-//! ([`SweepInputs`]), the sweep found in a trace ([`find_sweep`]), and a
+//! ([`SweepInputs`](crate::judge::inputs::SweepInputs)), the sweep found in a trace ([`find_sweep`]), and a
 //! minimal case ([`ReproCase`]): that sweep, the triangles within its
 //! reach, its expectation, written as a trace of its own and as a Rust
 //! test against the public API.

@@ -520,15 +520,15 @@ fn differently_rounding_engine_gives_ties_not_divergences() -> anyhow::Result<()
         if std::env::var_os("ALT_ENGINE_VERBOSE").is_some() {
             eprintln!("{text}");
         }
-        let matches = report.compared - report.ties - report.fragile.count;
+        let matches = report.compared - report.tie_members - report.fragile.count;
         lines.push(format!(
             "{name}: {} sweeps, {matches} match, {} ties, {} fragile divergences {:?}",
-            report.compared, report.ties, report.fragile.count, report.fragile.by_reason
+            report.compared, report.tie_members, report.fragile.count, report.fragile.by_reason
         ));
         for (t, n) in
             totals
                 .iter_mut()
-                .zip([report.compared, matches, report.ties, report.fragile.count])
+                .zip([report.compared, matches, report.tie_members, report.fragile.count])
         {
             *t += n;
         }
@@ -606,7 +606,7 @@ fn tie_member_is_judged_with_its_own_contact() -> anyhow::Result<()> {
     };
     let report = judge(&second)?;
     ensure!(
-        report.ties == 1 && report.divergent == 0 && report.fragile.count == 0,
+        report.tie_members == 1 && report.divergent == 0 && report.fragile.count == 0,
         "the second face with its own contact is a tie:\n{}",
         render_text(&report)
     );
@@ -616,7 +616,7 @@ fn tie_member_is_judged_with_its_own_contact() -> anyhow::Result<()> {
     };
     let report = judge(&wrong)?;
     ensure!(
-        report.ties == 0 && report.divergent + report.fragile.count == 1,
+        report.tie_members == 0 && report.divergent + report.fragile.count == 1,
         "the second face with the first face's contact is not:\n{}",
         render_text(&report)
     );

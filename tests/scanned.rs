@@ -453,17 +453,17 @@ fn check_on_a_scanned_mesh_reports_ties_not_divergences() -> anyhow::Result<()> 
         "a rule-following engine must not diverge on a robust decision:\n{text}"
     );
     let multi = contacts.iter().filter(|c| c.expected.len() > 1).count();
-    let matches = report.compared - report.ties - report.fragile.count;
+    let matches = report.compared - report.tie_members - report.fragile.count;
     println!(
         "    bunny: {} sweeps ({multi} exact ties of 2 or more tests), {matches} match, {} ties, \
          {} fragile divergences {:?}, 0 divergences",
-        report.compared, report.ties, report.fragile.count, report.fragile.by_reason
+        report.compared, report.tie_members, report.fragile.count, report.fragile.by_reason
     );
     ensure!(
-        report.compared as usize == contacts.len() && report.ties >= 50,
+        report.compared as usize == contacts.len() && report.tie_members >= 50,
         "the other engine should decide many exact ties otherwise: {} compared, {} ties",
         report.compared,
-        report.ties
+        report.tie_members
     );
     Ok(())
 }

@@ -25,7 +25,8 @@ use crate::conventions::EngineConventions;
 pub struct ConventionHints {
     /// Answers at `α = 0` where the ball starts within its radius of the
     /// mesh and the rules see no collision: `initial_overlap = "alpha0"`.
-    pub initial_overlap: u64,
+    #[serde(rename = "initial_overlap")]
+    pub starts_within_radius: u64,
     /// Edge and vertex answers whose only difference is the normal, which
     /// is the contact normal (centre minus contact): `normal = "contact"`.
     pub normal: u64,
@@ -42,7 +43,7 @@ impl ConventionHints {
 
     /// How many failing sweeps looked like one.
     pub fn total(&self) -> u64 {
-        self.initial_overlap + self.normal + self.precision
+        self.starts_within_radius + self.normal + self.precision
     }
 
     /// Counts one failing sweep under the first undeclared convention
@@ -59,7 +60,7 @@ impl ConventionHints {
         let rules = EngineConventions::default();
         if declared.initial_overlap == rules.initial_overlap && starts_in_contact(result, expected)
         {
-            self.initial_overlap += 1;
+            self.starts_within_radius += 1;
         } else if declared.normal == NormalRule::Face
             && is_contact_normal(result, expected, fields, tol)
         {
@@ -86,7 +87,7 @@ impl ConventionHints {
             }
         };
         part(
-            self.initial_overlap,
+            self.starts_within_radius,
             "hits at α = 0 where the ball starts within its radius",
             "initial_overlap = \"alpha0\"",
         );

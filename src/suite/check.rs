@@ -302,7 +302,7 @@ impl<'a> ReportBuilder<'a> {
         }
         match judged.agreement {
             Agreement::Match => {}
-            Agreement::Tie => self.report.ties += 1,
+            Agreement::Tie => self.report.tie_members += 1,
             Agreement::Precision { .. } | Agreement::Diverges { .. } => {
                 self.diverges(result, judged);
             }

@@ -131,7 +131,8 @@ pub struct DiffReport {
     pub same: u64,
     /// Sweeps whose outcomes differ only in which member of the tie set
     /// was chosen (an equally valid answer to the rules): counted as same.
-    pub ties: u64,
+    #[serde(rename = "ties")]
+    pub tie_members: u64,
     /// Sweeps whose outcomes differ.
     pub different: u64,
     /// Sweeps only in A.
@@ -268,7 +269,7 @@ pub fn diff(a: &Side, b: &Side, tolerances: &Tolerances) -> DiffReport {
         b: describe_side(b),
         compared: 0,
         same: 0,
-        ties: 0,
+        tie_members: 0,
         different: 0,
         only_in_a: 0,
         only_in_b: 0,
@@ -304,7 +305,7 @@ pub fn diff(a: &Side, b: &Side, tolerances: &Tolerances) -> DiffReport {
             || matches!(agreement(&oa, rb, tolerances), Agreement::Tie)
         {
             report.same += 1;
-            report.ties += 1;
+            report.tie_members += 1;
             continue;
         }
         report.different += 1;
@@ -363,12 +364,12 @@ pub fn render_diff_text(r: &DiffReport) -> String {
         }
     }
     if r.is_same() {
-        if r.ties > 0 {
+        if r.tie_members > 0 {
             let _ = writeln!(
                 s,
                 "same: {} sweeps, identical outcomes ({} of them ties: another member of the \
                  tie set, equally valid by the rules)",
-                r.compared, r.ties
+                r.compared, r.tie_members
             );
         } else {
             let _ = writeln!(

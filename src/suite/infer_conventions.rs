@@ -44,7 +44,7 @@ pub struct Trial {
     /// Their 99th percentile (nearest rank; 0 when there are none).
     pub p99_value_backward_error: f64,
     /// Answers that name another member of a tie.
-    pub ties: u64,
+    pub tie_members: u64,
     /// The margins the traces' face hits imply (one per trace that has one).
     pub margins: Vec<f64>,
     /// Traces that could not be checked.
@@ -71,7 +71,7 @@ impl Trial {
                     .max_value_backward_error
                     .max(within.max_value_backward_error);
             }
-            t.ties += r.ties;
+            t.tie_members += r.tie_members;
             if let Some(m) = r.inferred.as_ref().and_then(|i| i.margin) {
                 t.margins.push(m);
             }

@@ -78,11 +78,11 @@ fn counts_text(r: &TraceReport) -> String {
     if !r.tolerances.fields.is_all() {
         let _ = write!(counts, ", fields compared: {}", r.tolerances.fields.names());
     }
-    if r.ties > 0 {
+    if r.tie_members > 0 {
         let _ = write!(
             counts,
             ", {} (the expectation names another member of the tie set: a match)",
-            crate::numbers::counted(r.ties, "tie", "ties")
+            crate::numbers::counted(r.tie_members, "tie", "ties")
         );
     }
     if r.fragile.count > 0 {

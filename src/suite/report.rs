@@ -203,7 +203,8 @@ pub struct TraceReport {
     /// Sweeps whose expectation names another member of the replayed
     /// decision's tie set: an equally valid answer to the rules, counted
     /// as a match.
-    pub ties: u64,
+    #[serde(rename = "ties")]
+    pub tie_members: u64,
     /// Divergences on fragile decisions that rounding explains.
     #[serde(flatten)]
     pub fragile: Fragile,

@@ -8,7 +8,7 @@ use crate::trace::OutcomeMsg;
 use super::compare::{Field, FieldDiff, NOT_A_UNIT_VECTOR, Tolerances, compare};
 use super::perturbation::{Reproduced, Rounding, reproduce};
 use super::precision::Sensitivity;
-use super::reference::Decision;
+use super::reference::{Decision, MemberBounds};
 use crate::conventions::TieRule;
 
 /// How an answer stands against an expectation: the one judgement.
@@ -205,11 +205,18 @@ fn judge(
         };
     };
     let tol = tol_judged;
-    let on_expected = decision.disagreement(expected, tol);
+    // By backward error each tie member is held to its own bound.
+    let bounds = budget.map(|budget| MemberBounds {
+        fixed,
+        budget,
+        expected,
+        got,
+    });
+    let on_expected = decision.disagreement(expected, tol, bounds.as_ref());
     let on_got = if got_is_core {
         None
     } else {
-        decision.disagreement(got, tol)
+        decision.disagreement(got, tol, bounds.as_ref())
     };
     if on_expected.is_none() && on_got.is_none() {
         return Agreement::Tie;

@@ -40,6 +40,19 @@ impl Observer for Hits {
     }
 }
 
+/// By backward error, how a tie member's own bound is found: the fixed
+/// tolerances widened by that member's sensitivity at the budget (the
+/// answers' `Δα` observed, as for the primary). A member is then held to
+/// exactly what it would be held to as the primary: an edge member's
+/// contact normal turns with the centre, a face's does not.
+#[derive(Clone, Copy)]
+pub(super) struct MemberBounds<'t> {
+    pub fixed: &'t Tolerances,
+    pub budget: f64,
+    pub expected: &'t OutcomeMsg,
+    pub got: &'t OutcomeMsg,
+}
+
 /// The core's decision on one sweep under the scene's options and
 /// conventions: its outcome and the hits that can be members of its tie
 /// set.
@@ -106,14 +119,46 @@ impl<'a> Decision<'a> {
         Some([n.x, n.y, n.z])
     }
 
+    /// The tolerances `member` is judged with: its own bound under
+    /// `bounds`, else `tol` (the primary's).
+    fn member_tolerances(
+        &self,
+        member: &OutcomeMsg,
+        tol: &Tolerances,
+        bounds: Option<&MemberBounds>,
+    ) -> Tolerances {
+        let own = bounds.and_then(|b| {
+            let hit = SweepHit {
+                alpha: member.alpha,
+                triangle: member.triangle??,
+                feature: Feature::from_parts(member.kind, member.feature?)?,
+                normal: member
+                    .normal
+                    .flatten()
+                    .map(Into::into)
+                    .or(self.outcome.hit.map(|h| h.normal))?,
+                contact: member.contact??.into(),
+            };
+            let s = super::precision::Sensitivity::of_hit(self.scene, &self.sweep, &hit)?;
+            Some(
+                s.observing(b.expected, b.got, b.fixed)
+                    .widen(b.fixed, b.budget),
+            )
+        });
+        own.unwrap_or(*tol)
+    }
+
     /// `None` when the decision accepts `answer`: it matches the primary,
     /// or another member of the tie set with that member's own contact.
     /// Otherwise the fields that differ: from the first member the answer
-    /// names, or from the primary.
+    /// names, or from the primary. `tol` judges the primary; a member is
+    /// judged by its own bound under `bounds` (by backward error), else by
+    /// `tol` too.
     pub(super) fn disagreement(
         &self,
         answer: &OutcomeMsg,
         tol: &Tolerances,
+        bounds: Option<&MemberBounds>,
     ) -> Option<Vec<FieldDiff>> {
         let primary = OutcomeMsg::from_outcome(answer.frame, answer.ball, &self.outcome);
         let differ = compare(answer, &primary, tol);
@@ -136,7 +181,11 @@ impl<'a> Decision<'a> {
             {
                 member.normal = Some(self.member_normal(&tie, &contact, r.back()));
             }
-            let d = compare(answer, &member, tol);
+            let d = compare(
+                answer,
+                &member,
+                &self.member_tolerances(&member, tol, bounds),
+            );
             if d.is_empty() {
                 return None;
             }
@@ -164,7 +213,11 @@ impl<'a> Decision<'a> {
                     .is_some_and(|t| t.normal.dot(&h.normal) < 0.0);
                 member.normal = Some(self.member_normal(&tie, &h.contact, back));
             }
-            let d = compare(answer, &member, tol);
+            let d = compare(
+                answer,
+                &member,
+                &self.member_tolerances(&member, tol, bounds),
+            );
             if d.is_empty() {
                 return None;
             }

@@ -525,11 +525,12 @@ fn differently_rounding_engine_gives_ties_not_divergences() -> anyhow::Result<()
             "{name}: {} sweeps, {matches} match, {} ties, {} fragile divergences {:?}",
             report.compared, report.tie_members, report.fragile.count, report.fragile.by_reason
         ));
-        for (t, n) in
-            totals
-                .iter_mut()
-                .zip([report.compared, matches, report.tie_members, report.fragile.count])
-        {
+        for (t, n) in totals.iter_mut().zip([
+            report.compared,
+            matches,
+            report.tie_members,
+            report.fragile.count,
+        ]) {
             *t += n;
         }
     }

@@ -120,8 +120,19 @@ fn rapier_answers_every_sample_sweep_within_its_measured_failures() -> anyhow::R
         sum(&report, "precision_divergent"),
     );
     ensure!(
-        failing <= 40,
-        "{failing} failing sweeps (measured 10 of 6,427)"
+        failing <= 12,
+        "{failing} failing sweeps (measured 9 of 6,427)"
+    );
+    // Each one is Rapier's own, named in words (issue 47's done-when).
+    let unnamed: Vec<String> = all
+        .iter()
+        .flat_map(|t| t["divergences"].as_array().cloned().unwrap_or_default())
+        .filter(|d| d["limitation"].as_str().is_none_or(str::is_empty))
+        .map(|d| format!("frame {}, ball {}", d["frame"], d["ball"]))
+        .collect();
+    ensure!(
+        unnamed.is_empty(),
+        "failing sweeps that no known limitation names: {unnamed:?}"
     );
     ensure!(
         within >= 1000,

@@ -75,10 +75,17 @@ pub(crate) fn closest_point(triangle: &Triangle, p: &Point3<f64>) -> (Point3<f64
 ///
 /// Under [`InitialOverlap::Alpha0Always`] the direction is not asked: every
 /// triangle within `ρ` whose front holds the centre (or, two-sided, any,
-/// the normal facing the centre).
+/// the normal facing the centre). Under [`InitialOverlap::Alpha0Deeper`]
+/// the same triangles, those whose nearest point the path closes in on.
 pub fn initial_contacts(mesh: &Mesh, path: &SweptPath, options: &Options) -> Vec<(SweepHit, f64)> {
     let (facing, sides) = (options.facing, options.sides);
-    let always = options.initial_overlap == InitialOverlap::Alpha0Always;
+    // Under `alpha0_always` and `alpha0_deeper` the side is the centre's;
+    // under `alpha0_deeper` the path must close in on the contact point.
+    let always = matches!(
+        options.initial_overlap,
+        InitialOverlap::Alpha0Always | InitialOverlap::Alpha0Deeper
+    );
+    let deeper = options.initial_overlap == InitialOverlap::Alpha0Deeper;
     let triangles = mesh.triangles();
     let mut found = Vec::new();
     let mut consider = |t: &Triangle| {
@@ -105,6 +112,9 @@ pub fn initial_contacts(mesh: &Mesh, path: &SweptPath, options: &Options) -> Vec
             }
         };
         let distance = (path.p0 - point).norm();
+        if deeper && (path.p0 - point).dot(&path.d) >= 0.0 {
+            return;
+        }
         if distance < path.rho {
             let hit = SweepHit {
                 alpha: 0.0,
@@ -260,5 +270,43 @@ mod tests {
         assert_eq!(hit.normal, -nalgebra::Vector3::z());
         assert!(initial_contact(&m, &path(-0.25, -1.0), &always(Sides::One)).is_none());
         assert!(initial_contact(&m, &path(0.75, 1.0), &always(Sides::Two)).is_none());
+    }
+
+    /// Issue 47: with `stop_at_penetration` false, parry and Rapier report
+    /// a start within ρ only when the path goes deeper, judged at the
+    /// contact point. A ball overlapping the floor's corner vertex and
+    /// moving down but away from the vertex is a contact under `alpha0`
+    /// (the facing rule sees it approach the plane) and none under
+    /// `alpha0_deeper`; moving toward the vertex it is one under both; not
+    /// moving, it is none under `alpha0_deeper`.
+    #[test]
+    fn alpha0_deeper_judges_the_direction_at_the_contact_point() {
+        let m = floor();
+        let path = |p0: [f64; 3], d: [f64; 3]| {
+            let p1 = [p0[0] + d[0], p0[1] + d[1], p0[2] + d[2]];
+            SweptPath::new(&Sweep::new(p0, p1, 0.5), &Options::default()).expect("valid sweep")
+        };
+        let with = |initial_overlap| Options {
+            initial_overlap,
+            ..Options::default()
+        };
+        let (alpha0, deeper) = (
+            with(InitialOverlap::Alpha0),
+            with(InitialOverlap::Alpha0Deeper),
+        );
+        // Over the corner (0, 0, 0), 0.3 × √3 ≈ 0.52 > ρ: start nearer.
+        let start = [-0.2, -0.2, 0.2];
+        let away = path(start, [-0.1, -0.1, -0.05]);
+        let (hit, _) = initial_contact(&m, &away, &alpha0).expect("alpha0: a contact");
+        assert_eq!(hit.feature, Feature::Vertex(0));
+        assert!(initial_contact(&m, &away, &deeper).is_none());
+        let toward = path(start, [0.1, 0.1, -0.05]);
+        let (hit, _) = initial_contact(&m, &toward, &deeper).expect("deeper: a contact");
+        assert_eq!((hit.alpha, hit.feature), (0.0, Feature::Vertex(0)));
+        assert_eq!(hit.normal, m.triangles()[0].normal);
+        assert!(initial_contact(&m, &path(start, [0.0, 0.0, 0.0]), &deeper).is_none());
+        // On the face, the two agree: toward the plane a contact, away none.
+        assert!(initial_contact(&m, &path([1.0, 1.0, 0.25], [0.0, 0.0, -1.0]), &deeper).is_some());
+        assert!(initial_contact(&m, &path([1.0, 1.0, 0.25], [0.0, 0.0, 1.0]), &deeper).is_none());
     }
 }

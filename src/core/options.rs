@@ -92,6 +92,14 @@ pub enum InitialOverlap {
     /// whose front holds the centre (or whose plane does); two-sided, any,
     /// the normal facing the centre.
     Alpha0Always,
+    /// A hit at `α = 0` when the ball starts within `ρ` of a triangle and
+    /// its path goes deeper: the direction is judged at the contact point
+    /// (`(p0 − q)·d < 0`, the centre closing in on the nearest point `q`),
+    /// not by the triangle's facing rule, so a ball leaving an edge or a
+    /// vertex it overlaps is no hit, and a ball that does not move is none
+    /// (parry's and Rapier's casts with `stop_at_penetration` false). The
+    /// side as under `alpha0_always`: the one that holds the centre.
+    Alpha0Deeper,
 }
 
 impl InitialOverlap {

@@ -170,6 +170,16 @@ pub fn infer_conventions<E>(
                 ..c
             }),
         ),
+        // Or only where the path goes deeper, judged at the contact point
+        // (Rapier's stopAtPenetration false): kept only when more answers
+        // fit it than the value kept so far.
+        (
+            "initial_overlap",
+            Box::new(|c| EngineConventions {
+                initial_overlap: InitialOverlap::Alpha0Deeper,
+                ..c
+            }),
+        ),
         // After the initial overlap: a two-sided engine that also reports
         // starts in contact (Jolt) fits two sides only once those starts
         // are hits.
@@ -290,6 +300,18 @@ pub fn infer_conventions<E>(
                     format!(
                         "answers are hits at α = 0 where the ball starts within ρ of the mesh, \
                      moving away from it too; {fixed} fewer sweeps fail than {}",
+                        if best.initial_overlap.is_rules() {
+                            "under the rules".to_string()
+                        } else {
+                            format!("with \"{}\"", best.initial_overlap)
+                        }
+                    )
+                }
+                "initial_overlap" if trying.initial_overlap == InitialOverlap::Alpha0Deeper => {
+                    format!(
+                        "answers are hits at α = 0 where the ball starts within ρ of the mesh \
+                     and its path closes in on the contact point, none where it leaves an \
+                     edge or a vertex it overlaps; {fixed} fewer sweeps fail than {}",
                         if best.initial_overlap.is_rules() {
                             "under the rules".to_string()
                         } else {

@@ -234,6 +234,7 @@ const SLOW: &[&str] = &[
     "rapier_js::rapier_stop_at_penetration_switch_changes_the_starts_only",
     "rapier_js::rapier_passes_the_miss_rules_of_conform_under_its_table",
     "rapier_js::rapier_config_is_what_infer_config_prints",
+    "rapier_js::rapier_without_stop_at_penetration_fails_only_named_limitations_and_conforms",
 ];
 
 fn mark_slow(trials: Vec<Trial>) -> Vec<Trial> {

@@ -21,6 +21,8 @@
 
 mod bvh;
 mod contact;
+#[cfg(test)]
+mod contact_exact_tests;
 pub mod crossing;
 mod error;
 pub mod explain;

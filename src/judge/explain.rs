@@ -221,6 +221,19 @@ pub fn limitation(
             )
         });
     }
+    grazing(expected, &path, t, triangle).or_else(|| normal_at_a_touching_start(result, expected))
+}
+
+/// `a false hit while leaving at a grazing angle` (see [`limitation`]);
+/// `None` otherwise (then [`normal_at_a_touching_start`] may name it: a
+/// start within 1 % of `ρ` answered with a normal off).
+fn grazing(
+    expected: &OutcomeMsg,
+    path: &crate::core::SweptPath,
+    t: &crate::core::mesh::Triangle,
+    triangle: u32,
+) -> Option<String> {
+    let near = NEAR_MISS * path.rho;
     let centre = path.p0 + path.d * expected.alpha;
     let (point, _) = crate::core::closest_point(t, &centre);
     let outward = centre - point;

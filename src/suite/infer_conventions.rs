@@ -170,16 +170,6 @@ pub fn infer_conventions<E>(
                 ..c
             }),
         ),
-        // Or only where the path goes deeper, judged at the contact point
-        // (Rapier's stopAtPenetration false): kept only when more answers
-        // fit it than the value kept so far.
-        (
-            "initial_overlap",
-            Box::new(|c| EngineConventions {
-                initial_overlap: InitialOverlap::Alpha0Deeper,
-                ..c
-            }),
-        ),
         // After the initial overlap: a two-sided engine that also reports
         // starts in contact (Jolt) fits two sides only once those starts
         // are hits.
@@ -211,6 +201,20 @@ pub fn infer_conventions<E>(
             "ties",
             Box::new(|c| EngineConventions {
                 ties: TieRule::Any,
+                ..c
+            }),
+        ),
+        // Or a start within ρ only where the path goes deeper, judged at the
+        // contact point (Rapier's stopAtPenetration false): tried after the
+        // ties, kept only when more answers fit it than the value kept so
+        // far. Before the ties are declared, an engine that names any member
+        // of an α = 0 tie (Jolt) fails as many of its starts under
+        // `alpha0` as this leaves out, and the count could not tell them
+        // apart.
+        (
+            "initial_overlap",
+            Box::new(|c| EngineConventions {
+                initial_overlap: InitialOverlap::Alpha0Deeper,
                 ..c
             }),
         ),

@@ -197,6 +197,38 @@ function sweep(msg) {
   return { frame: msg.frame, ball: msg.ball, alpha, kind, triangle, feature, normal, contact };
 }
 
+// A contact query (`check --engine-contacts`): each triangle's own contact
+// with the ball, `Triangle.contactShape` (parry's ball-versus-triangle
+// contact, the pairwise query a trimesh's contact manifolds are made of),
+// with the query's contact distance as the prediction. No internal-edge fix
+// (a default trimesh has no `TriMeshFlags`): at a seam each triangle gives
+// its own contact, with its own normal, as a default trimesh collider's
+// manifolds do. The triangles far beyond reach are skipped first (in f64,
+// with a margin for Rapier's f32). Kind and feature from the contact point,
+// as for a sweep.
+function contacts(msg) {
+  const answer = { type: 'contacts', frame: msg.frame, ball: msg.ball, contacts: [] };
+  if (!scene) fail(`the contact query of frame ${msg.frame}, ball ${msg.ball} arrived before any scene`);
+  if (!scene.world) return answer;
+  const centre = msg.centre, shape = ball(msg.radius);
+  const reach = msg.radius + msg.distance;
+  const size = Math.max(...centre.map(Math.abs), reach);
+  const far = (reach * (1 + 1e-3) + 1e-5 * size) ** 2;
+  scene.corners.forEach((corners, t) => {
+    if (!(distanceSquared(centre, corners) <= far)) return;
+    const hit = triangleShape(t).contactShape(ORIGIN, IDENTITY, shape, vec(centre), IDENTITY, msg.distance);
+    if (!hit) return;
+    const point = xyz(hit.point1); // on the triangle, world space
+    const n = xyz(hit.normal1), len = Math.sqrt(dot(n, n)); // outward: toward the ball
+    const { kind, feature } = classify(point, corners);
+    const contact = { triangle: t, kind, point, separation: hit.distance };
+    if (feature !== null) contact.feature = feature;
+    if (len > 0) contact.normal = n.map((x) => x / len);
+    answer.contacts.push(contact);
+  });
+  return answer;
+}
+
 const lines = createInterface({ input: process.stdin, crlfDelay: Infinity });
 let lineNumber = 0;
 for await (const line of lines) {
@@ -210,5 +242,6 @@ for await (const line of lines) {
   }
   if (msg.type === 'scene') loadScene(msg);
   else if (msg.type === 'sweep') process.stdout.write(JSON.stringify(sweep(msg)) + '\n');
+  else if (msg.type === 'contact') process.stdout.write(JSON.stringify(contacts(msg)) + '\n');
   // other types: ignored (protocol v1)
 }

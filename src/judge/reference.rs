@@ -120,14 +120,17 @@ impl<'a> Decision<'a> {
     }
 
     /// The tolerances `member` is judged with: its own bound under
-    /// `bounds`, else `tol` (the primary's).
+    /// `bounds` when its values are its own (`ties = "any"`: its own
+    /// normal), else `tol` (the primary's: under the rule order a member
+    /// carries the primary's normal, which the primary's bound is for).
     fn member_tolerances(
         &self,
         member: &OutcomeMsg,
         tol: &Tolerances,
         bounds: Option<&MemberBounds>,
     ) -> Tolerances {
-        let own = bounds.and_then(|b| {
+        let own_values = self.scene.conventions.ties == TieRule::Any;
+        let own = bounds.filter(|_| own_values).and_then(|b| {
             let hit = SweepHit {
                 alpha: member.alpha,
                 triangle: member.triangle??,

@@ -67,6 +67,14 @@ const unitScale = new Jolt.Vec3(1, 1, 1), baseOffset = new Jolt.RVec3(0, 0, 0);
 // EActiveEdgeMode::CollideWithAll: every edge reports its geometric normal,
 // the ghost contacts Jolt's active edges exist to remove.
 const ghosts = process.argv.includes('--ghosts') || process.env.JOLT_GHOSTS === '1';
+// Vertices at exactly the same position are welded into one before the
+// MeshShape is built, as Jolt's own MeshShapeSettings(TriangleList) does
+// (Indexify): Jolt finds a triangle's neighbours by vertex index, so an
+// edge shared by position only is a boundary to it, an active edge, and
+// its contacts there are ghosts. `--no-weld` (or JOLT_NO_WELD=1) keeps the
+// trace's indices, to see those ghosts. The scene's triangles keep their
+// indices either way.
+const weld = !(process.argv.includes('--no-weld') || process.env.JOLT_NO_WELD === '1');
 const collideSettings = new Jolt.CollideShapeSettings();
 if (ghosts) collideSettings.mActiveEdgeMode = Jolt.EActiveEdgeMode_CollideWithAll;
 if (variant === 'back_faces') collideSettings.mBackFaceMode = Jolt.EBackFaceMode_CollideWithBackFaces;
@@ -82,15 +90,26 @@ function loadScene(msg) {
   }
   scene = { vertices: msg.vertices, triangles: msg.triangles, margin: msg.margin ?? 0, body: null, mesh: null };
   const vertices = new Jolt.VertexList(), triangles = new Jolt.IndexedTriangleList();
+  // index in the trace -> index in Jolt's vertex list (welded: the first
+  // vertex at that position; `-0` and `0` are one position).
+  const index = [], first = new Map();
   for (const [x, y, z] of msg.vertices) {
+    const key = `${x + 0},${y + 0},${z + 0}`;
+    if (weld && first.has(key)) {
+      index.push(first.get(key));
+      continue;
+    }
+    first.set(key, vertices.size());
+    index.push(vertices.size());
     const v = new Jolt.Float3(x, y, z);
     vertices.push_back(v);
     Jolt.destroy(v);
   }
-  msg.triangles.forEach(([a, b, c], index) => {
-    const t = new Jolt.IndexedTriangle(a, b, c, 0, index); // user data: the scene's triangle index
-    triangles.push_back(t);
-    Jolt.destroy(t);
+  msg.triangles.forEach(([a, b, c], t) => {
+    // User data: the scene's triangle index.
+    const tri = new Jolt.IndexedTriangle(index[a] ?? a, index[b] ?? b, index[c] ?? c, 0, t);
+    triangles.push_back(tri);
+    Jolt.destroy(tri);
   });
   // The constructor drops degenerate and duplicate triangles (Sanitize).
   const meshSettings = new Jolt.MeshShapeSettings(vertices, triangles, new Jolt.PhysicsMaterialList());

@@ -18,6 +18,7 @@ pub fn tests() -> Vec<Trial> {
     vec![
         trial!(every_case_decides_the_kind_of_its_rule),
         trial!(example_engine_passes_every_rule, timeout = LIMIT),
+        trial!(contact_bugs_fail_exactly_the_contact_rules, timeout = LIMIT),
         trial!(
             skip_vertex_bug_fails_exactly_the_vertex_rules,
             timeout = LIMIT
@@ -62,11 +63,16 @@ fn every_case_decides_the_kind_of_its_rule() -> anyhow::Result<()> {
             case.id()
         );
         ensure!(
-            case.sweep.frame == i as u64,
+            case.frame() == i as u64,
             "{}: frame {}",
             case.id(),
-            case.sweep.frame
+            case.frame()
         );
+        // The contact queries' sets are held to the core by the library's
+        // own test (conform::contact_cases).
+        let Some(s) = case.sweep() else {
+            continue;
+        };
         let mesh = Mesh::new(case.scene.vertices.clone(), &case.scene.triangles)
             .map_err(|e| anyhow::anyhow!("{}: {e}", case.id()))?;
         let options = Options {
@@ -74,7 +80,6 @@ fn every_case_decides_the_kind_of_its_rule() -> anyhow::Result<()> {
             facing: case.scene.facing,
             ..Options::default()
         };
-        let s = &case.sweep;
         let outcome = sweep_mesh(&mesh, &Sweep::new(s.p0, s.p1, s.radius), &options)
             .map_err(|e| anyhow::anyhow!("{}: {e}", case.id()))?;
         ensure!(
@@ -89,11 +94,14 @@ fn every_case_decides_the_kind_of_its_rule() -> anyhow::Result<()> {
     Ok(())
 }
 
-/// `conform --json` with the example engine and `extra` arguments: exit
-/// code and the document.
+/// `conform --contacts --json` with the example engine and `extra`
+/// arguments: exit code and the document. The contact rules run with every
+/// bug, so a bug of the sweeps is shown not to touch them, and the other
+/// way round.
 fn conform_json(extra: &str) -> anyhow::Result<(i32, serde_json::Value)> {
     let engine = example_engine_command(extra);
-    let (code, stdout, stderr) = run_bin(os!("conform", "--engine", &engine, "--json"))?;
+    let (code, stdout, stderr) =
+        run_bin(os!("conform", "--engine", &engine, "--contacts", "--json"))?;
     let doc = serde_json::from_str(&stdout)
         .map_err(|e| anyhow::anyhow!("not JSON ({e}): {stdout}\n{stderr}"))?;
     Ok((code, doc))
@@ -145,6 +153,62 @@ fn expect_failing(bug: &str, want: &[&str]) -> anyhow::Result<serde_json::Value>
         );
     }
     Ok(doc)
+}
+
+/// A contact generator's mistakes, each failing exactly the contact rules
+/// it breaks: the geometric normal where the rules expect the face's
+/// (ghost contacts on the flat seam and in the valley, the normal
+/// elsewhere), the contact distance ignored, back faces touched.
+fn contact_bugs_fail_exactly_the_contact_rules() -> anyhow::Result<()> {
+    let doc = expect_failing(
+        "contact-normal",
+        &[
+            "contact.edge",
+            "contact.vertex",
+            "contact.flat-seam",
+            "contact.shallow-convex-edge",
+            "contact.concave-corner",
+            "contact.speculative",
+        ],
+    )?;
+    let seam = doc["rules"]
+        .as_array()
+        .and_then(|rules| rules.iter().find(|r| r["rule"] == "contact.flat-seam"))
+        .map(|r| r["first_failure"]["contacts"].clone())
+        .unwrap_or_default();
+    ensure!(
+        seam["ghosts"][0]["angle_degrees"]
+            .as_f64()
+            .is_some_and(|d| d > 25.0 && d < 25.5),
+        "the flat seam's ghost contact, 25.2° off: {seam}"
+    );
+    expect_failing("contact-no-distance", &["contact.speculative"])?;
+    expect_failing("contact-back-faces", &["contact.back-facing"])?;
+    // The report's other forms: a JUnit failure of check's type for a
+    // contact query, and the case's words.
+    let dir = tempfile::tempdir()?;
+    let xml = dir.path().join("conform.xml");
+    let engine = example_engine_command("--bug contact-no-distance");
+    let (code, stdout, _) = run_bin(os!(
+        "conform",
+        "--engine",
+        &engine,
+        "--case",
+        "contact.speculative",
+        "--junit",
+        xml.as_os_str()
+    ))?;
+    let xml = std::fs::read_to_string(&xml)?;
+    ensure!(
+        code == 1
+            && stdout.contains("contacts: the core finds 1 contact, the answer has 0")
+            && stdout.contains(
+                "missing: the ball touches triangle 0 (face) at (1, 1, 0), separation 0.125"
+            )
+            && xml.contains(r#"type="contact_divergence""#),
+        "exit {code}:\n{stdout}\n{xml}"
+    );
+    Ok(())
 }
 
 fn skip_vertex_bug_fails_exactly_the_vertex_rules() -> anyhow::Result<()> {

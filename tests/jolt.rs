@@ -27,6 +27,7 @@ pub fn tests() -> Vec<Trial> {
         trial!(every_seeded_bug_fails_conform_and_check),
         trial!(jolt_keeps_a_contact_normal_within_one_degree_at_an_inactive_edge),
         trial!(jolts_contacts_pass_and_its_ghosts_show_with_collide_with_all),
+        trial!(jolt_passes_conforms_contact_rules_and_its_ghost_modes_fail_them),
     ]
 }
 
@@ -665,5 +666,44 @@ fn jolts_contacts_pass_and_its_ghosts_show_with_collide_with_all() -> anyhow::Re
         "clean Jolt on the unwelded mini-golf course (exit {code}): {:#}",
         t["ghost_contacts"]
     );
+    Ok(Completion::Completed)
+}
+
+/// conform's contact rules over the protocol, under Jolt's table: clean
+/// Jolt passes every one; with `EActiveEdgeMode::CollideWithAll` it fails
+/// exactly the places that must not push (a flat seam, a shallow convex
+/// edge, a valley), and with the trace's vertex indices unwelded only the
+/// seam shared by position only.
+fn jolt_passes_conforms_contact_rules_and_its_ghost_modes_fail_them() -> anyhow::Result<Completion>
+{
+    let engine = match jolt()? {
+        Ok(engine) => engine,
+        Err(skip) => return Ok(skip),
+    };
+    for (flag, want) in [
+        ("", &[][..]),
+        (
+            " --ghosts",
+            &[
+                "contact.flat-seam",
+                "contact.shallow-convex-edge",
+                "contact.concave-corner",
+            ][..],
+        ),
+        (" --no-weld", &["contact.flat-seam"][..]),
+    ] {
+        let command = format!("{engine}{flag}");
+        let (code, report) = run_json(
+            "clean",
+            &["conform", "--engine", &command, "--case", "contact"],
+        )?;
+        ensure!(
+            code == i32::from(!want.is_empty())
+                && report["failing_rules"] == serde_json::json!(want)
+                && report["cases"].as_u64() >= Some(16),
+            "Jolt{flag}: exit {code}, failing rules {}",
+            report["failing_rules"]
+        );
+    }
     Ok(Completion::Completed)
 }

@@ -28,6 +28,7 @@ pub fn tests() -> Vec<Trial> {
         trial!(rapier_passes_the_miss_rules_of_conform_under_its_table),
         trial!(rapier_without_stop_at_penetration_fails_only_named_limitations_and_conforms),
         trial!(rapiers_contacts_match_and_its_seam_ghosts_are_listed),
+        trial!(rapier_fails_conforms_must_not_push_contact_rules_with_ghosts),
         trial!(rapier_config_is_what_infer_config_prints),
         trial!(rapier_engine_faults_are_errors),
         trial!(a_tie_member_is_reported_by_what_differs_from_it),
@@ -538,6 +539,43 @@ fn rapiers_contacts_match_and_its_seam_ghosts_are_listed() -> anyhow::Result<Com
         engines >= 5,
         "{engines} ghost contacts of Rapier's own normals at the seams: {:#}",
         t["ghost_contacts"]
+    );
+    Ok(Completion::Completed)
+}
+
+/// conform's contact rules under Rapier's table: its pairwise triangle
+/// contacts (a default trimesh, no internal-edge fix) are right everywhere
+/// but at the flat seam and in the valley, where each triangle's own
+/// contact normal leans: ghost contacts, the failures of exactly those two
+/// rules. (The rules with a contact distance of 0 also hold the example to
+/// reading a query whose `distance` is left out.)
+fn rapier_fails_conforms_must_not_push_contact_rules_with_ghosts() -> anyhow::Result<Completion> {
+    let engine = match rapier()? {
+        Ok(engine) => engine,
+        Err(skip) => return Ok(skip),
+    };
+    let config = config();
+    let (code, report) = run_json(
+        &[
+            "conform", "--engine", &engine, "--case", "contact", "--config", &config,
+        ],
+        &[],
+    )?;
+    let ghosts: Vec<f64> = report["rules"]
+        .as_array()
+        .into_iter()
+        .flatten()
+        .filter_map(|r| r["first_failure"]["contacts"]["ghosts"][0]["angle_degrees"].as_f64())
+        .collect();
+    ensure!(
+        code == 1
+            && report["failing_rules"]
+                == serde_json::json!(["contact.flat-seam", "contact.concave-corner"])
+            && ghosts.len() == 2
+            && report["passed"].as_u64() >= Some(12),
+        "Rapier's contact rules (exit {code}): failing {}, ghosts {ghosts:?}, passed {}",
+        report["failing_rules"],
+        report["passed"]
     );
     Ok(Completion::Completed)
 }

@@ -39,6 +39,10 @@ reports about an engine that has it:
     contact-normal  contact queries answer the geometric normal (centre
                     minus closest point) instead of the face normal: ghost
                     contacts on flat seams
+    contact-no-distance  contact queries ignore the contact distance: only
+                    triangles within the radius are reported
+    contact-back-faces  contact queries report triangles whose back faces
+                    the centre too
 
 It also answers contact queries (`contact` lines, sent by `check
 --engine-contacts`): every triangle within the radius plus the contact
@@ -70,6 +74,8 @@ BUGS = (
     "ghost-flat",
     "lost-leaf",
     "contact-normal",
+    "contact-no-distance",
+    "contact-back-faces",
 )
 
 
@@ -355,13 +361,14 @@ def edge_point(t, e, p):
 def contacts(scene, msg, bugs):
     """The answer to a contact query: one contact per triangle in reach."""
     centre, radius = tuple(msg["centre"]), msg["radius"]
-    reach = radius + msg.get("distance", 0.0)
+    reach = radius + (0.0 if "contact-no-distance" in bugs else msg.get("distance", 0.0))
     found = []
     for t in scene["triangles"]:
         kind, feature, point = closest(t, centre)
         towards = sub(centre, point)
         gap = norm(towards)
-        if gap > reach or dot(t.normal, towards) < 0.0:
+        behind = dot(t.normal, towards) < 0.0 and "contact-back-faces" not in bugs
+        if gap > reach or behind:
             continue  # out of reach, or its back faces the ball
         normal = t.normal
         if "contact-normal" in bugs and gap > 0.0:

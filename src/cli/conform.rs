@@ -4,7 +4,7 @@
 use anyhow::{Context, bail};
 
 use super::Exit;
-use sweeptrace::conform::{self, ConformOptions, ConformStatus, RULES};
+use sweeptrace::conform::{self, CaseQuery, ConformOptions, ConformStatus, RULES};
 use sweeptrace::engine::EngineCommand;
 use sweeptrace::trace::EventBody;
 
@@ -18,6 +18,7 @@ Examples:
   sweeptrace conform --list
   sweeptrace conform --case vertex.hit --write-trace cases.mcap
   sweeptrace conform --engine 'python3 examples/engines/sweep_engine.py' --junit conform.xml
+  sweeptrace conform --engine 'python3 examples/engines/sweep_engine.py' --contacts
 
 Every case is a small scene and one sweep (sent to the engine as in `check
 --engine`, docs/ENGINE_PROTOCOL.md), grouped by the rule of
@@ -32,7 +33,10 @@ edge < vertex, then triangle, then feature chooses, and why), and a
 divergence fails even when a perturbation of the inputs reproduces it
 (counted as `fragile` too). --lenient lets both pass. One line per rule with passed / failed / fragile counts,
 then each failing rule's first failing case explained, with a command that
-runs it alone. Exit status: 0 every case passes, 1 a case fails, 2 a fault
+runs it alone. With --contacts, contact queries too (the `contact.*` rules:
+face, edges, vertices, a flat seam, a shallow convex edge, a concave corner,
+the contact distance, apart and behind), judged as `check --engine
+--engine-contacts` judges them; a ghost contact fails its rule. Exit status: 0 every case passes, 1 a case fails, 2 a fault
 of the engine or a bad argument, 125 the engine cannot be started.")]
 pub struct Args {
     /// The command that starts the engine, split like a shell's words, e.g.
@@ -43,11 +47,17 @@ pub struct Args {
     /// rules (`edge`, `edge.miss`).
     #[arg(long, value_name = "RULE[/INDEX]")]
     pub case: Option<String>,
-    /// List the rules and their cases (no engine needed).
+    /// Run the contact rules too (`contact.*`): contact queries, which the
+    /// engine must answer (docs/ENGINE_PROTOCOL.md, `contact`). Naming a
+    /// contact rule with --case runs it without this flag.
+    #[arg(long)]
+    pub contacts: bool,
+    /// List the rules and their cases (no engine needed; the contact rules'
+    /// too).
     #[arg(long)]
     pub list: bool,
     /// Write the chosen cases as a trace (each case's scene, then its sweep
-    /// as frame N, the case's number), to look at them with the other
+    /// or contact query as frame N, the case's number), to look at them with the other
     /// commands, e.g. `--case vertex.hit --write-trace cases.mcap`, then
     /// `sweeptrace sweep --trace cases.mcap --frame 21` or `sweeptrace
     /// replay cases.mcap --spawn`. No engine needed.
@@ -109,7 +119,7 @@ fn conventions(args: &Args) -> anyhow::Result<sweeptrace::conventions::EngineCon
 
 /// Runs the suite, prints the report, returns the exit code.
 pub fn run(args: Args) -> anyhow::Result<Exit> {
-    let cases = conform::select(args.case.as_deref())?;
+    let cases = conform::select(args.case.as_deref(), args.contacts || args.list)?;
     if args.list {
         print!("{}", list_text(&cases));
         return Ok(Exit::Success);
@@ -122,9 +132,8 @@ pub fn run(args: Args) -> anyhow::Result<Exit> {
                 match event.body {
                     EventBody::Scene(scene) => w.scene(log_time_nanos, &scene)?,
                     EventBody::Sweep(sweep) => w.sweep(log_time_nanos, &sweep)?,
-                    EventBody::Expected(_)
-                    | EventBody::Contact(_)
-                    | EventBody::ExpectedContacts(_) => {}
+                    EventBody::Contact(query) => w.contact(log_time_nanos, &query)?,
+                    EventBody::Expected(_) | EventBody::ExpectedContacts(_) => {}
                 }
             }
             Ok::<_, sweeptrace::trace::TraceError>(())
@@ -136,7 +145,7 @@ pub fn run(args: Args) -> anyhow::Result<Exit> {
             sweeptrace::numbers::counted(cases.len() as u64, "case", "cases"),
             cases
                 .iter()
-                .map(|c| format!("{} {}", c.sweep.frame, c.id()))
+                .map(|c| format!("{} {}", c.frame(), c.id()))
                 .collect::<Vec<_>>()
                 .join(", ")
         );
@@ -201,17 +210,27 @@ fn list_text(cases: &[conform::Case]) -> String {
         }
         s.push_str(&format!("{}: {}\n", rule.name, rule.description));
         for c in of_rule {
-            s.push_str(&format!(
-                "  {}: {} (radius {}, p0 {:?}, p1 {:?}, margin {}, facing {}; the core: {})\n",
-                c.id(),
-                c.what,
-                c.sweep.radius,
-                c.sweep.p0,
-                c.sweep.p1,
-                c.scene.margin,
-                c.scene.facing,
-                c.kind
-            ));
+            let asked = match &c.query {
+                CaseQuery::Sweep(sweep) => format!(
+                    "radius {}, p0 {:?}, p1 {:?}, margin {}, facing {}; the core: {}",
+                    sweep.radius, sweep.p0, sweep.p1, c.scene.margin, c.scene.facing, c.kind
+                ),
+                CaseQuery::Contact { query, set } => format!(
+                    "radius {}, centre {:?}, contact distance {}; the core: {}",
+                    query.radius,
+                    query.centre,
+                    query.distance,
+                    if set.is_empty() {
+                        "no contact".to_string()
+                    } else {
+                        set.iter()
+                            .map(|(t, f)| format!("{f} of triangle {t}"))
+                            .collect::<Vec<_>>()
+                            .join(", ")
+                    }
+                ),
+            };
+            s.push_str(&format!("  {}: {} ({asked})\n", c.id(), c.what));
         }
     }
     s

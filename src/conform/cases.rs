@@ -1,14 +1,15 @@
 //! The conformance cases: small scenes and one sweep each, grouped by the
-//! rule of docs/SEMANTICS.md they exercise. Every number is exact in
-//! binary where the rule's boundary matters, so the rules, not rounding,
-//! decide.
+//! rule of docs/SEMANTICS.md they exercise, then the contact queries'
+//! (super::contact_cases). Every number is exact in binary where the
+//! rule's boundary matters, so the rules, not rounding, decide.
 
-use crate::core::{Facing, Kind};
+use crate::core::{Facing, Feature, Kind};
 use crate::sim::scenes;
-use crate::trace::{SceneMsg, SweepMsg};
+use crate::trace::{ContactMsg, SceneMsg, SweepMsg};
 
-/// One case: a scene, a sweep, and the kind the core decides (checked by
-/// the test suite, so a case cannot silently stop testing its rule).
+/// One case: a scene, a sweep or a contact query, and what the core
+/// decides (checked by the test suite, so a case cannot silently stop
+/// testing its rule).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Case {
     /// The rule, e.g. `edge.miss.beyond-v1`.
@@ -19,10 +20,27 @@ pub struct Case {
     pub what: &'static str,
     /// The scene.
     pub scene: SceneMsg,
-    /// The sweep (its frame is the case's number in the suite, ball 0).
-    pub sweep: SweepMsg,
-    /// The kind of the core's outcome.
+    /// What the engine is asked (its frame is the case's number in the
+    /// suite, ball 0).
+    pub query: CaseQuery,
+    /// The kind of the core's outcome; for a contact query, of its
+    /// contact set's first contact (`none` when the set is empty).
     pub kind: Kind,
+}
+
+/// What a case asks the engine.
+#[derive(Clone, Debug, PartialEq)]
+pub enum CaseQuery {
+    /// A sweep.
+    Sweep(SweepMsg),
+    /// A contact query (`conform --contacts`).
+    Contact {
+        /// The query.
+        query: ContactMsg,
+        /// The core's contact set for it: each contact's triangle and
+        /// feature, in the set's order.
+        set: Vec<(u32, Feature)>,
+    },
 }
 
 impl Case {
@@ -30,10 +48,34 @@ impl Case {
     pub fn id(&self) -> String {
         format!("{}/{}", self.rule, self.index)
     }
+
+    /// The case's frame: its number in the suite.
+    pub fn frame(&self) -> u64 {
+        match &self.query {
+            CaseQuery::Sweep(sweep) => sweep.frame,
+            CaseQuery::Contact { query, .. } => query.frame,
+        }
+    }
+
+    /// Its sweep, unless it is a contact query.
+    pub fn sweep(&self) -> Option<&SweepMsg> {
+        match &self.query {
+            CaseQuery::Sweep(sweep) => Some(sweep),
+            CaseQuery::Contact { .. } => None,
+        }
+    }
+
+    /// Its contact query, unless it is a sweep.
+    pub fn contact(&self) -> Option<&ContactMsg> {
+        match &self.query {
+            CaseQuery::Sweep(_) => None,
+            CaseQuery::Contact { query, .. } => Some(query),
+        }
+    }
 }
 
 /// Triangle T of the worked examples.
-fn triangle_t(margin: f64, facing: Facing) -> SceneMsg {
+pub(super) fn triangle_t(margin: f64, facing: Facing) -> SceneMsg {
     scene(
         "triangle_t",
         vec![[0.0, 0.0, 0.0], [4.0, 0.0, 0.0], [0.0, 4.0, 0.0]],
@@ -43,7 +85,7 @@ fn triangle_t(margin: f64, facing: Facing) -> SceneMsg {
     )
 }
 
-fn scene(
+pub(super) fn scene(
     name: &str,
     vertices: Vec<[f64; 3]>,
     triangles: Vec<[u64; 3]>,
@@ -71,7 +113,7 @@ fn cube() -> SceneMsg {
 }
 
 /// A square `[0, 2]²` at z = 0 as two triangles sharing the diagonal.
-fn quad() -> SceneMsg {
+pub(super) fn quad() -> SceneMsg {
     scene(
         "quad",
         vec![
@@ -219,7 +261,8 @@ fn onto_terrain(i: usize, j: usize, upper: bool) -> ([f64; 3], [f64; 3]) {
     ([x, y, 5.0], [x, y, -5.0])
 }
 
-/// Every case, in the order of [`RULES`](super::RULES), numbered as frames from 0.
+/// Every case, in the order of [`RULES`](super::RULES), numbered as frames
+/// from 0: the sweeps, then the contact queries.
 pub fn cases() -> Vec<Case> {
     let t = || triangle_t(0.0, Facing::NonStrict);
     let tm = || triangle_t(0.125, Facing::NonStrict);
@@ -760,16 +803,18 @@ pub fn cases() -> Vec<Case> {
             index,
             what,
             scene,
-            sweep: SweepMsg {
+            query: CaseQuery::Sweep(SweepMsg {
                 frame: frame as u64,
                 ball: 0,
                 radius,
                 p0,
                 p1,
-            },
+            }),
             kind,
         });
     }
+    let first = out.len() as u64;
+    out.extend(super::contact_cases::contact_cases(first));
     out
 }
 
@@ -781,7 +826,7 @@ mod tests {
     /// The core's outcome of `case` under the rules.
     fn outcome(case: &Case) -> Outcome {
         let mesh = Mesh::new(case.scene.vertices.clone(), &case.scene.triangles).expect("mesh");
-        let s = &case.sweep;
+        let s = case.sweep().expect("a sweep case");
         sweep_mesh(
             &mesh,
             &Sweep::new(s.p0, s.p1, s.radius),

@@ -17,6 +17,7 @@ use crate::judge::Tolerances;
 use crate::judge::divergence::{Parties, divergence_line};
 use crate::junit::{Case, CaseResult, Detail, JunitOptions, Problem, Report, Suite, one_line};
 
+use super::render::contact_verdict_line;
 use super::{CaseFailure, ConformReport, RuleReport, render_case_failure, render_rule_failure};
 
 /// The group of a rule: its first dotted component (`edge` of
@@ -28,9 +29,11 @@ pub fn rule_group(rule: &str) -> &str {
 /// A divergent case on one line: its id, what it does, the tie order or
 /// the divergence.
 fn case_line(f: &CaseFailure) -> String {
-    let what = match &f.tie_order {
-        Some(t) => format!("tie order: {t}"),
-        None => divergence_line(&f.divergence, Parties::EngineAndCore),
+    let what = match (&f.tie_order, &f.divergence, &f.contacts) {
+        (Some(t), _, _) => format!("tie order: {t}"),
+        (None, Some(d), _) => divergence_line(d, Parties::EngineAndCore),
+        (None, None, Some(v)) => contact_verdict_line(v),
+        (None, None, None) => String::new(),
     };
     one_line(&format!("{} ({}): {what}", f.case, f.what))
 }
@@ -118,16 +121,11 @@ fn rule_case(rule: &RuleReport, classname: &str) -> Case {
                 crate::numbers::plural(rule.cases, "case"),
                 crate::numbers::verb(rule.failed, "fails", "fail")
             ),
-            kind: if rule
+            kind: rule
                 .first_failure
                 .as_ref()
-                .is_some_and(|f| f.tie_order.is_some())
-            {
-                "tie_order"
-            } else {
-                "divergence"
-            }
-            .to_string(),
+                .map_or("divergence", failure_type)
+                .to_string(),
             body: explained.clone().unwrap_or_default(),
         }),
         Some(first) if rule.fragile == 0 && rule.within_precision > 0 => CaseResult::Skipped {
@@ -159,18 +157,26 @@ fn rule_case(rule: &RuleReport, classname: &str) -> Case {
     }
 }
 
+/// The JUnit failure type of a divergent case: `tie_order`,
+/// `contact_divergence` (as `check` calls a contact query's) or
+/// `divergence`.
+fn failure_type(f: &CaseFailure) -> &'static str {
+    if f.tie_order.is_some() {
+        "tie_order"
+    } else if f.contacts.is_some() {
+        "contact_divergence"
+    } else {
+        "divergence"
+    }
+}
+
 fn divergent_case(f: &CaseFailure, classname: &str) -> Case {
     let body = render_case_failure(f, "");
     let (result, system_out) = if f.fails {
         (
             CaseResult::Failure(Problem {
                 message: case_line(f),
-                kind: if f.tie_order.is_some() {
-                    "tie_order"
-                } else {
-                    "divergence"
-                }
-                .to_string(),
+                kind: failure_type(f).to_string(),
                 body,
             }),
             None,

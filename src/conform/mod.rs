@@ -9,11 +9,12 @@
 //! [`render_text`] and [`render_json`] are pure functions of it.
 
 mod cases;
+mod contact_cases;
 mod junit;
 mod render;
 mod rules;
 
-pub use cases::{Case, cases};
+pub use cases::{Case, CaseQuery, cases};
 pub use junit::conform_junit;
 pub use render::{render_case_failure, render_json, render_rule_failure, render_text};
 pub use rules::{RULES, Rule};
@@ -25,7 +26,7 @@ use crate::core::explain::num;
 use crate::core::{Kind, Outcome};
 use crate::engine::{EngineAnswers, EngineCommand, EngineError, EngineOptions, EngineSession};
 use crate::judge::divergence::{Divergence, divergence_details};
-use crate::judge::{Agreement, Tolerances, agreement, compare};
+use crate::judge::{Agreement, ContactPairing, ContactVerdict, Tolerances, agreement, compare};
 use crate::replay::{ReplayEvent, ReplayOptions, replay_events};
 use crate::trace::{EventBody, EventHeader, OutcomeMsg, TraceEvent};
 
@@ -36,9 +37,14 @@ pub struct CaseFailure {
     pub case: String,
     /// What the case does.
     pub what: String,
-    /// The engine's answer against the core's outcome, explained
-    /// (`expected` is the engine's answer, `got` the core's).
-    pub divergence: Divergence,
+    /// A sweep's case: the engine's answer against the core's outcome,
+    /// explained (`expected` is the engine's answer, `got` the core's).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub divergence: Option<Divergence>,
+    /// A contact query's case: the engine's contacts judged against the
+    /// core's contact set (its problems, its ghost contacts).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub contacts: Option<ContactVerdict>,
     /// When the engine named another member of the core's tie set (a
     /// failure unless `--lenient`): which member the rule chooses and why.
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -254,13 +260,17 @@ pub struct UnknownCase {
     pub name: String,
 }
 
-/// The cases `only` selects (every case when `None`): a case
-/// (`edge.hit/2`), a rule (`edge.hit`) or a group of rules (`edge`,
-/// `edge.miss`); an error names the rules when nothing matches.
-pub fn select(only: Option<&str>) -> Result<Vec<Case>, UnknownCase> {
+/// The cases `only` selects (every case when `None`, the contact
+/// queries' only with `contacts`): a case (`edge.hit/2`), a rule
+/// (`edge.hit`) or a group of rules (`edge`, `edge.miss`, `contact`); an
+/// error names the rules when nothing matches.
+pub fn select(only: Option<&str>, contacts: bool) -> Result<Vec<Case>, UnknownCase> {
     let all = cases();
     let Some(only) = only else {
-        return Ok(all);
+        return Ok(all
+            .into_iter()
+            .filter(|c| contacts || c.sweep().is_some())
+            .collect());
     };
     let chosen: Vec<Case> = all
         .into_iter()
@@ -280,7 +290,8 @@ pub fn select(only: Option<&str>) -> Result<Vec<Case>, UnknownCase> {
     Ok(chosen)
 }
 
-/// A trace's events for `cases`: each case's scene, then its sweep.
+/// A trace's events for `cases`: each case's scene, then its sweep or
+/// contact query.
 pub fn case_events(cases: &[Case]) -> Vec<TraceEvent> {
     let mut events = Vec::with_capacity(2 * cases.len());
     for (i, case) in cases.iter().enumerate() {
@@ -295,7 +306,10 @@ pub fn case_events(cases: &[Case]) -> Vec<TraceEvent> {
         });
         events.push(TraceEvent {
             header: at(2 * i + 1),
-            body: EventBody::Sweep(case.sweep),
+            body: match &case.query {
+                CaseQuery::Sweep(sweep) => EventBody::Sweep(*sweep),
+                CaseQuery::Contact { query, .. } => EventBody::Contact(*query),
+            },
         });
     }
     events
@@ -369,7 +383,9 @@ pub fn run(
 ) -> Result<ConformReport, EngineError> {
     let session = EngineSession::start(command, engine)?;
     let events = case_events(cases).into_iter().map(Ok);
-    let mut answers = EngineAnswers::new(events, session, engine.window);
+    let asks_contacts = cases.iter().any(|c| c.contact().is_some());
+    let mut answers =
+        EngineAnswers::new(events, session, engine.window).with_contacts(asks_contacts);
     let mut rules: Vec<RuleReport> = Vec::new();
     let mut report = ConformReport {
         engine: command.text.clone(),
@@ -383,14 +399,42 @@ pub fn run(
         conventions: options.conventions,
         error: None,
     };
+    let tolerances = options.tolerances;
+    // The contact queries' answers, judged as they pass the replay.
+    let mut pairing = ContactPairing::new(
+        &tolerances,
+        &options.conventions,
+        crate::replay::ghost::GHOST_DEGREES,
+    );
+    let mut contact_verdicts: Vec<ContactVerdict> = Vec::new();
+    let events = answers.by_ref().inspect(|e| {
+        let judged = match e {
+            Ok(TraceEvent {
+                body: EventBody::Scene(scene),
+                ..
+            }) => {
+                pairing.scene(scene);
+                None
+            }
+            Ok(TraceEvent {
+                header,
+                body: EventBody::Contact(query),
+            }) => pairing.query(query, header.log_time_nanos),
+            Ok(TraceEvent {
+                body: EventBody::ExpectedContacts(answer),
+                ..
+            }) => pairing.answer(answer),
+            _ => None,
+        };
+        contact_verdicts.extend(judged.map(|j| j.verdict));
+    });
     let replay = replay_events(
-        answers.by_ref(),
+        events,
         ReplayOptions {
             conventions: options.conventions,
             ..ReplayOptions::default()
         },
     );
-    let tolerances = options.tolerances;
     for event in replay {
         let result = match event {
             Ok(ReplayEvent::Sweep(result)) => result,
@@ -403,34 +447,13 @@ pub fn run(
                 continue;
             }
         };
-        let Some(case) = cases.iter().find(|c| c.sweep.frame == result.frame) else {
+        let Some(case) = cases.iter().find(|c| c.frame() == result.frame) else {
             continue;
         };
         let Some(answer) = result.expected else {
             continue;
         };
-        let rule = match rules.iter_mut().find(|r| r.rule == case.rule) {
-            Some(rule) => rule,
-            None => {
-                let description = RULES
-                    .iter()
-                    .find(|r| r.name == case.rule)
-                    .map_or("", |r| r.description);
-                rules.push(RuleReport {
-                    rule: case.rule,
-                    description,
-                    cases: 0,
-                    passed: 0,
-                    failed: 0,
-                    fragile: 0,
-                    within_precision: 0,
-                    first_failure: None,
-                    not_applicable: options.conventions.replaces(case.rule),
-                    divergent_cases: Vec::new(),
-                });
-                rules.last_mut().expect("just pushed")
-            }
-        };
+        let rule = rule_of(&mut rules, case.rule, &options.conventions);
         if rule.not_applicable.is_some() {
             rule.cases += 1;
             continue;
@@ -498,7 +521,8 @@ pub fn run(
         let failure = CaseFailure {
             case: case.id(),
             what: case.what.to_string(),
-            divergence,
+            divergence: Some(divergence),
+            contacts: None,
             tie_order,
             repro: reproduce_command(&command.text, &case.id(), options),
             fails,
@@ -507,6 +531,49 @@ pub fn run(
             rule.first_failure = Some(failure.clone());
         }
         rule.divergent_cases.push(failure);
+    }
+    pairing.flush();
+    for verdict in contact_verdicts {
+        let Some(case) = cases.iter().find(|c| c.frame() == verdict.frame) else {
+            continue;
+        };
+        let rule = rule_of(&mut rules, case.rule, &options.conventions);
+        rule.cases += 1;
+        if rule.not_applicable.is_some() {
+            continue;
+        }
+        report.cases += 1;
+        // A ghost contact fails as a wrong contact does (as in `check`).
+        if verdict.agrees() && verdict.ghosts.is_empty() {
+            rule.passed += 1;
+            report.passed += 1;
+            continue;
+        }
+        rule.failed += 1;
+        report.failed += 1;
+        let mut verdict = verdict;
+        for ghost in &mut verdict.ghosts {
+            ghost.answer = true;
+        }
+        let failure = CaseFailure {
+            case: case.id(),
+            what: case.what.to_string(),
+            divergence: None,
+            contacts: Some(verdict),
+            tie_order: None,
+            repro: reproduce_command(&command.text, &case.id(), options),
+            fails: true,
+        };
+        if rule.first_failure.is_none() {
+            rule.first_failure = Some(failure.clone());
+        }
+        rule.divergent_cases.push(failure);
+    }
+    if pairing.without_answer > 0 && report.error.is_none() {
+        report.error = Some(format!(
+            "the engine left {} without an answer",
+            crate::numbers::counted(pairing.without_answer, "contact query", "contact queries")
+        ));
     }
     let run = answers.finish();
     if let Some(e) = run.error {
@@ -523,6 +590,38 @@ pub fn run(
     }
     report.rules.append(&mut rules);
     Ok(report)
+}
+
+/// The report of `rule`, added (empty, with whether a declared convention
+/// replaces it) the first time one of its cases is judged.
+fn rule_of<'r>(
+    rules: &'r mut Vec<RuleReport>,
+    rule: &'static str,
+    conventions: &EngineConventions,
+) -> &'r mut RuleReport {
+    let at = match rules.iter().position(|r| r.rule == rule) {
+        Some(at) => at,
+        None => {
+            let description = RULES
+                .iter()
+                .find(|r| r.name == rule)
+                .map_or("", |r| r.description);
+            rules.push(RuleReport {
+                rule,
+                description,
+                cases: 0,
+                passed: 0,
+                failed: 0,
+                fragile: 0,
+                within_precision: 0,
+                first_failure: None,
+                not_applicable: conventions.replaces(rule),
+                divergent_cases: Vec::new(),
+            });
+            rules.len() - 1
+        }
+    };
+    &mut rules[at]
 }
 
 /// For `serde(skip_serializing_if)`: a count of none.

@@ -6,6 +6,7 @@ use std::fmt::Write as _;
 
 use super::{CaseFailure, ConformReport, RuleReport};
 use crate::judge::divergence::{Parties, render_divergence_as};
+use crate::judge::{ContactVerdict, write_contact_verdict};
 
 /// The report in words: one line per rule (status, counts, what it
 /// checks), then each failing rule's first failing case explained with the
@@ -130,13 +131,34 @@ pub fn render_case_failure(f: &CaseFailure, indent: &str) -> String {
     if let Some(t) = &f.tie_order {
         let _ = writeln!(s, "{indent}tie order: {t}");
     }
-    s.push_str(&render_divergence_as(
-        &f.divergence,
-        indent,
-        Parties::EngineAndCore,
-    ));
+    if let Some(d) = &f.divergence {
+        s.push_str(&render_divergence_as(d, indent, Parties::EngineAndCore));
+    }
+    if let Some(v) = &f.contacts {
+        let _ = write!(s, "{indent}contacts: ");
+        write_contact_verdict(&mut s, v, &format!("{indent}  "));
+        for g in &v.ghosts {
+            let _ = writeln!(s, "{indent}  ghost contact: {g}");
+        }
+    }
     let _ = writeln!(s, "{indent}reproduce: {}", f.repro);
     s
+}
+
+/// A contact query's judgement on one line: the counts, then its first
+/// problem or ghost contact.
+pub(super) fn contact_verdict_line(v: &ContactVerdict) -> String {
+    let first = v
+        .problems
+        .first()
+        .map(ToString::to_string)
+        .or_else(|| v.ghosts.first().map(|g| format!("ghost contact: {g}")));
+    format!(
+        "the core finds {}, the engine reports {}{}",
+        crate::numbers::counted(v.reference as u64, "contact", "contacts"),
+        v.answered,
+        first.map_or_else(String::new, |f| format!("; {f}"))
+    )
 }
 
 /// The report as one JSON document (pretty-printed, ending with a newline),

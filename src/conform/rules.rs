@@ -185,4 +185,40 @@ pub const RULES: &[Rule] = &[
         name: "mesh.large",
         description: "a height field of 3,200 triangles hit at cells far apart in space and in index: each sweep finds its triangle (no part of the mesh is lost)",
     },
+    Rule {
+        name: "contact.face",
+        description: "(--contacts) the centre above the face's interior, within ρ: one contact, the face, the centre's projection, separation |c − q| − ρ and the face normal (Contacts)",
+    },
+    Rule {
+        name: "contact.edge",
+        description: "(--contacts) the centre in an edge's region: the closest point on the edge (computed in its standard frame) and the normal the `normal` convention expects there (Contacts; each of the three edges)",
+    },
+    Rule {
+        name: "contact.vertex",
+        description: "(--contacts) the centre in a vertex's region: the vertex, and the normal the `normal` convention expects there (Contacts; each of the three vertices)",
+    },
+    Rule {
+        name: "contact.flat-seam",
+        description: "(--contacts) two coplanar triangles: beside their shared edge, the other triangle's closest point is on that edge, a place that must not push: its normal is the faces' (a leaning normal there is a ghost contact, a failure under any convention)",
+    },
+    Rule {
+        name: "contact.shallow-convex-edge",
+        description: "(--contacts) a convex edge whose faces meet at 3.58°: the normal the convention expects at the edge (the face normal under `active_edges`, whose threshold is 5°; the contact normal under `contact`)",
+    },
+    Rule {
+        name: "contact.concave-corner",
+        description: "(--contacts) a valley: reaching over its line, the other face's closest point is on that concave edge, a place that must not push: its normal is the face's (a leaning normal there is a ghost contact, a failure under any convention)",
+    },
+    Rule {
+        name: "contact.speculative",
+        description: "(--contacts) the contact distance s: a triangle within ρ + s is a contact, with a positive separation; one beyond it is not (Contacts)",
+    },
+    Rule {
+        name: "contact.apart",
+        description: "(--contacts) a ball apart from the mesh, with no contact distance: no contact (Contacts)",
+    },
+    Rule {
+        name: "contact.back-facing",
+        description: "(--contacts) the centre behind the triangle: one-sided, no contact (Contacts; under sides = \"two\" a contact, and the rule does not apply)",
+    },
 ];

@@ -386,7 +386,9 @@ impl EngineConventions {
                 declares("facing", self.facing.to_string())
             }
             // Both sides collide: a contact from behind is a hit.
-            (_, "face.miss.back-facing" | "edge.miss.back-facing") if self.sides == Sides::Two => {
+            (_, "face.miss.back-facing" | "edge.miss.back-facing" | "contact.back-facing")
+                if self.sides == Sides::Two =>
+            {
                 declares("sides", self.sides.to_string())
             }
             (_, "start.inside") if self.initial_overlap != InitialOverlap::None => {

@@ -19,6 +19,8 @@
 //! or the reach), the normal by that distance over the radius. A place or
 //! a triangle within that tolerance of the reach may be reported or not.
 
+use std::fmt::Write as _;
+
 use nalgebra::{Point3, Vector3};
 use serde::Serialize;
 
@@ -257,6 +259,21 @@ impl ContactVerdict {
     /// Whether the engine's contacts agree (ghost contacts aside).
     pub fn agrees(&self) -> bool {
         self.problems.is_empty()
+    }
+}
+
+/// A contact query's judgement: how many contacts each side has (ending
+/// the current line), then each problem on a line of its own starting with
+/// `indent`.
+pub(crate) fn write_contact_verdict(s: &mut String, v: &ContactVerdict, indent: &str) {
+    let _ = writeln!(
+        s,
+        "the core finds {}, the answer has {}",
+        crate::numbers::counted(v.reference as u64, "contact", "contacts"),
+        v.answered
+    );
+    for p in &v.problems {
+        let _ = writeln!(s, "{indent}{p}");
     }
 }
 

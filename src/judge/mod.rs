@@ -52,6 +52,7 @@ pub use compare::{
 pub(crate) use contact_pairing::ContactPairing;
 #[cfg(feature = "viewer")]
 pub(crate) use contact_pairing::PairedContacts;
+pub(crate) use contacts::write_contact_verdict;
 pub use contacts::{ContactProblem, ContactTolerances, ContactVerdict};
 pub(crate) use decision::write_decision_line;
 #[cfg(feature = "viewer")]

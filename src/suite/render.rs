@@ -7,6 +7,7 @@ use serde_json::json;
 
 use super::report::{Status, TraceReport, counts_by_name};
 use crate::judge::divergence::{Parties, render_divergence_as};
+use crate::judge::write_contact_verdict;
 
 /// Who the two sides of a report's divergences are.
 pub fn sides_of(r: &TraceReport) -> Parties {
@@ -272,17 +273,12 @@ fn write_contacts(s: &mut String, r: &TraceReport) {
     }
     let _ = writeln!(s, "{line}");
     for v in &c.details {
-        let _ = writeln!(
+        let _ = write!(
             s,
-            "  contact divergence at frame {}, ball {}: the core finds {}, the answer has {}",
-            v.frame,
-            v.ball,
-            crate::numbers::counted(v.reference as u64, "contact", "contacts"),
-            v.answered
+            "  contact divergence at frame {}, ball {}: ",
+            v.frame, v.ball
         );
-        for p in &v.problems {
-            let _ = writeln!(s, "    {p}");
-        }
+        write_contact_verdict(s, v, "    ");
     }
 }
 

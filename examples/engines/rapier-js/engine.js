@@ -210,13 +210,14 @@ function contacts(msg) {
   const answer = { type: 'contacts', frame: msg.frame, ball: msg.ball, contacts: [] };
   if (!scene) fail(`the contact query of frame ${msg.frame}, ball ${msg.ball} arrived before any scene`);
   if (!scene.world) return answer;
-  const centre = msg.centre, shape = ball(msg.radius);
-  const reach = msg.radius + msg.distance;
+  // `distance` is left out of a query when it is 0 (docs/ENGINE_PROTOCOL.md).
+  const centre = msg.centre, shape = ball(msg.radius), distance = msg.distance ?? 0;
+  const reach = msg.radius + distance;
   const size = Math.max(...centre.map(Math.abs), reach);
   const far = (reach * (1 + 1e-3) + 1e-5 * size) ** 2;
   scene.corners.forEach((corners, t) => {
     if (!(distanceSquared(centre, corners) <= far)) return;
-    const hit = triangleShape(t).contactShape(ORIGIN, IDENTITY, shape, vec(centre), IDENTITY, msg.distance);
+    const hit = triangleShape(t).contactShape(ORIGIN, IDENTITY, shape, vec(centre), IDENTITY, distance);
     if (!hit) return;
     const point = xyz(hit.point1); // on the triangle, world space
     const n = xyz(hit.normal1), len = Math.sqrt(dot(n, n)); // outward: toward the ball

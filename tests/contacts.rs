@@ -27,6 +27,7 @@ pub fn tests() -> Vec<Trial> {
         trial!(a_geometric_normal_on_a_flat_seam_is_a_ghost_contact),
         trial!(contacts_pass_by_an_engine_check_and_say_so),
         trial!(an_engine_answers_contact_queries_with_engine_contacts),
+        trial!(infer_config_finds_the_contact_normal_from_contact_queries),
         trial!(bad_contact_messages_are_refused_with_the_field),
         trial!(python_reads_the_contact_channels),
         trial!(the_recording_draws_each_query_and_marks_its_ghosts),
@@ -430,6 +431,84 @@ fn an_engine_answers_contact_queries_with_engine_contacts() -> anyhow::Result<()
             && text.contains("contact queries diverge")
             && text.contains("from the expected (0, 0, 1)"),
         "{text}"
+    );
+    Ok(())
+}
+
+/// `--infer-config` with `--engine-contacts` judges the engine's contacts
+/// under each convention tried: on conform's contact cases (contact
+/// queries only), an engine that answers the geometric normal everywhere
+/// is found to use `normal = "contact"`, by the contact queries alone, and
+/// the clean engine the rules. Checked with the printed file, the normals
+/// agree; its ghost contacts still fail (no convention excuses them).
+fn infer_config_finds_the_contact_normal_from_contact_queries() -> anyhow::Result<()> {
+    let dir = tempfile::tempdir()?;
+    let trace = dir.path().join("contact_cases.mcap");
+    let out = bin()
+        .args(["conform", "--case", "contact", "--write-trace"])
+        .arg(&trace)
+        .output()?;
+    ensure!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let infer = |bug: &str| -> anyhow::Result<(String, String)> {
+        let engine = crate::engine::example_engine_command(bug);
+        let out = bin()
+            .arg("check")
+            .arg(&trace)
+            .args(["--engine", &engine, "--engine-contacts", "--infer-config"])
+            .output()?;
+        ensure!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        Ok((
+            String::from_utf8_lossy(&out.stdout).into_owned(),
+            String::from_utf8_lossy(&out.stderr).into_owned(),
+        ))
+    };
+    let (toml, progress) = infer("--bug contact-normal")?;
+    ensure!(
+        toml.contains("normal = \"contact\"")
+            && toml.contains(
+                "# Contact queries: 8 of 17 fail under the rules; under these conventions: 0."
+            )
+            && progress.contains(
+                "tried the rules: 0 of 0 compared sweeps and 8 of 17 contact queries fail"
+            ),
+        "{toml}\n{progress}"
+    );
+    let config = dir.path().join("sweeptrace.toml");
+    std::fs::write(&config, &toml)?;
+    let engine = crate::engine::example_engine_command("--bug contact-normal");
+    let out = bin()
+        .arg("check")
+        .arg(&trace)
+        .args([
+            "--engine",
+            &engine,
+            "--engine-contacts",
+            "--json",
+            "--config",
+        ])
+        .arg(&config)
+        .output()?;
+    let report: serde_json::Value = serde_json::from_slice(&out.stdout)?;
+    let t = &report["traces"][0];
+    ensure!(
+        out.status.code() == Some(1)
+            && t["contacts"]["divergent"] == 0
+            && t["ghosts"].as_u64() == Some(3),
+        "under the inferred table: {t:#}"
+    );
+    let (toml, _) = infer("")?;
+    ensure!(
+        toml.contains("# No convention fits better than the rules")
+            && toml.contains("# Contact queries: 0 of 17 fail under the rules"),
+        "{toml}"
     );
     Ok(())
 }

@@ -374,12 +374,7 @@ pub fn run(args: Args) -> anyhow::Result<Exit> {
                 reports.push(report);
             }
             let trial = sweeptrace::suite::infer_conventions::Trial::of(&reports);
-            eprintln!(
-                "tried {}: {} of {} compared sweeps fail",
-                conventions.summary(),
-                trial.failing,
-                trial.compared
-            );
+            eprintln!("tried {}: {}", conventions.summary(), trial.counts());
             Ok(trial)
         });
         return match inferred {

@@ -141,6 +141,9 @@ pub struct RecordedAnswers {
     expected_source: Option<ExpectedSource>,
     /// The engine's command, as the report names it.
     command: String,
+    /// Whether the engine answered the contact queries too
+    /// (`--engine-contacts`): its answers are then among the events.
+    contacts: bool,
 }
 
 /// Runs the engine over the trace at `path` once and keeps its answers;
@@ -159,7 +162,8 @@ pub fn record_engine_answers(
     };
     let session = EngineSession::start(command, engine)?;
     let mut reader = TraceReader::new(std::io::BufReader::with_capacity(1 << 16, file), &name);
-    let mut answers = EngineAnswers::new(reader.by_ref(), session, engine.window);
+    let mut answers =
+        EngineAnswers::new(reader.by_ref(), session, engine.window).with_contacts(engine.contacts);
     let mut events = Vec::new();
     for event in answers.by_ref() {
         match event {
@@ -177,6 +181,7 @@ pub fn record_engine_answers(
         events,
         expected_source: reader.expected_source().cloned(),
         command: command.text.clone(),
+        contacts: engine.contacts,
     }))
 }
 
@@ -189,7 +194,12 @@ pub fn check_recorded_answers(
     options: &CheckOptions,
 ) -> TraceReport {
     let events = recorded.events.iter().cloned().map(Ok);
-    let (mut report, _) = check_stream(events, name, options, ContactMode::NotAsked, |result| {
+    let contacts = if recorded.contacts {
+        ContactMode::JudgeEngine
+    } else {
+        ContactMode::NotAsked
+    };
+    let (mut report, _) = check_stream(events, name, options, contacts, |result| {
         judge_against_core(result, &options.tolerances)
     });
     report.engine = Some(EngineCheck {

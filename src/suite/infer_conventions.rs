@@ -34,6 +34,11 @@ pub struct Trial {
     pub failing: u64,
     /// Sweeps compared.
     pub compared: u64,
+    /// Contact queries whose answers disagree with the core's contact set
+    /// (ghost contacts aside: no convention makes them right).
+    pub contact_failing: u64,
+    /// Contact queries compared.
+    pub contact_compared: u64,
     /// Differences within single precision, and the largest backward error.
     pub precision: u64,
     /// The largest backward error among them.
@@ -64,6 +69,8 @@ impl Trial {
         for r in reports {
             t.failing += r.divergent;
             t.compared += r.compared;
+            t.contact_failing += r.contacts.divergent;
+            t.contact_compared += r.contacts.compared;
             if let Some(within) = &r.within_precision {
                 t.precision += within.count;
                 t.max_backward_error = t.max_backward_error.max(within.max_backward_error);
@@ -78,6 +85,67 @@ impl Trial {
             t.errors += u64::from(!r.errors.is_empty());
         }
         t
+    }
+
+    /// The answers that fail, sweeps and contact queries: what a convention
+    /// must lower to be kept.
+    pub fn failing_answers(&self) -> u64 {
+        self.failing + self.contact_failing
+    }
+
+    /// How many fewer answers fail here than in `before`, in words:
+    /// `3 fewer sweeps fail` when the contact queries are the same.
+    fn fewer_than(&self, before: &Trial) -> String {
+        // The sweeps' words are kept as they were ("1 fewer sweeps fail").
+        let change = |was: u64, now: u64, what: &str| {
+            if now <= was {
+                format!("{} fewer {what}", was - now)
+            } else {
+                format!("{} more {what}", now - was)
+            }
+        };
+        let queries = |was: u64, now: u64| {
+            let noun = if was.abs_diff(now) == 1 {
+                "contact query"
+            } else {
+                "contact queries"
+            };
+            change(was, now, noun)
+        };
+        let sweeps = change(before.failing, self.failing, "sweeps");
+        if self.contact_failing == before.contact_failing {
+            format!("{sweeps} fail")
+        } else if self.failing == before.failing {
+            let verb = if before.contact_failing.abs_diff(self.contact_failing) == 1 {
+                "fails"
+            } else {
+                "fail"
+            };
+            format!(
+                "{} {verb}",
+                queries(before.contact_failing, self.contact_failing)
+            )
+        } else {
+            format!(
+                "{sweeps} and {} fail",
+                queries(before.contact_failing, self.contact_failing)
+            )
+        }
+    }
+
+    /// The counts, for the progress lines: `N of M compared sweeps fail`,
+    /// and the contact queries' when there are some.
+    pub fn counts(&self) -> String {
+        let mut s = format!("{} of {} compared sweeps", self.failing, self.compared);
+        if self.contact_compared > 0 {
+            let _ = write!(
+                s,
+                " and {} of {} contact queries",
+                self.contact_failing, self.contact_compared
+            );
+        }
+        s.push_str(" fail");
+        s
     }
 }
 
@@ -267,10 +335,12 @@ pub fn infer_conventions<E>(
                 continue;
             }
             let trial = check(&trying)?;
-            if trial.errors > best_trial.errors || trial.failing >= best_trial.failing {
+            if trial.errors > best_trial.errors
+                || trial.failing_answers() >= best_trial.failing_answers()
+            {
                 if key == "normal"
                     && pass < 2
-                    && trial.failing == best_trial.failing
+                    && trial.failing_answers() == best_trial.failing_answers()
                     && let Some(e) = evidence.iter_mut().find(|e| e.key == "normal")
                 {
                     e.because.push_str(&format!(
@@ -280,21 +350,21 @@ pub fn infer_conventions<E>(
                 }
                 continue;
             }
-            let fixed = best_trial.failing - trial.failing;
+            let fixed = best_trial.failing_answers() - trial.failing_answers();
+            let fewer = trial.fewer_than(&best_trial);
             let because = match key {
                 "precision" => format!(
                     "{} answers differ from the exact rules by no more than single precision \
-                 explains (largest backward error {} u32 units of the sweep's scale); {fixed} \
-                 fewer sweeps fail",
+                 explains (largest backward error {} u32 units of the sweep's scale); {fewer}",
                     trial.precision,
                     crate::core::explain::num(trial.max_backward_error)
                 ),
                 "margin" => format!(
-                    "the face hits of every trace imply this margin; {fixed} fewer sweeps fail \
-                 with it than with each scene's own"
+                    "the face hits of every trace imply this margin; {fewer} with it than with \
+                 each scene's own"
                 ),
                 "facing" => {
-                    format!("{fixed} fewer sweeps fail with it than with each scene's rule")
+                    format!("{fewer} with it than with each scene's rule")
                 }
                 "sides" => format!(
                     "{fixed} answers hit triangles from behind (n·d > 0) as from the front, with \
@@ -303,7 +373,7 @@ pub fn infer_conventions<E>(
                 "initial_overlap" if trying.initial_overlap == InitialOverlap::Alpha0Always => {
                     format!(
                         "answers are hits at α = 0 where the ball starts within ρ of the mesh, \
-                     moving away from it too; {fixed} fewer sweeps fail than {}",
+                     moving away from it too; {fewer} than {}",
                         if best.initial_overlap.is_rules() {
                             "under the rules".to_string()
                         } else {
@@ -315,7 +385,7 @@ pub fn infer_conventions<E>(
                     format!(
                         "answers are hits at α = 0 where the ball starts within ρ of the mesh \
                      and its path closes in on the contact point, none where it leaves an \
-                     edge or a vertex it overlaps; {fixed} fewer sweeps fail than {}",
+                     edge or a vertex it overlaps; {fewer} than {}",
                         if best.initial_overlap.is_rules() {
                             "under the rules".to_string()
                         } else {
@@ -327,7 +397,7 @@ pub fn infer_conventions<E>(
                     "{fixed} answers are hits at α = 0 where the ball starts within ρ of the mesh"
                 ),
                 "normal" => format!(
-                    "{fixed} fewer sweeps fail: the answers give the contact normal{}",
+                    "{fewer}: the answers give the contact normal{}",
                     if trying.normal == NormalRule::ActiveEdges {
                         " at active edges and vertices, the face normal at flat and concave ones"
                     } else {
@@ -337,7 +407,7 @@ pub fn infer_conventions<E>(
                 "ties" => {
                     format!("{fixed} answers name a member of a tie with that member's own normal")
                 }
-                _ => format!("{fixed} fewer sweeps fail"),
+                _ => fewer,
             };
             evidence.retain(|e: &Evidence| e.key != key);
             best = trying;
@@ -419,7 +489,10 @@ fn calibrate<E>(
         accuracy: Some(accuracy),
         ..*best
     })?;
-    if trial.errors > best_trial.errors || trial.failing > best_trial.failing {
+    if trial.errors > best_trial.errors
+        || trial.failing > best_trial.failing
+        || trial.failing_answers() > best_trial.failing_answers()
+    {
         return Ok(None);
     }
     let because = if units < F32_BUDGET {
@@ -466,6 +539,15 @@ impl InferredConventions {
             "# Under the rules: {} of {} compared sweeps fail; under these conventions: {}.",
             self.under_rules.failing, self.under_rules.compared, self.under_inferred.failing
         );
+        if self.under_rules.contact_compared > 0 {
+            let _ = writeln!(
+                s,
+                "# Contact queries: {} of {} fail under the rules; under these conventions: {}.",
+                self.under_rules.contact_failing,
+                self.under_rules.contact_compared,
+                self.under_inferred.contact_failing
+            );
+        }
         let _ = writeln!(
             s,
             "# Check again with this file: inference never makes a run pass by itself."

@@ -28,6 +28,7 @@ pub fn tests() -> Vec<Trial> {
         trial!(contacts_pass_by_an_engine_check_and_say_so),
         trial!(an_engine_answers_contact_queries_with_engine_contacts),
         trial!(infer_config_finds_the_contact_normal_from_contact_queries),
+        trial!(diff_compares_the_contact_sets_of_two_traces),
         trial!(bad_contact_messages_are_refused_with_the_field),
         trial!(python_reads_the_contact_channels),
         trial!(the_recording_draws_each_query_and_marks_its_ghosts),
@@ -509,6 +510,80 @@ fn infer_config_finds_the_contact_normal_from_contact_queries() -> anyhow::Resul
         toml.contains("# No convention fits better than the rules")
             && toml.contains("# Contact queries: 0 of 17 fail under the rules"),
         "{toml}"
+    );
+    Ok(())
+}
+
+/// `diff` answers each side's contact queries with the core and compares
+/// the sets: the same trace twice is the same; triangle T raised by an
+/// eighth changes the contact of the query both sides share, and a
+/// query on one side only is counted and named. Text and JSON.
+fn diff_compares_the_contact_sets_of_two_traces() -> anyhow::Result<()> {
+    let dir = tempfile::tempdir()?;
+    let write = |name: &str, lift: f64, frames: &[u64]| -> anyhow::Result<std::path::PathBuf> {
+        let path = dir.path().join(name);
+        let mut scene = crate::support::scene_t(0.0);
+        for v in &mut scene.vertices {
+            v[2] += lift;
+        }
+        let mut w = TraceWriter::new(std::fs::File::create(&path)?)?;
+        w.scene(0, &scene)?;
+        for &frame in frames {
+            let query = ContactMsg {
+                frame,
+                ball: 0,
+                radius: 0.5,
+                centre: [1.0, 1.0, 0.25],
+                distance: 0.0,
+            };
+            w.contact(1 + frame, &query)?;
+        }
+        w.finish()?;
+        Ok(path)
+    };
+    let a = write("a.mcap", 0.0, &[0, 1])?;
+    let b = write("b.mcap", 0.125, &[0])?;
+    let run = |x: &Path, y: &Path, json: bool| -> anyhow::Result<(i32, String)> {
+        let mut command = bin();
+        command.arg("diff").arg(x).arg(y);
+        if json {
+            command.arg("--json");
+        }
+        // The raised triangle is another scene: compared on purpose.
+        command.arg("--allow-different-scenes");
+        let out = command.output()?;
+        Ok((
+            out.status.code().unwrap_or(-1),
+            String::from_utf8_lossy(&out.stdout).into_owned(),
+        ))
+    };
+    let (code, text) = run(&a, &a, false)?;
+    ensure!(
+        code == 0 && text.contains("contacts: 2 contact queries, the same contact sets"),
+        "exit {code}:\n{text}"
+    );
+    let (code, text) = run(&a, &b, false)?;
+    ensure!(
+        code == 1
+            && text.contains("contacts: 1 of 1 contact query differs; 1 only in A, 0 only in B")
+            && text.contains(
+                "first contact difference: frame 0, ball 0: triangle 0: separation -0.25 in A, -0.375 in B"
+            )
+            && text.contains("  A: triangle 0 (face) at (1, 1, 0), separation -0.25")
+            && text.contains("first contact query on one side only: frame 1, ball 0, in A"),
+        "exit {code}:\n{text}"
+    );
+    let (code, json) = run(&a, &b, true)?;
+    let doc: serde_json::Value = serde_json::from_str(&json)?;
+    let c = &doc["contacts"];
+    ensure!(
+        code == 1
+            && doc["same_outcomes"] == false
+            && c["compared"] == 1
+            && c["different"] == 1
+            && c["only_in_a"] == 1
+            && c["first"]["b"][0]["separation"] == -0.375,
+        "{doc:#}"
     );
     Ok(())
 }

@@ -6,7 +6,9 @@
 //! [`DiffReport`] counts the sweeps that are the same, differ, or exist on one
 //! side only, summarises the changes by kind (`edge -> none: 12`) and
 //! explains the first divergence on both sides (the tests that decided, from
-//! an exhaustive explained re-run of that one sweep).
+//! an exhaustive explained re-run of that one sweep). Contact queries are
+//! compared as well, each side's answered by the core
+//! ([`super::contact_diff`]).
 
 use crate::conventions::{FacingRule, MarginRule};
 use std::collections::BTreeMap;
@@ -24,7 +26,9 @@ use crate::numbers::plural;
 use crate::replay::{
     ReplayError, ReplayEvent, ReplayOptions, ReplaySummary, SceneState, SweepResult, replay_events,
 };
-use crate::trace::{OutcomeMsg, TraceError, TraceEvent};
+use crate::trace::{EventBody, OutcomeMsg, TraceError, TraceEvent};
+
+use super::contact_diff::{ContactDiff, SideQueries, diff_contacts, write_contact_diff};
 use std::sync::Arc;
 
 /// One side's replayed sweeps, by `(frame, ball)`.
@@ -42,6 +46,8 @@ pub struct Side {
     /// The replay's counts (what the frame and ball filters kept:
     /// [`ReplaySummary::selection`]).
     pub summary: ReplaySummary,
+    /// The contact queries the frame and ball filters kept.
+    contacts: SideQueries,
 }
 
 impl Side {
@@ -62,7 +68,25 @@ impl Side {
             duplicates: 0,
             scenes: Vec::new(),
             summary: ReplaySummary::default(),
+            contacts: SideQueries::default(),
         };
+        // The contact queries pass the replay by: kept with the number of
+        // scenes before them, answered by the core when compared.
+        let mut contacts = SideQueries::default();
+        let mut scenes_seen = 0usize;
+        let events = events.inspect(|e| match e {
+            Ok(TraceEvent {
+                body: EventBody::Scene(_),
+                ..
+            }) => scenes_seen += 1,
+            Ok(TraceEvent {
+                body: EventBody::Contact(query),
+                ..
+            }) if scenes_seen > 0 && options.wants(query.frame, query.ball) => {
+                contacts.add(scenes_seen - 1, *query);
+            }
+            _ => {}
+        });
         let mut replay = replay_events(events, options);
         for event in replay.by_ref() {
             match event? {
@@ -78,6 +102,8 @@ impl Side {
             }
         }
         side.summary = replay.summary();
+        drop(replay);
+        side.contacts = contacts;
         Ok(side)
     }
 
@@ -150,13 +176,21 @@ pub struct DiffReport {
     /// How the two sides' scenes differ, one line per difference
     /// ([`scene_differences`]); empty when they are the same.
     pub scene_differences: Vec<String>,
+    /// The contact queries compared (absent when neither side has one).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub contacts: Option<ContactDiff>,
     /// The tolerances used.
     pub tolerances: Tolerances,
 }
 
 impl DiffReport {
-    /// Whether the two replays agree on every sweep.
+    /// Whether the two replays agree on every sweep and contact query.
     pub fn is_same(&self) -> bool {
+        self.sweeps_same() && self.contacts.as_ref().is_none_or(ContactDiff::is_same)
+    }
+
+    /// Whether they agree on every sweep.
+    fn sweeps_same(&self) -> bool {
         self.different == 0 && self.only_in_a == 0 && self.only_in_b == 0
     }
 }
@@ -278,6 +312,11 @@ pub fn diff(a: &Side, b: &Side, tolerances: &Tolerances) -> DiffReport {
         first: None,
         first_unmatched: None,
         scene_differences: scene_differences(a, b),
+        contacts: diff_contacts(
+            (&a.contacts, &a.scenes, a.options.conventions.sides),
+            (&b.contacts, &b.scenes, b.options.conventions.sides),
+            tolerances,
+        ),
         tolerances: *tolerances,
     };
     let unmatched = |key: (u64, u32), side: char, report: &mut DiffReport| {
@@ -363,8 +402,10 @@ pub fn render_diff_text(r: &DiffReport) -> String {
             let _ = writeln!(s, "  {d}");
         }
     }
-    if r.is_same() {
-        if r.tie_members > 0 {
+    if r.sweeps_same() {
+        if r.compared == 0 && r.contacts.is_some() {
+            // Contact queries only: no line about sweeps.
+        } else if r.tie_members > 0 {
             let _ = writeln!(
                 s,
                 "same: {} sweeps, identical outcomes ({} of them ties: another member of the \
@@ -377,6 +418,9 @@ pub fn render_diff_text(r: &DiffReport) -> String {
                 "same: {}, identical outcomes",
                 crate::numbers::counted(r.compared, "sweep", "sweeps")
             );
+        }
+        if let Some(c) = &r.contacts {
+            write_contact_diff(&mut s, c);
         }
         return s;
     }
@@ -433,6 +477,9 @@ pub fn render_diff_text(r: &DiffReport) -> String {
             s,
             "first sweep on one side only: frame {frame}, ball {ball}, in {side}"
         );
+    }
+    if let Some(c) = &r.contacts {
+        write_contact_diff(&mut s, c);
     }
     s
 }

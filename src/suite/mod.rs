@@ -24,6 +24,7 @@ pub mod bless;
 mod check;
 pub mod config;
 mod contact_check;
+pub mod contact_diff;
 pub mod diff;
 pub mod discovery;
 pub mod engine_check;

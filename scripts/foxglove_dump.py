@@ -2,8 +2,11 @@
 """Read a Foxglove file written by `sweeptrace replay --foxglove` with Python's `mcap` package.
 
 Checks the channels (topic, schema name, encodings), that the summary's
-statistics match the messages read, that messages are in log_time order and
-that every message and schema is JSON; with --sweeps/--scenes, the counts.
+statistics match the messages read, that each channel's messages are in
+log_time order (the contact queries' two channels, present only for a
+trace with contact queries, are written after the sweeps: readers merge
+the channels by time) and that every message and schema is JSON; with
+--sweeps/--scenes/--contact-queries, the counts.
 With --dump FILE, writes one JSON line per schema record
 ({"schema", "encoding", "data"}) and then one per message ({"topic",
 "schema", "log_time", "data"}) for tests/foxglove/validate.mjs. Exits 1 on
@@ -32,6 +35,11 @@ CHANNELS = {
     "/decisions": "foxglove.Log",
     "/numbers": "sweeptrace.SweepNumbers",
 }
+# Present only when the trace has contact queries.
+CONTACT_CHANNELS = {
+    "/contact_queries": "foxglove.SceneUpdate",
+    "/contact_decisions": "foxglove.Log",
+}
 PER_SWEEP = ["/balls", "/sweeps", "/contacts", "/expected_outcome", "/ghosts", "/decisions", "/numbers"]
 
 
@@ -40,6 +48,7 @@ def main():
     parser.add_argument("file")
     parser.add_argument("--sweeps", type=int)
     parser.add_argument("--scenes", type=int)
+    parser.add_argument("--contact-queries", type=int)
     parser.add_argument("--dump")
     parser.add_argument("--trace", action="store_true",
                         help="a sweeptrace trace (JSON encoding), not a Foxglove file")
@@ -65,8 +74,8 @@ def main():
             names = set(topics.values())
             if not names or not all(n and n.startswith("sweeptrace.") for n in names):
                 problems.append(f"channels {topics}: not a sweeptrace trace's")
-        elif topics != CHANNELS:
-            problems.append(f"channels {topics}, expected {CHANNELS}")
+        elif topics != CHANNELS and topics != {**CHANNELS, **CONTACT_CHANNELS}:
+            problems.append(f"channels {topics}, expected {CHANNELS} (and {CONTACT_CHANNELS} with contact queries)")
         for schema in summary.schemas.values():
             try:
                 data = json.loads(schema.data)
@@ -77,12 +86,13 @@ def main():
                 dump.write(json.dumps({"schema": schema.name, "encoding": schema.encoding, "data": data}) + "\n")
 
         counts = {}
-        last = None
+        last = {}
         for schema, channel, message in reader.iter_messages(log_time_order=False):
             counts[channel.topic] = counts.get(channel.topic, 0) + 1
-            if last is not None and message.log_time < last:
-                problems.append(f"{channel.topic}: message at log_time {message.log_time} after one at {last}")
-            last = message.log_time
+            before = last.get(channel.topic)
+            if before is not None and message.log_time < before:
+                problems.append(f"{channel.topic}: message at log_time {message.log_time} after one at {before}")
+            last[channel.topic] = message.log_time
             try:
                 data = json.loads(message.data)
             except ValueError as e:
@@ -105,6 +115,10 @@ def main():
             extra = max((args.scenes or 1) - 1, 0) if topic not in ("/decisions", "/numbers") else 0
             if counts.get(topic, 0) != args.sweeps + extra:
                 problems.append(f"{topic}: {counts.get(topic, 0)} messages, expected {args.sweeps + extra}")
+    if args.contact_queries is not None:
+        for topic in CONTACT_CHANNELS:
+            if counts.get(topic, 0) != args.contact_queries:
+                problems.append(f"{topic}: {counts.get(topic, 0)} messages, expected {args.contact_queries}")
     if args.scenes is not None and counts.get("/mesh", 0) != args.scenes:
         problems.append(f"/mesh: {counts.get('/mesh', 0)} messages, expected {args.scenes}")
 

@@ -33,6 +33,7 @@ pub fn tests() -> Vec<Trial> {
         trial!(replay_foxglove_errors_name_the_file_and_leave_no_partial_file),
         trial!(replay_foxglove_keeps_what_was_read_of_a_truncated_trace),
         trial!(replay_foxglove_killed_leaves_no_partial_target),
+        trial!(replay_foxglove_carries_the_judged_contact_queries),
     ]
 }
 
@@ -757,4 +758,143 @@ fn replay_foxglove_killed_leaves_no_partial_target() -> anyhow::Result<()> {
         }
     }
     Ok(())
+}
+
+/// `replay --foxglove` of a trace with contact queries: each query judged
+/// as `check` judges it, on `/contact_queries` (a marker per answered
+/// contact, the ghost in the ghost colour with the faces' normal beside its
+/// own) and `/contact_decisions` (WARNING for the ghost, INFO for the query
+/// that agrees); Python reads the file and Node validates every message
+/// against Foxglove's schemas. A trace without queries has neither channel
+/// (the other tests' channel lists).
+fn replay_foxglove_carries_the_judged_contact_queries() -> anyhow::Result<Completion> {
+    use sweeptrace::trace::{ContactMsg, ContactPointMsg, ContactsMsg};
+    let dir = tempfile::tempdir()?;
+    let trace = dir.path().join("seam.mcap");
+    let quad = SceneMsg {
+        name: Some("quad".into()),
+        vertices: vec![
+            [0.0, 0.0, 0.0],
+            [2.0, 0.0, 0.0],
+            [2.0, 2.0, 0.0],
+            [0.0, 2.0, 0.0],
+        ],
+        triangles: vec![[0, 1, 2], [0, 2, 3]],
+        margin: 0.0,
+        facing: Facing::NonStrict,
+    };
+    let face = |triangle: u32, point: [f64; 3], separation: f64| ContactPointMsg {
+        triangle,
+        kind: Some(Kind::Face),
+        feature: None,
+        point: Some(point),
+        normal: Some([0.0, 0.0, 1.0]),
+        separation: Some(separation),
+    };
+    let lean = nalgebra::Vector3::new(0.125, -0.125, 0.375);
+    let mut w = TraceWriter::new(std::fs::File::create(&trace)?)?;
+    w.scene(0, &quad)?;
+    w.sweep(
+        1,
+        &SweepMsg {
+            frame: 0,
+            ball: 0,
+            radius: 0.5,
+            p0: [1.5, 0.5, 2.0],
+            p1: [1.5, 0.5, 0.0],
+        },
+    )?;
+    for (frame, centre, contacts) in [
+        (
+            1,
+            [1.125, 0.875, 0.375],
+            vec![
+                face(0, [1.125, 0.875, 0.0], -0.125),
+                // The seam's contact with the geometric normal: a ghost.
+                ContactPointMsg {
+                    triangle: 1,
+                    kind: Some(Kind::Edge),
+                    feature: Some(0),
+                    point: Some([1.0, 1.0, 0.0]),
+                    normal: Some(lean.normalize().into()),
+                    separation: Some(lean.norm() - 0.5),
+                },
+            ],
+        ),
+        (2, [1.5, 0.5, 0.25], vec![face(0, [1.5, 0.5, 0.0], -0.25)]),
+    ] {
+        w.contact(
+            2 * frame,
+            &ContactMsg {
+                frame,
+                ball: 0,
+                radius: 0.5,
+                centre,
+                distance: 0.0,
+            },
+        )?;
+        w.expected_contacts(
+            2 * frame + 1,
+            &ContactsMsg {
+                frame,
+                ball: 0,
+                contacts,
+            },
+        )?;
+    }
+    w.finish()?;
+    let out = dir.path().join("seam.foxglove.mcap");
+    let (code, _, stderr) = run_bin(os!(
+        "replay",
+        trace.as_os_str(),
+        "--foxglove",
+        out.as_os_str()
+    ))?;
+    ensure!(
+        code == 0 && stderr.contains("contacts in the Foxglove file: 2 queries drawn (3 contacts, 0 diverging from the core's, 1 ghost contact)"),
+        "exit {code}: {stderr}"
+    );
+    let all = messages(&std::fs::read(&out)?)?;
+    let queries = on(&all, "/contact_queries");
+    let logs = on(&all, "/contact_decisions");
+    ensure!(
+        queries.len() == 2 && logs.len() == 2,
+        "{} and {} messages",
+        queries.len(),
+        logs.len()
+    );
+    let seam = &queries[0]["entities"][0];
+    // The ghost colour, cyan (0, 215, 255).
+    let is_ghost = |x: &Value| {
+        x["color"]["r"].as_f64() == Some(0.0)
+            && x["color"]["g"].as_f64() == Some(215.0 / 255.0)
+            && x["color"]["b"].as_f64() == Some(1.0)
+    };
+    let ghost_spheres = seam["spheres"]
+        .as_array()
+        .map_or(0, |s| s.iter().filter(|x| is_ghost(x)).count());
+    ensure!(
+        seam["id"] == "contact_query/0"
+            && ghost_spheres == 1
+            && seam["arrows"].as_array().map(Vec::len) == Some(3)
+            && seam["metadata"]
+                .to_string()
+                .contains("ghost contact: frame 1, ball 0: edge 1.0"),
+        "the seam's query: {seam:#}"
+    );
+    ensure!(
+        logs[0]["level"] != logs[1]["level"]
+            && logs[0]["message"]
+                .as_str()
+                .is_some_and(|m| m.contains("ghost contact"))
+            && logs[1]["message"]
+                .as_str()
+                .is_some_and(|m| m.contains("the core finds 1 contact, the answer has 1")),
+        "the logs: {logs:#?}"
+    );
+    let dump = dir.path().join("dump.jsonl");
+    if let Some(why) = validate_foxglove_file(&out, 1, 1, &dump)? {
+        return Ok(Completion::ignored_with(why));
+    }
+    Ok(Completion::Completed)
 }

@@ -91,7 +91,11 @@ fn identity() -> Pose {
     at(&nalgebra::Point3::origin())
 }
 
-fn sphere(center: &nalgebra::Point3<f64>, radius: f64, rgba: [u8; 4]) -> SpherePrimitive {
+pub(super) fn sphere(
+    center: &nalgebra::Point3<f64>,
+    radius: f64,
+    rgba: [u8; 4],
+) -> SpherePrimitive {
     let diameter = 2.0 * radius;
     SpherePrimitive {
         pose: at(center),
@@ -124,7 +128,7 @@ pub fn rotation_from_x(direction: &nalgebra::Vector3<f64>) -> Quaternion {
 }
 
 /// An arrow from `tail` along the unit vector `direction`, `length` long.
-fn arrow(
+pub(super) fn arrow(
     tail: &nalgebra::Point3<f64>,
     direction: &nalgebra::Vector3<f64>,
     length: f64,
@@ -162,7 +166,7 @@ fn line(
     }
 }
 
-fn key_value(key: &str, value: impl ToString) -> KeyValuePair {
+pub(super) fn key_value(key: &str, value: impl ToString) -> KeyValuePair {
     KeyValuePair {
         key: key.to_string(),
         value: value.to_string(),

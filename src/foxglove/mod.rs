@@ -13,8 +13,10 @@
 //! | [`SWEEPS_TOPIC`] | `foxglove.SceneUpdate` | per sweep, entity `sweep/{ball}`: the path, and the swept sphere (radius ρ) at the contact |
 //! | [`CONTACTS_TOPIC`] | `foxglove.SceneUpdate` | per sweep, entity `contact/{ball}`: the contact point and the reported normal (deleted at a miss) |
 //! | [`EXPECTED_TOPIC`] | `foxglove.SceneUpdate` | per sweep, entity `expected/{ball}`: the expected ball, contact and normal where the sweep diverges (deleted elsewhere) |
+//! | [`CONTACT_QUERIES_TOPIC`] | `foxglove.SceneUpdate` | per contact query (`/contact`), entity `contact_query/{ball}`: each answered contact and its normal, marked as `check` judges it (agrees, a problem, a ghost contact), the expected normal beside a differing one, the places left out; written only when the trace has queries |
 //! | [`GHOSTS_TOPIC`] | `foxglove.SceneUpdate` | per sweep, entity `ghost/{ball}`: where the expected outcome is a ghost contact, a marker at it, the expected and the faces' normals and one label (deleted elsewhere) |
 //! | [`DECISIONS_TOPIC`] | `foxglove.Log` | per sweep, the decision in words; WARNING where `check` fails it |
+//! | [`CONTACT_DECISIONS_TOPIC`] | `foxglove.Log` | per contact query, its judgement in words (the counts, each problem and ghost contact); WARNING where `check` fails it; written only when the trace has queries |
 //! | [`NUMBERS_TOPIC`] | `sweeptrace.SweepNumbers` | per sweep, `α` and the decisive test's numbers, for the Plot panel |
 //!
 //! Inside (the submodules are private; every public item is named once,
@@ -28,6 +30,7 @@
 //! - `writer`: [`FoxgloveWriter`] over any `Write + Seek`, and
 //!   [`FoxgloveFile`], written under a temporary name and renamed.
 
+mod contacts;
 mod convert;
 mod messages;
 mod schemas;
@@ -53,6 +56,10 @@ pub const SWEEPS_TOPIC: &str = "/sweeps";
 pub const CONTACTS_TOPIC: &str = "/contacts";
 /// The expected outcomes where a sweep diverges.
 pub const EXPECTED_TOPIC: &str = "/expected_outcome";
+/// The contact queries, judged.
+pub const CONTACT_QUERIES_TOPIC: &str = "/contact_queries";
+/// The contact queries' judgements (Log).
+pub const CONTACT_DECISIONS_TOPIC: &str = "/contact_decisions";
 /// The ghost contacts of the expected outcomes.
 pub const GHOSTS_TOPIC: &str = "/ghosts";
 /// The decisions (Log).

@@ -13,6 +13,7 @@ use mcap::{Compression, WriteOptions, Writer};
 use serde::Serialize;
 use thiserror::Error;
 
+use super::contacts::{contact_query_log, contact_query_update};
 use super::convert::{
     ball_update, clear_update, contact_update, decision_log, expected_update, ghost_update,
     mesh_update, sweep_numbers, sweep_update,
@@ -23,13 +24,14 @@ use super::schemas::{
     SCHEMA_ENCODING, SWEEP_NUMBERS_SCHEMA, SWEEP_NUMBERS_SCHEMA_JSON,
 };
 use super::{
-    BALLS_TOPIC, CONTACTS_TOPIC, DECISIONS_TOPIC, EXPECTED_TOPIC, GHOSTS_TOPIC, MESH_TOPIC,
-    METADATA_NAME, NUMBERS_TOPIC, SWEEPS_TOPIC,
+    BALLS_TOPIC, CONTACT_DECISIONS_TOPIC, CONTACT_QUERIES_TOPIC, CONTACTS_TOPIC, DECISIONS_TOPIC,
+    EXPECTED_TOPIC, GHOSTS_TOPIC, MESH_TOPIC, METADATA_NAME, NUMBERS_TOPIC, SWEEPS_TOPIC,
 };
 use crate::atomic::PendingFile;
+use crate::judge::contact_marks::{ContactDrawing, ContactsDrawn, for_each_judged_query};
 use crate::judge::{Tolerances, divergence};
 use crate::replay::{ReplayEvent, SceneState, SweepResult};
-use crate::trace::library_string;
+use crate::trace::{TraceError, TraceEvent, library_string};
 
 /// Writing the Foxglove file failed.
 #[derive(Debug, Error)]
@@ -84,6 +86,9 @@ pub struct FoxgloveCounts {
     pub scenes: u64,
     /// Sweeps (one message on each per-sweep channel).
     pub sweeps: u64,
+    /// Contact queries (one message on the queries' channel and a Log
+    /// line each).
+    pub contact_queries: u64,
     /// Messages in all.
     pub messages: u64,
 }
@@ -117,6 +122,13 @@ pub struct FoxgloveWriter<W: Write + Seek> {
     file: String,
     options: FoxgloveOptions,
     channels: Channels,
+    /// The `foxglove.SceneUpdate` and `foxglove.Log` schemas, for the
+    /// contact queries' channels.
+    scene_update: u16,
+    log: u16,
+    /// The contact queries' channels (the queries, their Log lines), added
+    /// at the first query: a trace without any has neither.
+    contact_queries: Option<(u16, u16)>,
     counts: FoxgloveCounts,
     data: Vec<u8>,
 }
@@ -176,6 +188,9 @@ impl<W: Write + Seek> FoxgloveWriter<W> {
             file: file.to_string(),
             options,
             channels,
+            scene_update,
+            log,
+            contact_queries: None,
             counts: FoxgloveCounts::default(),
             data: Vec::new(),
         })
@@ -275,6 +290,54 @@ impl<W: Write + Seek> FoxgloveWriter<W> {
         self.put(c.numbers, NUMBERS_TOPIC, f, t, &numbers)?;
         self.counts.sweeps += 1;
         Ok(())
+    }
+
+    /// The trace's contact queries (`events`: the trace read again, sweeps
+    /// and expectations pass by), each judged as `check` judges it under
+    /// `how`, at its `log_time`: one message on
+    /// [`CONTACT_QUERIES_TOPIC`] and a Log line on
+    /// [`CONTACT_DECISIONS_TOPIC`] each: channels of their own, so that
+    /// each channel stays in `log_time` order when this is called after
+    /// the replay's events (MCAP readers merge the channels by time).
+    pub fn contact_queries(
+        &mut self,
+        events: impl Iterator<Item = Result<TraceEvent, TraceError>>,
+        how: &ContactDrawing<'_>,
+    ) -> Result<ContactsDrawn, FoxgloveError> {
+        for_each_judged_query(events, how, |p| {
+            let (queries, decisions) = match self.contact_queries {
+                Some(channels) => channels,
+                None => {
+                    let error = |cause| FoxgloveError::Write {
+                        file: self.file.clone(),
+                        cause,
+                    };
+                    let mut channel = |schema: u16, topic: &str| {
+                        self.writer
+                            .add_channel(schema, topic, MESSAGE_ENCODING, &BTreeMap::new())
+                            .map_err(error)
+                    };
+                    let channels = (
+                        channel(self.scene_update, CONTACT_QUERIES_TOPIC)?,
+                        channel(self.log, CONTACT_DECISIONS_TOPIC)?,
+                    );
+                    self.contact_queries = Some(channels);
+                    channels
+                }
+            };
+            let (f, t) = (p.query.frame, p.log_time_nanos);
+            self.put(
+                queries,
+                CONTACT_QUERIES_TOPIC,
+                f,
+                t,
+                &contact_query_update(p),
+            )?;
+            let log = contact_query_log(p, &self.options.trace_name);
+            self.put(decisions, CONTACT_DECISIONS_TOPIC, f, t, &log)?;
+            self.counts.contact_queries += 1;
+            Ok(())
+        })
     }
 
     /// Writes the last chunk, the summary and the footer; returns the

@@ -20,7 +20,6 @@ struct Built {
 
 /// One query judged by [`ContactPairing`], with what it was judged on (the
 /// recording draws them; `check` reads the verdict only).
-#[cfg_attr(not(feature = "viewer"), allow(dead_code))]
 pub(crate) struct PairedContacts {
     /// The query.
     pub(crate) query: ContactMsg,

@@ -31,6 +31,7 @@
 
 mod agreement;
 mod compare;
+pub mod contact_marks;
 mod contact_pairing;
 mod contacts;
 mod decision;
@@ -49,9 +50,7 @@ pub use compare::{
     DEFAULT_NORMAL_TOLERANCE_DEGREES, Field, FieldDiff, FieldSet, Tolerances, angle_degrees,
     compare,
 };
-pub(crate) use contact_pairing::ContactPairing;
-#[cfg(feature = "viewer")]
-pub(crate) use contact_pairing::PairedContacts;
+pub(crate) use contact_pairing::{ContactPairing, PairedContacts};
 pub(crate) use contacts::write_contact_verdict;
 pub use contacts::{ContactProblem, ContactTolerances, ContactVerdict};
 pub(crate) use decision::write_decision_line;

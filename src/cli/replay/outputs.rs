@@ -141,9 +141,7 @@ pub(super) struct Outputs {
     pub(super) sinks: Sinks,
     foxglove_target: Option<PathBuf>,
     /// The replay's options and tolerances, for the contacts drawn.
-    #[cfg_attr(not(feature = "viewer"), allow(dead_code))]
     options: ReplayOptions,
-    #[cfg_attr(not(feature = "viewer"), allow(dead_code))]
     tolerances: Tolerances,
 }
 
@@ -216,48 +214,49 @@ impl Outputs {
         })
     }
 
-    /// Draws the trace's `queries` contact queries into the recording
-    /// (when there is one and they are some), judged as `check` judges
-    /// them, at their frames: a second read of the trace.
-    #[cfg(feature = "viewer")]
+    /// Draws the trace's `queries` contact queries into the recording and
+    /// the Foxglove file (those there are, when they are some), judged as
+    /// `check` judges them, at their frames: a second read of the trace
+    /// for each.
     pub(super) fn draw_contacts(
         &mut self,
         trace_path: &Path,
         source_name: &str,
         queries: u64,
     ) -> anyhow::Result<()> {
-        let (options, tolerances) = (&self.options, &self.tolerances);
-        let Some(recording) = self.recording.as_mut().filter(|_| queries > 0) else {
+        if queries == 0 {
             return Ok(());
+        }
+        let (options, tolerances) = (self.options, self.tolerances);
+        let how = sweeptrace::judge::contact_marks::ContactDrawing {
+            tolerances: &tolerances,
+            conventions: &options.conventions,
+            ghost_degrees: sweeptrace::replay::ghost::GHOST_DEGREES,
+            frames: options.frames,
+            ball: options.ball,
         };
-        let file = std::fs::File::open(trace_path)
-            .with_context(|| format!("reading {source_name} again for its contacts"))?;
-        let reader = sweeptrace::TraceReader::new(std::io::BufReader::new(file), source_name);
-        let drawn = sweeptrace::viz::draw_contacts(
-            recording.logger().stream(),
-            reader,
-            &sweeptrace::viz::ContactDrawing {
-                tolerances,
-                conventions: &options.conventions,
-                ghost_degrees: sweeptrace::replay::ghost::GHOST_DEGREES,
-                frames: options.frames,
-                ball: options.ball,
-            },
-        )
-        .context("drawing the contact queries")?;
-        eprintln!(
-            "contacts: {} drawn ({} contacts, {} diverging from the core's, {})",
-            sweeptrace::numbers::counted(drawn.queries, "query", "queries"),
-            drawn.contacts,
-            drawn.divergent,
-            sweeptrace::numbers::counted(drawn.ghosts, "ghost contact", "ghost contacts")
-        );
-        Ok(())
-    }
-
-    /// Without the viewer there is no recording to draw into.
-    #[cfg(not(feature = "viewer"))]
-    pub(super) fn draw_contacts(&mut self, _: &Path, _: &str, _: u64) -> anyhow::Result<()> {
+        let read_again = || -> anyhow::Result<_> {
+            let file = std::fs::File::open(trace_path)
+                .with_context(|| format!("reading {source_name} again for its contacts"))?;
+            Ok(sweeptrace::TraceReader::new(
+                std::io::BufReader::new(file),
+                source_name,
+            ))
+        };
+        #[cfg(feature = "viewer")]
+        if let Some(recording) = self.recording.as_mut() {
+            let drawn =
+                sweeptrace::viz::draw_contacts(recording.logger().stream(), read_again()?, &how)
+                    .context("drawing the contact queries")?;
+            eprintln!("contacts: {}", drawn_words(&drawn));
+        }
+        if let Some(file) = self.sinks.foxglove.as_mut() {
+            let drawn = file
+                .writer()
+                .contact_queries(read_again()?, &how)
+                .context("writing the contact queries to the Foxglove file")?;
+            eprintln!("contacts in the Foxglove file: {}", drawn_words(&drawn));
+        }
         Ok(())
     }
 
@@ -345,4 +344,15 @@ impl Outputs {
         }
         Ok(wrote)
     }
+}
+
+/// What was drawn of the contact queries, in words.
+fn drawn_words(drawn: &sweeptrace::judge::contact_marks::ContactsDrawn) -> String {
+    format!(
+        "{} drawn ({} contacts, {} diverging from the core's, {})",
+        sweeptrace::numbers::counted(drawn.queries, "query", "queries"),
+        drawn.contacts,
+        drawn.divergent,
+        sweeptrace::numbers::counted(drawn.ghosts, "ghost contact", "ghost contacts")
+    )
 }

@@ -19,8 +19,12 @@
 // [`SweeptraceOutcome::fields`]: `normal` is given.
 #define SWEEPTRACE_FIELD_NORMAL 4
 
-// [`SweeptraceOutcome::fields`]: `contact` is given.
+// [`SweeptraceOutcome::fields`]: `contact` is given; for a
+// [`SweeptraceContact`], its `point`.
 #define SWEEPTRACE_FIELD_CONTACT 8
+
+// [`SweeptraceContact::fields`]: `separation` is given.
+#define SWEEPTRACE_FIELD_SEPARATION 16
 
 // What a call came to.
 typedef enum SweeptraceStatus {
@@ -75,6 +79,10 @@ typedef enum SweeptraceEncoding {
   SWEEPTRACE_ENCODING_CBOR = 1,
 } SweeptraceEncoding;
 
+// The contacts of one answer, filled in by `on_contact` with
+// [`sweeptrace_contacts_add`]. Opaque; valid during the call only.
+typedef struct SweeptraceContacts SweeptraceContacts;
+
 // A trace being written. Opaque: made by [`sweeptrace_writer_open`],
 // released by [`sweeptrace_writer_free`]. Use each writer from one thread
 // at a time; different writers may be used on different threads.
@@ -109,6 +117,31 @@ typedef struct SweeptraceOutcome {
   // Contact point on the mesh.
   double contact[3];
 } SweeptraceOutcome;
+
+// One contact of an engine's answer to a contact query, added with
+// [`sweeptrace_contacts_add`]. `triangle` is always given (an index in
+// the current scene); `fields` says which of the others are
+// (`SWEEPTRACE_FIELD_FEATURE`: `kind` and, on an edge or vertex,
+// `feature`; `SWEEPTRACE_FIELD_CONTACT`: `point`;
+// `SWEEPTRACE_FIELD_NORMAL`: `normal`; `SWEEPTRACE_FIELD_SEPARATION`:
+// `separation`); a field left out is not compared.
+typedef struct SweeptraceContact {
+  // The triangle touched, in the current scene.
+  uint32_t triangle;
+  // Which of the fields below are given: `SWEEPTRACE_FIELD_*` or-ed.
+  uint32_t fields;
+  // A [`SweeptraceKind`]: face, edge or vertex.
+  uint32_t kind;
+  // Edge or vertex of the triangle: 0, 1 or 2.
+  uint32_t feature;
+  // The point of the triangle touched.
+  double point[3];
+  // The normal, pointing toward the ball's centre.
+  double normal[3];
+  // The signed separation: the distance from the point to the centre,
+  // less the radius (negative: penetration).
+  double separation;
+} SweeptraceContact;
 
 // A scene, as [`sweeptrace_serve_engine`] gives it to
 // [`SweeptraceEngine::on_scene`]. Every pointer in it stays valid until the
@@ -209,6 +242,32 @@ typedef struct SweeptraceEngine {
   // Answers each sweep.
   SweeptraceSweepFn on_sweep;
 } SweeptraceEngine;
+
+// A contact query, as [`sweeptrace_serve_engine_contacts`] gives it to
+// its `on_contact` callback: what does a ball of `radius` centred at
+// `centre` touch in the last scene, counting a triangle up to `distance`
+// beyond touching (the engine's speculative contact distance; 0: only
+// what touches). The numbers are finite, `radius > 0`, `distance ≥ 0`.
+typedef struct SweeptraceContactQuery {
+  // The query's frame.
+  uint64_t frame;
+  // The query's ball.
+  uint32_t ball;
+  // The ball's radius.
+  double radius;
+  // The ball's centre.
+  double centre[3];
+  // The contact distance.
+  double distance;
+} SweeptraceContactQuery;
+
+// Called with each contact query: add the contacts the engine reports
+// with [`sweeptrace_contacts_add`] (none: it touches nothing) and return
+// 0, or return nonzero to stop the loop (it then returns 1 after printing
+// an error naming the query; nothing is written for it).
+typedef int (*SweeptraceContactFn)(void *user,
+                                   const struct SweeptraceContactQuery *query,
+                                   struct SweeptraceContacts *contacts);
 
 #ifdef __cplusplus
 extern "C" {
@@ -346,6 +405,16 @@ const char *sweeptrace_last_error(void);
 // Unknown values give `"unknown"`.
 const char *sweeptrace_status_name(uint32_t status);
 
+// Adds `*contact` to the answer `contacts` (copied). Returns 0, or 1 when
+// a pointer is null (nothing is added). The contacts are checked when the
+// callback returns.
+//
+// # Safety
+// `contacts` is the pointer `on_contact` was given, during that call;
+// `contact` is null or points to a [`SweeptraceContact`].
+int sweeptrace_contacts_add(struct SweeptraceContacts *contacts,
+                            const struct SweeptraceContact *contact);
+
 // Runs the engine protocol (docs/ENGINE_PROTOCOL.md) on the process's
 // standard input and output: reads each line sweeptrace sends, calls
 // `engine->on_scene(user, scene)` for a scene and
@@ -377,6 +446,25 @@ const char *sweeptrace_status_name(uint32_t status);
 // `engine` is null or points to a [`SweeptraceEngine`] whose callbacks
 // are null or valid functions, safe to call with `user`.
 int sweeptrace_serve_engine(const struct SweeptraceEngine *engine, void *user);
+
+// [`sweeptrace_serve_engine`], answering contact queries too (`sweeptrace
+// check --engine ... --engine-contacts`, `sweeptrace conform --contacts`):
+// for each, `on_contact(user, query, contacts)` adds the contacts the
+// engine reports with [`sweeptrace_contacts_add`], and the loop writes
+// them as the query's `contacts` line. Returns as
+// [`sweeptrace_serve_engine`] does, and 1 also when `on_contact` is null
+// (nothing is read), returns nonzero (the message names the query), or
+// gives an invalid contact (a `triangle` out of the scene, unknown bits
+// in `fields`, a `kind` that is not face, edge or vertex, a `feature`
+// above 2, a point, normal or separation that is not finite, a zero
+// normal): nothing is written for that query.
+//
+// # Safety
+// As [`sweeptrace_serve_engine`]; `on_contact` is null or a valid
+// function, safe to call with `user`.
+int sweeptrace_serve_engine_contacts(const struct SweeptraceEngine *engine,
+                                     SweeptraceContactFn on_contact,
+                                     void *user);
 
 #ifdef __cplusplus
 }  // extern "C"

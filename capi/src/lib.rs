@@ -21,7 +21,9 @@
 //! [`sweeptrace_serve_engine`] runs the engine protocol
 //! (docs/ENGINE_PROTOCOL.md) on standard input and output and calls the
 //! engine back with each scene and sweep ([`SweeptraceEngine`]), so the
-//! engine's author writes no JSON.
+//! engine's author writes no JSON; [`sweeptrace_serve_engine_contacts`]
+//! answers contact queries too (`--engine-contacts`, `conform
+//! --contacts`), with a third callback.
 //!
 //! `include/sweeptrace.h` is generated from this file by cbindgen.
 
@@ -105,8 +107,11 @@ pub const SWEEPTRACE_FIELD_TRIANGLE: u32 = 1;
 pub const SWEEPTRACE_FIELD_FEATURE: u32 = 2;
 /// [`SweeptraceOutcome::fields`]: `normal` is given.
 pub const SWEEPTRACE_FIELD_NORMAL: u32 = 4;
-/// [`SweeptraceOutcome::fields`]: `contact` is given.
+/// [`SweeptraceOutcome::fields`]: `contact` is given; for a
+/// [`SweeptraceContact`], its `point`.
 pub const SWEEPTRACE_FIELD_CONTACT: u32 = 8;
+/// [`SweeptraceContact::fields`]: `separation` is given.
+pub const SWEEPTRACE_FIELD_SEPARATION: u32 = 16;
 const ALL_FIELDS: u32 = SWEEPTRACE_FIELD_TRIANGLE
     | SWEEPTRACE_FIELD_FEATURE
     | SWEEPTRACE_FIELD_NORMAL
@@ -923,6 +928,158 @@ pub struct SweeptraceEngine {
     pub on_sweep: SweeptraceSweepFn,
 }
 
+/// A contact query, as [`sweeptrace_serve_engine_contacts`] gives it to
+/// its `on_contact` callback: what does a ball of `radius` centred at
+/// `centre` touch in the last scene, counting a triangle up to `distance`
+/// beyond touching (the engine's speculative contact distance; 0: only
+/// what touches). The numbers are finite, `radius > 0`, `distance ≥ 0`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug)]
+pub struct SweeptraceContactQuery {
+    /// The query's frame.
+    pub frame: u64,
+    /// The query's ball.
+    pub ball: u32,
+    /// The ball's radius.
+    pub radius: f64,
+    /// The ball's centre.
+    pub centre: [f64; 3],
+    /// The contact distance.
+    pub distance: f64,
+}
+
+/// One contact of an engine's answer to a contact query, added with
+/// [`sweeptrace_contacts_add`]. `triangle` is always given (an index in
+/// the current scene); `fields` says which of the others are
+/// (`SWEEPTRACE_FIELD_FEATURE`: `kind` and, on an edge or vertex,
+/// `feature`; `SWEEPTRACE_FIELD_CONTACT`: `point`;
+/// `SWEEPTRACE_FIELD_NORMAL`: `normal`; `SWEEPTRACE_FIELD_SEPARATION`:
+/// `separation`); a field left out is not compared.
+#[repr(C)]
+#[derive(Clone, Copy, Debug)]
+pub struct SweeptraceContact {
+    /// The triangle touched, in the current scene.
+    pub triangle: u32,
+    /// Which of the fields below are given: `SWEEPTRACE_FIELD_*` or-ed.
+    pub fields: u32,
+    /// A [`SweeptraceKind`]: face, edge or vertex.
+    pub kind: u32,
+    /// Edge or vertex of the triangle: 0, 1 or 2.
+    pub feature: u32,
+    /// The point of the triangle touched.
+    pub point: [f64; 3],
+    /// The normal, pointing toward the ball's centre.
+    pub normal: [f64; 3],
+    /// The signed separation: the distance from the point to the centre,
+    /// less the radius (negative: penetration).
+    pub separation: f64,
+}
+
+/// The contacts of one answer, filled in by `on_contact` with
+/// [`sweeptrace_contacts_add`]. Opaque; valid during the call only.
+pub struct SweeptraceContacts {
+    contacts: Vec<SweeptraceContact>,
+}
+
+/// Adds `*contact` to the answer `contacts` (copied). Returns 0, or 1 when
+/// a pointer is null (nothing is added). The contacts are checked when the
+/// callback returns.
+///
+/// # Safety
+/// `contacts` is the pointer `on_contact` was given, during that call;
+/// `contact` is null or points to a [`SweeptraceContact`].
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn sweeptrace_contacts_add(
+    contacts: *mut SweeptraceContacts,
+    contact: *const SweeptraceContact,
+) -> c_int {
+    if contacts.is_null() || contact.is_null() {
+        return 1;
+    }
+    // SAFETY: both non-null and valid by the contract.
+    unsafe { (*contacts).contacts.push(*contact) };
+    0
+}
+
+/// Called with each contact query: add the contacts the engine reports
+/// with [`sweeptrace_contacts_add`] (none: it touches nothing) and return
+/// 0, or return nonzero to stop the loop (it then returns 1 after printing
+/// an error naming the query; nothing is written for it).
+pub type SweeptraceContactFn = Option<
+    unsafe extern "C" fn(
+        user: *mut c_void,
+        query: *const SweeptraceContactQuery,
+        contacts: *mut SweeptraceContacts,
+    ) -> c_int,
+>;
+
+/// The contacts `list` as the protocol's answer to `query`, checked
+/// against a scene of `triangles` triangles.
+fn contacts_message(
+    query: &SweeptraceContactQuery,
+    list: &[SweeptraceContact],
+    triangles: usize,
+) -> Result<sweeptrace::trace::ContactsMsg, String> {
+    use sweeptrace::trace::ContactPointMsg;
+    let mut contacts = Vec::with_capacity(list.len());
+    for (i, c) in list.iter().enumerate() {
+        let at = format!("contact {i}");
+        if c.fields
+            & !(SWEEPTRACE_FIELD_FEATURE
+                | SWEEPTRACE_FIELD_CONTACT
+                | SWEEPTRACE_FIELD_NORMAL
+                | SWEEPTRACE_FIELD_SEPARATION)
+            != 0
+        {
+            return Err(format!(
+                "{at}: `fields` has unknown bits {:#x} (SWEEPTRACE_FIELD_FEATURE, _CONTACT, _NORMAL, _SEPARATION or-ed)",
+                c.fields
+            ));
+        }
+        if c.triangle as usize >= triangles {
+            return Err(format!(
+                "{at}: `triangle` {} is not in the scene ({})",
+                c.triangle,
+                sweeptrace::numbers::counted(triangles as u64, "triangle", "triangles")
+            ));
+        }
+        let given = |bit: u32| c.fields & bit != 0;
+        let (kind, feature) = if given(SWEEPTRACE_FIELD_FEATURE) {
+            let kind = match c.kind {
+                k if k == SweeptraceKind::Face as u32 => Kind::Face,
+                k if k == SweeptraceKind::Edge as u32 => Kind::Edge,
+                k if k == SweeptraceKind::Vertex as u32 => Kind::Vertex,
+                k => {
+                    return Err(format!(
+                        "{at}: `kind` {k} is not face, edge or vertex (SweeptraceKind)"
+                    ));
+                }
+            };
+            let feature =
+                (kind != Kind::Face).then_some(u8::try_from(c.feature).unwrap_or(u8::MAX));
+            (Some(kind), feature)
+        } else {
+            (None, None)
+        };
+        contacts.push(ContactPointMsg {
+            triangle: c.triangle,
+            kind,
+            feature,
+            point: given(SWEEPTRACE_FIELD_CONTACT).then_some(c.point),
+            normal: given(SWEEPTRACE_FIELD_NORMAL).then_some(c.normal),
+            separation: given(SWEEPTRACE_FIELD_SEPARATION).then_some(c.separation),
+        });
+    }
+    let message = sweeptrace::trace::ContactsMsg {
+        frame: query.frame,
+        ball: query.ball,
+        contacts,
+    };
+    sweeptrace::trace::validate::validate_contacts(&message)
+        .map_err(|p| format!("field `{}`: {}", p.field, p.problem))?;
+    Ok(message)
+}
+
 /// Why the loop stopped early.
 struct Stop(String);
 
@@ -945,12 +1102,15 @@ unsafe fn serve(
         *const SweeptraceSweep,
         *mut SweeptraceAnswer,
     ) -> c_int,
+    on_contact: SweeptraceContactFn,
     user: *mut c_void,
     input: &mut impl std::io::BufRead,
     output: &mut impl std::io::Write,
 ) -> Result<(), Stop> {
-    use sweeptrace::engine::protocol::{Request, answer_line, parse_request};
-    use sweeptrace::trace::validate::{validate_outcome, validate_scene, validate_sweep};
+    use sweeptrace::engine::protocol::{Request, answer_line, contacts_line, parse_request};
+    use sweeptrace::trace::validate::{
+        validate_contact, validate_outcome, validate_scene, validate_sweep,
+    };
 
     let mut scene: Option<SceneData> = None;
     let mut line = Vec::new();
@@ -972,13 +1132,53 @@ unsafe fn serve(
             .map_err(|e| Stop(format!("{at} is not a protocol message: {e}")))?;
         match request {
             Request::Other(_) => {}
-            // The C API has no contact callback: say so rather than leave
+            // Without a contact callback, say so rather than leave
             // sweeptrace waiting for an answer.
             Request::Contact(contact) => {
-                return Err(Stop(format!(
-                    "{at}: a contact query (frame {}, ball {}), but sweeptrace_serve_engine answers sweeps only: check without --engine-contacts",
-                    contact.frame, contact.ball
-                )));
+                let which = format!("frame {}, ball {}", contact.frame, contact.ball);
+                let Some(on_contact) = on_contact else {
+                    return Err(Stop(format!(
+                        "{at}: a contact query ({which}), but sweeptrace_serve_engine answers sweeps only: serve with sweeptrace_serve_engine_contacts, or check without --engine-contacts"
+                    )));
+                };
+                let Some(current) = &scene else {
+                    return Err(Stop(format!(
+                        "{at}: the contact query of {which} arrived before any scene"
+                    )));
+                };
+                validate_contact(&contact).map_err(|p| {
+                    Stop(format!(
+                        "{at}: contact query of {which}: field `{}`: {}",
+                        p.field, p.problem
+                    ))
+                })?;
+                let view = SweeptraceContactQuery {
+                    frame: contact.frame,
+                    ball: contact.ball,
+                    radius: contact.radius,
+                    centre: contact.centre,
+                    distance: contact.distance,
+                };
+                let mut list = SweeptraceContacts {
+                    contacts: Vec::new(),
+                };
+                // SAFETY: the callback's contract is the caller's; `list`
+                // lives through the call.
+                let status = unsafe { on_contact(user, &view, &mut list) };
+                if status != 0 {
+                    return Err(Stop(format!("on_contact returned {status} for {which}")));
+                }
+                let message = contacts_message(&view, &list.contacts, current.triangles.len() / 3)
+                    .map_err(|m| {
+                        Stop(format!(
+                            "invalid answer to the contact query of {which}: {m}"
+                        ))
+                    })?;
+                let text = contacts_line(&message).map_err(|e| Stop(e.to_string()))?;
+                output
+                    .write_all(text.as_bytes())
+                    .and_then(|()| output.flush())
+                    .map_err(|e| Stop(format!("cannot write the answer to {which}: {e}")))?;
             }
             Request::Scene(message) => {
                 validate_scene(&message).map_err(|p| {
@@ -1121,6 +1321,59 @@ pub unsafe extern "C" fn sweeptrace_serve_engine(
     engine: *const SweeptraceEngine,
     user: *mut c_void,
 ) -> c_int {
+    // SAFETY: the caller's contract is `serve_stdio`'s.
+    unsafe { serve_stdio(engine, None, user) }
+}
+
+/// [`sweeptrace_serve_engine`], answering contact queries too (`sweeptrace
+/// check --engine ... --engine-contacts`, `sweeptrace conform --contacts`):
+/// for each, `on_contact(user, query, contacts)` adds the contacts the
+/// engine reports with [`sweeptrace_contacts_add`], and the loop writes
+/// them as the query's `contacts` line. Returns as
+/// [`sweeptrace_serve_engine`] does, and 1 also when `on_contact` is null
+/// (nothing is read), returns nonzero (the message names the query), or
+/// gives an invalid contact (a `triangle` out of the scene, unknown bits
+/// in `fields`, a `kind` that is not face, edge or vertex, a `feature`
+/// above 2, a point, normal or separation that is not finite, a zero
+/// normal): nothing is written for that query.
+///
+/// # Safety
+/// As [`sweeptrace_serve_engine`]; `on_contact` is null or a valid
+/// function, safe to call with `user`.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn sweeptrace_serve_engine_contacts(
+    engine: *const SweeptraceEngine,
+    on_contact: SweeptraceContactFn,
+    user: *mut c_void,
+) -> c_int {
+    if on_contact.is_none() {
+        return fail_serving("`on_contact` is a null pointer".to_string());
+    }
+    // SAFETY: the caller's contract is `serve_stdio`'s.
+    unsafe { serve_stdio(engine, on_contact, user) }
+}
+
+/// Prints `sweeptrace engine: MESSAGE` on stderr, keeps it as the thread's
+/// last error, returns 1.
+fn fail_serving(message: String) -> c_int {
+    set_thread_error(&message);
+    let _ = catch_unwind(|| {
+        use std::io::Write;
+        let _ = writeln!(std::io::stderr(), "sweeptrace engine: {message}");
+    });
+    1
+}
+
+/// The loop of both serving functions on the process's standard input and
+/// output, under `catch_unwind`.
+///
+/// # Safety
+/// As [`sweeptrace_serve_engine_contacts`].
+unsafe fn serve_stdio(
+    engine: *const SweeptraceEngine,
+    on_contact: SweeptraceContactFn,
+    user: *mut c_void,
+) -> c_int {
     let result = catch_unwind(AssertUnwindSafe(|| -> Result<(), Stop> {
         if engine.is_null() {
             return Err(Stop("`engine` is a null pointer".to_string()));
@@ -1140,21 +1393,16 @@ pub unsafe extern "C" fn sweeptrace_serve_engine(
             serve(
                 on_scene,
                 on_sweep,
+                on_contact,
                 user,
                 &mut stdin.lock(),
                 &mut stdout.lock(),
             )
         }
     }));
-    let message = match result {
-        Ok(Ok(())) => return 0,
-        Ok(Err(Stop(message))) => message,
-        Err(payload) => panic_message(payload.as_ref()),
-    };
-    set_thread_error(&message);
-    let _ = catch_unwind(|| {
-        use std::io::Write;
-        let _ = writeln!(std::io::stderr(), "sweeptrace engine: {message}");
-    });
-    1
+    match result {
+        Ok(Ok(())) => 0,
+        Ok(Err(Stop(message))) => fail_serving(message),
+        Err(payload) => fail_serving(panic_message(payload.as_ref())),
+    }
 }

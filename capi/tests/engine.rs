@@ -1,7 +1,9 @@
 //! `sweeptrace_serve_engine`: examples/c/engine.c compiled with the system
-//! C compiler against the static library passes `conform` and `check
+//! C compiler against the static library passes `conform` (its contact
+//! rules too, through `sweeptrace_serve_engine_contacts`) and `check
 //! --engine` on the sample traces, its `--bug skip-vertex` fails exactly the
-//! vertex rules, a C++ lambda engine passes a trace, and the loop's
+//! vertex rules and its `--bug contact-normal` exactly the contact rules
+//! the Python engine's does, a C++ lambda engine passes a trace, and the loop's
 //! documented results (a callback's error, a sweep before any scene, a
 //! scene without triangles, invalid answers, unknown messages) hold.
 //!
@@ -20,14 +22,17 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Output, Stdio};
 use std::sync::Mutex;
 
-use sweeptrace::conform::{ConformOptions, cases, run, shell_quote};
+use sweeptrace::conform::{ConformOptions, run, select, shell_quote};
 use sweeptrace::core::Facing;
-use sweeptrace::engine::protocol::{parse_answer, scene_line, sweep_line};
+use sweeptrace::engine::protocol::{
+    contact_line, parse_answer, parse_contacts, scene_line, sweep_line,
+};
 use sweeptrace::engine::{EngineCommand, EngineOptions};
 use sweeptrace::suite::engine_check::check_file_with_engine;
 use sweeptrace::suite::report::Against;
 use sweeptrace::suite::{CheckOptions, Status, render_text};
 use sweeptrace::trace::PendingTrace;
+use sweeptrace::trace::{ContactMsg, ContactPointMsg};
 use sweeptrace::{SceneMsg, SweepMsg};
 
 /// Set to `1` to make the tests that need a C (or C++) compiler fail,
@@ -130,16 +135,18 @@ fn command(program: &Path, args: &str) -> EngineCommand {
     EngineCommand::parse(text.trim()).expect("a valid engine command")
 }
 
-/// The C engine's conformance: the rules that fail, and the report.
-fn conform_failures(engine: &EngineCommand) -> Vec<String> {
+/// The C engine's conformance (with the contact rules when it answers
+/// `contacts` queries): the rules that fail.
+fn conform_failures(engine: &EngineCommand, contacts: bool) -> Vec<String> {
     let options = ConformOptions {
         strict: true,
         ..ConformOptions::default()
     };
-    let report = run(engine, EngineOptions::default(), &cases(), &options)
+    let cases = select(None, contacts).expect("every case");
+    let report = run(engine, EngineOptions::default(), &cases, &options)
         .unwrap_or_else(|e| panic!("the engine cannot be started: {e}"));
     assert_eq!(report.error, None, "a fault of the engine");
-    assert_eq!(report.cases, cases().len() as u64);
+    assert_eq!(report.cases, cases.len() as u64);
     report
         .rules
         .iter()
@@ -153,8 +160,27 @@ fn c_engine_passes_every_conform_rule() {
     let Some(program) = compile("examples/c/engine.c", false) else {
         return;
     };
-    let failing = conform_failures(&command(&program, ""));
+    let failing = conform_failures(&command(&program, ""), true);
     assert!(failing.is_empty(), "rules failing: {failing:?}");
+}
+
+#[test]
+fn c_engine_contact_normal_bug_fails_exactly_the_contact_rules() {
+    let Some(program) = compile("examples/c/engine.c", false) else {
+        return;
+    };
+    // The rules tests/conform.rs lists for the Python engine's
+    // contact-normal.
+    let expected = [
+        "contact.edge",
+        "contact.vertex",
+        "contact.flat-seam",
+        "contact.shallow-convex-edge",
+        "contact.concave-corner",
+        "contact.speculative",
+    ];
+    let failing = conform_failures(&command(&program, "--bug contact-normal"), true);
+    assert_eq!(failing, expected);
 }
 
 #[test]
@@ -171,7 +197,7 @@ fn c_engine_skip_vertex_bug_fails_exactly_the_vertex_rules() {
         "tie.cube-corner",
         "margin.vertex-hit",
     ];
-    let failing = conform_failures(&command(&program, "--bug skip-vertex"));
+    let failing = conform_failures(&command(&program, "--bug skip-vertex"), true);
     assert_eq!(failing, expected);
 }
 
@@ -473,6 +499,78 @@ fn bad_input_and_a_null_callback_are_errors() {
     );
 }
 
+fn contact_query(frame: u64) -> String {
+    contact_line(&ContactMsg {
+        frame,
+        ball: 1,
+        radius: 0.5,
+        centre: [1.0, 1.0, 0.25],
+        distance: 0.0,
+    })
+    .expect("a contact line")
+}
+
+#[test]
+fn contact_queries_are_answered_through_the_contact_callback() {
+    let Some(program) = answers_engine() else {
+        return;
+    };
+    let input = format!(
+        "{}{}{}",
+        triangle_scene(Some("level"), vec![[0, 1, 2]]),
+        contact_query(3),
+        sweep(4)
+    );
+    let output = run_engine(&program, "contacts", &input);
+    assert_eq!(output.status.code(), Some(0), "{}", text(&output.stderr));
+    let stdout = text(&output.stdout);
+    let lines: Vec<&str> = stdout.lines().collect();
+    assert_eq!(lines.len(), 2, "{stdout}");
+    let answer = parse_contacts(lines[0].as_bytes()).expect("a contacts line");
+    assert_eq!((answer.frame, answer.ball), (3, 1));
+    assert_eq!(
+        answer.contacts,
+        vec![ContactPointMsg {
+            triangle: 0,
+            kind: Some(sweeptrace::Kind::Face),
+            feature: None,
+            point: Some([1.0, 1.0, 0.0]),
+            normal: Some([0.0, 0.0, 1.0]),
+            separation: Some(-0.25),
+        }]
+    );
+    parse_answer(lines[1].as_bytes()).expect("the sweep's outcome after it");
+    // Without a contact callback, a query is an error that says how to
+    // serve one.
+    let scene = triangle_scene(Some("level"), vec![[0, 1, 2]]);
+    assert_fails(
+        "miss",
+        &format!("{scene}{}", contact_query(3)),
+        0,
+        "input line 2: a contact query (frame 3, ball 1), but sweeptrace_serve_engine answers \
+         sweeps only: serve with sweeptrace_serve_engine_contacts, or check without --engine-contacts",
+    );
+    assert_fails(
+        "contact-bad",
+        &format!("{scene}{}", contact_query(3)),
+        0,
+        "invalid answer to the contact query of frame 3, ball 1: contact 0: `triangle` 5 is not \
+         in the scene (1 triangle)",
+    );
+    assert_fails(
+        "contact-fail",
+        &format!("{scene}{}", contact_query(3)),
+        0,
+        "on_contact returned 4 for frame 3, ball 1",
+    );
+    assert_fails(
+        "contact-null",
+        &format!("{scene}{}", contact_query(3)),
+        0,
+        "`on_contact` is a null pointer",
+    );
+}
+
 #[test]
 fn minimal_engine_runs_through_conform_and_the_docs_show_it_unchanged() {
     let example = std::fs::read_to_string(root().join("examples/c/minimal_engine.c"))
@@ -489,7 +587,7 @@ fn minimal_engine_runs_through_conform_and_the_docs_show_it_unchanged() {
     };
     // It answers "no collision" everywhere: no fault, the miss rules pass,
     // the hit rules fail.
-    let failing = conform_failures(&command(&program, ""));
+    let failing = conform_failures(&command(&program, ""), false);
     assert!(failing.contains(&"face.hit".to_string()), "{failing:?}");
     assert!(
         !failing.iter().any(|r| r.starts_with("face.miss")),
@@ -591,7 +689,7 @@ fn documented_engine_build_commands_link_and_the_engine_runs() {
             output.status,
             String::from_utf8_lossy(&output.stderr)
         );
-        let failing = conform_failures(&self::command(&program, ""));
+        let failing = conform_failures(&self::command(&program, ""), true);
         assert!(
             failing.is_empty(),
             "{file}: the engine `{command}` builds fails {failing:?}"

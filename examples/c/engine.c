@@ -1,9 +1,12 @@
 /* A swept-sphere vs triangle-mesh engine in plain C, served to sweeptrace
- * through the C API (sweeptrace_serve_engine: no JSON here). It is
+ * through the C API (sweeptrace_serve_engine_contacts: no JSON here). It is
  * examples/engines/sweep_engine.py ported line for line: the face test,
  * the edge test in the edge's standardized frame, the vertex test, the
  * facing rule, the margin, and the combination of hits with the tie window
- * (docs/SEMANTICS.md).
+ * (docs/SEMANTICS.md); and its contact queries: every triangle whose
+ * closest point is within the radius plus the contact distance, the point
+ * by Ericson's regions (an edge's computed in its standard frame), the
+ * face normal (docs/SEMANTICS.md, "Contacts").
  *
  *   cargo build --release -p sweeptrace-capi
  *   cc -std=c99 -Wall -Wextra -Werror examples/c/engine.c -I capi/include \
@@ -15,7 +18,9 @@
  *   sweeptrace check traces/ --engine ./engine
  *
  * `--bug skip-vertex` switches on a deliberate mistake (the vertex test
- * never runs, so corners are missed), to see what sweeptrace reports.
+ * never runs, so corners are missed), `--bug contact-normal` another (the
+ * contacts' normal is the geometric one, centre minus point: ghost contacts
+ * on flat seams), to see what sweeptrace reports.
  */
 #include <float.h>
 #include <math.h>
@@ -64,6 +69,7 @@ typedef struct {
     double margin;
     int strict;         /* facing rule: n.d < 0 instead of n.d <= 0 */
     int skip_vertex;    /* --bug skip-vertex */
+    int contact_normal; /* --bug contact-normal */
 } Engine;
 
 static Frame frame(Vec3 v0, Vec3 v1, Vec3 normal) {
@@ -272,19 +278,84 @@ static int on_sweep(void *user, const SweeptraceSweep *sweep, SweeptraceAnswer *
     return 0;
 }
 
+/* The point of edge k of `t` nearest to p, computed in the edge's standard
+ * frame: the centre's first coordinate there, clamped to [0, L]. */
+static Vec3 edge_point(const Triangle *t, int k, Vec3 p) {
+    const Frame *f = &t->edges[k];
+    double along = fmin(fmax(dot(sub(p, f->v0), f->x), 0.0), f->length);
+    return add(f->v0, scale(f->x, along));
+}
+
+/* The point of `t` nearest to p and its feature (Ericson, Real-Time
+ * Collision Detection, 5.1.5): kind SWEEPTRACE_KIND_FACE, _EDGE or _VERTEX,
+ * and the edge or vertex index. */
+static Vec3 closest(const Triangle *t, Vec3 p, uint32_t *kind, uint32_t *feature) {
+    Vec3 a = t->vertices[0], b = t->vertices[1], c = t->vertices[2];
+    Vec3 ab = sub(b, a), ac = sub(c, a), ap = sub(p, a);
+    double d1 = dot(ab, ap), d2 = dot(ac, ap);
+    *feature = 0;
+    *kind = SWEEPTRACE_KIND_VERTEX;
+    if (d1 <= 0.0 && d2 <= 0.0) return a;
+    Vec3 bp = sub(p, b);
+    double d3 = dot(ab, bp), d4 = dot(ac, bp);
+    if (d3 >= 0.0 && d4 <= d3) { *feature = 1; return b; }
+    double vc = d1 * d4 - d3 * d2;
+    *kind = SWEEPTRACE_KIND_EDGE;
+    if (vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0) return edge_point(t, 0, p);
+    Vec3 cp = sub(p, c);
+    double d5 = dot(ab, cp), d6 = dot(ac, cp);
+    if (d6 >= 0.0 && d5 <= d6) { *kind = SWEEPTRACE_KIND_VERTEX; *feature = 2; return c; }
+    double vb = d5 * d2 - d1 * d6;
+    if (vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0) { *feature = 2; return edge_point(t, 2, p); }
+    double va = d3 * d6 - d5 * d4;
+    if (va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0) { *feature = 1; return edge_point(t, 1, p); }
+    double denom = 1.0 / (va + vb + vc);
+    *kind = SWEEPTRACE_KIND_FACE;
+    return add(a, add(scale(ab, vb * denom), scale(ac, vc * denom)));
+}
+
+/* A contact query: one contact per usable triangle within the radius plus
+ * the contact distance whose front faces the centre (one-sided). */
+static int on_contact(void *user, const SweeptraceContactQuery *query, SweeptraceContacts *contacts) {
+    const Engine *engine = user;
+    Vec3 centre = vec(query->centre);
+    double reach = query->radius + query->distance;
+    for (size_t i = 0; i < engine->count; i++) {
+        const Triangle *t = &engine->triangles[i];
+        SweeptraceContact contact = {0};
+        Vec3 point = closest(t, centre, &contact.kind, &contact.feature);
+        Vec3 towards = sub(centre, point);
+        double gap = norm(towards);
+        if (gap > reach || dot(t->normal, towards) < 0.0) continue;
+        Vec3 normal = t->normal;
+        if (engine->contact_normal && gap > 0.0) normal = scale(towards, 1.0 / gap);
+        contact.triangle = t->index;
+        contact.fields = SWEEPTRACE_FIELD_FEATURE | SWEEPTRACE_FIELD_CONTACT |
+                         SWEEPTRACE_FIELD_NORMAL | SWEEPTRACE_FIELD_SEPARATION;
+        put(contact.point, point);
+        put(contact.normal, normal);
+        contact.separation = gap - query->radius;
+        if (sweeptrace_contacts_add(contacts, &contact) != 0) return 1;
+    }
+    return 0;
+}
+
 int main(int argc, char **argv) {
     Engine engine = {0};
     for (int i = 1; i < argc; i++) {
         if (i + 1 < argc && strcmp(argv[i], "--bug") == 0 && strcmp(argv[i + 1], "skip-vertex") == 0) {
             engine.skip_vertex = 1;
             i++;
+        } else if (i + 1 < argc && strcmp(argv[i], "--bug") == 0 && strcmp(argv[i + 1], "contact-normal") == 0) {
+            engine.contact_normal = 1;
+            i++;
         } else {
-            fprintf(stderr, "usage: %s [--bug skip-vertex]\n", argv[0]);
+            fprintf(stderr, "usage: %s [--bug skip-vertex | --bug contact-normal]\n", argv[0]);
             return 2;
         }
     }
     const SweeptraceEngine callbacks = {on_scene, on_sweep};
-    int status = sweeptrace_serve_engine(&callbacks, &engine);
+    int status = sweeptrace_serve_engine_contacts(&callbacks, on_contact, &engine);
     free(engine.triangles);
     return status;
 }

@@ -286,7 +286,7 @@ pub fn validate_outcome(outcome: &OutcomeMsg) -> Result<(), FieldProblem> {
 
 /// Checks a contact query: a finite radius `> 0`, a finite centre, a
 /// finite contact distance `≥ 0`.
-pub(crate) fn validate_contact(contact: &ContactMsg) -> Result<(), FieldProblem> {
+pub fn validate_contact(contact: &ContactMsg) -> Result<(), FieldProblem> {
     numbers::check(contact.radius, Rule::Positive).map_err(|e| FieldProblem::new("radius", e))?;
     finite3("centre", &contact.centre)?;
     numbers::check(contact.distance, Rule::NonNegative)
@@ -306,7 +306,7 @@ pub(crate) fn validate_contact(contact: &ContactMsg) -> Result<(), FieldProblem>
 /// Checks an engine's contacts: per contact, `kind` not `none`, `feature`
 /// in `0..=2` (and absent on a face), finite `point`, `normal` and
 /// `separation`, a nonzero normal.
-pub(crate) fn validate_contacts(contacts: &ContactsMsg) -> Result<(), FieldProblem> {
+pub fn validate_contacts(contacts: &ContactsMsg) -> Result<(), FieldProblem> {
     for (i, c) in contacts.contacts.iter().enumerate() {
         let field = |name: &str| format!("contacts[{i}].{name}");
         if c.kind == Some(Kind::None) {

@@ -135,6 +135,7 @@ pub fn contact_set(mesh: &Mesh, query: &ContactQuery, sides: Sides) -> Vec<Conta
     // loose by the rounding of the height so that `triangle_contact`
     // decides every case it could accept.
     let slack = 64.0 * f64::EPSILON * size;
+    let far = reach + slack;
     mesh.bvh()
         .traverse(&query.centre, &Vector3::zeros(), grow, 0.0, |range| {
             for position in range {
@@ -143,18 +144,47 @@ pub fn contact_set(mesh: &Mesh, query: &ContactQuery, sides: Sides) -> Vec<Conta
                 if height.abs() > reach + slack || (sides == Sides::One && height < -slack) {
                     continue;
                 }
-                if let Some(contact) = triangle_contact(&triangles[position], query, sides) {
+                // The triangle lies within `extent` of `v0`: on a height
+                // field the plane test keeps every triangle under the
+                // ball's reach, this one those the ball can touch, before
+                // the triangle's whole record is read (in a large mesh, a
+                // cache miss each).
+                let extent = f64::from(plane.extent);
+                if (query.centre - plane.v0).norm_squared() > (far + extent) * (far + extent) {
+                    continue;
+                }
+                // Then its bounding box, which holds the closest point.
+                let triangle = &triangles[position];
+                if box_distance_squared(&triangle.vertices, &query.centre) > far * far {
+                    continue;
+                }
+                if let Some(contact) = triangle_contact(triangle, query, sides) {
                     found.push(contact);
                 }
             }
             0.0
         });
-    found.sort_by(|a, b| {
-        a.separation
-            .total_cmp(&b.separation)
-            .then(a.triangle.cmp(&b.triangle))
-    });
-    found
+    // By separation, then triangle (each key distinct): the keys sorted
+    // apart from the contacts, which are large to move.
+    let mut order: Vec<(f64, u32, u32)> = found
+        .iter()
+        .enumerate()
+        .map(|(i, c)| (c.separation, c.triangle, i as u32))
+        .collect();
+    order.sort_unstable_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+    order.iter().map(|&(_, _, i)| found[i as usize]).collect()
+}
+
+/// The squared distance from `p` to the bounding box of `vertices`.
+fn box_distance_squared(vertices: &[Point3<f64>; 3], p: &Point3<f64>) -> f64 {
+    let [a, b, c] = vertices;
+    (0..3)
+        .map(|k| {
+            let (lo, hi) = (a[k].min(b[k]).min(c[k]), a[k].max(b[k]).max(c[k]));
+            let d = (lo - p[k]).max(p[k] - hi).max(0.0);
+            d * d
+        })
+        .sum()
 }
 
 #[cfg(test)]

@@ -126,14 +126,26 @@ pub(crate) struct Plane {
     pub(crate) v0: Point3<f64>,
     /// [`Triangle::index`].
     pub(crate) index: u32,
+    /// The largest distance from `v0` to the triangle's other vertices,
+    /// rounded up to single precision (it fills the record's padding): the
+    /// triangle lies within this distance of `v0`, which lets a contact
+    /// query pass it by without reading its whole record.
+    pub(crate) extent: f32,
 }
 
 impl Plane {
     fn of(triangle: &Triangle) -> Plane {
+        let [a, b, c] = triangle.vertices;
+        let far = (b - a).norm().max((c - a).norm());
+        let mut extent = far as f32;
+        if f64::from(extent) < far {
+            extent = extent.next_up();
+        }
         Plane {
             normal: triangle.normal,
-            v0: triangle.vertices[0],
+            v0: a,
             index: triangle.index,
+            extent,
         }
     }
 }

@@ -51,11 +51,11 @@ pub const DEFAULT_FLUSH_BYTES: usize = 32 << 20;
 /// its parts are joined into long chunks at the end, so the buffer's size no
 /// longer sets the chunks' length, only how often the buffer is written
 /// out (each flush writes one part per entity and set). A smaller buffer
-/// means more flushes, a larger one more memory for little speed: this is
-/// the largest of the sizes tried that keeps the long 64-ball session of
-/// BENCHMARKS.md, footer included, within the memory goal (the
+/// means more flushes, a larger one more memory for little speed: 8 MiB
+/// (12 before) with the allocator's settings of the binary took the
+/// 1.86 M-sweep session of BENCHMARKS.md from 205 to 165 MB (the
 /// measurements are there).
-pub const SPILL_FLUSH_BYTES: usize = 12 << 20;
+pub const SPILL_FLUSH_BYTES: usize = 8 << 20;
 
 /// Sweeps per [`PreparedSweeps`] that the command and the bench prepare on
 /// one worker (runs of consecutive sweeps of a batch, cut at this length).

@@ -48,12 +48,18 @@ pub const MAX_CHUNK_ROWS: usize = 16384;
 /// the first part that reaches it; the schema each part carries in the
 /// temporary file is not counted).
 ///
-/// Both are above the viewer store's compaction thresholds (4,096 rows,
-/// 384 KiB), which only say how far the viewer merges small chunks: the
-/// footer's index costs several KB per chunk until the file is finished
-/// (one row of a column per entity and component), so fewer, longer chunks
-/// keep that memory small. A larger limit gave fewer chunks but a larger
-/// file (see BENCHMARKS.md).
+/// Shorter chunks make a smaller file (likely because the chunks are
+/// compressed with LZ4, whose matches reach back 64 KiB at most, and a
+/// chunk lays its columns out one after the other: the same values in
+/// several columns of a row, a ball's position in its balls, capsule and
+/// contact, are only seen as repeats while the columns are short; not
+/// verified): 512 KiB gave 458 B a
+/// sweep on a 347 k-sweep session, 256 KiB 442; 4 MiB chunks (tried to
+/// bound the footer) 471, and 468 against 411 on a 1.86 M-sweep one. The
+/// other way, each chunk costs the footer's index about 7.5 KB of memory
+/// until the file is finished (one row of every timeline and component
+/// column), which grows with the trace: 256 KiB took a 9.4 M-sweep session
+/// from 309 to 460 MB (BENCHMARKS.md).
 pub const MAX_CHUNK_BYTES: usize = 512 << 10;
 
 /// Where a part lies in the file, its rows and the bytes of its arrays

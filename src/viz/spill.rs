@@ -16,7 +16,8 @@
 //! the file is written while the replay goes on; at the end
 //! [`Spill::drain`] sends the rest, entity after entity. Either way the
 //! parts are joined into chunks of up to [`MAX_CHUNK_ROWS`] rows and about
-//! [`MAX_CHUNK_BYTES`] bytes. Memory: one entity's pending chunk and the
+//! [`MAX_CHUNK_BYTES`] bytes ([`SHORT_CHUNK_BYTES`] for the recording's
+//! first [`SHORT_CHUNKS`] chunks). Memory: one entity's pending chunk and the
 //! index of the parts (32 bytes each). The rows, their ids and their times
 //! are unchanged; only the chunking and the order of the chunks in the file
 //! differ (the viewer orders rows by time, and rows of equal time by row
@@ -62,6 +63,17 @@ pub const MAX_CHUNK_ROWS: usize = 16384;
 /// from 309 to 460 MB (BENCHMARKS.md).
 pub const MAX_CHUNK_BYTES: usize = 512 << 10;
 
+/// The first [`SHORT_CHUNKS`] chunks of a recording hold about this many
+/// bytes at most instead of [`MAX_CHUNK_BYTES`]: shorter chunks make a
+/// smaller file, and while they are few their entries in the footer's
+/// index cost little (at most about 30 MB for all of them, whatever the
+/// trace's length). A 347 k-sweep session fits in them: 458 -> 442 B a
+/// sweep (BENCHMARKS.md).
+pub(crate) const SHORT_CHUNK_BYTES: usize = 256 << 10;
+
+/// How many chunks of a recording are cut at [`SHORT_CHUNK_BYTES`].
+pub(crate) const SHORT_CHUNKS: usize = 4096;
+
 /// Where a part lies in the file, its rows and the bytes of its arrays
 /// (without the schema each part carries in the file).
 #[derive(Clone, Copy, Debug)]
@@ -90,6 +102,8 @@ pub(crate) struct Spill {
     /// At most this many rows per chunk: [`MAX_CHUNK_ROWS`] unless set
     /// ([`Spill::set_max_rows`]).
     max_rows: usize,
+    /// Chunks handed out so far (see [`Spill::max_bytes`]).
+    chunks: usize,
 }
 
 impl Spill {
@@ -109,12 +123,23 @@ impl Spill {
             parts: FxHashMap::default(),
             buf: Vec::new(),
             max_rows: MAX_CHUNK_ROWS,
+            chunks: 0,
         })
     }
 
     /// At most `rows` rows per chunk (at least 1).
     pub(crate) fn set_max_rows(&mut self, rows: usize) {
         self.max_rows = rows.max(1);
+    }
+
+    /// About the most bytes of the next chunk: [`SHORT_CHUNK_BYTES`] for
+    /// the first [`SHORT_CHUNKS`], [`MAX_CHUNK_BYTES`] after.
+    fn max_bytes(&self) -> usize {
+        if self.chunks < SHORT_CHUNKS {
+            SHORT_CHUNK_BYTES
+        } else {
+            MAX_CHUNK_BYTES
+        }
     }
 
     fn error(&self, doing: &'static str, cause: io::Error) -> RecordError {
@@ -169,13 +194,14 @@ impl Spill {
         mut send: impl FnMut(Key, Part) -> Result<(), RecordError>,
     ) -> Result<(), RecordError> {
         let max_rows = self.max_rows;
-        let ready = |refs: &[PartRef]| {
-            refs.iter().map(|r| r.rows).sum::<usize>() >= max_rows
-                || refs.iter().map(|r| r.bytes).sum::<usize>() >= MAX_CHUNK_BYTES
-        };
         let mut flushed = false;
         for i in 0..self.order.len() {
             let key = self.order[i];
+            let max_bytes = self.max_bytes();
+            let ready = |refs: &[PartRef]| {
+                refs.iter().map(|r| r.rows).sum::<usize>() >= max_rows
+                    || refs.iter().map(|r| r.bytes).sum::<usize>() >= max_bytes
+            };
             let Some(refs) = self.parts.get_mut(&key) else {
                 continue;
             };
@@ -186,13 +212,13 @@ impl Spill {
             // worth: those wait for more.
             let (mut start, mut rows, mut bytes) = (0, 0, 0);
             for (j, r) in refs.iter().enumerate() {
-                if rows > 0 && (rows + r.rows > max_rows || bytes + r.bytes > MAX_CHUNK_BYTES) {
+                if rows > 0 && (rows + r.rows > max_rows || bytes + r.bytes > max_bytes) {
                     (start, rows, bytes) = (j, 0, 0);
                 }
                 rows += r.rows;
                 bytes += r.bytes;
             }
-            if rows >= max_rows || bytes >= MAX_CHUNK_BYTES {
+            if rows >= max_rows || bytes >= max_bytes {
                 start = refs.len();
             }
             let now: Vec<PartRef> = refs.drain(..start).collect();
@@ -268,9 +294,10 @@ impl Spill {
                 let n = (whole.num_rows() - start).min(self.max_rows);
                 let batch = whole.slice(start, n);
                 start += n;
-                if rows > 0 && (rows + n > self.max_rows || bytes >= MAX_CHUNK_BYTES) {
+                if rows > 0 && (rows + n > self.max_rows || bytes >= self.max_bytes()) {
                     let part = self.joined(&mut pending)?;
                     send(key, part)?;
+                    self.chunks += 1;
                     (rows, bytes) = (0, 0);
                 }
                 rows += n;
@@ -281,6 +308,7 @@ impl Spill {
         if rows > 0 {
             let part = self.joined(&mut pending)?;
             send(key, part)?;
+            self.chunks += 1;
         }
         Ok(())
     }

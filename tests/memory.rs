@@ -20,7 +20,7 @@ pub fn tests() -> Vec<Trial> {
 const SHORT_FRAMES: u32 = 600;
 
 /// How much more the three-times-longer session may take, in MiB. Measured
-/// (debug build): 81 and 95 MiB, the difference the footer's index of the
+/// (debug build): 88 and 102 MiB, the difference the footer's index of the
 /// extra chunks, the temporary file's index of its parts and how full the
 /// queues happen to be; keeping 400 bytes per sweep (a row's columns
 /// rather than its chunk) would add 54 MiB.

@@ -52,10 +52,9 @@ pub const DEFAULT_FLUSH_BYTES: usize = 32 << 20;
 /// longer sets the chunks' length, only how often the buffer is written
 /// out (each flush writes one part per entity and set). A smaller buffer
 /// means more flushes, a larger one more memory for little speed: 8 MiB
-/// (12 before) with the allocator's settings of the binary took the
-/// 1.86 M-sweep session of BENCHMARKS.md from 205 to 165 MB (the
-/// measurements are there).
-pub const SPILL_FLUSH_BYTES: usize = 8 << 20;
+/// saved 10 to 15 MB but cost 2 s of the 11 s of CPU of a 347 k-sweep
+/// session (BENCHMARKS.md has the measurements).
+pub const SPILL_FLUSH_BYTES: usize = 12 << 20;
 
 /// Sweeps per [`PreparedSweeps`] that the command and the bench prepare on
 /// one worker (runs of consecutive sweeps of a batch, cut at this length).

@@ -32,6 +32,7 @@ mod interrupts;
 mod jolt;
 mod junit;
 mod lean;
+mod memory;
 mod mesh;
 mod oracle;
 mod out_of_order;
@@ -166,6 +167,7 @@ fn main() {
     trials.extend(cbor::tests());
     trials.extend(contacts::tests());
     trials.extend(replay::tests());
+    trials.extend(memory::tests());
     trials.extend(primary_skips::tests());
     trials.extend(record::tests());
     trials.extend(prefetch::tests());
@@ -222,6 +224,7 @@ const SLOW: &[&str] = &[
     "replay::threads_do_not_change_the_outputs",
     "replay::spilled_recording_holds_the_same_rows",
     "replay::flush_by_bytes_keeps_the_content",
+    "memory::replay_memory_does_not_follow_the_trace_length",
     "jolt::clean_jolt_passes_check_under_its_inferred_config",
     "jolt::broken_jolt_variants_fail_check_naming_the_difference",
     "jolt::jolt_conforms_under_its_config_and_its_broken_variants_do_not",

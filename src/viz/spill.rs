@@ -16,7 +16,8 @@
 //! the file is written while the replay goes on; at the end
 //! [`Spill::drain`] sends the rest, entity after entity. Either way the
 //! parts are joined into chunks of up to [`MAX_CHUNK_ROWS`] rows and about
-//! [`MAX_CHUNK_BYTES`] bytes. Memory: one entity's pending chunk and the
+//! [`MAX_CHUNK_BYTES`] bytes ([`SHORT_CHUNK_BYTES`] for the recording's
+//! first [`SHORT_CHUNKS`] chunks). Memory: one entity's pending chunk and the
 //! index of the parts (32 bytes each). The rows, their ids and their times
 //! are unchanged; only the chunking and the order of the chunks in the file
 //! differ (the viewer orders rows by time, and rows of equal time by row
@@ -48,13 +49,30 @@ pub const MAX_CHUNK_ROWS: usize = 16384;
 /// the first part that reaches it; the schema each part carries in the
 /// temporary file is not counted).
 ///
-/// Both are above the viewer store's compaction thresholds (4,096 rows,
-/// 384 KiB), which only say how far the viewer merges small chunks: the
-/// footer's index costs several KB per chunk until the file is finished
-/// (one row of a column per entity and component), so fewer, longer chunks
-/// keep that memory small. A larger limit gave fewer chunks but a larger
-/// file (see BENCHMARKS.md).
+/// Shorter chunks make a smaller file (likely because the chunks are
+/// compressed with LZ4, whose matches reach back 64 KiB at most, and a
+/// chunk lays its columns out one after the other: the same values in
+/// several columns of a row, a ball's position in its balls, capsule and
+/// contact, are only seen as repeats while the columns are short; not
+/// verified): 512 KiB gave 458 B a
+/// sweep on a 347 k-sweep session, 256 KiB 442; 4 MiB chunks (tried to
+/// bound the footer) 471, and 468 against 411 on a 1.86 M-sweep one. The
+/// other way, each chunk costs the footer's index about 7.5 KB of memory
+/// until the file is finished (one row of every timeline and component
+/// column), which grows with the trace: 256 KiB took a 9.4 M-sweep session
+/// from 309 to 460 MB (BENCHMARKS.md).
 pub const MAX_CHUNK_BYTES: usize = 512 << 10;
+
+/// The first [`SHORT_CHUNKS`] chunks of a recording hold about this many
+/// bytes at most instead of [`MAX_CHUNK_BYTES`]: shorter chunks make a
+/// smaller file, and while they are few their entries in the footer's
+/// index cost little (at most about 30 MB for all of them, whatever the
+/// trace's length). A 347 k-sweep session fits in them: 458 -> 442 B a
+/// sweep (BENCHMARKS.md).
+pub(crate) const SHORT_CHUNK_BYTES: usize = 256 << 10;
+
+/// How many chunks of a recording are cut at [`SHORT_CHUNK_BYTES`].
+pub(crate) const SHORT_CHUNKS: usize = 4096;
 
 /// Where a part lies in the file, its rows and the bytes of its arrays
 /// (without the schema each part carries in the file).
@@ -84,6 +102,8 @@ pub(crate) struct Spill {
     /// At most this many rows per chunk: [`MAX_CHUNK_ROWS`] unless set
     /// ([`Spill::set_max_rows`]).
     max_rows: usize,
+    /// Chunks handed out so far (see [`Spill::max_bytes`]).
+    chunks: usize,
 }
 
 impl Spill {
@@ -103,12 +123,23 @@ impl Spill {
             parts: FxHashMap::default(),
             buf: Vec::new(),
             max_rows: MAX_CHUNK_ROWS,
+            chunks: 0,
         })
     }
 
     /// At most `rows` rows per chunk (at least 1).
     pub(crate) fn set_max_rows(&mut self, rows: usize) {
         self.max_rows = rows.max(1);
+    }
+
+    /// About the most bytes of the next chunk: [`SHORT_CHUNK_BYTES`] for
+    /// the first [`SHORT_CHUNKS`], [`MAX_CHUNK_BYTES`] after.
+    fn max_bytes(&self) -> usize {
+        if self.chunks < SHORT_CHUNKS {
+            SHORT_CHUNK_BYTES
+        } else {
+            MAX_CHUNK_BYTES
+        }
     }
 
     fn error(&self, doing: &'static str, cause: io::Error) -> RecordError {
@@ -163,13 +194,14 @@ impl Spill {
         mut send: impl FnMut(Key, Part) -> Result<(), RecordError>,
     ) -> Result<(), RecordError> {
         let max_rows = self.max_rows;
-        let ready = |refs: &[PartRef]| {
-            refs.iter().map(|r| r.rows).sum::<usize>() >= max_rows
-                || refs.iter().map(|r| r.bytes).sum::<usize>() >= MAX_CHUNK_BYTES
-        };
         let mut flushed = false;
         for i in 0..self.order.len() {
             let key = self.order[i];
+            let max_bytes = self.max_bytes();
+            let ready = |refs: &[PartRef]| {
+                refs.iter().map(|r| r.rows).sum::<usize>() >= max_rows
+                    || refs.iter().map(|r| r.bytes).sum::<usize>() >= max_bytes
+            };
             let Some(refs) = self.parts.get_mut(&key) else {
                 continue;
             };
@@ -180,13 +212,13 @@ impl Spill {
             // worth: those wait for more.
             let (mut start, mut rows, mut bytes) = (0, 0, 0);
             for (j, r) in refs.iter().enumerate() {
-                if rows > 0 && (rows + r.rows > max_rows || bytes + r.bytes > MAX_CHUNK_BYTES) {
+                if rows > 0 && (rows + r.rows > max_rows || bytes + r.bytes > max_bytes) {
                     (start, rows, bytes) = (j, 0, 0);
                 }
                 rows += r.rows;
                 bytes += r.bytes;
             }
-            if rows >= max_rows || bytes >= MAX_CHUNK_BYTES {
+            if rows >= max_rows || bytes >= max_bytes {
                 start = refs.len();
             }
             let now: Vec<PartRef> = refs.drain(..start).collect();
@@ -262,9 +294,10 @@ impl Spill {
                 let n = (whole.num_rows() - start).min(self.max_rows);
                 let batch = whole.slice(start, n);
                 start += n;
-                if rows > 0 && (rows + n > self.max_rows || bytes >= MAX_CHUNK_BYTES) {
+                if rows > 0 && (rows + n > self.max_rows || bytes >= self.max_bytes()) {
                     let part = self.joined(&mut pending)?;
                     send(key, part)?;
+                    self.chunks += 1;
                     (rows, bytes) = (0, 0);
                 }
                 rows += n;
@@ -275,6 +308,7 @@ impl Spill {
         if rows > 0 {
             let part = self.joined(&mut pending)?;
             send(key, part)?;
+            self.chunks += 1;
         }
         Ok(())
     }

@@ -187,6 +187,14 @@ fn set_difference(a: &[Contact], b: &[Contact], tolerances: &Tolerances) -> Opti
     None
 }
 
+/// Keeps in `first` the earliest `(frame, ball, side)` of what is on one
+/// side only (`diff`'s sweeps and contact queries alike).
+pub(crate) fn note_unmatched(first: &mut Option<(u64, u32, char)>, key: (u64, u32), side: char) {
+    if first.is_none_or(|(f, b, _)| key < (f, b)) {
+        *first = Some((key.0, key.1, side));
+    }
+}
+
 /// `x ≤ tolerance`, false for NaN.
 fn within(x: f64, tolerance: f64) -> bool {
     x <= tolerance
@@ -204,15 +212,10 @@ pub(crate) fn diff_contacts(
     }
     let (sets_a, sets_b) = (a.0.sets(a.1, a.2), b.0.sets(b.1, b.2));
     let mut report = ContactDiff::default();
-    let unmatched = |key: (u64, u32), side: char, report: &mut ContactDiff| {
-        if report.first_unmatched.is_none_or(|(f, b, _)| key < (f, b)) {
-            report.first_unmatched = Some((key.0, key.1, side));
-        }
-    };
     for (key, set_a) in &sets_a {
         let Some(set_b) = sets_b.get(key) else {
             report.only_in_a += 1;
-            unmatched(*key, 'A', &mut report);
+            note_unmatched(&mut report.first_unmatched, *key, 'A');
             continue;
         };
         report.compared += 1;
@@ -235,7 +238,7 @@ pub(crate) fn diff_contacts(
     for key in sets_b.keys() {
         if !sets_a.contains_key(key) {
             report.only_in_b += 1;
-            unmatched(*key, 'B', &mut report);
+            note_unmatched(&mut report.first_unmatched, *key, 'B');
         }
     }
     Some(report)

@@ -28,7 +28,9 @@ use crate::replay::{
 };
 use crate::trace::{EventBody, OutcomeMsg, TraceError, TraceEvent};
 
-use super::contact_diff::{ContactDiff, SideQueries, diff_contacts, write_contact_diff};
+use super::contact_diff::{
+    ContactDiff, SideQueries, diff_contacts, note_unmatched, write_contact_diff,
+};
 use std::sync::Arc;
 
 /// One side's replayed sweeps, by `(frame, ball)`.
@@ -319,15 +321,10 @@ pub fn diff(a: &Side, b: &Side, tolerances: &Tolerances) -> DiffReport {
         ),
         tolerances: *tolerances,
     };
-    let unmatched = |key: (u64, u32), side: char, report: &mut DiffReport| {
-        if report.first_unmatched.is_none_or(|(f, b, _)| key < (f, b)) {
-            report.first_unmatched = Some((key.0, key.1, side));
-        }
-    };
     for (key, ra) in &a.sweeps {
         let Some(rb) = b.sweeps.get(key) else {
             report.only_in_a += 1;
-            unmatched(*key, 'A', &mut report);
+            note_unmatched(&mut report.first_unmatched, *key, 'A');
             continue;
         };
         report.compared += 1;
@@ -386,7 +383,7 @@ pub fn diff(a: &Side, b: &Side, tolerances: &Tolerances) -> DiffReport {
     for key in b.sweeps.keys() {
         if !a.sweeps.contains_key(key) {
             report.only_in_b += 1;
-            unmatched(*key, 'B', &mut report);
+            note_unmatched(&mut report.first_unmatched, *key, 'B');
         }
     }
     report

@@ -761,6 +761,11 @@ fn the_recording_draws_each_query_and_marks_its_ghosts() -> anyhow::Result<()> {
             .any(|l| l == "ghost contact 5.4°: edge 20.2 is internal and flat"),
         "frame 93: {labels:?}"
     );
+    let series = d.texts_at("/plots/contacts/ball/0", "SeriesLines:names", i64::MIN);
+    ensure!(
+        series == ["contacts", "ghost contacts"],
+        "the plot's series: {series:?}"
+    );
     let log = d.texts_at("/divergences", "TextLog:text", 93);
     ensure!(
         log.iter()

@@ -809,6 +809,7 @@ pub(crate) fn decode_rrd(path: &std::path::Path) -> anyhow::Result<Decoded> {
                         || name == "kind"
                         || name == "verdict"
                         || name == "test"
+                        || name == "SeriesLines:names"
                     {
                         let texts: Vec<Vec<String>> = chunk
                             .iter_component::<rerun::components::Text>(*id)

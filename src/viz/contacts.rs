@@ -6,8 +6,15 @@
 //! a plot of how many contacts and ghost contacts each query has. What each
 //! query shows is the judge's ([`crate::judge::contact_marks`]), shared with
 //! the Foxglove file.
+//!
+//! The rows go into the logger's typed columns, as the sweeps' do (one
+//! chunk per entity, through the temporary file for a recording file), not
+//! row by row through the SDK: a query costs a handful of plain appends.
 
-use rerun::{Arrows3D, Points3D, RecordingStream, Scalars, TextLog, TextLogLevel, TimeCell};
+use std::collections::BTreeSet;
+
+use rerun::components::{Position3D, Radius, Scalar, TextLogLevel, Vector3D};
+use rerun::{Arrows3D, Color, Points3D, Scalars, SeriesLines, TextLog};
 
 use crate::judge::PairedContacts;
 use crate::judge::contact_marks::{
@@ -16,106 +23,144 @@ use crate::judge::contact_marks::{
 use crate::palette::{EXPECTED_COLOR, FACE_NORMAL_COLOR, GHOST_COLOR, NORMAL_COLOR};
 use crate::trace::{TraceError, TraceEvent};
 
-use super::convert::{rgba, ui_points};
-use super::{FRAME_TIMELINE, TIME_TIMELINE, TIMESTAMP_THRESHOLD_NANOS};
+use super::columns::Columns;
+use super::convert::{SERIES_COLORS, rgba, ui_points};
+use super::logger::time_of;
+use super::out::set;
+use super::paths::{CONTACT_SERIES, Entity};
+use super::{Logger, RecordError};
+
+/// Queries drawn between two looks at whether the logger's buffer is full
+/// (a look visits every entity's columns).
+const QUERIES_PER_LOOK: u32 = 64;
 
 /// Draws the contact queries of `events` (a trace read again: sweeps and
-/// expectations pass by) into `rec`, each at its frame and `log_time`.
+/// expectations pass by) into `logger`'s recording, each at its frame and
+/// `log_time`.
 pub fn draw_contacts(
-    rec: &RecordingStream,
+    logger: &mut Logger,
     events: impl Iterator<Item = Result<TraceEvent, TraceError>>,
     how: &ContactDrawing<'_>,
-) -> Result<ContactsDrawn, rerun::RecordingStreamError> {
-    for_each_judged_query(events, how, |paired| draw_one(rec, paired))
+) -> Result<ContactsDrawn, RecordError> {
+    let mut styled = BTreeSet::new();
+    let mut since_look = 0;
+    let drawn = for_each_judged_query(events, how, |paired| {
+        let ball = paired.query.ball;
+        if styled.insert(ball) {
+            let style = SeriesLines::new().with_names(CONTACT_SERIES).with_colors(
+                SERIES_COLORS[..CONTACT_SERIES.len()]
+                    .iter()
+                    .map(|&c| rgba(c)),
+            );
+            logger.log_static(Entity::ContactPlot(ball).path(), &style)?;
+        }
+        contact_rows(logger.columns(), paired);
+        since_look += 1;
+        if since_look == QUERIES_PER_LOOK {
+            since_look = 0;
+            logger.flush_if_full()?;
+        }
+        Ok::<_, RecordError>(())
+    })?;
+    logger.flush()?;
+    Ok(drawn)
 }
 
-fn draw_one(rec: &RecordingStream, p: &PairedContacts) -> Result<(), rerun::RecordingStreamError> {
+/// The rows of one judged query: its contacts, their normals, the expected
+/// normals, the places left out (each logged, empty or not, at every query
+/// of the ball), a line per ghost and problem in the divergences' log, and
+/// the ball's plot of the counts.
+fn contact_rows(columns: &mut Columns, p: &PairedContacts) {
     let q = &p.query;
-    rec.set_time_sequence(FRAME_TIMELINE, i64::try_from(q.frame).unwrap_or(i64::MAX));
-    let nanos = i64::try_from(p.log_time_nanos).unwrap_or(i64::MAX);
-    if p.log_time_nanos >= TIMESTAMP_THRESHOLD_NANOS {
-        rec.set_time(
-            TIME_TIMELINE,
-            TimeCell::from_timestamp_nanos_since_epoch(nanos),
-        );
-    } else {
-        rec.set_time(TIME_TIMELINE, TimeCell::from_duration_nanos(nanos));
-    }
+    let (b, frame, time) = (
+        q.ball,
+        i64::try_from(q.frame).unwrap_or(i64::MAX),
+        time_of(p.log_time_nanos),
+    );
     let length = (q.radius * 3.0) as f32;
     let arrow = |n: [f64; 3]| {
         let norm = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2])
             .sqrt()
             .max(f64::MIN_POSITIVE);
-        n.map(|x| (x / norm) as f32 * length)
+        Vector3D::from(n.map(|x| (x / norm) as f32 * length))
     };
-    let f32x3 = |p: [f64; 3]| p.map(|x| x as f32);
+    let at = |p: [f64; 3]| Position3D::from(p.map(|x| x as f32));
     let marks = contact_marks(p);
-    let (mut points, mut colors, mut labels, mut vectors) = (vec![], vec![], vec![], vec![]);
-    for c in &marks.contacts {
-        let (color, label) = match &c.mark {
-            Mark::Ghost(label) => (GHOST_COLOR, label.clone()),
-            Mark::Problem(problem) => (EXPECTED_COLOR, problem.clone()),
-            Mark::Agrees => (NORMAL_COLOR, String::new()),
-        };
-        points.push(f32x3(c.point));
-        colors.push(rgba(color));
-        labels.push(label);
-        vectors.push(c.normal.map_or([0.0; 3], arrow));
+    fn color_and_label(mark: &Mark) -> ([u8; 4], &str) {
+        match mark {
+            Mark::Ghost(label) => (GHOST_COLOR, label),
+            Mark::Problem(problem) => (EXPECTED_COLOR, problem),
+            Mark::Agrees => (NORMAL_COLOR, ""),
+        }
     }
-    let path = format!("world/ball/{}/contacts", q.ball);
-    rec.log(
-        path.as_str(),
-        &Points3D::new(points.clone())
-            .with_colors(colors.clone())
-            .with_radii([ui_points(5.0)])
-            .with_labels(labels),
-    )?;
-    rec.log(
-        format!("{path}/normals"),
-        &Arrows3D::from_vectors(vectors)
-            .with_origins(points)
-            .with_colors(colors)
-            .with_radii([ui_points(2.0)]),
-    )?;
+    let colors = || {
+        marks
+            .contacts
+            .iter()
+            .map(|c| rgba(color_and_label(&c.mark).0))
+    };
+    let points = || marks.contacts.iter().map(|c| at(c.point));
+    columns
+        .row(Entity::Contacts(b), set::CONTACT_POINTS, frame, time)
+        .put::<Position3D>(Points3D::descriptor_positions, points())
+        .put::<Color>(Points3D::descriptor_colors, colors())
+        .put::<Radius>(Points3D::descriptor_radii, [ui_points(5.0)])
+        .put_strs(
+            Points3D::descriptor_labels,
+            marks.contacts.iter().map(|c| color_and_label(&c.mark).1),
+        );
+    columns
+        .row(Entity::ContactNormals(b), set::ARROWS, frame, time)
+        .put::<Vector3D>(
+            Arrows3D::descriptor_vectors,
+            marks
+                .contacts
+                .iter()
+                .map(|c| c.normal.map_or(Vector3D::from([0.0; 3]), arrow)),
+        )
+        .put::<Position3D>(Arrows3D::descriptor_origins, points())
+        .put::<Color>(Arrows3D::descriptor_colors, colors())
+        .put::<Radius>(Arrows3D::descriptor_radii, [ui_points(2.0)]);
     // What the core expected where the answer differs: the normal beside a
     // differing or ghost normal, and the places left out.
-    let (origins, expected): (Vec<_>, Vec<_>) = marks
-        .expected_normals
-        .iter()
-        .map(|(at, n)| (f32x3(*at), arrow(*n)))
-        .unzip();
-    rec.log(
-        format!("{path}/expected"),
-        &Arrows3D::from_vectors(expected)
-            .with_origins(origins)
-            .with_colors([rgba(FACE_NORMAL_COLOR)])
-            .with_radii([ui_points(2.0)]),
-    )?;
-    let (missing, missing_labels): (Vec<_>, Vec<_>) = marks
-        .missing
-        .iter()
-        .map(|(at, words)| (f32x3(*at), words.clone()))
-        .unzip();
-    rec.log(
-        format!("{path}/missing"),
-        &Points3D::new(missing)
-            .with_colors([rgba(EXPECTED_COLOR)])
-            .with_radii([ui_points(6.0)])
-            .with_labels(missing_labels),
-    )?;
+    columns
+        .row(Entity::ContactExpected(b), set::ARROWS, frame, time)
+        .put::<Vector3D>(
+            Arrows3D::descriptor_vectors,
+            marks.expected_normals.iter().map(|(_, n)| arrow(*n)),
+        )
+        .put::<Position3D>(
+            Arrows3D::descriptor_origins,
+            marks.expected_normals.iter().map(|(p, _)| at(*p)),
+        )
+        .put::<Color>(Arrows3D::descriptor_colors, [rgba(FACE_NORMAL_COLOR)])
+        .put::<Radius>(Arrows3D::descriptor_radii, [ui_points(2.0)]);
+    columns
+        .row(Entity::ContactMissing(b), set::CONTACT_POINTS, frame, time)
+        .put::<Position3D>(
+            Points3D::descriptor_positions,
+            marks.missing.iter().map(|(p, _)| at(*p)),
+        )
+        .put::<Color>(Points3D::descriptor_colors, [rgba(EXPECTED_COLOR)])
+        .put::<Radius>(Points3D::descriptor_radii, [ui_points(6.0)])
+        .put_strs(
+            Points3D::descriptor_labels,
+            marks.missing.iter().map(|(_, words)| words.as_str()),
+        );
     // The text log of divergences gets a line per ghost and problem.
-    for line in marks.log {
-        rec.log(
-            super::paths::DIVERGENCES,
-            &TextLog::new(line).with_level(TextLogLevel::WARN),
-        )?;
+    for line in &marks.log {
+        columns
+            .row(Entity::Divergences, set::TEXT_LOG, frame, time)
+            .put_strs(TextLog::descriptor_text, [line.as_str()])
+            .put_strs(TextLog::descriptor_level, [TextLogLevel::WARN]);
     }
-    rec.log(
-        format!("plots/contacts/ball/{}", q.ball),
-        &Scalars::new([
-            p.answer.contacts.len() as f64,
-            p.verdict.ghosts.len() as f64,
-        ]),
-    )?;
-    Ok(())
+    columns
+        .row(Entity::ContactPlot(b), set::SCALAR, frame, time)
+        .put::<Scalar>(
+            Scalars::descriptor_scalars,
+            [
+                (p.answer.contacts.len() as f64).into(),
+                (p.verdict.ghosts.len() as f64).into(),
+            ],
+        );
 }

@@ -271,7 +271,7 @@ pub(crate) fn edge_strips(scene: &SceneState, class: EdgeClass) -> Vec<[[f32; 3]
 }
 
 /// The `time` timeline's value of a `log_time`.
-fn time_of(log_time_nanos: u64) -> columns::Time {
+pub(super) fn time_of(log_time_nanos: u64) -> columns::Time {
     let clamp = |n: u64| i64::try_from(n).unwrap_or(i64::MAX);
     if log_time_nanos >= TIMESTAMP_THRESHOLD_NANOS {
         columns::Time::Timestamp(clamp(log_time_nanos))
@@ -421,7 +421,7 @@ impl Logger {
         Ok(())
     }
 
-    fn log_static(
+    pub(super) fn log_static(
         &mut self,
         path: impl Into<String>,
         value: &dyn rerun::AsComponents,
@@ -578,6 +578,17 @@ impl Logger {
         if self.spare.len() < MAX_SPARE_PREPARED {
             self.spare.push(p);
         }
+        self.flush_if_full()
+    }
+
+    /// The buffer of rows, for rows other than sweeps' (see
+    /// [`Logger::flush_if_full`]).
+    pub(super) fn columns(&mut self) -> &mut columns::Columns {
+        &mut self.columns
+    }
+
+    /// Sends (or spills) the buffer when it holds enough rows or bytes.
+    pub(super) fn flush_if_full(&mut self) -> Result<(), RecordError> {
         if self.columns.rows() >= self.flush_rows || self.columns.bytes() >= self.flush_bytes {
             self.flush()?;
         }

@@ -55,6 +55,11 @@ pub(crate) mod set {
     pub const TUNNEL: u8 = 22;
     /// A ghost contact's mark: its point and two arrows.
     pub const GHOST: u8 = 23;
+    /// Labelled points: a contact query's contacts, or the places its
+    /// answer leaves out.
+    pub const CONTACT_POINTS: u8 = 24;
+    /// Arrows: a contact query's normals, or the normals expected.
+    pub const ARROWS: u8 = 25;
 }
 
 /// What a sweep's rows leave shown for its ball, of the entities that are

@@ -67,9 +67,20 @@
 //! status/ball/{ball}                  Scalars: 0 when the sweep matches its expectation,
 //!                                     1 when it diverges (sweeps with an expectation only)
 //! status/ball/{ball}/fragile          Scalars: 1 at each fragile decision (absent elsewhere)
+//! world/ball/{ball}/contacts          a contact query's answer (at the query's frame), one
+//!                                     row per query:
+//!                                       Points3D: each answered contact, coloured by its
+//!                                       verdict, a ghost or a problem labelled
+//! world/ball/{ball}/contacts/normals  Arrows3D: each answered contact's normal
+//! world/ball/{ball}/contacts/expected Arrows3D: the normal the core expects beside a
+//!                                     differing or ghost normal
+//! world/ball/{ball}/contacts/missing  Points3D: the places the answer leaves out, labelled
+//! plots/contacts/ball/{ball}          Scalars: contacts and ghost contacts of each query
+//!                                     (series named, static)
 //! log                                 TextLog: one line per sweep, the decision in words
 //! divergences                         TextLog: one line per divergent sweep and one
-//!                                     WARN line per tunnel and per ghost contact
+//!                                     WARN line per tunnel and per ghost contact, and one
+//!                                     per ghost or problem of a contact query
 //! ```
 //!
 //! What one sweep shows of a ball is on few entities, each with the
@@ -178,6 +189,20 @@ pub fn face(ball: u32) -> String {
     format!("plots/ball/{ball}/face")
 }
 
+/// The contacts an engine answered to the ball's contact query.
+pub fn contacts(ball: u32) -> String {
+    format!("world/ball/{ball}/contacts")
+}
+
+/// The numbers of contacts and ghost contacts of each contact query of
+/// the ball, a series each ([`CONTACT_SERIES`]).
+pub fn contact_plot(ball: u32) -> String {
+    format!("plots/contacts/ball/{ball}")
+}
+
+/// The series of [`contact_plot`], in the order of its values.
+pub const CONTACT_SERIES: [&str; 2] = ["contacts", "ghost contacts"];
+
 /// The series of [`quadratic`], in the order of its values.
 pub const QUADRATIC_NAMES: [&str; 6] = ["A", "B", "C", "discriminant", "s0", "s1"];
 /// The series of [`face`], in the order of its values.
@@ -201,6 +226,11 @@ pub(crate) enum Entity {
     Quadratic(u32),
     Face(u32),
     Log,
+    Contacts(u32),
+    ContactNormals(u32),
+    ContactExpected(u32),
+    ContactMissing(u32),
+    ContactPlot(u32),
 }
 
 impl Entity {
@@ -221,6 +251,11 @@ impl Entity {
             Entity::Quadratic(b) => quadratic(b),
             Entity::Face(b) => face(b),
             Entity::Log => LOG.to_string(),
+            Entity::Contacts(b) => contacts(b),
+            Entity::ContactNormals(b) => format!("{}/normals", contacts(b)),
+            Entity::ContactExpected(b) => format!("{}/expected", contacts(b)),
+            Entity::ContactMissing(b) => format!("{}/missing", contacts(b)),
+            Entity::ContactPlot(b) => contact_plot(b),
         }
     }
 }

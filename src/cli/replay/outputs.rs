@@ -245,9 +245,8 @@ impl Outputs {
         };
         #[cfg(feature = "viewer")]
         if let Some(recording) = self.recording.as_mut() {
-            let drawn =
-                sweeptrace::viz::draw_contacts(recording.logger().stream(), read_again()?, &how)
-                    .context("drawing the contact queries")?;
+            let drawn = sweeptrace::viz::draw_contacts(recording.logger(), read_again()?, &how)
+                .context("drawing the contact queries")?;
             eprintln!("contacts: {}", drawn_words(&drawn));
         }
         if let Some(file) = self.sinks.foxglove.as_mut() {

@@ -723,6 +723,100 @@ impl Decoded {
     }
 }
 
+/// Every row of a recording's data (not its blueprint), by entity and
+/// component: `(frame, time, the row's values as Arrow prints them)` in the
+/// order of the rows' frames, then of their row ids (static rows at frame
+/// `i64::MIN`). Two recordings with the same content give the same map
+/// however their rows are cut into chunks and whatever their row ids.
+pub(crate) type RrdContent = BTreeMap<(String, String), Vec<(i64, i64, String)>>;
+
+/// [`RrdContent`] of the recording at `path`.
+pub(crate) fn rrd_content(path: &std::path::Path) -> anyhow::Result<RrdContent> {
+    use rerun::external::arrow::array::Array as _;
+    use rerun::external::re_log_encoding::DecoderApp;
+    use rerun::log::{Chunk, LogMsg};
+    // (frame, row id, time, values) of each row.
+    type Rows = Vec<(i64, u128, i64, String)>;
+    let mut rows: BTreeMap<(String, String), Rows> = BTreeMap::new();
+    let file = std::fs::File::open(path)?;
+    for msg in DecoderApp::decode_lazy(BufReader::new(file)) {
+        let msg = msg.map_err(|e| anyhow::anyhow!("decoding {}: {e}", path.display()))?;
+        let LogMsg::ArrowMsg(store, arrow) = &msg else {
+            continue;
+        };
+        if store.kind() != rerun::StoreKind::Recording {
+            continue;
+        }
+        let chunk = Chunk::from_arrow_msg(arrow)?;
+        let entity = chunk.entity_path().to_string();
+        let index = |timeline: &'static str, fill: i64| -> Vec<i64> {
+            if chunk.is_static() {
+                vec![fill; chunk.num_rows()]
+            } else {
+                chunk
+                    .iter_indices(&timeline.into())
+                    .map(|(t, _)| t.as_i64())
+                    .collect()
+            }
+        };
+        let (frames, times) = (index("frame", i64::MIN), index("time", 0));
+        let ids: Vec<u128> = chunk.row_ids().map(|r| r.as_u128()).collect();
+        for (id, column) in chunk.components().iter() {
+            let list = &column.list_array;
+            for i in 0..list.len() {
+                let value = if list.is_null(i) {
+                    "null".to_string()
+                } else {
+                    format!("{:?}", list.value(i))
+                };
+                rows.entry((entity.clone(), id.to_string()))
+                    .or_default()
+                    .push((frames[i], ids[i], times[i], value));
+            }
+        }
+    }
+    Ok(rows
+        .into_iter()
+        .map(|(k, mut v)| {
+            v.sort_by_key(|(frame, id, _, _)| (*frame, *id));
+            let v = v
+                .into_iter()
+                .map(|(f, _, t, value)| (f, t, value))
+                .collect();
+            (k, v)
+        })
+        .collect())
+}
+
+/// The first difference between two [`RrdContent`]s, in words (none when
+/// they are the same).
+pub(crate) fn first_content_difference(a: &RrdContent, b: &RrdContent) -> Option<String> {
+    let keys: std::collections::BTreeSet<_> = a.keys().chain(b.keys()).collect();
+    for k in keys {
+        let (x, y) = (a.get(k), b.get(k));
+        if x == y {
+            continue;
+        }
+        let (x, y) = (
+            x.cloned().unwrap_or_default(),
+            y.cloned().unwrap_or_default(),
+        );
+        let at = x
+            .iter()
+            .zip(&y)
+            .position(|(p, q)| p != q)
+            .unwrap_or(x.len().min(y.len()));
+        return Some(format!(
+            "{k:?}: {} rows against {}; row {at}: {:?} against {:?}",
+            x.len(),
+            y.len(),
+            x.get(at),
+            y.get(at)
+        ));
+    }
+    None
+}
+
 pub(crate) fn decode_rrd(path: &std::path::Path) -> anyhow::Result<Decoded> {
     use rerun::external::re_log_encoding::DecoderApp;
     use rerun::log::{Chunk, LogMsg};

@@ -255,7 +255,7 @@ fn run_replay(args: Args) -> anyhow::Result<Exit> {
         outputs.abandon();
         bail!("{source_name}: {selection}; nothing written");
     }
-    outputs.draw_contacts(trace_path, &source_name, summary.contact_queries)?;
+    outputs.draw_contacts(trace_path, &source_name, summary.contact_queries, &pool)?;
     let streamed = outputs.streams_to_viewer();
     let wrote = outputs.finish()?;
     for line in &wrote {

@@ -10,7 +10,9 @@ use crate::conventions::EngineConventions;
 use crate::replay::FrameRange;
 use crate::trace::{EventBody, TraceError, TraceEvent};
 
-use super::contact_pairing::{ContactPairing, PairedContacts};
+use rayon::prelude::*;
+
+use super::contact_pairing::{ContactPairing, Pair, PairedContacts};
 use super::contacts::ContactProblem;
 use super::{ContactVerdict, Tolerances};
 
@@ -28,7 +30,13 @@ pub struct ContactDrawing<'a> {
     pub frames: FrameRange,
     /// and this ball.
     pub ball: Option<u32>,
+    /// The threads that judge the queries (each scene's, a batch at a
+    /// time); none: rayon's global pool.
+    pub pool: Option<&'a rayon::ThreadPool>,
 }
+
+/// Queries judged together, in parallel, before they are drawn in order.
+const JUDGED_TOGETHER: usize = 256;
 
 /// What was drawn of a trace's contact queries.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -55,8 +63,10 @@ impl ContactsDrawn {
 
 /// Reads `events` (a trace: sweeps and expectations pass by), pairs each
 /// contact query the selection keeps with its answer, judges it and hands
-/// it to `draw`. A read error ends the reading (the replay reported it
-/// already); an error of `draw` is returned.
+/// it to `draw`, in the trace's order (the queries of a scene are judged
+/// [`JUDGED_TOGETHER`] at a time, in parallel, on `how.pool`). A read
+/// error ends the reading (the replay reported it already); an error of
+/// `draw` is returned.
 pub(crate) fn for_each_judged_query<E>(
     events: impl Iterator<Item = Result<TraceEvent, TraceError>>,
     how: &ContactDrawing<'_>,
@@ -64,26 +74,48 @@ pub(crate) fn for_each_judged_query<E>(
 ) -> Result<ContactsDrawn, E> {
     let mut pairing = ContactPairing::new(how.tolerances, how.conventions, how.ghost_degrees);
     let mut drawn = ContactsDrawn::default();
+    let mut pairs = Vec::with_capacity(JUDGED_TOGETHER);
+    let mut judge_and_draw = |pairing: &ContactPairing<'_>, pairs: &mut Vec<Pair>| {
+        let mut judge = || -> Vec<Option<PairedContacts>> {
+            pairs
+                .par_drain(..)
+                .map(|pair| pairing.judge(pair))
+                .collect()
+        };
+        let judged = match how.pool {
+            Some(pool) => pool.install(judge),
+            None => judge(),
+        };
+        for paired in judged.iter().flatten() {
+            draw(paired)?;
+            drawn.add(paired);
+        }
+        Ok(())
+    };
     let wants =
         |frame: u64, ball: u32| how.frames.contains(frame) && how.ball.is_none_or(|b| b == ball);
     for event in events {
         let Ok(event) = event else { break };
-        let paired = match &event.body {
+        let pair = match &event.body {
             EventBody::Scene(scene) => {
+                judge_and_draw(&pairing, &mut pairs)?;
                 pairing.scene(scene);
                 None
             }
             EventBody::Contact(q) if wants(q.frame, q.ball) => {
-                pairing.query(q, event.header.log_time_nanos)
+                pairing.pair_query(q, event.header.log_time_nanos)
             }
-            EventBody::ExpectedContacts(a) if wants(a.frame, a.ball) => pairing.answer(a),
+            EventBody::ExpectedContacts(a) if wants(a.frame, a.ball) => pairing.pair_answer(a),
             _ => None,
         };
-        if let Some(paired) = paired {
-            draw(&paired)?;
-            drawn.add(&paired);
+        if let Some(pair) = pair {
+            pairs.push(pair);
+            if pairs.len() == JUDGED_TOGETHER {
+                judge_and_draw(&pairing, &mut pairs)?;
+            }
         }
     }
+    judge_and_draw(&pairing, &mut pairs)?;
     Ok(drawn)
 }
 

@@ -31,6 +31,14 @@ pub(crate) struct PairedContacts {
     pub(crate) verdict: ContactVerdict,
 }
 
+/// A query paired with its answer, not yet judged
+/// ([`ContactPairing::judge`]).
+pub(crate) struct Pair {
+    query: ContactMsg,
+    log_time_nanos: u64,
+    answer: ContactsMsg,
+}
+
 /// A trace's contact queries paired with their answers (the `/contact` and
 /// `/expected_contacts` of one frame and ball, in either order, within one
 /// scene) and judged against the scene: the fold `check` and the recording
@@ -86,9 +94,22 @@ impl<'a> ContactPairing<'a> {
         query: &ContactMsg,
         log_time_nanos: u64,
     ) -> Option<PairedContacts> {
+        let pair = self.pair_query(query, log_time_nanos)?;
+        self.judge(pair)
+    }
+
+    /// An answer; judged when its query came first.
+    pub(crate) fn answer(&mut self, answer: &ContactsMsg) -> Option<PairedContacts> {
+        let pair = self.pair_answer(answer)?;
+        self.judge(pair)
+    }
+
+    /// A query at `log_time_nanos`: the pair to judge (with
+    /// [`ContactPairing::judge`]) when its answer came first.
+    pub(crate) fn pair_query(&mut self, query: &ContactMsg, log_time_nanos: u64) -> Option<Pair> {
         let key = (query.frame, query.ball);
         match self.answers.remove(&key) {
-            Some(answer) => self.judge(*query, log_time_nanos, answer),
+            Some(answer) => self.paired(*query, log_time_nanos, answer),
             None => {
                 if self.queries.insert(key, (*query, log_time_nanos)).is_some() {
                     self.without_answer += 1;
@@ -98,11 +119,12 @@ impl<'a> ContactPairing<'a> {
         }
     }
 
-    /// An answer; judged when its query came first.
-    pub(crate) fn answer(&mut self, answer: &ContactsMsg) -> Option<PairedContacts> {
+    /// An answer: the pair to judge (with [`ContactPairing::judge`]) when
+    /// its query came first.
+    pub(crate) fn pair_answer(&mut self, answer: &ContactsMsg) -> Option<Pair> {
         let key = (answer.frame, answer.ball);
         match self.queries.remove(&key) {
-            Some((query, log_time_nanos)) => self.judge(query, log_time_nanos, answer.clone()),
+            Some((query, log_time_nanos)) => self.paired(query, log_time_nanos, answer.clone()),
             None => {
                 if self.answers.insert(key, answer.clone()).is_some() {
                     self.answers_without_query += 1;
@@ -120,12 +142,14 @@ impl<'a> ContactPairing<'a> {
         self.answers.clear();
     }
 
-    fn judge(
+    /// A query and its answer, once the scene is built for them (none when
+    /// the scene has no usable triangle: said in `errors` once).
+    fn paired(
         &mut self,
         query: ContactMsg,
         log_time_nanos: u64,
         answer: ContactsMsg,
-    ) -> Option<PairedContacts> {
+    ) -> Option<Pair> {
         let normal = self.conventions.normal;
         let scene = &self.scene;
         let built = self.built.get_or_insert_with(|| {
@@ -139,7 +163,7 @@ impl<'a> ContactPairing<'a> {
                 normals,
             })
         });
-        let Some(built) = built else {
+        if built.is_none() {
             if self.errors.is_empty() {
                 self.errors.push(format!(
                     "frame {}, ball {}: the contact query's scene has no usable triangle, so contacts cannot be judged",
@@ -147,7 +171,27 @@ impl<'a> ContactPairing<'a> {
                 ));
             }
             return None;
+        }
+        Some(Pair {
+            query,
+            log_time_nanos,
+            answer,
+        })
+    }
+
+    /// Judges `pair` against the current scene (the one it was paired in:
+    /// judge a scene's pairs before the next [`ContactPairing::scene`]).
+    /// Takes `&self`, so that the pairs of a scene can be judged in
+    /// parallel.
+    pub(crate) fn judge(&self, pair: Pair) -> Option<PairedContacts> {
+        let Some(Some(built)) = &self.built else {
+            return None;
         };
+        let Pair {
+            query,
+            log_time_nanos,
+            answer,
+        } = pair;
         let scene = ContactScene {
             mesh: &built.mesh,
             topology: &built.topology,

@@ -18,6 +18,7 @@ use sweeptrace::foxglove::{FoxgloveFile, FoxgloveOptions};
 use sweeptrace::judge::Tolerances;
 use sweeptrace::numbers::plural;
 use sweeptrace::replay::{ReplayEvent, ReplayOptions};
+use sweeptrace::trace::prefetch::{DEFAULT_PREFETCH_CHUNK, DEFAULT_PREFETCH_DEPTH, prefetch};
 
 /// Where the recording goes, if anywhere: `--rrd`, `--spawn`,
 /// `--connect`; with no output named at all, `<trace stem>.rrd`.
@@ -223,6 +224,7 @@ impl Outputs {
         trace_path: &Path,
         source_name: &str,
         queries: u64,
+        pool: &rayon::ThreadPool,
     ) -> anyhow::Result<()> {
         if queries == 0 {
             return Ok(());
@@ -234,14 +236,15 @@ impl Outputs {
             ghost_degrees: sweeptrace::replay::ghost::GHOST_DEGREES,
             frames: options.frames,
             ball: options.ball,
+            pool: Some(pool),
         };
+        // Decoded on a thread of its own while the queries are judged.
         let read_again = || -> anyhow::Result<_> {
             let file = std::fs::File::open(trace_path)
                 .with_context(|| format!("reading {source_name} again for its contacts"))?;
-            Ok(sweeptrace::TraceReader::new(
-                std::io::BufReader::new(file),
-                source_name,
-            ))
+            let reader = sweeptrace::TraceReader::new(std::io::BufReader::new(file), source_name);
+            prefetch(reader, DEFAULT_PREFETCH_CHUNK, DEFAULT_PREFETCH_DEPTH)
+                .context("starting the trace's reader")
         };
         #[cfg(feature = "viewer")]
         if let Some(recording) = self.recording.as_mut() {

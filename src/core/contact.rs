@@ -149,8 +149,14 @@ pub fn contact_set(mesh: &Mesh, query: &ContactQuery, sides: Sides) -> Vec<Conta
                 // ball's reach, this one those the ball can touch, before
                 // the triangle's whole record is read (in a large mesh, a
                 // cache miss each).
+                // In the plane: the centre's foot lies within
+                // `sqrt(far² - height²)` of the closest point, itself within
+                // `extent` of `v0` (tighter than the same bound in space
+                // when the ball rests on the plane, as on a height field).
                 let extent = f64::from(plane.extent);
-                if (query.centre - plane.v0).norm_squared() > (far + extent) * (far + extent) {
+                let in_plane = (query.centre - plane.v0).norm_squared() - height * height;
+                let within = (far * far - height * height).max(0.0).sqrt() + extent;
+                if in_plane > within * within * (1.0 + 16.0 * f64::EPSILON) {
                     continue;
                 }
                 // Then its bounding box, which holds the closest point.

@@ -713,6 +713,12 @@ impl Decoded {
             .unwrap_or_default()
     }
 
+    /// How many blueprints the recording holds (a second one leads with the
+    /// divergences).
+    pub(crate) fn blueprints(&self) -> usize {
+        self.blueprint_stores
+    }
+
     /// The texts of `entity`'s `component` at `frame` (empty when none).
     pub(crate) fn texts_at(&self, entity: &str, component: &str, frame: i64) -> Vec<String> {
         self.texts

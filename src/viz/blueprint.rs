@@ -18,7 +18,8 @@
 //!   plots (α, the quadratic, the face test, the divergence status); at the
 //!   bottom the decisions.
 //! - [`Layout::Divergences`], sent by [`super::Logger::finish`] when some
-//!   sweep diverged from its expectation, as the active layout: the
+//!   sweep or contact query diverged from its expectation (a ghost contact
+//!   too), as the active layout: the
 //!   divergences log on top, then the same views.
 //!
 //! Every plot shows the same window of frames around the time cursor

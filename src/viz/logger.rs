@@ -98,7 +98,7 @@ impl Default for LoggerOptions {
 /// only on the order of the rows, so the same events give the same chunks.
 ///
 /// The layout sent at the start leads with the followed ball; when some
-/// sweep diverged from its expectation, [`Logger::finish`] sends a second
+/// sweep (or contact query) diverged from its expectation, [`Logger::finish`] sends a second
 /// one that leads with the divergences and makes it the active one.
 #[derive(Debug)]
 pub struct Logger {
@@ -115,6 +115,9 @@ pub struct Logger {
     divergent: u64,
     /// Tunnels logged.
     tunnels: u64,
+    /// Contact queries drawn that diverge from the core's set or hold a
+    /// ghost contact ([`super::draw_contacts`]).
+    contact_divergences: u64,
     /// Where buffered rows go until the recording is finished, when it is
     /// a file ([`Logger::with_spill`]).
     spill: Option<Spill>,
@@ -313,6 +316,7 @@ impl Logger {
             flush_rows: DEFAULT_FLUSH_ROWS,
             flush_bytes: DEFAULT_FLUSH_BYTES,
             divergent: 0,
+            contact_divergences: 0,
             tunnels: 0,
             spill: None,
             spare: Vec::new(),
@@ -445,12 +449,13 @@ impl Logger {
 
     /// Sends what is buffered, flushes and hands the stream back (drop it,
     /// and every clone, to finish a file). When some sweep diverged from
-    /// its expectation, first sends the layout that leads with the
-    /// divergences (and tunnels), as the active one. Use
+    /// its expectation (or went through a triangle, or a contact query
+    /// diverged or held a ghost contact), first sends the layout that leads
+    /// with the divergences, as the active one. Use
     /// [`Logger::send_all`] first to see an error of the last rows.
     pub fn finish(mut self) -> RecordingStream {
         let _ = self.send_all();
-        if self.options.blueprint && self.divergent + self.tunnels > 0 {
+        if self.options.blueprint && self.divergent + self.tunnels + self.contact_divergences > 0 {
             // Every chunk before the second layout, so that the order of
             // the file's messages does not vary.
             let _ = self.flush_stream();
@@ -585,6 +590,13 @@ impl Logger {
     /// [`Logger::flush_if_full`]).
     pub(super) fn columns(&mut self) -> &mut columns::Columns {
         &mut self.columns
+    }
+
+    /// Counts `n` contact queries drawn that diverge or hold a ghost
+    /// contact: with one, the layout that leads with the divergences' log
+    /// is the active one ([`Logger::finish`]).
+    pub(super) fn count_contact_divergences(&mut self, n: u64) {
+        self.contact_divergences += n;
     }
 
     /// Sends (or spills) the buffer when it holds enough rows or bytes.

@@ -9,9 +9,12 @@
 //! the file larger and the footer's memory grow with the trace.
 //!
 //! When the recording goes to a file only, each flush's chunks are written
-//! here instead (Arrow IPC, to an anonymous temporary file next to the
-//! output, which disappears with the process however it ends). After each
-//! flush, [`Spill::drain_ready`] sends the entities that have a chunk's
+//! here instead (to an anonymous temporary file next to the output, which
+//! disappears with the process however it ends): each part's Arrow arrays
+//! as they are in memory (lengths, offsets, null bits and buffers), their
+//! types kept once per entity and set, not in the file; Arrow IPC wrote a
+//! schema with every part and cost twice as much (BENCHMARKS.md). After
+//! each flush, [`Spill::drain_ready`] sends the entities that have a chunk's
 //! worth waiting ([`MAX_CHUNK_ROWS`] rows or [`MAX_CHUNK_BYTES`] bytes), so
 //! the file is written while the replay goes on; at the end
 //! [`Spill::drain`] sends the rest, entity after entity. Either way the
@@ -27,15 +30,13 @@ use std::collections::hash_map::Entry;
 use std::fs::File;
 use std::io::{self, BufWriter, Read, Seek, SeekFrom, Write};
 use std::path::{Path, PathBuf};
-use std::sync::Arc;
 
 use rerun::external::arrow::array::{
-    Array, ArrayRef, AsArray, Int64Array, ListArray, RecordBatch, UInt64Array,
+    Array, ArrayData, AsArray, Int64Array, ListArray, UInt64Array,
 };
-use rerun::external::arrow::compute::concat_batches;
-use rerun::external::arrow::datatypes::{DataType, Field, Int64Type, Schema, UInt64Type};
-use rerun::external::arrow::ipc::reader::StreamReader;
-use rerun::external::arrow::ipc::writer::StreamWriter;
+use rerun::external::arrow::buffer::{BooleanBuffer, Buffer, NullBuffer};
+use rerun::external::arrow::compute::concat;
+use rerun::external::arrow::datatypes::DataType;
 use rustc_hash::FxHashMap;
 
 use super::RecordError;
@@ -97,6 +98,8 @@ pub(crate) struct Spill {
     order: Vec<Key>,
     /// The parts not sent yet, by key.
     parts: FxHashMap<Key, Vec<PartRef>>,
+    /// The types of each key's lists (the same in every part of the key).
+    shapes: FxHashMap<Key, Vec<Shape>>,
     /// Scratch: one part's bytes.
     buf: Vec<u8>,
     /// At most this many rows per chunk: [`MAX_CHUNK_ROWS`] unless set
@@ -121,6 +124,7 @@ impl Spill {
             written: 0,
             order: Vec::new(),
             parts: FxHashMap::default(),
+            shapes: FxHashMap::default(),
             buf: Vec::new(),
             max_rows: MAX_CHUNK_ROWS,
             chunks: 0,
@@ -154,19 +158,20 @@ impl Spill {
     /// before).
     pub(crate) fn put(&mut self, key: Key, part: Part) -> Result<(), RecordError> {
         let rows = part.rows.len();
-        let batch = to_batch(part)?;
-        let bytes = batch.get_array_memory_size();
-        self.buf.clear();
-        {
-            let mut w = StreamWriter::try_new(&mut self.buf, &batch.schema())?;
-            w.write(&batch)?;
-            w.finish()?;
-        }
-        let len = self.buf.len() as u64;
+        let columns = Arrays::of(part);
+        let bytes = columns.memory_size();
         let offset = self.written;
-        if let Err(cause) = self.file.write_all(&self.buf) {
-            return Err(self.error("writing", cause));
-        }
+        let written = match self.shapes.entry(key) {
+            Entry::Occupied(e) => columns.write(&mut self.file, e.get()),
+            Entry::Vacant(e) => {
+                let shapes = columns.lists.iter().map(|l| Shape::of(&l.to_data()));
+                columns.write(&mut self.file, e.insert(shapes.collect()))
+            }
+        };
+        let len = match written {
+            Ok(len) => len,
+            Err(cause) => return Err(self.error("writing", cause)),
+        };
         self.written += len;
         let r = PartRef {
             offset,
@@ -282,49 +287,38 @@ impl Spill {
         send: &mut impl FnMut(Key, Part) -> Result<(), RecordError>,
         read: &mut impl FnMut(u64),
     ) -> Result<(), RecordError> {
-        let mut pending: Vec<RecordBatch> = Vec::new();
+        let mut pending: Vec<Part> = Vec::new();
         let (mut rows, mut bytes) = (0usize, 0usize);
         for r in refs {
-            let whole = self.read(r.offset, r.len)?;
+            let whole = self.read(key, r.offset, r.len)?;
             read(r.len);
             // A part longer than a chunk is cut (slices share its
             // buffers).
+            let total = whole.rows.len();
             let mut start = 0;
-            while start < whole.num_rows() {
-                let n = (whole.num_rows() - start).min(self.max_rows);
-                let batch = whole.slice(start, n);
+            while start < total {
+                let n = (total - start).min(self.max_rows);
+                let part = slice(&whole, start, n);
                 start += n;
                 if rows > 0 && (rows + n > self.max_rows || bytes >= self.max_bytes()) {
-                    let part = self.joined(&mut pending)?;
-                    send(key, part)?;
+                    send(key, joined(&mut pending)?)?;
                     self.chunks += 1;
                     (rows, bytes) = (0, 0);
                 }
                 rows += n;
-                bytes += r.bytes * n / whole.num_rows();
-                pending.push(batch);
+                bytes += r.bytes * n / total;
+                pending.push(part);
             }
         }
         if rows > 0 {
-            let part = self.joined(&mut pending)?;
-            send(key, part)?;
+            send(key, joined(&mut pending)?)?;
             self.chunks += 1;
         }
         Ok(())
     }
 
-    /// [`joined`], with a part that does not read back as an error.
-    fn joined(&self, pending: &mut Vec<RecordBatch>) -> Result<Part, RecordError> {
-        joined(pending)?.ok_or_else(|| {
-            self.error(
-                "reading",
-                io::Error::new(io::ErrorKind::InvalidData, "a part does not read back"),
-            )
-        })
-    }
-
-    /// The part written at `offset`, as a record batch.
-    fn read(&mut self, offset: u64, len: u64) -> Result<RecordBatch, RecordError> {
+    /// The part of `key` written at `offset`.
+    fn read(&mut self, key: Key, offset: u64, len: u64) -> Result<Part, RecordError> {
         let file = self.file.get_mut();
         let buf = &mut self.buf;
         let read = (|| {
@@ -344,80 +338,243 @@ impl Spill {
         if let Err(cause) = read {
             return Err(self.error("reading", cause));
         }
-        let mut reader = StreamReader::try_new(&self.buf[..], None)?;
-        match reader.next() {
-            Some(batch) => Ok(batch?),
-            None => Err(self.error(
+        let part = self
+            .shapes
+            .get(&key)
+            .and_then(|shapes| read_part(&mut &self.buf[..], shapes));
+        part.ok_or_else(|| {
+            self.error(
                 "reading",
-                io::Error::new(io::ErrorKind::InvalidData, "a part is missing"),
-            )),
+                io::Error::new(io::ErrorKind::InvalidData, "a part does not read back"),
+            )
+        })
+    }
+}
+
+/// A part's columns as arrays (the vectors moved, not copied).
+struct Arrays {
+    frames: Int64Array,
+    times: Int64Array,
+    rows: UInt64Array,
+    lists: Vec<ListArray>,
+}
+
+impl Arrays {
+    fn of(part: Part) -> Arrays {
+        Arrays {
+            frames: Int64Array::from(part.frames),
+            times: Int64Array::from(part.times),
+            rows: UInt64Array::from(part.rows),
+            lists: part.lists,
+        }
+    }
+
+    /// The bytes the arrays take in memory (what a record batch of the
+    /// columns reports: their buffers' capacity included).
+    fn memory_size(&self) -> usize {
+        self.frames.get_array_memory_size()
+            + self.times.get_array_memory_size()
+            + self.rows.get_array_memory_size()
+            + self
+                .lists
+                .iter()
+                .map(|l| l.get_array_memory_size())
+                .sum::<usize>()
+    }
+
+    /// Writes the part (rows of a key whose lists have the shapes
+    /// `shapes`) to `w`: the number of rows, the `frame`, `time` and row
+    /// columns, then each list's array data. Returns the bytes written.
+    fn write(&self, w: &mut impl Write, shapes: &[Shape]) -> io::Result<u64> {
+        debug_assert_eq!(self.lists.len(), shapes.len());
+        let mut n = 0u64;
+        let mut put = |bytes: &[u8]| -> io::Result<()> {
+            n += bytes.len() as u64;
+            w.write_all(bytes)
+        };
+        put(&(self.rows.len() as u64).to_le_bytes())?;
+        for column in [
+            self.frames.values().inner(),
+            self.times.values().inner(),
+            self.rows.values().inner(),
+        ] {
+            put(column.as_slice())?;
+        }
+        for list in &self.lists {
+            write_data(&mut put, &list.to_data())?;
+        }
+        Ok(n)
+    }
+}
+
+/// The type of an array and of its children, kept once per key: a part in
+/// the file holds only its lengths, buffers and nulls.
+#[derive(Debug)]
+struct Shape {
+    data_type: DataType,
+    children: Vec<Shape>,
+}
+
+impl Shape {
+    fn of(data: &ArrayData) -> Shape {
+        Shape {
+            data_type: data.data_type().clone(),
+            children: data.child_data().iter().map(Shape::of).collect(),
         }
     }
 }
 
-/// A part as a record batch: columns `frame`, `time`, `row`, then one per
-/// component (its lists).
-fn to_batch(part: Part) -> Result<RecordBatch, RecordError> {
-    let Part {
-        frames,
-        times,
-        rows,
-        lists,
-    } = part;
-    let mut fields = vec![
-        Field::new("frame", DataType::Int64, false),
-        Field::new("time", DataType::Int64, false),
-        Field::new("row", DataType::UInt64, false),
-    ];
-    let mut columns: Vec<ArrayRef> = vec![
-        Arc::new(Int64Array::from(frames)),
-        Arc::new(Int64Array::from(times)),
-        Arc::new(UInt64Array::from(rows)),
-    ];
-    for (i, list) in lists.into_iter().enumerate() {
-        fields.push(Field::new(format!("c{i}"), list.data_type().clone(), true));
-        columns.push(Arc::new(list));
+/// One array's data: length, offset, nulls, buffers, then its children.
+fn write_data(put: &mut impl FnMut(&[u8]) -> io::Result<()>, data: &ArrayData) -> io::Result<()> {
+    let mut number = |v: usize| put(&(v as u64).to_le_bytes());
+    number(data.len())?;
+    number(data.offset())?;
+    let bytes = |b: &[u8], put: &mut dyn FnMut(&[u8]) -> io::Result<()>| {
+        put(&(b.len() as u64).to_le_bytes())?;
+        put(b)
+    };
+    match data.nulls() {
+        Some(nulls) => {
+            let inner = nulls.inner();
+            put(&[1])?;
+            put(&(inner.offset() as u64).to_le_bytes())?;
+            put(&(inner.len() as u64).to_le_bytes())?;
+            bytes(inner.inner().as_slice(), put)?;
+        }
+        None => put(&[0])?,
     }
-    Ok(RecordBatch::try_new(
-        Arc::new(Schema::new(fields)),
-        columns,
-    )?)
+    put(&(data.buffers().len() as u64).to_le_bytes())?;
+    for b in data.buffers() {
+        bytes(b.as_slice(), put)?;
+    }
+    for child in data.child_data() {
+        write_data(put, child)?;
+    }
+    Ok(())
 }
 
-/// The parts in `pending` (rows of one key, in order) as one; empties
-/// `pending`. `None` when they are not in the layout [`to_batch`] writes
-/// (a temporary file damaged under us).
-fn joined(pending: &mut Vec<RecordBatch>) -> Result<Option<Part>, RecordError> {
-    // Always a copy: the rows of a part that was cut are a slice of it.
-    let batch = concat_batches(&pending[0].schema(), pending.iter())?;
-    pending.clear();
-    let columns = batch.columns();
-    if columns.len() < 3 {
-        return Ok(None);
-    }
-    let int64 = |c: &ArrayRef| Some(c.as_primitive_opt::<Int64Type>()?.values().to_vec());
-    let (Some(frames), Some(times), Some(rows)) = (
-        int64(&columns[0]),
-        int64(&columns[1]),
-        columns[2]
-            .as_primitive_opt::<UInt64Type>()
-            .map(|a| a.values().to_vec()),
-    ) else {
-        return Ok(None);
+/// Reads what [`write_part`] wrote; `None` when it does not read back (a
+/// temporary file damaged under us).
+fn read_part(r: &mut &[u8], shapes: &[Shape]) -> Option<Part> {
+    let rows = take_number(r)?;
+    let mut column = || -> Option<Vec<u64>> {
+        let bytes = take(r, rows.checked_mul(8)?)?;
+        Some(
+            bytes
+                .chunks_exact(8)
+                .map(|b| u64::from_ne_bytes(b.try_into().unwrap_or_default()))
+                .collect(),
+        )
     };
-    let Some(lists) = columns[3..]
+    let frames = column()?.into_iter().map(|v| v as i64).collect();
+    let times = column()?.into_iter().map(|v| v as i64).collect();
+    let row_numbers = column()?;
+    let lists = shapes
         .iter()
-        .map(|c| c.as_list_opt::<i32>().cloned())
-        .collect::<Option<Vec<ListArray>>>()
-    else {
-        return Ok(None);
-    };
-    Ok(Some(Part {
+        .map(|shape| {
+            let data = read_data(r, shape)?;
+            Some(ListArray::from(data))
+                .filter(|l| l.len() == rows && *l.data_type() == shape.data_type)
+        })
+        .collect::<Option<Vec<ListArray>>>()?;
+    r.is_empty().then_some(Part {
         frames,
         times,
-        rows,
+        rows: row_numbers,
         lists,
-    }))
+    })
+}
+
+/// Reads what [`write_data`] wrote, of type `shape`. A null buffer without
+/// nulls is left out, as Arrow IPC's reader leaves it out.
+fn read_data(r: &mut &[u8], shape: &Shape) -> Option<ArrayData> {
+    let len = take_number(r)?;
+    let offset = take_number(r)?;
+    let nulls = match take(r, 1)?[0] {
+        0 => None,
+        _ => {
+            let (offset, len) = (take_number(r)?, take_number(r)?);
+            let bytes = take_bytes(r)?;
+            let bits = BooleanBuffer::new(bytes, offset, len);
+            Some(NullBuffer::new(bits)).filter(|n| n.null_count() > 0)
+        }
+    };
+    let buffers = (0..take_number(r)?)
+        .map(|_| take_bytes(r))
+        .collect::<Option<Vec<Buffer>>>()?;
+    let children = shape
+        .children
+        .iter()
+        .map(|child| read_data(r, child))
+        .collect::<Option<Vec<ArrayData>>>()?;
+    ArrayData::builder(shape.data_type.clone())
+        .len(len)
+        .offset(offset)
+        .nulls(nulls)
+        .buffers(buffers)
+        .child_data(children)
+        .build()
+        .ok()
+}
+
+fn take<'a>(r: &mut &'a [u8], n: usize) -> Option<&'a [u8]> {
+    if r.len() < n {
+        return None;
+    }
+    let (head, rest) = r.split_at(n);
+    *r = rest;
+    Some(head)
+}
+
+fn take_number(r: &mut &[u8]) -> Option<usize> {
+    let bytes = take(r, 8)?;
+    usize::try_from(u64::from_le_bytes(bytes.try_into().ok()?)).ok()
+}
+
+/// A buffer's bytes, copied into an aligned buffer.
+fn take_bytes(r: &mut &[u8]) -> Option<Buffer> {
+    let n = take_number(r)?;
+    Some(Buffer::from_slice_ref(take(r, n)?))
+}
+
+/// Rows `start..start + n` of `part` (the lists sliced, sharing their
+/// buffers).
+fn slice(part: &Part, start: usize, n: usize) -> Part {
+    let range = start..start + n;
+    Part {
+        frames: part.frames[range.clone()].to_vec(),
+        times: part.times[range.clone()].to_vec(),
+        rows: part.rows[range].to_vec(),
+        lists: part.lists.iter().map(|l| l.slice(start, n)).collect(),
+    }
+}
+
+/// The parts in `pending` (rows of one key, in order) as one, each list
+/// joined with Arrow's `concat`; empties `pending`.
+fn joined(pending: &mut Vec<Part>) -> Result<Part, RecordError> {
+    let columns = pending.first().map_or(0, |p| p.lists.len());
+    let mut lists = Vec::with_capacity(columns);
+    for i in 0..columns {
+        let arrays: Vec<&dyn Array> = pending.iter().map(|p| &p.lists[i] as &dyn Array).collect();
+        lists.push(concat(&arrays)?.as_list::<i32>().clone());
+    }
+    let part = Part {
+        frames: pending
+            .iter()
+            .flat_map(|p| p.frames.iter().copied())
+            .collect(),
+        times: pending
+            .iter()
+            .flat_map(|p| p.times.iter().copied())
+            .collect(),
+        rows: pending
+            .iter()
+            .flat_map(|p| p.rows.iter().copied())
+            .collect(),
+        lists,
+    };
+    pending.clear();
+    Ok(part)
 }
 
 #[cfg(test)]
@@ -466,6 +623,74 @@ mod tests {
             }
         }
         out
+    }
+
+    /// A part whose lists are of every layout the rows use (numbers with
+    /// nulls, strings, lists of fixed-size lists, a slice of a longer array)
+    /// comes back equal, as Arrow sees it, with its times and row numbers.
+    #[test]
+    fn a_part_of_every_layout_reads_back_equal() {
+        use rerun::external::arrow::array::{
+            Array, FixedSizeListArray, Float32Array, Float64Array, StringArray,
+        };
+        use rerun::external::arrow::datatypes::DataType;
+        let list = |values: Arc<dyn Array>, lengths: &[usize]| {
+            ListArray::new(
+                Arc::new(Field::new_list_field(values.data_type().clone(), true)),
+                OffsetBuffer::from_lengths(lengths.iter().copied()),
+                values,
+                None,
+            )
+        };
+        let numbers = Float64Array::from(vec![Some(1.5), None, Some(-0.0), Some(f64::NAN)]);
+        let texts = StringArray::from(vec!["edge 3.1", "", "hit"]);
+        let points = Float32Array::from((0..12).map(|i| i as f32).collect::<Vec<_>>());
+        let item = Arc::new(Field::new_list_field(DataType::Float32, false));
+        let points = FixedSizeListArray::new(item, 3, Arc::new(points), None);
+        let strips = list(Arc::new(points), &[2, 0, 1, 1]);
+        // Longer than the part, and sliced: an offset into its buffers.
+        let long = Float64Array::from((0..20).map(f64::from).collect::<Vec<_>>());
+        let sliced = list(Arc::new(long), &[5, 5, 5, 5]).slice(1, 3);
+        let lists = vec![
+            list(Arc::new(numbers), &[1, 1, 2]),
+            list(Arc::new(texts), &[2, 0, 1]),
+            strips.slice(0, 3),
+            sliced,
+        ];
+        let original = Part {
+            frames: vec![3, 3, 4],
+            times: vec![-7, 0, 9],
+            rows: vec![10, 11, 12],
+            lists: lists.clone(),
+        };
+        let dir = tempfile::tempdir().unwrap();
+        let mut spill = Spill::new(dir.path(), &dir.path().join("x.rrd")).unwrap();
+        let key = Key::for_test(Entity::Log, 0);
+        spill.put(key, original).unwrap();
+        let mut got = Vec::new();
+        spill
+            .drain(
+                |k, p| {
+                    got.push((k, p));
+                    Ok(())
+                },
+                |_, _| {},
+            )
+            .unwrap();
+        assert_eq!(got.len(), 1);
+        let (k, p) = &got[0];
+        assert_eq!(*k, key);
+        assert_eq!(
+            (&p.frames[..], &p.times[..]),
+            (&[3, 3, 4][..], &[-7, 0, 9][..])
+        );
+        assert_eq!(p.rows, [10, 11, 12]);
+        assert_eq!(p.lists.len(), lists.len());
+        for (i, (a, b)) in p.lists.iter().zip(&lists).enumerate() {
+            assert_eq!(a.data_type(), b.data_type(), "list {i}");
+            // NaN is not equal to itself: compare the debug texts.
+            assert_eq!(format!("{a:?}"), format!("{b:?}"), "list {i}");
+        }
     }
 
     /// Parts of two keys, interleaved and of uneven lengths, some longer

@@ -318,6 +318,53 @@ impl Bvh {
         self.bounds
     }
 
+    /// Visits every leaf whose box lies within `radius` of `centre` (the
+    /// distance from the point to the box, computed in `f64` from the boxes
+    /// rounded outward; pass a radius with a margin for the rounding of the
+    /// distance), in no particular order.
+    pub fn within(
+        &self,
+        centre: &Point3<f64>,
+        radius: f64,
+        mut leaf: impl FnMut(std::ops::Range<usize>),
+    ) {
+        let limit = radius * radius;
+        let mut stack = [0u32; STACK_DEPTH];
+        let mut len = 0usize;
+        let mut node_index = 0u32;
+        loop {
+            let node = &self.nodes[node_index as usize];
+            let mut distance = [0.0f64; WIDTH];
+            for axis in 0..3 {
+                let p = centre[axis];
+                for (c, d2) in distance.iter_mut().enumerate() {
+                    let below = node.lo[axis][c] as f64 - p;
+                    let above = p - node.hi[axis][c] as f64;
+                    let d = below.max(above).max(0.0);
+                    *d2 += d * d;
+                }
+            }
+            for (c, &d2) in distance.iter().enumerate().take(node.len as usize) {
+                if d2 > limit {
+                    continue;
+                }
+                let (child, count) = (node.child[c], node.count[c]);
+                if count == 0 {
+                    prefetch(&self.nodes[child as usize]);
+                    stack[len] = child;
+                    len += 1;
+                } else {
+                    leaf(child as usize..child as usize + count as usize);
+                }
+            }
+            if len == 0 {
+                return;
+            }
+            len -= 1;
+            node_index = stack[len];
+        }
+    }
+
     /// Visits, nearer first, every leaf whose box grown by `grow` is entered
     /// by the segment `p0 + t d`, `t ∈ [0, 1]`, at some `t ≤ cutoff`.
     /// `leaf` receives the range of triangle positions and returns the new
@@ -506,6 +553,46 @@ mod tests {
             }
         }
         (t0 <= t1).then_some(t0)
+    }
+
+    /// `within` visits every triangle whose exact box lies within the
+    /// radius of the point (and, for each visited, its whole leaf once),
+    /// on random soups, points and radii.
+    #[test]
+    fn within_visits_every_triangle_whose_box_is_within_reach() {
+        let mut rng = ChaCha8Rng::seed_from_u64(46);
+        for n in [1usize, 5, 40, 700] {
+            let mesh = random_mesh(&mut rng, n);
+            let bvh = mesh.bvh();
+            for _ in 0..300 {
+                let p = Point3::from([0; 3].map(|_| rng.random_range(-25.0..25.0)));
+                let radius = rng.random_range(0.0..6.0);
+                let mut visited = vec![0u32; mesh.triangles().len()];
+                bvh.within(&p, radius, |range| {
+                    for position in range {
+                        visited[position] += 1;
+                    }
+                });
+                assert!(visited.iter().all(|&v| v <= 1), "a triangle visited twice");
+                let mut near = 0;
+                for (position, t) in mesh.triangles().iter().enumerate() {
+                    let (lo, hi) = exact_box(t);
+                    let d2: f64 = (0..3)
+                        .map(|k| {
+                            let d = (lo[k] - p[k]).max(p[k] - hi[k]).max(0.0);
+                            d * d
+                        })
+                        .sum();
+                    if d2 <= radius * radius {
+                        near += 1;
+                        assert_eq!(visited[position], 1, "triangle at {position} missed");
+                    }
+                }
+                // Leaves hold their neighbours too, but not the whole mesh
+                // every time.
+                assert!(visited.iter().sum::<u32>() as usize >= near);
+            }
+        }
     }
 
     #[test]

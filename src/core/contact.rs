@@ -124,8 +124,8 @@ pub fn contact_set(mesh: &Mesh, query: &ContactQuery, sides: Sides) -> Vec<Conta
     if !(reach.is_finite() && query.centre.iter().all(|c| c.is_finite())) {
         return found;
     }
-    // The leaves whose boxes, grown by the reach, hold the centre. The boxes
-    // are rounded outward; the margin covers the rounding of the test.
+    // The leaves whose boxes lie within the reach of the centre. The boxes
+    // are rounded outward; the margin covers the rounding of the distance.
     let size = query.centre.iter().fold(reach, |m, c| m.max(c.abs()));
     let grow = reach + 8.0 * f64::EPSILON * size;
     let (triangles, planes) = (mesh.triangles(), mesh.planes());
@@ -136,40 +136,38 @@ pub fn contact_set(mesh: &Mesh, query: &ContactQuery, sides: Sides) -> Vec<Conta
     // decides every case it could accept.
     let slack = 64.0 * f64::EPSILON * size;
     let far = reach + slack;
-    mesh.bvh()
-        .traverse(&query.centre, &Vector3::zeros(), grow, 0.0, |range| {
-            for position in range {
-                let plane = &planes[position];
-                let height = plane.normal.dot(&(query.centre - plane.v0));
-                if height.abs() > reach + slack || (sides == Sides::One && height < -slack) {
-                    continue;
-                }
-                // The triangle lies within `extent` of `v0`: on a height
-                // field the plane test keeps every triangle under the
-                // ball's reach, this one those the ball can touch, before
-                // the triangle's whole record is read (in a large mesh, a
-                // cache miss each).
-                // In the plane: the centre's foot lies within
-                // `sqrt(far² - height²)` of the closest point, itself within
-                // `extent` of `v0` (tighter than the same bound in space
-                // when the ball rests on the plane, as on a height field).
-                let extent = f64::from(plane.extent);
-                let in_plane = (query.centre - plane.v0).norm_squared() - height * height;
-                let within = (far * far - height * height).max(0.0).sqrt() + extent;
-                if in_plane > within * within * (1.0 + 16.0 * f64::EPSILON) {
-                    continue;
-                }
-                // Then its bounding box, which holds the closest point.
-                let triangle = &triangles[position];
-                if box_distance_squared(&triangle.vertices, &query.centre) > far * far {
-                    continue;
-                }
-                if let Some(contact) = triangle_contact(triangle, query, sides) {
-                    found.push(contact);
-                }
+    mesh.bvh().within(&query.centre, grow, |range| {
+        for position in range {
+            let plane = &planes[position];
+            let height = plane.normal.dot(&(query.centre - plane.v0));
+            if height.abs() > reach + slack || (sides == Sides::One && height < -slack) {
+                continue;
             }
-            0.0
-        });
+            // The triangle lies within `extent` of `v0`: on a height
+            // field the plane test keeps every triangle under the
+            // ball's reach, this one those the ball can touch, before
+            // the triangle's whole record is read (in a large mesh, a
+            // cache miss each).
+            // In the plane: the centre's foot lies within
+            // `sqrt(far² - height²)` of the closest point, itself within
+            // `extent` of `v0` (tighter than the same bound in space
+            // when the ball rests on the plane, as on a height field).
+            let extent = f64::from(plane.extent);
+            let in_plane = (query.centre - plane.v0).norm_squared() - height * height;
+            let within = (far * far - height * height).max(0.0).sqrt() + extent;
+            if in_plane > within * within * (1.0 + 16.0 * f64::EPSILON) {
+                continue;
+            }
+            // Then its bounding box, which holds the closest point.
+            let triangle = &triangles[position];
+            if box_distance_squared(&triangle.vertices, &query.centre) > far * far {
+                continue;
+            }
+            if let Some(contact) = triangle_contact(triangle, query, sides) {
+                found.push(contact);
+            }
+        }
+    });
     // By separation, then triangle (each key distinct): the keys sorted
     // apart from the contacts, which are large to move.
     let mut order: Vec<(f64, u32, u32)> = found

@@ -39,7 +39,7 @@ pub fn tests() -> Vec<Trial> {
 }
 
 /// `record --scene mini_golf --contacts` (200 frames) into `dir`.
-fn record(dir: &Path, extra: &[&str]) -> anyhow::Result<std::path::PathBuf> {
+pub(crate) fn record(dir: &Path, extra: &[&str]) -> anyhow::Result<std::path::PathBuf> {
     let path = dir.join(format!("golf{}.mcap", extra.len()));
     let out = bin()
         .args([

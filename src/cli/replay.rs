@@ -176,7 +176,8 @@ fn run_replay(args: Args) -> anyhow::Result<Exit> {
     let mut outputs = Outputs::open(&args, target, &options, tolerances)?;
     let pool = worker_pool(args.threads)?;
 
-    let (read_ahead, progress, count) = read_with_progress(file, total_bytes, &source_name)?;
+    let (read_ahead, progress, count) =
+        read_with_progress(file, total_bytes, &source_name, "replaying")?;
     let batch_events = options.batch_events();
     let mut events = replay_events_parallel(read_ahead, options, batch_events, Some(pool.clone()));
     let mut trace_error = None;

@@ -5,11 +5,12 @@
 use std::fs::File;
 use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
+use std::sync::atomic::Ordering;
 
 use anyhow::Context;
 
 use super::Args;
-use super::progress::progress_bar;
+use super::progress::{progress_bar, read_with_progress};
 use crate::cli::viewer::{FinishedRecording, Recording, RecordingTarget};
 #[cfg(feature = "viewer")]
 use crate::cli::viewer::{RrdFileOptions, Viewer};
@@ -18,7 +19,6 @@ use sweeptrace::foxglove::{FoxgloveFile, FoxgloveOptions};
 use sweeptrace::judge::Tolerances;
 use sweeptrace::numbers::plural;
 use sweeptrace::replay::{ReplayEvent, ReplayOptions};
-use sweeptrace::trace::prefetch::{DEFAULT_PREFETCH_CHUNK, DEFAULT_PREFETCH_DEPTH, prefetch};
 
 /// Where the recording goes, if anywhere: `--rrd`, `--spawn`,
 /// `--connect`; with no output named at all, `<trace stem>.rrd`.
@@ -238,26 +238,41 @@ impl Outputs {
             ball: options.ball,
             pool: Some(pool),
         };
-        // Decoded on a thread of its own while the queries are judged.
-        let read_again = || -> anyhow::Result<_> {
+        // Decoded on a thread of its own while the queries are judged, in
+        // log-time order as the replay read it (through the chunk indexes
+        // when the trace has them: a recorder's chunks may overlap in
+        // time), with a progress bar.
+        let read_again = |what: &str| -> anyhow::Result<_> {
             let file = std::fs::File::open(trace_path)
                 .with_context(|| format!("reading {source_name} again for its contacts"))?;
-            let reader = sweeptrace::TraceReader::new(std::io::BufReader::new(file), source_name);
-            prefetch(reader, DEFAULT_PREFETCH_CHUNK, DEFAULT_PREFETCH_DEPTH)
-                .context("starting the trace's reader")
+            let total = file.metadata().map_or(0, |m| m.len());
+            let (events, bar, count) = read_with_progress(file, total, source_name, what)?;
+            let mut seen = 0u32;
+            let moving = bar.clone();
+            let events = events.inspect(move |_| {
+                seen = seen.wrapping_add(1);
+                if seen.is_multiple_of(1024) {
+                    moving.set_position(count.load(Ordering::Relaxed));
+                }
+            });
+            Ok((events, bar))
         };
         #[cfg(feature = "viewer")]
         if let Some(recording) = self.recording.as_mut() {
-            let drawn = sweeptrace::viz::draw_contacts(recording.logger(), read_again()?, &how)
-                .context("drawing the contact queries")?;
-            eprintln!("contacts: {}", drawn_words(&drawn));
+            let (events, bar) = read_again("drawing the contact queries")?;
+            let drawn = sweeptrace::viz::draw_contacts(recording.logger(), events, &how)
+                .context("drawing the contact queries");
+            bar.finish_and_clear();
+            eprintln!("contacts: {}", drawn_words(&drawn?));
         }
         if let Some(file) = self.sinks.foxglove.as_mut() {
+            let (events, bar) = read_again("writing the contact queries")?;
             let drawn = file
                 .writer()
-                .contact_queries(read_again()?, &how)
-                .context("writing the contact queries to the Foxglove file")?;
-            eprintln!("contacts in the Foxglove file: {}", drawn_words(&drawn));
+                .contact_queries(events, &how)
+                .context("writing the contact queries to the Foxglove file");
+            bar.finish_and_clear();
+            eprintln!("contacts in the Foxglove file: {}", drawn_words(&drawn?));
         }
         Ok(())
     }

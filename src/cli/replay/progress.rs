@@ -17,19 +17,21 @@ use sweeptrace::trace::{TraceError, TraceEvent, TraceReader};
 /// The trace's events, decoded on a thread of their own.
 type ReadAhead = Prefetched<Result<TraceEvent, TraceError>>;
 
-/// The trace in `file` decoded ahead, the "replaying" progress bar, and
-/// the count of bytes read that moves it.
+/// The trace in `file` decoded ahead (in log-time order, through the chunk
+/// indexes when it has them), a progress bar saying `what`, and the count
+/// of bytes read that moves it.
 pub(super) fn read_with_progress(
     file: File,
     total_bytes: u64,
     source_name: &str,
+    what: &str,
 ) -> anyhow::Result<(ReadAhead, ProgressBar, Arc<AtomicU64>)> {
     let count = Arc::new(AtomicU64::new(0));
     let reader = CountingReader {
         inner: BufReader::with_capacity(1 << 16, file),
         count: count.clone(),
     };
-    let progress = progress_bar(total_bytes, "replaying");
+    let progress = progress_bar(total_bytes, what);
     // Decode on a thread of its own, so reading overlaps the core's work.
     let read_ahead = prefetch(
         TraceReader::new_indexed(reader, source_name),

@@ -147,8 +147,8 @@ fn overlapping_chunks_written_by_python() -> anyhow::Result<Completion> {
 }
 
 /// A contact trace whose chunks overlap in time: `replay` draws every
-/// contact query into the recording and the Foxglove file, as `check`
-/// judges them all (the second read, for the queries, goes through the
+/// contact query into the recording and the Foxglove file, and `check
+/// --engine` asks the engine every one, as `check` judges them all (the second read, for the queries, goes through the
 /// chunk indexes like the first; in file order it stopped silently at the
 /// first message out of order, 1,006 of 2,238 queries drawn).
 fn overlapping_chunks_have_every_contact_query_drawn() -> anyhow::Result<Completion> {
@@ -191,5 +191,20 @@ fn overlapping_chunks_have_every_contact_query_drawn() -> anyhow::Result<Complet
     ] {
         ensure!(stderr.contains(line), "no {line:?} in: {stderr}");
     }
+    // An engine is asked every sweep and query in log-time order, as
+    // `check` reads them (in file order the trace was refused as out of
+    // order).
+    let engine = crate::engine::example_engine_command("");
+    let (code, stdout, stderr) = crate::support::run_bin(os!(
+        "check",
+        &overlapping,
+        "--engine",
+        &engine,
+        "--engine-contacts"
+    ))?;
+    ensure!(
+        code == 0 && stdout.contains("contacts: 2238 queries, 2238 compared, 0 diverge"),
+        "check --engine: exit {code}: {stdout}{stderr}"
+    );
     Ok(Completion::Completed)
 }

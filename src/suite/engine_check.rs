@@ -52,7 +52,8 @@ pub fn check_file_with_engine(
         }
     };
     let session = EngineSession::start(command, engine)?;
-    let mut reader = TraceReader::new(std::io::BufReader::with_capacity(1 << 16, file), &name);
+    let mut reader =
+        TraceReader::new_indexed(std::io::BufReader::with_capacity(1 << 16, file), &name);
     let (mut report, run) = match against {
         Against::Core => {
             let mut answers = EngineAnswers::new(reader.by_ref(), session, engine.window)
@@ -161,7 +162,8 @@ pub fn record_engine_answers(
         return Ok(None);
     };
     let session = EngineSession::start(command, engine)?;
-    let mut reader = TraceReader::new(std::io::BufReader::with_capacity(1 << 16, file), &name);
+    let mut reader =
+        TraceReader::new_indexed(std::io::BufReader::with_capacity(1 << 16, file), &name);
     let mut answers =
         EngineAnswers::new(reader.by_ref(), session, engine.window).with_contacts(engine.contacts);
     let mut events = Vec::new();

@@ -735,12 +735,24 @@ fn the_recording_draws_each_query_and_marks_its_ghosts() -> anyhow::Result<()> {
         .arg(&fixture)
         .arg("--rrd")
         .arg(&rrd)
+        .arg("--json")
         .output()?;
     let stderr = String::from_utf8_lossy(&out.stderr);
     ensure!(out.status.success(), "{stderr}");
     ensure!(
         stderr.contains("contacts: 180 queries drawn (159 contacts, 1 diverging from the core's, 8 ghost contacts)"),
         "{stderr}"
+    );
+    // The same counts for scripts, in the summary.
+    let summary: serde_json::Value = serde_json::from_slice(&out.stdout)?;
+    ensure!(
+        summary["contacts"]
+            == serde_json::json!({
+                "queries": 180,
+                "drawn": {"queries": 180, "contacts": 159, "divergent": 1, "ghosts": 8},
+            }),
+        "{}",
+        summary["contacts"]
     );
     let d = crate::replay::decode_rrd(&rrd)?;
     let drawn = d.frames_with("/world/ball/0/contacts", "Points3D:positions");

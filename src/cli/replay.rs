@@ -6,16 +6,15 @@ mod outputs;
 mod progress;
 mod summary_json;
 
-use super::NameFileOnce;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::Ordering;
 use std::time::Instant;
 
 use anyhow::bail;
 
-use super::Exit;
 use super::check_config::replay_error;
 use super::viewer::Recording;
+use super::{Exit, NameFileOnce};
 use outputs::{Outputs, recording_target};
 use progress::{read_with_progress, worker_pool};
 use summary_json::summary_json;
@@ -160,13 +159,11 @@ fn run_replay(args: Args) -> anyhow::Result<Exit> {
     }
     // The reference answers and divergence marks follow `check`'s conventions.
     let settings = super::check_config::for_trace(trace_path, &args.conventions, &args.config)?;
-    let conventions = settings.engine.conventions();
-    let tolerances = settings.tolerances();
+    let (conventions, tolerances) = (settings.engine.conventions(), settings.tolerances());
     let options = ReplayOptions {
         frames: args.frames.unwrap_or_default(),
         ball: args.ball,
-        // The decision lines of the recording and of the Foxglove file
-        // describe the decisive test: keep the records.
+        // The decision lines (recording, Foxglove) need the decisive test.
         explain: (target.is_some() || args.foxglove.is_some()).then_some(args.detail),
         conventions,
     };
@@ -245,6 +242,7 @@ fn run_replay(args: Args) -> anyhow::Result<Exit> {
                     None,
                     &[],
                     Some(&err),
+                    None,
                     started
                 )
             );
@@ -256,7 +254,7 @@ fn run_replay(args: Args) -> anyhow::Result<Exit> {
         outputs.abandon();
         bail!("{source_name}: {selection}; nothing written");
     }
-    outputs.draw_contacts(trace_path, &source_name, summary.contact_queries, &pool)?;
+    let drawn = outputs.draw_contacts(trace_path, &source_name, summary.contact_queries, &pool)?;
     let streamed = outputs.streams_to_viewer();
     let wrote = outputs.finish()?;
     for line in &wrote {
@@ -289,6 +287,7 @@ fn run_replay(args: Args) -> anyhow::Result<Exit> {
                 selected,
                 &wrote,
                 trace_error.as_deref(),
+                drawn.as_ref(),
                 started
             )
         );

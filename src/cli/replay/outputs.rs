@@ -17,6 +17,7 @@ use crate::cli::viewer::{RrdFileOptions, Viewer};
 use sweeptrace::atomic::{self, PendingFile};
 use sweeptrace::foxglove::{FoxgloveFile, FoxgloveOptions};
 use sweeptrace::judge::Tolerances;
+use sweeptrace::judge::contact_marks::ContactsDrawn;
 use sweeptrace::numbers::plural;
 use sweeptrace::replay::{ReplayEvent, ReplayOptions};
 
@@ -218,16 +219,16 @@ impl Outputs {
     /// Draws the trace's `queries` contact queries into the recording and
     /// the Foxglove file (those there are, when they are some), judged as
     /// `check` judges them, at their frames: a second read of the trace
-    /// for each.
+    /// for each. Returns what was drawn (none without such an output).
     pub(super) fn draw_contacts(
         &mut self,
         trace_path: &Path,
         source_name: &str,
         queries: u64,
         pool: &rayon::ThreadPool,
-    ) -> anyhow::Result<()> {
+    ) -> anyhow::Result<Option<ContactsDrawn>> {
         if queries == 0 {
-            return Ok(());
+            return Ok(None);
         }
         let (options, tolerances) = (self.options, self.tolerances);
         let how = sweeptrace::judge::contact_marks::ContactDrawing {
@@ -257,13 +258,16 @@ impl Outputs {
             });
             Ok((events, bar))
         };
+        let mut judged = None;
         #[cfg(feature = "viewer")]
         if let Some(recording) = self.recording.as_mut() {
             let (events, bar) = read_again("drawing the contact queries")?;
             let drawn = sweeptrace::viz::draw_contacts(recording.logger(), events, &how)
                 .context("drawing the contact queries");
             bar.finish_and_clear();
-            eprintln!("contacts: {}", drawn_words(&drawn?));
+            let drawn = drawn?;
+            eprintln!("contacts: {}", drawn_words(&drawn));
+            judged = Some(drawn);
         }
         if let Some(file) = self.sinks.foxglove.as_mut() {
             let (events, bar) = read_again("writing the contact queries")?;
@@ -272,9 +276,11 @@ impl Outputs {
                 .contact_queries(events, &how)
                 .context("writing the contact queries to the Foxglove file");
             bar.finish_and_clear();
-            eprintln!("contacts in the Foxglove file: {}", drawn_words(&drawn?));
+            let drawn = drawn?;
+            eprintln!("contacts in the Foxglove file: {}", drawn_words(&drawn));
+            judged = judged.or(Some(drawn));
         }
-        Ok(())
+        Ok(judged)
     }
 
     /// The recording and the other outputs, apart, for the pipeline.
@@ -364,7 +370,7 @@ impl Outputs {
 }
 
 /// What was drawn of the contact queries, in words.
-fn drawn_words(drawn: &sweeptrace::judge::contact_marks::ContactsDrawn) -> String {
+fn drawn_words(drawn: &ContactsDrawn) -> String {
     format!(
         "{} drawn ({} contacts, {} diverging from the core's, {})",
         sweeptrace::numbers::counted(drawn.queries, "query", "queries"),

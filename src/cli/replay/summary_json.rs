@@ -1,6 +1,7 @@
 //! `replay --json`: the summary as one JSON object.
 
 use std::time::Instant;
+use sweeptrace::judge::contact_marks::ContactsDrawn;
 
 use super::Args;
 
@@ -17,6 +18,7 @@ pub(super) fn summary_json(
     selection: Option<String>,
     wrote: &[String],
     truncation: Option<&sweeptrace::trace::TraceError>,
+    contacts: Option<&ContactsDrawn>,
     started: Instant,
 ) -> String {
     use serde_json::{Map, Value, json};
@@ -63,6 +65,15 @@ pub(super) fn summary_json(
             })).collect::<Vec<_>>(),
         },
         "degenerate_triangles": summary.degenerate_triangles,
+        "contacts": (summary.contact_queries > 0).then(|| json!({
+            "queries": summary.contact_queries,
+            "drawn": contacts.map(|d| json!({
+                "queries": d.queries,
+                "contacts": d.contacts,
+                "divergent": d.divergent,
+                "ghosts": d.ghosts,
+            })),
+        })),
         "wrote": wrote,
         "incomplete": truncation.map(|e| format!("{e:#}")),
         "seconds": {

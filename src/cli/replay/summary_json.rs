@@ -11,6 +11,10 @@ use super::Args;
 /// declared), the files written (each "wrote" line),
 /// the selection of a filter that kept part of the trace, and `incomplete`
 /// (the error of a trace that ends early, or `null`).
+#[expect(
+    clippy::too_many_arguments,
+    reason = "each argument is one part of the document, from a different stage of the replay"
+)]
 pub(super) fn summary_json(
     args: &Args,
     conventions: &sweeptrace::conventions::EngineConventions,

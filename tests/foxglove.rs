@@ -34,6 +34,7 @@ pub fn tests() -> Vec<Trial> {
         trial!(replay_foxglove_keeps_what_was_read_of_a_truncated_trace),
         trial!(replay_foxglove_killed_leaves_no_partial_target),
         trial!(replay_foxglove_carries_the_judged_contact_queries),
+        trial!(a_new_scene_deletes_the_contact_queries_drawn_before_it),
     ]
 }
 
@@ -897,4 +898,71 @@ fn replay_foxglove_carries_the_judged_contact_queries() -> anyhow::Result<Comple
         return Ok(Completion::ignored_with(why));
     }
     Ok(Completion::Completed)
+}
+
+/// At a new scene the previous scene's contact queries are deleted from
+/// `/contact_queries` (one deletion of every entity, at the scene's
+/// `log_time`), as the per-sweep topics' entities are: a mini-golf contact
+/// trace with its scene sent again before frame 100.
+fn a_new_scene_deletes_the_contact_queries_drawn_before_it() -> anyhow::Result<()> {
+    use sweeptrace::trace::EventBody;
+    let dir = tempfile::tempdir()?;
+    let source = crate::contacts::record(dir.path(), &[])?;
+    let events: Vec<_> =
+        TraceReader::new(std::fs::File::open(&source)?, "golf").collect::<Result<_, _>>()?;
+    let scene = events
+        .iter()
+        .find(|e| matches!(e.body, EventBody::Scene(_)))
+        .context("no scene")?
+        .clone();
+    let at = events
+        .iter()
+        .position(|e| matches!(&e.body, EventBody::Sweep(s) if s.frame == 100))
+        .context("no frame 100")?;
+    let t = events[at].header.log_time_nanos;
+    let trace = dir.path().join("two_scenes.mcap");
+    let mut w = TraceWriter::new(std::fs::File::create(&trace)?)?;
+    for (i, event) in events.iter().enumerate() {
+        if i == at {
+            let mut again = scene.clone();
+            again.header.log_time_nanos = t;
+            crate::support::write_event(&mut w, &again)?;
+        }
+        crate::support::write_event(&mut w, event)?;
+    }
+    w.finish()?;
+    let out = dir.path().join("two_scenes.foxglove.mcap");
+    let (code, _, stderr) = run_bin(os!("replay", &trace, "--foxglove", &out))?;
+    ensure!(code == 0, "exit {code}: {stderr}");
+    let all = messages(&std::fs::read(&out)?)?;
+    let queries: Vec<(u64, &Value)> = all
+        .iter()
+        .filter(|(topic, ..)| topic == "/contact_queries")
+        .map(|(_, _, time, v)| (*time, v))
+        .collect();
+    let deletions: Vec<usize> = (0..queries.len())
+        .filter(|&i| {
+            queries[i].1["deletions"]
+                .as_array()
+                .is_some_and(|d| !d.is_empty())
+        })
+        .collect();
+    ensure!(deletions.len() == 1, "deletions at {deletions:?}");
+    let (time, clear) = queries[deletions[0]];
+    ensure!(
+        time == t
+            && clear["deletions"][0]["type"] == 1
+            && clear["entities"].as_array().is_some_and(Vec::is_empty),
+        "at {time} (the scene at {t}): {clear}"
+    );
+    ensure!(
+        queries[..deletions[0]].iter().all(|(time, _)| *time < t)
+            && queries[deletions[0] + 1..]
+                .iter()
+                .all(|(time, _)| *time >= t)
+            && deletions[0] > 0
+            && deletions[0] + 1 < queries.len(),
+        "the deletion is not between the two scenes' queries"
+    );
+    Ok(())
 }

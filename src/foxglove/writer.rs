@@ -28,7 +28,7 @@ use super::{
     EXPECTED_TOPIC, GHOSTS_TOPIC, MESH_TOPIC, METADATA_NAME, NUMBERS_TOPIC, SWEEPS_TOPIC,
 };
 use crate::atomic::PendingFile;
-use crate::judge::contact_marks::{ContactDrawing, ContactsDrawn, for_each_judged_query};
+use crate::judge::contact_marks::{ContactDrawing, ContactsDrawn, Judged, for_each_judged_query};
 use crate::judge::{Tolerances, divergence};
 use crate::replay::{ReplayEvent, SceneState, SweepResult};
 use crate::trace::{TraceError, TraceEvent, library_string};
@@ -304,7 +304,19 @@ impl<W: Write + Seek> FoxgloveWriter<W> {
         events: impl Iterator<Item = Result<TraceEvent, TraceError>>,
         how: &ContactDrawing<'_>,
     ) -> Result<ContactsDrawn, FoxgloveError> {
-        for_each_judged_query(events, how, |p| {
+        for_each_judged_query(events, how, |judged| {
+            let p = match judged {
+                Judged::Query(p) => p,
+                // The previous scene's queries go, as the per-sweep
+                // channels' entities do (`scene`).
+                Judged::NewScene { log_time_nanos: t } => {
+                    if let Some((queries, _)) = self.contact_queries {
+                        let clear = clear_update(Time::from_nanos(t));
+                        self.put(queries, CONTACT_QUERIES_TOPIC, 0, t, &clear)?;
+                    }
+                    return Ok(());
+                }
+            };
             let (queries, decisions) = match self.contact_queries {
                 Some(channels) => channels,
                 None => {

@@ -38,6 +38,18 @@ pub struct ContactDrawing<'a> {
 /// Queries judged together, in parallel, before they are drawn in order.
 const JUDGED_TOGETHER: usize = 256;
 
+/// What [`for_each_judged_query`] hands its drawing, in the trace's order.
+pub(crate) enum Judged<'a> {
+    /// A judged query.
+    Query(&'a PairedContacts),
+    /// A scene after the first, at its `log_time` (the previous scene's
+    /// queries are all drawn; what they show may be cleared).
+    NewScene {
+        /// The scene's `log_time`.
+        log_time_nanos: u64,
+    },
+}
+
 /// What was drawn of a trace's contact queries.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct ContactsDrawn {
@@ -63,42 +75,32 @@ impl ContactsDrawn {
 
 /// Reads `events` (a trace: sweeps and expectations pass by), pairs each
 /// contact query the selection keeps with its answer, judges it and hands
-/// it to `draw`, in the trace's order (the queries of a scene are judged
+/// it to `draw`, with each scene change, in the trace's order (the queries of a scene are judged
 /// [`JUDGED_TOGETHER`] at a time, in parallel, on `how.pool`). A read
 /// error ends the reading (the replay reported it already); an error of
 /// `draw` is returned.
 pub(crate) fn for_each_judged_query<E>(
     events: impl Iterator<Item = Result<TraceEvent, TraceError>>,
     how: &ContactDrawing<'_>,
-    mut draw: impl FnMut(&PairedContacts) -> Result<(), E>,
+    mut draw: impl FnMut(Judged<'_>) -> Result<(), E>,
 ) -> Result<ContactsDrawn, E> {
     let mut pairing = ContactPairing::new(how.tolerances, how.conventions, how.ghost_degrees);
     let mut drawn = ContactsDrawn::default();
     let mut pairs = Vec::with_capacity(JUDGED_TOGETHER);
-    let mut judge_and_draw = |pairing: &ContactPairing<'_>, pairs: &mut Vec<Pair>| {
-        let mut judge = || -> Vec<Option<PairedContacts>> {
-            pairs
-                .par_drain(..)
-                .map(|pair| pairing.judge(pair))
-                .collect()
-        };
-        let judged = match how.pool {
-            Some(pool) => pool.install(judge),
-            None => judge(),
-        };
-        for paired in judged.iter().flatten() {
-            draw(paired)?;
-            drawn.add(paired);
-        }
-        Ok(())
-    };
+    let mut scenes = 0u64;
     let wants =
         |frame: u64, ball: u32| how.frames.contains(frame) && how.ball.is_none_or(|b| b == ball);
     for event in events {
         let Ok(event) = event else { break };
         let pair = match &event.body {
             EventBody::Scene(scene) => {
-                judge_and_draw(&pairing, &mut pairs)?;
+                judge_and_draw(&pairing, &mut pairs, how.pool, &mut draw, &mut drawn)?;
+                if scenes > 0 {
+                    draw(Judged::NewScene {
+                        log_time_nanos: event.header.log_time_nanos,
+                    })?;
+                }
+                scenes += 1;
                 pairing.scene(scene);
                 None
             }
@@ -111,12 +113,38 @@ pub(crate) fn for_each_judged_query<E>(
         if let Some(pair) = pair {
             pairs.push(pair);
             if pairs.len() == JUDGED_TOGETHER {
-                judge_and_draw(&pairing, &mut pairs)?;
+                judge_and_draw(&pairing, &mut pairs, how.pool, &mut draw, &mut drawn)?;
             }
         }
     }
-    judge_and_draw(&pairing, &mut pairs)?;
+    judge_and_draw(&pairing, &mut pairs, how.pool, &mut draw, &mut drawn)?;
     Ok(drawn)
+}
+
+/// Judges `pairs` (emptied) in parallel on `pool`, then draws them in
+/// their order and counts them.
+fn judge_and_draw<E>(
+    pairing: &ContactPairing<'_>,
+    pairs: &mut Vec<Pair>,
+    pool: Option<&rayon::ThreadPool>,
+    draw: &mut impl FnMut(Judged<'_>) -> Result<(), E>,
+    drawn: &mut ContactsDrawn,
+) -> Result<(), E> {
+    let mut judge = || -> Vec<Option<PairedContacts>> {
+        pairs
+            .par_drain(..)
+            .map(|pair| pairing.judge(pair))
+            .collect()
+    };
+    let judged = match pool {
+        Some(pool) => pool.install(judge),
+        None => judge(),
+    };
+    for paired in judged.iter().flatten() {
+        draw(Judged::Query(paired))?;
+        drawn.add(paired);
+    }
+    Ok(())
 }
 
 /// How an answered contact is marked.

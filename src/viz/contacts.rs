@@ -18,7 +18,7 @@ use rerun::{Arrows3D, Color, Points3D, Scalars, SeriesLines, TextLog};
 
 use crate::judge::PairedContacts;
 use crate::judge::contact_marks::{
-    ContactDrawing, ContactsDrawn, Mark, contact_marks, for_each_judged_query,
+    ContactDrawing, ContactsDrawn, Judged, Mark, contact_marks, for_each_judged_query,
 };
 use crate::palette::{EXPECTED_COLOR, FACE_NORMAL_COLOR, GHOST_COLOR, NORMAL_COLOR};
 use crate::trace::{TraceError, TraceEvent};
@@ -44,7 +44,12 @@ pub fn draw_contacts(
 ) -> Result<ContactsDrawn, RecordError> {
     let mut styled = BTreeSet::new();
     let mut since_look = 0;
-    let drawn = for_each_judged_query(events, how, |paired| {
+    let drawn = for_each_judged_query(events, how, |judged| {
+        // (A ball's entities keep what its last query showed until its
+        // next one, across scenes as for its sweeps.)
+        let Judged::Query(paired) = judged else {
+            return Ok(());
+        };
         let ball = paired.query.ball;
         if styled.insert(ball) {
             let style = SeriesLines::new().with_names(CONTACT_SERIES).with_colors(

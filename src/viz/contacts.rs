@@ -23,7 +23,7 @@ use crate::judge::contact_marks::{
 use crate::palette::{EXPECTED_COLOR, FACE_NORMAL_COLOR, GHOST_COLOR, NORMAL_COLOR};
 use crate::trace::{TraceError, TraceEvent};
 
-use super::columns::Columns;
+use super::columns::{Columns, Time};
 use super::convert::{SERIES_COLORS, rgba, ui_points};
 use super::logger::time_of;
 use super::out::set;
@@ -108,53 +108,48 @@ fn contact_rows(columns: &mut Columns, p: &PairedContacts) {
             .map(|c| rgba(color_and_label(&c.mark).0))
     };
     let points = || marks.contacts.iter().map(|c| at(c.point));
-    columns
-        .row(Entity::Contacts(b), set::CONTACT_POINTS, frame, time)
-        .put::<Position3D>(Points3D::descriptor_positions, points())
-        .put::<Color>(Points3D::descriptor_colors, colors())
-        .put::<Radius>(Points3D::descriptor_radii, [ui_points(5.0)])
-        .put_strs(
-            Points3D::descriptor_labels,
-            marks.contacts.iter().map(|c| color_and_label(&c.mark).1),
-        );
-    columns
-        .row(Entity::ContactNormals(b), set::ARROWS, frame, time)
-        .put::<Vector3D>(
-            Arrows3D::descriptor_vectors,
-            marks
-                .contacts
-                .iter()
-                .map(|c| c.normal.map_or(Vector3D::from([0.0; 3]), arrow)),
-        )
-        .put::<Position3D>(Arrows3D::descriptor_origins, points())
-        .put::<Color>(Arrows3D::descriptor_colors, colors())
-        .put::<Radius>(Arrows3D::descriptor_radii, [ui_points(2.0)]);
+    let when = (frame, time);
+    labelled_points(
+        columns,
+        Entity::Contacts(b),
+        when,
+        points(),
+        colors(),
+        5.0,
+        marks.contacts.iter().map(|c| color_and_label(&c.mark).1),
+    );
+    let normals = marks
+        .contacts
+        .iter()
+        .map(|c| c.normal.map_or(Vector3D::from([0.0; 3]), arrow));
+    arrows(
+        columns,
+        Entity::ContactNormals(b),
+        when,
+        normals,
+        points(),
+        colors(),
+    );
     // What the core expected where the answer differs: the normal beside a
     // differing or ghost normal, and the places left out.
-    columns
-        .row(Entity::ContactExpected(b), set::ARROWS, frame, time)
-        .put::<Vector3D>(
-            Arrows3D::descriptor_vectors,
-            marks.expected_normals.iter().map(|(_, n)| arrow(*n)),
-        )
-        .put::<Position3D>(
-            Arrows3D::descriptor_origins,
-            marks.expected_normals.iter().map(|(p, _)| at(*p)),
-        )
-        .put::<Color>(Arrows3D::descriptor_colors, [rgba(FACE_NORMAL_COLOR)])
-        .put::<Radius>(Arrows3D::descriptor_radii, [ui_points(2.0)]);
-    columns
-        .row(Entity::ContactMissing(b), set::CONTACT_POINTS, frame, time)
-        .put::<Position3D>(
-            Points3D::descriptor_positions,
-            marks.missing.iter().map(|(p, _)| at(*p)),
-        )
-        .put::<Color>(Points3D::descriptor_colors, [rgba(EXPECTED_COLOR)])
-        .put::<Radius>(Points3D::descriptor_radii, [ui_points(6.0)])
-        .put_strs(
-            Points3D::descriptor_labels,
-            marks.missing.iter().map(|(_, words)| words.as_str()),
-        );
+    let expected = &marks.expected_normals;
+    arrows(
+        columns,
+        Entity::ContactExpected(b),
+        when,
+        expected.iter().map(|(_, n)| arrow(*n)),
+        expected.iter().map(|(p, _)| at(*p)),
+        [rgba(FACE_NORMAL_COLOR)],
+    );
+    labelled_points(
+        columns,
+        Entity::ContactMissing(b),
+        when,
+        marks.missing.iter().map(|(p, _)| at(*p)),
+        [rgba(EXPECTED_COLOR)],
+        6.0,
+        marks.missing.iter().map(|(_, words)| words.as_str()),
+    );
     // The text log of divergences gets a line per ghost and problem.
     for line in &marks.log {
         columns
@@ -171,4 +166,40 @@ fn contact_rows(columns: &mut Columns, p: &PairedContacts) {
                 (p.verdict.ghosts.len() as f64).into(),
             ],
         );
+}
+
+/// A row of labelled points (`radius` in UI points) of `entity` at `when`
+/// (frame, time).
+fn labelled_points<'s>(
+    columns: &mut Columns,
+    entity: Entity,
+    when: (i64, Time),
+    positions: impl IntoIterator<Item = Position3D>,
+    colors: impl IntoIterator<Item = Color>,
+    radius: f32,
+    labels: impl IntoIterator<Item = &'s str>,
+) {
+    columns
+        .row(entity, set::CONTACT_POINTS, when.0, when.1)
+        .put::<Position3D>(Points3D::descriptor_positions, positions)
+        .put::<Color>(Points3D::descriptor_colors, colors)
+        .put::<Radius>(Points3D::descriptor_radii, [ui_points(radius)])
+        .put_strs(Points3D::descriptor_labels, labels);
+}
+
+/// A row of arrows (2 UI points wide) of `entity` at `when` (frame, time).
+fn arrows(
+    columns: &mut Columns,
+    entity: Entity,
+    when: (i64, Time),
+    vectors: impl IntoIterator<Item = Vector3D>,
+    origins: impl IntoIterator<Item = Position3D>,
+    colors: impl IntoIterator<Item = Color>,
+) {
+    columns
+        .row(entity, set::ARROWS, when.0, when.1)
+        .put::<Vector3D>(Arrows3D::descriptor_vectors, vectors)
+        .put::<Position3D>(Arrows3D::descriptor_origins, origins)
+        .put::<Color>(Arrows3D::descriptor_colors, colors)
+        .put::<Radius>(Arrows3D::descriptor_radii, [ui_points(2.0)]);
 }

@@ -33,6 +33,7 @@ pub fn tests() -> Vec<Trial> {
         trial!(python_reads_the_contact_channels),
         trial!(the_recording_draws_each_query_and_marks_its_ghosts),
         trial!(the_contacts_drawn_do_not_depend_on_the_threads),
+        trial!(the_layout_plots_the_followed_balls_contact_queries),
         trial!(a_divergent_contact_query_is_a_junit_failure_and_an_annotation),
         trial!(a_seam_contact_may_be_dropped_where_flat_not_where_concave),
     ]
@@ -775,8 +776,15 @@ fn the_recording_draws_each_query_and_marks_its_ghosts() -> anyhow::Result<()> {
         "frame 93: {labels:?}"
     );
     // Its sweeps have no expectation: the ghosts alone make the layout
-    // that leads with the divergences' log the active one.
+    // that leads with the divergences' log the active one; it plots the
+    // ball's contact queries.
     ensure!(d.blueprints() == 2, "{} blueprints", d.blueprints());
+    let active = &d.view_origins()[1];
+    ensure!(
+        active.iter().any(|o| o == "/plots/contacts/ball/0")
+            && active.iter().any(|o| o == "/divergences"),
+        "the active layout's views: {active:?}"
+    );
     let series = d.texts_at("/plots/contacts/ball/0", "SeriesLines:names", i64::MIN);
     ensure!(
         series == ["contacts", "ghost contacts"],
@@ -849,6 +857,57 @@ fn the_contacts_drawn_do_not_depend_on_the_threads() -> anyhow::Result<()> {
         anyhow::bail!("one thread against four: {d}");
     }
     ensure!(foxglove[0] == foxglove[1], "the Foxglove files differ");
+    Ok(())
+}
+
+/// A trace whose contact queries all agree gets, at the end, the first
+/// layout again with a plot of the followed ball's contacts and ghost
+/// contacts (the queries are drawn after the sweeps); a trace without
+/// contact queries, or a replay following a ball that has none, keeps the
+/// first layout only.
+fn the_layout_plots_the_followed_balls_contact_queries() -> anyhow::Result<()> {
+    let dir = tempfile::tempdir()?;
+    let trace = record(dir.path(), &[])?;
+    let sweeps_only = Path::new(env!("CARGO_MANIFEST_DIR")).join("traces/record_mini_golf.mcap");
+    let origins = |trace: &Path, extra: &[&str]| -> anyhow::Result<Vec<Vec<String>>> {
+        let rrd = dir.path().join("layout.rrd");
+        let out = bin()
+            .arg("replay")
+            .arg(trace)
+            .arg("--rrd")
+            .arg(&rrd)
+            .args(extra)
+            .output()?;
+        ensure!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        Ok(crate::replay::decode_rrd(&rrd)?.view_origins().to_vec())
+    };
+    let plot = |ball: u32| format!("/plots/contacts/ball/{ball}");
+    let with = origins(&trace, &[])?;
+    ensure!(with.len() == 2, "{} layouts: {with:?}", with.len());
+    ensure!(
+        !with[0].contains(&plot(0)) && with[1].contains(&plot(0)),
+        "the layouts' views: {with:?}"
+    );
+    ensure!(
+        !with[1].iter().any(|o| o == "/divergences"),
+        "the queries agree, yet the layout leads with the divergences: {:?}",
+        with[1]
+    );
+    // Following ball 1 (its queries only drawn): its plot.
+    let one = origins(&trace, &["--ball", "1"])?;
+    ensure!(
+        one.len() == 2 && one[1].contains(&plot(1)),
+        "following ball 1: {one:?}"
+    );
+    let without = origins(&sweeps_only, &[])?;
+    ensure!(
+        without.len() == 1 && !without[0].iter().any(|o| o.starts_with("/plots/contacts")),
+        "a trace without contact queries: {without:?}"
+    );
     Ok(())
 }
 

@@ -657,6 +657,9 @@ pub(crate) struct Decoded {
     pub(crate) components: BTreeMap<String, BTreeMap<i64, std::collections::BTreeSet<String>>>,
     /// Blueprint entity paths, per blueprint store (in the order received).
     blueprint_paths: Vec<Vec<String>>,
+    /// The origins of the views, per blueprint store (in the order
+    /// received).
+    blueprint_origins: Vec<Vec<String>>,
 }
 
 impl PartialEq for Decoded {
@@ -717,6 +720,12 @@ impl Decoded {
     /// divergences).
     pub(crate) fn blueprints(&self) -> usize {
         self.blueprint_stores
+    }
+
+    /// The origins of the views of each blueprint, in the order received
+    /// (the last is the active one).
+    pub(crate) fn view_origins(&self) -> &[Vec<String>] {
+        &self.blueprint_origins
     }
 
     /// The texts of `entity`'s `component` at `frame` (empty when none).
@@ -835,6 +844,7 @@ pub(crate) fn decode_rrd(path: &std::path::Path) -> anyhow::Result<Decoded> {
                 if info.info.store_id.kind() == rerun::StoreKind::Blueprint {
                     d.blueprint_stores += 1;
                     d.blueprint_paths.push(Vec::new());
+                    d.blueprint_origins.push(Vec::new());
                 } else {
                     d.recording_ids
                         .insert(info.info.store_id.recording_id().to_string());
@@ -845,6 +855,17 @@ pub(crate) fn decode_rrd(path: &std::path::Path) -> anyhow::Result<Decoded> {
                 if store.kind() != rerun::StoreKind::Recording {
                     if let Some(paths) = d.blueprint_paths.last_mut() {
                         paths.push(chunk.entity_path().to_string());
+                    }
+                    for (id, _) in chunk.components().iter() {
+                        if *id != "ViewBlueprint:space_origin" {
+                            continue;
+                        }
+                        let origins = chunk
+                            .iter_component::<rerun::blueprint::components::ViewOrigin>(*id)
+                            .flat_map(|b| b.iter().map(|o| o.to_string()).collect::<Vec<_>>());
+                        if let Some(all) = d.blueprint_origins.last_mut() {
+                            all.extend(origins);
+                        }
                     }
                     continue;
                 }

@@ -22,6 +22,11 @@
 //!   too), as the active layout: the
 //!   divergences log on top, then the same views.
 //!
+//! When the recording has contact queries, the layout sent by
+//! [`super::Logger::finish`] (either) also plots the followed ball's
+//! contacts and ghost contacts per query, beside the divergence status
+//! (the queries are drawn after the sweeps, so only the end knows of them).
+//!
 //! Every plot shows the same window of frames around the time cursor
 //! (`TimeAxis` with a cursor-relative view range), so a frame reads across
 //! them.
@@ -80,27 +85,32 @@ pub enum Layout {
 }
 
 impl Layout {
-    fn name(self) -> &'static str {
-        match self {
-            Layout::FollowBall => "blueprint",
-            Layout::Divergences => "blueprint-divergences",
+    /// The name the layout's ids derive from (a layout with the contacts'
+    /// plot is another blueprint, with ids of its own).
+    fn name(self, contacts: bool) -> &'static str {
+        match (self, contacts) {
+            (Layout::FollowBall, false) => "blueprint",
+            (Layout::Divergences, false) => "blueprint-divergences",
+            (Layout::FollowBall, true) => "blueprint-contacts",
+            (Layout::Divergences, true) => "blueprint-divergences-contacts",
         }
     }
 }
 
-/// Sends `layout` (following ball `follow_ball`) to `rec` as its active and
-/// default blueprint, with ids that depend only on the recording id and the
-/// layout.
+/// Sends `layout` (following ball `follow_ball`, with the plot of its
+/// contact queries when `contacts`) to `rec` as its active and default
+/// blueprint, with ids that depend only on the recording id and the layout.
 pub fn send_blueprint(
     rec: &RecordingStream,
     layout: Layout,
     follow_ball: u32,
+    contacts: bool,
 ) -> Result<(), RecordingStreamError> {
     let Some(info) = rec.store_info() else {
         // A disabled stream: nothing is recorded.
         return Ok(());
     };
-    let (msgs, activation) = blueprint_messages(&info, layout, follow_ball)?;
+    let (msgs, activation) = blueprint_messages(&info, layout, follow_ball, contacts)?;
     rec.send_blueprint(msgs, activation);
     // The blueprint's messages go to the sink through the stream's command
     // channel, the recording's chunks through its batcher; the thread that
@@ -115,14 +125,16 @@ pub fn send_blueprint(
 
 /// The messages of `layout` for the recording `info` (store info first,
 /// then one chunk per blueprint entity), and the command that makes it the
-/// active and default blueprint.
+/// active and default blueprint. `contacts`: with the plot of the followed
+/// ball's contact queries.
 pub fn blueprint_messages(
     info: &StoreInfo,
     layout: Layout,
     follow_ball: u32,
+    contacts: bool,
 ) -> Result<(Vec<LogMsg>, BlueprintActivationCommand), RecordingStreamError> {
     let recording_id = info.store_id.recording_id().to_string();
-    let ids = Ids::new(&recording_id, layout.name());
+    let ids = Ids::new(&recording_id, layout.name(contacts));
     let store_id = StoreId::new(
         StoreKind::Blueprint,
         info.store_id.application_id().clone(),
@@ -172,6 +184,14 @@ pub fn blueprint_messages(
         "Divergent (1) and fragile decisions (…/fragile) per ball",
         paths::STATUS,
     )?;
+    let contact_plot = if contacts {
+        Some(b.plot(
+            &format!("Contacts and ghost contacts per contact query (ball {ball})"),
+            &paths::contact_plot(ball),
+        )?)
+    } else {
+        None
+    };
     let log = b.view("TextLog", "Decisions", paths::LOG, &["$origin/**"])?;
 
     let top = b.container(
@@ -182,12 +202,11 @@ pub fn blueprint_messages(
     )?;
     let root = match layout {
         Layout::FollowBall => {
-            let plots = b.container(
-                ContainerKind::Horizontal,
-                &[alpha, quadratic, face, status],
-                None,
-                None,
-            )?;
+            let plots: Vec<Item> = [alpha, quadratic, face, status]
+                .into_iter()
+                .chain(contact_plot)
+                .collect();
+            let plots = b.container(ContainerKind::Horizontal, &plots, None, None)?;
             b.container(
                 ContainerKind::Vertical,
                 &[top, plots, log],
@@ -202,12 +221,11 @@ pub fn blueprint_messages(
                 paths::DIVERGENCES,
                 &["$origin/**"],
             )?;
-            let plots = b.container(
-                ContainerKind::Horizontal,
-                &[status, alpha, quadratic, face],
-                None,
-                None,
-            )?;
+            let plots: Vec<Item> = std::iter::once(status)
+                .chain(contact_plot)
+                .chain([alpha, quadratic, face])
+                .collect();
+            let plots = b.container(ContainerKind::Horizontal, &plots, None, None)?;
             b.container(
                 ContainerKind::Vertical,
                 &[divergences, top, plots, log],

@@ -60,9 +60,10 @@ pub fn draw_contacts(
             logger.log_static(Entity::ContactPlot(ball).path(), &style)?;
         }
         contact_rows(logger.columns(), paired);
-        if !paired.verdict.agrees() || !paired.verdict.ghosts.is_empty() {
-            logger.count_contact_divergences(1);
-        }
+        logger.count_contact_query(
+            ball,
+            !paired.verdict.agrees() || !paired.verdict.ghosts.is_empty(),
+        );
         since_look += 1;
         if since_look == QUERIES_PER_LOOK {
             since_look = 0;

@@ -118,6 +118,9 @@ pub struct Logger {
     /// Contact queries drawn that diverge from the core's set or hold a
     /// ghost contact ([`super::draw_contacts`]).
     contact_divergences: u64,
+    /// Whether a contact query of the followed ball was drawn (the layout
+    /// sent at the end then plots them).
+    followed_contacts: bool,
     /// Where buffered rows go until the recording is finished, when it is
     /// a file ([`Logger::with_spill`]).
     spill: Option<Spill>,
@@ -305,7 +308,12 @@ impl Logger {
         rec.set_log_time_enabled(false);
         rec.set_log_tick_enabled(false);
         if options.blueprint {
-            blueprint::send_blueprint(&rec, Layout::FollowBall, options.prepare.follow_ball)?;
+            blueprint::send_blueprint(
+                &rec,
+                Layout::FollowBall,
+                options.prepare.follow_ball,
+                false,
+            )?;
         }
         let mut logger = Logger {
             rec,
@@ -317,6 +325,7 @@ impl Logger {
             flush_bytes: DEFAULT_FLUSH_BYTES,
             divergent: 0,
             contact_divergences: 0,
+            followed_contacts: false,
             tunnels: 0,
             spill: None,
             spare: Vec::new(),
@@ -451,18 +460,27 @@ impl Logger {
     /// and every clone, to finish a file). When some sweep diverged from
     /// its expectation (or went through a triangle, or a contact query
     /// diverged or held a ghost contact), first sends the layout that leads
-    /// with the divergences, as the active one. Use
-    /// [`Logger::send_all`] first to see an error of the last rows.
+    /// with the divergences, as the active one; when the followed ball's
+    /// contact queries were drawn, the layout sent (that one, or the first
+    /// again) plots them too. Use [`Logger::send_all`] first to see an
+    /// error of the last rows.
     pub fn finish(mut self) -> RecordingStream {
         let _ = self.send_all();
-        if self.options.blueprint && self.divergent + self.tunnels + self.contact_divergences > 0 {
+        let diverged = self.divergent + self.tunnels + self.contact_divergences > 0;
+        if self.options.blueprint && (diverged || self.followed_contacts) {
+            let layout = if diverged {
+                Layout::Divergences
+            } else {
+                Layout::FollowBall
+            };
             // Every chunk before the second layout, so that the order of
             // the file's messages does not vary.
             let _ = self.flush_stream();
             let _ = blueprint::send_blueprint(
                 &self.rec,
-                Layout::Divergences,
+                layout,
                 self.options.prepare.follow_ball,
+                self.followed_contacts,
             );
         }
         let _ = self.flush_stream();
@@ -592,11 +610,13 @@ impl Logger {
         &mut self.columns
     }
 
-    /// Counts `n` contact queries drawn that diverge or hold a ghost
-    /// contact: with one, the layout that leads with the divergences' log
-    /// is the active one ([`Logger::finish`]).
-    pub(super) fn count_contact_divergences(&mut self, n: u64) {
-        self.contact_divergences += n;
+    /// Counts a contact query of `ball` drawn, `diverges` when it diverges
+    /// or holds a ghost contact: with one, the layout that leads with the
+    /// divergences' log is the active one; with one of the followed ball,
+    /// the layout sent at the end plots its queries ([`Logger::finish`]).
+    pub(super) fn count_contact_query(&mut self, ball: u32, diverges: bool) {
+        self.contact_divergences += u64::from(diverges);
+        self.followed_contacts |= ball == self.options.prepare.follow_ball;
     }
 
     /// Sends (or spills) the buffer when it holds enough rows or bytes.

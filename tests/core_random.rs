@@ -508,9 +508,18 @@ fn primary_collector_equals_collecting_every_record() -> anyhow::Result<()> {
                 if tested != skipping.records {
                     anyhow::bail!("{}: the tested records are not the others", at());
                 }
+                // Every record of each skipped triangle, gathered in one
+                // pass (a search of all records per skipped triangle made
+                // this test two thirds of its own time).
+                let mut of_skipped: std::collections::HashMap<u32, Vec<&TestRecord>> =
+                    std::collections::HashMap::new();
+                for r in &every.records {
+                    if skipped.contains_key(&r.triangle()) {
+                        of_skipped.entry(r.triangle()).or_default().push(r);
+                    }
+                }
                 for (&t, &reason) in &skipped {
-                    let of_t: Vec<&TestRecord> =
-                        every.records.iter().filter(|r| r.triangle() == t).collect();
+                    let of_t = of_skipped.get(&t).map_or(&[][..], Vec::as_slice);
                     let face = of_t.iter().find_map(|r| match r {
                         TestRecord::Face(f) => Some(*f),
                         _ => None,

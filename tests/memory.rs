@@ -1,10 +1,12 @@
 //! The memory of `replay --rrd` does not follow the trace's length: the
 //! peak resident memory of the command, measured by the kernel for that
-//! one child process (`wait4`), on a session and on one three times as
-//! long. What a replay holds besides its bounded buffers (the footer's
-//! index of the chunks, the temporary file's index of its parts) grows by
-//! a few MB over that length; anything kept per sweep (rows, results,
-//! summaries) would add tens of MB.
+//! one process, on a session and on one three times as long, without the
+//! footer (`--no-rrd-footer`: the footer's index of the chunks is the one
+//! part known to grow with the length, about 7.5 KB a chunk,
+//! BENCHMARKS.md). What a replay holds besides its bounded buffers (the
+//! temporary file's index of its parts) grows by a few MB over that
+//! length; anything kept per sweep (rows, results, summaries) would add
+//! tens of MB.
 
 use libtest_mimic::Trial;
 
@@ -16,14 +18,17 @@ pub fn tests() -> Vec<Trial> {
 }
 
 /// Frames of the shorter session (64 balls on a 2,048-triangle terrain:
-/// about 57 k sweeps, enough to fill the logger's buffer several times).
-const SHORT_FRAMES: u32 = 600;
+/// about 114 k sweeps, past the replay's warm-up: at 600 frames its
+/// buffers had not all reached their working size, and the peak rose by
+/// 24 MiB from 600 to 1,800 frames, then by 3 from 1,800 to 3,000).
+const SHORT_FRAMES: u32 = 1200;
 
 /// How much more the three-times-longer session may take, in MiB. Measured
-/// (debug build): 88 and 102 MiB, the difference the footer's index of the
-/// extra chunks, the temporary file's index of its parts and how full the
-/// queues happen to be; keeping 400 bytes per sweep (a row's columns
-/// rather than its chunk) would add 54 MiB.
+/// (debug build, without the footer): 100 and 110 MiB at 1,200 and 3,600
+/// frames (102 and 107 beside two other tests), the difference the
+/// temporary file's index of its parts and how full the queues happen to
+/// be; keeping 400 bytes per sweep (seeded: a row's columns rather than its
+/// chunk) adds 116 MiB.
 #[cfg(unix)]
 const ALLOWED_GROWTH_MIB: libc::c_long = 25;
 
@@ -43,39 +48,48 @@ fn record(path: &std::path::Path, frames: u32) -> anyhow::Result<()> {
     Ok(())
 }
 
-/// Peak resident memory (KiB) of `replay TRACE --rrd OUT`, as the kernel
-/// counted it for that process.
+/// Started from a small process: Linux keeps, at `exec`, the high-water
+/// mark of the memory the process had before (`ru_maxrss` is the larger of
+/// the two), and a child spawned from this test process starts from this
+/// process's memory (`vfork`), that of every test running in it: a child
+/// of this process reported 153 and 190 MiB, the test process's own
+/// growth, where the replay took 100 and 110. Python runs the replay and
+/// prints its children's peak.
+#[cfg(unix)]
+const PEAK_OF_CHILD: &str = "\
+import resource, subprocess, sys
+r = subprocess.run(sys.argv[1:], stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+if r.returncode != 0:
+    sys.exit('replay failed: ' + r.stderr.decode(errors='replace'))
+print(resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss)
+";
+
+/// Peak resident memory (KiB) of `replay TRACE --rrd OUT --no-rrd-footer`,
+/// as the kernel counted it for that process.
 #[cfg(unix)]
 fn replay_peak_kib(trace: &std::path::Path, out: &std::path::Path) -> anyhow::Result<libc::c_long> {
-    let child = bin()
+    let out = std::process::Command::new("python3")
+        .arg("-c")
+        .arg(PEAK_OF_CHILD)
+        .arg(bin().get_program())
         .arg("replay")
         .arg(trace)
         .arg("--rrd")
         .arg(out)
-        .stdout(std::process::Stdio::null())
-        .stderr(std::process::Stdio::piped())
-        .spawn()?;
-    let pid = libc::pid_t::try_from(child.id())?;
-    let mut stderr = child.stderr.expect("piped");
-    let reader = std::thread::spawn(move || {
-        let mut text = String::new();
-        let _ = std::io::Read::read_to_string(&mut stderr, &mut text);
-        text
-    });
-    let mut status: libc::c_int = 0;
-    // SAFETY: all-zero bytes are a valid `rusage`.
-    let mut usage: libc::rusage = unsafe { std::mem::zeroed() };
-    // SAFETY: `pid` is our child, not waited for yet (its `Child` handle
-    // is dropped without waiting); both pointers are valid.
-    let waited = unsafe { libc::wait4(pid, &mut status, 0, &mut usage) };
-    anyhow::ensure!(waited == pid, "wait4: {}", std::io::Error::last_os_error());
-    let text = reader.join().unwrap_or_default();
+        .arg("--no-rrd-footer")
+        .output()
+        .map_err(|e| anyhow::anyhow!("python3 (which measures the replay) did not start: {e}"))?;
+    let stdout = String::from_utf8_lossy(&out.stdout);
     anyhow::ensure!(
-        libc::WIFEXITED(status) && libc::WEXITSTATUS(status) == 0,
-        "replay failed: {text}"
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
     );
     // Linux counts ru_maxrss in KiB.
-    Ok(usage.ru_maxrss)
+    stdout
+        .trim()
+        .parse()
+        .map_err(|e| anyhow::anyhow!("the peak printed, {stdout:?}: {e}"))
 }
 
 #[cfg(unix)]

@@ -24,8 +24,9 @@ pub fn tests() -> Vec<Trial> {
 const SHORT_FRAMES: u32 = 1200;
 
 /// How much more the three-times-longer session may take, in MiB. Measured
-/// (debug build, without the footer): 100 and 110 MiB at 1,200 and 3,600
-/// frames (102 and 107 beside two other tests), the difference the
+/// (debug build, without the footer): 94 and 101 MiB at 1,200 and 3,600
+/// frames (100 and 110 with the crate at -O2; 102 and 107 beside two other
+/// tests), the difference the
 /// temporary file's index of its parts and how full the queues happen to
 /// be; keeping 400 bytes per sweep (seeded: a row's columns rather than its
 /// chunk) adds 116 MiB.

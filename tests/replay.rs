@@ -62,6 +62,7 @@ pub fn tests() -> Vec<Trial> {
         trial!(plots_hold_the_decisive_numbers_nan_where_missing),
         trial!(expected_edge_test_only_of_an_existing_triangle),
         trial!(rrd_draws_edges_by_class_and_labels_each_defect),
+        trial!(a_later_scene_replaces_the_mesh_at_its_first_sweep),
     ]
 }
 
@@ -1057,10 +1058,14 @@ fn rrd_reads_back_through_rerun() -> anyhow::Result<()> {
         "timelines {:?}",
         d.timelines
     );
+    // The mesh is logged on the timelines (at frame 0, the trace's only
+    // scene), so that a later scene can clear it.
     ensure!(
-        d.static_entities.contains("/world/mesh/0"),
-        "the mesh is not static: {:?}",
-        d.static_entities
+        d.frames_with("/world/mesh/0", "Mesh3D:vertex_positions")
+            == std::collections::BTreeSet::from([0])
+            && !d.static_entities.contains("/world/mesh/0"),
+        "the mesh is not at frame 0: {:?}",
+        d.components.get("/world/mesh/0")
     );
 
     // α at every frame equals the outcome, exactly.
@@ -1743,17 +1748,17 @@ fn rrd_shows_edges_features_and_explanations() -> anyhow::Result<()> {
     // One triangle: its three edges are boundary edges, and that is the
     // only class logged.
     let edges: Vec<&String> = d
-        .static_entities
-        .iter()
+        .components
+        .keys()
         .filter(|e| e.starts_with("/world/mesh/0/edges/"))
         .collect();
     ensure!(
         edges == ["/world/mesh/0/edges/boundary"]
             && d.strips
                 .get("/world/mesh/0/edges/boundary")
-                .and_then(|m| m.get(&i64::MIN))
+                .and_then(|m| m.get(&0))
                 == Some(&3),
-        "static edges: {edges:?}, strips {:?}",
+        "edges: {edges:?}, strips {:?}",
         d.strips.get("/world/mesh/0/edges/boundary")
     );
     let frames = |v: &[i64]| {
@@ -2499,11 +2504,77 @@ fn expected_edge_test_only_of_an_existing_triangle() -> anyhow::Result<()> {
     Ok(())
 }
 
+/// A trace with a second scene (a level change): each frame shows the mesh
+/// its sweeps were tested against. The cube is shown from frame 0, its
+/// first sweep's, and cleared, with its edges, at frame 3, the floor's
+/// first sweep's, where the floor is shown; the same through the logger a
+/// sweep at a time and through the replay's pipeline (the command line, 4
+/// threads). Before, every scene's mesh was static: shown at every frame.
+fn a_later_scene_replaces_the_mesh_at_its_first_sweep() -> anyhow::Result<()> {
+    let dir = tempfile::tempdir()?;
+    let sweep = |frame: u64| SweepMsg {
+        frame,
+        ball: 0,
+        radius: 0.25,
+        p0: [5.0, 5.0, 5.0],
+        p1: [5.0, 5.0, 4.0],
+    };
+    let mut events = events_for(cube_scene(), &[sweep(0), sweep(1), sweep(2)]);
+    events.push(Ok(event(
+        3_500_000,
+        4,
+        EventBody::Scene(crate::support::flipped_floor()),
+    )));
+    events.push(Ok(event(4_000_000, 5, EventBody::Sweep(sweep(3)))));
+    let trace = dir.path().join("levels.mcap");
+    let mut w = TraceWriter::new(std::fs::File::create(&trace)?)?;
+    for e in &events {
+        let Ok(e) = e else { continue };
+        crate::support::write_event(&mut w, e)?;
+    }
+    w.finish()?;
+    let by_logger = dir.path().join("logger.rrd");
+    write_rrd(events, Detail::Primary, &by_logger)?;
+    let by_replay = dir.path().join("replay.rrd");
+    let out = crate::support::bin()
+        .arg("replay")
+        .arg(&trace)
+        .args(["--threads", "4", "--rrd"])
+        .arg(&by_replay)
+        .output()?;
+    ensure!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let at = |v: &[i64]| {
+        v.iter()
+            .copied()
+            .collect::<std::collections::BTreeSet<i64>>()
+    };
+    for path in [&by_logger, &by_replay] {
+        let d = decode_rrd(path)?;
+        let shown = |e: &str, c: &str| d.frames_with(e, c);
+        ensure!(
+            shown("/world/mesh/0", "Mesh3D:vertex_positions") == at(&[0])
+                && shown("/world/mesh/0", "Clear:is_recursive") == at(&[3])
+                && shown("/world/mesh/0/edges/convex", "LineStrips3D:strips") == at(&[0])
+                && shown("/world/mesh/1", "Mesh3D:vertex_positions") == at(&[3])
+                && shown("/world/mesh/1", "Clear:is_recursive").is_empty(),
+            "{}: the cube {:?}, the floor {:?}",
+            path.display(),
+            d.components.get("/world/mesh/0"),
+            d.components.get("/world/mesh/1")
+        );
+    }
+    Ok(())
+}
+
 /// The mesh's edges by class and its defects in the recording: a scene of
 /// the cube (convex and flat edges) and a floor with a flipped triangle
-/// (boundary and flat edges, one defect): one static LineStrips3D per class
-/// the scene has, a segment per edge, in the class's own radius; one static
-/// Points3D per defect kind with one label per defect.
+/// (boundary and flat edges, one defect): one LineStrips3D per class the
+/// scene has, a segment per edge, in the class's own radius; one Points3D
+/// per defect kind with one label per defect.
 fn rrd_draws_edges_by_class_and_labels_each_defect() -> anyhow::Result<()> {
     let dir = tempfile::tempdir()?;
     let path = dir.path().join("classes.rrd");
@@ -2520,13 +2591,14 @@ fn rrd_draws_edges_by_class_and_labels_each_defect() -> anyhow::Result<()> {
     events.push(Ok(event(2, 2, EventBody::Sweep(sweep))));
     write_rrd(events, Detail::Primary, &path)?;
     let d = decode_rrd(&path)?;
-    let segments = |entity: &str| -> Option<usize> {
-        d.strips.get(entity).and_then(|m| m.get(&i64::MIN)).copied()
-    };
+    // Both scenes come before the only sweep: both are logged at frame 0,
+    // the cube's cleared there.
+    let segments =
+        |entity: &str| -> Option<usize> { d.strips.get(entity).and_then(|m| m.get(&0)).copied() };
     let classes = |scene: usize| -> BTreeMap<String, Option<usize>> {
         let prefix = format!("/world/mesh/{scene}/edges/");
-        d.static_entities
-            .iter()
+        d.components
+            .keys()
             .filter_map(|e| {
                 e.strip_prefix(&prefix)
                     .map(|c| (c.to_string(), segments(e)))
@@ -2551,7 +2623,7 @@ fn rrd_draws_edges_by_class_and_labels_each_defect() -> anyhow::Result<()> {
     let radius = |e: &str| {
         d.radii
             .get(e)
-            .and_then(|m| m.get(&i64::MIN))
+            .and_then(|m| m.get(&0))
             .and_then(|r| r.first())
             .map(|r| r.abs())
     };
@@ -2572,8 +2644,8 @@ fn rrd_draws_edges_by_class_and_labels_each_defect() -> anyhow::Result<()> {
     // Defects: none on the cube; on the floor one flipped triangle, one
     // label, at its centroid.
     let defect_entities: Vec<&String> = d
-        .static_entities
-        .iter()
+        .components
+        .keys()
         .filter(|e| e.contains("/defects"))
         .collect();
     ensure!(
@@ -2581,7 +2653,7 @@ fn rrd_draws_edges_by_class_and_labels_each_defect() -> anyhow::Result<()> {
         "defect entities {defect_entities:?}"
     );
     let topology = sweeptrace::core::topology::Topology::new(&floor.vertices, &floor.triangles)?;
-    let labels = d.texts_at("/world/mesh/1/defects/flipped", "Points3D:labels", i64::MIN);
+    let labels = d.texts_at("/world/mesh/1/defects/flipped", "Points3D:labels", 0);
     ensure!(
         labels == ["flipped triangle 9"] && labels.len() == topology.defects().len(),
         "defect labels {labels:?}, defects {:?}",
@@ -2589,8 +2661,18 @@ fn rrd_draws_edges_by_class_and_labels_each_defect() -> anyhow::Result<()> {
     );
     ensure!(
         d.frames_with("/world/mesh/1/defects/flipped", "Points3D:positions")
-            == std::collections::BTreeSet::from([i64::MIN]),
-        "the defect has no static position"
+            == std::collections::BTreeSet::from([0]),
+        "the defect has no position at frame 0"
+    );
+    // The first scene is cleared where the second is shown.
+    ensure!(
+        d.frames_with("/world/mesh/0", "Clear:is_recursive")
+            == std::collections::BTreeSet::from([0])
+            && d.frames_with("/world/mesh/1", "Clear:is_recursive")
+                .is_empty(),
+        "clears: {:?}, {:?}",
+        d.components.get("/world/mesh/0"),
+        d.components.get("/world/mesh/1")
     );
     Ok(())
 }

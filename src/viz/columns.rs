@@ -205,6 +205,30 @@ impl Columns {
         path: String,
         batches: Vec<SerializedComponentBatch>,
     ) -> Result<(), RecordingStreamError> {
+        self.send_row(rec, path, batches, None)
+    }
+
+    /// Sends a row of `path` at `frame` and `time` at once, in a chunk of
+    /// its own (a row too large to share a chunk: a scene's mesh).
+    pub fn send_at(
+        &mut self,
+        rec: &RecordingStream,
+        path: String,
+        batches: Vec<SerializedComponentBatch>,
+        frame: i64,
+        time: Time,
+    ) -> Result<(), RecordingStreamError> {
+        self.send_row(rec, path, batches, Some((frame, time)))
+    }
+
+    /// A row of `path`, static or at `(frame, time)`, sent as a chunk.
+    fn send_row(
+        &mut self,
+        rec: &RecordingStream,
+        path: String,
+        batches: Vec<SerializedComponentBatch>,
+        at: Option<(i64, Time)>,
+    ) -> Result<(), RecordingStreamError> {
         if batches.is_empty() {
             return Ok(());
         }
@@ -219,12 +243,16 @@ impl Columns {
             let list = list_array(batch.array, &mut lengths)?;
             components.push((batch.descriptor, list));
         }
+        let timelines = match at {
+            None => Default::default(),
+            Some((frame, time)) => entity::timelines(vec![frame], vec![time.nanos()], time),
+        };
         let chunk = Chunk::from_native_row_ids(
             id,
             path.as_str().into(),
             None,
             &[row],
-            Default::default(),
+            timelines,
             components.into_iter().collect(),
         )
         .map_err(RecordingStreamError::Chunk)?;

@@ -42,6 +42,8 @@ pub fn draw_contacts(
     events: impl Iterator<Item = Result<TraceEvent, TraceError>>,
     how: &ContactDrawing<'_>,
 ) -> Result<ContactsDrawn, RecordError> {
+    // A scene without sweeps (a trace of contact queries only) is shown now.
+    logger.show_pending_scene(None)?;
     let mut styled = BTreeSet::new();
     let mut since_look = 0;
     let drawn = for_each_judged_query(events, how, |judged| {

@@ -7,8 +7,8 @@ use std::path::Path;
 use std::sync::Arc;
 
 use rerun::{
-    AsComponents as _, LineStrips3D, Mesh3D, Points3D, RecordingStream, RecordingStreamError,
-    SeriesLines, SeriesPoints, ViewCoordinates,
+    AsComponents as _, Clear, LineStrips3D, Mesh3D, Points3D, RecordingStream,
+    RecordingStreamError, SeriesLines, SeriesPoints, ViewCoordinates,
 };
 use strum::IntoEnumIterator as _;
 
@@ -121,6 +121,13 @@ pub struct Logger {
     /// Whether a contact query of the followed ball was drawn (the layout
     /// sent at the end then plots them).
     followed_contacts: bool,
+    /// The largest frame of the sweeps logged so far.
+    last_frame: Option<u64>,
+    /// A scene logged and not yet shown: it is shown at its first sweep's
+    /// frame ([`Logger::log_scene`]).
+    pending_scene: Option<Arc<SceneState>>,
+    /// The scene whose mesh is shown.
+    mesh_shown: Option<usize>,
     /// Where buffered rows go until the recording is finished, when it is
     /// a file ([`Logger::with_spill`]).
     spill: Option<Spill>,
@@ -326,6 +333,9 @@ impl Logger {
             divergent: 0,
             contact_divergences: 0,
             followed_contacts: false,
+            last_frame: None,
+            pending_scene: None,
+            mesh_shown: None,
             tunnels: 0,
             spill: None,
             spare: Vec::new(),
@@ -443,6 +453,22 @@ impl Logger {
             .send_static(&self.rec, path.into(), value.as_serialized_batches())
     }
 
+    /// Sends one row of `path` at `at` (frame, time) at once.
+    fn log_at(
+        &mut self,
+        path: impl Into<String>,
+        value: &dyn rerun::AsComponents,
+        (frame, time): (i64, columns::Time),
+    ) -> Result<(), RecordingStreamError> {
+        self.columns.send_at(
+            &self.rec,
+            path.into(),
+            value.as_serialized_batches(),
+            frame,
+            time,
+        )
+    }
+
     /// The stream.
     pub fn stream(&self) -> &RecordingStream {
         &self.rec
@@ -465,6 +491,7 @@ impl Logger {
     /// again) plots them too. Use [`Logger::send_all`] first to see an
     /// error of the last rows.
     pub fn finish(mut self) -> RecordingStream {
+        let _ = self.show_pending_scene(None);
         let _ = self.send_all();
         let diverged = self.divergent + self.tunnels + self.contact_divergences > 0;
         if self.options.blueprint && (diverged || self.followed_contacts) {
@@ -495,12 +522,47 @@ impl Logger {
         }
     }
 
-    /// Logs a scene's mesh (static, one Mesh3D, flat-shaded), its edges
-    /// (static, one LineStrips3D per class, every edge once) and its
-    /// defects (static, one Points3D per kind, a label each, drawn when the
-    /// scene has at most `MAX_DRAWN_DEFECT_LABELS` of them), from the scene's
-    /// topology.
+    /// Notes that a sweep of `frame` is logged next (in trace order): a
+    /// scene logged before it and not shown yet is shown at that frame.
+    pub(super) fn saw_frame(&mut self, frame: u64) -> Result<(), RecordingStreamError> {
+        self.show_pending_scene(Some(frame))?;
+        self.last_frame = Some(self.last_frame.map_or(frame, |f| f.max(frame)));
+        Ok(())
+    }
+
+    /// Logs a scene: its mesh (one Mesh3D, flat-shaded), its edges (one
+    /// LineStrips3D per class, every edge once) and its defects (one
+    /// Points3D per kind, a label each, drawn when the scene has at most
+    /// `MAX_DRAWN_DEFECT_LABELS` of them), from the scene's topology, at the
+    /// scene's `log_time` and at the frame of its first sweep, where the
+    /// previous scene's are cleared: each frame shows the mesh its sweeps
+    /// were tested against (a trace may hold a scene per level, or the same
+    /// scene sent again). A scene without sweeps is shown at the frame
+    /// after the last sweep (0 before any), when the next scene comes or
+    /// the sweeps end ([`Logger::show_pending_scene`]).
     pub fn log_scene(&mut self, scene: &Arc<SceneState>) -> Result<(), RecordingStreamError> {
+        self.show_pending_scene(None)?;
+        self.pending_scene = Some(Arc::clone(scene));
+        Ok(())
+    }
+
+    /// Shows the scene logged and not yet shown, if any, at `frame` (its
+    /// first sweep's), or without one at the frame after the last sweep.
+    pub(super) fn show_pending_scene(
+        &mut self,
+        frame: Option<u64>,
+    ) -> Result<(), RecordingStreamError> {
+        let Some(scene) = self.pending_scene.take() else {
+            return Ok(());
+        };
+        let frame = frame.unwrap_or_else(|| self.last_frame.map_or(0, |f| f.saturating_add(1)));
+        let when = (
+            i64::try_from(frame).unwrap_or(i64::MAX),
+            time_of(scene.log_time_nanos),
+        );
+        if let Some(previous) = self.mesh_shown.replace(scene.number) {
+            self.log_at(paths::mesh(previous), &Clear::recursive(), when)?;
+        }
         let mut triangles: Vec<&Triangle> = scene.mesh.triangles().iter().collect();
         triangles.sort_by_key(|t| t.index);
         let mut positions = Vec::with_capacity(triangles.len() * 3);
@@ -516,10 +578,10 @@ impl Logger {
             .with_vertex_normals(normals)
             .with_triangle_indices(indices)
             .with_albedo_factor(albedo(MESH_COLOR));
-        self.log_static(paths::mesh(scene.number), &mesh)?;
+        self.log_at(paths::mesh(scene.number), &mesh, when)?;
 
         for class in EdgeClass::iter() {
-            let strips = edge_strips(scene, class);
+            let strips = edge_strips(&scene, class);
             if strips.is_empty() {
                 continue;
             }
@@ -527,7 +589,7 @@ impl Logger {
             let edges = LineStrips3D::new(strips)
                 .with_radii([ui_points(radius)])
                 .with_colors([rgba(color)]);
-            self.log_static(paths::edges(scene.number, class), &edges)?;
+            self.log_at(paths::edges(scene.number, class), &edges, when)?;
         }
         let draw_labels = scene.topology.defects().len() <= MAX_DRAWN_DEFECT_LABELS;
         for kind in DefectKind::iter() {
@@ -546,13 +608,14 @@ impl Logger {
                 .with_colors([rgba(DEFECT_COLOR)])
                 .with_labels(labels)
                 .with_show_labels(draw_labels);
-            self.log_static(paths::defects(scene.number, kind), &defects)?;
+            self.log_at(paths::defects(scene.number, kind), &defects, when)?;
         }
         Ok(())
     }
 
     /// Logs one sweep's result at its frame.
     pub fn log_sweep(&mut self, r: &SweepResult) -> Result<(), RecordError> {
+        self.saw_frame(r.frame)?;
         let before = self.shown_before([r]);
         let prepared = prepare_sweeps([r], &before, &self.options.prepare);
         self.log_prepared(prepared)

@@ -2,16 +2,17 @@
 //!
 //! ```text
 //! world                               view coordinates (right-handed, z up), static
-//! world/mesh/{scene}                  Mesh3D of each scene, static
+//! world/mesh/{scene}                  Mesh3D of each scene, at its first sweep's frame,
+//!                                     cleared (with its children) where the next scene shows
 //! world/mesh/{scene}/edges/{class}    LineStrips3D: the edges of one class (boundary,
 //!                                     convex, flat, concave, non_manifold; see
 //!                                     `core::topology::EdgeClass`), a strip each, in the class's
-//!                                     colour and width, static (a class the mesh has no
+//!                                     colour and width, with the mesh (a class the mesh has no
 //!                                     edge of is not logged)
 //! world/mesh/{scene}/defects/{kind}   Points3D: the defects of one kind (flipped,
 //!                                     crack, t_junction, ...; see `core::topology::DefectKind`),
 //!                                     a point at each with one label each
-//!                                     ("flipped triangle 812"), static (a kind the mesh
+//!                                     ("flipped triangle 812"), with the mesh (a kind the mesh
 //!                                     has none of is not logged)
 //! world/ball/{ball}                   the sweep, one row per sweep:
 //!                                       Ellipsoids3D: the ball at p0, at the contact, at p1
@@ -111,12 +112,12 @@ pub const STATUS: &str = "status";
 /// The log of divergent sweeps.
 pub const DIVERGENCES: &str = "divergences";
 
-/// The static edges of class `class` of scene `scene`.
+/// The edges of class `class` of scene `scene`.
 pub fn edges(scene: usize, class: EdgeClass) -> String {
     format!("world/mesh/{scene}/edges/{class}")
 }
 
-/// The static defects of kind `kind` of scene `scene`.
+/// The defects of kind `kind` of scene `scene`.
 pub fn defects(scene: usize, kind: DefectKind) -> String {
     format!("world/mesh/{scene}/defects/{kind}")
 }

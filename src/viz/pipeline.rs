@@ -125,6 +125,11 @@ impl BatchRecorder for Logger {
                 })
             }
             Ok(ReplayEvent::Sweep(result)) => {
+                self.saw_frame(result.frame)
+                    .map_err(|cause| LogError::Sweeps {
+                        frame: result.frame,
+                        cause: cause.into(),
+                    })?;
                 if prepared.0.front().is_some_and(|(start, _)| *start == index)
                     && let Some((_, rows)) = prepared.0.pop_front()
                 {

@@ -2,7 +2,7 @@
 //! numbers and component columns, taken out as a [`Part`] and made a chunk.
 
 use rerun::log::{Chunk, ChunkComponents, ChunkId, RowId, TimeColumn};
-use rerun::{EntityPath, RecordingStreamError};
+use rerun::{EntityPath, RecordingStreamError, TimelineName};
 
 use super::component::Column;
 use super::{Key, Part, row_id};
@@ -72,18 +72,7 @@ impl EntityColumns {
             rows,
             lists,
         } = part;
-        let time_column = if self.key.timestamps {
-            TimeColumn::new_timestamp_nanos_since_epoch(TIME_TIMELINE, times)
-        } else {
-            TimeColumn::new_duration_nanos(TIME_TIMELINE, times)
-        };
-        let timelines = [
-            TimeColumn::new_sequence(FRAME_TIMELINE, frames),
-            time_column,
-        ]
-        .into_iter()
-        .map(|c| (*c.timeline().name(), c))
-        .collect();
+        let timelines = timelines_of(frames, times, self.key.timestamps);
         let components: ChunkComponents = self
             .columns
             .iter()
@@ -103,4 +92,33 @@ impl EntityColumns {
         )
         .map_err(RecordingStreamError::Chunk)
     }
+}
+
+/// The `frame` and `time` columns of rows at `frames` and `times` (the
+/// time a timestamp or a duration, as `kind` is).
+pub(super) fn timelines<C: FromIterator<(TimelineName, TimeColumn)>>(
+    frames: Vec<i64>,
+    times: Vec<i64>,
+    kind: super::Time,
+) -> C {
+    timelines_of(frames, times, kind.is_timestamp())
+}
+
+fn timelines_of<C: FromIterator<(TimelineName, TimeColumn)>>(
+    frames: Vec<i64>,
+    times: Vec<i64>,
+    timestamps: bool,
+) -> C {
+    let time_column = if timestamps {
+        TimeColumn::new_timestamp_nanos_since_epoch(TIME_TIMELINE, times)
+    } else {
+        TimeColumn::new_duration_nanos(TIME_TIMELINE, times)
+    };
+    [
+        TimeColumn::new_sequence(FRAME_TIMELINE, frames),
+        time_column,
+    ]
+    .into_iter()
+    .map(|c| (*c.timeline().name(), c))
+    .collect()
 }

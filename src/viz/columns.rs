@@ -245,7 +245,9 @@ impl Columns {
         }
         let timelines = match at {
             None => Default::default(),
-            Some((frame, time)) => entity::timelines(vec![frame], vec![time.nanos()], time),
+            Some((frame, time)) => {
+                entity::timelines(vec![frame], vec![time.nanos()], time.is_timestamp())
+            }
         };
         let chunk = Chunk::from_native_row_ids(
             id,

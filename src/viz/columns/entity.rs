@@ -72,7 +72,7 @@ impl EntityColumns {
             rows,
             lists,
         } = part;
-        let timelines = timelines_of(frames, times, self.key.timestamps);
+        let timelines = timelines(frames, times, self.key.timestamps);
         let components: ChunkComponents = self
             .columns
             .iter()
@@ -95,16 +95,8 @@ impl EntityColumns {
 }
 
 /// The `frame` and `time` columns of rows at `frames` and `times` (the
-/// time a timestamp or a duration, as `kind` is).
+/// times timestamps when `timestamps`, else durations).
 pub(super) fn timelines<C: FromIterator<(TimelineName, TimeColumn)>>(
-    frames: Vec<i64>,
-    times: Vec<i64>,
-    kind: super::Time,
-) -> C {
-    timelines_of(frames, times, kind.is_timestamp())
-}
-
-fn timelines_of<C: FromIterator<(TimelineName, TimeColumn)>>(
     frames: Vec<i64>,
     times: Vec<i64>,
     timestamps: bool,

@@ -5,7 +5,7 @@ use crate::core::Fragility;
 use crate::replay::SweepResult;
 use crate::trace::OutcomeMsg;
 
-use super::compare::{Field, FieldDiff, NOT_A_UNIT_VECTOR, Tolerances, compare};
+use super::compare::{Field, FieldDiff, NOT_A_UNIT_VECTOR, Tolerances, compare, differing};
 use super::perturbation::{Reproduced, Rounding, reproduce};
 use super::precision::Sensitivity;
 use super::reference::{Decision, MemberBounds};
@@ -170,7 +170,7 @@ fn judge(
     let fixed = tol;
     let tol_judged = widened.as_ref().unwrap_or(tol);
     if let Some(s) = &sensitivity
-        && compare(expected, got, tol_judged).is_empty()
+        && differing(expected, got, tol_judged).is_empty()
     {
         return Agreement::Precision {
             backward_error: s.backward_error(&fields, expected, got),
@@ -213,12 +213,8 @@ fn judge(
         got,
     });
     let on_expected = decision.disagreement(expected, tol, bounds.as_ref());
-    let on_got = if got_is_core {
-        None
-    } else {
-        decision.disagreement(got, tol, bounds.as_ref())
-    };
-    if on_expected.is_none() && on_got.is_none() {
+    let got_refused = !got_is_core && !decision.accepts(got, tol, bounds.as_ref());
+    if on_expected.is_none() && !got_refused {
         return Agreement::Tie;
     }
     // Against the core's own outcome, the fields that differ are those
@@ -240,7 +236,7 @@ fn judge(
             expected,
             on_expected.is_some(),
             got,
-            on_got.is_some(),
+            got_refused,
             result,
             rounding,
         ) {
@@ -270,7 +266,7 @@ fn judge(
             expected,
             on_expected.is_some(),
             got,
-            on_got.is_some(),
+            got_refused,
             result,
             Rounding::F64(tol),
         )

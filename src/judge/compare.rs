@@ -235,68 +235,97 @@ fn distance(a: [f64; 3], b: [f64; 3]) -> f64 {
 /// one that single precision widens).
 pub(crate) const NOT_A_UNIT_VECTOR: &str = "not a unit vector";
 
-/// How two normals differ, in words; `None` when they match: identical, or
-/// within the angle and both of unit length.
-fn normal_difference(w: [f64; 3], h: [f64; 3], tol: &Tolerances) -> Option<String> {
+/// What a difference is reported as: its words (`String`), or only the
+/// fact that there is one (`()`, for the judge's searches, which compare
+/// many times and read no words).
+trait Words {
+    fn say(words: impl FnOnce() -> String) -> Self;
+}
+
+impl Words for String {
+    fn say(words: impl FnOnce() -> String) -> String {
+        words()
+    }
+}
+
+impl Words for () {
+    fn say(_: impl FnOnce() -> String) {}
+}
+
+/// How two normals differ; `None` when they match: identical, or within
+/// the angle and both of unit length.
+fn normal_difference<W: Words>(w: [f64; 3], h: [f64; 3], tol: &Tolerances) -> Option<W> {
     if w == h && w.iter().all(|x| x.is_finite()) {
         return None;
     }
     let Some(angle) = angle_degrees(w, h) else {
-        return Some("one of the normals has zero or non-finite length".to_string());
+        return Some(W::say(|| {
+            "one of the normals has zero or non-finite length".to_string()
+        }));
     };
-    let mut words = Vec::new();
-    if angle > tol.normal_degrees {
-        words.push(format!(
-            "angle {}° > {}°",
-            num(angle),
-            num(tol.normal_degrees)
-        ));
+    let wide = angle > tol.normal_degrees;
+    let lengths = [w, h].map(|v| Vector3::from(v).norm());
+    let not_unit = |length: f64| (length - 1.0).abs() > tol.normal_length();
+    if !wide && !lengths.iter().any(|&l| not_unit(l)) {
+        return None;
     }
-    for v in [w, h] {
-        let length = Vector3::from(v).norm();
-        if (length - 1.0).abs() > tol.normal_length() {
+    Some(W::say(|| {
+        let mut words = Vec::new();
+        if wide {
+            words.push(format!(
+                "angle {}° > {}°",
+                num(angle),
+                num(tol.normal_degrees)
+            ));
+        }
+        for length in lengths.into_iter().filter(|&l| not_unit(l)) {
             words.push(format!(
                 "|n| = {}, {NOT_A_UNIT_VECTOR} (within {} of 1)",
                 num(length),
                 num(tol.normal_length())
             ));
         }
-    }
-    (!words.is_empty()).then(|| words.join("; "))
+        words.join("; ")
+    }))
 }
 
-/// How two contact points differ, in words; `None` when they match.
-fn contact_difference(w: [f64; 3], h: [f64; 3], tol: &Tolerances) -> Option<String> {
+/// How two contact points differ; `None` when they match.
+fn contact_difference<W: Words>(w: [f64; 3], h: [f64; 3], tol: &Tolerances) -> Option<W> {
     let d = distance(w, h);
+    let too_far = || W::say(|| format!("distance {} > {}", num(d), num(tol.contact)));
     // NaN (a non-finite point) is a difference too.
     if d.is_nan() {
-        return Some(format!("distance {} > {}", num(d), num(tol.contact)));
+        return Some(too_far());
     }
     let Some(axis) = tol.contact_axis else {
-        return (d > tol.contact).then(|| format!("distance {} > {}", num(d), num(tol.contact)));
+        return (d > tol.contact).then(too_far);
     };
     let moved = Vector3::from(h) - Vector3::from(w);
     let along = moved.dot(&Vector3::from(axis.axis)).abs();
     let across = (d * d - along * along).max(0.0).sqrt();
     if along > axis.tolerance {
-        let off = if axis.plane {
-            "off the triangle's plane"
-        } else {
-            "along the contact normal"
-        };
-        return Some(format!(
-            "contact {} {off} > {} (distance {})",
-            num(along),
-            num(axis.tolerance),
-            num(d)
-        ));
+        return Some(W::say(|| {
+            let off = if axis.plane {
+                "off the triangle's plane"
+            } else {
+                "along the contact normal"
+            };
+            format!(
+                "contact {} {off} > {} (distance {})",
+                num(along),
+                num(axis.tolerance),
+                num(d)
+            )
+        }));
     }
     (across > tol.contact).then(|| {
-        format!(
-            "distance {} across the normal > {}",
-            num(across),
-            num(tol.contact)
-        )
+        W::say(|| {
+            format!(
+                "distance {} across the normal > {}",
+                num(across),
+                num(tol.contact)
+            )
+        })
     })
 }
 
@@ -311,89 +340,121 @@ fn contact_difference(w: [f64; 3], h: [f64; 3], tol: &Tolerances) -> Option<Stri
 /// matching key). A NaN anywhere counts as a difference, never as a match.
 /// Fields outside `tol.fields` are not compared.
 pub fn compare(expected: &OutcomeMsg, got: &OutcomeMsg, tol: &Tolerances) -> Vec<FieldDiff> {
-    let mut out = compare_all(expected, got, tol);
-    out.retain(|d| tol.fields.contains(d.field));
+    let mut out = Vec::new();
+    differences::<String>(expected, got, tol, |field, detail| {
+        let (expected, got) = values(field, expected, got);
+        out.push(FieldDiff {
+            field,
+            expected,
+            got,
+            detail,
+        });
+    });
     out
 }
 
-/// [`compare`] over every field the expectation holds.
-fn compare_all(expected: &OutcomeMsg, got: &OutcomeMsg, tol: &Tolerances) -> Vec<FieldDiff> {
-    let mut out = Vec::new();
-    if expected.kind != got.kind {
-        out.push(FieldDiff {
-            field: Field::Kind,
-            expected: json!(expected.kind),
-            got: json!(got.kind),
-            detail: None,
-        });
+/// The fields [`compare`] would return, without their values or words:
+/// for the judge's searches, which compare the same answer many times.
+pub fn differing(expected: &OutcomeMsg, got: &OutcomeMsg, tol: &Tolerances) -> FieldSet {
+    let mut set = FieldSet(0);
+    differences::<()>(expected, got, tol, |field, _| {
+        set.0 |= FieldSet::bit(field);
+    });
+    set
+}
+
+impl FieldSet {
+    /// Whether the set holds no field.
+    pub fn is_empty(self) -> bool {
+        self.0 == 0
     }
-    if let Some(want) = expected.triangle {
-        let have = got.triangle.flatten();
-        if want != have {
-            out.push(FieldDiff {
-                field: Field::Triangle,
-                expected: json!(want),
-                got: json!(have),
-                detail: None,
-            });
+}
+
+/// A field's expected and replayed values, as [`FieldDiff`] shows them.
+fn values(field: Field, expected: &OutcomeMsg, got: &OutcomeMsg) -> (Value, Value) {
+    match field {
+        Field::Kind => (json!(expected.kind), json!(got.kind)),
+        Field::Triangle => (
+            json!(expected.triangle.flatten()),
+            json!(got.triangle.flatten()),
+        ),
+        Field::Feature => (
+            json!(expected.feature.flatten()),
+            json!(got.feature.flatten()),
+        ),
+        Field::Alpha => (json!(expected.alpha), json!(got.alpha)),
+        Field::Normal => (
+            vec3(&expected.normal.flatten()),
+            vec3(&got.normal.flatten()),
+        ),
+        Field::Contact => (
+            vec3(&expected.contact.flatten()),
+            vec3(&got.contact.flatten()),
+        ),
+    }
+}
+
+/// Calls `found` with each field of `tol.fields` the expectation holds and
+/// `got` does not match, in the order of [`Field`], with the difference's
+/// words (when `W` keeps them; `None` where the values say it).
+fn differences<W: Words>(
+    expected: &OutcomeMsg,
+    got: &OutcomeMsg,
+    tol: &Tolerances,
+    mut found: impl FnMut(Field, Option<W>),
+) {
+    let mut found = |field: Field, detail: Option<W>| {
+        if tol.fields.contains(field) {
+            found(field, detail);
         }
+    };
+    if expected.kind != got.kind {
+        found(Field::Kind, None);
+    }
+    if let Some(want) = expected.triangle
+        && want != got.triangle.flatten()
+    {
+        found(Field::Triangle, None);
     }
     // A face has no feature: an expected face hit matches a face hit whatever
     // feature it names (`null`, or the 0 older recordings wrote).
     let both_faces = expected.kind == Kind::Face && got.kind == Kind::Face;
-    if let Some(want) = expected.feature.filter(|_| !both_faces) {
-        let have = got.feature.flatten();
-        if want != have {
-            out.push(FieldDiff {
-                field: Field::Feature,
-                expected: json!(want),
-                got: json!(have),
-                detail: None,
-            });
-        }
+    if let Some(want) = expected.feature.filter(|_| !both_faces)
+        && want != got.feature.flatten()
+    {
+        found(Field::Feature, None);
     }
     let delta = (got.alpha - expected.alpha).abs();
     if delta.is_nan() || delta > tol.alpha {
-        out.push(FieldDiff {
-            field: Field::Alpha,
-            expected: json!(expected.alpha),
-            got: json!(got.alpha),
-            detail: Some(format!("|Δα| = {} > {}", num(delta), num(tol.alpha))),
-        });
+        found(
+            Field::Alpha,
+            Some(W::say(|| {
+                format!("|Δα| = {} > {}", num(delta), num(tol.alpha))
+            })),
+        );
     }
     if let Some(want) = expected.normal {
-        let have = got.normal.flatten();
         // Null on one side only: the values say it (`engine null, core
         // [0, 0, 1]`), in the words of whoever renders the two sides.
-        let differs = match (want, have) {
-            (None, None) => None,
-            (Some(_), None) | (None, Some(_)) => Some(None),
-            (Some(w), Some(h)) => normal_difference(w, h, tol).map(Some),
-        };
-        if let Some(detail) = differs {
-            out.push(FieldDiff {
-                field: Field::Normal,
-                expected: vec3(&want),
-                got: vec3(&have),
-                detail,
-            });
+        match (want, got.normal.flatten()) {
+            (None, None) => {}
+            (Some(_), None) | (None, Some(_)) => found(Field::Normal, None),
+            (Some(w), Some(h)) => {
+                if let Some(detail) = normal_difference(w, h, tol) {
+                    found(Field::Normal, Some(detail));
+                }
+            }
         }
     }
     if let Some(want) = expected.contact {
-        let have = got.contact.flatten();
-        let differs = match (want, have) {
-            (None, None) => None,
-            (Some(_), None) | (None, Some(_)) => Some(None),
-            (Some(w), Some(h)) => contact_difference(w, h, tol).map(Some),
-        };
-        if let Some(detail) = differs {
-            out.push(FieldDiff {
-                field: Field::Contact,
-                expected: vec3(&want),
-                got: vec3(&have),
-                detail,
-            });
+        match (want, got.contact.flatten()) {
+            (None, None) => {}
+            (Some(_), None) | (None, Some(_)) => found(Field::Contact, None),
+            (Some(w), Some(h)) => {
+                if let Some(detail) = contact_difference(w, h, tol) {
+                    found(Field::Contact, Some(detail));
+                }
+            }
         }
     }
-    out
 }

@@ -233,10 +233,7 @@ impl Rounding<'_> {
     /// units, accepts `answer`; `None` when it does not.
     fn accepts(self, decision: &Decision, answer: &OutcomeMsg, k: f64) -> Option<f64> {
         match self {
-            Rounding::F64(tol) => decision
-                .disagreement(answer, tol, None)
-                .is_none()
-                .then_some(k),
+            Rounding::F64(tol) => decision.accepts(answer, tol, None).then_some(k),
             Rounding::F32 {
                 fixed,
                 sensitivity,
@@ -342,7 +339,7 @@ fn widening_needed(
 ) -> Option<f64> {
     let accepts = |units: f64| {
         let tol = s.map_or(*fixed, |s| s.widen(fixed, units));
-        decision.disagreement(answer, &tol, None).is_none()
+        decision.accepts(answer, &tol, None)
     };
     if budget < 0.0 || !accepts(budget.max(0.0)) {
         return None;

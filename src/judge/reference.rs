@@ -13,7 +13,7 @@ use crate::core::{
 use crate::replay::SceneState;
 use crate::trace::OutcomeMsg;
 
-use super::compare::{FieldDiff, Tolerances, compare};
+use super::compare::{FieldDiff, Tolerances, compare, differing};
 use crate::conventions::TieRule;
 
 /// Keeps the records of the tests that hit.
@@ -151,8 +151,25 @@ impl<'a> Decision<'a> {
         own.unwrap_or(*tol)
     }
 
-    /// `None` when the decision accepts `answer`: it matches the primary,
-    /// or another member of the tie set with that member's own contact.
+    /// Whether the decision accepts `answer`: it matches the primary, or
+    /// another member of the tie set with that member's own contact (see
+    /// [`Decision::disagreement`], which says why not; this one only
+    /// compares, for the searches that ask many times).
+    pub(super) fn accepts(
+        &self,
+        answer: &OutcomeMsg,
+        tol: &Tolerances,
+        bounds: Option<&MemberBounds>,
+    ) -> bool {
+        let primary = OutcomeMsg::from_outcome(answer.frame, answer.ball, &self.outcome);
+        differing(answer, &primary, tol).is_empty()
+            || self.members(primary).any(|(member, _)| {
+                let tol = self.member_tolerances(&member, tol, bounds);
+                differing(answer, &member, &tol).is_empty()
+            })
+    }
+
+    /// `None` when the decision accepts `answer` ([`Decision::accepts`]).
     /// Otherwise the fields that differ: from the first member the answer
     /// names, or from the primary. `tol` judges the primary; a member is
     /// judged by its own bound under `bounds` (by backward error), else by
@@ -163,40 +180,43 @@ impl<'a> Decision<'a> {
         tol: &Tolerances,
         bounds: Option<&MemberBounds>,
     ) -> Option<Vec<FieldDiff>> {
-        let primary = OutcomeMsg::from_outcome(answer.frame, answer.ball, &self.outcome);
-        let differ = compare(answer, &primary, tol);
-        if differ.is_empty() {
+        if self.accepts(answer, tol, bounds) {
             return None;
         }
-        let mut named: Option<Vec<FieldDiff>> = None;
-        for r in &self.hits {
-            let Some(tie) = Tie::of(r) else { continue };
-            if !self.outcome.ties_with(tie.alpha) {
-                continue;
-            }
+        let primary = OutcomeMsg::from_outcome(answer.frame, answer.ball, &self.outcome);
+        let named = self
+            .members(primary)
+            .find(|(_, tie)| names_tie(answer, tie))
+            .map(|(member, _)| {
+                compare(
+                    answer,
+                    &member,
+                    &self.member_tolerances(&member, tol, bounds),
+                )
+            });
+        Some(named.unwrap_or_else(|| compare(answer, &primary, tol)))
+    }
+
+    /// The members of the tie set other than the primary, in order (the
+    /// sweep's tied hits, then the initial contacts), each as the outcome
+    /// it stands for: the primary's fields with the member's kind,
+    /// triangle, feature and contact, and its own normal under
+    /// [`TieRule::Any`].
+    fn members(&self, primary: OutcomeMsg) -> impl Iterator<Item = (OutcomeMsg, Tie)> + '_ {
+        let any = self.scene.conventions.ties == TieRule::Any;
+        let hits = self.hits.iter().filter_map(move |r| {
+            let tie = Tie::of(r).filter(|t| self.outcome.ties_with(t.alpha))?;
             let mut member = primary;
             member.kind = tie.kind();
             member.triangle = Some(Some(tie.triangle));
             member.feature = Some(tie.feature.index());
             member.contact = Some(r.contact().map(|c| [c.x, c.y, c.z]));
-            if self.scene.conventions.ties == TieRule::Any
-                && let Some(contact) = r.contact()
-            {
+            if any && let Some(contact) = r.contact() {
                 member.normal = Some(self.member_normal(&tie, &contact, r.back()));
             }
-            let d = compare(
-                answer,
-                &member,
-                &self.member_tolerances(&member, tol, bounds),
-            );
-            if d.is_empty() {
-                return None;
-            }
-            if names_tie(answer, &tie) {
-                named.get_or_insert(d);
-            }
-        }
-        for h in &self.initial {
+            Some((member, tie))
+        });
+        let initial = self.initial.iter().map(move |h| {
             let tie = Tie {
                 triangle: h.triangle,
                 feature: h.feature,
@@ -207,7 +227,7 @@ impl<'a> Decision<'a> {
             member.triangle = Some(Some(tie.triangle));
             member.feature = Some(tie.feature.index());
             member.contact = Some(Some([h.contact.x, h.contact.y, h.contact.z]));
-            if self.scene.conventions.ties == TieRule::Any {
+            if any {
                 // An initial contact's normal is its side's (`-n` on a back).
                 let back = self
                     .scene
@@ -216,19 +236,9 @@ impl<'a> Decision<'a> {
                     .is_some_and(|t| t.normal.dot(&h.normal) < 0.0);
                 member.normal = Some(self.member_normal(&tie, &h.contact, back));
             }
-            let d = compare(
-                answer,
-                &member,
-                &self.member_tolerances(&member, tol, bounds),
-            );
-            if d.is_empty() {
-                return None;
-            }
-            if names_tie(answer, &tie) {
-                named.get_or_insert(d);
-            }
-        }
-        Some(named.unwrap_or(differ))
+            (member, tie)
+        });
+        hits.chain(initial)
     }
 }
 

@@ -2510,6 +2510,8 @@ fn expected_edge_test_only_of_an_existing_triangle() -> anyhow::Result<()> {
 /// first sweep's, where the floor is shown; the same through the logger a
 /// sweep at a time and through the replay's pipeline (the command line, 4
 /// threads). Before, every scene's mesh was static: shown at every frame.
+/// The balls' drawings are cleared there too: ball 1, which has no sweep
+/// on the floor, no longer stands on it.
 fn a_later_scene_replaces_the_mesh_at_its_first_sweep() -> anyhow::Result<()> {
     let dir = tempfile::tempdir()?;
     let sweep = |frame: u64| SweepMsg {
@@ -2519,13 +2521,20 @@ fn a_later_scene_replaces_the_mesh_at_its_first_sweep() -> anyhow::Result<()> {
         p0: [5.0, 5.0, 5.0],
         p1: [5.0, 5.0, 4.0],
     };
-    let mut events = events_for(cube_scene(), &[sweep(0), sweep(1), sweep(2)]);
+    // Ball 1 is only in the first scene: its drawing goes with the cube.
+    let other = SweepMsg {
+        ball: 1,
+        p0: [-5.0, 5.0, 5.0],
+        p1: [-5.0, 5.0, 4.0],
+        ..sweep(1)
+    };
+    let mut events = events_for(cube_scene(), &[sweep(0), sweep(1), other, sweep(2)]);
     events.push(Ok(event(
         3_500_000,
-        4,
+        5,
         EventBody::Scene(crate::support::flipped_floor()),
     )));
-    events.push(Ok(event(4_000_000, 5, EventBody::Sweep(sweep(3)))));
+    events.push(Ok(event(4_000_000, 6, EventBody::Sweep(sweep(3)))));
     let trace = dir.path().join("levels.mcap");
     let mut w = TraceWriter::new(std::fs::File::create(&trace)?)?;
     for e in &events {
@@ -2565,6 +2574,16 @@ fn a_later_scene_replaces_the_mesh_at_its_first_sweep() -> anyhow::Result<()> {
             path.display(),
             d.components.get("/world/mesh/0"),
             d.components.get("/world/mesh/1")
+        );
+        ensure!(
+            shown("/world/ball/1", "Ellipsoids3D:centers") == at(&[1])
+                && shown("/world/ball/1", "Clear:is_recursive") == at(&[3])
+                && shown("/world/ball/0", "Clear:is_recursive") == at(&[3])
+                && shown("/world/ball/0", "Ellipsoids3D:centers") == at(&[0, 1, 2, 3]),
+            "{}: ball 1 {:?}, ball 0 {:?}",
+            path.display(),
+            d.components.get("/world/ball/1"),
+            d.components.get("/world/ball/0")
         );
     }
     Ok(())

@@ -535,8 +535,9 @@ impl Logger {
     /// Points3D per kind, a label each, drawn when the scene has at most
     /// `MAX_DRAWN_DEFECT_LABELS` of them), from the scene's topology, at the
     /// scene's `log_time` and at the frame of its first sweep, where the
-    /// previous scene's are cleared: each frame shows the mesh its sweeps
-    /// were tested against (a trace may hold a scene per level, or the same
+    /// previous scene's are cleared, with what every ball showed (its
+    /// sweep, its contacts; not its plots): each frame shows the mesh its
+    /// sweeps were tested against (a trace may hold a scene per level, or the same
     /// scene sent again). A scene without sweeps is shown at the frame
     /// after the last sweep (0 before any), when the next scene comes or
     /// the sweeps end ([`Logger::show_pending_scene`]).
@@ -562,6 +563,14 @@ impl Logger {
         );
         if let Some(previous) = self.mesh_shown.replace(scene.number) {
             self.log_at(paths::mesh(previous), &Clear::recursive(), when)?;
+            // What the balls showed belongs to the previous scene: a ball
+            // absent from this one would keep its last sweep and contacts
+            // on the new mesh. Each ball's next sweep draws it again (its
+            // rows come after this clear, at this frame too).
+            let balls: Vec<u32> = self.balls.iter().copied().collect();
+            for b in balls {
+                self.log_at(paths::ball(b), &Clear::recursive(), when)?;
+            }
         }
         let mut triangles: Vec<&Triangle> = scene.mesh.triangles().iter().collect();
         triangles.sort_by_key(|t| t.index);

@@ -14,7 +14,8 @@
 //!                                     a point at each with one label each
 //!                                     ("flipped triangle 812"), with the mesh (a kind the mesh
 //!                                     has none of is not logged)
-//! world/ball/{ball}                   the sweep, one row per sweep:
+//! world/ball/{ball}                   the sweep, one row per sweep (cleared, with its
+//!                                     children, where a new scene shows):
 //!                                       Ellipsoids3D: the ball at p0, at the contact, at p1
 //!                                       Capsules3D: the volume swept with radius ρ (wireframe)
 //!                                       Points3D: the contact point (none when nothing is hit)

@@ -802,7 +802,9 @@ fn the_recording_draws_each_query_and_marks_its_ghosts() -> anyhow::Result<()> {
 /// The contact queries are judged in parallel batches and drawn in order:
 /// a recording made on one thread has the same content as one made on
 /// four, row for row (2,238 queries of the mini-golf course, several
-/// batches), and the Foxglove file is the same byte for byte.
+/// batches), and the Foxglove file is the same byte for byte; the same
+/// again for each file written alone (with both, the queries are judged
+/// once for the two).
 fn the_contacts_drawn_do_not_depend_on_the_threads() -> anyhow::Result<()> {
     let dir = tempfile::tempdir()?;
     // Every fifth answer with a contact turned upside down, so that the
@@ -857,6 +859,36 @@ fn the_contacts_drawn_do_not_depend_on_the_threads() -> anyhow::Result<()> {
         anyhow::bail!("one thread against four: {d}");
     }
     ensure!(foxglove[0] == foxglove[1], "the Foxglove files differ");
+    // Both files are drawn from one judgement of each query; each alone
+    // (its own judgement) is the same.
+    let alone = |output: &str, file: &Path| -> anyhow::Result<String> {
+        let out = bin()
+            .arg("replay")
+            .arg(&trace)
+            .arg(output)
+            .arg(file)
+            .output()?;
+        let stderr = String::from_utf8_lossy(&out.stderr).into_owned();
+        ensure!(out.status.success(), "{stderr}");
+        Ok(stderr)
+    };
+    let mcap = dir.path().join("alone.foxglove.mcap");
+    let stderr = alone("--foxglove", &mcap)?;
+    ensure!(
+        stderr.contains("contacts in the Foxglove file: 2238 queries drawn"),
+        "{stderr}"
+    );
+    ensure!(
+        std::fs::read(&mcap)? == foxglove[0],
+        "the Foxglove file written alone differs from the one written beside the recording"
+    );
+    let rrd = dir.path().join("alone.rrd");
+    alone("--rrd", &rrd)?;
+    if let Some(d) =
+        crate::replay::first_content_difference(&crate::replay::rrd_content(&rrd)?, &contents[0])
+    {
+        anyhow::bail!("the recording alone against beside the Foxglove file: {d}");
+    }
     Ok(())
 }
 

@@ -28,7 +28,9 @@ use super::{
     EXPECTED_TOPIC, GHOSTS_TOPIC, MESH_TOPIC, METADATA_NAME, NUMBERS_TOPIC, SWEEPS_TOPIC,
 };
 use crate::atomic::PendingFile;
-use crate::judge::contact_marks::{ContactDrawing, ContactsDrawn, Judged, for_each_judged_query};
+use crate::judge::contact_marks::{
+    ContactDrawing, ContactEvent, ContactsDrawn, for_each_judged_query,
+};
 use crate::judge::{Tolerances, divergence};
 use crate::replay::{ReplayEvent, SceneState, SweepResult};
 use crate::trace::{TraceError, TraceEvent, library_string};
@@ -299,57 +301,62 @@ impl<W: Write + Seek> FoxgloveWriter<W> {
     /// [`CONTACT_DECISIONS_TOPIC`] each: channels of their own, so that
     /// each channel stays in `log_time` order when this is called after
     /// the replay's events (MCAP readers merge the channels by time).
+    /// (`crate::viz::draw_contacts` judges them once for both files when a
+    /// recording is drawn too.)
     pub fn contact_queries(
         &mut self,
         events: impl Iterator<Item = Result<TraceEvent, TraceError>>,
         how: &ContactDrawing<'_>,
     ) -> Result<ContactsDrawn, FoxgloveError> {
-        for_each_judged_query(events, how, |judged| {
-            let p = match judged {
-                Judged::Query(p) => p,
-                // The previous scene's queries go, as the per-sweep
-                // channels' entities do (`scene`).
-                Judged::NewScene { log_time_nanos: t } => {
-                    if let Some((queries, _)) = self.contact_queries {
-                        let clear = clear_update(Time::from_nanos(t));
-                        self.put(queries, CONTACT_QUERIES_TOPIC, 0, t, &clear)?;
-                    }
-                    return Ok(());
+        for_each_judged_query(events, how, |event| self.contact_event(event))
+    }
+
+    /// Writes one judged query, or clears the previous scene's at a new one.
+    pub(crate) fn contact_event(&mut self, event: ContactEvent<'_>) -> Result<(), FoxgloveError> {
+        let p = match event {
+            ContactEvent::Query(p) => p,
+            // The previous scene's queries go, as the per-sweep
+            // channels' entities do (`scene`).
+            ContactEvent::NewScene { log_time_nanos: t } => {
+                if let Some((queries, _)) = self.contact_queries {
+                    let clear = clear_update(Time::from_nanos(t));
+                    self.put(queries, CONTACT_QUERIES_TOPIC, 0, t, &clear)?;
                 }
-            };
-            let (queries, decisions) = match self.contact_queries {
-                Some(channels) => channels,
-                None => {
-                    let error = |cause| FoxgloveError::Write {
-                        file: self.file.clone(),
-                        cause,
-                    };
-                    let mut channel = |schema: u16, topic: &str| {
-                        self.writer
-                            .add_channel(schema, topic, MESSAGE_ENCODING, &BTreeMap::new())
-                            .map_err(error)
-                    };
-                    let channels = (
-                        channel(self.scene_update, CONTACT_QUERIES_TOPIC)?,
-                        channel(self.log, CONTACT_DECISIONS_TOPIC)?,
-                    );
-                    self.contact_queries = Some(channels);
-                    channels
-                }
-            };
-            let (f, t) = (p.query.frame, p.log_time_nanos);
-            self.put(
-                queries,
-                CONTACT_QUERIES_TOPIC,
-                f,
-                t,
-                &contact_query_update(p),
-            )?;
-            let log = contact_query_log(p, &self.options.trace_name);
-            self.put(decisions, CONTACT_DECISIONS_TOPIC, f, t, &log)?;
-            self.counts.contact_queries += 1;
-            Ok(())
-        })
+                return Ok(());
+            }
+        };
+        let (queries, decisions) = match self.contact_queries {
+            Some(channels) => channels,
+            None => {
+                let error = |cause| FoxgloveError::Write {
+                    file: self.file.clone(),
+                    cause,
+                };
+                let mut channel = |schema: u16, topic: &str| {
+                    self.writer
+                        .add_channel(schema, topic, MESSAGE_ENCODING, &BTreeMap::new())
+                        .map_err(error)
+                };
+                let channels = (
+                    channel(self.scene_update, CONTACT_QUERIES_TOPIC)?,
+                    channel(self.log, CONTACT_DECISIONS_TOPIC)?,
+                );
+                self.contact_queries = Some(channels);
+                channels
+            }
+        };
+        let (f, t) = (p.query.frame, p.log_time_nanos);
+        self.put(
+            queries,
+            CONTACT_QUERIES_TOPIC,
+            f,
+            t,
+            &contact_query_update(p),
+        )?;
+        let log = contact_query_log(p, &self.options.trace_name);
+        self.put(decisions, CONTACT_DECISIONS_TOPIC, f, t, &log)?;
+        self.counts.contact_queries += 1;
+        Ok(())
     }
 
     /// Writes the last chunk, the summary and the footer; returns the

@@ -39,7 +39,8 @@ pub struct ContactDrawing<'a> {
 const JUDGED_TOGETHER: usize = 256;
 
 /// What [`for_each_judged_query`] hands its drawing, in the trace's order.
-pub(crate) enum Judged<'a> {
+#[derive(Clone, Copy)]
+pub(crate) enum ContactEvent<'a> {
     /// A judged query.
     Query(&'a PairedContacts),
     /// A scene after the first, at its `log_time` (the previous scene's
@@ -82,7 +83,7 @@ impl ContactsDrawn {
 pub(crate) fn for_each_judged_query<E>(
     events: impl Iterator<Item = Result<TraceEvent, TraceError>>,
     how: &ContactDrawing<'_>,
-    mut draw: impl FnMut(Judged<'_>) -> Result<(), E>,
+    mut draw: impl FnMut(ContactEvent<'_>) -> Result<(), E>,
 ) -> Result<ContactsDrawn, E> {
     let mut pairing = ContactPairing::new(how.tolerances, how.conventions, how.ghost_degrees);
     let mut drawn = ContactsDrawn::default();
@@ -96,7 +97,7 @@ pub(crate) fn for_each_judged_query<E>(
             EventBody::Scene(scene) => {
                 judge_and_draw(&pairing, &mut pairs, how.pool, &mut draw, &mut drawn)?;
                 if scenes > 0 {
-                    draw(Judged::NewScene {
+                    draw(ContactEvent::NewScene {
                         log_time_nanos: event.header.log_time_nanos,
                     })?;
                 }
@@ -127,7 +128,7 @@ fn judge_and_draw<E>(
     pairing: &ContactPairing<'_>,
     pairs: &mut Vec<Pair>,
     pool: Option<&rayon::ThreadPool>,
-    draw: &mut impl FnMut(Judged<'_>) -> Result<(), E>,
+    draw: &mut impl FnMut(ContactEvent<'_>) -> Result<(), E>,
     drawn: &mut ContactsDrawn,
 ) -> Result<(), E> {
     let mut judge = || -> Vec<Option<PairedContacts>> {
@@ -141,7 +142,7 @@ fn judge_and_draw<E>(
         None => judge(),
     };
     for paired in judged.iter().flatten() {
-        draw(Judged::Query(paired))?;
+        draw(ContactEvent::Query(paired))?;
         drawn.add(paired);
     }
     Ok(())

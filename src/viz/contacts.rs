@@ -12,13 +12,17 @@
 //! row by row through the SDK: a query costs a handful of plain appends.
 
 use std::collections::BTreeSet;
+use std::io::{Seek, Write};
+
+use thiserror::Error;
 
 use rerun::components::{Position3D, Radius, Scalar, TextLogLevel, Vector3D};
 use rerun::{Arrows3D, Color, Points3D, Scalars, SeriesLines, TextLog};
 
+use crate::foxglove::{FoxgloveError, FoxgloveWriter};
 use crate::judge::PairedContacts;
 use crate::judge::contact_marks::{
-    ContactDrawing, ContactsDrawn, Judged, Mark, contact_marks, for_each_judged_query,
+    ContactDrawing, ContactEvent, ContactsDrawn, Mark, contact_marks, for_each_judged_query,
 };
 use crate::palette::{EXPECTED_COLOR, FACE_NORMAL_COLOR, GHOST_COLOR, NORMAL_COLOR};
 use crate::trace::{TraceError, TraceEvent};
@@ -36,45 +40,85 @@ const QUERIES_PER_LOOK: u32 = 64;
 
 /// Draws the contact queries of `events` (a trace read again: sweeps and
 /// expectations pass by) into `logger`'s recording, each at its frame and
-/// `log_time`.
-pub fn draw_contacts(
+/// `log_time`; with `foxglove`, writes them into that file too
+/// ([`FoxgloveWriter::contact_queries`]), judged once for both.
+pub fn draw_contacts<W: Write + Seek>(
     logger: &mut Logger,
+    mut foxglove: Option<&mut FoxgloveWriter<W>>,
     events: impl Iterator<Item = Result<TraceEvent, TraceError>>,
     how: &ContactDrawing<'_>,
-) -> Result<ContactsDrawn, RecordError> {
+) -> Result<ContactsDrawn, DrawContactsError> {
     // A scene without sweeps (a trace of contact queries only) is shown now.
-    logger.show_pending_scene(None)?;
-    let mut styled = BTreeSet::new();
-    let mut since_look = 0;
-    let drawn = for_each_judged_query(events, how, |judged| {
+    logger
+        .show_pending_scene(None)
+        .map_err(|e| DrawContactsError::Recording(e.into()))?;
+    let mut rows = QueryRows {
+        logger,
+        styled: BTreeSet::new(),
+        since_look: 0,
+    };
+    let drawn = for_each_judged_query(events, how, |event| {
+        rows.draw(event).map_err(DrawContactsError::Recording)?;
+        if let Some(file) = foxglove.as_deref_mut() {
+            file.contact_event(event)
+                .map_err(DrawContactsError::Foxglove)?;
+        }
+        Ok(())
+    })?;
+    rows.logger.flush().map_err(DrawContactsError::Recording)?;
+    Ok(drawn)
+}
+
+/// Drawing the contact queries failed.
+#[derive(Debug, Error)]
+#[non_exhaustive]
+pub enum DrawContactsError {
+    /// Into the recording.
+    #[error("drawing the contact queries")]
+    Recording(#[source] RecordError),
+    /// Into the Foxglove file.
+    #[error("writing the contact queries to the Foxglove file")]
+    Foxglove(#[source] FoxgloveError),
+}
+
+/// The recording's side of [`draw_contacts`].
+struct QueryRows<'l> {
+    logger: &'l mut Logger,
+    /// The balls whose plot's style is sent.
+    styled: BTreeSet<u32>,
+    /// Queries drawn since the last look at the logger's buffer.
+    since_look: u32,
+}
+
+impl QueryRows<'_> {
+    fn draw(&mut self, event: ContactEvent<'_>) -> Result<(), RecordError> {
         // (A ball's entities keep what its last query showed until its
         // next one, across scenes as for its sweeps.)
-        let Judged::Query(paired) = judged else {
+        let ContactEvent::Query(paired) = event else {
             return Ok(());
         };
         let ball = paired.query.ball;
-        if styled.insert(ball) {
+        if self.styled.insert(ball) {
             let style = SeriesLines::new().with_names(CONTACT_SERIES).with_colors(
                 SERIES_COLORS[..CONTACT_SERIES.len()]
                     .iter()
                     .map(|&c| rgba(c)),
             );
-            logger.log_static(Entity::ContactPlot(ball).path(), &style)?;
+            self.logger
+                .log_static(Entity::ContactPlot(ball).path(), &style)?;
         }
-        contact_rows(logger.columns(), paired);
-        logger.count_contact_query(
+        contact_rows(self.logger.columns(), paired);
+        self.logger.count_contact_query(
             ball,
             !paired.verdict.agrees() || !paired.verdict.ghosts.is_empty(),
         );
-        since_look += 1;
-        if since_look == QUERIES_PER_LOOK {
-            since_look = 0;
-            logger.flush_if_full()?;
+        self.since_look += 1;
+        if self.since_look == QUERIES_PER_LOOK {
+            self.since_look = 0;
+            self.logger.flush_if_full()?;
         }
-        Ok::<_, RecordError>(())
-    })?;
-    logger.flush()?;
-    Ok(drawn)
+        Ok(())
+    }
 }
 
 /// The rows of one judged query: its contacts, their normals, the expected

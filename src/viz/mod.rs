@@ -45,7 +45,7 @@ mod spill;
 
 use rerun::RecordingStreamBuilder;
 
-pub use contacts::draw_contacts;
+pub use contacts::{DrawContactsError, draw_contacts};
 pub use ids::{IdHasher, recording_id};
 pub use logger::{
     DEFAULT_FLUSH_BYTES, DEFAULT_FLUSH_ROWS, Logger, LoggerOptions, PreparedSweeps,

@@ -218,8 +218,8 @@ impl Outputs {
 
     /// Draws the trace's `queries` contact queries into the recording and
     /// the Foxglove file (those there are, when they are some), judged as
-    /// `check` judges them, at their frames: a second read of the trace
-    /// for each. Returns what was drawn (none without such an output).
+    /// `check` judges them, at their frames: a second read of the trace,
+    /// one for both. Returns what was drawn (none without such an output).
     pub(super) fn draw_contacts(
         &mut self,
         trace_path: &Path,
@@ -258,29 +258,44 @@ impl Outputs {
             });
             Ok((events, bar))
         };
-        let mut judged = None;
+        let foxglove = self.sinks.foxglove.as_mut();
+        // With a recording, its drawing writes the Foxglove file's too: the
+        // trace is read and the queries judged once for both.
         #[cfg(feature = "viewer")]
         if let Some(recording) = self.recording.as_mut() {
-            let (events, bar) = read_again("drawing the contact queries")?;
-            let drawn = sweeptrace::viz::draw_contacts(recording.logger(), events, &how)
-                .context("drawing the contact queries");
+            let what = if foxglove.is_some() {
+                "drawing and writing the contact queries"
+            } else {
+                "drawing the contact queries"
+            };
+            let (events, bar) = read_again(what)?;
+            let with_file = foxglove.is_some();
+            let drawn = sweeptrace::viz::draw_contacts(
+                recording.logger(),
+                foxglove.map(|file| file.writer()),
+                events,
+                &how,
+            );
             bar.finish_and_clear();
             let drawn = drawn?;
             eprintln!("contacts: {}", drawn_words(&drawn));
-            judged = Some(drawn);
+            if with_file {
+                eprintln!("contacts in the Foxglove file: {}", drawn_words(&drawn));
+            }
+            return Ok(Some(drawn));
         }
-        if let Some(file) = self.sinks.foxglove.as_mut() {
-            let (events, bar) = read_again("writing the contact queries")?;
-            let drawn = file
-                .writer()
-                .contact_queries(events, &how)
-                .context("writing the contact queries to the Foxglove file");
-            bar.finish_and_clear();
-            let drawn = drawn?;
-            eprintln!("contacts in the Foxglove file: {}", drawn_words(&drawn));
-            judged = judged.or(Some(drawn));
-        }
-        Ok(judged)
+        let Some(file) = foxglove else {
+            return Ok(None);
+        };
+        let (events, bar) = read_again("writing the contact queries")?;
+        let drawn = file
+            .writer()
+            .contact_queries(events, &how)
+            .context("writing the contact queries to the Foxglove file");
+        bar.finish_and_clear();
+        let drawn = drawn?;
+        eprintln!("contacts in the Foxglove file: {}", drawn_words(&drawn));
+        Ok(Some(drawn))
     }
 
     /// The recording and the other outputs, apart, for the pipeline.

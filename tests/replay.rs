@@ -119,6 +119,11 @@ fn random_sweeps(seed: u64, frames: u64, balls: u32) -> Vec<SweepMsg> {
     out
 }
 
+/// A set of frames, as `Decoded::frames_with` gives them.
+fn frames(v: &[i64]) -> std::collections::BTreeSet<i64> {
+    v.iter().copied().collect()
+}
+
 fn events_for(scene: SceneMsg, sweeps: &[SweepMsg]) -> Events {
     let mut ev = vec![Ok(event(0, 0, EventBody::Scene(scene)))];
     for (i, s) in sweeps.iter().enumerate() {
@@ -1761,11 +1766,6 @@ fn rrd_shows_edges_features_and_explanations() -> anyhow::Result<()> {
         "edges: {edges:?}, strips {:?}",
         d.strips.get("/world/mesh/0/edges/boundary")
     );
-    let frames = |v: &[i64]| {
-        v.iter()
-            .copied()
-            .collect::<std::collections::BTreeSet<i64>>()
-    };
 
     // The primary triangle and its feature.
     let primary = "/world/ball/0/primary";
@@ -2479,11 +2479,6 @@ fn expected_edge_test_only_of_an_existing_triangle() -> anyhow::Result<()> {
     );
     let d = decode_rrd(&path)?;
     let slot0 = "/world/ball/0/edge/0";
-    let frames = |v: &[i64]| {
-        v.iter()
-            .copied()
-            .collect::<std::collections::BTreeSet<i64>>()
-    };
     ensure!(
         d.frames_with(slot0, "Capsules3D:lengths") == frames(&[0, 2])
             && d.frames_with(slot0, "Clear:is_recursive") == frames(&[1]),
@@ -2556,19 +2551,14 @@ fn a_later_scene_replaces_the_mesh_at_its_first_sweep() -> anyhow::Result<()> {
         "{}",
         String::from_utf8_lossy(&out.stderr)
     );
-    let at = |v: &[i64]| {
-        v.iter()
-            .copied()
-            .collect::<std::collections::BTreeSet<i64>>()
-    };
     for path in [&by_logger, &by_replay] {
         let d = decode_rrd(path)?;
         let shown = |e: &str, c: &str| d.frames_with(e, c);
         ensure!(
-            shown("/world/mesh/0", "Mesh3D:vertex_positions") == at(&[0])
-                && shown("/world/mesh/0", "Clear:is_recursive") == at(&[3])
-                && shown("/world/mesh/0/edges/convex", "LineStrips3D:strips") == at(&[0])
-                && shown("/world/mesh/1", "Mesh3D:vertex_positions") == at(&[3])
+            shown("/world/mesh/0", "Mesh3D:vertex_positions") == frames(&[0])
+                && shown("/world/mesh/0", "Clear:is_recursive") == frames(&[3])
+                && shown("/world/mesh/0/edges/convex", "LineStrips3D:strips") == frames(&[0])
+                && shown("/world/mesh/1", "Mesh3D:vertex_positions") == frames(&[3])
                 && shown("/world/mesh/1", "Clear:is_recursive").is_empty(),
             "{}: the cube {:?}, the floor {:?}",
             path.display(),
@@ -2576,10 +2566,10 @@ fn a_later_scene_replaces_the_mesh_at_its_first_sweep() -> anyhow::Result<()> {
             d.components.get("/world/mesh/1")
         );
         ensure!(
-            shown("/world/ball/1", "Ellipsoids3D:centers") == at(&[1])
-                && shown("/world/ball/1", "Clear:is_recursive") == at(&[3])
-                && shown("/world/ball/0", "Clear:is_recursive") == at(&[3])
-                && shown("/world/ball/0", "Ellipsoids3D:centers") == at(&[0, 1, 2, 3]),
+            shown("/world/ball/1", "Ellipsoids3D:centers") == frames(&[1])
+                && shown("/world/ball/1", "Clear:is_recursive") == frames(&[3])
+                && shown("/world/ball/0", "Clear:is_recursive") == frames(&[3])
+                && shown("/world/ball/0", "Ellipsoids3D:centers") == frames(&[0, 1, 2, 3]),
             "{}: ball 1 {:?}, ball 0 {:?}",
             path.display(),
             d.components.get("/world/ball/1"),

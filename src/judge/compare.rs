@@ -115,6 +115,11 @@ impl FieldSet {
         self.0 & FieldSet::bit(field) != 0
     }
 
+    /// Whether the set holds no field.
+    pub fn is_empty(self) -> bool {
+        self.0 == 0
+    }
+
     /// Whether the set holds every field.
     pub fn is_all(self) -> bool {
         self == FieldSet::ALL
@@ -361,13 +366,6 @@ pub fn differing(expected: &OutcomeMsg, got: &OutcomeMsg, tol: &Tolerances) -> F
         set.0 |= FieldSet::bit(field);
     });
     set
-}
-
-impl FieldSet {
-    /// Whether the set holds no field.
-    pub fn is_empty(self) -> bool {
-        self.0 == 0
-    }
 }
 
 /// A field's expected and replayed values, as [`FieldDiff`] shows them.

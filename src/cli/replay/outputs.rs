@@ -263,13 +263,12 @@ impl Outputs {
         // trace is read and the queries judged once for both.
         #[cfg(feature = "viewer")]
         if let Some(recording) = self.recording.as_mut() {
-            let what = if foxglove.is_some() {
+            let with_file = foxglove.is_some();
+            let (events, bar) = read_again(if with_file {
                 "drawing and writing the contact queries"
             } else {
                 "drawing the contact queries"
-            };
-            let (events, bar) = read_again(what)?;
-            let with_file = foxglove.is_some();
+            })?;
             let drawn = sweeptrace::viz::draw_contacts(
                 recording.logger(),
                 foxglove.map(|file| file.writer()),
